@@ -1,0 +1,169 @@
+"""Impact kinematics, the impact coefficients of Eqs. (21)-(25) and the result record.
+
+Frame and signs (the paper's Fig. 6 is missing from the text; this is the convention of the toolkit):
+
+* (n, t, t'): n is the outward surface normal, t and t' span the surface.
+* Incident velocity of magnitude v at incidence angle alpha from the normal and azimuth theta in
+  the tangent plane: v_n = -v cos(alpha), v_t = v sin(alpha) cos(theta), v_t' = v sin(alpha) sin(theta).
+* Spin omega = (omega_n, omega_t, omega_t'). Eqs. (19)-(20) are used as printed,
+  I omega_t' ' = r F_t and I omega_t ' = -r F_t', so the slip velocity of the contact point that
+  friction opposes is u_t = v_t + r omega_t', u_t' = v_t' - r omega_t. Rolling without slip in +t
+  therefore has omega_t' = -v_t / r.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+__all__ = [
+    "ImpactResult",
+    "incident_velocity",
+    "slip_velocity",
+    "impact_coefficients",
+]
+
+OUTCOMES = ("rebound", "capture")
+
+
+def incident_velocity(speed: float, incidence_deg: float, azimuth_deg: float) -> tuple[float, float, float]:
+    """Incident velocity components (v_n, v_t, v_t') from magnitude and angles. [m/s]
+
+    Parameters
+    ----------
+    speed : float
+        Magnitude of the incident velocity. [m/s]
+    incidence_deg : float
+        Angle from the surface normal, in [0, 90). [deg]
+    azimuth_deg : float
+        Direction of the tangential component in the (t, t') plane, from t towards t'. [deg]
+    """
+    a = math.radians(incidence_deg)
+    th = math.radians(azimuth_deg)
+    return -speed * math.cos(a), speed * math.sin(a) * math.cos(th), speed * math.sin(a) * math.sin(th)
+
+
+def slip_velocity(radius, v_t, v_tp, omega_t, omega_tp):
+    """Velocity of the contact point relative to the surface, (u_t, u_t'). [m/s]
+
+    u_t = v_t + r omega_t', u_t' = v_t' - r omega_t (consistent with Eqs. (19)-(20) as printed).
+    """
+    return v_t + radius * omega_tp, v_tp - radius * omega_t
+
+
+def impact_coefficients(mass, moment_of_inertia, velocity_in, omega_in, velocity_out, omega_out, captured):
+    """Restitution, impulse ratios and kinetic energy loss ratios, Eqs. (21)-(25).
+
+    Parameters
+    ----------
+    mass : float  [kg]
+    moment_of_inertia : float  [kg m^2]
+    velocity_in, velocity_out : sequence of 3 floats
+        (v_n, v_t, v_t') before and after. For a captured sphere velocity_out is the final state
+        (normal component 0, tangential components of the final rolling or sliding motion). [m/s]
+    omega_in, omega_out : sequence of 3 floats
+        (omega_n, omega_t, omega_t') before and after. [rad/s]
+    captured : bool
+
+    Returns
+    -------
+    dict with e_n, mu_t, mu_tp, K_L, K_t. For a captured sphere e_n = 0 and the impulse ratios are
+    NaN (there is no rebound and so no impulse ratio); K_L and K_t use the final state.
+    """
+    vn_i, vt_i, vtp_i = velocity_in
+    vn_r, vt_r, vtp_r = velocity_out
+    if captured:
+        e_n = 0.0
+        mu_t = mu_tp = math.nan
+    else:
+        e_n = -vn_r / vn_i  # Eq. (21), both as magnitudes
+        dvn = vn_r - vn_i
+        mu_t = (vt_r - vt_i) / dvn  # Eq. (22)
+        mu_tp = (vtp_r - vtp_i) / dvn  # Eq. (23)
+    v2_i = vn_i**2 + vt_i**2 + vtp_i**2
+    v2_r = vn_r**2 + vt_r**2 + vtp_r**2
+    w2_i = float(np.dot(omega_in, omega_in))
+    w2_r = float(np.dot(omega_out, omega_out))
+    energy_in = mass * v2_i + moment_of_inertia * w2_i
+    k_t = (energy_in - mass * v2_r - moment_of_inertia * w2_r) / energy_in  # Eq. (24)
+    k_l = (v2_i - v2_r) / v2_i  # Eq. (25)
+    return {"e_n": e_n, "mu_t": mu_t, "mu_tp": mu_tp, "K_L": k_l, "K_t": k_t}
+
+
+@dataclass(frozen=True)
+class ImpactResult:
+    """Outcome of one impact. Vectors are (n, t, t') components.
+
+    Attributes
+    ----------
+    outcome : str
+        "rebound" or "capture".
+    e_n : float
+        Normal restitution coefficient, Eq. (21); 0 when captured. [-]
+    mu_t, mu_tp : float
+        Tangential impulse ratios in t and t', Eqs. (22)-(23); NaN when captured. [-]
+    K_L, K_t : float
+        Translational and total kinetic energy loss ratios, Eqs. (25) and (24). [-]
+    velocity_in, velocity_out : tuple of float
+        Centre velocity before and after (final state when captured). [m/s]
+    omega_in, omega_out : tuple of float
+        Spin before and after. [rad/s]
+    contact_time : float
+        Duration of contact; inf when captured (the sphere stays). [s]
+    capture_time : float
+        Time at which the contact energy first fell below zero; NaN for a rebound. [s]
+    max_penetration : float
+        Largest approach x = -n of the centre. [m]
+    slip_ended : bool
+        True if friction brought the contact-point slip to zero (the sphere then rolls).
+    slip_end_time : float
+        Time at which sliding ended; NaN if it did not. [s]
+    friction_impulse : float
+        int |F_n| dt over the contact (to the end of the tail when captured). [N s]
+    dissipated_energy : float
+        Energy dissipated by normal damping plus friction (sliding and twist), tracked by the
+        solver, so that initial kinetic energy = final kinetic energy (+ contact energy when
+        captured) + dissipated_energy. [J]
+    final_contact_energy : float
+        Contact potential energy V(x) plus normal kinetic energy left at the end; 0 for a rebound,
+        the energy of the settled sphere when captured. [J]
+    method : str
+        "engine" or "reference:<scipy method>".
+    stop_reason : str
+        Why the integration stopped: "separation", "capture", ...
+    """
+
+    outcome: str
+    e_n: float
+    mu_t: float
+    mu_tp: float
+    K_L: float
+    K_t: float
+    velocity_in: tuple[float, float, float]
+    omega_in: tuple[float, float, float]
+    velocity_out: tuple[float, float, float]
+    omega_out: tuple[float, float, float]
+    contact_time: float
+    capture_time: float
+    max_penetration: float
+    slip_ended: bool
+    slip_end_time: float
+    friction_impulse: float
+    dissipated_energy: float
+    final_contact_energy: float
+    method: str
+    stop_reason: str
+
+    def to_dict(self) -> dict:
+        """Plain dict; non-finite floats become None so that the result is valid JSON."""
+
+        def clean(v):
+            if isinstance(v, float) and not math.isfinite(v):
+                return None
+            if isinstance(v, tuple):
+                return [clean(x) for x in v]
+            return v
+
+        return {k: clean(v) for k, v in asdict(self).items()}

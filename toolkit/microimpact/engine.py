@@ -1,0 +1,615 @@
+"""Fast impact engine: a compiled solver of the normal contact, Eq. (27), with events.
+
+Why this is cheap (see the decoupling section of the model notes, verified in the tests against the
+full 3-D reference solver):
+
+* the normal motion does not depend on the tangential or rotational state, so one 1-D solve per
+  normal speed serves every incidence angle, azimuth, spin and friction coefficient;
+* the tangential and rotational outcome depends on the normal solve only through two integrals,
+  J = int |F_n| dt and J_a = int a |F_n| dt (see :mod:`microimpact.tangential`);
+* the contact energy E = m x'^2/2 + V(x) never increases, so E < 0 is an exact capture test.
+
+Numerical formulation
+---------------------
+Nondimensional penetration xi = x / X and time tau = t / T (Eqs. (28)-(30), T corrected), so that
+xi'' = -a_h xi^(3/2) (1 + C1 y) + a_a xi^(1/2) (1 - C2 y), y = xi'. With adhesion (f0 > 0) the
+paper's scales give a_h = a_a = 1. Without adhesion X = 0 and the Hertz impact scales
+x* = (5 m v^2 / (4 K sqrt r))^(2/5), t* = x*/v are used instead (a_h = 5/4, a_a = 0).
+
+The xi^(1/2) terms make the force non-smooth in tau where contact starts and ends, which costs
+adaptive solvers order and steps there. With s = sqrt(xi) and the Sundman-type time change
+d tau = s d sigma the system becomes polynomial, hence smooth everywhere, including s = 0:
+
+    ds/dsigma = y / 2,   dy/dsigma = a_a s^2 (1 - C2 y) - a_h s^4 (1 + C1 y),   dtau/dsigma = s.
+
+Separation is the simple root s = 0 (with y < 0). The friction impulse J is the total variation
+of y, because the nondimensional normal force is -dy/dtau: it is summed exactly over the monotone
+pieces of y, whose ends (the zeros of dy/dsigma) are located as events. J_a and the damping
+dissipation D are integrated as extra states. Integration is Dormand-Prince 5(4) with error control
+on all states; events are located by re-stepping from the start of the step (Illinois method), so
+their accuracy is that of the integrator.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit, prange
+
+__all__ = ["NormalSolution", "EngineError", "solve_normal", "solve_normal_many", "nondimensional_scales"]
+
+# Status codes of the compiled core
+_OK = 0
+_MAX_STEPS = 1
+_STEP_UNDERFLOW = 2
+
+# Outcome codes
+REBOUND = 0
+CAPTURE = 1
+OUTCOME_NAMES = ("rebound", "capture")
+
+_NSTATE = 5  # s, y, tau, D, J_a
+_MAX_STEPS_DEFAULT = 2_000_000
+
+# Dormand-Prince 5(4) tableau (Dormand & Prince 1980, J. Comput. Appl. Math. 6:19-26).
+_C2, _C3, _C4, _C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
+_A21 = 1.0 / 5.0
+_A31, _A32 = 3.0 / 40.0, 9.0 / 40.0
+_A41, _A42, _A43 = 44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0
+_A51, _A52, _A53, _A54 = 19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0
+_A61, _A62, _A63, _A64, _A65 = 9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0
+_B1, _B3, _B4, _B5, _B6 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0
+# error coefficients: b - b_hat
+_E1, _E3, _E4, _E5, _E6, _E7 = (
+    71.0 / 57600.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+)
+
+
+class EngineError(RuntimeError):
+    """The compiled solver could not finish an impact (step limit or step-size underflow)."""
+
+
+# --------------------------------------------------------------------------- compiled core
+@njit(cache=True, fastmath=False)
+def _rhs(u, c1, c2, ah, aa, sgn, out):
+    s = u[0]
+    y = u[1]
+    s2 = s * s
+    g = aa * s2 * (1.0 - c2 * y) - ah * s2 * s2 * (1.0 + c1 * y)
+    out[0] = 0.5 * y
+    out[1] = g
+    out[2] = s
+    out[3] = (ah * c1 * s2 * s2 + aa * c2 * s2) * y * y
+    out[4] = sgn * s * g
+
+
+@njit(cache=True)
+def _step(u0, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err):
+    """One DP5 step from u0 (derivative k1) over h; writes u1, err and k[6] = f(u1)."""
+    n = u0.shape[0]
+    for i in range(n):
+        k[0, i] = k1[i]
+    for i in range(n):
+        tmp[i] = u0[i] + h * _A21 * k[0, i]
+    _rhs(tmp, c1, c2, ah, aa, sgn, k[1])
+    for i in range(n):
+        tmp[i] = u0[i] + h * (_A31 * k[0, i] + _A32 * k[1, i])
+    _rhs(tmp, c1, c2, ah, aa, sgn, k[2])
+    for i in range(n):
+        tmp[i] = u0[i] + h * (_A41 * k[0, i] + _A42 * k[1, i] + _A43 * k[2, i])
+    _rhs(tmp, c1, c2, ah, aa, sgn, k[3])
+    for i in range(n):
+        tmp[i] = u0[i] + h * (_A51 * k[0, i] + _A52 * k[1, i] + _A53 * k[2, i] + _A54 * k[3, i])
+    _rhs(tmp, c1, c2, ah, aa, sgn, k[4])
+    for i in range(n):
+        tmp[i] = u0[i] + h * (
+            _A61 * k[0, i] + _A62 * k[1, i] + _A63 * k[2, i] + _A64 * k[3, i] + _A65 * k[4, i]
+        )
+    _rhs(tmp, c1, c2, ah, aa, sgn, k[5])
+    for i in range(n):
+        u1[i] = u0[i] + h * (_B1 * k[0, i] + _B3 * k[2, i] + _B4 * k[3, i] + _B5 * k[4, i] + _B6 * k[5, i])
+    _rhs(u1, c1, c2, ah, aa, sgn, k[6])
+    for i in range(n):
+        err[i] = h * (
+            _E1 * k[0, i] + _E3 * k[2, i] + _E4 * k[3, i] + _E5 * k[4, i] + _E6 * k[5, i] + _E7 * k[6, i]
+        )
+
+
+@njit(cache=True)
+def _energy(s, y, ah, aa):
+    s3 = s * s * s
+    return 0.5 * y * y + ah * 0.4 * s3 * s * s - aa * (2.0 / 3.0) * s3
+
+
+@njit(cache=True)
+def _event_value(code, u, ku, ah, aa, target):
+    if code == 0:  # separation: s = 0
+        return u[0]
+    if code == 1:  # y crosses target (turning point: target 0; friction-impulse target)
+        return u[1] - target
+    if code == 2:  # extremum of y: dy/dsigma = 0
+        return ku[1]
+    return _energy(u[0], u[1], ah, aa)  # code 3: capture, E = 0
+
+
+@njit(cache=True)
+def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
+    """Step length h* in (0, h] at which event ``code`` crosses zero (Illinois method on re-steps)."""
+    a, b = 0.0, h
+    fa, fb = g0, g1
+    side = 0
+    hs = b
+    for _ in range(60):
+        hs = (a * fb - b * fa) / (fb - fa)
+        if not (hs > a and hs < b):
+            hs = 0.5 * (a + b)
+        _step(u0, k1, hs, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        fs = _event_value(code, u1, k[6], ah, aa, target)
+        if fs == 0.0 or (b - a) < 1e-14 * h:
+            break
+        if (fs > 0.0) == (fb > 0.0):
+            b, fb = hs, fs
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            a, fa = hs, fs
+            if side == 1:
+                fb *= 0.5
+            side = 1
+        if abs(b - a) < 1e-13 * h:
+            break
+    return hs
+
+
+@njit(cache=True)
+def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, settle_amp,
+               max_steps, rec, rec_cap):
+    """Integrate one normal impact.
+
+    Returns (status, outcome, y_end, tau_end, D, J, Ja, smax, tau_capture, tau_jtarget, E_end,
+    n_steps, n_rejected, n_rec). J and Ja are the nondimensional friction and twist impulses.
+    """
+    n = _NSTATE
+    u = np.zeros(n)
+    u[1] = y0
+    k = np.zeros((7, n))
+    tmp = np.zeros(n)
+    u1 = np.zeros(n)
+    err = np.zeros(n)
+    k1 = np.zeros(n)
+    kend = np.zeros(n)
+    # sign of dy/dsigma at first contact (its leading term in s)
+    lead = aa * (1.0 - c2 * y0)
+    if lead == 0.0:
+        lead = -ah * (1.0 + c1 * y0)
+    sgn = 1.0 if lead > 0.0 else -1.0
+    _rhs(u, c1, c2, ah, aa, sgn, k1)
+
+    yref = max(1.0, y0)
+    sref = max(1.0, y0 ** 0.4)
+    atol = np.empty(n)
+    atol[0] = rtol * sref
+    atol[1] = rtol * yref
+    atol[2] = rtol * sref
+    atol[3] = rtol * 0.5 * yref * yref
+    atol[4] = rtol * sref * yref
+
+    noise = 10.0 * (atol[0] + atol[1])
+    # equilibrium data for the tail bound of a captured sphere
+    xe = aa / ah if ah > 0.0 else 0.0
+    omega0 = 1.0
+    q = 0.0
+    if aa > 0.0:
+        se = math.sqrt(xe)
+        omega0 = math.sqrt(ah * se)
+        ceq = ah * c1 * xe * se + aa * c2 * se
+        zeta = ceq / (2.0 * omega0)
+        if zeta < 1.0:
+            q = math.exp(-math.pi * zeta / math.sqrt(1.0 - zeta * zeta))
+
+    h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
+    if y0 < 1.0:
+        h = min(1e-3 * (12.0 / y0) ** (1.0 / 3.0), 1e-2)
+    J = 0.0
+    smax = 0.0
+    tau_capture = math.nan
+    tau_jtarget = math.nan
+    captured = False
+    turned = False
+    outcome = -1
+    status = _OK
+    n_steps = 0
+    n_rej = 0
+    n_rec = 0
+    if rec_cap > 0:
+        rec[0, 0] = 0.0
+        rec[0, 1] = 0.0
+        rec[0, 2] = y0
+        n_rec = 1
+    while True:
+        if n_steps + n_rej >= max_steps:
+            status = _MAX_STEPS
+            break
+        _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        en = 0.0
+        for i in range(n):
+            sc = atol[i] + rtol * max(abs(u[i]), abs(u1[i]))
+            en += (err[i] / sc) ** 2
+        en = math.sqrt(en / n)
+        if en > 1.0:
+            n_rej += 1
+            h *= max(0.2, 0.9 * en ** -0.2)
+            if h < 1e-300:
+                status = _STEP_UNDERFLOW
+                break
+            continue
+        # accepted: look for events inside the step, take the earliest
+        hev = h
+        code = -1
+        ev_target = 0.0
+        g0 = k1[1]
+        g1 = k[6, 1]
+        if u[0] > 0.0 and u1[0] <= 0.0:
+            hh = _locate(0, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            if hh < hev or code < 0:
+                hev, code = hh, 0
+            _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        # an extremum of y ends the current monotone piece: dy/dsigma leaves its expected sign.
+        # (Comparing with the expected sign, not with g0, keeps the root just found at the start
+        # of this step from being found again through round-off.)
+        if u[0] > 0.0 and g1 * sgn < 0.0:
+            if g0 * sgn <= 0.0:
+                g0 = sgn * 1e-300
+            hh = _locate(2, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            if code < 0 or hh < hev:
+                hev, code = hh, 2
+            _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        if not turned and u[1] > 0.0 and u1[1] <= 0.0:
+            hh = _locate(1, 0.0, u, k1, h, u[1], u1[1], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            if code < 0 or hh < hev:
+                hev, code, ev_target = hh, 1, 0.0
+            _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        if not captured and aa > 0.0:
+            e0 = _energy(u[0], u[1], ah, aa)
+            e1 = _energy(u1[0], u1[1], ah, aa)
+            if e0 >= 0.0 and e1 < 0.0:
+                hh = _locate(3, 0.0, u, k1, h, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                if code < 0 or hh < hev:
+                    hev, code = hh, 3
+                _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        if math.isnan(tau_jtarget) and j_target > 0.0:
+            dj = abs(u1[1] - u[1])
+            if J < j_target and J + dj >= j_target:
+                yt = u[1] + (j_target - J) * (1.0 if u1[1] > u[1] else -1.0)
+                hh = _locate(1, yt, u, k1, h, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                if code < 0 or hh < hev:
+                    hev, code, ev_target = hh, 4, yt
+                _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        if code >= 0 and hev < h:
+            _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        # advance
+        J += abs(u1[1] - u[1])
+        for i in range(n):
+            u[i] = u1[i]
+        n_steps += 1
+        if code == 0:
+            u[0] = 0.0  # exactly at the surface
+        if code == 1:
+            turned = True
+            u[1] = 0.0
+        if code == 4:
+            tau_jtarget = u[2]
+        if u[0] > smax:
+            smax = u[0]
+        if code == 2:
+            sgn = -sgn
+        _rhs(u, c1, c2, ah, aa, sgn, kend)
+        for i in range(n):
+            k1[i] = kend[i]
+        if rec_cap > 0 and n_rec < rec_cap:
+            rec[n_rec, 0] = u[2]
+            rec[n_rec, 1] = u[0]
+            rec[n_rec, 2] = u[1]
+            n_rec += 1
+        if code == 0:
+            outcome = REBOUND
+            break
+        if code == 3:
+            captured = True
+            tau_capture = u[2]
+        if captured:
+            # linearised amplitude about the equilibrium, from the state itself (E - E_min would
+            # cancel to round-off long before the tail is negligible)
+            dx = u[0] * u[0] - xe
+            amp = math.sqrt(dx * dx + (u[1] / omega0) ** 2)
+            # below a few absolute tolerances the amplitude is integration noise, not motion
+            amp = max(amp - noise, 0.0)
+            if follow:
+                done = amp <= settle_amp
+            elif need_tail:
+                # friction impulse still to come: the total variation of y over the decaying
+                # oscillation, about 2 |y|_max per half period, a geometric series of ratio q
+                done = 2.0 * omega0 * amp * (1.0 + 1.0 / (1.0 - q)) <= tail_tol * J
+            else:
+                # stop at the first turning point, the largest penetration (the energy only
+                # falls afterwards), or once settled for an overdamped approach that never turns
+                done = turned or amp == 0.0
+            if done:
+                outcome = CAPTURE
+                break
+        # next step size
+        if en == 0.0:
+            fac = 5.0
+        else:
+            fac = min(5.0, max(0.2, 0.9 * en ** -0.2))
+        h *= fac
+    e_end = _energy(u[0], u[1], ah, aa)
+    return (status, outcome, u[1], u[2], u[3], J, u[4], smax * smax, tau_capture, tau_jtarget, e_end,
+            n_steps, n_rej, n_rec)
+
+
+@njit(cache=True, parallel=True)
+def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, out):
+    dummy = np.zeros((1, 3))
+    for i in prange(y0.shape[0]):
+        r = _integrate(y0[i], c1[i], c2[i], ah, aa, rtol, need_tail[i], tail_tol, 0.0, False, 0.0,
+                       max_steps, dummy, 0)
+        out[i, 0] = r[0]
+        out[i, 1] = r[1]
+        out[i, 2] = r[2]
+        out[i, 3] = r[3]
+        out[i, 4] = r[4]
+        out[i, 5] = r[5]
+        out[i, 6] = r[6]
+        out[i, 7] = r[7]
+        out[i, 8] = r[8]
+        out[i, 9] = r[10]
+        out[i, 10] = r[11]
+
+
+# --------------------------------------------------------------------------- Python interface
+@dataclass(frozen=True)
+class Scales:
+    """Nondimensional scales of one impact: length [m], time [s], a_h, a_a [-]."""
+
+    length: float
+    time: float
+    a_hertz: float
+    a_adhesion: float
+
+
+def nondimensional_scales(contact, normal_speed: float) -> Scales:
+    """Length and time scales used by the solvers (see the module docstring)."""
+    if contact.adhesion_line_force > 0.0:
+        return Scales(contact.length_scale, contact.time_scale, 1.0, 1.0)
+    x = (5.0 * contact.mass * normal_speed**2 / (4.0 * contact.stiffness * math.sqrt(contact.radius))) ** 0.4
+    return Scales(x, x / normal_speed, 1.25, 0.0)
+
+
+@dataclass(frozen=True)
+class NormalSolution:
+    """Result of a normal-contact solve (SI units).
+
+    Attributes
+    ----------
+    outcome : str
+        "rebound" or "capture".
+    e_n : float
+        Normal restitution coefficient, Eq. (21); 0 if captured. [-]
+    contact_time : float
+        Duration of contact; inf if captured. [s]
+    capture_time : float
+        Time at which the contact energy first fell below zero; NaN for a rebound. [s]
+    max_penetration : float
+        Largest penetration x = -n. [m]
+    friction_impulse : float
+        J = int |F_n| dt over the contact; for a captured sphere over the part integrated (the
+        settled tail is bounded by ``tail_tolerance`` relative to J). [N s]
+    twist_impulse : float
+        J_a = int a |F_n| dt, drives the twist friction torque. [N m s]
+    dissipated_energy : float
+        Energy removed by the normal damping (Eq. (27)). [J]
+    final_energy : float
+        Normal kinetic plus contact energy at the end (m v_out^2/2 for a rebound). [J]
+    slip_end_time : float
+        Time at which J reached the requested ``friction_impulse_target``; NaN if not reached or
+        not requested. [s]
+    n_steps, n_rejected : int
+        Accepted and rejected integration steps.
+    time, penetration, penetration_rate : numpy.ndarray or None
+        Trajectory at the accepted steps, when asked for. [s], [m], [m/s]
+    """
+
+    outcome: str
+    e_n: float
+    contact_time: float
+    capture_time: float
+    max_penetration: float
+    friction_impulse: float
+    twist_impulse: float
+    dissipated_energy: float
+    final_energy: float
+    slip_end_time: float
+    n_steps: int
+    n_rejected: int
+    time: np.ndarray | None = None
+    penetration: np.ndarray | None = None
+    penetration_rate: np.ndarray | None = None
+
+
+def _check_speed(normal_speed: float) -> float:
+    v = float(normal_speed)
+    if not math.isfinite(v) or v <= 0.0:
+        raise ValueError(f"normal_speed must be a finite number > 0, got {normal_speed!r}")
+    return v
+
+
+def solve_normal(
+    contact,
+    normal_speed: float,
+    *,
+    rtol: float = 1e-10,
+    trajectory: bool = False,
+    follow_capture: bool = False,
+    need_tail: bool = False,
+    tail_tolerance: float | None = None,
+    friction_impulse_target: float | None = None,
+    settle_amplitude: float = 1e-4,
+    max_steps: int = _MAX_STEPS_DEFAULT,
+) -> NormalSolution:
+    """Solve the normal contact, Eq. (27), of one impact.
+
+    Parameters
+    ----------
+    contact : Contact
+    normal_speed : float
+        Incident normal speed, > 0. [m/s]
+    rtol : float
+        Relative tolerance of the integration (absolute tolerances scale with it). [-]
+    trajectory : bool
+        Also return the trajectory at the accepted steps.
+    follow_capture : bool
+        For a captured sphere keep integrating until the oscillation amplitude is below
+        ``settle_amplitude`` times the equilibrium penetration X (for phase portraits).
+    need_tail : bool
+        For a captured sphere keep integrating until the friction impulse still to come is below
+        ``tail_tolerance`` (default ``rtol``) relative to J (needed for the tangential outcome).
+        Without it a capture stops at the exact energy test.
+    friction_impulse_target : float, optional
+        Record the time at which J reaches this value (end of sliding). [N s]
+    settle_amplitude : float
+        See ``follow_capture``. [-]
+    max_steps : int
+        Step limit; EngineError beyond it.
+
+    Returns
+    -------
+    NormalSolution
+    """
+    v = _check_speed(normal_speed)
+    if not (0.0 < rtol < 1.0):
+        raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
+    sc = nondimensional_scales(contact, v)
+    c_h, c_a = contact.damping_coefficients(v)
+    u = sc.length / sc.time
+    y0 = v / u
+    j_unit = contact.mass * u  # N s
+    jt = 0.0 if friction_impulse_target is None else float(friction_impulse_target) / j_unit
+    cap = 4096 if (trajectory or follow_capture) else 0
+    while True:
+        rec = np.zeros((max(cap, 1), 3))
+        r = _integrate(y0, c_h * u, c_a * u, sc.a_hertz, sc.a_adhesion, rtol, need_tail,
+                       rtol if tail_tolerance is None else tail_tolerance, jt, follow_capture,
+                       settle_amplitude * (sc.a_adhesion / sc.a_hertz if sc.a_adhesion > 0 else 1.0),
+                       max_steps, rec, cap)
+        if cap == 0 or r[13] < cap:
+            break
+        cap *= 4
+    status, outcome = r[0], r[1]
+    if status != _OK:
+        why = "step limit reached" if status == _MAX_STEPS else "step size underflow"
+        raise EngineError(f"engine failed for normal speed {v!r} m/s: {why} after {r[11]} steps")
+    energy_unit = contact.mass * u * u
+    captured = outcome == CAPTURE
+    time = pen = rate = None
+    if cap:
+        n = r[13]
+        time = rec[:n, 0] * sc.time
+        pen = rec[:n, 1] ** 2 * sc.length
+        rate = rec[:n, 2] * u
+    return NormalSolution(
+        outcome=OUTCOME_NAMES[outcome],
+        e_n=0.0 if captured else -r[2] / y0,
+        contact_time=math.inf if captured else r[3] * sc.time,
+        capture_time=r[8] * sc.time,
+        max_penetration=r[7] * sc.length,
+        friction_impulse=r[5] * j_unit,
+        twist_impulse=r[6] * j_unit * math.sqrt(contact.radius * sc.length),
+        dissipated_energy=r[4] * energy_unit,
+        final_energy=r[10] * energy_unit,
+        slip_end_time=r[9] * sc.time,
+        n_steps=int(r[11]),
+        n_rejected=int(r[12]),
+        time=time,
+        penetration=pen,
+        penetration_rate=rate,
+    )
+
+
+def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = 1e-10,
+                      tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT) -> dict:
+    """Solve many normal impacts in parallel (both cores); arrays in, dict of SI arrays out.
+
+    Parameters
+    ----------
+    contact : Contact
+    normal_speed : array_like, 1-D
+        Distinct incident normal speeds, > 0. [m/s]
+    need_tail : array_like of bool, optional
+        Per speed, whether a captured sphere must be followed for its friction impulse.
+
+    Returns
+    -------
+    dict with arrays ``captured`` (bool), ``e_n`` [-], ``contact_time`` [s], ``capture_time`` [s],
+    ``max_penetration`` [m], ``friction_impulse`` [N s], ``twist_impulse`` [N m s],
+    ``dissipated_energy`` [J], ``final_energy`` [J], ``n_steps``.
+    """
+    v = np.ascontiguousarray(normal_speed, dtype=float).ravel()
+    if v.size and (not np.all(np.isfinite(v)) or np.any(v <= 0.0)):
+        bad = v[~(np.isfinite(v) & (v > 0.0))][0]
+        raise ValueError(f"normal speeds must be finite and > 0, got {bad!r}")
+    nt = np.zeros(v.shape, dtype=np.bool_) if need_tail is None else np.ascontiguousarray(need_tail, dtype=np.bool_).ravel()
+    if contact.adhesion_line_force > 0.0:
+        length, time, ah, aa = contact.length_scale, contact.time_scale, 1.0, 1.0
+        u = np.full(v.shape, length / time)
+    else:
+        ah, aa = 1.25, 0.0
+        length = (5.0 * contact.mass * v**2 / (4.0 * contact.stiffness * math.sqrt(contact.radius))) ** 0.4
+        u = v.copy()  # x*/t* = v
+        time = length / u
+    if contact.damping_reference_speed is None:
+        vref = v
+    else:
+        vref = np.full(v.shape, contact.damping_reference_speed)
+    scale = contact.damping_speed_scale * vref**0.2
+    c1 = contact.zeta_hertz / scale * u
+    c2 = contact.zeta_adhesion / scale * u
+    y0 = v / u
+    out = np.empty((v.size, 11))
+    _integrate_many(y0, c1, c2, ah, aa, float(rtol), nt, float(rtol if tail_tolerance is None else tail_tolerance),
+                    int(max_steps), out)
+    status = out[:, 0]
+    if np.any(status != _OK):
+        i = int(np.flatnonzero(status != _OK)[0])
+        raise EngineError(f"engine failed for normal speed {v[i]!r} m/s (status {int(status[i])})")
+    captured = out[:, 1] == CAPTURE
+    ju = contact.mass * u
+    eu = contact.mass * u * u
+    return {
+        "captured": captured,
+        "e_n": np.where(captured, 0.0, -out[:, 2] / y0),
+        "contact_time": np.where(captured, np.inf, out[:, 3] * time),
+        "capture_time": out[:, 8] * time,
+        "max_penetration": out[:, 7] * length,
+        "friction_impulse": out[:, 5] * ju,
+        "twist_impulse": out[:, 6] * ju * np.sqrt(contact.radius * length),
+        "dissipated_energy": out[:, 4] * eu,
+        "final_energy": out[:, 9] * eu,
+        "n_steps": out[:, 10].astype(np.int64),
+    }
+
+
+def set_threads(n: int | None = None) -> None:
+    """Use ``n`` threads for :func:`solve_normal_many` (default: all cores)."""
+    import numba
+
+    numba.set_num_threads(n or os.cpu_count() or 1)

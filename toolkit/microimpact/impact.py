@@ -1,0 +1,269 @@
+"""Public impact API: one impact (:func:`simulate_impact`) or a broadcast batch (:func:`simulate_many`).
+
+Both use the fast engine (one compiled normal solve per distinct normal speed plus the closed-form
+tangential map); ``simulate_impact(..., method="reference")`` runs the full 3-D scipy solver instead.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+
+from . import engine
+from .coefficients import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
+from .tangential import sliding_friction_impulse, tangential_outcome
+
+__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES"]
+
+# name: (units, long_name) of every variable that simulate_many returns
+RESULT_VARIABLES: dict[str, tuple[str, str]] = {
+    "outcome": ("1", "impact outcome (0 rebound, 1 capture)"),
+    "e_n": ("1", "normal coefficient of restitution, Eq. (21)"),
+    "mu_t": ("1", "tangential impulse ratio in t, Eq. (22)"),
+    "mu_tp": ("1", "tangential impulse ratio in t', Eq. (23)"),
+    "K_L": ("1", "translational kinetic energy loss ratio, Eq. (25)"),
+    "K_t": ("1", "total kinetic energy loss ratio, Eq. (24)"),
+    "velocity_out_n": ("m s-1", "normal velocity after impact (final state if captured)"),
+    "velocity_out_t": ("m s-1", "tangential velocity in t after impact"),
+    "velocity_out_tp": ("m s-1", "tangential velocity in t' after impact"),
+    "omega_out_n": ("rad s-1", "spin about n after impact"),
+    "omega_out_t": ("rad s-1", "spin about t after impact"),
+    "omega_out_tp": ("rad s-1", "spin about t' after impact"),
+    "contact_time": ("s", "duration of contact (inf if captured)"),
+    "max_penetration": ("m", "largest penetration x = -n"),
+    "slip_ended": ("1", "1 if sliding ended and the sphere rolls"),
+    "friction_impulse": ("N s", "integral of |F_n| over the contact"),
+    "dissipated_energy": ("J", "energy dissipated by damping and friction"),
+}
+
+
+def _check_inputs(speed, incidence_deg, azimuth_deg, omega):
+    speed = np.asarray(speed, dtype=float)
+    inc = np.asarray(incidence_deg, dtype=float)
+    if not np.all(np.isfinite(speed)) or np.any(speed <= 0.0):
+        raise ValueError(f"speed must be finite and > 0 m/s, got {speed[~(np.isfinite(speed) & (speed > 0))].ravel()[0]!r}")
+    if not np.all(np.isfinite(inc)) or np.any((inc < 0.0) | (inc >= 90.0)):
+        raise ValueError(f"incidence_deg must lie in [0, 90) deg, got {inc[~(np.isfinite(inc) & (inc >= 0) & (inc < 90))].ravel()[0]!r}")
+    if not np.all(np.isfinite(np.asarray(azimuth_deg, dtype=float))):
+        raise ValueError(f"azimuth_deg must be finite, got {azimuth_deg!r}")
+    for name, w in zip(("omega_n", "omega_t", "omega_tp"), omega):
+        if not np.all(np.isfinite(np.asarray(w, dtype=float))):
+            raise ValueError(f"{name} must be finite, got {w!r}")
+
+
+def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0, 0.0, 0.0), *,
+                    rtol: float = 1e-10, method: str = "engine") -> ImpactResult:
+    """Simulate one impact of a sphere on the flat surface.
+
+    Parameters
+    ----------
+    contact : Contact
+    speed : float
+        Magnitude of the incident velocity. [m/s]
+    incidence_deg : float
+        Incidence angle from the surface normal, in [0, 90). [deg]
+    azimuth_deg : float
+        Direction of the tangential velocity in the (t, t') plane. [deg]
+    omega : tuple of 3 float
+        Initial spin (omega_n, omega_t, omega_t'). [rad/s]
+    rtol : float
+        Relative tolerance of the integration. [-]
+    method : {"engine", "reference"}
+        The compiled engine (default) or the full 3-D scipy reference solver.
+
+    Returns
+    -------
+    ImpactResult
+    """
+    if len(omega) != 3:
+        raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_tp), got {omega!r}")
+    _check_inputs(speed, incidence_deg, azimuth_deg, omega)
+    if method == "reference":
+        from .reference import simulate_reference
+
+        return simulate_reference(contact, speed, incidence_deg, azimuth_deg, omega, rtol=rtol)
+    if method != "engine":
+        raise ValueError(f"method must be 'engine' or 'reference', got {method!r}")
+    v_in = incident_velocity(float(speed), float(incidence_deg), float(azimuth_deg))
+    w_in = tuple(float(w) for w in omega)
+    m, inertia, r, f = contact.mass, contact.moment_of_inertia, contact.radius, contact.friction
+    u_t, u_tp = slip_velocity(r, v_in[1], v_in[2], w_in[1], w_in[2])
+    slip = math.hypot(u_t, u_tp)
+    needs_tangential = f > 0.0 and (slip > 0.0 or w_in[0] != 0.0)
+    j_star = float(sliding_friction_impulse(m, f, slip))
+    sol = engine.solve_normal(
+        contact, -v_in[0], rtol=rtol, need_tail=needs_tangential,
+        friction_impulse_target=j_star if needs_tangential and 0.0 < j_star < math.inf else None,
+    )
+    tan = tangential_outcome(m, inertia, r, f, v_in, w_in, sol.friction_impulse, sol.twist_impulse)
+    captured = sol.outcome == "capture"
+    v_out = (0.0 if captured else sol.e_n * -v_in[0], float(tan["v_t"]), float(tan["v_tp"]))
+    w_out = (float(tan["omega_n"]), float(tan["omega_t"]), float(tan["omega_tp"]))
+    coef = impact_coefficients(m, inertia, v_in, w_in, v_out, w_out, captured)
+    slip_ended = bool(tan["slip_ended"])
+    return ImpactResult(
+        outcome=sol.outcome,
+        **coef,
+        velocity_in=v_in,
+        omega_in=w_in,
+        velocity_out=v_out,
+        omega_out=w_out,
+        contact_time=sol.contact_time,
+        capture_time=sol.capture_time,
+        max_penetration=sol.max_penetration,
+        slip_ended=slip_ended,
+        slip_end_time=(0.0 if slip == 0.0 else sol.slip_end_time) if slip_ended else math.nan,
+        friction_impulse=sol.friction_impulse,
+        dissipated_energy=sol.dissipated_energy + float(tan["friction_dissipation"]),
+        final_contact_energy=sol.final_energy if captured else 0.0,
+        method="engine",
+        stop_reason=sol.outcome if not captured else ("settled" if needs_tangential else "capture"),
+    )
+
+
+def _as_dataarray(name, value):
+    if isinstance(value, xr.DataArray):
+        return value.rename(name)
+    a = np.asarray(value, dtype=float)
+    if a.ndim == 0:
+        return xr.DataArray(a, name=name)
+    dims = ("impact",) if a.ndim == 1 else tuple(f"impact_{i}" for i in range(a.ndim))
+    return xr.DataArray(a, dims=dims, name=name)
+
+
+def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0, 0.0, 0.0), friction=None, *,
+                  rtol: float = 1e-10) -> xr.Dataset:
+    """Simulate a batch of impacts, broadcasting the inputs, on both cores.
+
+    Each distinct normal speed is solved once by the compiled engine; every angle, azimuth, spin
+    and friction coefficient that shares it costs only the closed-form tangential map. Captured
+    impacts that need no tangential result stop at the exact energy test.
+
+    Parameters
+    ----------
+    contact : Contact
+    speed, incidence_deg, azimuth_deg : scalar, array_like or xarray.DataArray
+        As in :func:`simulate_impact`. [m/s], [deg], [deg]
+    omega : tuple of 3 scalars, arrays or DataArrays
+        (omega_n, omega_t, omega_t'). [rad/s]
+    friction : scalar, array_like or DataArray, optional
+        Coulomb coefficient f; default ``contact.friction``. [-]
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions from broadcasting the inputs (DataArrays by dimension name; plain arrays are
+        named ``impact`` or ``impact_0, impact_1, ...``). Variables are named after the fields of
+        :class:`ImpactResult` (vectors split into ``_n``, ``_t``, ``_tp``) and carry ``units`` and
+        ``long_name``; the inputs are included as variables. ``outcome`` is 0 for a rebound and 1
+        for a capture (CF flag attributes).
+    """
+    if len(omega) != 3:
+        raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_tp), got {omega!r}")
+    if friction is None:
+        friction = contact.friction
+    inputs = {
+        "speed": speed,
+        "incidence_deg": incidence_deg,
+        "azimuth_deg": azimuth_deg,
+        "omega_n": omega[0],
+        "omega_t": omega[1],
+        "omega_tp": omega[2],
+        "friction": friction,
+    }
+    plain = {k: np.asarray(v, dtype=float) for k, v in inputs.items() if not isinstance(v, xr.DataArray)}
+    if plain:  # plain arrays broadcast with numpy rules, then join the DataArrays by dimension name
+        plain = dict(zip(plain, np.broadcast_arrays(*plain.values())))
+    arrays = xr.broadcast(*(_as_dataarray(k, plain.get(k, v)) for k, v in inputs.items()))
+    dims = arrays[0].dims
+    arrays = [a.transpose(*dims) for a in arrays]
+    shape = arrays[0].shape
+    flat = {a.name: np.ascontiguousarray(a.values, dtype=float).ravel() for a in arrays}
+    _check_inputs(flat["speed"], flat["incidence_deg"], flat["azimuth_deg"], (flat["omega_n"], flat["omega_t"], flat["omega_tp"]))
+    if np.any(~np.isfinite(flat["friction"]) | (flat["friction"] < 0.0)):
+        raise ValueError("friction must be finite and >= 0")
+
+    alpha = np.radians(flat["incidence_deg"])
+    theta = np.radians(flat["azimuth_deg"])
+    v = flat["speed"]
+    v_n = -v * np.cos(alpha)
+    v_t = v * np.sin(alpha) * np.cos(theta)
+    v_tp = v * np.sin(alpha) * np.sin(theta)
+    w = (flat["omega_n"], flat["omega_t"], flat["omega_tp"])
+    f = flat["friction"]
+    m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
+    u_t, u_tp = slip_velocity(r, v_t, v_tp, w[1], w[2])
+    needs_tangential = (f > 0.0) & ((np.hypot(u_t, u_tp) > 0.0) | (w[0] != 0.0))
+
+    speeds, inverse = np.unique(-v_n, return_inverse=True)
+    need_tail = np.bincount(inverse, weights=needs_tangential, minlength=speeds.size) > 0
+    sol = engine.solve_normal_many(contact, speeds, need_tail, rtol=rtol)
+    g = {k: val[inverse] for k, val in sol.items()}
+    captured = g["captured"]
+
+    tan = tangential_outcome(m, inertia, r, f, (v_n, v_t, v_tp), w, g["friction_impulse"], g["twist_impulse"])
+    vn_out = np.where(captured, 0.0, -g["e_n"] * v_n)
+    # Eqs. (21)-(25), vectorised (impact_coefficients is the scalar form of the same formulas)
+    dvn = vn_out - v_n
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mu_t = np.where(captured, np.nan, (tan["v_t"] - v_t) / dvn)
+        mu_tp = np.where(captured, np.nan, (tan["v_tp"] - v_tp) / dvn)
+    v2_in = v**2
+    v2_out = vn_out**2 + tan["v_t"] ** 2 + tan["v_tp"] ** 2
+    w2_in = w[0] ** 2 + w[1] ** 2 + w[2] ** 2
+    w2_out = tan["omega_n"] ** 2 + tan["omega_t"] ** 2 + tan["omega_tp"] ** 2
+    e_in = m * v2_in + inertia * w2_in
+    results = {
+        "outcome": captured.astype(np.int8),
+        "e_n": g["e_n"],
+        "mu_t": mu_t,
+        "mu_tp": mu_tp,
+        "K_L": (v2_in - v2_out) / v2_in,
+        "K_t": (e_in - m * v2_out - inertia * w2_out) / e_in,
+        "velocity_out_n": vn_out,
+        "velocity_out_t": tan["v_t"],
+        "velocity_out_tp": tan["v_tp"],
+        "omega_out_n": tan["omega_n"],
+        "omega_out_t": tan["omega_t"],
+        "omega_out_tp": tan["omega_tp"],
+        "contact_time": g["contact_time"],
+        "max_penetration": g["max_penetration"],
+        "slip_ended": tan["slip_ended"].astype(np.int8),
+        "friction_impulse": g["friction_impulse"],
+        "dissipated_energy": g["dissipated_energy"] + tan["friction_dissipation"],
+    }
+    coords = {name: c for a in arrays for name, c in a.coords.items()}
+    ds = xr.Dataset(coords=coords)
+    input_meta = {
+        "speed": ("m s-1", "incident speed"),
+        "incidence_deg": ("degree", "incidence angle from the surface normal"),
+        "azimuth_deg": ("degree", "azimuth of the tangential velocity"),
+        "omega_n": ("rad s-1", "initial spin about n"),
+        "omega_t": ("rad s-1", "initial spin about t"),
+        "omega_tp": ("rad s-1", "initial spin about t'"),
+        "friction": ("1", "Coulomb friction coefficient"),
+    }
+    for a in arrays:
+        if a.name not in ds.coords:
+            units, long_name = input_meta[a.name]
+            ds[a.name] = xr.DataArray(a.values, dims=dims, attrs={"units": units, "long_name": long_name})
+    for name, values in results.items():
+        units, long_name = RESULT_VARIABLES[name]
+        ds[name] = xr.DataArray(values.reshape(shape), dims=dims, attrs={"units": units, "long_name": long_name})
+    ds["outcome"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="rebound capture")
+    ds["slip_ended"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="sliding rolling")
+    ds.attrs.update(contact_attributes(contact))
+    ds.attrs["solver"] = f"microimpact engine (Dormand-Prince 5(4), rtol={rtol:g})"
+    return ds
+
+
+def contact_attributes(contact) -> dict:
+    """Contact parameters as flat NetCDF attributes (``contact_<field>``, SI units)."""
+    out = {}
+    for name, value in contact.__dict__.items():
+        out[f"contact_{name}"] = "per-impact normal speed" if value is None else value
+    return out

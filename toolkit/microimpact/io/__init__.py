@@ -1,0 +1,35 @@
+"""Lab-data input and atomic file output.
+
+* :func:`read_impacts` - read and validate a CSV of measured impacts (format: data/README.md,
+  "Measured-impact CSV format"); returns a DataFrame in canonical columns and SI units (angles in
+  [deg] in ``*_deg`` columns), or raises one :class:`ImpactDataError` listing every problem.
+* :func:`read_materials`, :func:`default_materials_path`, :class:`MaterialPair` - the materials
+  config (data/README.md, "Materials config").
+* :func:`atomic_write`, :func:`atomic_path`, :func:`write_csv`, :func:`write_netcdf` - writers that
+  leave either the old or the complete new file, never a partial one.
+* :mod:`microimpact.io.units` - the one table of accepted units.
+"""
+
+from .files import atomic_path, atomic_write, write_csv, write_netcdf
+from .impacts import CANONICAL_COLUMNS, COLUMN_UNITS, ImpactDataError, ImpactDataWarning, Problem, read_impacts
+from .materials import MaterialPair, MaterialsError, default_materials_path, read_materials
+from .units import UNITS, UnitError
+
+__all__ = [
+    "read_impacts",
+    "ImpactDataError",
+    "ImpactDataWarning",
+    "Problem",
+    "CANONICAL_COLUMNS",
+    "COLUMN_UNITS",
+    "read_materials",
+    "default_materials_path",
+    "MaterialPair",
+    "MaterialsError",
+    "atomic_path",
+    "atomic_write",
+    "write_csv",
+    "write_netcdf",
+    "UNITS",
+    "UnitError",
+]

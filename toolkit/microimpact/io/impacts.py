@@ -1,0 +1,609 @@
+"""Read and validate a CSV of measured microsphere impacts.
+
+The file format is documented in ``data/README.md``, section "Measured-impact CSV format".
+:func:`read_impacts` checks the whole file at once and raises ONE :class:`ImpactDataError` that
+lists every problem found, each located by file, data row, line and column.
+
+Returned table
+--------------
+One row per impact, in file order, with these columns (always all of them, in this order; NaN or
+missing where a value is neither given nor derivable). Uncertainties are standard uncertainties
+(one standard deviation) in the unit of their quantity.
+
+======================================  ======  ==================================================
+column                                  unit    meaning
+======================================  ======  ==================================================
+``row``                                 [-]     1-based data row in the file (blank lines skipped)
+``line``                                [-]     1-based line of the file where the row starts
+``id``, ``size_class``, ``material_pair``       text labels as written (missing: NA)
+``radius``                              [m]     sphere radius (``diameter`` / 2 if diameter given)
+``speed``                               [m/s]   incident speed magnitude
+``incidence_deg``                       [deg]   incidence angle from the surface normal, [0, 90)
+``normal_speed``                        [m/s]   incident normal speed magnitude, > 0
+``rebound_normal_speed``                [m/s]   rebound normal speed magnitude, >= 0
+``e_n``                                 [1]     normal coefficient of restitution, [0, 1]
+``rebound_tangential_speed``            [m/s]   rebound tangential speed of the centre, >= 0
+``rebound_angle_deg``                   [deg]   rebound angle from the surface normal
+``<quantity>_uncertainty``              as qty  for each quantity above from ``radius`` on
+======================================  ======  ==================================================
+
+Angles are kept in degrees in columns whose names end in ``_deg``, the convention of
+:func:`microimpact.coefficients.incident_velocity`; everything else is SI.
+
+Derived columns (first-order propagation of independent standard uncertainties; a derived
+uncertainty is NaN unless every input it needs has an uncertainty):
+
+* ``normal_speed = speed cos(incidence)`` when speed and incidence angle are given;
+  ``speed = normal_speed / cos(incidence)`` when normal speed and incidence angle are given;
+  speed and incidence angle are NaN when only the normal speed is given.
+* ``e_n = rebound_normal_speed / normal_speed`` or ``rebound_normal_speed = e_n normal_speed``.
+* ``rebound_angle = atan(rebound_tangential_speed / rebound_normal_speed)`` or
+  ``rebound_tangential_speed = rebound_normal_speed tan(rebound_angle)``.
+
+``df.attrs`` holds ``source`` (the path as given, str), ``sha256`` (of the file's bytes) and
+``units`` (column -> unit string), so later flags and writers can point back to the file.
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+import hashlib
+import io as _stdio
+import math
+import os
+import re
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .units import INTERNAL_UNIT, UnitError, accepted_units, conversion_factor, parse_header_field
+
+__all__ = [
+    "read_impacts",
+    "ImpactDataError",
+    "ImpactDataWarning",
+    "Problem",
+    "CANONICAL_COLUMNS",
+    "COLUMN_UNITS",
+    "MAX_LISTED_PROBLEMS",
+]
+
+#: at most this many problems are written out in an ImpactDataError message (all are in .problems)
+MAX_LISTED_PROBLEMS = 200
+
+_MISSING = frozenset({"", "nan", "na", "n/a", "null", "none"})
+_BOM = b"\xef\xbb\xbf"
+
+
+@dataclass(frozen=True)
+class _Quantity:
+    """A numeric input column: its dimension, output column, scale and accepted range."""
+
+    dimension: str
+    canonical: str
+    scale: float = 1.0  # applied after unit conversion (diameter -> radius)
+    low: float = 0.0
+    low_open: bool = True
+    high: float = math.inf
+    high_open: bool = True
+
+    def range_text(self) -> str:
+        unit = " deg" if self.dimension == "angle" else ""
+        if math.isinf(self.high):
+            return f"{'>' if self.low_open else '>='} {self.low:g}{unit}"
+        lo = "(" if self.low_open else "["
+        hi = ")" if self.high_open else "]"
+        return f"in {lo}{self.low:g}, {self.high:g}{hi}{unit}"
+
+    def ok(self, x: np.ndarray) -> np.ndarray:
+        lo = x > self.low if self.low_open else x >= self.low
+        hi = x < self.high if self.high_open else x <= self.high
+        return lo & hi
+
+
+_BASE: dict[str, _Quantity] = {
+    "radius": _Quantity("length", "radius"),
+    "diameter": _Quantity("length", "radius", scale=0.5),
+    "speed": _Quantity("speed", "speed"),
+    "incidence_angle": _Quantity("angle", "incidence_deg", low_open=False, high=90.0),
+    "normal_speed": _Quantity("speed", "normal_speed"),
+    "rebound_normal_speed": _Quantity("speed", "rebound_normal_speed", low_open=False),
+    "e_n": _Quantity("dimensionless", "e_n", low_open=False, high=1.0, high_open=False),
+    "rebound_tangential_speed": _Quantity("speed", "rebound_tangential_speed", low_open=False),
+    "rebound_angle": _Quantity("angle", "rebound_angle_deg", low_open=False, high=90.0),
+}
+_QUANTITIES: dict[str, _Quantity] = dict(_BASE)
+for _name, _q in _BASE.items():
+    _QUANTITIES[f"{_name}_uncertainty"] = _Quantity(
+        _q.dimension, f"{_q.canonical}_uncertainty", scale=_q.scale, low_open=False
+    )
+_LABELS = ("id", "size_class", "material_pair")
+_KNOWN = tuple(_QUANTITIES) + _LABELS
+
+#: the columns of the returned DataFrame, in order
+CANONICAL_COLUMNS: tuple[str, ...] = (
+    "row",
+    "line",
+    *_LABELS,
+    *(c for q in ("radius", "speed", "incidence_deg", "normal_speed", "rebound_normal_speed", "e_n",
+                  "rebound_tangential_speed", "rebound_angle_deg") for c in (q, f"{q}_uncertainty")),
+)
+#: unit of each numeric column of the returned DataFrame
+COLUMN_UNITS: dict[str, str] = {"row": "1", "line": "1"} | {
+    q.canonical: INTERNAL_UNIT[q.dimension] for q in _QUANTITIES.values()
+}
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One problem found in an impact file.
+
+    Attributes
+    ----------
+    message : str
+        What is wrong and what is accepted.
+    row : int or None
+        1-based data row (blank lines not counted), None for problems of the file or header.
+    line : int or None
+        1-based line of the file.
+    column : str or None
+        Header field as written in the file.
+    value : str or None
+        The offending cell or header text as written.
+    """
+
+    message: str
+    row: int | None = None
+    line: int | None = None
+    column: str | None = None
+    value: str | None = None
+
+    def format(self, source: str) -> str:
+        """The problem as one line, prefixed by the file name ``source``."""
+        where = [source]
+        if self.row is not None:
+            where.append(f"row {self.row} (line {self.line})")
+        elif self.line is not None:
+            where.append(f"line {self.line}")
+        if self.column is not None:
+            where.append(f"column {self.column!r}")
+        if self.value is not None:
+            where.append(f"value {self.value!r}")
+        return ", ".join(where) + ": " + self.message
+
+
+class ImpactDataError(ValueError):
+    """An impact file that cannot be used; the message lists every problem found.
+
+    Attributes
+    ----------
+    source : str
+        The file's name as given.
+    problems : tuple of Problem
+        All problems, in the order found (the message lists the first
+        :data:`MAX_LISTED_PROBLEMS`).
+    """
+
+    def __init__(self, source: str, problems):
+        self.source = str(source)
+        self.problems = tuple(problems)
+        n = len(self.problems)
+        lines = [f"{n} problem{'s' if n != 1 else ''} in impact file {self.source}:"]
+        name = Path(self.source).name
+        lines += ["  - " + p.format(name) for p in self.problems[:MAX_LISTED_PROBLEMS]]
+        if n > MAX_LISTED_PROBLEMS:
+            lines.append(f"  ... and {n - MAX_LISTED_PROBLEMS} more (all are in ImpactDataError.problems)")
+        lines.append("The format is described in data/README.md, section 'Measured-impact CSV format'.")
+        super().__init__("\n".join(lines))
+
+
+class ImpactDataWarning(UserWarning):
+    """Something in an impact file that was ignored (e.g. an unknown column)."""
+
+
+# --------------------------------------------------------------------------- bytes and text
+def _decode(data: bytes) -> tuple[str, list[Problem]]:
+    """UTF-8 text of ``data`` (BOM removed); every undecodable byte becomes a Problem."""
+    offset0 = len(_BOM) if data.startswith(_BOM) else 0
+    problems: list[Problem] = []
+    pos = offset0
+    while True:
+        try:
+            data[pos:].decode("utf-8")
+            break
+        except UnicodeDecodeError as e:
+            bad = pos + e.start
+            line = data.count(b"\n", 0, bad) + 1
+            problems.append(
+                Problem(
+                    f"byte 0x{data[bad]:02X} at byte offset {bad} is not valid UTF-8; save the file "
+                    "as UTF-8 (e.g. 'CSV UTF-8' in a spreadsheet program)",
+                    line=line,
+                )
+            )
+            pos += e.end
+            if len(problems) >= MAX_LISTED_PROBLEMS:
+                break
+    return data[offset0:].decode("utf-8", errors="replace"), problems
+
+
+@dataclass(frozen=True)
+class _Column:
+    index: int  # position in the header
+    field: str  # header text as written
+    name: str
+    unit: str | None
+
+
+# --------------------------------------------------------------------------- header
+def _check_header(fields: list[str]) -> tuple[dict[str, _Column], dict[str, float], list[Problem], list[str]]:
+    """Columns by name, unit factors, header problems and ignored fields."""
+    problems: list[Problem] = []
+    ignored: list[str] = []
+    columns: dict[str, _Column] = {}
+    misplaced_unit: set[str] = set()  # 'radius (um)': reported once, not also as missing
+    factors: dict[str, float] = {}
+    for i, raw in enumerate(fields):
+        name, unit = parse_header_field(raw)
+        col = _Column(i, raw.strip(), name, unit)
+        if name not in _KNOWN:
+            m = re.fullmatch(r"(\w+)\s*\((.*)\)", name)
+            if m and m.group(1) in _QUANTITIES:
+                misplaced_unit.add(m.group(1))
+                problems.append(Problem(
+                    f"units go in square brackets: write '{m.group(1)} [{m.group(2).strip()}]'",
+                    line=1, column=col.field))
+            else:
+                ignored.append(col.field)
+            continue
+        if name in columns:
+            first = columns[name]
+            how = "the same column appears" if first.field == col.field else f"{name!r} is given"
+            problems.append(Problem(
+                f"{how} twice (columns {first.index + 1} and {i + 1}, as {first.field!r} and "
+                f"{col.field!r}); keep one", line=1, column=col.field))
+            continue
+        columns[name] = col
+        if name in _LABELS:
+            if unit is not None:
+                problems.append(Problem(
+                    f"{name!r} is a text label column and takes no unit; write the header as {name!r}",
+                    line=1, column=col.field))
+            continue
+        dim = _QUANTITIES[name].dimension
+        if unit is None:
+            hint = " (units go in square brackets)" if "(" in col.field else ""
+            example = accepted_units(dim)[0]
+            problems.append(Problem(
+                f"column has no unit{hint}; write it as '{name} [unit]', e.g. '{name} [{example}]'; "
+                f"accepted units: {', '.join(accepted_units(dim))}", line=1, column=col.field))
+            continue
+        try:
+            factors[name] = conversion_factor(unit, dim) * _QUANTITIES[name].scale
+        except UnitError as e:
+            problems.append(Problem(str(e), line=1, column=col.field))
+
+    def have(*names):
+        return [n for n in names if n in columns]
+
+    def mentioned(*names):
+        return [n for n in names if n in columns or n in misplaced_unit]
+
+    def fields_of(names):
+        return " and ".join(repr(columns[n].field) for n in names)
+
+    # the same quantity given twice
+    for group, what in (
+        (("radius", "diameter"), "the particle size"),
+        (("radius_uncertainty", "diameter_uncertainty"), "the particle size uncertainty"),
+        (("rebound_normal_speed", "e_n"), "the normal rebound"),
+        (("rebound_tangential_speed", "rebound_angle"), "the tangential rebound"),
+    ):
+        if len(have(*group)) > 1:
+            problems.append(Problem(f"columns {fields_of(group)} both give {what}; keep one", line=1))
+    incident = set(have("speed", "incidence_angle", "normal_speed"))
+    if incident == {"speed", "incidence_angle", "normal_speed"} or incident == {"speed", "normal_speed"}:
+        problems.append(Problem(
+            f"columns {fields_of(sorted(incident))} over-determine the incident velocity; give "
+            "'speed' + 'incidence_angle', or 'normal_speed' (optionally with 'incidence_angle')", line=1))
+    # missing required columns
+    speed_units = ", ".join(accepted_units("speed"))
+    if not mentioned("radius", "diameter"):
+        problems.append(Problem(
+            "no particle size column; add 'radius [unit]' or 'diameter [unit]' with a length unit "
+            f"({', '.join(accepted_units('length'))})", line=1))
+    if not incident and not mentioned("speed", "incidence_angle", "normal_speed"):
+        problems.append(Problem(
+            "no incident velocity columns; add 'speed [unit]' and 'incidence_angle [unit]', or "
+            f"'normal_speed [unit]' (speed units: {speed_units}; angle units: "
+            f"{', '.join(accepted_units('angle'))})", line=1))
+    elif incident == {"speed"}:
+        problems.append(Problem(
+            f"column {fields_of(['speed'])} needs 'incidence_angle [deg]' next to it, or replace it "
+            "by 'normal_speed [m/s]'", line=1))
+    elif incident == {"incidence_angle"}:
+        problems.append(Problem(
+            f"column {fields_of(['incidence_angle'])} needs 'speed [m/s]' or 'normal_speed [m/s]' "
+            "next to it", line=1))
+    if not mentioned("rebound_normal_speed", "e_n"):
+        problems.append(Problem(
+            f"no rebound column; add 'rebound_normal_speed [unit]' ({speed_units}) or 'e_n [1]'", line=1))
+    # uncertainty without its quantity
+    for name in columns:
+        if name.endswith("_uncertainty"):
+            base = name[: -len("_uncertainty")]
+            size_ok = base in ("radius", "diameter") and have("radius", "diameter")
+            if base not in columns and not size_ok:
+                problems.append(Problem(
+                    f"uncertainty column without a {base!r} column; add '{base} [unit]' or drop it",
+                    line=1, column=columns[name].field))
+    return columns, factors, problems, ignored
+
+
+def _required(columns: Mapping[str, _Column]) -> set[str]:
+    req = {n for n in ("radius", "diameter", "normal_speed", "rebound_normal_speed", "e_n") if n in columns}
+    if "speed" in columns:
+        req |= {"speed", "incidence_angle"} & set(columns)
+    return req
+
+
+# --------------------------------------------------------------------------- propagation
+def _unc(*terms):
+    """sqrt(sum of squares) of the terms; NaN if any is NaN (first-order propagation)."""
+    return np.sqrt(sum(np.square(t) for t in terms))
+
+
+def _derive(v: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
+    """Fill the derived columns of the internal table ``v`` (canonical names, NaN = not given)."""
+    nan = np.full(n, np.nan)
+    out = {k: v.get(k, nan) for k in COLUMN_UNITS if k not in ("row", "line")}
+    rad = math.pi / 180.0
+    # incident
+    a, sa = out["incidence_deg"] * rad, out["incidence_deg_uncertainty"] * rad
+    if "speed" in v:
+        sp, ssp = out["speed"], out["speed_uncertainty"]
+        out["normal_speed"] = sp * np.cos(a)
+        out["normal_speed_uncertainty"] = _unc(np.cos(a) * ssp, sp * np.sin(a) * sa)
+    elif "normal_speed" in v and "incidence_deg" in v:
+        vn, svn = out["normal_speed"], out["normal_speed_uncertainty"]
+        out["speed"] = vn / np.cos(a)
+        out["speed_uncertainty"] = _unc(svn / np.cos(a), vn * np.sin(a) / np.cos(a) ** 2 * sa)
+    vn, svn = out["normal_speed"], out["normal_speed_uncertainty"]
+    # normal rebound
+    if "rebound_normal_speed" in v:
+        r, sr = out["rebound_normal_speed"], out["rebound_normal_speed_uncertainty"]
+        out["e_n"] = r / vn
+        out["e_n_uncertainty"] = _unc(sr / vn, r * svn / vn**2)
+    else:
+        e, se = out["e_n"], out["e_n_uncertainty"]
+        out["rebound_normal_speed"] = e * vn
+        out["rebound_normal_speed_uncertainty"] = _unc(vn * se, e * svn)
+    r, sr = out["rebound_normal_speed"], out["rebound_normal_speed_uncertainty"]
+    # tangential rebound
+    if "rebound_tangential_speed" in v:
+        t, st = out["rebound_tangential_speed"], out["rebound_tangential_speed_uncertainty"]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out["rebound_angle_deg"] = np.degrees(np.arctan2(t, r))
+            out["rebound_angle_deg_uncertainty"] = np.degrees(_unc(r * st, t * sr) / (r**2 + t**2))
+    elif "rebound_angle_deg" in v:
+        b, sb = out["rebound_angle_deg"] * rad, out["rebound_angle_deg_uncertainty"] * rad
+        out["rebound_tangential_speed"] = r * np.tan(b)
+        out["rebound_tangential_speed_uncertainty"] = _unc(np.tan(b) * sr, r * sb / np.cos(b) ** 2)
+    return out
+
+
+# --------------------------------------------------------------------------- main entry
+def read_impacts(path, *, materials=None) -> pd.DataFrame:
+    """Read and validate a CSV of measured impacts; return it in canonical columns and units.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        CSV file in the format of data/README.md, "Measured-impact CSV format". Read only; the
+        file is never modified.
+    materials : mapping of str to MaterialPair, str or os.PathLike, optional
+        Materials config (as returned by :func:`microimpact.io.read_materials`, or its path).
+        When given, every non-empty ``material_pair`` cell must name one of its pairs. When None,
+        ``material_pair`` labels are not checked.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per impact with the columns :data:`CANONICAL_COLUMNS` (described in the module
+        docstring), SI units with angles in [deg]. ``attrs``: ``source``, ``sha256``, ``units``.
+
+    Raises
+    ------
+    ImpactDataError
+        If anything is wrong. The message lists every problem (up to
+        :data:`MAX_LISTED_PROBLEMS`; all are in ``.problems``), each with file name, data row, line
+        of the file, column as written, the bad value and what is accepted.
+    FileNotFoundError
+        If ``path`` does not exist.
+
+    Warns
+    -----
+    ImpactDataWarning
+        For columns that are not part of the format; they are ignored.
+    """
+    source = os.fspath(path)
+    name = Path(source).name
+    data = Path(source).read_bytes()
+    sha256 = hashlib.sha256(data).hexdigest()
+    if not data.strip(_BOM + b" \t\r\n"):
+        what = "empty (0 bytes)" if not data else "blank (only whitespace)"
+        raise ImpactDataError(source, [Problem(
+            f"the file is {what}; expected a header line such as "
+            "'radius [um],speed [m/s],incidence_angle [deg],e_n [1]' followed by one row per impact")])
+    text, problems = _decode(data)
+
+    reader = csv.reader(_stdio.StringIO(text, newline=""))
+    header: list[str] | None = None
+    header_line = 1
+    records: list[list[str]] = []
+    rows: list[int] = []
+    lines: list[int] = []
+    ragged: list[Problem] = []
+    prev = 0
+    try:
+        for rec in reader:
+            start, prev = prev + 1, reader.line_num
+            if not "".join(rec).strip():
+                continue  # blank line or a line of empty fields
+            if header is None:
+                header, header_line = rec, start
+                continue
+            rows.append(len(rows) + 1)
+            lines.append(start)
+            records.append(rec)
+    except csv.Error as e:  # e.g. NUL byte
+        problems.append(Problem(f"cannot be parsed as CSV: {e}", line=reader.line_num))
+        raise ImpactDataError(source, problems) from None
+    assert header is not None  # the file is not blank
+
+    if len(header) == 1:
+        for delim, label in ((";", "';' (semicolon)"), ("\t", "tabs")):
+            if delim in header[0]:
+                problems.append(Problem(
+                    f"the file uses {label} to separate columns; ',' (comma) is required, with '.' "
+                    "as the decimal point; re-export it as comma-separated CSV", line=header_line))
+                raise ImpactDataError(source, problems)
+
+    columns, factors, header_problems, ignored = _check_header(header)
+    if header_line != 1:
+        header_problems = [Problem(p.message, p.row, header_line, p.column, p.value) for p in header_problems]
+    problems += header_problems
+    if ignored:
+        hints = []
+        for f in ignored:
+            close = difflib.get_close_matches(parse_header_field(f)[0], _KNOWN, n=1)
+            hints.append(f"{f!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+        warnings.warn(
+            f"{name}: ignoring columns that are not part of the impact format: {', '.join(hints)}",
+            ImpactDataWarning, stacklevel=2)
+    if not records:
+        problems.append(Problem(
+            "the file has a header but no data rows; add one row per impact", line=header_line))
+        raise ImpactDataError(source, problems)
+
+    # rows with the wrong number of fields are reported and left out of the value checks
+    width = len(header)
+    keep = []
+    for i, rec in enumerate(records):
+        if len(rec) == width:
+            keep.append(i)
+            continue
+        hint = " (a decimal comma? use '.' as the decimal point)" if len(rec) > width else ""
+        ragged.append(Problem(
+            f"has {len(rec)} fields but the header has {width} columns{hint}",
+            row=rows[i], line=lines[i], value=",".join(rec)))
+    problems += ragged
+    if len(keep) != len(records):
+        records = [records[i] for i in keep]
+        rows = [rows[i] for i in keep]
+        lines = [lines[i] for i in keep]
+    n = len(records)
+    row_arr = np.asarray(rows, dtype=np.int64)
+    line_arr = np.asarray(lines, dtype=np.int64)
+    cells = {c.name: np.array([rec[c.index].strip() for rec in records], dtype=object) for c in columns.values()}
+
+    def cell_problems(mask, col: _Column, message: str):
+        for i in np.flatnonzero(mask):
+            problems.append(Problem(message, int(row_arr[i]), int(line_arr[i]), col.field, cells[col.name][i]))
+
+    required = _required(columns)
+    values: dict[str, np.ndarray] = {}
+    for cname, col in columns.items():
+        if cname in _LABELS:
+            continue
+        q = _QUANTITIES[cname]
+        raw = cells[cname]
+        num = pd.to_numeric(pd.Series(raw), errors="coerce").to_numpy(dtype=float)
+        missing = np.zeros(n, dtype=bool)
+        nan_idx = np.flatnonzero(np.isnan(num))
+        missing[nan_idx] = [raw[i].lower() in _MISSING for i in nan_idx]
+        unit = col.unit if cname in factors else INTERNAL_UNIT[q.dimension]
+        in_unit = " (unitless)" if q.dimension == "dimensionless" else f" in {unit}"
+        text_bad = np.isnan(num) & ~missing
+        cell_problems(text_bad, col, f"is not a number; expected a number{in_unit}")
+        if cname in required:
+            cell_problems(missing, col, f"empty or NaN cell in a required column; give a number{in_unit}")
+        inf = np.isinf(num)
+        cell_problems(inf, col, f"is not finite; expected a finite number{in_unit}")
+        if cname not in factors:
+            continue  # unit unknown: range checks would be meaningless
+        x = num * factors[cname]
+        with np.errstate(invalid="ignore"):
+            out_of_range = np.isfinite(x) & ~q.ok(x / q.scale)
+        what = "uncertainty must be" if cname.endswith("_uncertainty") else "must be"
+        if q.dimension == "angle" and unit not in ("deg", "degree", "degrees", "\u00b0"):
+            for i in np.flatnonzero(out_of_range):
+                problems.append(Problem(
+                    f"is {x[i]:.6g} deg; {what} {q.range_text()}",
+                    int(row_arr[i]), int(line_arr[i]), col.field, raw[i]))
+        else:
+            qualifier = " (speeds are magnitudes)" if q.dimension == "speed" and q.low == 0 else ""
+            cell_problems(out_of_range, col, f"{what} {q.range_text()}{qualifier}")
+        x = np.where(np.isfinite(x), x, np.nan)
+        values[q.canonical] = x
+
+    labels: dict[str, np.ndarray] = {}
+    for cname in _LABELS:
+        if cname in columns:
+            raw = cells[cname]
+            labels[cname] = np.where(raw == "", None, raw)
+    if "id" in labels:
+        ids = pd.Series(labels["id"])
+        dup = ids.notna() & ids.duplicated(keep="first")
+        for i in np.flatnonzero(dup.to_numpy()):
+            first = int(row_arr[np.flatnonzero((ids == ids.iloc[i]).to_numpy())[0]])
+            problems.append(Problem(
+                f"id is not unique (first on row {first}); give each impact its own id",
+                int(row_arr[i]), int(line_arr[i]), columns["id"].field, labels["id"][i]))
+    if materials is not None and "material_pair" in labels:
+        if not isinstance(materials, Mapping):
+            from .materials import read_materials
+
+            materials = read_materials(materials)
+        known = sorted(materials)
+        bad = np.array([m is not None and m not in materials for m in labels["material_pair"]], dtype=bool)
+        cell_problems(bad, columns["material_pair"],
+                      f"is not a pair in the materials config; known pairs: {', '.join(known)}")
+
+    if any(p.row is None for p in problems):
+        raise ImpactDataError(source, _sorted(problems))  # header broken: derived checks are moot
+
+    out = _derive(values, n)
+    # checks that need derived values
+    vn, r = out["normal_speed"], out["rebound_normal_speed"]
+    if "rebound_normal_speed" in values:
+        with np.errstate(invalid="ignore"):
+            too_fast = r > vn
+        col = columns["rebound_normal_speed"]
+        for i in np.flatnonzero(too_fast):
+            problems.append(Problem(
+                f"is larger than the incident normal speed ({vn[i]:.6g} m/s), so e_n = "
+                f"{r[i] / vn[i]:.4g} > 1; e_n must be in [0, 1]",
+                int(row_arr[i]), int(line_arr[i]), col.field, cells["rebound_normal_speed"][i]))
+    if problems:
+        raise ImpactDataError(source, _sorted(problems))
+
+    frame = {"row": row_arr, "line": line_arr}
+    for cname in _LABELS:
+        frame[cname] = pd.array(labels.get(cname, [None] * n), dtype="string")
+    frame |= {k: out[k] for k in CANONICAL_COLUMNS if k in out}
+    df = pd.DataFrame(frame, columns=list(CANONICAL_COLUMNS))
+    df.attrs["source"] = source
+    df.attrs["sha256"] = sha256
+    df.attrs["units"] = dict(COLUMN_UNITS)
+    return df
+
+
+def _sorted(problems: list[Problem]) -> list[Problem]:
+    """File/header problems first, then by row, keeping the order within a row."""
+    return sorted(problems, key=lambda p: (p.row is not None, p.row or 0, p.line or 0))

@@ -1,0 +1,274 @@
+"""Materials config: contact properties of named sphere/surface material pairs.
+
+The bundled config is ``toolkit/microimpact/io/materials.yaml`` (the single source of truth;
+``data/materials.yaml`` is a user-facing copy that the test suite keeps byte-identical). Its path is
+:func:`default_materials_path`. The format is documented in ``data/README.md``, section
+"Materials config", and enforced by :data:`MATERIALS_SCHEMA` (JSON Schema, unknown keys refused).
+
+A pair stores material properties, not per-particle ones: the adhesion line force f0 follows from
+the work of adhesion w_A for each particle radius through Eq. (7) of Cheng, Brach & Dunn (2002),
+f0 = (9/(2 pi) K r w_A^2)^(1/3), so :meth:`MaterialPair.contact` takes the radius.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from importlib.resources import files
+from pathlib import Path
+
+import jsonschema
+import yaml
+
+from ..params import Contact, adhesion_line_force_from_work, stiffness_from_elastic
+
+__all__ = ["MaterialPair", "MaterialsError", "read_materials", "default_materials_path", "MATERIALS_SCHEMA"]
+
+_ELASTIC = ("youngs_modulus_sphere", "poisson_sphere", "youngs_modulus_surface", "poisson_surface")
+
+
+def _num(description: str, **bounds) -> dict:
+    return {"type": "number", "description": description, **bounds}
+
+
+_PAIR_SCHEMA = {
+    "type": "object",
+    "additionalProperties": False,
+    "required": ["density", "work_of_adhesion"],
+    "properties": {
+        "description": {"type": "string", "description": "What the pair is."},
+        "reference": {"type": "string", "description": "Where the values come from."},
+        "density": _num("Sphere density. [kg/m^3]", exclusiveMinimum=0),
+        "stiffness": _num("Effective stiffness K = 4 / (3 pi (k1 + k2)), Eq. (3). [Pa]", exclusiveMinimum=0),
+        "youngs_modulus_sphere": _num("Young's modulus of the sphere E1. [Pa]", exclusiveMinimum=0),
+        "poisson_sphere": _num("Poisson ratio of the sphere nu1. [-]", exclusiveMinimum=-1, exclusiveMaximum=0.5),
+        "youngs_modulus_surface": _num("Young's modulus of the surface E2. [Pa]", exclusiveMinimum=0),
+        "poisson_surface": _num("Poisson ratio of the surface nu2. [-]", exclusiveMinimum=-1, exclusiveMaximum=0.5),
+        "work_of_adhesion": _num("Dupre work of adhesion w_A; f0 follows from Eq. (7). [J/m^2]", minimum=0),
+        "friction": _num("Coulomb friction coefficient f. [-]", minimum=0),
+        "zeta_hertz": _num("Starting value of zeta_H, Eq. (15). [-]", minimum=0),
+        "zeta_adhesion": _num("Starting value of zeta_A, Eq. (14). [-]", minimum=0),
+        "damping_reference_speed": _num("Fixed reference speed v_n of Eqs. (14)-(15). [m/s]", exclusiveMinimum=0),
+    },
+    # either stiffness alone, or all four elastic constants without stiffness
+    "oneOf": [
+        {"required": ["stiffness"], "not": {"anyOf": [{"required": [k]} for k in _ELASTIC]}},
+        {"required": list(_ELASTIC), "not": {"required": ["stiffness"]}},
+    ],
+}
+
+#: JSON Schema of a materials config file
+MATERIALS_SCHEMA: dict = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "title": "microimpact materials config",
+    "type": "object",
+    "additionalProperties": False,
+    "required": ["pairs"],
+    "properties": {
+        "pairs": {
+            "type": "object",
+            "minProperties": 1,
+            "propertyNames": {"pattern": r"^[A-Za-z][A-Za-z0-9_]*$"},
+            "additionalProperties": _PAIR_SCHEMA,
+        }
+    },
+}
+
+
+class MaterialsError(ValueError):
+    """A materials config that cannot be used; the message lists every problem with its key path."""
+
+    def __init__(self, source: str, problems: list[str]):
+        self.source = str(source)
+        self.problems = tuple(problems)
+        super().__init__("\n".join(self.problems))
+
+
+@dataclass(frozen=True)
+class MaterialPair:
+    """Contact properties of a sphere material on a surface material.
+
+    Parameters
+    ----------
+    name : str
+        Key of the pair in the config, as used in the ``material_pair`` column of impact files.
+    density : float
+        Sphere density. [kg/m^3]
+    stiffness : float
+        Effective stiffness K, Eq. (3); computed from the elastic constants when those are given. [Pa]
+    work_of_adhesion : float
+        Dupre work of adhesion w_A. [J/m^2]
+    friction : float
+        Coulomb friction coefficient f. [-]
+    zeta_hertz, zeta_adhesion : float
+        Starting values of the damping coefficients zeta_H, zeta_A, Eqs. (14)-(15). [-]
+    damping_reference_speed : float or None
+        Fixed reference speed of Eqs. (14)-(15); None uses each impact's normal speed. [m/s]
+    youngs_modulus_sphere, poisson_sphere, youngs_modulus_surface, poisson_surface : float or None
+        Elastic constants E1 [Pa], nu1 [-], E2 [Pa], nu2 [-], when the pair was given that way.
+    description, reference : str
+        Free text.
+    """
+
+    name: str
+    density: float
+    stiffness: float
+    work_of_adhesion: float
+    friction: float = 0.0
+    zeta_hertz: float = 0.0
+    zeta_adhesion: float = 0.0
+    damping_reference_speed: float | None = None
+    youngs_modulus_sphere: float | None = None
+    poisson_sphere: float | None = None
+    youngs_modulus_surface: float | None = None
+    poisson_surface: float | None = None
+    description: str = ""
+    reference: str = ""
+
+    def adhesion_line_force(self, radius: float) -> float:
+        """f0 for a sphere of this radius, Eq. (7). [N/m]
+
+        Parameters
+        ----------
+        radius : float
+            Sphere radius. [m]
+        """
+        return adhesion_line_force_from_work(self.stiffness, radius, self.work_of_adhesion)
+
+    def contact(self, radius: float) -> Contact:
+        """The :class:`~microimpact.Contact` of a sphere of this radius, f0 from Eq. (7).
+
+        Parameters
+        ----------
+        radius : float
+            Sphere radius. [m]
+
+        Returns
+        -------
+        Contact
+            Built with :meth:`Contact.from_elastic` when elastic constants are given, otherwise
+            with :meth:`Contact.from_work_of_adhesion`.
+        """
+        kwargs = dict(
+            friction=self.friction,
+            zeta_hertz=self.zeta_hertz,
+            zeta_adhesion=self.zeta_adhesion,
+            damping_reference_speed=self.damping_reference_speed,
+        )
+        if self.youngs_modulus_sphere is not None:
+            return Contact.from_elastic(
+                radius, self.density, self.youngs_modulus_sphere, self.poisson_sphere,
+                self.youngs_modulus_surface, self.poisson_surface,
+                work_of_adhesion=self.work_of_adhesion, **kwargs,
+            )
+        return Contact.from_work_of_adhesion(radius, self.density, self.stiffness, self.work_of_adhesion, **kwargs)
+
+
+def default_materials_path() -> Path:
+    """Path of the materials config bundled with the package (``microimpact/io/materials.yaml``)."""
+    return Path(str(files("microimpact.io") / "materials.yaml"))
+
+
+# --------------------------------------------------------------------------- YAML loading
+class _Loader(yaml.SafeLoader):
+    """SafeLoader that reads YAML 1.2 floats (``1.776e9``) and refuses duplicate keys."""
+
+
+_Loader.add_implicit_resolver(  # YAML 1.1 needs '1.776e+9'; accept '1.776e9' and '380e9' too
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*\.[0-9_]*|\.[0-9_]+|[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)?$"
+               r"|^[-+]?\.(?:inf|Inf|INF)$|^\.(?:nan|NaN|NAN)$"),
+    list("-+0123456789."),
+)
+
+
+def _construct_mapping(loader, node, deep=False):
+    seen: dict = {}
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"duplicate key {key!r} (first on line {seen[key] + 1})", key_node.start_mark)
+        seen[key] = key_node.start_mark.line
+    return loader.construct_mapping(node, deep)
+
+
+_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+
+
+def _format_error(name: str, err: jsonschema.ValidationError) -> list[str]:
+    path = ".".join(str(p) for p in err.absolute_path)
+    where = f"{name}: {path}" if path else name
+    v, inst = err.validator, err.instance
+    if v == "exclusiveMinimum":
+        return [f"{where}: {inst!r} is not > {err.validator_value}"]
+    if v == "minimum":
+        return [f"{where}: {inst!r} is not >= {err.validator_value}"]
+    if v == "exclusiveMaximum":
+        return [f"{where}: {inst!r} is not < {err.validator_value}"]
+    if v == "type":
+        return [f"{where}: {inst!r} is not a {err.validator_value} (units are given in the docs, not in the value)"]
+    if v == "additionalProperties":
+        allowed = sorted(err.schema.get("properties", {}))
+        extra = sorted(set(inst) - set(allowed))
+        return [f"{where}: unknown key {k!r}; allowed keys: {', '.join(allowed)}" for k in extra]
+    if v == "required":
+        return [f"{where}: {err.message.replace('property', 'key')}"]
+    if v == "oneOf":
+        given = [k for k in ("stiffness", *_ELASTIC) if k in inst]
+        return [f"{where}: give either 'stiffness' or all four of {', '.join(_ELASTIC)}, not both "
+                f"(given: {', '.join(given) or 'none'})"]
+    if v == "pattern" or err.validator == "propertyNames":
+        return [f"{where}: pair name {inst!r} must start with a letter and contain only letters, digits and '_'"]
+    return [f"{where}: {err.message}"]
+
+
+def read_materials(path) -> dict[str, MaterialPair]:
+    """Read and validate a materials config.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        YAML file with a top-level ``pairs`` mapping (see data/README.md, "Materials config").
+
+    Returns
+    -------
+    dict of str to MaterialPair
+        The pairs by name, in file order.
+
+    Raises
+    ------
+    MaterialsError
+        If the file is not valid YAML or does not match :data:`MATERIALS_SCHEMA`; the message lists
+        every problem as ``<file>: <key path>: <what is wrong>``, e.g.
+        ``materials.yaml: pairs.alumina.density: -3 is not > 0``.
+    """
+    source = os.fspath(path)
+    name = Path(source).name
+    try:
+        doc = yaml.load(Path(source).read_text(encoding="utf-8"), Loader=_Loader)
+    except UnicodeDecodeError as e:
+        raise MaterialsError(source, [f"{name}: byte offset {e.start}: not valid UTF-8"]) from None
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f"{name}: line {mark.line + 1}, column {mark.column + 1}" if mark else name
+        raise MaterialsError(source, [f"{where}: not valid YAML: {getattr(e, 'problem', None) or e}"]) from None
+    if doc is None:
+        raise MaterialsError(source, [f"{name}: the file is empty; expected a top-level 'pairs:' mapping"])
+    validator = jsonschema.Draft202012Validator(MATERIALS_SCHEMA)
+    errors = sorted(validator.iter_errors(doc), key=lambda e: [str(p) for p in e.absolute_path])
+    if errors:
+        problems = [msg for err in errors for msg in _format_error(name, err)]
+        raise MaterialsError(source, problems)
+    pairs: dict[str, MaterialPair] = {}
+    for key, entry in doc["pairs"].items():
+        entry = {k: (float(v) if isinstance(v, (int, float)) else v) for k, v in entry.items()}
+        stiffness = entry.pop("stiffness", None)
+        if stiffness is None:
+            stiffness = stiffness_from_elastic(
+                entry["youngs_modulus_sphere"], entry["poisson_sphere"],
+                entry["youngs_modulus_surface"], entry["poisson_surface"],
+            )
+        pairs[key] = MaterialPair(name=key, stiffness=stiffness, **entry)
+    return pairs

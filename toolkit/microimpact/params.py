@@ -1,0 +1,240 @@
+"""Contact parameters of a microsphere on a flat surface and the constants derived from them.
+
+Implements Eqs. (3)-(7), (14)-(15) and (29)-(32) of Cheng, Brach & Dunn (2002),
+"Three-Dimensional Modeling of Microsphere Contact/Impact with Smooth, Flat Surfaces",
+Aerosol Science and Technology 36(11):1081-1093, doi:10.1080/02786820290092221.
+
+All quantities are SI. Departures from the printed paper:
+
+* Eq. (30) is printed as T = m / (sqrt(r) K X^(1/2)), which has units of s^2. The time scale that
+  makes Eq. (28) dimensionless, and C1, C2 of Eqs. (31)-(32) dimensionless, is its square root:
+  T = sqrt(m / (sqrt(r) K X^(1/2))) = sqrt(m / sqrt(2 pi r f0 K)).
+* Eqs. (14)-(15): the bracket (r^3 K sqrt(v_n) / m)^(2/5) has units of a speed, so C_H and C_A are
+  in s/m. The reference speed v_n is, by default, each impact's own incident normal speed (the
+  paper's "typically the initial normal velocity"); a fixed reference speed can be set instead.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields, replace
+
+__all__ = ["Contact", "rolling_spin"]
+
+
+def _check_positive(name: str, value: float) -> None:
+    if not math.isfinite(value) or value <= 0.0:
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+
+
+def _check_non_negative(name: str, value: float) -> None:
+    if not math.isfinite(value) or value < 0.0:
+        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+
+
+def _check_poisson(name: str, value: float) -> None:
+    if not math.isfinite(value) or not -1.0 < value < 0.5:
+        raise ValueError(f"{name} must lie in (-1, 0.5), got {value!r}")
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Parameters of a homogeneous elastic microsphere in contact with a flat surface.
+
+    Parameters
+    ----------
+    radius : float
+        Sphere radius r. [m]
+    density : float
+        Sphere density. [kg/m^3]
+    stiffness : float
+        Effective material stiffness K = 4 / (3 pi (k1 + k2)), Eq. (3); equals (4/3) E*. [Pa]
+    adhesion_line_force : float
+        Intensity f0 of the adhesion ring force, Eq. (5). [N/m]
+    zeta_hertz : float
+        Nondimensional Hertzian damping coefficient zeta_H, Eq. (15). [-]
+    zeta_adhesion : float
+        Nondimensional adhesion damping coefficient zeta_A, Eq. (14). [-]
+    friction : float
+        Coulomb friction coefficient f. [-]
+    damping_reference_speed : float or None
+        Reference speed v_n of Eqs. (14)-(15). None (the paper's default) uses each impact's own
+        incident normal speed; a float fixes it for every impact. [m/s]
+
+    Raises
+    ------
+    ValueError
+        If a value is not finite, radius, density or stiffness is not positive, or f0, a zeta or
+        the friction coefficient is negative. The message names the field and the value.
+    """
+
+    radius: float
+    density: float
+    stiffness: float
+    adhesion_line_force: float
+    zeta_hertz: float = 0.0
+    zeta_adhesion: float = 0.0
+    friction: float = 0.0
+    damping_reference_speed: float | None = None
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name == "damping_reference_speed" and value is None:
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                try:
+                    value = float(value)
+                except (TypeError, ValueError):
+                    raise ValueError(f"{f.name} must be a number, got {value!r}") from None
+            object.__setattr__(self, f.name, float(value))
+        for name in ("radius", "density", "stiffness"):
+            _check_positive(name, getattr(self, name))
+        for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction"):
+            _check_non_negative(name, getattr(self, name))
+        if self.damping_reference_speed is not None:
+            _check_positive("damping_reference_speed", self.damping_reference_speed)
+
+    # ----------------------------------------------------------------- constructors
+    @classmethod
+    def from_elastic(
+        cls,
+        radius: float,
+        density: float,
+        youngs_modulus_sphere: float,
+        poisson_sphere: float,
+        youngs_modulus_surface: float,
+        poisson_surface: float,
+        adhesion_line_force: float | None = None,
+        *,
+        work_of_adhesion: float | None = None,
+        **kwargs,
+    ) -> "Contact":
+        """Build a contact from Young's moduli and Poisson ratios, Eqs. (3)-(4).
+
+        Parameters
+        ----------
+        youngs_modulus_sphere, youngs_modulus_surface : float
+            Young's moduli E1, E2. [Pa]
+        poisson_sphere, poisson_surface : float
+            Poisson ratios nu1, nu2, each in (-1, 0.5). [-]
+        adhesion_line_force : float, optional
+            f0. [N/m] Give this or ``work_of_adhesion``; neither means no adhesion.
+        work_of_adhesion : float, optional
+            Dupre work of adhesion w_A; f0 then follows from Eq. (7). [J/m^2]
+        **kwargs
+            Other :class:`Contact` fields (zetas, friction, damping_reference_speed).
+        """
+        _check_positive("youngs_modulus_sphere", youngs_modulus_sphere)
+        _check_positive("youngs_modulus_surface", youngs_modulus_surface)
+        _check_poisson("poisson_sphere", poisson_sphere)
+        _check_poisson("poisson_surface", poisson_surface)
+        stiffness = stiffness_from_elastic(
+            youngs_modulus_sphere, poisson_sphere, youngs_modulus_surface, poisson_surface
+        )
+        if adhesion_line_force is not None and work_of_adhesion is not None:
+            raise ValueError("give adhesion_line_force or work_of_adhesion, not both")
+        if work_of_adhesion is not None:
+            return cls.from_work_of_adhesion(radius, density, stiffness, work_of_adhesion, **kwargs)
+        return cls(radius, density, stiffness, adhesion_line_force or 0.0, **kwargs)
+
+    @classmethod
+    def from_work_of_adhesion(
+        cls, radius: float, density: float, stiffness: float, work_of_adhesion: float, **kwargs
+    ) -> "Contact":
+        """Build a contact whose f0 follows from the work of adhesion w_A, Eq. (7).
+
+        Parameters
+        ----------
+        work_of_adhesion : float
+            Dupre work of adhesion w_A = gamma_1 + gamma_2 - gamma_12. [J/m^2]
+        """
+        _check_positive("radius", radius)
+        _check_positive("stiffness", stiffness)
+        _check_non_negative("work_of_adhesion", work_of_adhesion)
+        f0 = adhesion_line_force_from_work(stiffness, radius, work_of_adhesion)
+        return cls(radius, density, stiffness, f0, **kwargs)
+
+    def with_(self, **changes) -> "Contact":
+        """A copy with some fields changed (validated again)."""
+        return replace(self, **changes)
+
+    # ----------------------------------------------------------------- derived
+    @property
+    def mass(self) -> float:
+        """Sphere mass m = (4/3) pi r^3 rho. [kg]"""
+        return 4.0 / 3.0 * math.pi * self.radius**3 * self.density
+
+    @property
+    def moment_of_inertia(self) -> float:
+        """Centroidal moment of inertia of a homogeneous sphere, I = (2/5) m r^2. [kg m^2]"""
+        return 0.4 * self.mass * self.radius**2
+
+    @property
+    def work_of_adhesion(self) -> float:
+        """Work of adhesion w_A that gives this f0 through Eq. (7). [J/m^2]"""
+        return math.sqrt(2.0 * math.pi * self.adhesion_line_force**3 / (9.0 * self.stiffness * self.radius))
+
+    @property
+    def length_scale(self) -> float:
+        """X = 2 pi f0 / K, Eq. (29): the static equilibrium penetration. [m]"""
+        return 2.0 * math.pi * self.adhesion_line_force / self.stiffness
+
+    @property
+    def time_scale(self) -> float:
+        """T = sqrt(m / sqrt(2 pi r f0 K)), Eq. (30) corrected (printed as T^2). [s]"""
+        return math.sqrt(self.mass / math.sqrt(2.0 * math.pi * self.radius * self.adhesion_line_force * self.stiffness))
+
+    @property
+    def damping_speed_scale(self) -> float:
+        """Speed scale (r^3 K / m)^(2/5) of Eqs. (14)-(15) without the sqrt(v_n) factor. [(m/s)^(4/5)]"""
+        return (self.radius**3 * self.stiffness / self.mass) ** 0.4
+
+    def reference_speed(self, normal_speed: float) -> float:
+        """The damping reference speed v_n used for an impact with this incident normal speed. [m/s]"""
+        return normal_speed if self.damping_reference_speed is None else self.damping_reference_speed
+
+    def damping_coefficients(self, normal_speed: float) -> tuple[float, float]:
+        """Dimensional damping coefficients (C_H, C_A), Eqs. (14)-(15). [s/m]
+
+        Parameters
+        ----------
+        normal_speed : float
+            Incident normal speed of the impact; used as v_n unless a fixed
+            ``damping_reference_speed`` is set. [m/s]
+        """
+        v = self.reference_speed(normal_speed)
+        _check_positive("damping reference speed", v)
+        scale = self.damping_speed_scale * v**0.2  # (r^3 K sqrt(v) / m)^(2/5)
+        return self.zeta_hertz / scale, self.zeta_adhesion / scale
+
+    def nondimensional_damping(self, normal_speed: float) -> tuple[float, float]:
+        """(C1, C2) = (C_H, C_A) X / T, Eqs. (31)-(32). [-]"""
+        c_h, c_a = self.damping_coefficients(normal_speed)
+        u = self.length_scale / self.time_scale
+        return c_h * u, c_a * u
+
+    @property
+    def rolling_spin_per_speed(self) -> float:
+        """Spin per unit centre speed for rolling without slip, 1/r. [rad/m]"""
+        return 1.0 / self.radius
+
+
+def stiffness_from_elastic(e1: float, nu1: float, e2: float, nu2: float) -> float:
+    """Effective stiffness K = 4 / (3 pi (k1 + k2)), k_i = (1 - nu_i^2) / (pi E_i), Eqs. (3)-(4). [Pa]"""
+    k1 = (1.0 - nu1**2) / (math.pi * e1)
+    k2 = (1.0 - nu2**2) / (math.pi * e2)
+    return 4.0 / (3.0 * math.pi * (k1 + k2))
+
+
+def adhesion_line_force_from_work(stiffness: float, radius: float, work_of_adhesion: float) -> float:
+    """Adhesion line force f0 = (9/(2 pi) K r w_A^2)^(1/3), Eq. (7). [N/m]
+
+    Eq. (7) equates the Brach-Dunn equilibrium contact radius with the JKR zero-load radius.
+    """
+    return (9.0 / (2.0 * math.pi) * stiffness * radius * work_of_adhesion**2) ** (1.0 / 3.0)
+
+
+def rolling_spin(speed: float, radius: float) -> float:
+    """Spin of a sphere rolling without slip at centre speed ``speed``: speed / radius. [rad/s]"""
+    return speed / radius

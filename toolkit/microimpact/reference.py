@@ -1,0 +1,684 @@
+"""Reference solver: the full 3-D contact equations integrated with :func:`scipy.integrate.solve_ivp`.
+
+This module integrates every degree of freedom of the model of Cheng, Brach & Dunn (2002),
+Aerosol Sci. Technol. 36:1081-1093, doi:10.1080/02786820290092221 -- the normal motion, Eq. (27),
+the two tangential translations, Eqs. (16)-(17), and the three spins, Eqs. (18)-(20) -- with event
+location for separation, capture, the end of sliding and the end of twisting. It makes no use of
+the decoupling of the normal motion from the rest, so it can be used to verify the fast engine and
+as the accurate end of a work-precision benchmark. It is slow (pure-Python right-hand side): a few
+milliseconds to a few tenths of a second per impact.
+
+Equations (nondimensional, see *Scales* below; primes are d/dtau)
+------------------------------------------------------------------
+State ``(xi, y, v_t, v_t', w_n, w_t, w_t', D, J)``; xi = x / L the penetration (x = -n), y = xi',
+v the centre velocity in units of V = L / T_c, w = r omega / V the spins as rim speeds, D the
+dissipated energy in units of m V^2 and J = int |F_n| dtau the friction impulse in units of m V.
+With s = sqrt(max(xi, 0)) (the clip makes the force vanish outside contact):
+
+* normal, Eq. (27):       xi'' = -a_H s^3 (1 + c_1 y) + a_A s (1 - c_2 y) =: -F_n
+* slip of the contact point (coefficients.slip_velocity): u_t = v_t + w_t', u_t' = v_t' - w_t
+* friction, Eqs. (16)-(17): v' = F = -f |F_n| u / |u| while sliding, also while F_n < 0
+  ("pulling" friction); F = 0 once sliding has ended (rolling, no rolling resistance)
+* Eqs. (19)-(20) as printed: w_t'' = k F_t, w_t' = -k F_t', with k = m r^2 / I (5/2 for a
+  homogeneous sphere), so that u' = (1 + k) F
+* twist, Eq. (18) in a derived form (see :func:`microimpact.forces.twist_friction_torque`):
+  w_n' = -k (3 pi / 16) f sqrt(L / r) s |F_n| sign(w_n) until w_n reaches 0, then w_n = 0
+* dissipation: D' = (a_H c_1 s^3 + a_A c_2 s) y^2 + f |F_n| |u| + (3 pi / 16) f sqrt(L / r) s |F_n| |w_n|
+* J' = |F_n|
+
+The nondimensional contact energy E = y^2 / 2 + (2/5) a_H xi^(5/2) - (2/3) a_A xi^(3/2) obeys
+E' = -(a_H c_1 s^3 + a_A c_2 s) y^2 <= 0, so E < 0 is an exact capture test.
+
+Scales
+------
+* Adhesive contact (f0 > 0): the paper's scales, Eqs. (29)-(32) with T corrected (see
+  :mod:`microimpact.params`): L = X = 2 pi f0 / K, T_c = T, so a_H = a_A = 1 and (c_1, c_2) =
+  (C1, C2) = ``contact.nondimensional_damping(v_n)``; Eq. (28) exactly.
+* No adhesion (f0 = 0): X = 0 and T is infinite, so the Hertz impact scales are used instead:
+  L = x* = (5 m v_n^2 / (4 K sqrt(r)))^(2/5) (the undamped maximum penetration) and T_c = x* / v_n,
+  giving a_H = 5/4, a_A = 0, c_1 = C_H v_n, c_2 = C_A v_n, y(0) = 1. (Departure: the paper only
+  gives the adhesive scaling.)
+
+Events and switching
+--------------------
+* separation: xi = 0 with xi decreasing (terminal; outcome "rebound").
+* capture: E = 0 with E decreasing (terminal). If nothing tangential is left (f = 0, or no slip and
+  no twist left) the run stops there ("capture"); otherwise the captured oscillation is integrated
+  until sliding and twisting have both ended ("slip and twist ended") or the motion has settled
+  ("settled", see :func:`_tail_constants`).
+* end of sliding: the slip direction is constant (u' is parallel to u, the inertia being isotropic
+  in the tangent plane), so the signed projection p = u . e0 of the slip on its initial direction
+  e0 = u0 / |u0| falls through zero *transversally* (p' = -(1 + k) f |F_n| < 0 whenever F_n != 0)
+  at the instant sliding stops. That root is well conditioned, unlike the tangential zero of |u|
+  or the ill-conditioned crossing of |u|^2 - eps (slope ~ sqrt(eps)). To keep the right-hand side
+  smooth across the root inside the step that locates it, the friction direction is written
+  sign(p) u / |u|: identical to u / |u| while sliding (p > 0), and the smooth continuation of the
+  pre-root motion past it. After the event the integration restarts from the event state with
+  F = 0; sliding never restarts.
+* end of twisting: w_n = 0, handled in the same way with sign(w_n(0)) in place of sign(w_n); after
+  the event w_n is set to exactly 0.
+* turning points y = 0 (non-terminal) give the maximum penetration.
+
+Everything at the interface is SI; everything inside is nondimensional.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .coefficients import ImpactResult, impact_coefficients, incident_velocity
+from .params import Contact
+
+__all__ = [
+    "ReferenceSolverError",
+    "simulate_reference",
+    "reference_trajectory",
+    "ReferenceTrajectory",
+]
+
+#: Longest nondimensional time allowed before an outcome (rebound or capture). A rebound lasts
+#: O(1)-O(10) time units in either scaling; 1e4 is generous.
+_MAX_TAU_CONTACT = 1.0e4
+
+#: Phase-space radius below which the linearised settle bound is trusted (|xi - 1|, |y| < 0.05).
+_LINEAR_RADIUS = 0.05
+
+#: Safety factor on the linearised tail bound, covering the O(radius) nonlinear corrections of
+#: force and damping within the radius above (at most ~10 %) with a wide margin.
+_TAIL_SAFETY = 2.0
+
+_THREE_PI_16 = 3.0 * math.pi / 16.0
+
+# State indices.
+_S, _Y, _VT, _VTP, _WN, _WT, _WTP, _D, _J, _TAU = range(10)
+
+
+class ReferenceSolverError(RuntimeError):
+    """The reference integration failed or ran out of time without an outcome."""
+
+
+# --------------------------------------------------------------------------- validation
+def _as_real(name: str, value) -> float:
+    if isinstance(value, bool):
+        raise ValueError(f"{name} must be a real number, got {value!r}")
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number, got {value!r}") from None
+    if not math.isfinite(out):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return out
+
+
+def _validate_speed(name: str, speed) -> float:
+    v = _as_real(name, speed)
+    if v <= 0.0:
+        raise ValueError(f"{name} must be > 0, got {speed!r}")
+    return v
+
+
+def _validate_common(rtol, atol, settle_tolerance):
+    rtol = _as_real("rtol", rtol)
+    atol = _as_real("atol", atol)
+    if rtol <= 0.0:
+        raise ValueError(f"rtol must be > 0, got {rtol!r}")
+    if atol <= 0.0:
+        raise ValueError(f"atol must be > 0, got {atol!r}")
+    if settle_tolerance is None:
+        settle_tolerance = rtol
+    settle_tolerance = _as_real("settle_tolerance", settle_tolerance)
+    if settle_tolerance <= 0.0:
+        raise ValueError(f"settle_tolerance must be > 0, got {settle_tolerance!r}")
+    return rtol, atol, settle_tolerance
+
+
+# --------------------------------------------------------------------------- scales
+@dataclass(frozen=True)
+class _Scales:
+    """Nondimensionalisation of one impact (see the module docstring)."""
+
+    length: float  # L [m]
+    time: float  # T_c [s]
+    a_h: float  # Hertz coefficient [-]
+    a_a: float  # adhesion coefficient [-]
+    c1: float  # Hertz damping, C_H L / T_c [-]
+    c2: float  # adhesion damping, C_A L / T_c [-]
+    k_rot: float  # m r^2 / I [-]
+    twist: float  # (3 pi / 16) sqrt(L / r) [-], times f gives the twist torque factor
+    mass: float  # [kg]
+    radius: float  # [m]
+
+    @property
+    def speed(self) -> float:
+        """Velocity scale V = L / T_c. [m/s]"""
+        return self.length / self.time
+
+    @property
+    def adhesive(self) -> bool:
+        return self.a_a > 0.0
+
+
+def _scales(contact: Contact, normal_speed: float) -> _Scales:
+    """Scales for an impact with incident normal speed ``normal_speed`` [m/s]."""
+    m, r, k = contact.mass, contact.radius, contact.stiffness
+    c_h, c_a = contact.damping_coefficients(normal_speed)  # [s/m]
+    if contact.adhesion_line_force > 0.0:
+        length, time = contact.length_scale, contact.time_scale
+        a_h = a_a = 1.0
+    else:
+        length = (5.0 * m * normal_speed**2 / (4.0 * k * math.sqrt(r))) ** 0.4
+        time = length / normal_speed
+        a_h, a_a = 1.25, 0.0
+    v = length / time
+    return _Scales(
+        length=length,
+        time=time,
+        a_h=a_h,
+        a_a=a_a,
+        c1=c_h * v,
+        c2=c_a * v,
+        k_rot=m * r * r / contact.moment_of_inertia,
+        twist=_THREE_PI_16 * math.sqrt(length / r),
+        mass=m,
+        radius=r,
+    )
+
+
+def _energy(sc: _Scales, s: float, y: float) -> float:
+    """Nondimensional normal contact energy E = y^2/2 + (2/5) a_H s^5 - (2/3) a_A s^3, s = sqrt(xi)."""
+    s2 = s * s
+    return 0.5 * y * y + 0.4 * sc.a_h * s2 * s2 * s - (2.0 / 3.0) * sc.a_a * s2 * s
+
+
+def _tail_constants(c: float) -> tuple[float, float, float]:
+    """Constants (b, sqrt(kappa), sigma) of the linearised settle bound about (xi, y) = (1, 0).
+
+    Near the adhesive equilibrium the motion is z' = J z with z = (x, y), x = xi - 1,
+    J = [[0, 1], [-1, -c]] (Eq. 35), c = C1 + C2, and -F_n = y' = -x - c y. Take the quadratic
+    form W = x^2 + b x y + y^2 (positive definite for |b| < 2). Then
+
+        -W' = z^T P z,  P = [[b, b c / 2], [b c / 2, 2 c - b]],
+
+    and W' <= -2 sigma W with 2 sigma = lambda_min(Q^-1 P), Q = [[1, b/2], [b/2, 1]]. Also
+    |F_n| = |x + c y| <= sqrt(kappa W) with kappa = a^T Q^-1 a, a = (1, c). Hence the friction
+    impulse still to come obeys
+
+        int_tau^inf |F_n| dtau <= sqrt(kappa W(tau)) / sigma.
+
+    For c < 2 the choice b = c gives W' = -c W exactly (2 sigma = c, the decay of the envelope
+    A e^(-c tau / 2) of the damped oscillation) and kappa = 1 / (1 - c^2/4) = 1 / omega_f^2. For
+    c >= 2 (over-damped, incident speeds below the critical speed of Eq. 38) b = 4c / (4 + c^2),
+    half the largest b that keeps P positive definite; sigma then is of the order of the slow
+    eigenvalue 1/c.
+    """
+    # b = c up to 1.9 (beyond, Q -> singular and kappa -> inf near critical damping).
+    b = min(c, 1.9) if c < 2.0 else 4.0 * c / (4.0 + c * c)
+    q = np.array([[1.0, 0.5 * b], [0.5 * b, 1.0]])
+    p = np.array([[b, 0.5 * b * c], [0.5 * b * c, 2.0 * c - b]])
+    lam = np.linalg.eigvals(np.linalg.solve(q, p)).real.min()
+    sigma = 0.5 * float(lam)
+    a = np.array([1.0, c])
+    kappa = float(a @ np.linalg.solve(q, a))
+    if not sigma > 0.0:  # pragma: no cover - cannot happen for c > 0
+        raise ReferenceSolverError(f"no decay rate for the settle bound at C = {c!r}")
+    return b, math.sqrt(kappa), sigma
+
+
+# --------------------------------------------------------------------------- right-hand side
+def _make_rhs(sc: _Scales, f: float, e0: tuple[float, float], sliding: bool, twist_sign: float):
+    """Right-hand side d/dsigma for one mode (Sundman form; see :func:`simulate_reference`).
+
+    ``twist_sign`` is sign(w_n(0)) while twisting, else 0. The state is
+    (s, y, v_t, v_t', w_n, w_t, w_t', D, J, tau) with s = sqrt(xi) and dtau/dsigma = s.
+    """
+    a_h, a_a, c1, c2, k = sc.a_h, sc.a_a, sc.c1, sc.c2, sc.k_rot
+    tw = f * sc.twist
+    e0t, e0p = e0
+    sqrt = math.sqrt
+
+    def rhs(_sigma, z):
+        s, y = z[0], z[1]
+        acc = -a_h * s * s * s * (1.0 + c1 * y) + a_a * s * (1.0 + c2 * y)  # xi'' = -F_n
+        abs_fn = abs(acc)
+        d_rate = (a_h * c1 * s * s * s + a_a * c2 * s) * y * y
+        ft = fp = 0.0
+        if sliding:
+            ut = z[2] + z[6]
+            up = z[3] - z[5]
+            nu = sqrt(ut * ut + up * up)
+            if nu > 0.0:
+                g = -f * abs_fn / nu
+                if ut * e0t + up * e0p < 0.0:  # smooth continuation past the slip-end root
+                    g = -g
+                ft, fp = g * ut, g * up
+            else:
+                ft, fp = -f * abs_fn * e0t, -f * abs_fn * e0p
+            d_rate -= ft * ut + fp * up  # friction power -F . u
+        dwn = 0.0
+        if twist_sign != 0.0:
+            torque = tw * s * abs_fn * twist_sign  # >= 0 on the physical side
+            dwn = -k * torque
+            d_rate += torque * z[4]
+        # d/dsigma = s d/dtau, except ds/dsigma = y / 2.
+        return [0.5 * y, s * acc, s * ft, s * fp, s * dwn, -k * s * fp, k * s * ft, s * d_rate, s * abs_fn, s]
+
+    return rhs
+
+
+def _event(fun, terminal: bool, direction: float):
+    fun.terminal = terminal
+    fun.direction = direction
+    return fun
+
+
+# --------------------------------------------------------------------------- public API
+def simulate_reference(
+    contact: Contact,
+    speed: float,
+    incidence_deg: float = 0.0,
+    azimuth_deg: float = 0.0,
+    omega: Sequence[float] = (0.0, 0.0, 0.0),
+    *,
+    rtol: float = 1e-10,
+    atol: float = 1e-13,
+    method: str = "DOP853",
+    max_step: float = math.inf,
+    settle_tolerance: float | None = None,
+) -> ImpactResult:
+    """Integrate one impact with the full 3-D equations (reference solution).
+
+    Parameters
+    ----------
+    contact : Contact
+        Contact parameters. The damping coefficients use the incident normal speed as the
+        reference speed of Eqs. (14)-(15) unless ``contact.damping_reference_speed`` is set.
+    speed : float
+        Magnitude of the incident velocity, > 0. [m/s]
+    incidence_deg : float
+        Incidence angle alpha from the surface normal, in [0, 90). [deg]
+    azimuth_deg : float
+        Azimuth theta of the tangential velocity, from t towards t'. [deg]
+    omega : sequence of 3 floats
+        Incident spin (omega_n, omega_t, omega_t'). [rad/s]
+    rtol, atol : float
+        Tolerances passed to :func:`scipy.integrate.solve_ivp`; they apply to the
+        nondimensional state (all components O(1) for an adhesive impact). [-]
+    method : str
+        A :func:`scipy.integrate.solve_ivp` method; explicit ones ("DOP853", "RK45") are
+        appropriate (the problem is not stiff).
+    max_step : float
+        Largest step in nondimensional time. [-]
+    settle_tolerance : float, optional
+        After capture with sliding or twisting still going on: stop when the friction impulse
+        still to come is bounded by ``settle_tolerance`` times the impulse so far. Default
+        ``rtol``. [-]
+
+    Returns
+    -------
+    ImpactResult
+        All fields in SI units; ``method`` is ``"reference:<method>"``. ``stop_reason`` is
+        "separation" (rebound), "capture" (captured, nothing tangential left to integrate),
+        "slip and twist ended" or "settled" (captured, tail integrated). For a captured sphere the
+        reported normal velocity is 0, ``contact_time`` is inf and ``final_contact_energy`` is the
+        normal contact energy (kinetic plus V) at the end of the integration.
+
+    Raises
+    ------
+    ValueError
+        For a non-finite or non-positive speed, an incidence outside [0, 90), a non-finite
+        azimuth or spin, or bad tolerances; the message names the argument and the value.
+    ReferenceSolverError
+        If solve_ivp fails or no outcome is reached within a generous time.
+
+    Notes
+    -----
+    Departures from the printed paper: Eq. (30) corrected (T, not T^2); Eq. (18) replaced by the
+    derived twist torque (3 pi / 16) f a |F_n|; with f0 = 0 the Hertz scales replace X, T. The
+    paper used a fixed-step Runge-Kutta-Gill method; this uses adaptive solve_ivp with events.
+    """
+    speed = _validate_speed("speed", speed)
+    incidence = _as_real("incidence_deg", incidence_deg)
+    if not 0.0 <= incidence < 90.0:
+        raise ValueError(f"incidence_deg must lie in [0, 90), got {incidence_deg!r}")
+    azimuth = _as_real("azimuth_deg", azimuth_deg)
+    try:
+        omega_list = list(omega)
+    except TypeError:
+        raise ValueError(f"omega must be a sequence of 3 spins, got {omega!r}") from None
+    if len(omega_list) != 3:
+        raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_t'), got {omega!r}")
+    omega_in = tuple(_as_real(f"omega[{i}]", w) for i, w in enumerate(omega_list))
+    rtol, atol, settle_tol = _validate_common(rtol, atol, settle_tolerance)
+    max_step = float(max_step)
+    if not max_step > 0.0:
+        raise ValueError(f"max_step must be > 0, got {max_step!r}")
+
+    vel_in = incident_velocity(speed, incidence, azimuth)
+    vn_speed = -vel_in[0]
+    sc = _scales(contact, vn_speed)
+    V, r, m = sc.speed, sc.radius, sc.mass
+    f = contact.friction
+
+    z0 = np.array(
+        [
+            0.0,
+            vn_speed / V,
+            vel_in[1] / V,
+            vel_in[2] / V,
+            r * omega_in[0] / V,
+            r * omega_in[1] / V,
+            r * omega_in[2] / V,
+            0.0,
+            0.0,
+            0.0,
+        ]
+    )
+    u0 = (z0[_VT] + z0[_WTP], z0[_VTP] - z0[_WT])
+    u0_norm = math.hypot(*u0)
+    sliding = f > 0.0 and u0_norm > 0.0
+    e0 = (u0[0] / u0_norm, u0[1] / u0_norm) if u0_norm > 0.0 else (1.0, 0.0)
+    twisting = f > 0.0 and z0[_WN] != 0.0
+    twist_sign = math.copysign(1.0, z0[_WN]) if twisting else 0.0
+
+    # ---- events (all on the nondimensional state)
+    def ev_separation(_t, z):
+        return z[_S]
+
+    def ev_capture(_t, z):
+        return _energy(sc, z[_S], z[_Y])
+
+    def ev_turn(_t, z):
+        return z[_Y]
+
+    def ev_slip(_t, z):
+        return (z[_VT] + z[_WTP]) * e0[0] + (z[_VTP] - z[_WT]) * e0[1]
+
+    def ev_twist(_t, z):
+        return z[_WN] * twist_sign
+
+    settle = None
+    if sc.adhesive:
+        c_tot = sc.c1 + sc.c2
+        if c_tot > 0.0:
+            b_w, sqrt_kappa, sigma = _tail_constants(c_tot)
+
+            def ev_settle(_t, z):
+                x = z[_S] * z[_S] - 1.0
+                y = z[_Y]
+                w = x * x + b_w * x * y + y * y
+                tail = _TAIL_SAFETY * sqrt_kappa * math.sqrt(max(w, 0.0)) / sigma
+                return max(tail - settle_tol * z[_J], math.hypot(x, y) - _LINEAR_RADIUS)
+
+            settle = ev_settle
+            tail_time = 10.0 * (math.log(1.0 / settle_tol) + 10.0) / sigma
+
+    turn_xi: list[float] = []
+    sigma0 = 0.0
+    z = z0
+    captured = False
+    tau_capture = math.nan
+    tau_slip = math.nan
+    slip_ended = False
+    sigma_limit = _MAX_TAU_CONTACT
+    stop_reason = None
+    n_phases = 0
+
+    while stop_reason is None:
+        n_phases += 1
+        if n_phases > 10:  # pragma: no cover - at most 4 switches can happen
+            raise ReferenceSolverError("too many mode switches")
+        names = ["separation", "turn"]
+        events = [_event(ev_separation, True, -1.0), _event(ev_turn, False, -1.0)]
+        if not captured and sc.adhesive:
+            names.append("capture")
+            events.append(_event(ev_capture, True, -1.0))
+        if sliding:
+            names.append("slip")
+            events.append(_event(ev_slip, True, -1.0))
+        if twisting:
+            names.append("twist")
+            events.append(_event(ev_twist, True, -1.0))
+        if captured and settle is not None:
+            names.append("settle")
+            events.append(_event(settle, True, -1.0))
+
+        rhs = _make_rhs(sc, f, e0, sliding, twist_sign if twisting else 0.0)
+        sol = solve_ivp(
+            rhs,
+            (sigma0, sigma_limit),
+            z,
+            method=method,
+            rtol=rtol,
+            atol=atol,
+            max_step=max_step,
+            events=events,
+        )
+        if sol.status == -1:
+            raise ReferenceSolverError(
+                f"solve_ivp ({method}) failed at tau = {sol.y[_TAU, -1]:.6g} "
+                f"(t = {sol.y[_TAU, -1] * sc.time:.6g} s): {sol.message}"
+            )
+        turn_xi.extend(float(v[_S]) ** 2 for v in sol.y_events[1])
+        if sol.status == 0:
+            what = "captured tail did not settle" if captured else "no separation and no capture"
+            raise ReferenceSolverError(
+                f"{what} by nondimensional time {sol.y[_TAU, -1]:.6g} "
+                f"({sol.y[_TAU, -1] * sc.time:.6g} s); state {sol.y[:, -1]!r}"
+            )
+        # Which terminal event stopped the run: the one whose last event time is the end time.
+        sigma_end = sol.t[-1]
+        fired = None
+        for name, t_ev, y_ev, ev in zip(names, sol.t_events, sol.y_events, events):
+            if ev.terminal and len(t_ev) and t_ev[-1] == sigma_end:
+                fired = name
+                z = np.array(y_ev[-1], dtype=float)
+                break
+        if fired is None:  # pragma: no cover - solve_ivp guarantees a terminal event here
+            raise ReferenceSolverError(f"solve_ivp stopped without a recognised event: {sol.message}")
+        sigma0 = sigma_end
+        tau_end = z[_TAU]
+
+        if fired == "separation":
+            if captured:
+                raise ReferenceSolverError(
+                    "separation after capture (E < 0): numerical error exceeds the energy margin; "
+                    "tighten rtol/atol"
+                )
+            stop_reason = "separation"
+        elif fired == "capture":
+            captured = True
+            tau_capture = tau_end
+            if not (sliding or twisting) or settle is None:
+                stop_reason = "capture"
+            else:
+                # s = sqrt(xi) -> 1 in the tail, so sigma and tau advance alike there.
+                sigma_limit = sigma_end + tail_time + _MAX_TAU_CONTACT
+        elif fired == "slip":
+            sliding = False
+            slip_ended = True
+            tau_slip = tau_end
+        elif fired == "twist":
+            twisting = False
+            z[_WN] = 0.0
+        elif fired == "settle":
+            stop_reason = "settled"
+        if stop_reason is None and captured and not (sliding or twisting):
+            stop_reason = "slip and twist ended"
+
+    # ---- results in SI units
+    T = sc.time
+    vt, vtp = z[_VT] * V, z[_VTP] * V
+    omega_out = (z[_WN] * V / r, z[_WT] * V / r, z[_WTP] * V / r)
+    if captured:
+        vel_out = (0.0, vt, vtp)
+        contact_time = math.inf
+        capture_time = tau_capture * T
+        final_contact = _energy(sc, z[_S], z[_Y]) * m * V * V
+    else:
+        vel_out = (-z[_Y] * V, vt, vtp)
+        contact_time = z[_TAU] * T
+        capture_time = math.nan
+        final_contact = 0.0
+    coeffs = impact_coefficients(m, contact.moment_of_inertia, vel_in, omega_in, vel_out, omega_out, captured)
+    max_xi = max(turn_xi) if turn_xi else float(z[_S]) ** 2
+    return ImpactResult(
+        outcome="capture" if captured else "rebound",
+        e_n=float(coeffs["e_n"]),
+        mu_t=float(coeffs["mu_t"]),
+        mu_tp=float(coeffs["mu_tp"]),
+        K_L=float(coeffs["K_L"]),
+        K_t=float(coeffs["K_t"]),
+        velocity_in=tuple(float(v) for v in vel_in),
+        omega_in=omega_in,
+        velocity_out=tuple(float(v) for v in vel_out),
+        omega_out=tuple(float(w) for w in omega_out),
+        contact_time=float(contact_time),
+        capture_time=float(capture_time),
+        max_penetration=float(max_xi * sc.length),
+        slip_ended=slip_ended,
+        slip_end_time=float(tau_slip * T),
+        friction_impulse=float(z[_J] * m * V),
+        dissipated_energy=float(z[_D] * m * V * V),
+        final_contact_energy=float(final_contact),
+        method=f"reference:{method}",
+        stop_reason=stop_reason,
+    )
+
+
+@dataclass(frozen=True)
+class ReferenceTrajectory:
+    """Normal motion of one impact at the solver's steps (SI units).
+
+    Attributes
+    ----------
+    time : ndarray
+        Time since first contact. [s]
+    penetration : ndarray
+        x = -n. [m]
+    penetration_rate : ndarray
+        x' = -n'. [m/s]
+    energy : ndarray
+        Normal contact energy E = m x'^2 / 2 + V(x). [J]
+    dissipated_energy : ndarray
+        Energy dissipated by normal damping so far (integrated independently of E). [J]
+    outcome : str
+        "rebound", "capture" or "in contact" (duration reached before either).
+    capture_time : float
+        Time at which E first fell below 0; NaN if it did not. [s]
+    """
+
+    time: np.ndarray
+    penetration: np.ndarray
+    penetration_rate: np.ndarray
+    energy: np.ndarray
+    dissipated_energy: np.ndarray
+    outcome: str
+    capture_time: float
+
+    def to_xarray(self):
+        """The trajectory as an :class:`xarray.Dataset` with a ``time`` coordinate."""
+        import xarray as xr
+
+        units = {"penetration": "m", "penetration_rate": "m/s", "energy": "J", "dissipated_energy": "J"}
+        ds = xr.Dataset(
+            {k: ("time", getattr(self, k), {"units": u}) for k, u in units.items()},
+            coords={"time": ("time", self.time, {"units": "s"})},
+            attrs={"outcome": self.outcome, "capture_time_s": self.capture_time},
+        )
+        return ds
+
+
+def reference_trajectory(
+    contact: Contact,
+    normal_speed: float,
+    *,
+    duration: float | None = None,
+    rtol: float = 1e-10,
+    atol: float = 1e-13,
+    method: str = "DOP853",
+    max_step: float = math.inf,
+) -> ReferenceTrajectory:
+    """Normal motion, Eq. (27), of an impact at the solver's steps.
+
+    The normal motion does not depend on the tangential state, so only (xi, y, D) are integrated.
+
+    Parameters
+    ----------
+    contact : Contact
+    normal_speed : float
+        Incident normal speed, > 0. [m/s]
+    duration : float, optional
+        None: stop at separation or at capture. A float: stop at separation or after this much
+        time, whichever comes first (so the captured oscillation can be followed). [s]
+    rtol, atol, method, max_step
+        As for :func:`simulate_reference`.
+
+    Returns
+    -------
+    ReferenceTrajectory
+    """
+    normal_speed = _validate_speed("normal_speed", normal_speed)
+    rtol, atol, _ = _validate_common(rtol, atol, None)
+    sc = _scales(contact, normal_speed)
+    tau_end = math.inf if duration is None else _validate_speed("duration", duration) / sc.time
+    rhs10 = _make_rhs(sc, 0.0, (1.0, 0.0), False, 0.0)
+
+    # State (s, y, D, tau), independent variable sigma (dtau/dsigma = s), as in simulate_reference.
+    def rhs(t, z):
+        out = rhs10(t, z)
+        return [out[_S], out[_Y], out[_D], out[_TAU]]
+
+    def ev_sep(_t, z):
+        return z[0]
+
+    def ev_cap(_t, z):
+        return _energy(sc, z[0], z[1])
+
+    def ev_end(_t, z):
+        return z[3] - tau_end
+
+    events = [_event(ev_sep, True, -1.0), _event(ev_cap, duration is None, -1.0), _event(ev_end, True, 1.0)]
+    if not sc.adhesive:
+        events[1] = _event(lambda _t, z: 1.0, False, 0.0)  # no capture without adhesion
+    sigma_limit = _MAX_TAU_CONTACT if duration is None else 2.0 * tau_end + _MAX_TAU_CONTACT
+    sol = solve_ivp(
+        rhs,
+        (0.0, sigma_limit),
+        [0.0, normal_speed / sc.speed, 0.0, 0.0],
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        max_step=max_step,
+        events=events,
+    )
+    if sol.status == -1:
+        raise ReferenceSolverError(f"solve_ivp ({method}) failed: {sol.message}")
+    captured = sc.adhesive and len(sol.t_events[1]) > 0
+    if len(sol.t_events[0]):
+        outcome = "rebound"
+    elif captured and (duration is None or len(sol.t_events[2])):
+        outcome = "capture"
+    elif duration is not None and len(sol.t_events[2]):
+        outcome = "in contact"
+    else:
+        raise ReferenceSolverError(
+            f"no separation and no capture by nondimensional time {sol.y[3, -1]:.6g}: {sol.message}"
+        )
+    # Include the terminal event state (solve_ivp already appends it as the last point).
+    V, m = sc.speed, sc.mass
+    s_, y, d, tau = sol.y
+    energy = np.array([_energy(sc, a, b) for a, b in zip(s_, y)]) * m * V * V
+    return ReferenceTrajectory(
+        time=tau * sc.time,
+        penetration=s_ * s_ * sc.length,
+        penetration_rate=y * V,
+        energy=energy,
+        dissipated_energy=d * m * V * V,
+        outcome=outcome,
+        capture_time=float(sol.y_events[1][0][3] * sc.time) if captured else math.nan,
+    )
