@@ -171,8 +171,41 @@ def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, er
 
 
 @njit(cache=True)
+def _linear_tail_variation(dx, y, omega0, c):
+    """Total variation of y from now to rest for dx'' = -omega0^2 dx - c dx' (dx' = y)."""
+    yp = -omega0 * omega0 * dx - c * y
+    a = 0.5 * c
+    if a < omega0 * (1.0 - 1e-9):
+        wd = math.sqrt(omega0 * omega0 - a * a)
+        b = (yp + a * y) / wd
+        # y' = e^{-a tau} (P cos + Q sin), extrema of y every pi/wd from the first, theta1
+        pc = yp
+        qs = -a * b - wd * y
+        th = math.atan2(qs, pc) + 0.5 * math.pi
+        while th < 0.0:
+            th += math.pi
+        while th >= math.pi:
+            th -= math.pi
+        y1 = math.exp(-a * th / wd) * (y * math.cos(th) + b * math.sin(th))
+        q = math.exp(-a * math.pi / wd)  # ratio of successive |extrema|
+        return abs(y1 - y) + abs(y1) * (1.0 + q) / (1.0 - q)
+    disc = math.sqrt(max(a * a - omega0 * omega0, 0.0)) + 1e-9 * omega0
+    l1 = -a + disc
+    l2 = -a - disc
+    ca = (yp - l2 * y) / (l1 - l2)
+    cb = y - ca
+    if ca != 0.0:
+        ratio = -cb * l2 / (ca * l1)
+        if ratio > 1.0:  # one extremum ahead, then monotone to rest
+            t1 = math.log(ratio) / (l1 - l2)
+            y1 = ca * math.exp(l1 * t1) + cb * math.exp(l2 * t1)
+            return abs(y1 - y) + abs(y1)
+    return abs(y)
+
+
+@njit(cache=True)
 def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, settle_amp,
-               max_steps, rec, rec_cap):
+               max_steps, rec, rec_cap, j_stop, ja_stop):
     """Integrate one normal impact.
 
     Returns (status, outcome, y_end, tau_end, D, J, Ja, smax, tau_capture, tau_jtarget, E_end,
@@ -207,14 +240,11 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
     # equilibrium data for the tail bound of a captured sphere
     xe = aa / ah if ah > 0.0 else 0.0
     omega0 = 1.0
-    q = 0.0
+    ceq = 0.0
     if aa > 0.0:
         se = math.sqrt(xe)
-        omega0 = math.sqrt(ah * se)
-        ceq = ah * c1 * xe * se + aa * c2 * se
-        zeta = ceq / (2.0 * omega0)
-        if zeta < 1.0:
-            q = math.exp(-math.pi * zeta / math.sqrt(1.0 - zeta * zeta))
+        omega0 = math.sqrt(ah * se)  # sqrt(V''(xi_e))
+        ceq = ah * c1 * xe * se + aa * c2 * se  # damping coefficient at the equilibrium
 
     h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
     if y0 < 1.0:
@@ -335,10 +365,17 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             amp = max(amp - noise, 0.0)
             if follow:
                 done = amp <= settle_amp
+            elif need_tail and J >= j_stop and u[4] >= ja_stop:
+                done = True  # sliding and twist have ended: the rest of the tail changes nothing
             elif need_tail:
-                # friction impulse still to come: the total variation of y over the decaying
-                # oscillation, about 2 |y|_max per half period, a geometric series of ratio q
-                done = 2.0 * omega0 * amp * (1.0 + 1.0 / (1.0 - q)) <= tail_tol * J
+                # the friction impulse still to come is the total variation of y over the
+                # decaying motion; in the linear regime it has a closed form, whose relative error
+                # is of the order of the amplitude over the equilibrium penetration
+                tail = _linear_tail_variation(u[0] * u[0] - xe, u[1], omega0, ceq)
+                done = (amp / xe) * tail <= tail_tol * J or amp == 0.0
+                if done:
+                    J += tail
+                    u[4] += math.sqrt(xe) * tail
             else:
                 # stop at the first turning point, the largest penetration (the energy only
                 # falls afterwards), or once settled for an overdamped approach that never turns
@@ -358,11 +395,11 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
 
 
 @njit(cache=True, parallel=True)
-def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, out):
+def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_stop, ja_stop, out):
     dummy = np.zeros((1, 3))
     for i in prange(y0.shape[0]):
         r = _integrate(y0[i], c1[i], c2[i], ah, aa, rtol, need_tail[i], tail_tol, 0.0, False, 0.0,
-                       max_steps, dummy, 0)
+                       max_steps, dummy, 0, j_stop[i], ja_stop[i])
         out[i, 0] = r[0]
         out[i, 1] = r[1]
         out[i, 2] = r[2]
@@ -465,6 +502,8 @@ def solve_normal(
     friction_impulse_target: float | None = None,
     settle_amplitude: float = 1e-4,
     max_steps: int = _MAX_STEPS_DEFAULT,
+    friction_impulse_stop: float = math.inf,
+    twist_impulse_stop: float = math.inf,
 ) -> NormalSolution:
     """Solve the normal contact, Eq. (27), of one impact.
 
@@ -488,6 +527,9 @@ def solve_normal(
         Record the time at which J reaches this value (end of sliding). [N s]
     settle_amplitude : float
         See ``follow_capture``. [-]
+    friction_impulse_stop, twist_impulse_stop : float
+        With ``need_tail``, a captured sphere stops as soon as J and J_a have both reached these
+        (sliding and twist are over, so the rest of the tail cannot change the outcome). [N s], [N m s]
     max_steps : int
         Step limit; EngineError beyond it.
 
@@ -510,7 +552,8 @@ def solve_normal(
         r = _integrate(y0, c_h * u, c_a * u, sc.a_hertz, sc.a_adhesion, rtol, need_tail,
                        rtol if tail_tolerance is None else tail_tolerance, jt, follow_capture,
                        settle_amplitude * (sc.a_adhesion / sc.a_hertz if sc.a_adhesion > 0 else 1.0),
-                       max_steps, rec, cap)
+                       max_steps, rec, cap, friction_impulse_stop / j_unit,
+                       twist_impulse_stop / (j_unit * math.sqrt(contact.radius * sc.length)))
         if cap == 0 or r[13] < cap:
             break
         cap *= 4
@@ -546,7 +589,8 @@ def solve_normal(
 
 
 def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = 1e-10,
-                      tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT) -> dict:
+                      tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT,
+                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> dict:
     """Solve many normal impacts in parallel (both cores); arrays in, dict of SI arrays out.
 
     Parameters
@@ -556,6 +600,9 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = 1e
         Distinct incident normal speeds, > 0. [m/s]
     need_tail : array_like of bool, optional
         Per speed, whether a captured sphere must be followed for its friction impulse.
+    friction_impulse_stop, twist_impulse_stop : array_like, optional
+        Per speed, the impulses beyond which the tail is not needed (see :func:`solve_normal`).
+        [N s], [N m s]
 
     Returns
     -------
@@ -584,15 +631,17 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = 1e
     c1 = contact.zeta_hertz / scale * u
     c2 = contact.zeta_adhesion / scale * u
     y0 = v / u
+    ju = contact.mass * u
+    jstop = np.broadcast_to(np.asarray(friction_impulse_stop, dtype=float), v.shape) / ju
+    jastop = np.broadcast_to(np.asarray(twist_impulse_stop, dtype=float), v.shape) / (ju * np.sqrt(contact.radius * length))
     out = np.empty((v.size, 11))
     _integrate_many(y0, c1, c2, ah, aa, float(rtol), nt, float(rtol if tail_tolerance is None else tail_tolerance),
-                    int(max_steps), out)
+                    int(max_steps), np.ascontiguousarray(jstop), np.ascontiguousarray(jastop), out)
     status = out[:, 0]
     if np.any(status != _OK):
         i = int(np.flatnonzero(status != _OK)[0])
         raise EngineError(f"engine failed for normal speed {v[i]!r} m/s (status {int(status[i])})")
     captured = out[:, 1] == CAPTURE
-    ju = contact.mass * u
     eu = contact.mass * u * u
     return {
         "captured": captured,

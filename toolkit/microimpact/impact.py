@@ -13,7 +13,7 @@ import xarray as xr
 
 from . import engine
 from .coefficients import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
-from .tangential import sliding_friction_impulse, tangential_outcome
+from .tangential import sliding_friction_impulse, tangential_outcome, twist_stop_impulse
 
 __all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES"]
 
@@ -43,9 +43,9 @@ def _check_inputs(speed, incidence_deg, azimuth_deg, omega):
     speed = np.asarray(speed, dtype=float)
     inc = np.asarray(incidence_deg, dtype=float)
     if not np.all(np.isfinite(speed)) or np.any(speed <= 0.0):
-        raise ValueError(f"speed must be finite and > 0 m/s, got {speed[~(np.isfinite(speed) & (speed > 0))].ravel()[0]!r}")
+        raise ValueError(f"speed must be finite and > 0 m/s, got {float(speed[~(np.isfinite(speed) & (speed > 0))].ravel()[0])!r}")
     if not np.all(np.isfinite(inc)) or np.any((inc < 0.0) | (inc >= 90.0)):
-        raise ValueError(f"incidence_deg must lie in [0, 90) deg, got {inc[~(np.isfinite(inc) & (inc >= 0) & (inc < 90))].ravel()[0]!r}")
+        raise ValueError(f"incidence_deg must lie in [0, 90) deg, got {float(inc[~(np.isfinite(inc) & (inc >= 0) & (inc < 90))].ravel()[0])!r}")
     if not np.all(np.isfinite(np.asarray(azimuth_deg, dtype=float))):
         raise ValueError(f"azimuth_deg must be finite, got {azimuth_deg!r}")
     for name, w in zip(("omega_n", "omega_t", "omega_tp"), omega):
@@ -96,6 +96,7 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
     sol = engine.solve_normal(
         contact, -v_in[0], rtol=rtol, need_tail=needs_tangential,
         friction_impulse_target=j_star if needs_tangential and 0.0 < j_star < math.inf else None,
+        friction_impulse_stop=j_star, twist_impulse_stop=float(twist_stop_impulse(inertia, f, w_in[0])),
     )
     tan = tangential_outcome(m, inertia, r, f, v_in, w_in, sol.friction_impulse, sol.twist_impulse)
     captured = sol.outcome == "capture"
@@ -201,7 +202,14 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
 
     speeds, inverse = np.unique(-v_n, return_inverse=True)
     need_tail = np.bincount(inverse, weights=needs_tangential, minlength=speeds.size) > 0
-    sol = engine.solve_normal_many(contact, speeds, need_tail, rtol=rtol)
+    # a captured sphere is followed until every impact sharing its normal speed has stopped
+    # sliding and twisting
+    j_stop = np.zeros(speeds.size)
+    ja_stop = np.zeros(speeds.size)
+    np.maximum.at(j_stop, inverse, np.where(needs_tangential, sliding_friction_impulse(m, f, np.hypot(u_t, u_tp)), 0.0))
+    np.maximum.at(ja_stop, inverse, np.where(needs_tangential, twist_stop_impulse(inertia, f, w[0]), 0.0))
+    sol = engine.solve_normal_many(contact, speeds, need_tail, rtol=rtol,
+                                   friction_impulse_stop=j_stop, twist_impulse_stop=ja_stop)
     g = {k: val[inverse] for k, val in sol.items()}
     captured = g["captured"]
 

@@ -85,6 +85,9 @@ __all__ = [
 #: O(1)-O(10) time units in either scaling; 1e4 is generous.
 _MAX_TAU_CONTACT = 1.0e4
 
+#: Restarts allowed (F_n changes sign twice per cycle of a captured oscillation).
+_MAX_PHASES = 200_000
+
 #: Phase-space radius below which the linearised settle bound is trusted (|xi - 1|, |y| < 0.05).
 _LINEAR_RADIUS = 0.05
 
@@ -230,10 +233,11 @@ def _tail_constants(c: float) -> tuple[float, float, float]:
 
 
 # --------------------------------------------------------------------------- right-hand side
-def _make_rhs(sc: _Scales, f: float, e0: tuple[float, float], sliding: bool, twist_sign: float):
+def _make_rhs(sc: _Scales, f: float, e0: tuple[float, float], sliding: bool, twist_sign: float, fn_sign: float):
     """Right-hand side d/dsigma for one mode (Sundman form; see :func:`simulate_reference`).
 
-    ``twist_sign`` is sign(w_n(0)) while twisting, else 0. The state is
+    ``twist_sign`` is sign(w_n(0)) while twisting, else 0; ``fn_sign`` is the sign of xi'' = -F_n
+    in this phase, so that |F_n| = fn_sign * xi'' is smooth within the phase. The state is
     (s, y, v_t, v_t', w_n, w_t, w_t', D, J, tau) with s = sqrt(xi) and dtau/dsigma = s.
     """
     a_h, a_a, c1, c2, k = sc.a_h, sc.a_a, sc.c1, sc.c2, sc.k_rot
@@ -243,12 +247,12 @@ def _make_rhs(sc: _Scales, f: float, e0: tuple[float, float], sliding: bool, twi
 
     def rhs(_sigma, z):
         s, y = z[0], z[1]
-        acc = -a_h * s * s * s * (1.0 + c1 * y) + a_a * s * (1.0 + c2 * y)  # xi'' = -F_n
-        abs_fn = abs(acc)
+        acc = -a_h * s * s * s * (1.0 + c1 * y) + a_a * s * (1.0 - c2 * y)  # xi'' = -F_n
+        abs_fn = fn_sign * acc  # |F_n| on the physical side, smooth across the phase's end
         d_rate = (a_h * c1 * s * s * s + a_a * c2 * s) * y * y
         ft = fp = 0.0
         if sliding:
-            ut = z[2] + z[6]
+            ut = z[2] - z[6]
             up = z[3] - z[5]
             nu = sqrt(ut * ut + up * up)
             if nu > 0.0:
@@ -401,6 +405,16 @@ def simulate_reference(
     def ev_twist(_t, z):
         return z[_WN] * twist_sign
 
+    def ev_force(_t, z):
+        # xi'' / s: changes sign with F_n, without the trivial root s = 0 at first contact.
+        s, y = z[_S], z[_Y]
+        return sc.a_a * (1.0 - sc.c2 * y) - sc.a_h * s * s * (1.0 + sc.c1 * y)
+
+    # Sign of xi'' = -F_n just after first contact: xi''/s -> a_A (1 - c2 y0) as s -> 0; without
+    # adhesion (or if that vanishes) the Hertz term -a_H s^2 (1 + c1 y0) < 0 decides.
+    g0 = sc.a_a * (1.0 - sc.c2 * z0[_Y])
+    fn_sign = 1.0 if g0 > 0.0 else -1.0
+
     settle = None
     if sc.adhesive:
         c_tot = sc.c1 + sc.c2
@@ -430,8 +444,8 @@ def simulate_reference(
 
     while stop_reason is None:
         n_phases += 1
-        if n_phases > 10:  # pragma: no cover - at most 4 switches can happen
-            raise ReferenceSolverError("too many mode switches")
+        if n_phases > _MAX_PHASES:
+            raise ReferenceSolverError(f"more than {_MAX_PHASES} restarts without an outcome")
         names = ["separation", "turn"]
         events = [_event(ev_separation, True, -1.0), _event(ev_turn, False, -1.0)]
         if not captured and sc.adhesive:
@@ -446,8 +460,10 @@ def simulate_reference(
         if captured and settle is not None:
             names.append("settle")
             events.append(_event(settle, True, -1.0))
+        names.append("force")
+        events.append(_event(ev_force, True, -fn_sign))
 
-        rhs = _make_rhs(sc, f, e0, sliding, twist_sign if twisting else 0.0)
+        rhs = _make_rhs(sc, f, e0, sliding, twist_sign if twisting else 0.0, fn_sign)
         sol = solve_ivp(
             rhs,
             (sigma0, sigma_limit),
@@ -507,6 +523,8 @@ def simulate_reference(
             z[_WN] = 0.0
         elif fired == "settle":
             stop_reason = "settled"
+        elif fired == "force":
+            fn_sign = -fn_sign
         if stop_reason is None and captured and not (sliding or twisting):
             stop_reason = "slip and twist ended"
 
@@ -626,7 +644,7 @@ def reference_trajectory(
     rtol, atol, _ = _validate_common(rtol, atol, None)
     sc = _scales(contact, normal_speed)
     tau_end = math.inf if duration is None else _validate_speed("duration", duration) / sc.time
-    rhs10 = _make_rhs(sc, 0.0, (1.0, 0.0), False, 0.0)
+    rhs10 = _make_rhs(sc, 0.0, (1.0, 0.0), False, 0.0, 1.0)
 
     # State (s, y, D, tau), independent variable sigma (dtau/dsigma = s), as in simulate_reference.
     def rhs(t, z):

@@ -17,7 +17,7 @@ import numpy as np
 
 from .coefficients import slip_velocity
 
-__all__ = ["sliding_friction_impulse", "tangential_outcome"]
+__all__ = ["sliding_friction_impulse", "twist_stop_impulse", "tangential_outcome"]
 
 TWIST_TORQUE_FACTOR = 3.0 * np.pi / 16.0  # torque = factor * f * a * |F_n|
 
@@ -31,6 +31,18 @@ def sliding_friction_impulse(mass, friction, slip_speed):
     with np.errstate(divide="ignore", invalid="ignore"):
         j = np.where(slip_speed > 0.0, 2.0 * mass * slip_speed / (7.0 * friction), 0.0)
     return np.where((friction == 0.0) & (slip_speed > 0.0), np.inf, j)
+
+
+def twist_stop_impulse(moment_of_inertia, friction, omega_n):
+    """Twist impulse J_a* = |omega_n| I / ((3 pi/16) f) after which the spin about n has stopped. [N m s]
+
+    Returns 0 where there is no twist and inf where there is twist but no friction.
+    """
+    friction, omega_n = np.broadcast_arrays(np.asarray(friction, dtype=float), np.asarray(omega_n, dtype=float))
+    w0 = np.abs(omega_n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        j = np.where(w0 > 0.0, w0 * moment_of_inertia / (TWIST_TORQUE_FACTOR * friction), 0.0)
+    return np.where((friction == 0.0) & (w0 > 0.0), np.inf, j)
 
 
 def tangential_outcome(mass, moment_of_inertia, radius, friction, velocity_in, omega_in, friction_impulse, twist_impulse):
@@ -81,9 +93,7 @@ def tangential_outcome(mass, moment_of_inertia, radius, friction, velocity_in, o
     # twist: |omega_n| falls by k J_a until it reaches zero
     k = TWIST_TORQUE_FACTOR * f / moment_of_inertia
     w0 = np.abs(w_n)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ja_star = np.where(k > 0.0, w0 / k, np.inf)
-    ja_s = np.minimum(ja, ja_star)
+    ja_s = np.minimum(ja, twist_stop_impulse(moment_of_inertia, f, w_n))
     out_w_n = np.sign(w_n) * np.maximum(w0 - k * ja_s, 0.0)
     twist_loss = moment_of_inertia * (w0**2 - out_w_n**2) / 2.0
     slip_ended = (slip == 0.0) | (jn >= j_star)

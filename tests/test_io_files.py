@@ -1,0 +1,158 @@
+"""Tests of atomic output: microimpact.io.atomic_write, atomic_path, write_csv, write_netcdf."""
+
+from __future__ import annotations
+
+import os
+import stat
+import subprocess
+import sys
+import textwrap
+
+import netCDF4
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+
+from microimpact.io import atomic_path, atomic_write, write_csv, write_netcdf
+
+
+def leftovers(directory):
+    return sorted(p.name for p in directory.iterdir() if p.name.endswith(".tmp"))
+
+
+def test_atomic_write_text_and_binary(tmp_path):
+    target = tmp_path / "out.txt"
+    with atomic_write(target) as f:
+        f.write("héllo\n")
+        assert not target.exists()  # nothing visible until the block succeeds
+    assert target.read_text(encoding="utf-8") == "héllo\n"
+    with atomic_write(target, "wb") as f:
+        f.write(b"\x00\x01")
+    assert target.read_bytes() == b"\x00\x01"
+    assert leftovers(tmp_path) == []
+
+
+def test_exception_leaves_old_file_and_no_temp(tmp_path):
+    target = tmp_path / "out.txt"
+    target.write_text("old")
+    with pytest.raises(RuntimeError):
+        with atomic_write(target) as f:
+            f.write("half of the new")
+            raise RuntimeError("interrupted")
+    assert target.read_text() == "old"
+    assert leftovers(tmp_path) == []
+
+
+def test_exception_on_new_file_creates_nothing(tmp_path):
+    with pytest.raises(KeyboardInterrupt):
+        with atomic_write(tmp_path / "new.txt") as f:
+            f.write("x")
+            raise KeyboardInterrupt
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_killed_process_leaves_old_file_intact(tmp_path):
+    """A process killed mid-write (os._exit, no cleanup) cannot leave a half-written target."""
+    target = tmp_path / "out.txt"
+    target.write_text("old complete content")
+    script = textwrap.dedent(f"""
+        import os
+        from microimpact.io import atomic_write
+        with atomic_write({str(target)!r}) as f:
+            f.write("partial")
+            f.flush()
+            os._exit(3)
+    """)
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True)
+    assert proc.returncode == 3, proc.stderr.decode()
+    assert target.read_text() == "old complete content"
+
+
+def test_permissions_follow_umask_or_existing_file(tmp_path):
+    new = tmp_path / "new.txt"
+    with atomic_write(new) as f:
+        f.write("x")
+    umask = os.umask(0)
+    os.umask(umask)
+    assert stat.S_IMODE(new.stat().st_mode) == 0o666 & ~umask  # not mkstemp's 0600
+    old = tmp_path / "old.txt"
+    old.write_text("x")
+    old.chmod(0o640)
+    with atomic_write(old) as f:
+        f.write("y")
+    assert stat.S_IMODE(old.stat().st_mode) == 0o640
+
+
+def test_bad_mode_and_missing_directory(tmp_path):
+    with pytest.raises(ValueError, match="mode"):
+        with atomic_write(tmp_path / "x", "a"):
+            pass
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        with atomic_write(tmp_path / "no" / "x"):
+            pass
+
+
+def test_atomic_path_requires_a_file(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nothing was written"):
+        with atomic_path(tmp_path / "x.bin") as tmp:
+            tmp.unlink()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_write_csv_round_trip(tmp_path):
+    df = pd.DataFrame({"row": [1, 2], "radius": [3.45e-6, 1.0 / 3.0], "id": ["a", "b,c"]})
+    path = write_csv(df, tmp_path / "t.csv")
+    pd.testing.assert_frame_equal(pd.read_csv(path), df)
+    assert leftovers(tmp_path) == []
+
+
+def _dataset():
+    return xr.Dataset(
+        {
+            "e_n": (("speed",), np.linspace(0.1, 0.9, 50), {"units": "1", "long_name": "normal restitution"}),
+            "captured": (("speed",), np.arange(50) % 2 == 0),
+            "label": ((), "x"),
+            "scalar": ((), 1.5),
+        },
+        coords={"speed": ("speed", np.linspace(1, 50, 50), {"units": "m/s"})},
+        attrs={"title": "test"},
+    )
+
+
+def test_write_netcdf_compresses_numeric_variables(tmp_path):
+    ds = _dataset()
+    path = write_netcdf(ds, tmp_path / "r.nc")
+    with netCDF4.Dataset(path) as nc:
+        assert nc.variables["e_n"].filters()["zlib"] is True
+        assert nc.variables["speed"].filters()["zlib"] is True
+        assert nc.variables["e_n"].units == "1"
+    with xr.open_dataset(path) as back:
+        xr.testing.assert_identical(back.load(), ds)
+    assert leftovers(tmp_path) == []
+
+
+def test_write_netcdf_rewrites_a_dataset_read_from_netcdf(tmp_path):
+    first = write_netcdf(_dataset(), tmp_path / "a.nc")
+    with xr.open_dataset(first) as ds:
+        ds = ds.load()
+    write_netcdf(ds.assign(extra=ds.e_n * 2), first)  # overwrite the file it came from
+    with xr.open_dataset(first) as back:
+        np.testing.assert_allclose(back.extra, ds.e_n * 2)
+
+
+def test_write_netcdf_failure_keeps_old_file(tmp_path, monkeypatch):
+    path = tmp_path / "r.nc"
+    write_netcdf(_dataset(), path)
+    before = path.read_bytes()
+
+    def broken(self, target, **kwargs):
+        with open(target, "wb") as f:
+            f.write(b"CDF half")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", broken)
+    with pytest.raises(OSError, match="disk full"):
+        write_netcdf(_dataset(), path)
+    assert path.read_bytes() == before
+    assert leftovers(tmp_path) == []

@@ -1,0 +1,84 @@
+"""Tests of microimpact.reproduction: the generated reproduction table and its Markdown file."""
+
+from __future__ import annotations
+
+import pytest
+
+from microimpact.presets import WALL_1990
+from microimpact.reproduction import COLUMNS, reproduction_table, write_reproduction_markdown
+
+
+@pytest.fixture(scope="module")
+def table():
+    return reproduction_table()
+
+
+def test_every_row_is_filled(table):
+    assert list(table.columns) == COLUMNS
+    assert table["id"].is_unique
+    assert len(table) >= 30
+    for col in ("id", "claim", "source", "paper_value", "toolkit_value"):
+        assert all(isinstance(x, str) and x.strip() for x in table[col]), col
+    assert all(a is True or a is False or a == "n/a" for a in table["agree"])
+    # every disagreement and every "n/a" must say why
+    for _, row in table.iterrows():
+        if row["agree"] is not True:
+            assert row["note"].strip(), row["id"]
+
+
+def test_required_rows_present(table):
+    ids = set(table["id"])
+    for required in (
+        "T1-wA",
+        "T1-rows-consistent",
+        "T1-f0-scaling",
+        "C1C2-1mps",
+        "Eq38-vc",
+        "Fig5b-frequency",
+        "Fig5b-frequency-r6.89",
+        "Fig5-motion-1",
+        "Fig5-motion-0.5",
+        "Fig5-motion-1e-05",
+        "Capture-velocity",
+        "Spin-2.9e5",
+        "Fig7-K-vs-speed",
+        "Fig7-KL-gt-Kt",
+        "Fig10-en-spin",
+        "Fig12-mu-gt-f",
+        "Fig13-one-curve",
+    ):
+        assert required in ids, required
+
+
+def test_key_verdicts(table):
+    agree = dict(zip(table["id"], table["agree"]))
+    assert agree["Eq38-vc"] is True
+    assert agree["Fig5-motion-0.5"] is True and agree["Fig5-motion-1e-05"] is True
+    assert agree["Fig5-motion-1"] is False  # engine captures at 1 m/s; the paper shows a rebound
+    assert agree["Fig5b-frequency"] is False
+    assert agree["Spin-2.9e5"] is False  # right value for r = 3.45 um, the text says radius 6.89 um
+    assert agree["Fig10-en-spin"] is True and agree["Fig13-one-curve"] is True
+    assert agree["Fig3-fit"] == "n/a"
+
+
+def test_values_are_computed_not_typed():
+    """Changing the contact changes the toolkit values (they are computed on each call)."""
+    other = reproduction_table(WALL_1990.with_(zeta_adhesion=20.0))
+    base = reproduction_table()
+    row = lambda df, i: df.loc[df["id"] == i, "toolkit_value"].item()  # noqa: E731
+    assert row(other, "Eq38-vc") != row(base, "Eq38-vc")
+    assert row(other, "Capture-velocity") != row(base, "Capture-velocity")
+
+
+def test_markdown_written(table, tmp_path):
+    path = write_reproduction_markdown(table, tmp_path / "sub" / "reproduction.md")
+    text = path.read_text(encoding="utf-8")
+    assert text.startswith("# Reproduction of Cheng, Brach & Dunn (2002)")
+    table_lines = [line for line in text.splitlines() if line.startswith("| ")]
+    assert len(table_lines) == len(table) + 2  # header and separator
+    assert all(line.count(" | ") == len(COLUMNS) - 1 for line in table_lines)  # escaped pipes only
+
+
+def test_markdown_rejects_wrong_columns(table, tmp_path):
+    with pytest.raises(ValueError, match="lacks columns"):
+        write_reproduction_markdown(table.drop(columns=["note"]), tmp_path / "x.md")
