@@ -1,10 +1,33 @@
-# microimpact report pipeline (grows with the workflow issue).
+# microimpact report pipeline: fit -> simulations -> sensitivity sweeps -> NetCDF -> PDF report.
+#
+#   snakemake --cores 2                                   # bundled (synthetic) data
+#   snakemake --cores 2 --config data=path/to/impacts.csv # the same report for your data
+#   snakemake --profile workflow/profiles/slurm           # on a SLURM cluster (docs/cluster.md)
+#
+# Every rule runs a thin script in workflow/scripts/ that calls one microimpact function; the
+# configuration (workflow/config/config.yaml) is validated against its JSON schema first.
+from snakemake.utils import min_version, validate
+
+min_version("8.0")
+
+
+configfile: "workflow/config/config.yaml"
+
+
+validate(config, "workflow/config/config.schema.yaml")
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/data.smk"
+include: "workflow/rules/fit.smk"
+include: "workflow/rules/dynamics.smk"
+include: "workflow/rules/sweeps.smk"
+include: "workflow/rules/validation.smk"
+include: "workflow/rules/benchmark.smk"
+include: "workflow/rules/report.smk"
+
+
 rule all:
     input:
-        "results/impact_example.json",
-
-rule example_impact:
-    output:
-        "results/impact_example.json",
-    shell:
-        "microimpact simulate --preset wall1990 --speed 2.0 --incidence-deg 10 --json > {output}"
+        "reports/report.pdf",
+    default_target: True

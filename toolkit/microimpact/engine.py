@@ -282,49 +282,58 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 status = _STEP_UNDERFLOW
                 break
             continue
-        # accepted: look for events inside the step, take the earliest
+        # accepted. Events that end a piece of the solution (separation; an extremum of y, where
+        # the sign of |F_n| flips) shorten the step to the earliest of them.
         hev = h
         code = -1
-        ev_target = 0.0
         g0 = k1[1]
         g1 = k[6, 1]
         if u[0] > 0.0 and u1[0] <= 0.0:
-            hh = _locate(0, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
-            if hh < hev or code < 0:
-                hev, code = hh, 0
+            hev = _locate(0, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            code = 0
             _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-        # an extremum of y ends the current monotone piece: dy/dsigma leaves its expected sign.
-        # (Comparing with the expected sign, not with g0, keeps the root just found at the start
-        # of this step from being found again through round-off.)
+        # an extremum of y: dy/dsigma leaves its expected sign (comparing with the expected sign,
+        # not with g0, keeps the root just found at the start of this step from being found again)
         if u[0] > 0.0 and g1 * sgn < 0.0:
             if g0 * sgn <= 0.0:
                 g0 = sgn * 1e-300
             hh = _locate(2, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
             if code < 0 or hh < hev:
                 hev, code = hh, 2
-            _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        if code >= 0:
+            _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        # Events that are only recorded (largest penetration, capture, end of sliding) are
+        # located inside the step without changing it, so the trajectory, and e_n, do not depend
+        # on which of them a caller asked for.
+        recorded = False
         if not turned and u[1] > 0.0 and u1[1] <= 0.0:
-            hh = _locate(1, 0.0, u, k1, h, u[1], u1[1], c1, c2, ah, aa, sgn, k, tmp, u1, err)
-            if code < 0 or hh < hev:
-                hev, code, ev_target = hh, 1, 0.0
-            _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            _locate(1, 0.0, u, k1, hev, u[1], u1[1], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            turned = True
+            if u1[0] > smax:
+                smax = u1[0]
+            recorded = True
         if not captured and aa > 0.0:
+            if recorded:
+                _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                recorded = False
             e0 = _energy(u[0], u[1], ah, aa)
             e1 = _energy(u1[0], u1[1], ah, aa)
             if e0 >= 0.0 and e1 < 0.0:
-                hh = _locate(3, 0.0, u, k1, h, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-                if code < 0 or hh < hev:
-                    hev, code = hh, 3
-                _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                _locate(3, 0.0, u, k1, hev, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                captured = True
+                tau_capture = u1[2]
+                recorded = True
         if math.isnan(tau_jtarget) and j_target > 0.0:
-            dj = abs(u1[1] - u[1])
+            if recorded:
+                _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                recorded = False
+            dj = abs(u1[1] - u[1])  # y is monotone within the (possibly shortened) step
             if J < j_target and J + dj >= j_target:
                 yt = u[1] + (j_target - J) * (1.0 if u1[1] > u[1] else -1.0)
-                hh = _locate(1, yt, u, k1, h, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-                if code < 0 or hh < hev:
-                    hev, code, ev_target = hh, 4, yt
-                _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-        if code >= 0 and hev < h:
+                _locate(1, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                tau_jtarget = u1[2]
+                recorded = True
+        if recorded:
             _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         # advance
         J += abs(u1[1] - u[1])
@@ -333,11 +342,6 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         n_steps += 1
         if code == 0:
             u[0] = 0.0  # exactly at the surface
-        if code == 1:
-            turned = True
-            u[1] = 0.0
-        if code == 4:
-            tau_jtarget = u[2]
         if u[0] > smax:
             smax = u[0]
         if code == 2:
@@ -353,9 +357,6 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         if code == 0:
             outcome = REBOUND
             break
-        if code == 3:
-            captured = True
-            tau_capture = u[2]
         if captured:
             # linearised amplitude about the equilibrium, from the state itself (E - E_min would
             # cancel to round-off long before the tail is negligible)

@@ -47,6 +47,8 @@ from datetime import datetime, timezone
 import numpy as np
 import xarray as xr
 
+from .impact import RESULT_VARIABLES as RESULT_META
+
 __all__ = [
     "TABLE2_CASES",
     "SWEEP_INPUTS",
@@ -57,6 +59,9 @@ __all__ = [
     "combine_sweeps",
     "save_sweep",
     "load_sweep",
+    "restitution_curves",
+    "kharaz_contact",
+    "kharaz_comparison",
     "PAPER_REFERENCE",
 ]
 
@@ -84,7 +89,7 @@ _VALID = {
 }
 _META_KEYS = ("description", "chunk")
 
-_SPEED = {"start": 0.2, "stop": 10.0, "num": 50, "spacing": "linear"}  # 0.2 m/s steps
+_SPEED = {"start": 0.2, "stop": 10.0, "num": 99, "spacing": "linear"}  # 0.1 m/s steps
 
 #: Default grids of the five cases of Table 2. Where the paper gives no increment, the choice is
 #: stated in the description. At alpha = 0 the azimuth theta of case 2.4/2.5 has no effect.
@@ -480,3 +485,130 @@ def load_sweep(path) -> xr.Dataset:
     """Read a sweep written by :func:`save_sweep` into memory (file closed afterwards)."""
     with xr.open_dataset(path, decode_timedelta=False) as ds:
         return ds.load()
+
+
+# ----------------------------------------------------------------------------- model curves for figures
+def restitution_curves(fit_dataset: xr.Dataset, speed=None, *, radius=None, rtol: float = 1e-8) -> xr.Dataset:
+    """Model e_n(v_n) curves at the best fit of a damping fit, one per sphere radius (Fig. 3 lines).
+
+    Parameters
+    ----------
+    fit_dataset : xarray.Dataset
+        :meth:`microimpact.fitting.DampingFit.to_dataset` output.
+    speed : spec value, optional
+        Normal speeds (a list or a range dict as in a sweep spec). [m/s] Default: 60 log-spaced
+        speeds spanning the data, widened by 20 % each way.
+    radius : sequence of float, optional
+        Radii. [m] Default: the distinct radii of the fitted points.
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+
+    Returns
+    -------
+    xarray.Dataset
+        ``e_n`` and ``outcome`` on dims (``radius`` [m], ``speed`` [m/s], the normal speed).
+    """
+    from .fitting import DampingFit
+    from .impact import simulate_many
+
+    fit = DampingFit.from_dataset(fit_dataset)
+    v_data = np.asarray(fit_dataset["normal_speed"].values, dtype=float)
+    if speed is None:
+        speed = {"start": float(v_data.min()) / 1.2, "stop": float(v_data.max()) * 1.2, "num": 60, "spacing": "log"}
+    speeds = np.atleast_1d(_values("speed", speed))
+    radii = np.unique(fit_dataset["radius"].values) if radius is None else np.atleast_1d(np.asarray(radius, float))
+    e_n, outcome = [], []
+    for r in radii:
+        res = simulate_many(fit.contact(float(r)), speeds, rtol=rtol)
+        e_n.append(res["e_n"].values)
+        outcome.append(res["outcome"].values)
+    return xr.Dataset(
+        {
+            "e_n": (("radius", "speed"), np.array(e_n), dict(zip(("units", "long_name"), RESULT_META["e_n"]))),
+            "outcome": (("radius", "speed"), np.array(outcome), dict(zip(("units", "long_name"), RESULT_META["outcome"]))),
+        },
+        coords={
+            "radius": ("radius", radii, {"units": "m", "long_name": "sphere radius"}),
+            "speed": ("speed", speeds, {"units": "m s-1", "long_name": "incident normal speed"}),
+        },
+        attrs={"title": "model e_n curves at the best-fit damping", "references": PAPER_REFERENCE},
+    )
+
+
+def kharaz_contact():
+    """Contact of the Kharaz et al. (2001) oblique impacts: 5 mm alumina sphere on soda-lime glass.
+
+    r = 2.5 mm, 4000 kg/m^3, E = 380 GPa, nu = 0.23 on E = 70 GPa, nu = 0.25 (K from Eqs. (3)-(4)),
+    f = 0.092, no adhesion, no damping (e_n = 1): the conditions of the DEM verification cases
+    that reproduce the data (see data/README.md of the shared data).
+    """
+    from .params import Contact
+
+    return Contact.from_elastic(2.5e-3, 4000.0, 380e9, 0.23, 70e9, 0.25, 0.0, friction=0.092)
+
+
+def kharaz_comparison(measured, contact=None, incidence_deg=None, *, speed: float = 3.9,
+                      rtol: float = 1e-8) -> xr.Dataset:
+    """Model versus the measured oblique impacts of Kharaz, Gorham & Salman (2001).
+
+    Parameters
+    ----------
+    measured : str, os.PathLike or pandas.DataFrame
+        The long table ``kharaz2001_oblique.csv``: columns quantity (tangential_restitution,
+        rebound_spin, rebound_angle), incidence_angle_deg, value, units.
+    contact : Contact, optional
+        Default :func:`kharaz_contact`.
+    incidence_deg : sequence of float, optional
+        Model angles. [deg] Default 0.25-85 deg in 0.25 deg steps.
+    speed : float
+        Impact speed of the experiments. [m/s]
+
+    Returns
+    -------
+    xarray.Dataset
+        Model curves on ``incidence_deg``: ``tangential_restitution`` v_t,out / v_t,in [1],
+        ``rebound_spin`` |omega_out| [rad s-1], ``rebound_angle`` atan(|v_t,out| / v_n,out) from
+        the normal [degree]; measured values as ``measured_<quantity>`` on dimension
+        ``<quantity>_point`` with the angle in ``measured_<quantity>_incidence_deg``.
+    """
+    import pandas as pd
+
+    from .impact import simulate_many
+
+    df = measured if isinstance(measured, pd.DataFrame) else pd.read_csv(measured)
+    missing = {"quantity", "incidence_angle_deg", "value"} - set(df.columns)
+    if missing:
+        raise ValueError(f"measured table lacks column(s) {sorted(missing)}")
+    contact = kharaz_contact() if contact is None else contact
+    angles = np.arange(0.25, 85.0001, 0.25) if incidence_deg is None else np.asarray(incidence_deg, dtype=float)
+    res = simulate_many(contact, speed, xr.DataArray(angles, dims="incidence_deg"), rtol=rtol)
+    v_t_in = speed * np.sin(np.radians(angles))
+    v_t_out = res["velocity_out_t"].values
+    spin = np.sqrt(res["omega_out_n"] ** 2 + res["omega_out_t"] ** 2 + res["omega_out_tp"] ** 2).values
+    angle_out = np.degrees(np.arctan2(np.abs(v_t_out), res["velocity_out_n"].values))
+    meta = {
+        "tangential_restitution": ("1", "tangential restitution v_t,out / v_t,in of the centre"),
+        "rebound_spin": ("rad s-1", "angular speed after impact"),
+        "rebound_angle": ("degree", "rebound angle from the surface normal"),
+    }
+    ds = xr.Dataset(coords={"incidence_deg": ("incidence_deg", angles, {
+        "units": "degree", "long_name": "incidence angle from the surface normal"})})
+    for name, values in zip(meta, (v_t_out / v_t_in, spin, angle_out)):
+        ds[name] = ("incidence_deg", values, {"units": meta[name][0], "long_name": "model " + meta[name][1]})
+        rows = df[df["quantity"] == name]
+        dim = f"{name}_point"
+        ds[f"measured_{name}"] = (dim, rows["value"].to_numpy(float), {
+            "units": meta[name][0], "long_name": "measured " + meta[name][1]})
+        ds[f"measured_{name}_incidence_deg"] = (dim, rows["incidence_angle_deg"].to_numpy(float), {
+            "units": "degree", "long_name": "incidence angle of the measurement"})
+    ds.attrs.update({
+        "title": "Oblique impact of 5 mm alumina spheres on glass: model vs Kharaz et al. (2001)",
+        "references": "Kharaz, Gorham & Salman (2001), Powder Technology 120:281-291, "
+        f"doi:10.1016/S0032-5910(01)00283-2; {PAPER_REFERENCE}",
+        "impact_speed": float(speed),
+        "impact_speed_units": "m s-1",
+    })
+    from .impact import contact_attributes
+
+    ds.attrs.update(contact_attributes(contact))
+    return ds

@@ -1,0 +1,667 @@
+"""Fit the damping coefficients zeta_H and zeta_A (and optionally w_A) to measured e_n(v_n).
+
+The paper's procedure (Cheng, Brach & Dunn 2002, section "Determination of the damping
+coefficients", Fig. 3): least-squares regression of the normal coefficient of restitution e_n,
+Eq. (21), against the incident normal speed v_n, with the normal contact law of Eq. (27) and the
+damping forms of Eqs. (14)-(15). Here the fit is done with lmfit and
+
+* JOINTLY over particle sizes: every radius r gets its own f0 from ONE shared work of adhesion
+  w_A through Eq. (7), f0 = (9/(2 pi) K r w_A^2)^(1/3) (a fit per size would fit f0, which is not a
+  material property; see notes/model-notes.md section 1);
+* with the model e_n(v_n) from :func:`microimpact.engine.solve_normal_many`, one call per distinct
+  radius per evaluation (about 1 ms for 25 speeds), so a 100-point fit takes about a second;
+* from a coarse global start: chi-square on a log-spaced (zeta_H, zeta_A) grid, then
+  Levenberg-Marquardt (``leastsq``) from the best grid point, with bounds zeta >= 0 (w_A > 0).
+
+Residuals and capture
+---------------------
+Below the capture velocity the model predicts capture and e_n = 0. The model e_n is continuous and
+tends to 0 at the capture velocity (roughly as the square root of the distance to it, see
+:func:`microimpact.dynamics.capture_bracket`), so a measured rebound that the model predicts as
+captured simply gets the residual (0 - e_n,measured) / sigma: no special case, no discontinuity
+in chi-square. A measured capture (e_n = 0) is fitted the same way.
+
+Weights
+-------
+``weights="auto"`` uses the ``e_n_uncertainty`` column (standard uncertainty) when every row has
+one > 0, and, when every row also has a ``normal_speed_uncertainty``, adds the speed error through
+the effective-variance method (Orear 1982, Am. J. Phys. 50:912, doi:10.1119/1.12972):
+
+    sigma_eff^2 = sigma_e^2 + (d e_n / d v_n)^2 sigma_vn^2,
+
+with the slope d e_n / d v_n of the model at the current best fit, updated twice (fit, re-weight,
+fit again, re-weight, fit again). The speed term matters near the capture velocity, where e_n rises
+steeply with v_n: at 1.1 v_c a 1 % speed error is a ~5 % error in e_n.
+With stated uncertainties the covariance is NOT rescaled by the reduced chi-square (lmfit
+``scale_covar=False``); unweighted fits rescale it (the residual scatter estimates sigma).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import lmfit
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from . import engine
+from .params import Contact
+
+__all__ = [
+    "DampingFit",
+    "FitProblem",
+    "fit_damping",
+    "damping_residual",
+    "model_restitution",
+    "PARAMETER_NAMES",
+    "DEFAULT_START_GRID",
+]
+
+#: names of the fitted parameters, in the order of the correlation matrix
+PARAMETER_NAMES = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
+_PARAM_META = {
+    "zeta_hertz": ("1", "nondimensional Hertzian damping coefficient zeta_H, Eq. (15)"),
+    "zeta_adhesion": ("1", "nondimensional adhesion damping coefficient zeta_A, Eq. (14)"),
+    "work_of_adhesion": ("J m-2", "Dupre work of adhesion w_A, f0 from Eq. (7)"),
+}
+#: default start grid: log-spaced zeta_H and zeta_A values on which chi-square is evaluated
+DEFAULT_START_GRID = (np.geomspace(0.01, 10.0, 13), np.geomspace(0.1, 1000.0, 13))
+#: sigma levels of the lmfit confidence intervals
+SIGMA_LEVELS = (-2, -1, 1, 2)
+
+
+# --------------------------------------------------------------------------- the model
+@dataclass(frozen=True)
+class FitProblem:
+    """The data of a damping fit arranged for fast model evaluation (one engine call per radius).
+
+    Attributes
+    ----------
+    radii : tuple of float
+        Distinct particle radii. [m]
+    groups : tuple of numpy.ndarray
+        For each radius, the indices of its points in the data order.
+    normal_speed : numpy.ndarray
+        Incident normal speed of each point. [m/s]
+    density : float
+        Sphere density. [kg/m^3]
+    stiffness : float
+        Effective stiffness K, Eq. (3). [Pa]
+    friction : float
+        Coulomb friction coefficient (not used by e_n; kept for the fitted contact). [-]
+    damping_reference_speed : float or None
+        Fixed reference speed of Eqs. (14)-(15), None for each impact's own normal speed. [m/s]
+    """
+
+    radii: tuple
+    groups: tuple
+    normal_speed: np.ndarray
+    density: float
+    stiffness: float
+    friction: float = 0.0
+    damping_reference_speed: float | None = None
+
+    @classmethod
+    def from_arrays(cls, radius, normal_speed, base) -> "FitProblem":
+        """Group points by radius; ``base`` supplies density, stiffness, friction, reference speed."""
+        radius = np.asarray(radius, dtype=float)
+        v = np.asarray(normal_speed, dtype=float)
+        radii, inverse = np.unique(radius, return_inverse=True)
+        groups = tuple(np.flatnonzero(inverse == i) for i in range(radii.size))
+        return cls(tuple(float(r) for r in radii), groups, v, float(base.density), float(base.stiffness),
+                   float(getattr(base, "friction", 0.0) or 0.0), getattr(base, "damping_reference_speed", None))
+
+    def contact(self, radius, zeta_hertz, zeta_adhesion, work_of_adhesion) -> Contact:
+        """The Contact of one radius, f0 from w_A through Eq. (7)."""
+        return Contact.from_work_of_adhesion(
+            radius, self.density, self.stiffness, work_of_adhesion, zeta_hertz=zeta_hertz,
+            zeta_adhesion=zeta_adhesion, friction=self.friction,
+            damping_reference_speed=self.damping_reference_speed)
+
+
+def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_adhesion, *, rtol=1e-8,
+                      speed_factor=1.0) -> np.ndarray:
+    """Model e_n of every point, Eqs. (21), (27): one engine call per distinct radius.
+
+    Parameters
+    ----------
+    problem : FitProblem
+    zeta_hertz, zeta_adhesion : float
+        Damping coefficients, Eqs. (14)-(15). [-]
+    work_of_adhesion : float
+        w_A shared by all radii; f0 per radius from Eq. (7). [J/m^2]
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+    speed_factor : float
+        Multiply every normal speed by this (for finite-difference slopes). [-]
+
+    Returns
+    -------
+    numpy.ndarray
+        e_n in the data order; 0 where the model predicts capture. [-]
+    """
+    out = np.empty(problem.normal_speed.size)
+    for r, idx in zip(problem.radii, problem.groups):
+        c = problem.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion)
+        out[idx] = engine.solve_normal_many(c, problem.normal_speed[idx] * speed_factor, rtol=rtol)["e_n"]
+    return out
+
+
+def damping_residual(params, problem: FitProblem, e_n=None, sigma=None, *, rtol=1e-8):
+    """lmfit objective: (model - e_n) / sigma, or the model e_n itself when ``e_n`` is None.
+
+    Parameters
+    ----------
+    params : lmfit.Parameters or mapping
+        ``zeta_hertz``, ``zeta_adhesion``, ``work_of_adhesion``. [-], [-], [J/m^2]
+    problem : FitProblem
+    e_n : array_like, optional
+        Measured restitution coefficients in the data order. [-]
+    sigma : array_like, optional
+        Their standard uncertainties; None means unweighted. [-]
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+
+    Returns
+    -------
+    numpy.ndarray
+        Model e_n (``e_n`` None), else the (weighted) residuals. Plain residuals are used for
+        points the model predicts as captured (model e_n = 0 is continuous at the capture
+        velocity).
+    """
+    p = params.valuesdict() if hasattr(params, "valuesdict") else dict(params)
+    model = model_restitution(problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=rtol)
+    if e_n is None:
+        return model
+    res = model - np.asarray(e_n, dtype=float)
+    return res if sigma is None else res / np.asarray(sigma, dtype=float)
+
+
+# --------------------------------------------------------------------------- result
+@dataclass(frozen=True, eq=False)
+class DampingFit:
+    """Result of :func:`fit_damping`.
+
+    Attributes
+    ----------
+    values : dict
+        Best-fit ``zeta_hertz`` [-], ``zeta_adhesion`` [-], ``work_of_adhesion`` [J/m^2] (fixed
+        parameters at their given value).
+    stderr : dict
+        Standard errors (NaN for fixed parameters), same units.
+    varied : tuple of str
+        Names of the fitted parameters.
+    correlation : numpy.ndarray
+        Correlation matrix of :data:`PARAMETER_NAMES` (NaN rows/columns for fixed ones). [-]
+    confidence_intervals : dict
+        For each varied parameter, {sigma level: limit} for levels -2, -1, 1, 2 from
+        :func:`lmfit.conf_interval` (NaN when not computed or when it failed).
+    chisqr, redchi, aic, bic : float
+        Chi-square, reduced chi-square, Akaike and Bayesian information criteria (lmfit's).
+    n_points : int
+        Number of data points fitted.
+    data : pandas.DataFrame
+        The data used: ``row`` (CSV data row), ``radius`` [m], ``normal_speed`` [m/s], ``e_n``,
+        ``sigma`` (uncertainty used, effective variance included) [-], ``model`` [-],
+        ``residual`` ((model - e_n)/sigma) [-].
+    density, stiffness, friction : float
+        Material of the fit: [kg/m^3], [Pa], [-].
+    damping_reference_speed : float or None
+        [m/s]; None = each impact's own normal speed.
+    weighting : str
+        "e_n uncertainty", "e_n uncertainty + effective variance", "given", or "none".
+    scale_covar : bool
+        Whether the covariance was scaled by the reduced chi-square.
+    info : dict
+        nfev, success, message, method, rtol, elapsed_s, source, sha256, material_pair,
+        ci_message.
+    """
+
+    values: dict
+    stderr: dict
+    varied: tuple
+    correlation: np.ndarray
+    confidence_intervals: dict
+    chisqr: float
+    redchi: float
+    aic: float
+    bic: float
+    n_points: int
+    data: pd.DataFrame
+    density: float
+    stiffness: float
+    friction: float = 0.0
+    damping_reference_speed: float | None = None
+    weighting: str = "none"
+    scale_covar: bool = True
+    info: dict = field(default_factory=dict)
+
+    # convenient accessors
+    @property
+    def zeta_hertz(self) -> float:
+        """Fitted zeta_H. [-]"""
+        return self.values["zeta_hertz"]
+
+    @property
+    def zeta_adhesion(self) -> float:
+        """Fitted zeta_A. [-]"""
+        return self.values["zeta_adhesion"]
+
+    @property
+    def work_of_adhesion(self) -> float:
+        """w_A (fitted or fixed). [J/m^2]"""
+        return self.values["work_of_adhesion"]
+
+    def contact(self, radius: float) -> Contact:
+        """The Contact of a sphere of this radius with the fitted parameters (f0 from Eq. (7)).
+
+        Parameters
+        ----------
+        radius : float
+            Sphere radius. [m]
+        """
+        return Contact.from_work_of_adhesion(
+            radius, self.density, self.stiffness, self.work_of_adhesion,
+            zeta_hertz=self.zeta_hertz, zeta_adhesion=self.zeta_adhesion, friction=self.friction,
+            damping_reference_speed=self.damping_reference_speed)
+
+    # ------------------------------------------------------------------ report
+    def report(self) -> str:
+        """Readable summary: values, errors, intervals, correlations and fit statistics."""
+        lines = ["Damping fit (Cheng, Brach & Dunn 2002, Eqs. (14)-(15), (21), (27))"]
+        src = self.info.get("source")
+        if src:
+            lines.append(f"  data        : {src}" + (f"  [{self.info['material_pair']}]" if self.info.get("material_pair") else ""))
+        radii = sorted(set(self.data["radius"]))
+        lines.append(f"  points      : {self.n_points} over {len(radii)} radii "
+                     f"({', '.join(f'{r * 1e6:.3g}' for r in radii)} um)")
+        lines.append(f"  weighting   : {self.weighting}; covariance "
+                     f"{'scaled by' if self.scale_covar else 'not scaled by'} reduced chi-square")
+        lines.append(f"  material    : density {self.density:g} kg/m3, K {self.stiffness:.4g} Pa, "
+                     f"friction {self.friction:g}, damping reference speed "
+                     f"{'per-impact normal speed' if self.damping_reference_speed is None else f'{self.damping_reference_speed:g} m/s'}")
+        lines.append("  parameters  :")
+        for name in PARAMETER_NAMES:
+            unit = "J/m2" if name == "work_of_adhesion" else "-"
+            v, s = self.values[name], self.stderr[name]
+            if name in self.varied:
+                ci = self.confidence_intervals.get(name, {})
+                rel = f" ({100 * s / abs(v):.2g} %)" if v and math.isfinite(s) else ""
+                txt = f"    {name:<17}= {v:.6g} +/- {s:.3g}{rel} [{unit}]"
+                if ci and all(math.isfinite(ci.get(k, math.nan)) for k in (-1, 1)):
+                    txt += f"; 1-sigma CI [{ci[-1]:.5g}, {ci[1]:.5g}]"
+                    if all(math.isfinite(ci.get(k, math.nan)) for k in (-2, 2)):
+                        txt += f", 2-sigma CI [{ci[-2]:.5g}, {ci[2]:.5g}]"
+                lines.append(txt)
+            else:
+                lines.append(f"    {name:<17}= {v:.6g} (fixed) [{unit}]")
+        if len(self.varied) > 1:
+            idx = [PARAMETER_NAMES.index(n) for n in self.varied]
+            lines.append("  correlations:")
+            for a in range(len(idx)):
+                for b in range(a + 1, len(idx)):
+                    lines.append(f"    {self.varied[a]} / {self.varied[b]}: "
+                                 f"{self.correlation[idx[a], idx[b]]:+.3f}")
+        lines.append(f"  chi-square  : {self.chisqr:.4g}, reduced {self.redchi:.4g} "
+                     f"({self.n_points - len(self.varied)} degrees of freedom)")
+        lines.append(f"  AIC, BIC    : {self.aic:.4g}, {self.bic:.4g}")
+        lines.append(f"  evaluations : {self.info.get('nfev', '?')} ({self.info.get('elapsed_s', math.nan):.2f} s), "
+                     f"{self.info.get('message', '')}")
+        if self.info.get("ci_message"):
+            lines.append(f"  note        : {self.info['ci_message']}")
+        return "\n".join(lines)
+
+    def __str__(self) -> str:  # pragma: no cover - convenience
+        return self.report()
+
+    # ------------------------------------------------------------------ NetCDF
+    def to_dataset(self) -> xr.Dataset:
+        """The fit as an xarray Dataset with CF attributes (``units``, ``long_name``).
+
+        Parameters are scalar variables ``zeta_hertz``, ``zeta_adhesion``, ``work_of_adhesion``
+        with ``<name>_stderr`` and ``<name>_confidence_limit(sigma_level)``; the data used are along
+        dimension ``point``; the correlation matrix along ``parameter`` x ``parameter_b``.
+        """
+        d = self.data
+        point = np.arange(len(d))
+        ds = xr.Dataset(coords={
+            "point": ("point", point, {"long_name": "index of the fitted point"}),
+            "parameter": ("parameter", np.array(PARAMETER_NAMES, dtype=object), {"long_name": "fit parameter"}),
+            "parameter_b": ("parameter_b", np.array(PARAMETER_NAMES, dtype=object), {"long_name": "fit parameter"}),
+            "sigma_level": ("sigma_level", np.array(SIGMA_LEVELS, dtype=np.int8),
+                            {"units": "1", "long_name": "confidence level in standard deviations (negative: lower limit)"}),
+        })
+        for name in PARAMETER_NAMES:
+            units, long_name = _PARAM_META[name]
+            varied = name in self.varied
+            ds[name] = xr.DataArray(self.values[name], attrs={
+                "units": units, "long_name": long_name, "varied": int(varied)})
+            ds[f"{name}_stderr"] = xr.DataArray(self.stderr[name], attrs={
+                "units": units, "long_name": f"standard error of {name}"})
+            ci = self.confidence_intervals.get(name, {})
+            ds[f"{name}_confidence_limit"] = xr.DataArray(
+                np.array([ci.get(s, np.nan) for s in SIGMA_LEVELS], dtype=float), dims=("sigma_level",),
+                attrs={"units": units, "long_name": f"lmfit.conf_interval limit of {name}"})
+        ds["correlation"] = xr.DataArray(self.correlation, dims=("parameter", "parameter_b"), attrs={
+            "units": "1", "long_name": "correlation of the fitted parameters"})
+        meta = {
+            "row": ("1", "data row of the impact in the source CSV"),
+            "radius": ("m", "sphere radius"),
+            "normal_speed": ("m s-1", "incident normal speed"),
+            "e_n": ("1", "measured normal coefficient of restitution"),
+            "sigma": ("1", "uncertainty of e_n used as weight (effective variance included)"),
+            "model": ("1", "model normal coefficient of restitution at the best fit, Eq. (21)"),
+            "residual": ("1", "(model - measured) / sigma"),
+        }
+        for col, (units, long_name) in meta.items():
+            values = d[col].to_numpy(dtype=np.int64 if col == "row" else float)
+            name = {"e_n": "e_n_measured", "model": "e_n_model"}.get(col, col)
+            ds[name] = xr.DataArray(values, dims=("point",), attrs={"units": units, "long_name": long_name})
+        ds.attrs.update({
+            "title": "damping fit of the microsphere impact model (Cheng, Brach & Dunn 2002)",
+            "Conventions": "CF-1.8",
+            "chisqr": float(self.chisqr), "redchi": float(self.redchi), "aic": float(self.aic),
+            "bic": float(self.bic), "n_points": int(self.n_points),
+            "varied": " ".join(self.varied),
+            "density": self.density, "stiffness": self.stiffness, "friction": self.friction,
+            "damping_reference_speed": ("per-impact normal speed" if self.damping_reference_speed is None
+                                        else float(self.damping_reference_speed)),
+            "weighting": self.weighting, "scale_covar": int(self.scale_covar),
+        })
+        for k, v in self.info.items():
+            if v is None:
+                continue
+            ds.attrs[f"fit_{k}"] = int(v) if isinstance(v, (bool, np.bool_)) else (v if isinstance(v, (int, float, str)) else str(v))
+        return ds
+
+    def save(self, path) -> Path:
+        """Write :meth:`to_dataset` to NetCDF atomically (:func:`microimpact.io.write_netcdf`)."""
+        from .io import write_netcdf
+
+        return write_netcdf(self.to_dataset(), path)
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset) -> "DampingFit":
+        """Inverse of :meth:`to_dataset`."""
+        a = ds.attrs
+        varied = tuple(a["varied"].split()) if a.get("varied") else ()
+        values = {n: float(ds[n]) for n in PARAMETER_NAMES}
+        stderr = {n: float(ds[f"{n}_stderr"]) for n in PARAMETER_NAMES}
+        cis = {}
+        for n in varied:
+            lim = ds[f"{n}_confidence_limit"].values
+            cis[n] = {int(s): float(x) for s, x in zip(ds["sigma_level"].values, lim)}
+        data = pd.DataFrame({
+            "row": ds["row"].values.astype(np.int64), "radius": ds["radius"].values,
+            "normal_speed": ds["normal_speed"].values, "e_n": ds["e_n_measured"].values,
+            "sigma": ds["sigma"].values, "model": ds["e_n_model"].values, "residual": ds["residual"].values,
+        })
+        ref = a.get("damping_reference_speed")
+        info = {k.removeprefix("fit_"): (v.item() if hasattr(v, "item") else v) for k, v in a.items() if k.startswith("fit_")}
+        return cls(values=values, stderr=stderr, varied=varied, correlation=np.array(ds["correlation"].values, dtype=float),
+                   confidence_intervals=cis, chisqr=float(a["chisqr"]), redchi=float(a["redchi"]), aic=float(a["aic"]),
+                   bic=float(a["bic"]), n_points=int(a["n_points"]), data=data, density=float(a["density"]),
+                   stiffness=float(a["stiffness"]), friction=float(a["friction"]),
+                   damping_reference_speed=None if isinstance(ref, str) else float(ref),
+                   weighting=str(a["weighting"]), scale_covar=bool(int(a["scale_covar"])), info=info)
+
+    @classmethod
+    def load(cls, path) -> "DampingFit":
+        """Read a fit written by :meth:`save`.
+
+        Raises
+        ------
+        ValueError
+            If the file is not a damping-fit NetCDF (names the file and the missing variable).
+        """
+        path = Path(path)
+        try:
+            with xr.open_dataset(path, engine="netcdf4") as ds:
+                ds = ds.load()
+        except FileNotFoundError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - netCDF4 raises OSError/ValueError variously
+            raise ValueError(f"{path}: cannot be read as NetCDF ({exc})") from None
+        try:
+            return cls.from_dataset(ds)
+        except KeyError as exc:
+            raise ValueError(f"{path}: not a damping-fit file written by DampingFit.save "
+                             f"(missing {exc.args[0]!r})") from None
+
+
+# --------------------------------------------------------------------------- fit
+def _material(base):
+    """density, stiffness, w_A, friction, reference speed from a MaterialPair, Contact or DampingFit."""
+    try:
+        return (float(base.density), float(base.stiffness), float(base.work_of_adhesion),
+                float(getattr(base, "friction", 0.0) or 0.0), getattr(base, "damping_reference_speed", None))
+    except AttributeError:
+        raise ValueError("base must give density, stiffness and work_of_adhesion (a MaterialPair, "
+                         f"Contact or DampingFit), got {type(base).__name__}") from None
+
+
+def _table_arrays(table):
+    """Columns needed by the fit, checked; errors name the data row and column."""
+    if isinstance(table, pd.DataFrame):
+        df = table
+    else:
+        df = pd.DataFrame(table)
+    missing = [c for c in ("radius", "normal_speed", "e_n") if c not in df.columns]
+    if missing:
+        raise ValueError(f"the impact table lacks column(s) {', '.join(missing)}; read it with microimpact.io.read_impacts")
+    rows = df["row"].to_numpy(dtype=np.int64) if "row" in df.columns else np.arange(1, len(df) + 1)
+    src = df.attrs.get("source", "impact table")
+    if len(df) == 0:
+        raise ValueError(f"{src}: no impacts to fit")
+    if "material_pair" in df.columns:
+        pairs = sorted({str(p) for p in df["material_pair"].dropna().unique()})
+        if len(pairs) > 1:
+            raise ValueError(f"{src}: the table mixes material pairs ({', '.join(pairs)}); fit one pair at a time "
+                             "(e.g. microimpact fit --material-pair NAME)")
+    out = {}
+    for col in ("radius", "normal_speed", "e_n"):
+        x = df[col].to_numpy(dtype=float)
+        bad = ~np.isfinite(x) | ((x <= 0) if col != "e_n" else (x < 0) | (x > 1))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"{src}: row {rows[i]}, column {col!r}: value {x[i]!r} cannot be fitted "
+                             f"({'must be finite and > 0' if col != 'e_n' else 'e_n must lie in [0, 1]'})")
+        out[col] = x
+    for col in ("e_n_uncertainty", "normal_speed_uncertainty"):
+        out[col] = df[col].to_numpy(dtype=float) if col in df.columns else np.full(len(df), np.nan)
+    return df, rows, out, src
+
+
+def _sigma_e(weights, arrays, rows, src):
+    """(sigma_e or None, use_effective_variance, label)."""
+    n = arrays["e_n"].size
+    if weights is None or (isinstance(weights, str) and weights == "none"):
+        return None, False, "none"
+    if isinstance(weights, str):
+        if weights not in ("auto", "e_n"):
+            raise ValueError(f"weights must be 'auto', 'e_n', 'none' or an array of uncertainties, got {weights!r}")
+        s = arrays["e_n_uncertainty"]
+        given = np.isfinite(s)
+        if weights == "auto" and not given.any():
+            return None, False, "none"
+        bad = ~given | (s <= 0)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"{src}: row {rows[i]}, column 'e_n_uncertainty': value {s[i]!r}; weighting by "
+                             "e_n uncertainties needs a value > 0 in every row (or use weights='none')")
+        sv = arrays["normal_speed_uncertainty"]
+        eff = weights == "auto" and bool(np.all(np.isfinite(sv)))
+        return s, eff, "e_n uncertainty + effective variance" if eff else "e_n uncertainty"
+    s = np.asarray(weights, dtype=float)
+    if s.shape != (n,) or not np.all(np.isfinite(s) & (s > 0)):
+        raise ValueError(f"weights given as an array must be {n} finite uncertainties > 0")
+    return s, False, "given"
+
+
+def _effective_sigma(problem, p, sigma_e, sigma_v, rtol, h=1e-4):
+    """sqrt(sigma_e^2 + (de/dv sigma_v)^2) with the model slope by central differences."""
+    up = model_restitution(problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=rtol, speed_factor=1 + h)
+    dn = model_restitution(problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=rtol, speed_factor=1 - h)
+    slope = (up - dn) / (2 * h * problem.normal_speed)
+    return np.sqrt(sigma_e**2 + (slope * sigma_v) ** 2)
+
+
+def fit_damping(
+    table,
+    base,
+    *,
+    fit_work_of_adhesion: bool = False,
+    weights="auto",
+    start_grid=DEFAULT_START_GRID,
+    rtol: float = 1e-8,
+    confidence_intervals: bool = True,
+    scale_covar: bool | None = None,
+) -> DampingFit:
+    """Fit zeta_H, zeta_A (and optionally w_A) to measured e_n(v_n), jointly over particle sizes.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Impacts as returned by :func:`microimpact.io.read_impacts`: columns ``radius`` [m],
+        ``normal_speed`` [m/s], ``e_n`` [-], optional ``e_n_uncertainty`` [-],
+        ``normal_speed_uncertainty`` [m/s], ``row``, ``material_pair`` (one pair only).
+    base : MaterialPair, Contact or DampingFit
+        The material: density [kg/m^3], stiffness K [Pa], work of adhesion w_A [J/m^2] (a
+        Contact's :attr:`~microimpact.Contact.work_of_adhesion`; the start value when
+        ``fit_work_of_adhesion``), friction [-] and damping reference speed [m/s].
+    fit_work_of_adhesion : bool
+        Also fit w_A (shared by all radii, f0 per radius from Eq. (7)).
+    weights : {"auto", "e_n", "none"} or array_like
+        "auto": e_n uncertainties if the table has them (plus the effective variance of the
+        speed uncertainty when every row has a ``normal_speed_uncertainty``), else unweighted;
+        "e_n": e_n uncertainties only; "none": unweighted; an array: the uncertainties. [-]
+    start_grid : (array_like, array_like)
+        zeta_H and zeta_A values [-] on which chi-square is evaluated; the fit starts from the
+        best grid point (w_A at its base value).
+    rtol : float
+        Relative tolerance of the engine's normal solves. [-]
+    confidence_intervals : bool
+        Compute 1- and 2-sigma :func:`lmfit.conf_interval` limits (a profile fit per limit).
+    scale_covar : bool, optional
+        Scale the covariance by the reduced chi-square; default: only for unweighted fits.
+
+    Returns
+    -------
+    DampingFit
+
+    Raises
+    ------
+    ValueError
+        For a table that cannot be fitted (names the row and column), mixed material pairs, or
+        bad arguments.
+
+    Notes
+    -----
+    Model: e_n(v_n) of Eq. (21) from the normal contact law Eq. (27) with
+    C = zeta (r^3 K sqrt(v_n) / m)^(-2/5), Eqs. (14)-(15), and f0(r) = (9/(2 pi) K r w_A^2)^(1/3),
+    Eq. (7). The model e_n is 0 below the capture velocity and continuous there, so plain
+    residuals are used for every point (see the module docstring).
+    """
+    t0 = time.perf_counter()
+    density, stiffness, w_a0, friction, vref = _material(base)
+    df, rows, arr, src = _table_arrays(table)
+    sigma_e, effective, weighting = _sigma_e(weights, arr, rows, src)
+    problem = FitProblem.from_arrays(arr["radius"], arr["normal_speed"], base)
+    e_n = arr["e_n"]
+    n_var = 3 if fit_work_of_adhesion else 2
+    if e_n.size <= n_var:
+        raise ValueError(f"{src}: {e_n.size} point(s) cannot determine {n_var} parameters")
+    if fit_work_of_adhesion and not w_a0 > 0:
+        raise ValueError("fitting w_A needs a start value > 0 (base.work_of_adhesion)")
+    if scale_covar is None:
+        scale_covar = sigma_e is None
+    sigma = sigma_e
+
+    # coarse global start on the (zeta_H, zeta_A) grid
+    gh, ga = (np.asarray(g, dtype=float).ravel() for g in start_grid)
+    if gh.size == 0 or ga.size == 0 or np.any(gh < 0) or np.any(ga < 0):
+        raise ValueError("start_grid must be two non-empty arrays of zeta values >= 0")
+    best = (math.inf, gh[0], ga[0])
+    for zh in gh:
+        for za in ga:
+            r = damping_residual({"zeta_hertz": zh, "zeta_adhesion": za, "work_of_adhesion": w_a0},
+                                 problem, e_n, sigma, rtol=rtol)
+            chi2 = float(r @ r)
+            if chi2 < best[0]:
+                best = (chi2, zh, za)
+    nfev = gh.size * ga.size
+
+    params = lmfit.Parameters()
+    params.add("zeta_hertz", value=best[1], min=0.0)
+    params.add("zeta_adhesion", value=best[2], min=0.0)
+    params.add("work_of_adhesion", value=w_a0, min=1e-12 if fit_work_of_adhesion else 0.0, vary=fit_work_of_adhesion)
+
+    def run(params, sigma):
+        mini = lmfit.Minimizer(damping_residual, params, fcn_args=(problem,),
+                               fcn_kws={"e_n": e_n, "sigma": sigma, "rtol": rtol}, scale_covar=scale_covar)
+        return mini, mini.minimize(method="leastsq")
+
+    mini, result = run(params, sigma)
+    nfev += result.nfev
+    if effective:
+        for _ in range(2):  # re-weight with the slope at the current best fit, refit
+            sigma = _effective_sigma(problem, result.params.valuesdict(), sigma_e, arr["normal_speed_uncertainty"], rtol)
+            mini, result = run(result.params, sigma)
+            nfev += result.nfev + 2 * len(problem.radii)
+
+    varied = tuple(n for n in PARAMETER_NAMES if result.params[n].vary)
+    values = {n: float(result.params[n].value) for n in PARAMETER_NAMES}
+    stderr = {n: (float(result.params[n].stderr) if result.params[n].vary and result.params[n].stderr is not None
+                  else math.nan) for n in PARAMETER_NAMES}
+    corr = np.full((3, 3), np.nan)
+    for i, a in enumerate(PARAMETER_NAMES):
+        if a in varied:
+            corr[i, i] = 1.0
+            for j, b in enumerate(PARAMETER_NAMES):
+                cb = (result.params[a].correl or {}).get(b)
+                if cb is not None:
+                    corr[i, j] = cb
+
+    cis: dict = {}
+    ci_message = ""
+    if confidence_intervals and result.errorbars:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                raw = lmfit.conf_interval(mini, result, p_names=list(varied), sigmas=[1, 2])
+            for name, rows_ci in raw.items():
+                # rows are (probability, value) for -2, -1, 0, +1, +2 sigma
+                lims = [v for _, v in rows_ci]
+                cis[name] = {-2: float(lims[0]), -1: float(lims[1]), 1: float(lims[3]), 2: float(lims[4])}
+        except Exception as exc:  # noqa: BLE001 - report, do not fail the fit
+            ci_message = f"confidence intervals not computed: {exc}"
+    elif confidence_intervals:
+        ci_message = "confidence intervals not computed: lmfit could not estimate the covariance"
+    if not confidence_intervals:
+        ci_message = "confidence intervals not requested"
+
+    p = result.params.valuesdict()
+    model = damping_residual(p, problem, rtol=rtol)
+    sig_used = np.ones_like(e_n) if sigma is None else np.asarray(sigma, dtype=float)
+    data = pd.DataFrame({"row": rows, "radius": arr["radius"], "normal_speed": arr["normal_speed"],
+                         "e_n": e_n, "sigma": sig_used if sigma is not None else np.full_like(e_n, np.nan),
+                         "model": model, "residual": (model - e_n) / sig_used})
+    pair = None
+    if "material_pair" in df.columns:
+        labels = df["material_pair"].dropna().unique()
+        pair = str(labels[0]) if len(labels) == 1 else None
+    info = {"nfev": int(nfev), "success": bool(result.success), "message": str(result.message),
+            "method": "coarse log grid + lmfit leastsq", "rtol": float(rtol),
+            "elapsed_s": time.perf_counter() - t0, "source": df.attrs.get("source"),
+            "sha256": df.attrs.get("sha256"), "material_pair": pair, "ci_message": ci_message or None}
+    return DampingFit(values=values, stderr=stderr, varied=varied, correlation=corr, confidence_intervals=cis,
+                      chisqr=float(result.chisqr), redchi=float(result.redchi), aic=float(result.aic),
+                      bic=float(result.bic), n_points=int(e_n.size), data=data, density=density,
+                      stiffness=stiffness, friction=friction, damping_reference_speed=vref,
+                      weighting=weighting, scale_covar=bool(scale_covar), info=info)

@@ -1,0 +1,133 @@
+"""SYNTHETIC microsphere e_n(v_n) data generated from stated parameters (not measurements).
+
+No digitized copy of the Wall et al. (1990) e_n(v) data that Cheng, Brach & Dunn (2002) fit in
+their Fig. 3 is public, so the bundled example data ``data/synthetic_microspheres.csv`` is made
+here, by the model itself, from Table 1 row 1 style parameters (ammonium fluorescein on polished
+silicon) plus a stated noise model. It exists to exercise and test the fit; it is not evidence for
+the model. Regenerate it with ``python workflow/scripts/make_synthetic_data.py``.
+
+Noise model (defaults)
+----------------------
+For each radius r, ``n_per_radius`` nominal speeds v are log-spaced from ``start_factor`` times the
+capture velocity v_c(r) to ``max_speed``. Per impact (one ``numpy.random.default_rng(seed)`` stream,
+drawn in file order):
+
+* true incidence angle alpha = |N(0, angle_sd_deg)| (recorded as 0 deg with uncertainty
+  ``angle_sd_deg``); true normal speed v cos(alpha);
+* recorded speed = v (1 + speed_rel_sd N(0,1)), ``speed_uncertainty`` = speed_rel_sd x recorded speed;
+* recorded e_n = e_n,true (1 + e_n_rel_sd N(0,1)), clipped to [0, 1], with e_n,true the model at the
+  true normal speed; ``e_n_uncertainty`` = e_n_rel_sd x e_n,true (the stated instrument precision).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from . import engine
+from .params import Contact
+
+__all__ = ["SYNTHETIC_DEFAULTS", "make_synthetic_impacts", "write_synthetic_impacts"]
+
+#: generating parameters of data/synthetic_microspheres.csv
+SYNTHETIC_DEFAULTS = dict(
+    radii=(1.29e-6, 1.72e-6, 2.58e-6, 3.45e-6),  # [m], Table 1 row 1 range 1.29-3.45 um
+    density=1350.0,  # [kg/m3]
+    stiffness=1.776e9,  # [Pa]
+    work_of_adhesion=0.215834,  # [J/m2], the materials-config value (f0 = 7.422 N/m at 3.45 um)
+    zeta_hertz=0.50,  # [-]
+    zeta_adhesion=29.0,  # [-]
+    friction=0.15,  # [-] (does not affect e_n)
+    n_per_radius=25,
+    start_factor=1.1,  # first speed = 1.1 v_c(r)
+    max_speed=100.0,  # [m/s]
+    e_n_rel_sd=0.03,
+    speed_rel_sd=0.01,
+    angle_sd_deg=1.0,
+    seed=20020101,
+    material_pair="ammonium_fluorescein_on_silicon",
+)
+
+
+def make_synthetic_impacts(**overrides) -> pd.DataFrame:
+    """Make the synthetic e_n(v) table, in the measured-impact CSV format (units in the header).
+
+    Parameters
+    ----------
+    **overrides
+        Any key of :data:`SYNTHETIC_DEFAULTS`: ``radii`` [m], ``density`` [kg/m^3], ``stiffness``
+        [Pa], ``work_of_adhesion`` [J/m^2], ``zeta_hertz``, ``zeta_adhesion``, ``friction`` [-],
+        ``n_per_radius``, ``start_factor`` [-], ``max_speed`` [m/s], ``e_n_rel_sd``,
+        ``speed_rel_sd`` [-], ``angle_sd_deg`` [deg], ``seed``, ``material_pair``. Zero noise
+        levels give exact model values.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``id, size_class, material_pair, radius [um], speed [m/s], incidence_angle [deg],
+        e_n [1], speed_uncertainty [m/s], incidence_angle_uncertainty [deg], e_n_uncertainty [1]``
+        (the angle uncertainty column only when ``angle_sd_deg`` > 0). ``attrs["generating"]``
+        holds the parameters, ``attrs["true_e_n"]`` and ``attrs["true_normal_speed"]`` the
+        noise-free values.
+    """
+    from .dynamics import capture_velocity
+
+    unknown = set(overrides) - set(SYNTHETIC_DEFAULTS)
+    if unknown:
+        raise ValueError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(SYNTHETIC_DEFAULTS)}")
+    p = {**SYNTHETIC_DEFAULTS, **overrides}
+    rng = np.random.default_rng(p["seed"])
+    rows = []
+    true_e, true_vn = [], []
+    for r in p["radii"]:
+        c = Contact.from_work_of_adhesion(r, p["density"], p["stiffness"], p["work_of_adhesion"],
+                                          zeta_hertz=p["zeta_hertz"], zeta_adhesion=p["zeta_adhesion"],
+                                          friction=p["friction"])
+        vc = capture_velocity(c)
+        v = np.geomspace(p["start_factor"] * vc, p["max_speed"], p["n_per_radius"])
+        alpha = np.abs(rng.normal(0.0, p["angle_sd_deg"], v.size)) if p["angle_sd_deg"] > 0 else np.zeros(v.size)
+        vn = v * np.cos(np.radians(alpha))
+        e = engine.solve_normal_many(c, vn, rtol=1e-10)["e_n"]
+        speed = v * (1.0 + p["speed_rel_sd"] * rng.normal(size=v.size))
+        e_rec = np.clip(e * (1.0 + p["e_n_rel_sd"] * rng.normal(size=v.size)), 0.0, 1.0)
+        label = f"d{2 * r * 1e6:.2f}um"
+        for i in range(v.size):
+            row = {
+                "id": f"syn-{label}-{i + 1:02d}",
+                "size_class": label,
+                "material_pair": p["material_pair"],
+                "radius [um]": round(r * 1e6, 6),
+                "speed [m/s]": float(f"{speed[i]:.6g}"),
+                "incidence_angle [deg]": 0.0,
+                "e_n [1]": float(f"{e_rec[i]:.6g}"),
+                "speed_uncertainty [m/s]": float(f"{p['speed_rel_sd'] * speed[i]:.3g}"),
+                "e_n_uncertainty [1]": float(f"{p['e_n_rel_sd'] * e[i]:.3g}"),
+            }
+            if p["angle_sd_deg"] > 0:
+                row["incidence_angle_uncertainty [deg]"] = p["angle_sd_deg"]
+            rows.append(row)
+        true_e.append(e)
+        true_vn.append(vn)
+    df = pd.DataFrame(rows)
+    if p["e_n_rel_sd"] == 0:
+        df = df.drop(columns="e_n_uncertainty [1]")
+    if p["speed_rel_sd"] == 0:
+        df = df.drop(columns="speed_uncertainty [m/s]")
+    df.attrs["generating"] = {k: (list(v) if isinstance(v, tuple) else v) for k, v in p.items()}
+    df.attrs["true_e_n"] = np.concatenate(true_e)
+    df.attrs["true_normal_speed"] = np.concatenate(true_vn)
+    return df
+
+
+def write_synthetic_impacts(path, **overrides):
+    """Make the synthetic table and write it atomically as CSV (:func:`microimpact.io.write_csv`).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    from .io import write_csv
+
+    df = make_synthetic_impacts(**overrides)
+    return write_csv(df, path, float_format="%.6g")

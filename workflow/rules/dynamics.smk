@@ -1,0 +1,59 @@
+# Simulations with the paper's parameters (config "simulation", Table 1 row 2 by default):
+# Fig. 5 phase portraits, the numbers of the nonlinear analysis, the Fig. 4 bifurcation plane and
+# the reproduction table of the paper's claims.
+
+
+rule phase_portraits:
+    output:
+        "results/phase_portraits.nc",
+    params:
+        contact=simulation_contact(),
+        speeds=config["phase_portrait_speeds"],
+    log:
+        "logs/phase_portraits.log",
+    benchmark:
+        "benchmarks/phase_portraits.tsv"
+    script:
+        "../scripts/phase_portraits.py"
+
+
+rule dynamics_summary:
+    output:
+        "results/dynamics.nc",
+    params:
+        contact=simulation_contact(),
+        speeds=config["phase_portrait_speeds"],
+    log:
+        "logs/dynamics_summary.log",
+    benchmark:
+        "benchmarks/dynamics_summary.tsv"
+    script:
+        "../scripts/dynamics_summary.py"
+
+
+rule bifurcation:
+    output:
+        "results/bifurcation.nc",
+    params:
+        contact=simulation_contact(),
+        speeds=config["phase_portrait_speeds"],
+    log:
+        "logs/bifurcation.log",
+    benchmark:
+        "benchmarks/bifurcation.tsv"
+    script:
+        "../scripts/bifurcation.py"
+
+
+rule reproduction:
+    output:
+        table="results/reproduction.csv",
+        markdown="results/reproduction.md",
+    params:
+        contact=simulation_contact(),
+    log:
+        "logs/reproduction.log",
+    benchmark:
+        "benchmarks/reproduction.tsv"
+    script:
+        "../scripts/reproduction.py"

@@ -1,0 +1,11 @@
+"""Rule validate_data: read and check the impact CSV, write the validated table (SI units)."""
+
+import sys
+
+sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+
+from microimpact.io import read_impacts, write_csv  # noqa: E402
+
+table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821
+write_csv(table, snakemake.output.table)  # noqa: F821
+print(f"{len(table)} impacts from {snakemake.input.data} (sha256 {table.attrs.get('sha256', '?')})")  # noqa: F821
