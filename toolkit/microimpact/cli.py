@@ -99,6 +99,110 @@ def build_parser() -> argparse.ArgumentParser:
 _EXTRA_COMMANDS: list = []
 
 
+# ------------------------------------------------------------------ fit, flags (microimpact.fitting, .diagnostics)
+def _existing_file(path: str, what: str):
+    from pathlib import Path
+
+    if not Path(path).is_file():
+        raise UsageError(f"{what} {path!r} does not exist or is not a file")
+    return Path(path)
+
+
+def _writable(path: str, what: str):
+    from pathlib import Path
+
+    p = Path(path)
+    if not (p.parent if str(p.parent) else Path(".")).is_dir():
+        raise UsageError(f"{what} {path!r}: directory {str(p.parent)!r} does not exist")
+    return p
+
+
+def _impacts_for_pair(args):
+    """Read the impact CSV (validated against the materials config) and pick the material pair."""
+    from .io import default_materials_path, read_impacts, read_materials
+
+    data = _existing_file(args.data, "data file")
+    config = _existing_file(args.config, "materials config") if args.config else default_materials_path()
+    pairs = read_materials(config)
+    table = read_impacts(data, materials=pairs)
+    labels = sorted({str(x) for x in table["material_pair"].dropna().unique()})
+    name = args.material_pair or (labels[0] if len(labels) == 1 else None)
+    if name is None:
+        raise UsageError(f"{data}: give --material-pair (the file has {'pairs ' + ', '.join(labels) if labels else 'no material_pair column'})")
+    if name not in pairs:
+        raise UsageError(f"unknown material pair {name!r}; known pairs in {config}: {', '.join(pairs)}")
+    keep = table["material_pair"].isna() | (table["material_pair"] == name)
+    if not keep.any():
+        raise UsageError(f"{data}: no impacts of material pair {name!r}")
+    sub = table[keep.to_numpy()].reset_index(drop=True)
+    sub.attrs = dict(table.attrs)
+    return sub, pairs[name]
+
+
+def _cmd_fit(args) -> int:
+    from .fitting import fit_damping
+
+    out = _writable(args.out, "--out")
+    table, pair = _impacts_for_pair(args)
+    print(f"fitting {len(table)} impacts of {pair.name} ...", file=sys.stderr, flush=True)
+    fit = fit_damping(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
+                      confidence_intervals=not args.no_confidence_intervals)
+    fit.save(out)
+    print(fit.report())
+    print(f"wrote {out}", file=sys.stderr)
+    return 0
+
+
+def register_fit(sub) -> None:
+    """``microimpact fit DATA.csv --out fit.nc``: fit zeta_H, zeta_A (and w_A) to e_n(v_n)."""
+    p = sub.add_parser("fit", help="fit the damping coefficients to measured e_n(v_n)")
+    p.add_argument("data", help="measured-impact CSV (data/README.md, 'Measured-impact CSV format')")
+    p.add_argument("--config", help="materials config YAML (default: the bundled one)")
+    p.add_argument("--material-pair", help="material pair to fit (default: the file's only pair)")
+    p.add_argument("--fit-work-of-adhesion", action="store_true", help="also fit w_A (shared by all radii)")
+    p.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto", help="weighting (default auto)")
+    p.add_argument("--no-confidence-intervals", action="store_true", help="skip lmfit.conf_interval (faster)")
+    p.add_argument("--out", required=True, help="output NetCDF of the fit")
+    p.set_defaults(func=_cmd_fit)
+
+
+def _cmd_flags(args) -> int:
+    from .diagnostics import flag_measurements, write_flags
+    from .fitting import DampingFit
+
+    out = _writable(args.out, "--out")
+    nc = _writable(args.nc, "--nc") if args.nc else None
+    fit = DampingFit.load(_existing_file(args.fit, "fit file"))
+    table, _ = _impacts_for_pair(args)
+    ds = flag_measurements(table, fit, spin_bound=args.spin_bound, angle_uncertainty_deg=args.angle_uncertainty_deg,
+                           progress=True)
+    write_flags(ds, out, nc)
+    n = ds.sizes["impact"]
+    print(f"{n} impacts: {int(ds['rotation_sensitive'].sum())} rotation_sensitive, "
+          f"{int(ds['angle_sensitive'].sum())} angle_sensitive, {int(ds['near_capture'].sum())} near_capture; "
+          f"wrote {out}" + (f" and {nc}" if nc else ""))
+    return 0
+
+
+def register_flags(sub) -> None:
+    """``microimpact flags DATA.csv --fit fit.nc --out flags.csv``: per-measurement flags."""
+    p = sub.add_parser("flags", help="flag impacts sensitive to unmeasured spin, angle error, or near capture")
+    p.add_argument("data", help="measured-impact CSV")
+    p.add_argument("--fit", required=True, help="fit NetCDF written by 'microimpact fit'")
+    p.add_argument("--config", help="materials config YAML (default: the bundled one)")
+    p.add_argument("--material-pair", help="material pair (default: the file's only pair)")
+    p.add_argument("--out", required=True, help="output CSV, one row per impact keyed by 'row'")
+    p.add_argument("--nc", help="also write the flags as NetCDF")
+    p.add_argument("--spin-bound", type=_finite_float, default=None, metavar="RAD_S",
+                   help="largest initial spin sampled [rad/s] (default: speed / radius per impact)")
+    p.add_argument("--angle-uncertainty-deg", type=_finite_float, default=None, metavar="DEG",
+                   help="incidence-angle uncertainty [deg] (default: the file's column, else 2)")
+    p.set_defaults(func=_cmd_flags)
+
+
+_EXTRA_COMMANDS += [register_fit, register_flags]
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     try:

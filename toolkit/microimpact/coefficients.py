@@ -121,14 +121,16 @@ class ImpactResult:
     slip_end_time : float
         Time at which sliding ended; NaN if it did not. [s]
     friction_impulse : float
-        int |F_n| dt over the contact (to the end of the tail when captured). [N s]
+        int |F_n| dt over the contact; for a captured sphere over the part followed, which lasts
+        until sliding and twist have ended or the rest of the tail is negligible. [N s]
     dissipated_energy : float
-        Energy dissipated by normal damping plus friction (sliding and twist), tracked by the
-        solver, so that initial kinetic energy = final kinetic energy (+ contact energy when
-        captured) + dissipated_energy. [J]
+        Energy dissipated by normal damping plus friction (sliding and twist), so that initial
+        kinetic energy = final kinetic energy + final_contact_energy + dissipated_energy. For a
+        rebound the damping part is integrated by the solver; for a captured sphere it is all the
+        damping down to rest at the equilibrium. [J]
     final_contact_energy : float
-        Contact potential energy V(x) plus normal kinetic energy left at the end; 0 for a rebound,
-        the energy of the settled sphere when captured. [J]
+        Normal contact energy left at the end: 0 for a rebound; for a captured sphere the energy
+        V(X) = -(4/15) m (X/T)^2 of the sphere at rest at the equilibrium. [J]
     method : str
         "engine" or "reference:<scipy method>".
     stop_reason : str

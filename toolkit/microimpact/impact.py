@@ -35,7 +35,7 @@ RESULT_VARIABLES: dict[str, tuple[str, str]] = {
     "max_penetration": ("m", "largest penetration x = -n"),
     "slip_ended": ("1", "1 if sliding ended and the sphere rolls"),
     "friction_impulse": ("N s", "integral of |F_n| over the contact"),
-    "dissipated_energy": ("J", "energy dissipated by damping and friction"),
+    "dissipated_energy": ("J", "energy dissipated by damping and friction (to rest if captured)"),
 }
 
 
@@ -117,11 +117,25 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
         slip_ended=slip_ended,
         slip_end_time=(0.0 if slip == 0.0 else sol.slip_end_time) if slip_ended else math.nan,
         friction_impulse=sol.friction_impulse,
-        dissipated_energy=sol.dissipated_energy + float(tan["friction_dissipation"]),
-        final_contact_energy=sol.final_energy if captured else 0.0,
+        dissipated_energy=_normal_dissipation(contact, -v_in[0], captured, sol.dissipated_energy)
+        + float(tan["friction_dissipation"]),
+        final_contact_energy=settled_contact_energy(contact) if captured else 0.0,
         method="engine",
         stop_reason=sol.outcome if not captured else ("settled" if needs_tangential else "capture"),
     )
+
+
+def settled_contact_energy(contact) -> float:
+    """Contact energy V(X) = -(4/15) m (X/T)^2 of a sphere at rest at the equilibrium. [J]"""
+    return -4.0 / 15.0 * contact.mass * (contact.length_scale / contact.time_scale) ** 2
+
+
+def _normal_dissipation(contact, normal_speed, captured, tracked):
+    """Energy dissipated by the normal damping: as tracked by the solver for a rebound; for a
+    captured sphere all of it down to rest at the equilibrium, m v_n^2/2 - V(X), which does not
+    depend on how far the solver followed the captured oscillation."""
+    to_rest = 0.5 * contact.mass * np.square(normal_speed) - settled_contact_energy(contact) if contact.adhesion_line_force > 0 else 0.0
+    return np.where(captured, to_rest, tracked)
 
 
 def _as_dataarray(name, value):
@@ -242,7 +256,8 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         "max_penetration": g["max_penetration"],
         "slip_ended": tan["slip_ended"].astype(np.int8),
         "friction_impulse": g["friction_impulse"],
-        "dissipated_energy": g["dissipated_energy"] + tan["friction_dissipation"],
+        "dissipated_energy": _normal_dissipation(contact, -v_n, captured, g["dissipated_energy"])
+        + tan["friction_dissipation"],
     }
     coords = {name: c for a in arrays for name, c in a.coords.items()}
     ds = xr.Dataset(coords=coords)

@@ -512,7 +512,7 @@ def plot_bifurcation_plane(ds: xr.Dataset, *, label_points: bool = True) -> Plot
     line = ds["critical_line_C2"].values if "critical_line_C2" in ds else 2.0 - c1
     ok = line >= min(c2)
     ax.plot(c1[ok], line[ok], color="k", lw=1.5, label="C = C1 + C2 = 2")
-    ax.text(0.55, 0.62, "C < 2\nspiral sink", ha="center", va="center", fontsize=7.5)
+    ax.text(0.85, 0.42, "C < 2\nspiral sink", ha="center", va="center", fontsize=7)
     ax.text(0.72, 0.72, "C > 2: sink\n(no oscillation)", transform=ax.transAxes, ha="center", fontsize=8)
     handles = []
     if "case" in ds.dims:
@@ -535,8 +535,9 @@ def plot_bifurcation_plane(ds: xr.Dataset, *, label_points: bool = True) -> Plot
                                   label=f"v_n = {_fmt_value(v)} m/s"))
     ax.set_xlabel(r"$C_1 = C_H X/T$, Eq. (31) [-]")
     ax.set_ylabel(r"$C_2 = C_A X/T$, Eq. (32) [-]")
-    ax.set_xlim(c1.min(), c1.max())
-    ax.set_ylim(c2.min(), c2.max())
+    pad1, pad2 = 0.02 * np.ptp(c1), 0.02 * np.ptp(c2)  # points sit near C1 = 0: keep them off the spine
+    ax.set_xlim(c1.min() - pad1, c1.max())
+    ax.set_ylim(c2.min() - pad2, c2.max())
     ax.grid(False)
     ax.legend(handles=[Line2D([], [], color="k", lw=1.5, label="C = 2")] + handles, loc="upper left",
               bbox_to_anchor=(1.02, 1.0), frameon=False, fontsize=7)
@@ -581,7 +582,7 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
         else:
             order = np.argsort(v)
             ax.plot(v[order], fit["e_n_model"].values[sel][order], color=col, lw=1.3)
-        handles.append(Line2D([], [], color=col, marker="o", ms=3.2, label=f"d = {2 * r * 1e6:.3g} um"))
+        handles.append(Line2D([], [], color=col, marker="o", ms=3.2, label=f"d = {2 * r * 1e6:.3g} µm"))
     ax.set_xscale("log")
     ax.set_xlabel(r"incident normal speed $v_n$ [m/s]")
     ax.set_ylabel(r"$e_n$ [-]")

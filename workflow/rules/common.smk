@@ -10,6 +10,19 @@ wildcard_constraints:
     nchunks=r"\d+",
 
 
+def as_bool(value):
+    """A validated flag: a bool, or its text form from snakemake --config."""
+    return value if isinstance(value, bool) else str(value).lower() == "true"
+
+
+# normalise the flags (the schema allows their text form) so that scripts receive bools
+config.setdefault("data_synthetic", "auto")
+if config["data_synthetic"] != "auto":
+    config["data_synthetic"] = as_bool(config["data_synthetic"])
+config["fit"] = {k: (as_bool(v) if k != "weights" else v) for k, v in config["fit"].items()}
+config["benchmark"] = {"quick": True, **config["benchmark"]}
+config["benchmark"] = {k: as_bool(v) for k, v in config["benchmark"].items()}
+
 SWEEP_CASES = list(config["sweeps"])
 SWEEP_CHUNKS = int(config["sweep_chunks"])
 BENCHMARK_ENABLED = bool(config["benchmark"]["enabled"])
@@ -41,6 +54,6 @@ def sweep_chunk_files(wildcards):
     ]
 
 
-def benchmark_outputs():
+def benchmark_outputs(wildcards):
     """Work-precision results for the report; none when the benchmark is switched off."""
     return {"work_precision": "results/work_precision.nc"} if BENCHMARK_ENABLED else {}

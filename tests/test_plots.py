@@ -1,0 +1,148 @@
+"""Figure functions: they return labelled matplotlib Figures with captions and save to PDF."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+import xarray as xr  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+from microimpact import dynamics, plots, presets, sweeps  # noqa: E402
+
+C = presets.WALL_1990
+SPEEDS = [0.5, 1.2, 1.6, 3.0, 10.0]
+
+
+@pytest.fixture(scope="module")
+def sweep23():
+    spec = dict(sweeps.TABLE2_CASES["2.3"], speed=SPEEDS, incidence_deg=[0.0, 30.0])
+    return sweeps.run_sweep(C, spec, case="2.3")
+
+
+@pytest.fixture(scope="module")
+def sweep22():
+    spec = dict(sweeps.TABLE2_CASES["2.2"], speed=SPEEDS, omega_tp=[0.0, 1.8e5])
+    return sweeps.run_sweep(C, spec, case="2.2", capture_speed=False)
+
+
+def axes_with_data(fig):
+    return [ax for ax in fig.axes if ax.lines or ax.collections]
+
+
+def check(plot, tmp_path, name, units=("[",)):
+    assert isinstance(plot, plots.Plot)
+    assert isinstance(plot.figure, Figure)
+    assert len(plot.caption) > 40
+    for ax in axes_with_data(plot.figure):
+        for label in (ax.get_xlabel(), ax.get_ylabel()):
+            assert label, f"{name}: unlabelled axis"
+            assert any(u in label for u in units), f"{name}: no unit in {label!r}"
+    path = tmp_path / f"{name}.pdf"
+    plot.figure.savefig(path)
+    assert path.read_bytes()[:5] == b"%PDF-"
+    return plot
+
+
+def test_energy_loss(sweep23, tmp_path):
+    p = check(plots.plot_energy_loss(sweep23), tmp_path, "fig11")
+    assert p.paper_figure == "11"
+    ax = p.figure.axes[0]
+    assert "[-]" in ax.get_ylabel() and "[m/s]" in ax.get_xlabel()
+    legend = p.figure.axes[2].get_legend()
+    assert legend is not None and "deg" in legend.get_title().get_text()
+    assert "1.45" in p.caption  # capture velocity is stated (and marked)
+
+
+def test_restitution_and_impulse_gaps_below_capture(sweep23, tmp_path):
+    p = check(plots.plot_restitution_and_impulse(sweep23), tmp_path, "fig12")
+    assert p.paper_figure == "12"
+    assert len(axes_with_data(p.figure)) == 3  # e_n, mu_t, mu_t'
+    mu_ax = p.figure.axes[1]
+    y = mu_ax.lines[0].get_ydata()
+    # captured impacts (0.5 and 1.2 m/s) are gaps, not zeros
+    assert np.isnan(y[:2]).all() and np.isfinite(y[2:]).all()
+
+
+def test_in_plane_sweep_drops_the_zero_panel(sweep22, tmp_path):
+    # case 2.2 spins about t' only: mu_t' is 0 throughout and is left out (said in the caption)
+    p = check(plots.plot_restitution_and_impulse(sweep22), tmp_path, "fig10")
+    assert len(axes_with_data(p.figure)) == 2
+    assert "not shown" in p.caption
+    check(plots.plot_energy_loss(sweep22), tmp_path, "fig9")  # capture estimated from the grid
+
+
+def test_two_curve_dimensions_need_a_selection():
+    spec = {"speed": [1.6, 3.0], "incidence_deg": [0.0, 10.0], "friction": [0.1, 0.2]}
+    ds = sweeps.run_sweep(C, spec, capture_speed=False)
+    with pytest.raises(ValueError, match="several dimensions"):
+        plots.plot_energy_loss(ds)
+    plots.plot_energy_loss(ds.sel(friction=0.1))
+
+
+def test_phase_portraits(tmp_path):
+    portraits = [dynamics.phase_portrait(C, v, rtol=1e-8) for v in (0.5, 1e-5)]
+    p = check(plots.plot_phase_portraits(portraits), tmp_path, "fig5")
+    assert "capture with oscillation" in p.caption and "capture without oscillation" in p.caption
+
+
+def test_bifurcation_plane(tmp_path):
+    ds = dynamics.bifurcation_plane(n_c1=41, n_c2=41)
+    p = check(plots.plot_bifurcation_plane(ds), tmp_path, "fig4", units=("[-]",))
+    assert "C = 2" in p.caption or "C > 2" in p.caption
+
+
+def fit_dataset():
+    """Hand-built dataset with the layout of fitting.DampingFit.to_dataset() (no fit run)."""
+    rng = np.random.default_rng(0)
+    radius = np.repeat([1.29e-6, 3.45e-6], 6)
+    v = np.tile(np.geomspace(2, 60, 6), 2)
+    e_model = 0.7 * (1 - np.exp(-v / 5 / (radius / 3.45e-6) ** -1))
+    ds = xr.Dataset(
+        {
+            "radius": ("point", radius, {"units": "m", "long_name": "sphere radius"}),
+            "normal_speed": ("point", v, {"units": "m s-1", "long_name": "incident normal speed"}),
+            "e_n_measured": ("point", e_model + rng.normal(0, 0.02, v.size), {"units": "1", "long_name": "measured"}),
+            "sigma": ("point", np.full(v.size, 0.02), {"units": "1", "long_name": "uncertainty"}),
+            "e_n_model": ("point", e_model, {"units": "1", "long_name": "model"}),
+            "zeta_hertz": ((), 0.5, {"units": "1"}),
+            "zeta_hertz_stderr": ((), 0.05, {"units": "1"}),
+            "zeta_adhesion": ((), 29.0, {"units": "1"}),
+            "zeta_adhesion_stderr": ((), 0.2, {"units": "1"}),
+            "work_of_adhesion": ((), 0.216, {"units": "J m-2"}),
+            "work_of_adhesion_stderr": ((), np.nan, {"units": "J m-2"}),
+        },
+        attrs={"redchi": 1.1, "fit_source": "synthetic_impacts.csv"},
+    )
+    return ds
+
+
+def test_fit(tmp_path):
+    p = check(plots.plot_fit(fit_dataset()), tmp_path, "fig3")
+    assert "SYNTHETIC" in p.caption and "(fixed)" in p.caption
+    assert len(p.figure.axes[0].get_legend().get_texts()) == 4  # 2 sizes + data + model
+
+
+def test_work_precision(tmp_path):
+    ds = xr.Dataset(
+        {
+            "time_per_impact": (("method", "setting"), [[1e-5, 2e-5], [1e-3, 4e-3]], {"units": "s"}),
+            "max_error_e_n": (("method", "setting"), [[1e-5, 1e-8], [1e-4, np.nan]], {"units": "1"}),
+            "max_error_mu": (("method", "setting"), [[1e-5, 1e-8], [1e-4, 1e-9]], {"units": "1"}),
+        },
+        coords={"method": ["engine", "reference"], "setting": ["1e-6", "1e-9"]},
+    )
+    p = check(plots.plot_work_precision(ds), tmp_path, "work_precision")
+    ax = p.figure.axes[0]
+    assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
+
+
+def test_kharaz(tmp_path):
+    import pandas as pd
+
+    df = pd.DataFrame({"quantity": ["tangential_restitution", "rebound_spin", "rebound_angle"],
+                       "incidence_angle_deg": [20.0, 20.0, 20.0], "value": [0.6, 570.0, 12.0],
+                       "units": ["1", "rad s-1", "degree"]})
+    ds = sweeps.kharaz_comparison(df, incidence_deg=np.arange(1.0, 80.0, 3.0))
+    check(plots.plot_kharaz(ds), tmp_path, "kharaz")

@@ -1,0 +1,819 @@
+"""The PDF report of the pipeline, and the few pipeline products that no other module makes.
+
+:func:`build_report` assembles ``reports/report.pdf`` from the NetCDF/CSV results of the Snakemake
+workflow (``Snakefile``, ``workflow/``): a title page with provenance, the damping fit (Fig. 3
+analogue), the nonlinear analysis (Figs. 4 and 5), the Table 2 sweeps (Figs. 7-14), the
+measurement flags, the Kharaz et al. (2001) validation, the work-precision benchmark, the
+reproduction table of the paper's claims and the configuration. Figures come from
+:mod:`microimpact.plots` (one :class:`~microimpact.plots.Plot` per figure, with its caption); this
+module only lays them out on A4 pages with matplotlib's PdfPages (figures are embedded as 200 dpi
+images, captions and tables as text so the PDF is searchable).
+
+Pipeline products defined here (used by the workflow's thin scripts):
+
+* :func:`phase_portraits` / :func:`save_phase_portraits` / :func:`load_phase_portraits` - the
+  Fig. 5 trajectories at several speeds in one NetCDF file (one group per speed);
+* :func:`dynamics_summary` - the numbers of the nonlinear analysis (v_c, capture speed, C,
+  omega_f) as a Dataset;
+* :func:`is_synthetic`, :func:`git_commit`, :func:`provenance` - what the title page states.
+
+Paper: Cheng, Brach & Dunn (2002), Aerosol Sci. Technol. 36:1081-1093, doi:10.1080/02786820290092221.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import math
+import os
+import platform
+import subprocess
+import textwrap
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+__all__ = [
+    "build_report",
+    "phase_portraits",
+    "save_phase_portraits",
+    "load_phase_portraits",
+    "dynamics_summary",
+    "is_synthetic",
+    "git_commit",
+    "provenance",
+    "PAGE_SIZE",
+]
+
+PAPER = ("Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere "
+         "Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093, "
+         "doi:10.1080/02786820290092221")
+
+#: A4 portrait, inches
+PAGE_SIZE = (8.27, 11.69)
+_MARGIN_X = 0.65  # in
+_TOP = 0.75  # in, below the top edge: running header
+_BOTTOM = 0.75  # in, above the bottom edge: footer
+_TEXT_WIDTH = PAGE_SIZE[0] - 2 * _MARGIN_X
+_DPI = 200  # embedded figures
+_BODY_PT = 8.5
+_TABLE_PT = 6.6
+
+
+# =============================================================================== products
+def phase_portraits(contact, speeds: Sequence[float], **kwargs) -> list[xr.Dataset]:
+    """Fig. 5 trajectories: :func:`microimpact.dynamics.phase_portrait` at each normal speed.
+
+    Parameters
+    ----------
+    contact : Contact
+    speeds : sequence of float
+        Incident normal speeds. [m/s]
+    **kwargs
+        Passed to :func:`~microimpact.dynamics.phase_portrait` (``rtol``, ``settle_amplitude``).
+
+    Returns
+    -------
+    list of xarray.Dataset
+        One trajectory per speed, in the order given.
+    """
+    from .dynamics import phase_portrait
+
+    return [phase_portrait(contact, float(v), **kwargs) for v in speeds]
+
+
+def _group_name(i: int, ds: xr.Dataset) -> str:
+    return f"portrait_{i}"
+
+
+def save_phase_portraits(portraits: Sequence[xr.Dataset], path) -> Path:
+    """Write several phase portraits to one NetCDF-4 file atomically, one group per trajectory.
+
+    Groups are ``portrait_0``, ``portrait_1``, ... in the order given (each keeps its own ``time``
+    coordinate and attributes); the root group lists them in the attribute ``portraits`` and
+    their speeds in ``normal_speeds`` [m/s].
+    """
+    from .io.files import _netcdf_encoding, atomic_path
+
+    path = Path(path)
+    names = [_group_name(i, ds) for i, ds in enumerate(portraits)]
+    root = xr.Dataset(attrs={
+        "title": "Phase portraits of normal impacts (Cheng, Brach & Dunn 2002, Fig. 5)",
+        "portraits": " ".join(names),
+        "normal_speeds": np.array([float(ds.attrs.get("normal_speed", math.nan)) for ds in portraits]),
+        "normal_speeds_units": "m/s",
+        "references": PAPER,
+    })
+    with atomic_path(path) as tmp:
+        root.to_netcdf(tmp, mode="w", engine="netcdf4", format="NETCDF4")
+        for name, ds in zip(names, portraits):
+            ds.to_netcdf(tmp, mode="a", group=name, engine="netcdf4", format="NETCDF4",
+                         encoding=_netcdf_encoding(ds))
+    return path
+
+
+def load_phase_portraits(path) -> list[xr.Dataset]:
+    """Read the trajectories written by :func:`save_phase_portraits`, in their order."""
+    with xr.open_dataset(path, engine="netcdf4") as root:
+        names = str(root.attrs.get("portraits", "")).split()
+    out = []
+    for name in names:
+        with xr.open_dataset(path, group=name, engine="netcdf4") as ds:
+            out.append(ds.load())
+    return out
+
+
+def dynamics_summary(contact, speeds: Sequence[float]) -> xr.Dataset:
+    """The numbers of the nonlinear analysis (Eqs. (29)-(38)) for a contact at some normal speeds.
+
+    Parameters
+    ----------
+    contact : Contact
+        Must be adhesive (f0 > 0) for the nondimensional analysis.
+    speeds : sequence of float
+        Incident normal speeds. [m/s]
+
+    Returns
+    -------
+    xarray.Dataset
+        Scalars ``mass`` [kg], ``length_scale`` X [m], ``time_scale`` T [s],
+        ``critical_velocity`` v_c (Eq. (38), NaN with a fixed damping reference speed) [m/s] and
+        ``capture_velocity`` (largest captured normal speed, by bisection) [m/s]; along ``speed``
+        [m/s]: ``C1``, ``C2``, ``C`` (Eqs. (31)-(35)) [-], ``equilibrium_type`` (text) and
+        ``asymptotic_frequency`` omega_f (NaN for C >= 2) [rad/s].
+    """
+    from . import dynamics
+
+    speeds = np.asarray([float(v) for v in speeds])
+    c12 = np.array([contact.nondimensional_damping(v) for v in speeds]).reshape(-1, 2)
+    c = c12.sum(axis=1)
+    omega_f = np.array([float(dynamics.asymptotic_frequency(contact, v)) for v in speeds])
+    try:
+        v_c = float(dynamics.critical_velocity(contact))
+    except ValueError:
+        v_c = math.nan
+    ds = xr.Dataset(
+        {
+            "mass": ((), contact.mass, {"units": "kg", "long_name": "sphere mass m"}),
+            "length_scale": ((), contact.length_scale, {"units": "m", "long_name": "length scale X = 2 pi f0 / K, Eq. (29)"}),
+            "time_scale": ((), contact.time_scale, {"units": "s", "long_name": "time scale T, Eq. (30) corrected"}),
+            "critical_velocity": ((), v_c, {"units": "m/s", "long_name": "critical velocity v_c (C = 2), Eq. (38)"}),
+            "capture_velocity": ((), float(dynamics.capture_velocity(contact)), {
+                "units": "m/s", "long_name": "normal capture velocity (below it the sphere is captured)"}),
+            "C1": ("speed", c12[:, 0], {"units": "1", "long_name": "C1 = C_H X / T, Eq. (31)"}),
+            "C2": ("speed", c12[:, 1], {"units": "1", "long_name": "C2 = C_A X / T, Eq. (32)"}),
+            "C": ("speed", c, {"units": "1", "long_name": "total damping C = C1 + C2, Eq. (35)"}),
+            "equilibrium_type": ("speed", np.array([dynamics.equilibrium_type(x) for x in c], dtype=object), {
+                "long_name": "nature of the equilibrium (1, 0), Eq. (36)"}),
+            "asymptotic_frequency": ("speed", omega_f, {
+                "units": "rad/s", "long_name": "asymptotic angular frequency sqrt(4 - C^2) / (2 T) (Eq. (37) corrected)"}),
+        },
+        coords={"speed": ("speed", speeds, {"units": "m/s", "long_name": "incident normal speed"})},
+        attrs={"title": "Nonlinear dynamics of the normal contact (Cheng, Brach & Dunn 2002, Eqs. 28-38)",
+               "references": PAPER},
+    )
+    from .impact import contact_attributes
+
+    ds.attrs.update(contact_attributes(contact))
+    return ds
+
+
+# =============================================================================== provenance
+def is_synthetic(data_path, flag="auto") -> bool:
+    """Whether a data file is synthetic: ``flag`` if it is a bool; for "auto", True when the file
+    name contains "synthetic" (the bundled data/synthetic_microspheres.csv does)."""
+    if isinstance(flag, bool):
+        return flag
+    if flag != "auto":
+        raise ValueError(f"data_synthetic must be true, false or 'auto', got {flag!r}")
+    return "synthetic" in Path(os.fspath(data_path)).name.lower()
+
+
+def git_commit(directory=".") -> str | None:
+    """``<commit>`` (``+ uncommitted changes`` when the tree is dirty) of the git checkout at
+    ``directory``, or None when git or the repository is not available. Read-only."""
+    try:
+        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=directory, capture_output=True, text=True,
+                              timeout=10, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=directory,
+                               capture_output=True, text=True, timeout=10, check=True).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return head + (" + uncommitted changes" if dirty else "") if head else None
+
+
+def provenance(config: Mapping | None = None, *, data_path=None, data_table=None) -> dict[str, str]:
+    """The facts of the title page, as label -> text."""
+    from . import __version__
+
+    config = dict(config or {})
+    data_path = data_path or config.get("data")
+    synthetic = is_synthetic(data_path or "", config.get("data_synthetic", "auto")) if data_path else False
+    out = {
+        "toolkit": f"microimpact {__version__}",
+        "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "git commit": git_commit() or "not available (not a git checkout)",
+        "python": f"{platform.python_version()} on {platform.system()} {platform.machine()}",
+        "data": f"{data_path}" + ("  -- SYNTHETIC data (generated, not measured)" if synthetic else "  -- measured data"),
+    }
+    if data_table is not None and len(data_table):
+        t = data_table
+        radii = np.unique(np.round(t["radius"].to_numpy(float) * 1e6, 4))
+        v = t["normal_speed"].to_numpy(float)
+        out["data content"] = (f"{len(t)} impacts, {len(radii)} radii ({', '.join(f'{r:g}' for r in radii)} um), "
+                               f"normal speed {np.nanmin(v):.3g}-{np.nanmax(v):.3g} m/s")
+        sha = t.attrs.get("sha256") if hasattr(t, "attrs") else None
+        if sha:
+            out["data sha256"] = sha
+    if config:
+        out["materials"] = f"{config.get('materials')} (pair {config.get('material_pair')})"
+        sim = config.get("simulation", {})
+        out["simulation contact"] = ", ".join(f"{k} = {v:g}" for k, v in sim.items() if isinstance(v, (int, float)))
+        fit = config.get("fit", {})
+        out["fit options"] = ", ".join(f"{k} = {v}" for k, v in fit.items()) or "defaults"
+        sweeps = config.get("sweeps", {})
+        out["sweeps"] = (f"Table 2 cases {', '.join(sweeps)}; {config.get('sweep_chunks', 1)} chunk(s) per case"
+                         if sweeps else "none")
+        bench = config.get("benchmark", {})
+        out["benchmark"] = ("on" + (" (quick)" if bench.get("quick", True) else " (full)")) if bench.get("enabled") else "off"
+    return out
+
+
+# =============================================================================== page layout
+def _wrap(text: str, width: int) -> list[str]:
+    lines: list[str] = []
+    for para in str(text).split("\n"):
+        lines.extend(textwrap.wrap(para, width=width, break_long_words=True, break_on_hyphens=False) or [""])
+    return lines
+
+
+@dataclass
+class _Page:
+    figure: object
+    section: str
+    y: float  # inches from the top edge to the next free line
+
+
+@dataclass
+class _Layout:
+    """Flows headings, figures, paragraphs and tables onto A4 pages (all figures kept until the end)."""
+
+    title: str
+    pages: list = field(default_factory=list)
+    contents: list = field(default_factory=list)  # (section, page index)
+
+    # ------------------------------------------------------------------ pages
+    def new_page(self, section: str) -> _Page:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=PAGE_SIZE)
+        page = _Page(fig, section, _TOP + 0.15)
+        self.pages.append(page)
+        return page
+
+    @property
+    def page(self) -> _Page:
+        return self.pages[-1]
+
+    def _room(self, height: float) -> bool:
+        return self.page.y + height <= PAGE_SIZE[1] - _BOTTOM
+
+    def ensure(self, height: float) -> _Page:
+        if not self.pages or not self._room(height):
+            self.new_page(self.pages[-1].section if self.pages else "")
+        return self.page
+
+    def _text(self, x_in: float, y_in: float, text: str, **kw):
+        return self.page.figure.text(x_in / PAGE_SIZE[0], 1.0 - y_in / PAGE_SIZE[1], text, va="top", **kw)
+
+    # ------------------------------------------------------------------ blocks
+    def section(self, title: str, *, new_page: bool = True) -> None:
+        if new_page or not self.pages:
+            self.new_page(title)
+        else:
+            self.ensure(0.8)
+            self.page.section = title
+        self.contents.append((title, len(self.pages) - 1))
+        self._text(_MARGIN_X, self.page.y, title, fontsize=13, fontweight="bold")
+        self.page.y += 0.38
+
+    def heading(self, text: str) -> None:
+        self.ensure(0.9)
+        self._text(_MARGIN_X, self.page.y, text, fontsize=10, fontweight="bold")
+        self.page.y += 0.26
+
+    def paragraph(self, text: str, *, size: float = _BODY_PT, mono: bool = False, gap: float = 0.1,
+                  color: str = "black") -> None:
+        chars = int(_TEXT_WIDTH * 72 / (size * (0.61 if mono else 0.53)))
+        line_h = size * 1.32 / 72
+        lines = _wrap(text, chars)
+        while lines:
+            self.ensure(line_h * min(len(lines), 2))
+            fit = max(1, int((PAGE_SIZE[1] - _BOTTOM - self.page.y) / line_h))
+            chunk, lines = lines[:fit], lines[fit:]
+            self._text(_MARGIN_X, self.page.y, "\n".join(chunk), fontsize=size, linespacing=1.32,
+                       family="monospace" if mono else "sans-serif", color=color)
+            self.page.y += line_h * len(chunk)
+        self.page.y += gap
+
+    def plot(self, plot, *, max_height: float = 5.2) -> None:
+        """A :class:`microimpact.plots.Plot`: the figure as an image, its caption below."""
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        fig = plot.figure
+        w, h = fig.get_size_inches()
+        scale = min(1.0, _TEXT_WIDTH / w, max_height / h)
+        ww, hh = w * scale, h * scale
+        cap_lines = len(_wrap(plot.caption, int(_TEXT_WIDTH * 72 / (_BODY_PT * 0.53))))
+        self.ensure(hh + 0.1 + cap_lines * _BODY_PT * 1.32 / 72)
+        canvas = FigureCanvasAgg(fig)
+        fig.set_dpi(_DPI)
+        canvas.draw()
+        img = np.asarray(canvas.buffer_rgba())
+        x0 = _MARGIN_X + (_TEXT_WIDTH - ww) / 2
+        ax = self.page.figure.add_axes([x0 / PAGE_SIZE[0], 1.0 - (self.page.y + hh) / PAGE_SIZE[1],
+                                        ww / PAGE_SIZE[0], hh / PAGE_SIZE[1]])
+        ax.imshow(img, interpolation="antialiased", aspect="auto")
+        ax.set_axis_off()
+        self.page.y += hh + 0.08
+        label = f"Figure (analogue of the paper's Fig. {plot.paper_figure}). " if plot.paper_figure else "Figure. "
+        self.paragraph(label + plot.caption, gap=0.22)
+        import matplotlib.pyplot as plt  # noqa: F401 - figures made with Figure() need no closing
+
+    def table(self, df: pd.DataFrame, widths: Mapping[str, int], *, headers: Mapping[str, str] | None = None,
+              size: float = _TABLE_PT, caption: str | None = None) -> None:
+        """A table as monospaced text with wrapped cells, paginated with the header repeated.
+
+        ``widths`` gives the columns to show and their width in characters.
+        """
+        headers = dict(headers or {})
+        cols = [c for c in widths if c in df.columns]
+        line_h = size * 1.3 / 72
+        char_w = size * 0.602 / 72  # DejaVu Sans Mono advance width
+        total = sum(widths[c] for c in cols) + 2 * (len(cols) - 1)
+        scale_size = size if total * char_w <= _TEXT_WIDTH else size * _TEXT_WIDTH / (total * char_w)
+        line_h = scale_size * 1.3 / 72
+
+        def fmt_row(cells: list[list[str]]) -> list[str]:
+            n = max(len(c) for c in cells)
+            return ["  ".join((c[i] if i < len(c) else "").ljust(widths[col]) for c, col in zip(cells, cols)).rstrip()
+                    for i in range(n)]
+
+        head = fmt_row([_wrap(headers.get(c, c), widths[c]) for c in cols])
+        rule = "-" * total
+        rows = []
+        for _, r in df.iterrows():
+            rows.append(fmt_row([_wrap(_cell(r[c]), widths[c]) for c in cols]))
+        if caption:
+            self.paragraph(caption)
+        i = 0
+        while i < len(rows):
+            self.ensure(line_h * (len(head) + 1 + len(rows[i])))
+            avail = PAGE_SIZE[1] - _BOTTOM - self.page.y
+            block = head + [rule]
+            while i < len(rows) and (len(block) + len(rows[i])) * line_h <= avail:
+                block += rows[i]
+                i += 1
+            if len(block) == len(head) + 1:  # a single row taller than a page: cut it
+                block += rows[i][: max(1, int(avail / line_h) - len(block))]
+                i += 1
+            self._text(_MARGIN_X, self.page.y, "\n".join(block), fontsize=scale_size, family="monospace",
+                       linespacing=1.3)
+            self.page.y += line_h * len(block) + 0.15
+            if i < len(rows):
+                self.new_page(self.page.section)
+                self._text(_MARGIN_X, self.page.y, f"{self.page.section} (continued)", fontsize=10, fontweight="bold")
+                self.page.y += 0.26
+
+    # ------------------------------------------------------------------ output
+    def save(self, path, metadata: Mapping[str, str]) -> None:
+        from matplotlib.backends.backend_pdf import PdfPages
+
+        from .io.files import atomic_path
+
+        n = len(self.pages)
+        with atomic_path(path) as tmp:
+            with PdfPages(tmp, metadata=dict(metadata)) as pdf:
+                for k, page in enumerate(self.pages, start=1):
+                    fig = page.figure
+                    fig.text(_MARGIN_X / PAGE_SIZE[0], 1.0 - 0.45 / PAGE_SIZE[1], self.title, fontsize=7, color="0.4",
+                             va="bottom")
+                    fig.text(1.0 - _MARGIN_X / PAGE_SIZE[0], 1.0 - 0.45 / PAGE_SIZE[1], page.section, fontsize=7,
+                             color="0.4", va="bottom", ha="right")
+                    fig.add_artist(_hline(fig, 1.0 - 0.5 / PAGE_SIZE[1]))
+                    fig.text(0.5, 0.4 / PAGE_SIZE[1], f"page {k} of {n}", fontsize=7, color="0.4", ha="center")
+                    pdf.savefig(fig)
+
+
+def _hline(fig, y):
+    from matplotlib.lines import Line2D
+
+    x0, x1 = _MARGIN_X / PAGE_SIZE[0], 1 - _MARGIN_X / PAGE_SIZE[0]
+    return Line2D([x0, x1], [y, y], transform=fig.transFigure, color="0.6", lw=0.5)
+
+
+def _cell(value) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
+    if isinstance(value, (float, np.floating)):
+        return "" if math.isnan(value) else f"{value:.4g}"
+    return str(value)
+
+
+# =============================================================================== inputs
+def _dataset(obj) -> xr.Dataset:
+    if isinstance(obj, xr.Dataset):
+        return obj
+    with xr.open_dataset(obj, engine="netcdf4", decode_timedelta=False) as ds:
+        return ds.load()
+
+
+def _frame(obj) -> pd.DataFrame:
+    return obj if isinstance(obj, pd.DataFrame) else pd.read_csv(obj, keep_default_na=False, na_values=[""])
+
+
+def _as_list(obj) -> list:
+    if obj is None:
+        return []
+    if isinstance(obj, (str, os.PathLike, xr.Dataset)):
+        return [obj]
+    return list(obj)
+
+
+# =============================================================================== sections
+def _fit_section(lay: _Layout, fit_ds: xr.Dataset, data_table: pd.DataFrame | None, synthetic: bool) -> None:
+    from . import plots
+    from .fitting import PARAMETER_NAMES
+
+    lay.section("1. Damping fit (analogue of Fig. 3)")
+    src = fit_ds.attrs.get("fit_source", "the data")
+    lay.paragraph(
+        f"zeta_H and zeta_A of Eqs. (14)-(15) fitted by weighted least squares to the measured normal "
+        f"restitution e_n(v_n) of {src}"
+        + (" -- SYNTHETIC data generated with known parameters, not a measurement" if synthetic else "")
+        + ", jointly over all sphere sizes with one work of adhesion w_A (f0 per radius from Eq. (7)). "
+        f"Weighting: {fit_ds.attrs.get('weighting', '?')}.")
+    curves = None
+    try:
+        from .sweeps import restitution_curves
+
+        curves = restitution_curves(fit_ds)
+    except (ImportError, ValueError) as exc:  # pragma: no cover - drawn at the data points instead
+        lay.paragraph(f"(model curves not available: {exc}; the model is drawn at the data points)", color="0.4")
+    lay.plot(plots.plot_fit(fit_ds, curves), max_height=4.0)
+
+    rows = []
+    for name in PARAMETER_NAMES:
+        units = fit_ds[name].attrs.get("units", "")
+        v = float(fit_ds[name])
+        se = float(fit_ds[f"{name}_stderr"])
+        varied = bool(int(fit_ds[name].attrs.get("varied", 1)))
+        lim = fit_ds[f"{name}_confidence_limit"]
+        levels = [int(s) for s in lim["sigma_level"].values]
+        prof = dict(zip(levels, (float(x) for x in lim.values)))
+        if not varied:
+            rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": "fixed",
+                         "ci1": "", "ci2": "", "method": "fixed (materials config)"})
+            continue
+        if all(math.isfinite(prof.get(k, math.nan)) for k in (-1, 1, -2, 2)):
+            ci1, ci2, method = (prof[-1], prof[1]), (prof[-2], prof[2]), "profile likelihood (lmfit.conf_interval)"
+        else:
+            ci1, ci2, method = (v - se, v + se), (v - 2 * se, v + 2 * se), "covariance: value +/- k stderr"
+        rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": f"{se:.3g}",
+                     "ci1": f"[{ci1[0]:.5g}, {ci1[1]:.5g}]", "ci2": f"[{ci2[0]:.5g}, {ci2[1]:.5g}]", "method": method})
+    lay.heading("Fitted parameters")
+    lay.table(pd.DataFrame(rows), {"parameter": 17, "units": 6, "value": 10, "stderr": 9, "ci1": 20, "ci2": 20,
+                                   "method": 34},
+              headers={"ci1": "1-sigma interval", "ci2": "2-sigma interval", "stderr": "std. error"}, size=7.2)
+    a = fit_ds.attrs
+    corr = fit_ds["correlation"]
+    names = [str(n) for n in corr["parameter"].values]
+    varied = str(a.get("varied", "")).split()
+    pairs = [f"{p}/{q} {float(corr.sel(parameter=p, parameter_b=q)):+.3f}"
+             for i, p in enumerate(names) for q in names[i + 1:] if p in varied and q in varied]
+    lay.paragraph(
+        f"{int(a.get('n_points', 0))} points; chi-square {float(a.get('chisqr', math.nan)):.4g}, reduced chi-square "
+        f"{float(a.get('redchi', math.nan)):.4g}; AIC {float(a.get('aic', math.nan)):.4g}, BIC {float(a.get('bic', math.nan)):.4g}; "
+        f"correlations: {', '.join(pairs) or 'n/a'}. Material: density {float(a.get('density', math.nan)):g} kg/m^3, "
+        f"K = {float(a.get('stiffness', math.nan)):.4g} Pa, damping reference speed: {a.get('damping_reference_speed', '?')}. "
+        f"{a.get('fit_ci_message', '')}")
+    if data_table is not None and len(data_table):
+        t = data_table
+        summary = (t.assign(diameter_um=np.round(2e6 * t["radius"], 3))
+                   .groupby("diameter_um")
+                   .agg(n=("normal_speed", "size"), v_min=("normal_speed", "min"), v_max=("normal_speed", "max"),
+                        e_min=("e_n", "min"), e_max=("e_n", "max"))
+                   .reset_index())
+        for c in ("v_min", "v_max", "e_min", "e_max"):
+            summary[c] = summary[c].map(lambda x: f"{x:.3g}")
+        lay.heading("Data by sphere size (validated table, SI units)")
+        lay.table(summary, {"diameter_um": 14, "n": 6, "v_min": 12, "v_max": 12, "e_min": 10, "e_max": 10},
+                  headers={"diameter_um": "diameter [um]", "n": "impacts", "v_min": "min v_n [m/s]",
+                           "v_max": "max v_n [m/s]", "e_min": "min e_n [-]", "e_max": "max e_n [-]"}, size=7.2)
+
+
+def _dynamics_section(lay: _Layout, bif: xr.Dataset, portraits: list[xr.Dataset], dyn: xr.Dataset | None) -> None:
+    from . import plots
+
+    lay.section("2. Nonlinear dynamics of the normal contact (Figs. 4, 5)")
+    if dyn is not None:
+        lay.paragraph(
+            f"Simulation contact: r = {dyn.attrs.get('contact_radius', math.nan) * 1e6:.3g} um, "
+            f"f0 = {dyn.attrs.get('contact_adhesion_line_force', math.nan):.4g} N/m, "
+            f"zeta_H = {dyn.attrs.get('contact_zeta_hertz', math.nan):.3g}, zeta_A = {dyn.attrs.get('contact_zeta_adhesion', math.nan):.3g}; "
+            f"m = {float(dyn['mass']):.4g} kg, X = {float(dyn['length_scale']):.4g} m, T = {float(dyn['time_scale']):.4g} s. "
+            f"Critical velocity v_c (C = 2, Eq. (38)) = {float(dyn['critical_velocity']):.4g} m/s; "
+            f"normal capture velocity = {float(dyn['capture_velocity']):.4g} m/s.")
+    lay.plot(plots.plot_bifurcation_plane(bif), max_height=4.2)
+    if dyn is not None:
+        df = pd.DataFrame({
+            "speed": [f"{v:.3g}" for v in dyn["speed"].values],
+            "C1": [f"{x:.4g}" for x in dyn["C1"].values],
+            "C2": [f"{x:.4g}" for x in dyn["C2"].values],
+            "C": [f"{x:.4g}" for x in dyn["C"].values],
+            "type": [str(x) for x in dyn["equilibrium_type"].values],
+            "omega_f": [f"{x:.4g}" if math.isfinite(x) else "none (C >= 2)" for x in dyn["asymptotic_frequency"].values],
+        })
+        lay.heading("Damping and equilibrium at the phase-portrait speeds")
+        lay.table(df, {"speed": 14, "C1": 10, "C2": 10, "C": 10, "type": 14, "omega_f": 22},
+                  headers={"speed": "v_n [m/s]", "C1": "C1 [-]", "C2": "C2 [-]", "C": "C [-]",
+                           "type": "equilibrium", "omega_f": "omega_f [rad/s]"}, size=7.2)
+    lay.section("3. Phase portraits (analogue of Fig. 5)")
+    lay.plot(plots.plot_phase_portraits(portraits), max_height=7.5)
+
+
+def _sweep_section(lay: _Layout, sweeps: list[xr.Dataset], number: int) -> None:
+    from . import plots
+
+    for k, ds in enumerate(sorted(sweeps, key=lambda d: str(d.attrs.get("case", "")))):
+        case = str(ds.attrs.get("case", "?"))
+        figs = plots.TABLE2_FIGURES.get(case, (None, None))
+        nums = ", ".join(f for f in figs if f)
+        lay.section(f"{number}.{k + 1} Table 2 case {case}" + (f" (Figs. {nums})" if nums else ""))
+        if ds.attrs.get("case_description"):
+            lay.paragraph(str(ds.attrs["case_description"]) + ".")
+        if figs[0] is not None:
+            lay.plot(plots.plot_energy_loss(ds), max_height=3.6)
+        lay.plot(plots.plot_restitution_and_impulse(ds), max_height=4.2)
+
+
+def _flags_section(lay: _Layout, flags: pd.DataFrame, number: int) -> None:
+    lay.section(f"{number}. Measurement flags")
+    lay.paragraph(
+        "Each measured impact compared with the fitted model (microimpact.diagnostics.flag_measurements): "
+        "impacts whose rebound is not explained by the model within their uncertainty, or whose rotation or angle "
+        "measurement should be checked, are flagged. The full table is results/flags.csv (and .nc).")
+    if flags.empty:
+        lay.paragraph("No impacts in the flags table.")
+        return
+    widths = _auto_widths(flags, total=128)
+    lay.table(flags, widths)
+
+
+def _auto_widths(df: pd.DataFrame, total: int) -> dict[str, int]:
+    """Column widths (characters) proportional to content length, header words kept whole."""
+    want = {}
+    for c in df.columns:
+        content = df[c].map(_cell).str.len()
+        longest_word = max((len(w) for w in str(c).split("_")), default=4)
+        want[c] = int(max(longest_word, min(40, np.percentile(content, 90) if len(content) else 4)))
+    n = len(want)
+    avail = total - 2 * (n - 1)
+    s = sum(want.values())
+    if s > avail:
+        want = {c: max(4, int(w * avail / s)) for c, w in want.items()}
+    return want
+
+
+def _kharaz_section(lay: _Layout, kh: xr.Dataset, number: int) -> None:
+    from . import plots
+
+    lay.section(f"{number}. Validation: oblique impacts of Kharaz et al. (2001)")
+    lay.paragraph(
+        "Real measurements (digitized): 5 mm alumina spheres on soda-lime glass at 3.9 m/s. They test the "
+        "tangential/rotational part of the model in its non-adhesive limit; microsphere data with rotation "
+        f"are not publicly available. {kh.attrs.get('conditions', '')}")
+    lay.plot(plots.plot_kharaz(_kharaz_for_plot(kh)), max_height=3.2)
+    if "friction" in kh and "fitted_friction" in kh:
+        lay.paragraph(
+            f"Friction: nominal {float(kh['friction']):.4g}; fitted to the tangential restitution above "
+            f"{kh.attrs.get('sliding_threshold_deg', 30):g} deg: {float(kh['fitted_friction']):.4g} +/- "
+            f"{float(kh.get('fitted_friction_stderr', np.nan)):.2g}. Model sliding/rolling transition at "
+            f"{float(kh['transition_angle']):.3g} deg.")
+    try:
+        from .validation import kharaz_summary
+
+        summary = kharaz_summary(kh)
+    except (ImportError, KeyError):
+        summary = None
+    if summary is not None:
+        lay.heading("RMS model - measured")
+        lay.table(summary, {"quantity": 24, "units": 8, "regime": 12, "rms_nominal_friction": 16,
+                            "rms_fitted_friction": 16},
+                  headers={"rms_nominal_friction": "nominal friction", "rms_fitted_friction": "fitted friction"},
+                  size=7.2)
+
+
+def _kharaz_for_plot(kh: xr.Dataset) -> xr.Dataset:
+    """The layout :func:`microimpact.plots.plot_kharaz` reads, from either comparison layout.
+
+    ``microimpact.validation.kharaz_comparison`` stores ``<q>_measured`` / ``<q>_model`` on the
+    measured angles; ``plot_kharaz`` expects model curves ``<q>`` on ``incidence_deg`` and
+    ``measured_<q>`` with ``measured_<q>_incidence_deg``.
+    """
+    if "tangential_restitution" in kh.data_vars or "tangential_restitution_model" not in kh:
+        return kh
+    out = xr.Dataset(attrs=dict(kh.attrs))
+    angles = np.unique(np.concatenate([kh[f"{q}_incidence_deg"].values for q in
+                                       ("tangential_restitution", "rebound_spin", "rebound_angle") if f"{q}_model" in kh]))
+    out.coords["incidence_deg"] = ("incidence_deg", angles, {"units": "degree"})
+    for q in ("tangential_restitution", "rebound_spin", "rebound_angle"):
+        if f"{q}_model" not in kh:
+            continue
+        a = kh[f"{q}_incidence_deg"].values
+        order = np.argsort(a)
+        out[q] = ("incidence_deg", np.interp(angles, a[order], kh[f"{q}_model"].values[order]),
+                  dict(kh[f"{q}_model"].attrs))
+        out[f"measured_{q}"] = (f"{q}_point", kh[f"{q}_measured"].values, dict(kh[f"{q}_measured"].attrs))
+        out[f"measured_{q}_incidence_deg"] = (f"{q}_point", a, {"units": "degree"})
+    out.attrs.setdefault("impact_speed", 3.9)
+    if "friction" in kh:
+        out.attrs.setdefault("contact_friction", float(kh["friction"]))
+    return out
+
+
+def _benchmark_section(lay: _Layout, wp: xr.Dataset | None, number: int) -> None:
+    from . import plots
+
+    lay.section(f"{number}. Work-precision benchmark", new_page=True)
+    if wp is None:
+        lay.paragraph("The work-precision benchmark was switched off in the configuration (benchmark.enabled: "
+                      "false); run with --config 'benchmark={enabled: true}' to include it.")
+        return
+    lay.paragraph(str(wp.attrs.get("description", wp.attrs.get("title", "")))
+                  + (" Quick mode (few settings)." if str(wp.attrs.get("quick", "")).lower() in ("1", "true") else ""))
+    lay.plot(plots.plot_work_precision(wp), max_height=4.0)
+
+
+def _reproduction_section(lay: _Layout, repro: pd.DataFrame, number: int) -> None:
+    lay.section(f"{number}. Reproduction of the paper's numbers and statements")
+    agree = repro["agree"].astype(str).str.lower()
+    n_yes = int(agree.isin(["true", "yes"]).sum())
+    n_no = int(agree.isin(["false", "no"]).sum())
+    lay.paragraph(
+        f"Every toolkit value is computed when the pipeline runs (microimpact.reproduction). {len(repro)} rows: "
+        f"{n_yes} agree, {n_no} disagree, {len(repro) - n_yes - n_no} not checkable (the paper's figures are "
+        "missing from the available text). Disagreements are reported, not tuned away; see the notes.")
+    df = repro.copy()
+    df["agree"] = agree.map({"true": "yes", "false": "NO", "yes": "yes", "no": "NO"}).fillna(agree)
+    lay.table(df, {"id": 12, "claim": 30, "source": 10, "paper_value": 18, "toolkit_value": 18, "agree": 5,
+                   "note": 30},
+              headers={"paper_value": "paper", "toolkit_value": "toolkit"})
+
+
+def _title_page(lay: _Layout, title: str, prov: Mapping[str, str], contents: list[tuple[str, int]]) -> object:
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=PAGE_SIZE)
+    W, H = PAGE_SIZE
+
+    def text(x, y, s, **kw):
+        fig.text(x / W, 1 - y / H, s, va="top", **kw)
+
+    text(_MARGIN_X, 1.3, "\n".join(textwrap.wrap(title, 48)), fontsize=20, fontweight="bold", linespacing=1.25)
+    text(_MARGIN_X, 2.35, "\n".join(textwrap.wrap(
+        "Microsphere impact model of " + PAPER + ": fit of the damping coefficients, 3-D impact simulations, "
+        "nonlinear dynamics, Table 2 sensitivity sweeps and validation.", 95)), fontsize=9, linespacing=1.35)
+    if "SYNTHETIC" in prov.get("data", ""):
+        text(_MARGIN_X, 3.25, "DATA: SYNTHETIC (generated with known parameters; not a measurement)", fontsize=11,
+             fontweight="bold", color="#b00000")
+    y = 3.7
+    text(_MARGIN_X, y, "Provenance", fontsize=12, fontweight="bold")
+    y += 0.3
+    for key, value in prov.items():
+        lines = _wrap(value, 88)
+        text(_MARGIN_X, y, key, fontsize=8.5, fontweight="bold")
+        text(_MARGIN_X + 1.45, y, "\n".join(lines), fontsize=8.5, linespacing=1.3)
+        y += 0.17 * len(lines) + 0.06
+    y += 0.25
+    text(_MARGIN_X, y, "Contents", fontsize=12, fontweight="bold")
+    y += 0.3
+    for name, page in contents:
+        text(_MARGIN_X, y, name, fontsize=9)
+        text(W - _MARGIN_X, y, f"page {page + 2}", fontsize=9, ha="right")
+        y += 0.2
+    text(_MARGIN_X, H - 0.9, "\n".join(textwrap.wrap(
+        "Generated by the microimpact Snakemake pipeline (Snakefile, workflow/); every number and figure is computed "
+        "from the files under results/. Units are SI unless stated; angles in degrees.", 110)), fontsize=7.5,
+        color="0.35")
+    return fig
+
+
+# =============================================================================== entry point
+def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduction=None, flags=None,
+                 kharaz=None, work_precision=None, dynamics=None, data_table=None, config=None,
+                 title: str | None = None) -> Path:
+    """Build the PDF report from the pipeline's results.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        PDF to write (atomically).
+    fit : path or xarray.Dataset
+        ``DampingFit.save`` output (results/fit.nc).
+    phase_portraits : path or list of xarray.Dataset
+        :func:`save_phase_portraits` file or the trajectories.
+    bifurcation : path or xarray.Dataset
+        :func:`microimpact.dynamics.bifurcation_plane` output.
+    sweeps : sequence of paths or Datasets
+        :func:`microimpact.sweeps.run_sweep` outputs, one per Table 2 case (any order).
+    reproduction : path or DataFrame, optional
+        :func:`microimpact.reproduction.reproduction_table` (CSV).
+    flags : path or DataFrame, optional
+        The measurement-flags table (CSV).
+    kharaz : path or xarray.Dataset, optional
+        :func:`microimpact.validation.kharaz_comparison` output.
+    work_precision : path or xarray.Dataset, optional
+        Benchmark Dataset; None: the page says the benchmark was switched off.
+    dynamics : path or xarray.Dataset, optional
+        :func:`dynamics_summary` output.
+    data_table : path or DataFrame, optional
+        The validated impact table (SI units) for the data summary.
+    config : mapping, optional
+        The pipeline configuration (title page and appendix).
+    title : str, optional
+        Report title; default ``config["report_title"]`` or a generic one.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    from . import __version__
+
+    config = dict(config or {})
+    title = title or config.get("report_title") or "Microsphere contact/impact report"
+    data = _frame(data_table) if data_table is not None else None
+    prov = provenance(config, data_table=data)
+    synthetic = "SYNTHETIC" in prov.get("data", "")
+
+    lay = _Layout(title)
+    _fit_section(lay, _dataset(fit), data, synthetic)
+    portraits = load_phase_portraits(phase_portraits) if isinstance(phase_portraits, (str, os.PathLike)) \
+        else list(phase_portraits)
+    _dynamics_section(lay, _dataset(bifurcation), portraits, _dataset(dynamics) if dynamics is not None else None)
+    number = 4
+    sweep_ds = [_dataset(s) for s in _as_list(sweeps)]
+    if sweep_ds:
+        lay.section(f"{number}. Sensitivity to the initial conditions (Table 2, Figs. 7-14)", new_page=True)
+        lay.paragraph(
+            "Each Table 2 case is swept over the incident speed and one curve-family parameter with the fast "
+            "engine (one normal solve per distinct normal speed, closed-form tangential map). Curves: rebound "
+            "solid, captured dotted; grey bands mark capture. Contact: the configured simulation parameters.")
+        _sweep_section(lay, sweep_ds, number)
+        number += 1
+    if flags is not None:
+        _flags_section(lay, _frame(flags), number)
+        number += 1
+    if kharaz is not None:
+        _kharaz_section(lay, _dataset(kharaz), number)
+        number += 1
+    _benchmark_section(lay, _dataset(work_precision) if work_precision is not None else None, number)
+    number += 1
+    if reproduction is not None:
+        _reproduction_section(lay, _frame(reproduction), number)
+        number += 1
+    if config:
+        import yaml
+
+        lay.section(f"{number}. Appendix: configuration")
+        lay.paragraph("The configuration this report was made with (workflow/config/config.yaml merged with "
+                      "command-line overrides), validated against workflow/config/config.schema.yaml.")
+        lay.paragraph(yaml.safe_dump(_plain(config), sort_keys=False, width=110), mono=True, size=7)
+
+    title_fig = _title_page(lay, title, prov, lay.contents)
+    lay.pages.insert(0, _Page(title_fig, "title", 0.0))
+    path = Path(path)
+    lay.save(path, {"Title": title, "Author": f"microimpact {__version__}",
+                    "Subject": "Microsphere impact model of Cheng, Brach & Dunn (2002)",
+                    "Keywords": "synthetic data" if synthetic else "measured data"})
+    return path
+
+
+def _plain(obj):
+    if isinstance(obj, Mapping):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj if isinstance(obj, (str, int, float, bool, type(None))) else str(obj)

@@ -1,0 +1,15 @@
+# Validation of the tangential/rotational part of the model against real measured oblique
+# impacts (Kharaz et al. 2001; data/README.md).
+
+
+rule kharaz:
+    input:
+        config["kharaz_data"],
+    output:
+        "results/kharaz.nc",
+    log:
+        "logs/kharaz.log",
+    benchmark:
+        "benchmarks/kharaz.tsv"
+    script:
+        "../scripts/kharaz.py"

@@ -1,0 +1,15 @@
+"""Rule flags: each measured impact's sensitivity to unmeasured spin and angle error, and whether it
+is near capture, under the fitted model -> results/flags.csv + results/flags.nc."""
+
+import sys
+
+sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+
+from microimpact.diagnostics import flag_measurements, write_flags  # noqa: E402
+from microimpact.fitting import DampingFit  # noqa: E402
+from microimpact.io import read_impacts  # noqa: E402
+
+table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821
+ds = flag_measurements(table, DampingFit.load(snakemake.input.fit))  # noqa: F821
+write_flags(ds, snakemake.output.csv, snakemake.output.nc)  # noqa: F821
+print(ds)
