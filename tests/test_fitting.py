@@ -6,7 +6,6 @@ from zeta_H = 0.50, zeta_A = 29.0 (data/README.md), so the fit must give them ba
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np

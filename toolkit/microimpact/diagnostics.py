@@ -40,6 +40,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -219,8 +220,8 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
         ds = ds.transpose("impact", "spin_sample", "angle_sample")
         for c in _COEFS:
             x = ds[c].values
-            with np.errstate(invalid="ignore"), np.testing.suppress_warnings() as sup:
-                sup.filter(RuntimeWarning)
+            with np.errstate(invalid="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN slices (captured samples)
                 out[c][idx] = x[:, 0, k0]
                 out[f"{c}_min_spin"][idx] = np.nanmin(x[:, :, k0], axis=1)
                 out[f"{c}_max_spin"][idx] = np.nanmax(x[:, :, k0], axis=1)

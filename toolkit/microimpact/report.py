@@ -400,6 +400,10 @@ class _Layout:
             with PdfPages(tmp, metadata=dict(metadata)) as pdf:
                 for k, page in enumerate(self.pages, start=1):
                     fig = page.figure
+                    if k == 1:  # the title page carries no running header
+                        fig.text(0.5, 0.4 / PAGE_SIZE[1], f"page {k} of {n}", fontsize=7, color="0.4", ha="center")
+                        pdf.savefig(fig)
+                        continue
                     fig.text(_MARGIN_X / PAGE_SIZE[0], 1.0 - 0.45 / PAGE_SIZE[1], self.title, fontsize=7, color="0.4",
                              va="bottom")
                     fig.text(1.0 - _MARGIN_X / PAGE_SIZE[0], 1.0 - 0.45 / PAGE_SIZE[1], page.section, fontsize=7,
@@ -538,14 +542,18 @@ def _dynamics_section(lay: _Layout, bif: xr.Dataset, portraits: list[xr.Dataset]
             "C2": [f"{x:.4g}" for x in dyn["C2"].values],
             "C": [f"{x:.4g}" for x in dyn["C"].values],
             "type": [str(x) for x in dyn["equilibrium_type"].values],
-            "omega_f": [f"{x:.4g}" if math.isfinite(x) else "none (C >= 2)" for x in dyn["asymptotic_frequency"].values],
+            "omega_f": [f"{x:.4g}" if math.isfinite(x) and c < 2 else "none (C >= 2)"
+                        for x, c in zip(dyn["asymptotic_frequency"].values, dyn["C"].values)],
         })
         lay.heading("Damping and equilibrium at the phase-portrait speeds")
         lay.table(df, {"speed": 14, "C1": 10, "C2": 10, "C": 10, "type": 14, "omega_f": 22},
                   headers={"speed": "v_n [m/s]", "C1": "C1 [-]", "C2": "C2 [-]", "C": "C [-]",
                            "type": "equilibrium", "omega_f": "omega_f [rad/s]"}, size=7.2)
     lay.section("3. Phase portraits (analogue of Fig. 5)")
-    lay.plot(plots.plot_phase_portraits(portraits), max_height=7.5)
+    # at most two panels per figure: four side by side on a page width leave unreadable axes
+    groups = [portraits] if len(portraits) <= 2 else [portraits[i:i + 2] for i in range(0, len(portraits), 2)]
+    for group in groups:
+        lay.plot(plots.plot_phase_portraits(group), max_height=4.0)
 
 
 def _sweep_section(lay: _Layout, sweeps: list[xr.Dataset], number: int) -> None:
@@ -555,7 +563,8 @@ def _sweep_section(lay: _Layout, sweeps: list[xr.Dataset], number: int) -> None:
         case = str(ds.attrs.get("case", "?"))
         figs = plots.TABLE2_FIGURES.get(case, (None, None))
         nums = ", ".join(f for f in figs if f)
-        lay.section(f"{number}.{k + 1} Table 2 case {case}" + (f" (Figs. {nums})" if nums else ""))
+        lay.section(f"{number}.{k + 1} Table 2 case {case}" + (f" (Fig{'s' if ',' in nums else ''}. {nums})" if nums else ""),
+                    new_page=k > 0)
         if ds.attrs.get("case_description"):
             lay.paragraph(str(ds.attrs["case_description"]) + ".")
         if figs[0] is not None:
@@ -563,32 +572,48 @@ def _sweep_section(lay: _Layout, sweeps: list[xr.Dataset], number: int) -> None:
         lay.plot(plots.plot_restitution_and_impulse(ds), max_height=4.2)
 
 
-def _flags_section(lay: _Layout, flags: pd.DataFrame, number: int) -> None:
+def _flags_section(lay: _Layout, flags: pd.DataFrame, data: pd.DataFrame | None, number: int) -> None:
     lay.section(f"{number}. Measurement flags")
-    lay.paragraph(
-        "Each measured impact compared with the fitted model (microimpact.diagnostics.flag_measurements): "
-        "impacts whose rebound is not explained by the model within their uncertainty, or whose rotation or angle "
-        "measurement should be checked, are flagged. The full table is results/flags.csv (and .nc).")
     if flags.empty:
         lay.paragraph("No impacts in the flags table.")
         return
-    widths = _auto_widths(flags, total=128)
-    lay.table(flags, widths)
+    n = len(flags)
+    count = {k: int(flags[k].sum()) if k in flags else 0 for k in ("rotation_sensitive", "angle_sensitive", "near_capture")}
+    lay.paragraph(
+        "Each measured impact simulated under the fitted model with plausible unmeasured initial spin (up to the "
+        "rolling spin v/r, 3-D directions) and with the incidence angle moved by its uncertainty "
+        "(microimpact.diagnostics.flag_measurements). Flags: R = rotation-sensitive (an unmeasured spin changes "
+        "mu or K_L by more than the threshold), A = angle-sensitive (the angle error changes e_n, mu or the "
+        "outcome), C = near capture (normal speed below 1.5 x the capture velocity, where e_n is steep). "
+        f"Of {n} impacts: {count['rotation_sensitive']} R, {count['angle_sensitive']} A, {count['near_capture']} C. "
+        "Spreads are max - min over the samples; all columns are in results/flags.csv (and .nc).")
 
+    def spread(q, over):
+        lo, hi = f"{q}_min_{over}", f"{q}_max_{over}"
+        return (flags[hi] - flags[lo]) if lo in flags and hi in flags else pd.Series(np.nan, index=flags.index)
 
-def _auto_widths(df: pd.DataFrame, total: int) -> dict[str, int]:
-    """Column widths (characters) proportional to content length, header words kept whole."""
-    want = {}
-    for c in df.columns:
-        content = df[c].map(_cell).str.len()
-        longest_word = max((len(w) for w in str(c).split("_")), default=4)
-        want[c] = int(max(longest_word, min(40, np.percentile(content, 90) if len(content) else 4)))
-    n = len(want)
-    avail = total - 2 * (n - 1)
-    s = sum(want.values())
-    if s > avail:
-        want = {c: max(4, int(w * avail / s)) for c, w in want.items()}
-    return want
+    t = pd.DataFrame({"row": flags["row"]})
+    if data is not None and "row" in data:
+        d = data.set_index("row")
+        t["d"] = flags["row"].map(2e6 * d["radius"]).map(lambda x: f"{x:.3g}")
+        t["v_n"] = flags["row"].map(d["normal_speed"]).map(lambda x: f"{x:.3g}")
+        t["alpha"] = flags["row"].map(d["incidence_deg"]).map(lambda x: f"{x:.3g}")
+        t["e_meas"] = flags["row"].map(d["e_n"]).map(lambda x: f"{x:.3f}")
+    t["e_n"] = flags.get("e_n", np.nan)
+    t["ratio"] = flags.get("capture_speed_ratio", np.nan)
+    t["mu_spin"] = np.fmax(spread("mu_t", "spin"), spread("mu_tp", "spin"))
+    t["KL_spin"] = spread("K_L", "spin")
+    t["e_angle"] = spread("e_n", "angle")
+    t["mu_angle"] = np.fmax(spread("mu_t", "angle"), spread("mu_tp", "angle"))
+    t["flags"] = ["".join(c for c, k in (("R", "rotation_sensitive"), ("A", "angle_sensitive"), ("C", "near_capture"))
+                          if k in flags and int(r[k])) or "-" for _, r in flags.iterrows()]
+    for c in ("e_n", "ratio", "mu_spin", "KL_spin", "e_angle", "mu_angle"):
+        t[c] = t[c].map(lambda x: "" if not np.isfinite(x) else f"{x:.3g}")
+    lay.table(t, {"row": 5, "d": 9, "v_n": 9, "alpha": 9, "e_meas": 9, "e_n": 9, "ratio": 9, "mu_spin": 9,
+                  "KL_spin": 9, "e_angle": 9, "mu_angle": 9, "flags": 5},
+              headers={"d": "d [um]", "v_n": "v_n [m/s]", "alpha": "alpha [deg]", "e_meas": "e_n meas.",
+                       "e_n": "e_n model", "ratio": "v_n/v_cap", "mu_spin": "d mu spin", "KL_spin": "d K_L spin",
+                       "e_angle": "d e_n angle", "mu_angle": "d mu angle"}, size=7.0)
 
 
 def _kharaz_section(lay: _Layout, kh: xr.Dataset, number: int) -> None:
@@ -782,7 +807,7 @@ def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduc
         _sweep_section(lay, sweep_ds, number)
         number += 1
     if flags is not None:
-        _flags_section(lay, _frame(flags), number)
+        _flags_section(lay, _frame(flags), data, number)
         number += 1
     if kharaz is not None:
         _kharaz_section(lay, _dataset(kharaz), number)

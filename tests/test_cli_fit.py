@@ -1,0 +1,114 @@
+"""Tests of the ``microimpact fit`` and ``microimpact flags`` subcommands (real files in tmp_path)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+
+from microimpact.cli import main
+from microimpact.fitting import DampingFit
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "data" / "synthetic_microspheres.csv"  # SYNTHETIC data (data/README.md)
+
+
+def files(d):
+    return sorted(p.name for p in Path(d).iterdir())
+
+
+@pytest.fixture(scope="module")
+def small_csv(tmp_path_factory):
+    """Every fifth impact of the synthetic file: 20 points over 4 radii (a fast fit)."""
+    d = tmp_path_factory.mktemp("data")
+    lines = DATA.read_text().splitlines()
+    path = d / "small.csv"
+    path.write_text("\n".join([lines[0]] + lines[1::5]) + "\n")
+    return path
+
+
+@pytest.fixture(scope="module")
+def fitted(small_csv, tmp_path_factory):
+    out = tmp_path_factory.mktemp("fit") / "fit.nc"
+    rc = main(["fit", str(small_csv), "--out", str(out), "--no-confidence-intervals"])
+    assert rc == 0
+    return out
+
+
+def test_fit_writes_and_prints_report(fitted, capsys):
+    fit = DampingFit.load(fitted)
+    assert fit.n_points == 20
+    assert fit.info["material_pair"] == "ammonium_fluorescein_on_silicon"
+    assert 0.2 < fit.zeta_hertz < 1.0 and 20 < fit.zeta_adhesion < 40
+    assert files(fitted.parent) == ["fit.nc"]  # no temporary files left
+
+
+def test_fit_report_on_stdout(small_csv, tmp_path, capsys):
+    out = tmp_path / "f.nc"
+    assert main(["fit", str(small_csv), "--out", str(out), "--no-confidence-intervals",
+                 "--material-pair", "ammonium_fluorescein_on_silicon", "--weights", "e_n"]) == 0
+    captured = capsys.readouterr()
+    assert "zeta_adhesion" in captured.out and "reduced" in captured.out
+    assert "fitting 20 impacts" in captured.err
+
+
+def test_flags(small_csv, fitted, tmp_path, capsys):
+    out, nc = tmp_path / "flags.csv", tmp_path / "flags.nc"
+    rc = main(["flags", str(small_csv), "--fit", str(fitted), "--out", str(out), "--nc", str(nc),
+               "--angle-uncertainty-deg", "1.5"])
+    assert rc == 0
+    captured = capsys.readouterr()
+    assert "flags: radius" in captured.err  # progress on stderr
+    assert "near_capture" in captured.out
+    table = pd.read_csv(out)
+    assert len(table) == 20 and table.columns[0] == "row"
+    np.testing.assert_allclose(table["angle_uncertainty_deg"], 1.5)
+    with xr.open_dataset(nc) as ds:
+        assert ds.sizes["impact"] == 20
+    assert files(tmp_path) == ["flags.csv", "flags.nc"]
+
+
+def _fails(argv, tmp_path, capsys, match):
+    before = files(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("microimpact: error: ") and match in err
+    assert files(tmp_path) == before  # nothing written
+
+
+def test_bad_input_fit(small_csv, tmp_path, capsys):
+    out = str(tmp_path / "fit.nc")
+    _fails(["fit", str(tmp_path / "missing.csv"), "--out", out], tmp_path, capsys, "does not exist")
+    _fails(["fit", str(ROOT / "tests" / "data" / "bad_csv" / "semicolon.csv"), "--out", out], tmp_path, capsys, "semicolon")
+    _fails(["fit", str(small_csv), "--out", str(tmp_path / "no" / "fit.nc")], tmp_path, capsys, "directory")
+    _fails(["fit", str(small_csv), "--out", out, "--material-pair", "unobtainium"], tmp_path, capsys, "unknown material pair")
+    _fails(["fit", str(small_csv), "--out", out, "--material-pair", "alumina_on_soda_lime_glass"], tmp_path, capsys,
+           "no impacts of material pair")
+    _fails(["fit", str(small_csv)], tmp_path, capsys, "--out")
+    bad_cfg = tmp_path / "m.yaml"
+    bad_cfg.write_text("pairs: {x: {density: -1}}\n")
+    before = files(tmp_path)
+    assert main(["fit", str(small_csv), "--out", out, "--config", str(bad_cfg)]) == 2
+    assert files(tmp_path) == before
+
+
+def test_bad_input_flags(small_csv, fitted, tmp_path, capsys):
+    out = str(tmp_path / "flags.csv")
+    _fails(["flags", str(small_csv), "--fit", str(small_csv), "--out", out], tmp_path, capsys, "cannot be read as NetCDF")
+    _fails(["flags", str(small_csv), "--fit", str(tmp_path / "none.nc"), "--out", out], tmp_path, capsys, "does not exist")
+    _fails(["flags", str(small_csv), "--fit", str(fitted), "--out", out, "--spin-bound", "nan"], tmp_path, capsys, "finite")
+    _fails(["flags", str(small_csv), "--fit", str(fitted), "--out", out, "--nc", str(tmp_path / "x" / "f.nc")],
+           tmp_path, capsys, "directory")
+
+
+def test_entry_point_exit_status(tmp_path):
+    r = subprocess.run([sys.executable, "-m", "microimpact.cli", "fit", str(tmp_path / "missing.csv"), "--out",
+                        str(tmp_path / "f.nc")], capture_output=True, text=True)
+    assert r.returncode == 2
+    assert r.stderr.count("\n") == 1 and "does not exist" in r.stderr
+    assert files(tmp_path) == []
