@@ -137,7 +137,7 @@ def _event_value(code, u, ku, ah, aa, target):
         return u[1] - target
     if code == 2:  # extremum of y: dy/dsigma = 0
         return ku[1]
-    return _energy(u[0], u[1], ah, aa)  # code 3: capture, E = 0
+    return _energy(u[0], u[1], ah, aa) - target  # code 3: capture, E = target
 
 
 @njit(cache=True)
@@ -168,6 +168,22 @@ def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, er
         if abs(b - a) < 1e-13 * h:
             break
     return hs
+
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
+
+
+@njit(cache=True)
+def _creeping_twist_tail(xi, xe, c1, c2, ah, aa):
+    """int s |dy| along the inertia-free path y = (a_a - a_h xi)/(a_h c1 xi + a_a c2) from xi to xe."""
+    total = 0.0
+    half = 0.5 * (xe - xi)
+    mid = 0.5 * (xe + xi)
+    for i in range(_GL_X.shape[0]):
+        x = mid + half * _GL_X[i]
+        d = ah * c1 * x + aa * c2
+        total += _GL_W[i] * math.sqrt(x) * ah * aa * (c1 + c2) / (d * d)
+    return abs(half) * total
 
 
 @njit(cache=True)
@@ -237,6 +253,8 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
     atol[4] = rtol * sref * yref
 
     noise = 10.0 * (atol[0] + atol[1])
+    damped = c1 > 0.0 or c2 > 0.0
+    ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
     # equilibrium data for the tail bound of a captured sphere
     xe = aa / ah if ah > 0.0 else 0.0
     omega0 = 1.0
@@ -245,6 +263,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         se = math.sqrt(xe)
         omega0 = math.sqrt(ah * se)  # sqrt(V''(xi_e))
         ceq = ah * c1 * xe * se + aa * c2 * se  # damping coefficient at the equilibrium
+    overdamped = ceq > 2.0 * omega0
 
     h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
     if y0 < 1.0:
@@ -302,6 +321,10 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 hev, code = hh, 2
         if code >= 0:
             _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            # dy/dsigma ~ s^2 vanishes at the surface too, so an extremum found at the end of
+            # contact is the separation itself
+            if code == 2 and u1[0] <= 0.0 and u1[1] < 0.0:
+                code = 0
         # Events that are only recorded (largest penetration, capture, end of sliding) are
         # located inside the step without changing it, so the trajectory, and e_n, do not depend
         # on which of them a caller asked for.
@@ -312,14 +335,17 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             if u1[0] > smax:
                 smax = u1[0]
             recorded = True
-        if not captured and aa > 0.0:
+        # capture: E below zero by more than the integration can drift (without damping E is
+        # conserved, so a negative E could only be integration error); a true capture keeps
+        # losing energy and crosses the margin a little later
+        if not captured and damped and aa > 0.0:
             if recorded:
                 _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 recorded = False
-            e0 = _energy(u[0], u[1], ah, aa)
-            e1 = _energy(u1[0], u1[1], ah, aa)
+            e0 = _energy(u[0], u[1], ah, aa) - ecap
+            e1 = _energy(u1[0], u1[1], ah, aa) - ecap
             if e0 >= 0.0 and e1 < 0.0:
-                _locate(3, 0.0, u, k1, hev, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                _locate(3, ecap, u, k1, hev, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 captured = True
                 tau_capture = u1[2]
                 recorded = True
@@ -364,8 +390,25 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             amp = math.sqrt(dx * dx + (u[1] / omega0) ** 2)
             # below a few absolute tolerances the amplitude is integration noise, not motion
             amp = max(amp - noise, 0.0)
+            # Strongly overdamped: once inertia is negligible (|xi''| << |V'(xi)|) and the sphere
+            # creeps towards the equilibrium, the motion is a gradient flow that approaches
+            # X monotonically. An explicit solver would need ~C^2 steps to follow it, and
+            # nothing more is to be learnt: y falls monotonically to 0 (its total variation from
+            # here is |y|) and the largest penetration is X itself (or what was reached before).
+            creeping = False
+            if overdamped and dx * u[1] < 0.0 and u[0] > 0.0:
+                vp = ah * u[0] ** 3 - aa * u[0]
+                creeping = abs(kend[1] / u[0]) <= 1e-6 * abs(vp)
             if follow:
                 done = amp <= settle_amp
+            elif creeping:
+                done = True
+                J += abs(u[1])
+                u[4] += _creeping_twist_tail(u[0] * u[0], xe, c1, c2, ah, aa)
+                if xe > smax * smax:
+                    smax = math.sqrt(xe)
+            elif not turned:
+                done = False  # the largest penetration is not known yet
             elif need_tail and J >= j_stop and u[4] >= ja_stop:
                 done = True  # sliding and twist have ended: the rest of the tail changes nothing
             elif need_tail:
@@ -378,9 +421,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                     J += tail
                     u[4] += math.sqrt(xe) * tail
             else:
-                # stop at the first turning point, the largest penetration (the energy only
-                # falls afterwards), or once settled for an overdamped approach that never turns
-                done = turned or amp == 0.0
+                done = True  # captured and past the largest penetration
             if done:
                 outcome = CAPTURE
                 break

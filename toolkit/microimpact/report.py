@@ -6,7 +6,7 @@ analogue), the nonlinear analysis (Figs. 4 and 5), the Table 2 sweeps (Figs. 7-1
 measurement flags, the Kharaz et al. (2001) validation, the work-precision benchmark, the
 reproduction table of the paper's claims and the configuration. Figures come from
 :mod:`microimpact.plots` (one :class:`~microimpact.plots.Plot` per figure, with its caption); this
-module only lays them out on A4 pages with matplotlib's PdfPages (figures are embedded as 200 dpi
+module only lays them out on A4 pages with matplotlib's PdfPages (figures are embedded as 160 dpi
 images, captions and tables as text so the PDF is searchable).
 
 Pipeline products defined here (used by the workflow's thin scripts):
@@ -23,7 +23,6 @@ Paper: Cheng, Brach & Dunn (2002), Aerosol Sci. Technol. 36:1081-1093, doi:10.10
 from __future__ import annotations
 
 import datetime as _dt
-import json
 import math
 import os
 import platform
@@ -59,7 +58,7 @@ _MARGIN_X = 0.65  # in
 _TOP = 0.75  # in, below the top edge: running header
 _BOTTOM = 0.75  # in, above the bottom edge: footer
 _TEXT_WIDTH = PAGE_SIZE[0] - 2 * _MARGIN_X
-_DPI = 200  # embedded figures
+_DPI = 160  # embedded figures
 _BODY_PT = 8.5
 _TABLE_PT = 6.6
 
@@ -86,10 +85,6 @@ def phase_portraits(contact, speeds: Sequence[float], **kwargs) -> list[xr.Datas
     return [phase_portrait(contact, float(v), **kwargs) for v in speeds]
 
 
-def _group_name(i: int, ds: xr.Dataset) -> str:
-    return f"portrait_{i}"
-
-
 def save_phase_portraits(portraits: Sequence[xr.Dataset], path) -> Path:
     """Write several phase portraits to one NetCDF-4 file atomically, one group per trajectory.
 
@@ -100,7 +95,7 @@ def save_phase_portraits(portraits: Sequence[xr.Dataset], path) -> Path:
     from .io.files import _netcdf_encoding, atomic_path
 
     path = Path(path)
-    names = [_group_name(i, ds) for i, ds in enumerate(portraits)]
+    names = [f"portrait_{i}" for i in range(len(portraits))]
     root = xr.Dataset(attrs={
         "title": "Phase portraits of normal impacts (Cheng, Brach & Dunn 2002, Fig. 5)",
         "portraits": " ".join(names),
@@ -337,12 +332,11 @@ class _Layout:
         x0 = _MARGIN_X + (_TEXT_WIDTH - ww) / 2
         ax = self.page.figure.add_axes([x0 / PAGE_SIZE[0], 1.0 - (self.page.y + hh) / PAGE_SIZE[1],
                                         ww / PAGE_SIZE[0], hh / PAGE_SIZE[1]])
-        ax.imshow(img, interpolation="antialiased", aspect="auto")
+        ax.imshow(img, interpolation="none", aspect="auto")
         ax.set_axis_off()
         self.page.y += hh + 0.08
         label = f"Figure (analogue of the paper's Fig. {plot.paper_figure}). " if plot.paper_figure else "Figure. "
         self.paragraph(label + plot.caption, gap=0.22)
-        import matplotlib.pyplot as plt  # noqa: F401 - figures made with Figure() need no closing
 
     def table(self, df: pd.DataFrame, widths: Mapping[str, int], *, headers: Mapping[str, str] | None = None,
               size: float = _TABLE_PT, caption: str | None = None) -> None:
@@ -681,9 +675,39 @@ def _benchmark_section(lay: _Layout, wp: xr.Dataset | None, number: int) -> None
         lay.paragraph("The work-precision benchmark was switched off in the configuration (benchmark.enabled: "
                       "false); run with --config 'benchmark={enabled: true}' to include it.")
         return
-    lay.paragraph(str(wp.attrs.get("description", wp.attrs.get("title", "")))
-                  + (" Quick mode (few settings)." if str(wp.attrs.get("quick", "")).lower() in ("1", "true") else ""))
-    lay.plot(plots.plot_work_precision(wp), max_height=4.0)
+    a = wp.attrs
+    quick = str(a.get("quick", "")).lower() in ("1", "true")
+    lay.paragraph(
+        f"{str(a.get('title', 'Work-precision benchmark')).capitalize()} (microimpact.benchmark"
+        f"{', quick mode: small test set, few settings' if quick else ', full study'}) on the Table 1 row 2 contact: "
+        f"{a.get('n_normal_speeds', '?')} normal impacts from just above the capture speed "
+        f"({float(a.get('capture_speed', math.nan)):.4g} m/s) to 100 m/s and {a.get('n_oblique_cases', '?')} oblique "
+        f"impacts. Reference: {a.get('reference', '?')}. Machine: {a.get('machine_processor', '?')}, "
+        f"{a.get('machine_cpu_count', '?')} cores (1-min load average at start {float(a.get('machine_load_average_1min_at_start', math.nan)):.2g}); "
+        f"the benchmark took {float(a.get('total_seconds', math.nan)):.3g} s.")
+    lay.plot(plots.plot_work_precision(wp), max_height=3.6)
+    rows = []
+    for i, m in enumerate(wp["method"].values):
+        err = np.asarray(wp["max_error_e_n"].isel(method=i).values, float)
+        t = np.asarray(wp["time_per_impact"].isel(method=i).values, float)
+        ok = np.isfinite(err) & np.isfinite(t)
+        if not ok.any():
+            continue
+        j = int(np.argmin(np.where(ok, err, np.inf)))
+        rows.append({"method": str(m), "err": f"{err[j]:.3g}", "time": f"{t[j]:.3g}",
+                     "fast": f"{np.nanmin(np.where(ok, t, np.nan)):.3g}",
+                     "timing": str(wp["timing_mode"].values[i]) if "timing_mode" in wp else ""})
+    if rows:
+        lay.heading("Most accurate setting of each method")
+        lay.table(pd.DataFrame(rows), {"method": 13, "err": 12, "time": 14, "fast": 14, "timing": 60},
+                  headers={"err": "max |e_n err|", "time": "time/impact [s]", "fast": "fastest [s]",
+                           "timing": "how timed"}, size=7.0)
+    ratio = a.get("ratio_dop853_to_engine_single")
+    if ratio is not None:
+        lay.paragraph(
+            f"At the target error {float(a.get('target_error_e_n', math.nan)):.0e} in e_n: DOP853 / engine time ratio "
+            f"{float(ratio):.3g} (single calls), {float(a.get('ratio_dop853_to_engine_batch', math.nan)):.3g} (batch); "
+            f"target {float(a.get('target_ratio', math.nan)):g}. {a.get('target_ratio_note', '')}")
 
 
 def _reproduction_section(lay: _Layout, repro: pd.DataFrame, number: int) -> None:
@@ -697,7 +721,7 @@ def _reproduction_section(lay: _Layout, repro: pd.DataFrame, number: int) -> Non
         "missing from the available text). Disagreements are reported, not tuned away; see the notes.")
     df = repro.copy()
     df["agree"] = agree.map({"true": "yes", "false": "NO", "yes": "yes", "no": "NO"}).fillna(agree)
-    lay.table(df, {"id": 12, "claim": 30, "source": 10, "paper_value": 18, "toolkit_value": 18, "agree": 5,
+    lay.table(df, {"id": 12, "claim": 28, "source": 12, "paper_value": 18, "toolkit_value": 18, "agree": 5,
                    "note": 30},
               headers={"paper_value": "paper", "toolkit_value": "toolkit"})
 

@@ -34,8 +34,7 @@ nondimensional state, whose energy unit is m (X/T)^2.
 Distance between two results
 ----------------------------
 Two results of the same case (rtol 1e-8 vs 1e-10, engine vs reference) are compared by
-``result_distance``: the largest of |delta(m v_n_out^2 / 2)| / E_scale, |delta final contact
-energy| / E_scale, and the tangential velocity and rim-speed (r omega) differences divided by
+``result_distance``: the largest of |delta(m v_n_out^2 / 2)| / E_scale and the tangential velocity and rim-speed (r omega) differences divided by
 the speed scale sqrt(2 E_scale / m). The normal part is compared as an energy because e_n is
 ill-conditioned near the capture threshold (e_n ~ sqrt(v - v_c)); comparing energies makes a
 capture-versus-rebound disagreement count only by the rebound energy it misses, so it is
@@ -179,10 +178,9 @@ def result_distance(contact: Contact, a, b) -> float:
     e_scale = energy_scale(contact, ke_in)
     v_scale = math.sqrt(2.0 * e_scale / contact.mass)
     m, r = contact.mass, contact.radius
-    d = [
-        abs(0.5 * m * (a.velocity_out[0] ** 2 - b.velocity_out[0] ** 2)) / e_scale,
-        abs(a.final_contact_energy - b.final_contact_energy) / e_scale,
-    ]
+    # final_contact_energy is left out: for a capture it is the energy wherever the integration
+    # stopped (a tolerance-dependent point of the decaying oscillation), not a converged quantity
+    d = [abs(0.5 * m * (a.velocity_out[0] ** 2 - b.velocity_out[0] ** 2)) / e_scale]
     d += [abs(a.velocity_out[i] - b.velocity_out[i]) / v_scale for i in (1, 2)]
     d += [r * abs(a.omega_out[i] - b.omega_out[i]) / v_scale for i in range(3)]
     return float(max(d))

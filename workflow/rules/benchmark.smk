@@ -1,16 +1,23 @@
-# Work-precision study of the fast engine against the scipy reference solver (switchable:
-# config benchmark.enabled; quick mode by default).
+# Work-precision study of the fast engine against the scipy reference solvers and the paper's
+# fixed-step Runge-Kutta-Gill method (switchable: config benchmark.enabled; quick by default).
 
 
 rule work_precision:
     output:
-        "results/work_precision.nc",
+        netcdf="results/benchmark/benchmark.nc",
+        json="results/benchmark/benchmark.json",
+        markdown="results/benchmark/benchmark.md",
+        pdf="results/benchmark/work_precision.pdf",
+        png="results/benchmark/work_precision.png",
     params:
-        quick=config["benchmark"].get("quick", True),
+        quick=config["benchmark"]["quick"],
+        throughput=config["benchmark"]["throughput"],
+        out_dir=lambda wildcards, output: os.path.dirname(output.netcdf),
     log:
         "logs/work_precision.log",
     benchmark:
         "benchmarks/work_precision.tsv"
-    threads: 1
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/work_precision.py"

@@ -1,5 +1,6 @@
 # Helpers shared by the rules (no rules here). The config was validated by the Snakefile.
 import importlib.util
+import os
 from snakemake.exceptions import WorkflowError
 from pathlib import Path
 
@@ -20,7 +21,7 @@ config.setdefault("data_synthetic", "auto")
 if config["data_synthetic"] != "auto":
     config["data_synthetic"] = as_bool(config["data_synthetic"])
 config["fit"] = {k: (as_bool(v) if k != "weights" else v) for k, v in config["fit"].items()}
-config["benchmark"] = {"quick": True, **config["benchmark"]}
+config["benchmark"] = {"quick": True, "throughput": False, **config["benchmark"]}
 config["benchmark"] = {k: as_bool(v) for k, v in config["benchmark"].items()}
 
 SWEEP_CASES = list(config["sweeps"])
@@ -56,4 +57,4 @@ def sweep_chunk_files(wildcards):
 
 def benchmark_outputs(wildcards):
     """Work-precision results for the report; none when the benchmark is switched off."""
-    return {"work_precision": "results/work_precision.nc"} if BENCHMARK_ENABLED else {}
+    return {"work_precision": "results/benchmark/benchmark.nc"} if BENCHMARK_ENABLED else {}

@@ -12,5 +12,7 @@ rule validate_data:
         "logs/validate_data.log",
     benchmark:
         "benchmarks/validate_data.tsv"
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/validate_data.py"

@@ -13,6 +13,8 @@ rule phase_portraits:
         "logs/phase_portraits.log",
     benchmark:
         "benchmarks/phase_portraits.tsv"
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/phase_portraits.py"
 
@@ -27,6 +29,8 @@ rule dynamics_summary:
         "logs/dynamics_summary.log",
     benchmark:
         "benchmarks/dynamics_summary.tsv"
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/dynamics_summary.py"
 
@@ -41,6 +45,8 @@ rule bifurcation:
         "logs/bifurcation.log",
     benchmark:
         "benchmarks/bifurcation.tsv"
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/bifurcation.py"
 
@@ -55,5 +61,7 @@ rule reproduction:
         "logs/reproduction.log",
     benchmark:
         "benchmarks/reproduction.tsv"
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/reproduction.py"

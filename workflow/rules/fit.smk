@@ -16,6 +16,8 @@ rule fit:
         "logs/fit.log",
     benchmark:
         "benchmarks/fit.tsv"
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/fit.py"
 
@@ -33,5 +35,7 @@ rule flags:
         "logs/flags.log",
     benchmark:
         "benchmarks/flags.tsv"
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/flags.py"

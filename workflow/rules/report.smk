@@ -21,5 +21,7 @@ rule report:
         "logs/report.log",
     benchmark:
         "benchmarks/report.tsv"
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/report.py"

@@ -14,6 +14,8 @@ if SWEEP_CHUNKS == 1:
             "logs/sweeps/case_{case}.log",
         benchmark:
             "benchmarks/sweeps/case_{case}.tsv"
+        conda:
+            "../envs/microimpact.yaml"
         script:
             "../scripts/sweep.py"
 
@@ -29,6 +31,8 @@ else:
             "logs/sweeps/case_{case}_chunk_{chunk}_of_{nchunks}.log",
         benchmark:
             "benchmarks/sweeps/case_{case}_chunk_{chunk}_of_{nchunks}.tsv"
+        conda:
+            "../envs/microimpact.yaml"
         script:
             "../scripts/sweep_chunk.py"
 
@@ -41,5 +45,7 @@ else:
             "logs/sweeps/gather_case_{case}.log",
         benchmark:
             "benchmarks/sweeps/gather_case_{case}.tsv"
+        conda:
+            "../envs/microimpact.yaml"
         script:
             "../scripts/gather_sweep.py"

@@ -11,5 +11,7 @@ rule kharaz:
         "logs/kharaz.log",
     benchmark:
         "benchmarks/kharaz.tsv"
+    conda:
+        "../envs/microimpact.yaml"
     script:
         "../scripts/kharaz.py"

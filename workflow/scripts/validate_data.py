@@ -1,8 +1,12 @@
-"""Rule validate_data: read and check the impact CSV, write the validated table (SI units)."""
+"""Rule validate_data: read and check the impact CSV, write the validated table (SI units).
+
+stderr is left on the terminal: a bad file stops the pipeline here with one ImpactDataError that
+lists every problem (file, row, line, column, value, what is accepted) where the analyst sees it.
+"""
 
 import sys
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.stdout = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact.io import read_impacts, write_csv  # noqa: E402
 

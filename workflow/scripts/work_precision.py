@@ -1,12 +1,13 @@
-"""Rule work_precision: accuracy against cost of the engine and the scipy reference solver."""
+"""Rule work_precision: accuracy against cost of the engine, scipy's solvers and Runge-Kutta-Gill
+-> results/benchmark/ (benchmark.nc, .json, .md, work_precision.pdf/.png)."""
 
 import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
-from microimpact.benchmark import run_benchmark  # noqa: E402
-from microimpact.io import write_netcdf  # noqa: E402
+from microimpact.benchmark import run_benchmark, write_benchmark  # noqa: E402
 
-ds = run_benchmark(quick=snakemake.params.quick)  # noqa: F821
-write_netcdf(ds, snakemake.output[0])  # noqa: F821
+params = snakemake.params  # noqa: F821
+ds = run_benchmark(quick=params.quick, throughput=params.throughput, verbose=True)
+write_benchmark(ds, params.out_dir)
 print(ds)

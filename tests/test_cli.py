@@ -1,0 +1,105 @@
+"""Command line: bad arguments give exit status 2, one stderr line, nothing on stdout."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+from microimpact import cli
+
+GOOD = ["simulate", "--speed", "1.0", "--json"]
+FIELDS = ["outcome", "e_n", "mu_t", "mu_tp", "K_L", "K_t", "velocity_out", "omega_out", "contact_time",
+          "max_penetration", "slip_ended"]
+
+# (argv after "simulate", a word the error line must contain: the option or field at fault)
+BAD = [
+    ([], "--speed"),  # missing --speed
+    (["--speed", "abc"], "--speed"),
+    (["--speed", "nan"], "--speed"),
+    (["--speed", "inf"], "--speed"),
+    (["--speed", "-1"], "speed"),
+    (["--speed", "0"], "speed"),
+    (["--speed", "1", "--incidence-deg", "90"], "incidence_deg"),
+    (["--speed", "1", "--incidence-deg", "-5"], "incidence_deg"),
+    (["--speed", "1", "--incidence-deg", "nan"], "--incidence-deg"),
+    (["--speed", "1", "--preset", "nosuch"], "preset"),
+    (["--speed", "1", "--bogus", "3"], "--bogus"),
+    (["--speed", "1", "--poisson", "0.3"], "--poisson"),  # no Poisson option: unknown
+    (["--speed", "1", "--radius", "-1e-6"], "radius"),
+    (["--speed", "1", "--radius", "0"], "radius"),
+    (["--speed", "1", "--density", "-3"], "density"),
+    (["--speed", "1", "--stiffness", "x"], "--stiffness"),
+    (["--speed", "1", "--friction", "-0.1"], "friction"),
+    (["--speed", "1", "--zeta-hertz", "-1"], "zeta_hertz"),
+    (["--speed", "1", "--adhesion-line-force", "inf"], "--adhesion-line-force"),
+    (["--speed", "1", "--omega-n", "nan"], "--omega-n"),
+    (["--speed", "1", "--rtol", "2"], "rtol"),
+    (["--speed", "1", "--method", "magic"], "--method"),
+]
+
+
+def run_main(argv, capsys):
+    status = cli.main(argv)
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+@pytest.mark.parametrize("argv,word", BAD, ids=[" ".join(a) or "missing-speed" for a, _ in BAD])
+def test_bad_arguments(argv, word, capsys):
+    status, out, err = run_main(["simulate", *argv], capsys)
+    assert status == 2
+    assert out == ""
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("microimpact: error:")
+    assert word in lines[0]
+
+
+def test_no_command(capsys):
+    status, out, err = run_main([], capsys)
+    assert (status, out) == (2, "")
+    assert err.startswith("microimpact: error:") and len(err.splitlines()) == 1
+
+
+def check_json(text):
+    d = json.loads(text)
+    for name in FIELDS:
+        assert name in d, name
+    assert d["outcome"] in ("rebound", "capture")
+    assert 0.0 <= d["e_n"] <= 1.0
+    assert len(d["velocity_out"]) == 3 and len(d["omega_out"]) == 3
+    return d
+
+
+def test_good_run_json(capsys):
+    status, out, err = run_main(GOOD, capsys)
+    assert status == 0 and err == ""
+    d = check_json(out)
+    assert d["outcome"] == "capture"  # Wall (1990) preset at 1 m/s is captured (model notes sec. 2)
+    assert d["mu_t"] is None  # NaN for a capture becomes null: the output is strict JSON
+
+
+def test_good_rebound_json(capsys):
+    status, out, _ = run_main(["simulate", "--speed", "10", "--incidence-deg", "30", "--omega-t", "1e5", "--json"], capsys)
+    assert status == 0
+    d = check_json(out)
+    assert d["outcome"] == "rebound"
+    assert all(math.isfinite(x) for x in d["velocity_out"])
+
+
+def subprocess_run(args):
+    return subprocess.run([sys.executable, "-m", "microimpact.cli", *args], capture_output=True, text=True, timeout=120)
+
+
+def test_subprocess_good_and_bad():
+    good = subprocess_run(GOOD)
+    assert good.returncode == 0, good.stderr
+    check_json(good.stdout)
+    bad = subprocess_run(["simulate", "--speed", "nan"])
+    assert bad.returncode == 2 and bad.stdout == ""
+    assert bad.stderr.startswith("microimpact: error:") and len(bad.stderr.splitlines()) == 1
+    assert "--speed" in bad.stderr
