@@ -486,13 +486,16 @@ def simulate_reference(
     sigma_limit = _MAX_TAU_CONTACT
     stop_reason = None
     n_phases = 0
+    await_turn = False
 
     while stop_reason is None:
         n_phases += 1
         if n_phases > _MAX_PHASES:
             raise ReferenceSolverError(f"more than {_MAX_PHASES} restarts without an outcome")
         names = ["separation", "turn"]
-        events = [_event(ev_separation, True, -1.0), _event(ev_turn, False, -1.0)]
+        # after a capture with nothing tangential left, run on to the first turning point only:
+        # the largest penetration (the energy falls afterwards)
+        events = [_event(ev_separation, True, -1.0), _event(ev_turn, await_turn, -1.0)]
         if not captured and sc.adhesive:
             names.append("capture")
             events.append(_event(ev_capture, True, -1.0))
@@ -525,6 +528,12 @@ def simulate_reference(
                 f"(t = {sol.y[_TAU, -1] * sc.time:.6g} s): {sol.message}"
             )
         turn_xi.extend(float(v[_S]) ** 2 for v in sol.y_events[1])
+        if sol.status == 0 and await_turn:
+            # crept to the equilibrium without turning: the supremum of xi is its limit, 1
+            turn_xi.append(max(1.0, float(sol.y[_S, -1]) ** 2))
+            z = sol.y[:, -1]
+            stop_reason = "capture"
+            break
         if sol.status == 0:
             what = "captured tail did not settle" if captured else "no separation and no capture"
             raise ReferenceSolverError(
@@ -551,11 +560,18 @@ def simulate_reference(
                     "tighten rtol/atol"
                 )
             stop_reason = "separation"
+        elif fired == "turn":
+            stop_reason = "capture"
         elif fired == "capture":
             captured = True
             tau_capture = tau_end
             if not (sliding or twisting) or settle is None:
-                stop_reason = "capture"
+                if turn_xi or z[_Y] <= 0.0:
+                    stop_reason = "capture"
+                else:
+                    await_turn = True
+                    # an overdamped sphere may creep to the equilibrium without turning: bounded
+                    sigma_limit = sigma_end + _MAX_TAU_CONTACT
             else:
                 # s = sqrt(xi) -> 1 in the tail, so sigma and tau advance alike there.
                 sigma_limit = sigma_end + tail_time + _MAX_TAU_CONTACT
@@ -570,18 +586,21 @@ def simulate_reference(
             stop_reason = "settled"
         elif fired == "force":
             fn_sign = -fn_sign
-        if stop_reason is None and captured and not (sliding or twisting):
+        if stop_reason is None and captured and not (sliding or twisting) and not await_turn:
             stop_reason = "slip and twist ended"
 
     # ---- results in SI units
     T = sc.time
     vt, vtp = z[_VT] * V, z[_VTP] * V
     omega_out = (z[_WN] * V / r, z[_WT] * V / r, z[_WTP] * V / r)
+    dissipated = float(z[_D] * m * V * V)
     if captured:
         vel_out = (0.0, vt, vtp)
         contact_time = math.inf
         capture_time = tau_capture * T
-        final_contact = _energy(sc, z[_S], z[_Y]) * m * V * V
+        # settled at rest at the equilibrium: the normal energy left at the stop is dissipated too
+        final_contact = _energy(sc, 1.0, 0.0) * m * V * V
+        dissipated += (_energy(sc, z[_S], z[_Y]) - _energy(sc, 1.0, 0.0)) * m * V * V
     else:
         vel_out = (-z[_Y] * V, vt, vtp)
         contact_time = z[_TAU] * T
@@ -606,7 +625,7 @@ def simulate_reference(
         slip_ended=slip_ended,
         slip_end_time=float(tau_slip * T),
         friction_impulse=float(z[_J] * m * V),
-        dissipated_energy=float(z[_D] * m * V * V),
+        dissipated_energy=dissipated,
         final_contact_energy=float(final_contact),
         method=f"reference:{method}",
         stop_reason=stop_reason,
