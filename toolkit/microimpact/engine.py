@@ -147,14 +147,18 @@ def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, er
     fa, fb = g0, g1
     side = 0
     hs = b
+    prev = -1.0
     for _ in range(60):
         hs = (a * fb - b * fa) / (fb - fa)
         if not (hs > a and hs < b):
             hs = 0.5 * (a + b)
         _step(u0, k1, hs, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         fs = _event_value(code, u1, k[6], ah, aa, target)
-        if fs == 0.0 or (b - a) < 1e-14 * h:
+        # converged when the iterate stops moving (superlinear convergence: the next move would
+        # be far below the integration error) or the bracket has collapsed
+        if fs == 0.0 or abs(hs - prev) < 1e-12 * h or (b - a) < 1e-14 * h:
             break
+        prev = hs
         if (fs > 0.0) == (fb > 0.0):
             b, fb = hs, fs
             if side == -1:
