@@ -290,7 +290,8 @@ def test_bad_data_file_stops_at_validation_with_every_problem(tmp_path):
                    "3.45,2.0,0,0.5\n"
                    "3.45,2.0,90,0.5\n"
                    "3.45,-1,0,1.5\n")
-    proc = snakemake(root, "--cores", "1", "--config", "data=data/bad.csv")
+    # target the fit (only validate_data runs before it) so that no unrelated job starts
+    proc = snakemake(root, "results/fit.nc", "--cores", "1", "--config", "data=data/bad.csv")
     assert proc.returncode != 0
     assert "Error in rule validate_data" in proc.stdout
     assert "ImpactDataError" in proc.stdout
