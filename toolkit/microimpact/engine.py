@@ -339,6 +339,27 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             if u1[0] > smax:
                 smax = u1[0]
             recorded = True
+            if not damped:
+                # Without damping the motion is time-reversible: the way out mirrors the way in,
+                # so e_n = 1 exactly and every integral doubles. Integrating the way out instead
+                # would let round-off in E (relative to the depth of the well) trap a slow sphere.
+                j_turn = J + abs(u1[1] - u[1])
+                tau_turn = u1[2]
+                ja_turn = u1[4]
+                if math.isnan(tau_jtarget) and 0.0 < j_target <= j_turn:
+                    # reached on the way in, within this step (the way out is left to the caller)
+                    _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                    yt = u[1] - (j_target - J)
+                    _locate(1, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                    tau_jtarget = u1[2]
+                J = 2.0 * j_turn
+                u[0] = 0.0
+                u[1] = -y0
+                u[2] = 2.0 * tau_turn
+                u[3] = 0.0
+                u[4] = 2.0 * ja_turn
+                outcome = REBOUND
+                break
         # capture: E below zero by more than the integration can drift (without damping E is
         # conserved, so a negative E could only be integration error); a true capture keeps
         # losing energy and crosses the margin a little later
@@ -399,10 +420,15 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             # X monotonically. An explicit solver would need ~C^2 steps to follow it, and
             # nothing more is to be learnt: y falls monotonically to 0 (its total variation from
             # here is |y|) and the largest penetration is X itself (or what was reached before).
+            # Criterion: moving towards X, decelerating (so y falls monotonically to zero from
+            # here: its total variation is exactly |y|), and inertia small against the static force.
             creeping = False
             if overdamped and dx * u[1] < 0.0 and u[0] > 0.0:
                 vp = ah * u[0] ** 3 - aa * u[0]
-                creeping = abs(kend[1] / u[0]) <= 1e-6 * abs(vp)
+                acc = kend[1] / u[0]
+                # (beyond C ~ 100 the deceleration, ~y/C^2, drowns in the integration noise and
+                # the slow manifold is followed to O(1/C^2) anyway)
+                creeping = abs(acc) <= 1e-3 * abs(vp) and (acc * u[1] < 0.0 or ceq > 100.0 * omega0)
             if follow:
                 done = amp <= settle_amp
             elif creeping:
@@ -607,6 +633,12 @@ def solve_normal(
         if cap == 0 or r[13] < cap:
             break
         cap *= 4
+    undamped = c_h == 0.0 and c_a == 0.0
+    if undamped and jt > 0.0 and math.isnan(r[9]) and jt < r[5]:
+        # time-reversible motion: J reaches jt on the way out when it reached J - jt on the way in
+        r_in = _integrate(y0, 0.0, 0.0, sc.a_hertz, sc.a_adhesion, rtol, False, rtol, r[5] - jt, False, 0.0,
+                          max_steps, rec, 0, math.inf, math.inf)
+        r = r[:9] + (r[3] - r_in[9],) + r[10:]
     status, outcome = r[0], r[1]
     if status != _OK:
         why = "step limit reached" if status == _MAX_STEPS else "step size underflow"
