@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from microimpact.io import atomic_path, atomic_write, write_csv, write_netcdf
+from microimpact.io import atomic_path, atomic_write, write_csv, write_netcdf, write_netcdf_groups
 
 
 def leftovers(directory):
@@ -139,6 +139,21 @@ def test_write_netcdf_rewrites_a_dataset_read_from_netcdf(tmp_path):
     write_netcdf(ds.assign(extra=ds.e_n * 2), first)  # overwrite the file it came from
     with xr.open_dataset(first) as back:
         np.testing.assert_allclose(back.extra, ds.e_n * 2)
+
+
+def test_write_netcdf_groups(tmp_path):
+    root = xr.Dataset(attrs={"title": "root", "members": "b a"})
+    path = write_netcdf_groups({"b": _dataset(), None: root, "a": _dataset().isel(speed=slice(0, 5))},
+                               tmp_path / "g.nc")
+    with netCDF4.Dataset(path) as nc:
+        assert list(nc.groups) == ["b", "a"] and nc.title == "root"
+        assert nc.groups["b"].variables["e_n"].filters()["zlib"] is True
+    for name, expected in (("b", _dataset()), ("a", _dataset().isel(speed=slice(0, 5)))):
+        with xr.open_dataset(path, group=name) as back:
+            xr.testing.assert_identical(back.load(), expected)
+    assert leftovers(tmp_path) == []
+    with pytest.raises(ValueError, match="no groups"):
+        write_netcdf_groups({}, tmp_path / "empty.nc")
 
 
 def test_write_netcdf_failure_keeps_old_file(tmp_path, monkeypatch):

@@ -141,8 +141,11 @@ def test_work_precision(tmp_path):
 def test_kharaz(tmp_path):
     import pandas as pd
 
+    from microimpact.validation import kharaz_comparison
+
     df = pd.DataFrame({"quantity": ["tangential_restitution", "rebound_spin", "rebound_angle"],
                        "incidence_angle_deg": [20.0, 20.0, 20.0], "value": [0.6, 570.0, 12.0],
                        "units": ["1", "rad s-1", "degree"]})
-    ds = sweeps.kharaz_comparison(df, incidence_deg=np.arange(1.0, 80.0, 3.0))
+    df.to_csv(tmp_path / "kharaz.csv", index=False)
+    ds = kharaz_comparison(tmp_path / "kharaz.csv", fit_friction=False, curve_incidence_deg=np.arange(1.0, 80.0, 3.0))
     check(plots.plot_kharaz(ds), tmp_path, "kharaz")

@@ -233,17 +233,3 @@ def test_case25_high_spin_keeps_sliding_at_low_friction():
     assert mu[1] > mu[0]
     np.testing.assert_allclose(mu / fast["friction"].values, 1 / math.sqrt(2), rtol=0.1)
 
-
-def test_kharaz_comparison_rigid_body_limits():
-    # non-adhesive, undamped (e_n = 1), Coulomb f = 0.092: rolling ends the impact below
-    # tan(alpha) = (7/2) f (1 + e_n), where v_t,out / v_t,in = 5/7 exactly
-    import pandas as pd
-
-    df = pd.DataFrame({"quantity": ["rebound_spin"], "incidence_angle_deg": [10.0], "value": [200.0], "units": ["rad s-1"]})
-    ds = sweeps.kharaz_comparison(df, incidence_deg=[10.0, 20.0, 60.0])
-    np.testing.assert_allclose(ds["tangential_restitution"].sel(incidence_deg=[10.0, 20.0]), 5 / 7, rtol=1e-6)
-    # sliding throughout at 60 deg: v_t,out = v_t,in - f (1 + e) v_n
-    a = math.radians(60.0)
-    expect = 1 - 0.092 * 2 * math.cos(a) / math.sin(a)
-    assert float(ds["tangential_restitution"].sel(incidence_deg=60.0)) == pytest.approx(expect, rel=1e-6)
-    assert ds["measured_rebound_spin"].values.tolist() == [200.0]

@@ -112,3 +112,37 @@ def test_read_errors_name_the_line(tmp_path):
     bad.write_text(text)
     with pytest.raises(ValueError, match=r"line 2, column 'units'"):
         read_kharaz(bad)
+
+
+def test_model_curves_rigid_body_limits(tmp_path):
+    # non-adhesive, undamped (e_n = 1), Coulomb f = 0.092: rolling ends the impact below
+    # tan(alpha) = (7/2) f (1 + e_n), where v_t,out / v_t,in = 5/7 exactly
+    import pandas as pd
+
+    path = tmp_path / "k.csv"
+    pd.DataFrame({"quantity": ["rebound_spin"], "incidence_angle_deg": [10.0], "value": [200.0],
+                  "units": ["rad s-1"]}).to_csv(path, index=False)
+    ds = kharaz_comparison(path, fit_friction=False, curve_incidence_deg=[10.0, 20.0, 60.0])
+    tr = ds["tangential_restitution_curve"]
+    np.testing.assert_allclose(tr.sel(curve_incidence_deg=[10.0, 20.0]), 5 / 7, rtol=1e-6)
+    # sliding throughout at 60 deg: v_t,out = v_t,in - f (1 + e) v_n
+    a = math.radians(60.0)
+    expect = 1 - 0.092 * 2 * math.cos(a) / math.sin(a)
+    assert float(tr.sel(curve_incidence_deg=60.0)) == pytest.approx(expect, rel=1e-6)
+    assert ds["rebound_spin_measured"].values.tolist() == [200.0]
+
+
+def test_model_curves_default_grid(ds):
+    grid = ds["curve_incidence_deg"]
+    assert grid.attrs["units"] == "degree" and grid.attrs["long_name"]
+    np.testing.assert_allclose(grid.values, np.arange(0.25, 85.0001, 0.25))
+    for q in ("tangential_restitution", "rebound_spin", "rebound_angle"):
+        for name in (f"{q}_curve", f"{q}_curve_fitted"):
+            assert ds[name].dims == ("curve_incidence_deg",)
+            assert ds[name].attrs["units"] == ds[f"{q}_measured"].attrs["units"] and ds[name].attrs["long_name"]
+        # the curve passes through the model values at the measured angles inside the grid
+        a = ds[f"{q}_incidence_deg"].values
+        inside = (a >= grid.values[0]) & (a <= grid.values[-1])
+        assert inside.sum() >= 5
+        np.testing.assert_allclose(np.interp(a[inside], grid.values, ds[f"{q}_curve"].values),
+                                   ds[f"{q}_model"].values[inside], rtol=2e-2)

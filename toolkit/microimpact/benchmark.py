@@ -49,9 +49,7 @@ import json
 import math
 import os
 import platform
-import signal
 import sys
-import threading
 import time
 import tracemalloc
 from dataclasses import dataclass, field
@@ -62,6 +60,8 @@ import xarray as xr
 from numba import njit, prange
 
 from . import engine
+from ._timeout import TimeLimitExceeded
+from ._timeout import time_limit as _time_limit  # time_limit is also a parameter name here
 from .impact import simulate_impact, simulate_many
 from .presets import WALL_1990
 
@@ -361,29 +361,6 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> d
 
 
 # =============================================================================== timing helpers
-class _TimeLimit(Exception):
-    pass
-
-
-@contextlib.contextmanager
-def _time_limit(seconds: float):
-    """Raise _TimeLimit if the block runs longer than ``seconds`` (main thread on POSIX only)."""
-    if seconds is None or not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def handler(signum, frame):
-        raise _TimeLimit()
-
-    old = signal.signal(signal.SIGALRM, handler)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
-        signal.signal(signal.SIGALRM, old)
-
-
 def _timed(func, repeats: int):
     """(median seconds, last result) of ``repeats`` calls of ``func``."""
     times = []
@@ -418,7 +395,7 @@ def _run_reference(contact, speeds, cases, rtol, method="DOP853", atol=None, tim
                 t0 = time.perf_counter()
                 e_n[i] = simulate_reference(contact, float(v), rtol=rtol, atol=atol, method=method).e_n
                 times[i] = time.perf_counter() - t0
-        except _TimeLimit:
+        except TimeLimitExceeded:
             times[i] = math.inf
     obl = _oblique_nan(len(cases))
     for j, case in enumerate(cases):
@@ -429,7 +406,7 @@ def _run_reference(contact, speeds, cases, rtol, method="DOP853", atol=None, tim
                                        rtol=rtol, atol=atol, method=method)
             obl["captured"][j] = r.outcome == "capture"
             obl["mu_t"][j], obl["mu_tp"][j], obl["K_L"][j] = r.mu_t, r.mu_tp, r.K_L
-        except _TimeLimit:
+        except TimeLimitExceeded:
             obl["timeout"][j] = True
         except Exception as exc:  # noqa: BLE001 - a failing reference is a result to report
             obl["failed"][j] = f"{type(exc).__name__}: {exc}"[:200]

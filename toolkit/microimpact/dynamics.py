@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Iterable, Sequence
 
 import numpy as np
@@ -37,7 +38,7 @@ import xarray as xr
 from scipy.optimize import brentq
 
 from .forces import contact_potential_energy
-from .params import Contact
+from .params import PAPER_REFERENCE, Contact
 
 __all__ = [
     "nondimensional_rhs",
@@ -57,6 +58,10 @@ __all__ = [
     "capture_velocity",
     "motion_type",
     "phase_portrait",
+    "phase_portraits",
+    "save_phase_portraits",
+    "load_phase_portraits",
+    "dynamics_summary",
     "table1_cases",
     "bifurcation_plane",
     "SPIRAL_SINK",
@@ -773,4 +778,108 @@ def bifurcation_plane(
             "region_meanings": "0: C < 2 spiral sink (damped oscillation); 1: C = 2 critical; 2: C > 2 sink (no oscillation)",
         },
     )
+    return ds
+
+
+# ----------------------------------------------------------------------------- pipeline products
+def phase_portraits(contact: Contact, speeds: Sequence[float], **kwargs) -> list[xr.Dataset]:
+    """Fig. 5 trajectories: :func:`phase_portrait` at each normal speed.
+
+    Parameters
+    ----------
+    contact : Contact
+    speeds : sequence of float
+        Incident normal speeds. [m/s]
+    **kwargs
+        Passed to :func:`phase_portrait` (``rtol``, ``settle_amplitude``).
+
+    Returns
+    -------
+    list of xarray.Dataset
+        One trajectory per speed, in the order given.
+    """
+    return [phase_portrait(contact, float(v), **kwargs) for v in speeds]
+
+
+def save_phase_portraits(portraits: Sequence[xr.Dataset], path) -> Path:
+    """Write several phase portraits to one NetCDF-4 file atomically, one group per trajectory.
+
+    Groups are ``portrait_0``, ``portrait_1``, ... in the order given (each keeps its own ``time``
+    coordinate and attributes); the root group lists them in the attribute ``portraits`` and
+    their speeds in ``normal_speeds`` [m/s]. Written with :func:`microimpact.io.files.write_netcdf_groups`.
+    """
+    from .io.files import write_netcdf_groups
+
+    names = [f"portrait_{i}" for i in range(len(portraits))]
+    root = xr.Dataset(attrs={
+        "title": "Phase portraits of normal impacts (Cheng, Brach & Dunn 2002, Fig. 5)",
+        "portraits": " ".join(names),
+        "normal_speeds": np.array([float(ds.attrs.get("normal_speed", math.nan)) for ds in portraits]),
+        "normal_speeds_units": "m/s",
+        "references": PAPER_REFERENCE,
+    })
+    return write_netcdf_groups({None: root, **dict(zip(names, portraits))}, path)
+
+
+def load_phase_portraits(path) -> list[xr.Dataset]:
+    """Read the trajectories written by :func:`save_phase_portraits`, in their order."""
+    with xr.open_dataset(path, engine="netcdf4") as root:
+        names = str(root.attrs.get("portraits", "")).split()
+    out = []
+    for name in names:
+        with xr.open_dataset(path, group=name, engine="netcdf4") as ds:
+            out.append(ds.load())
+    return out
+
+
+def dynamics_summary(contact: Contact, speeds: Sequence[float]) -> xr.Dataset:
+    """The numbers of the nonlinear analysis (Eqs. (29)-(38)) for a contact at some normal speeds.
+
+    Parameters
+    ----------
+    contact : Contact
+        Must be adhesive (f0 > 0) for the nondimensional analysis.
+    speeds : sequence of float
+        Incident normal speeds. [m/s]
+
+    Returns
+    -------
+    xarray.Dataset
+        Scalars ``mass`` [kg], ``length_scale`` X [m], ``time_scale`` T [s],
+        ``critical_velocity`` v_c (Eq. (38), NaN with a fixed damping reference speed) [m/s] and
+        ``capture_velocity`` (largest captured normal speed, by bisection) [m/s]; along ``speed``
+        [m/s]: ``C1``, ``C2``, ``C`` (Eqs. (31)-(35)) [-], ``equilibrium_type`` (text) and
+        ``asymptotic_frequency`` omega_f (NaN for C >= 2) [rad/s].
+    """
+    from .impact import contact_attributes
+
+    speeds = np.asarray([float(v) for v in speeds])
+    c12 = np.array([contact.nondimensional_damping(v) for v in speeds]).reshape(-1, 2)
+    c = c12.sum(axis=1)
+    omega_f = np.array([float(asymptotic_frequency(contact, v)) for v in speeds])
+    try:
+        v_c = float(critical_velocity(contact))
+    except ValueError:
+        v_c = math.nan
+    ds = xr.Dataset(
+        {
+            "mass": ((), contact.mass, {"units": "kg", "long_name": "sphere mass m"}),
+            "length_scale": ((), contact.length_scale, {"units": "m", "long_name": "length scale X = 2 pi f0 / K, Eq. (29)"}),
+            "time_scale": ((), contact.time_scale, {"units": "s", "long_name": "time scale T, Eq. (30) corrected"}),
+            "critical_velocity": ((), v_c, {"units": "m/s", "long_name": "critical velocity v_c (C = 2), Eq. (38)"}),
+            "capture_velocity": ((), float(capture_velocity(contact)), {
+                "units": "m/s", "long_name": "normal capture velocity (below it the sphere is captured)"}),
+            "C1": ("speed", c12[:, 0], {"units": "1", "long_name": "C1 = C_H X / T, Eq. (31)"}),
+            "C2": ("speed", c12[:, 1], {"units": "1", "long_name": "C2 = C_A X / T, Eq. (32)"}),
+            "C": ("speed", c, {"units": "1", "long_name": "total damping C = C1 + C2, Eq. (35)"}),
+            "equilibrium_type": ("speed", np.array([equilibrium_type(x) for x in c], dtype=object), {
+                "long_name": "nature of the equilibrium (1, 0), Eq. (36)"}),
+            "asymptotic_frequency": ("speed", omega_f, {
+                "units": "rad/s", "long_name": "asymptotic angular frequency sqrt(4 - C^2) / (2 T) (Eq. (37) corrected)"}),
+        },
+        coords={"speed": ("speed", speeds, {"units": "m/s", "long_name": "incident normal speed"})},
+        attrs={"title": "Nonlinear dynamics of the normal contact (Cheng, Brach & Dunn 2002, Eqs. 28-38)",
+               "references": PAPER_REFERENCE},
+    )
+    ds.attrs.update(contact_attributes(contact))
     return ds

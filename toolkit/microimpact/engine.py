@@ -130,47 +130,66 @@ def _energy(s, y, ah, aa):
 
 
 @njit(cache=True)
-def _event_value(code, u, ku, ah, aa, target):
-    if code == 0:  # separation: s = 0
-        return u[0]
-    if code == 1:  # y crosses target (turning point: target 0; friction-impulse target)
-        return u[1] - target
-    if code == 2:  # extremum of y: dy/dsigma = 0
-        return ku[1]
-    return _energy(u[0], u[1], ah, aa) - target  # code 3: capture, E = target
+def _hermite(p0, p1, d0, d1, h, th):
+    """Cubic Hermite interpolant on a step of length h at the fraction th."""
+    th2 = th * th
+    th3 = th2 * th
+    return (2.0 * th3 - 3.0 * th2 + 1.0) * p0 + (th3 - 2.0 * th2 + th) * h * d0 + (3.0 * th2 - 2.0 * th3) * p1 + (th3 - th2) * h * d1
+
+
+@njit(cache=True)
+def _event_on_interpolant(code, target, th, u0, k1, u1, k7, h, ah, aa):
+    if code == 2:  # d/dth of the y interpolant (proportional to dy/dsigma)
+        y0, y1, d0, d1 = u0[1], u1[1], k1[1], k7[1]
+        return (6.0 * th * th - 6.0 * th) * (y0 - y1) + (3.0 * th * th - 4.0 * th + 1.0) * h * d0 + (3.0 * th * th - 2.0 * th) * h * d1
+    s = _hermite(u0[0], u1[0], k1[0], k7[0], h, th)
+    if code == 0:
+        return s
+    y = _hermite(u0[1], u1[1], k1[1], k7[1], h, th)
+    if code == 1:
+        return y - target
+    return _energy(s, y, ah, aa) - target
 
 
 @njit(cache=True)
 def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
-    """Step length h* in (0, h] at which event ``code`` crosses zero (Illinois method on re-steps)."""
-    a, b = 0.0, h
-    fa, fb = g0, g1
+    """Step length h* in (0, h] at which event ``code`` crosses zero; on return u1, k[6] hold the
+    step to h*.
+
+    The root is found on the cubic Hermite interpolant of the step (no right-hand-side calls),
+    then the step is taken again to h*. That suffices: at every event of this model the quantities
+    that are kept are stationary in sigma (at separation ds/dsigma = y/2 but dy/dsigma, dtau/dsigma
+    ~ s, s^2 vanish; at an extremum or a turning point the located variable is stationary), or the
+    event only records a time.
+    """
+    k7 = k[6].copy()
+    end = u1.copy()
+    a, b = 0.0, 1.0
+    if code == 2:
+        fa, fb = g0 * h, g1 * h
+    else:
+        fa, fb = g0, g1
     side = 0
-    hs = b
-    prev = -1.0
-    for _ in range(60):
-        hs = (a * fb - b * fa) / (fb - fa)
-        if not (hs > a and hs < b):
-            hs = 0.5 * (a + b)
-        _step(u0, k1, hs, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-        fs = _event_value(code, u1, k[6], ah, aa, target)
-        # converged when the iterate stops moving (superlinear convergence: the next move would
-        # be far below the integration error) or the bracket has collapsed
-        if fs == 0.0 or abs(hs - prev) < 1e-12 * h or (b - a) < 1e-14 * h:
+    th = 1.0
+    for _ in range(50):
+        th = (a * fb - b * fa) / (fb - fa)
+        if not (th > a and th < b):
+            th = 0.5 * (a + b)
+        fs = _event_on_interpolant(code, target, th, u0, k1, end, k7, h, ah, aa)
+        if fs == 0.0 or (b - a) < 1e-13:
             break
-        prev = hs
         if (fs > 0.0) == (fb > 0.0):
-            b, fb = hs, fs
+            b, fb = th, fs
             if side == -1:
                 fa *= 0.5
             side = -1
         else:
-            a, fa = hs, fs
+            a, fa = th, fs
             if side == 1:
                 fb *= 0.5
             side = 1
-        if abs(b - a) < 1e-13 * h:
-            break
+    hs = th * h
+    _step(u0, k1, hs, c1, c2, ah, aa, sgn, k, tmp, u1, err)
     return hs
 
 
@@ -395,11 +414,16 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             u[0] = 0.0  # exactly at the surface
         if u[0] > smax:
             smax = u[0]
-        if code == 2:
-            sgn = -sgn
-        _rhs(u, c1, c2, ah, aa, sgn, kend)
-        for i in range(n):
-            k1[i] = kend[i]
+        if code == 2 or code == 0:
+            if code == 2:
+                sgn = -sgn
+            _rhs(u, c1, c2, ah, aa, sgn, kend)
+            for i in range(n):
+                k1[i] = kend[i]
+        else:
+            for i in range(n):
+                k1[i] = k[6, i]  # first same as last
+                kend[i] = k1[i]
         if rec_cap > 0 and n_rec < rec_cap:
             rec[n_rec, 0] = u[2]
             rec[n_rec, 1] = u[0]
@@ -428,7 +452,13 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 acc = kend[1] / u[0]
                 # (beyond C ~ 100 the deceleration, ~y/C^2, drowns in the integration noise and
                 # the slow manifold is followed to O(1/C^2) anyway)
-                creeping = abs(acc) <= 1e-3 * abs(vp) and (acc * u[1] < 0.0 or ceq > 100.0 * omega0)
+                stiff = ceq > 100.0 * omega0
+                creeping = abs(acc) <= 1e-3 * abs(vp) and (acc * u[1] < 0.0 or stiff)
+                # The twist tail along the inertia-free path is accurate to the neglected inertia
+                # only (~1e-3 here, ~1/C^2 on the slow manifold), so when the tail matters it is
+                # followed by the integrator unless that is impractical (C > 100: ~C^2 steps).
+                if need_tail and not stiff:
+                    creeping = False
             if follow:
                 done = amp <= settle_amp
             elif creeping:

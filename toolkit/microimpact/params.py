@@ -19,7 +19,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 
-__all__ = ["Contact", "rolling_spin"]
+__all__ = ["Contact", "rolling_spin", "PAPER_REFERENCE"]
+
+#: full citation of the paper, for the ``references`` attribute of the toolkit's results
+PAPER_REFERENCE = (
+    "Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere "
+    "Contact/Impact with Smooth, Flat Surfaces, Aerosol Science and Technology 36(11):1081-1093, "
+    "doi:10.1080/02786820290092221"
+)
 
 
 def _check_positive(name: str, value: float) -> None:

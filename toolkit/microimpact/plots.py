@@ -16,7 +16,7 @@ function                             paper figure              input
 :func:`plot_energy_loss`             Figs. 7, 9, 11            :func:`sweeps.run_sweep`
 :func:`plot_restitution_and_impulse` Figs. 8, 10, 12, 13, 14   :func:`sweeps.run_sweep`
 :func:`plot_work_precision`          (none)                    benchmark Dataset
-:func:`plot_kharaz`                  (none)                    :func:`sweeps.kharaz_comparison`
+:func:`plot_kharaz`                  (none)                    :func:`validation.kharaz_comparison`
 ==================================== ========================= ======================================
 """
 
@@ -658,40 +658,54 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
     Parameters
     ----------
     ds : xarray.Dataset
-        From :func:`microimpact.sweeps.kharaz_comparison`: model curves ``tangential_restitution``
-        [1], ``rebound_spin`` [rad/s], ``rebound_angle`` [deg] on ``incidence_deg``; measured
-        ``measured_<name>`` with angles ``measured_<name>_incidence_deg``.
+        From :func:`microimpact.validation.kharaz_comparison`: model curves ``<q>_curve`` (and
+        ``<q>_curve_fitted``, fitted friction, drawn dashed when present) on ``curve_incidence_deg``
+        for q = ``tangential_restitution`` [1], ``rebound_spin`` [rad/s], ``rebound_angle`` [deg];
+        measured ``<q>_measured`` at the angles ``<q>_incidence_deg``.
     """
-    names = [n for n in ("tangential_restitution", "rebound_spin", "rebound_angle") if n in ds]
+    names = [n for n in ("tangential_restitution", "rebound_spin", "rebound_angle") if f"{n}_curve" in ds]
     labels = {
         "tangential_restitution": r"$v_{t,out} / v_{t,in}$ [-]",
         "rebound_spin": r"rebound spin $|\omega|$ [rad/s]",
         "rebound_angle": r"rebound angle [deg]",
     }
+    angles = ds["curve_incidence_deg"].values
+    lim = float(np.max(angles))
+    f = float(ds["friction"]) if "friction" in ds else None
+    f_fit = float(ds["fitted_friction"]) if "fitted_friction" in ds else math.nan
     fig = _figure(WIDTH, 2.5)
     axes = np.atleast_1d(fig.subplots(1, len(names)))
     for k, (ax, name) in enumerate(zip(axes, names)):
-        ax.plot(ds["incidence_deg"].values, ds[name].values, color="C0", label="model")
-        if f"measured_{name}" in ds:
-            ax.plot(ds[f"measured_{name}_incidence_deg"].values, ds[f"measured_{name}"].values, "o", ms=4,
+        ax.plot(angles, ds[f"{name}_curve"].values, color="C0",
+                label="model" + (f", f = {f:.3g}" if f is not None else ""))
+        if f"{name}_curve_fitted" in ds and math.isfinite(f_fit):
+            ax.plot(angles, ds[f"{name}_curve_fitted"].values, color="C0", ls="--", lw=0.9,
+                    label=f"model, fitted f = {f_fit:.3g}")
+        if f"{name}_measured" in ds:
+            ax.plot(ds[f"{name}_incidence_deg"].values, ds[f"{name}_measured"].values, "o", ms=4,
                     color="C3", mfc="none", mew=1.0, label="Kharaz et al. (2001)")
         if name == "rebound_angle":
-            lim = float(ds["incidence_deg"].max())
             ax.plot([0, lim], [0, lim], color="0.6", lw=0.7, ls="--", label="specular")
         ax.set_xlabel(r"incidence angle $\alpha$ [deg]")
         ax.set_ylabel(labels[name])
         _panel_label(ax, f"({'abc'[k]}) " + name.replace("_", " "))
-        ax.set_xlim(0, float(ds["incidence_deg"].max()))
+        ax.set_xlim(0, lim)
     axes[names.index("rebound_angle") if "rebound_angle" in names else 0].legend(frameon=False, loc="upper left")
     speed = ds.attrs.get("impact_speed")
-    f = ds.attrs.get("contact_friction")
+    zeta = float(ds["zeta_hertz"]) if "zeta_hertz" in ds else None
+    e_n = float(ds["e_n_model"]) if "e_n_model" in ds else None
+    damping = ("" if zeta is None else ", no damping" if zeta == 0.0
+               else f", e_n = {e_n:.3g}" if e_n is not None else "")
     caption = (
         "Oblique impact of 5 mm alumina spheres on glass"
         + (f" at {float(speed):g} m/s" if speed is not None else "")
         + ": tangential restitution, rebound spin and rebound angle against the incidence angle. Circles: "
         "measurements of Kharaz, Gorham & Salman (2001), doi:10.1016/S0032-5910(01)00283-2 (digitized); "
-        "line: the model in its non-adhesive, tangentially rigid limit"
-        + (f" (f = {float(f):g}, no damping)" if f is not None else "")
+        "solid line: the model in its non-adhesive, tangentially rigid limit"
+        + (f" (f = {f:g}{damping})" if f is not None else "")
+        + ("; dashed: the same with the friction fitted above "
+           f"{float(ds.attrs.get('sliding_threshold_deg', 30.0)):g} deg (f = {f_fit:.4g})"
+           if any(f"{n}_curve_fitted" in ds for n in names) and math.isfinite(f_fit) else "")
         + ". Below about 30 deg the measurements show effects of tangential compliance that a rigid "
         "Coulomb contact does not have."
     )

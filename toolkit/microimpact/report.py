@@ -9,13 +9,9 @@ reproduction table of the paper's claims and the configuration. Figures come fro
 module only lays them out on A4 pages with matplotlib's PdfPages (figures are embedded as 160 dpi
 images, captions and tables as text so the PDF is searchable).
 
-Pipeline products defined here (used by the workflow's thin scripts):
-
-* :func:`phase_portraits` / :func:`save_phase_portraits` / :func:`load_phase_portraits` - the
-  Fig. 5 trajectories at several speeds in one NetCDF file (one group per speed);
-* :func:`dynamics_summary` - the numbers of the nonlinear analysis (v_c, capture speed, C,
-  omega_f) as a Dataset;
-* :func:`is_synthetic`, :func:`git_commit`, :func:`provenance` - what the title page states.
+Also defined here: :func:`is_synthetic`, :func:`git_commit`, :func:`provenance` - what the title
+page states. :func:`phase_portraits`, :func:`save_phase_portraits`, :func:`load_phase_portraits`
+and :func:`dynamics_summary` live in :mod:`microimpact.dynamics` and are re-exported here.
 
 Paper: Cheng, Brach & Dunn (2002), Aerosol Sci. Technol. 36:1081-1093, doi:10.1080/02786820290092221.
 """
@@ -28,13 +24,16 @@ import os
 import platform
 import subprocess
 import textwrap
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import xarray as xr
+
+from .dynamics import dynamics_summary, load_phase_portraits, phase_portraits, save_phase_portraits
+from .params import PAPER_REFERENCE
 
 __all__ = [
     "build_report",
@@ -48,9 +47,6 @@ __all__ = [
     "PAGE_SIZE",
 ]
 
-PAPER = ("Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere "
-         "Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093, "
-         "doi:10.1080/02786820290092221")
 
 #: A4 portrait, inches
 PAGE_SIZE = (8.27, 11.69)
@@ -61,120 +57,6 @@ _TEXT_WIDTH = PAGE_SIZE[0] - 2 * _MARGIN_X
 _DPI = 160  # embedded figures
 _BODY_PT = 8.5
 _TABLE_PT = 6.6
-
-
-# =============================================================================== products
-def phase_portraits(contact, speeds: Sequence[float], **kwargs) -> list[xr.Dataset]:
-    """Fig. 5 trajectories: :func:`microimpact.dynamics.phase_portrait` at each normal speed.
-
-    Parameters
-    ----------
-    contact : Contact
-    speeds : sequence of float
-        Incident normal speeds. [m/s]
-    **kwargs
-        Passed to :func:`~microimpact.dynamics.phase_portrait` (``rtol``, ``settle_amplitude``).
-
-    Returns
-    -------
-    list of xarray.Dataset
-        One trajectory per speed, in the order given.
-    """
-    from .dynamics import phase_portrait
-
-    return [phase_portrait(contact, float(v), **kwargs) for v in speeds]
-
-
-def save_phase_portraits(portraits: Sequence[xr.Dataset], path) -> Path:
-    """Write several phase portraits to one NetCDF-4 file atomically, one group per trajectory.
-
-    Groups are ``portrait_0``, ``portrait_1``, ... in the order given (each keeps its own ``time``
-    coordinate and attributes); the root group lists them in the attribute ``portraits`` and
-    their speeds in ``normal_speeds`` [m/s].
-    """
-    from .io.files import _netcdf_encoding, atomic_path
-
-    path = Path(path)
-    names = [f"portrait_{i}" for i in range(len(portraits))]
-    root = xr.Dataset(attrs={
-        "title": "Phase portraits of normal impacts (Cheng, Brach & Dunn 2002, Fig. 5)",
-        "portraits": " ".join(names),
-        "normal_speeds": np.array([float(ds.attrs.get("normal_speed", math.nan)) for ds in portraits]),
-        "normal_speeds_units": "m/s",
-        "references": PAPER,
-    })
-    with atomic_path(path) as tmp:
-        root.to_netcdf(tmp, mode="w", engine="netcdf4", format="NETCDF4")
-        for name, ds in zip(names, portraits):
-            ds.to_netcdf(tmp, mode="a", group=name, engine="netcdf4", format="NETCDF4",
-                         encoding=_netcdf_encoding(ds))
-    return path
-
-
-def load_phase_portraits(path) -> list[xr.Dataset]:
-    """Read the trajectories written by :func:`save_phase_portraits`, in their order."""
-    with xr.open_dataset(path, engine="netcdf4") as root:
-        names = str(root.attrs.get("portraits", "")).split()
-    out = []
-    for name in names:
-        with xr.open_dataset(path, group=name, engine="netcdf4") as ds:
-            out.append(ds.load())
-    return out
-
-
-def dynamics_summary(contact, speeds: Sequence[float]) -> xr.Dataset:
-    """The numbers of the nonlinear analysis (Eqs. (29)-(38)) for a contact at some normal speeds.
-
-    Parameters
-    ----------
-    contact : Contact
-        Must be adhesive (f0 > 0) for the nondimensional analysis.
-    speeds : sequence of float
-        Incident normal speeds. [m/s]
-
-    Returns
-    -------
-    xarray.Dataset
-        Scalars ``mass`` [kg], ``length_scale`` X [m], ``time_scale`` T [s],
-        ``critical_velocity`` v_c (Eq. (38), NaN with a fixed damping reference speed) [m/s] and
-        ``capture_velocity`` (largest captured normal speed, by bisection) [m/s]; along ``speed``
-        [m/s]: ``C1``, ``C2``, ``C`` (Eqs. (31)-(35)) [-], ``equilibrium_type`` (text) and
-        ``asymptotic_frequency`` omega_f (NaN for C >= 2) [rad/s].
-    """
-    from . import dynamics
-
-    speeds = np.asarray([float(v) for v in speeds])
-    c12 = np.array([contact.nondimensional_damping(v) for v in speeds]).reshape(-1, 2)
-    c = c12.sum(axis=1)
-    omega_f = np.array([float(dynamics.asymptotic_frequency(contact, v)) for v in speeds])
-    try:
-        v_c = float(dynamics.critical_velocity(contact))
-    except ValueError:
-        v_c = math.nan
-    ds = xr.Dataset(
-        {
-            "mass": ((), contact.mass, {"units": "kg", "long_name": "sphere mass m"}),
-            "length_scale": ((), contact.length_scale, {"units": "m", "long_name": "length scale X = 2 pi f0 / K, Eq. (29)"}),
-            "time_scale": ((), contact.time_scale, {"units": "s", "long_name": "time scale T, Eq. (30) corrected"}),
-            "critical_velocity": ((), v_c, {"units": "m/s", "long_name": "critical velocity v_c (C = 2), Eq. (38)"}),
-            "capture_velocity": ((), float(dynamics.capture_velocity(contact)), {
-                "units": "m/s", "long_name": "normal capture velocity (below it the sphere is captured)"}),
-            "C1": ("speed", c12[:, 0], {"units": "1", "long_name": "C1 = C_H X / T, Eq. (31)"}),
-            "C2": ("speed", c12[:, 1], {"units": "1", "long_name": "C2 = C_A X / T, Eq. (32)"}),
-            "C": ("speed", c, {"units": "1", "long_name": "total damping C = C1 + C2, Eq. (35)"}),
-            "equilibrium_type": ("speed", np.array([dynamics.equilibrium_type(x) for x in c], dtype=object), {
-                "long_name": "nature of the equilibrium (1, 0), Eq. (36)"}),
-            "asymptotic_frequency": ("speed", omega_f, {
-                "units": "rad/s", "long_name": "asymptotic angular frequency sqrt(4 - C^2) / (2 T) (Eq. (37) corrected)"}),
-        },
-        coords={"speed": ("speed", speeds, {"units": "m/s", "long_name": "incident normal speed"})},
-        attrs={"title": "Nonlinear dynamics of the normal contact (Cheng, Brach & Dunn 2002, Eqs. 28-38)",
-               "references": PAPER},
-    )
-    from .impact import contact_attributes
-
-    ds.attrs.update(contact_attributes(contact))
-    return ds
 
 
 # =============================================================================== provenance
@@ -618,53 +500,20 @@ def _kharaz_section(lay: _Layout, kh: xr.Dataset, number: int) -> None:
         "Real measurements (digitized): 5 mm alumina spheres on soda-lime glass at 3.9 m/s. They test the "
         "tangential/rotational part of the model in its non-adhesive limit; microsphere data with rotation "
         f"are not publicly available. {kh.attrs.get('conditions', '')}")
-    lay.plot(plots.plot_kharaz(_kharaz_for_plot(kh)), max_height=3.2)
+    lay.plot(plots.plot_kharaz(kh), max_height=3.2)
     if "friction" in kh and "fitted_friction" in kh:
         lay.paragraph(
             f"Friction: nominal {float(kh['friction']):.4g}; fitted to the tangential restitution above "
             f"{kh.attrs.get('sliding_threshold_deg', 30):g} deg: {float(kh['fitted_friction']):.4g} +/- "
             f"{float(kh.get('fitted_friction_stderr', np.nan)):.2g}. Model sliding/rolling transition at "
             f"{float(kh['transition_angle']):.3g} deg.")
-    try:
-        from .validation import kharaz_summary
+    from .validation import kharaz_summary
 
-        summary = kharaz_summary(kh)
-    except (ImportError, KeyError):
-        summary = None
-    if summary is not None:
-        lay.heading("RMS model - measured")
-        lay.table(summary, {"quantity": 24, "units": 8, "regime": 12, "rms_nominal_friction": 16,
-                            "rms_fitted_friction": 16},
-                  headers={"rms_nominal_friction": "nominal friction", "rms_fitted_friction": "fitted friction"},
-                  size=7.2)
-
-
-def _kharaz_for_plot(kh: xr.Dataset) -> xr.Dataset:
-    """The layout :func:`microimpact.plots.plot_kharaz` reads, from either comparison layout.
-
-    ``microimpact.validation.kharaz_comparison`` stores ``<q>_measured`` / ``<q>_model`` on the
-    measured angles; ``plot_kharaz`` expects model curves ``<q>`` on ``incidence_deg`` and
-    ``measured_<q>`` with ``measured_<q>_incidence_deg``.
-    """
-    if "tangential_restitution" in kh.data_vars or "tangential_restitution_model" not in kh:
-        return kh
-    out = xr.Dataset(attrs=dict(kh.attrs))
-    angles = np.unique(np.concatenate([kh[f"{q}_incidence_deg"].values for q in
-                                       ("tangential_restitution", "rebound_spin", "rebound_angle") if f"{q}_model" in kh]))
-    out.coords["incidence_deg"] = ("incidence_deg", angles, {"units": "degree"})
-    for q in ("tangential_restitution", "rebound_spin", "rebound_angle"):
-        if f"{q}_model" not in kh:
-            continue
-        a = kh[f"{q}_incidence_deg"].values
-        order = np.argsort(a)
-        out[q] = ("incidence_deg", np.interp(angles, a[order], kh[f"{q}_model"].values[order]),
-                  dict(kh[f"{q}_model"].attrs))
-        out[f"measured_{q}"] = (f"{q}_point", kh[f"{q}_measured"].values, dict(kh[f"{q}_measured"].attrs))
-        out[f"measured_{q}_incidence_deg"] = (f"{q}_point", a, {"units": "degree"})
-    out.attrs.setdefault("impact_speed", 3.9)
-    if "friction" in kh:
-        out.attrs.setdefault("contact_friction", float(kh["friction"]))
-    return out
+    lay.heading("RMS model - measured")
+    lay.table(kharaz_summary(kh), {"quantity": 24, "units": 8, "regime": 12, "rms_nominal_friction": 16,
+                                 "rms_fitted_friction": 16},
+              headers={"rms_nominal_friction": "nominal friction", "rms_fitted_friction": "fitted friction"},
+              size=7.2)
 
 
 def _benchmark_section(lay: _Layout, wp: xr.Dataset | None, number: int) -> None:
@@ -737,7 +586,7 @@ def _title_page(lay: _Layout, title: str, prov: Mapping[str, str], contents: lis
 
     text(_MARGIN_X, 1.3, "\n".join(textwrap.wrap(title, 48)), fontsize=20, fontweight="bold", linespacing=1.25)
     text(_MARGIN_X, 2.35, "\n".join(textwrap.wrap(
-        "Microsphere impact model of " + PAPER + ": fit of the damping coefficients, 3-D impact simulations, "
+        "Microsphere impact model of " + PAPER_REFERENCE + ": fit of the damping coefficients, 3-D impact simulations, "
         "nonlinear dynamics, Table 2 sensitivity sweeps and validation.", 95)), fontsize=9, linespacing=1.35)
     if "SYNTHETIC" in prov.get("data", ""):
         text(_MARGIN_X, 3.25, "DATA: SYNTHETIC (generated with known parameters; not a measurement)", fontsize=11,
@@ -844,10 +693,12 @@ def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduc
     if config:
         import yaml
 
+        from .sweeps import _plain
+
         lay.section(f"{number}. Appendix: configuration")
         lay.paragraph("The configuration this report was made with (workflow/config/config.yaml merged with "
                       "command-line overrides), validated against workflow/config/config.schema.yaml.")
-        lay.paragraph(yaml.safe_dump(_plain(config), sort_keys=False, width=110), mono=True, size=7)
+        lay.paragraph(yaml.safe_dump(_plain(config, unknown=str), sort_keys=False, width=110), mono=True, size=7)
 
     title_fig = _title_page(lay, title, prov, lay.contents)
     lay.pages.insert(0, _Page(title_fig, "title", 0.0))
@@ -856,13 +707,3 @@ def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduc
                     "Subject": "Microsphere impact model of Cheng, Brach & Dunn (2002)",
                     "Keywords": "synthetic data" if synthetic else "measured data"})
     return path
-
-
-def _plain(obj):
-    if isinstance(obj, Mapping):
-        return {str(k): _plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
-    if isinstance(obj, np.generic):
-        return obj.item()
-    return obj if isinstance(obj, (str, int, float, bool, type(None))) else str(obj)

@@ -22,6 +22,7 @@ import numpy as np
 import pandas as pd
 
 from . import dynamics
+from .io.files import atomic_write
 from .params import Contact
 from .presets import WALL_1990
 
@@ -729,7 +730,8 @@ def write_reproduction_markdown(df: pd.DataFrame, path) -> Path:
     df : pandas.DataFrame
         Output of :func:`reproduction_table`.
     path : str or path-like
-        Destination file; parent folders are created.
+        Destination file, replaced atomically (:func:`microimpact.io.files.atomic_write`);
+        parent folders are created.
 
     Returns
     -------
@@ -756,5 +758,6 @@ def write_reproduction_markdown(df: pd.DataFrame, path) -> Path:
     ]
     for _, row in df.iterrows():
         lines.append("| " + " | ".join(_cell(row[c]) for c in COLUMNS) + " |")
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with atomic_write(path) as f:
+        f.write("\n".join(lines) + "\n")
     return path

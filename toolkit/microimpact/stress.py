@@ -48,18 +48,16 @@ Run from the command line::
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import math
-import signal
 import sys
-import threading
 import time
 from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
 
+from ._timeout import TimeLimitExceeded, time_limit
 from .params import Contact
 
 __all__ = ["TOLERANCES", "INPUT_RANGES", "draw_cases", "check_case", "stress_sweep", "StressReport",
@@ -204,31 +202,6 @@ def _nonfinite_fields(result) -> list[str]:
     return bad
 
 
-class _Timeout(Exception):
-    pass
-
-
-@contextlib.contextmanager
-def _time_box(seconds: float | None):
-    """Raise _Timeout in the block after ``seconds`` (POSIX main thread only; else no limit)."""
-    usable = (seconds is not None and hasattr(signal, "setitimer")
-              and threading.current_thread() is threading.main_thread())
-    if not usable:
-        yield
-        return
-
-    def handler(signum, frame):
-        raise _Timeout
-
-    old = signal.signal(signal.SIGALRM, handler)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
-        signal.signal(signal.SIGALRM, old)
-
-
 # ------------------------------------------------------------------------------------- one case
 def check_case(case: dict, *, reference: bool = False, case_time_limit: float = 30.0,
                tolerances: dict | None = None) -> dict:
@@ -281,9 +254,9 @@ def check_case(case: dict, *, reference: bool = False, case_time_limit: float = 
     if reference:
         t1 = time.perf_counter()
         try:
-            with _time_box(case_time_limit):
+            with time_limit(case_time_limit):
                 ref = simulate_impact(*args, rtol=1e-10, method="reference")
-        except _Timeout:
+        except TimeLimitExceeded:
             fail.append(("timeout", f"reference solver exceeded {case_time_limit:g} s"))
         except Exception as exc:  # noqa: BLE001
             # the reference solver is the colleague's tool; its failure is reported, not hidden

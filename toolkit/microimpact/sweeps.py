@@ -48,6 +48,7 @@ import numpy as np
 import xarray as xr
 
 from .impact import RESULT_VARIABLES as RESULT_META
+from .params import PAPER_REFERENCE
 
 __all__ = [
     "TABLE2_CASES",
@@ -60,16 +61,8 @@ __all__ = [
     "save_sweep",
     "load_sweep",
     "restitution_curves",
-    "kharaz_contact",
-    "kharaz_comparison",
     "PAPER_REFERENCE",
 ]
-
-PAPER_REFERENCE = (
-    "Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere "
-    "Contact/Impact with Smooth, Flat Surfaces, Aerosol Science and Technology 36(11):1081-1093, "
-    "doi:10.1080/02786820290092221"
-)
 
 #: spec key -> (units, long_name) of the sweep inputs, in dimension order
 SWEEP_INPUTS: dict[str, tuple[str, str]] = {
@@ -246,17 +239,23 @@ def resolve_spec(spec: Mapping) -> dict[str, float | np.ndarray]:
     return {k: _values(k, spec[k]) for k in SWEEP_INPUTS if k in spec}
 
 
-def _plain(obj):
-    """A JSON-able copy (numpy scalars and arrays become Python numbers and lists)."""
+def _plain(obj, unknown=None):
+    """A JSON-able copy (numpy scalars and arrays become Python numbers and lists).
+
+    ``unknown``, if given, converts any other object that is not a str, int, float, bool or None
+    (e.g. ``str``); by default such objects are kept as they are.
+    """
     if isinstance(obj, Mapping):
-        return {str(k): _plain(v) for k, v in obj.items()}
+        return {str(k): _plain(v, unknown) for k, v in obj.items()}
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
+        return [_plain(v, unknown) for v in obj]
     if isinstance(obj, np.generic):
         return obj.item()
-    return obj
+    if unknown is None or isinstance(obj, (str, int, float, bool, type(None))):
+        return obj
+    return unknown(obj)
 
 
 def _spec_json(spec: Mapping) -> str:
@@ -543,81 +542,3 @@ def restitution_curves(fit_dataset: xr.Dataset, speed=None, *, radius=None, rtol
         attrs={"title": "model e_n curves at the best-fit damping", "references": PAPER_REFERENCE},
     )
 
-
-def kharaz_contact():
-    """Contact of the Kharaz et al. (2001) oblique impacts: 5 mm alumina sphere on soda-lime glass.
-
-    r = 2.5 mm, 4000 kg/m^3, E = 380 GPa, nu = 0.23 on E = 70 GPa, nu = 0.25 (K from Eqs. (3)-(4)),
-    f = 0.092, no adhesion, no damping (e_n = 1): the conditions of the DEM verification cases
-    that reproduce the data (see data/README.md of the shared data).
-    """
-    from .params import Contact
-
-    return Contact.from_elastic(2.5e-3, 4000.0, 380e9, 0.23, 70e9, 0.25, 0.0, friction=0.092)
-
-
-def kharaz_comparison(measured, contact=None, incidence_deg=None, *, speed: float = 3.9,
-                      rtol: float = 1e-8) -> xr.Dataset:
-    """Model versus the measured oblique impacts of Kharaz, Gorham & Salman (2001).
-
-    Parameters
-    ----------
-    measured : str, os.PathLike or pandas.DataFrame
-        The long table ``kharaz2001_oblique.csv``: columns quantity (tangential_restitution,
-        rebound_spin, rebound_angle), incidence_angle_deg, value, units.
-    contact : Contact, optional
-        Default :func:`kharaz_contact`.
-    incidence_deg : sequence of float, optional
-        Model angles. [deg] Default 0.25-85 deg in 0.25 deg steps.
-    speed : float
-        Impact speed of the experiments. [m/s]
-
-    Returns
-    -------
-    xarray.Dataset
-        Model curves on ``incidence_deg``: ``tangential_restitution`` v_t,out / v_t,in [1],
-        ``rebound_spin`` |omega_out| [rad s-1], ``rebound_angle`` atan(|v_t,out| / v_n,out) from
-        the normal [degree]; measured values as ``measured_<quantity>`` on dimension
-        ``<quantity>_point`` with the angle in ``measured_<quantity>_incidence_deg``.
-    """
-    import pandas as pd
-
-    from .impact import simulate_many
-
-    df = measured if isinstance(measured, pd.DataFrame) else pd.read_csv(measured)
-    missing = {"quantity", "incidence_angle_deg", "value"} - set(df.columns)
-    if missing:
-        raise ValueError(f"measured table lacks column(s) {sorted(missing)}")
-    contact = kharaz_contact() if contact is None else contact
-    angles = np.arange(0.25, 85.0001, 0.25) if incidence_deg is None else np.asarray(incidence_deg, dtype=float)
-    res = simulate_many(contact, speed, xr.DataArray(angles, dims="incidence_deg"), rtol=rtol)
-    v_t_in = speed * np.sin(np.radians(angles))
-    v_t_out = res["velocity_out_t"].values
-    spin = np.sqrt(res["omega_out_n"] ** 2 + res["omega_out_t"] ** 2 + res["omega_out_tp"] ** 2).values
-    angle_out = np.degrees(np.arctan2(np.abs(v_t_out), res["velocity_out_n"].values))
-    meta = {
-        "tangential_restitution": ("1", "tangential restitution v_t,out / v_t,in of the centre"),
-        "rebound_spin": ("rad s-1", "angular speed after impact"),
-        "rebound_angle": ("degree", "rebound angle from the surface normal"),
-    }
-    ds = xr.Dataset(coords={"incidence_deg": ("incidence_deg", angles, {
-        "units": "degree", "long_name": "incidence angle from the surface normal"})})
-    for name, values in zip(meta, (v_t_out / v_t_in, spin, angle_out)):
-        ds[name] = ("incidence_deg", values, {"units": meta[name][0], "long_name": "model " + meta[name][1]})
-        rows = df[df["quantity"] == name]
-        dim = f"{name}_point"
-        ds[f"measured_{name}"] = (dim, rows["value"].to_numpy(float), {
-            "units": meta[name][0], "long_name": "measured " + meta[name][1]})
-        ds[f"measured_{name}_incidence_deg"] = (dim, rows["incidence_angle_deg"].to_numpy(float), {
-            "units": "degree", "long_name": "incidence angle of the measurement"})
-    ds.attrs.update({
-        "title": "Oblique impact of 5 mm alumina spheres on glass: model vs Kharaz et al. (2001)",
-        "references": "Kharaz, Gorham & Salman (2001), Powder Technology 120:281-291, "
-        f"doi:10.1016/S0032-5910(01)00283-2; {PAPER_REFERENCE}",
-        "impact_speed": float(speed),
-        "impact_speed_units": "m s-1",
-    })
-    from .impact import contact_attributes
-
-    ds.attrs.update(contact_attributes(contact))
-    return ds

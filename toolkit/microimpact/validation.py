@@ -45,7 +45,6 @@ import xarray as xr
 
 from . import engine
 from .impact import simulate_many
-from .params import Contact
 
 __all__ = ["kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
            "KHARAZ_CONDITIONS"]
@@ -142,7 +141,7 @@ def _model(contact, angles, friction):
 
 
 def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, sliding_threshold_deg: float = 30.0,
-                      fit_friction: bool = True) -> xr.Dataset:
+                      fit_friction: bool = True, curve_incidence_deg=None) -> xr.Dataset:
     """Compare the model's tangential restitution, rebound spin and rebound angle with Kharaz (2001).
 
     Parameters
@@ -160,6 +159,8 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
     fit_friction : bool
         Also fit the friction coefficient (lmfit, leastsq) to the tangential restitution at
         angles above ``sliding_threshold_deg``.
+    curve_incidence_deg : sequence of float, optional
+        Incidence angles of the model curves. [deg] Default 0.25-85 deg in 0.25 deg steps.
 
     Returns
     -------
@@ -168,7 +169,9 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         dimension ``q`` with coordinate ``q_incidence_deg``: ``q_measured``, ``q_model`` (nominal
         friction), ``q_difference`` (model - measured), ``q_sliding`` (1 above the threshold) and,
         with ``fit_friction``, ``q_model_fitted`` and ``q_difference_fitted``; ``omega_out_tp_model``
-        (signed spin, see the module docstring). Scalars: ``friction``, ``fitted_friction``
+        (signed spin, see the module docstring). Model curves on the fine angle grid
+        ``curve_incidence_deg``: ``q_curve`` (nominal friction) and, with ``fit_friction``,
+        ``q_curve_fitted``. Scalars: ``friction``, ``fitted_friction``
         (+ ``fitted_friction_stderr``), ``e_n_model``, ``zeta_hertz``, ``rolling_limit`` (5/7) and
         ``transition_angle`` (model sliding/rolling boundary, tan = (7/2) f (1 + e_n)). RMS
         differences per quantity and regime are attributes ``rms_<q>_<sliding|below>[_fitted]``
@@ -202,12 +205,22 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
 
     e_n = float(engine.solve_normal_many(contact, np.array([KHARAZ_CONDITIONS["speed"]]), rtol=1e-10)["e_n"][0])
     ds = xr.Dataset()
+    grid = (np.arange(0.25, 85.0001, 0.25) if curve_incidence_deg is None
+            else np.asarray(curve_incidence_deg, dtype=float).reshape(-1))
+    ds.coords["curve_incidence_deg"] = ("curve_incidence_deg", grid, {
+        "units": "degree", "long_name": "incidence angle from the surface normal (model curves)"})
+    curves = {"": (_model(contact, grid, f_nom), f"friction {f_nom:g}")}
+    if fit_friction:
+        curves["_fitted"] = (_model(contact, grid, f_fit), f"fitted friction {f_fit:.4g}")
     for q, (units, long_name) in _QUANTITIES.items():
         sub = data[data["quantity"] == q]
         a = sub["incidence_angle_deg"].to_numpy()
         meas = sub["value"].to_numpy()
         mod = _model(contact, a, f_nom)
         sliding = (a > sliding_threshold_deg).astype(np.int8)
+        for suffix, (curve, label) in curves.items():
+            ds[f"{q}_curve{suffix}"] = ("curve_incidence_deg", curve[q], {
+                "units": units, "long_name": f"model {long_name}, {label}"})
         ds.coords[f"{q}_incidence_deg"] = ((q,), a, {"units": "degree", "long_name": "incidence angle from the surface normal"})
         ds[f"{q}_measured"] = ((q,), meas, {"units": units, "long_name": f"measured {long_name} (Kharaz et al. 2001)"})
         ds[f"{q}_model"] = ((q,), mod[q], {"units": units, "long_name": f"model {long_name}, friction {f_nom:g}"})
@@ -241,6 +254,8 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         "conditions": "5 mm alumina sphere on soda-lime glass, 3.9 m/s, no adhesion, "
                       f"e_n = {e_n:.4g} (zeta_H = {contact.zeta_hertz:.4g})",
         "sliding_threshold_deg": float(sliding_threshold_deg),
+        "impact_speed": float(KHARAZ_CONDITIONS["speed"]),
+        "impact_speed_units": "m s-1",
         "spin_convention": "omega_t' < 0 is forward rolling for v_t > 0 (slip u_t = v_t + r omega_t'); compared as |omega|",
         "Conventions": "CF-1.8",
     })

@@ -5,11 +5,10 @@ import sys
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact import Contact  # noqa: E402
-from microimpact.io import atomic_path, write_csv  # noqa: E402
+from microimpact.io import write_csv  # noqa: E402
 from microimpact.reproduction import reproduction_table, write_reproduction_markdown  # noqa: E402
 
 table = reproduction_table(Contact(**snakemake.params.contact))  # noqa: F821
 write_csv(table, snakemake.output.table)  # noqa: F821
-with atomic_path(snakemake.output.markdown) as tmp:  # noqa: F821
-    write_reproduction_markdown(table, tmp)
+write_reproduction_markdown(table, snakemake.output.markdown)  # noqa: F821
 print(table.to_string())

@@ -5,12 +5,12 @@
   [deg] in ``*_deg`` columns), or raises one :class:`ImpactDataError` listing every problem.
 * :func:`read_materials`, :func:`default_materials_path`, :class:`MaterialPair` - the materials
   config (data/README.md, "Materials config").
-* :func:`atomic_write`, :func:`atomic_path`, :func:`write_csv`, :func:`write_netcdf` - writers that
-  leave either the old or the complete new file, never a partial one.
+* :func:`atomic_write`, :func:`atomic_path`, :func:`write_csv`, :func:`write_netcdf`,
+  :func:`write_netcdf_groups` - writers that leave either the old or the complete new file, never a partial one.
 * :mod:`microimpact.io.units` - the one table of accepted units.
 """
 
-from .files import atomic_path, atomic_write, write_csv, write_netcdf
+from .files import atomic_path, atomic_write, write_csv, write_netcdf, write_netcdf_groups
 from .impacts import CANONICAL_COLUMNS, COLUMN_UNITS, ImpactDataError, ImpactDataWarning, Problem, read_impacts
 from .materials import MaterialPair, MaterialsError, default_materials_path, read_materials
 from .units import UNITS, UnitError
@@ -30,6 +30,7 @@ __all__ = [
     "atomic_write",
     "write_csv",
     "write_netcdf",
+    "write_netcdf_groups",
     "UNITS",
     "UnitError",
 ]

@@ -16,12 +16,12 @@ import contextlib
 import os
 import stat
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["atomic_path", "atomic_write", "write_netcdf", "write_csv", "NETCDF_COMPRESSION"]
+__all__ = ["atomic_path", "atomic_write", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION"]
 
 #: encoding added to every numeric, non-scalar NetCDF variable
 NETCDF_COMPRESSION = {"zlib": True, "complevel": 4}
@@ -156,9 +156,36 @@ def write_netcdf(ds, path) -> Path:
     pathlib.Path
         ``path``.
     """
+    return write_netcdf_groups({None: ds}, path)
+
+
+def write_netcdf_groups(groups: Mapping, path) -> Path:
+    """Write several xarray Datasets to one NetCDF-4 file atomically, one group each.
+
+    Numeric variables are zlib-compressed and each variable's own encoding is kept, as in
+    :func:`write_netcdf`.
+
+    Parameters
+    ----------
+    groups : mapping of str or None to xarray.Dataset
+        Group name -> contents, written in this order; the key ``None`` (or ``"/"``) is the root
+        group, written first wherever it stands in the mapping.
+    path : str or os.PathLike
+        Output file; replaced atomically.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    items = sorted(groups.items(), key=lambda item: item[0] not in (None, "/"))  # stable: root first
+    if not items:
+        raise ValueError(f"nothing to write to {path}: no groups given")
     path = Path(path)
     with atomic_path(path) as tmp:
-        ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=_netcdf_encoding(ds))
+        for i, (name, ds) in enumerate(items):
+            ds.to_netcdf(tmp, mode="w" if i == 0 else "a", group=None if name in (None, "/") else str(name),
+                         engine="netcdf4", format="NETCDF4", encoding=_netcdf_encoding(ds))
     return path
 
 
