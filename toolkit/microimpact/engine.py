@@ -465,12 +465,8 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 done = True
                 J += abs(u[1])
                 u[4] += _creeping_twist_tail(u[0] * u[0], xe, c1, c2, ah, aa)
-                if xe > smax * smax:
-                    smax = math.sqrt(xe)
             elif amp == 0.0:
                 done = True  # settled to within the integration noise
-                if not turned and xe > smax * smax:
-                    smax = math.sqrt(xe)  # crept up to the equilibrium without turning
             elif not turned:
                 done = False  # the largest penetration is not known yet
             elif need_tail and J >= j_stop and u[4] >= ja_stop:
@@ -488,6 +484,8 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 done = True  # captured and past the largest penetration
             if done:
                 outcome = CAPTURE
+                if not turned and xe > smax * smax:
+                    smax = math.sqrt(xe)  # approached the equilibrium without turning: its supremum
                 break
         # next step size
         if en == 0.0:
