@@ -70,5 +70,7 @@ def test_strongly_overdamped_capture_matches_reference():
     assert a.outcome == b.outcome == "capture"
     np.testing.assert_allclose(a.velocity_out, b.velocity_out, rtol=0, atol=ATOL * 1e-3)
     np.testing.assert_allclose(a.omega_out, b.omega_out, rtol=0, atol=ATOL * 1e-3 / c.radius)
-    # the creeping sphere approaches the equilibrium X monotonically: its supremum
-    assert a.max_penetration == pytest.approx(c.length_scale, rel=1e-12, abs=0)
+    # the creeping sphere approaches the equilibrium X monotonically: its supremum, up to the
+    # integration noise near the equilibrium (~10 atol, 1e-9 relative at rtol 1e-10)
+    assert a.max_penetration == pytest.approx(c.length_scale, rel=1e-7, abs=0)
+    assert a.max_penetration <= c.length_scale * (1 + 1e-9)
