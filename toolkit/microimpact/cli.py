@@ -200,7 +200,46 @@ def register_flags(sub) -> None:
     p.set_defaults(func=_cmd_flags)
 
 
-_EXTRA_COMMANDS += [register_fit, register_flags]
+def _cmd_sweep(args) -> int:
+    from .io.files import write_netcdf
+    from .sweeps import TABLE2_CASES, run_sweep
+
+    if args.case not in TABLE2_CASES:
+        raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(sorted(TABLE2_CASES))}")
+    out = _writable(args.out, "--out")
+    ds = run_sweep(contact_from_args(args), case=args.case, rtol=args.rtol)
+    write_netcdf(ds, out)
+    print(f"case {args.case}: {dict(ds.sizes)} impacts, {int(ds['outcome'].sum())} captured; wrote {out}")
+    return 0
+
+
+def register_sweep(sub) -> None:
+    """``microimpact sweep --case 2.1 --out case.nc``: one Table 2 sweep to NetCDF."""
+    p = sub.add_parser("sweep", help="run one of the Table 2 sweeps (2.1-2.5) and write NetCDF")
+    add_contact_options(p)
+    p.add_argument("--case", required=True, help="Table 2 case: 2.1, 2.2, 2.3, 2.4 or 2.5")
+    p.add_argument("--rtol", type=_finite_float, default=1e-8, help="relative tolerance (default 1e-8)")
+    p.add_argument("--out", required=True, help="output NetCDF")
+    p.set_defaults(func=_cmd_sweep)
+
+
+def _cmd_reproduce(args) -> int:
+    from .reproduction import reproduction_table, write_reproduction_markdown
+
+    out = _writable(args.out, "--out")
+    write_reproduction_markdown(reproduction_table(), out)
+    print(f"wrote {out}")
+    return 0
+
+
+def register_reproduce(sub) -> None:
+    """``microimpact reproduce --out docs/reproduction.md``: the paper-versus-toolkit table."""
+    p = sub.add_parser("reproduce", help="write the table of the paper's claims against the toolkit (Markdown)")
+    p.add_argument("--out", required=True, help="output Markdown file")
+    p.set_defaults(func=_cmd_reproduce)
+
+
+_EXTRA_COMMANDS += [register_fit, register_flags, register_sweep, register_reproduce]
 
 
 def main(argv=None) -> int:
@@ -210,7 +249,7 @@ def main(argv=None) -> int:
         if not getattr(args, "command", None):
             raise UsageError("a command is required: " + ", ".join(["simulate"] + [r.__name__.removeprefix("register_") for r in _EXTRA_COMMANDS]))
         return args.func(args)
-    except (UsageError, ValueError) as exc:
+    except (UsageError, ValueError, RuntimeError) as exc:  # RuntimeError: solver failures
         print(f"microimpact: error: {exc}", file=sys.stderr)
         return 2
 
