@@ -107,7 +107,9 @@ def test_batch_equals_single():
     many = solve_normal_many(WALL_1990, v, rtol=1e-10)
     for i, vi in enumerate(v):
         one = solve_normal(WALL_1990, vi, rtol=1e-10)
-        assert many["e_n"][i] == one.e_n  # same compiled code, bit for bit
+        # same kernel; fastmath lets LLVM fuse multiply-adds differently where it is inlined
+        # into the parallel loop, so only round-off may differ
+        assert many["e_n"][i] == pytest.approx(one.e_n, rel=1e-12, abs=0)
         assert many["captured"][i] == (one.outcome == "capture")
 
 

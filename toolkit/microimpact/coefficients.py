@@ -84,8 +84,8 @@ def impact_coefficients(mass, moment_of_inertia, velocity_in, omega_in, velocity
         mu_tp = (vtp_r - vtp_i) / dvn  # Eq. (23)
     v2_i = vn_i**2 + vt_i**2 + vtp_i**2
     v2_r = vn_r**2 + vt_r**2 + vtp_r**2
-    w2_i = float(np.dot(omega_in, omega_in))
-    w2_r = float(np.dot(omega_out, omega_out))
+    w2_i = sum(w * w for w in omega_in)
+    w2_r = sum(w * w for w in omega_out)
     energy_in = mass * v2_i + moment_of_inertia * w2_i
     k_t = (energy_in - mass * v2_r - moment_of_inertia * w2_r) / energy_in  # Eq. (24)
     k_l = (v2_i - v2_r) / v2_i  # Eq. (25)

@@ -78,7 +78,21 @@ class EngineError(RuntimeError):
 
 
 # --------------------------------------------------------------------------- compiled core
-@njit(cache=True, fastmath=False)
+@njit(cache=True, fastmath=True, inline="always")
+def _rhs_row(u, c1, c2, ah, aa, sgn, k, j):
+    """d/dsigma of the state u, written into row j of k (see the module docstring)."""
+    s = u[0]
+    y = u[1]
+    s2 = s * s
+    g = aa * s2 * (1.0 - c2 * y) - ah * s2 * s2 * (1.0 + c1 * y)
+    k[j, 0] = 0.5 * y
+    k[j, 1] = g
+    k[j, 2] = s
+    k[j, 3] = (ah * c1 * s2 * s2 + aa * c2 * s2) * y * y
+    k[j, 4] = sgn * s * g
+
+
+@njit(cache=True, fastmath=True)
 def _rhs(u, c1, c2, ah, aa, sgn, out):
     s = u[0]
     y = u[1]
@@ -91,32 +105,32 @@ def _rhs(u, c1, c2, ah, aa, sgn, out):
     out[4] = sgn * s * g
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath=True)
 def _step(u0, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err):
     """One DP5 step from u0 (derivative k1) over h; writes u1, err and k[6] = f(u1)."""
-    n = u0.shape[0]
+    n = _NSTATE  # a compile-time constant lets LLVM unroll the stage loops
     for i in range(n):
         k[0, i] = k1[i]
     for i in range(n):
         tmp[i] = u0[i] + h * _A21 * k[0, i]
-    _rhs(tmp, c1, c2, ah, aa, sgn, k[1])
+    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 1)
     for i in range(n):
         tmp[i] = u0[i] + h * (_A31 * k[0, i] + _A32 * k[1, i])
-    _rhs(tmp, c1, c2, ah, aa, sgn, k[2])
+    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 2)
     for i in range(n):
         tmp[i] = u0[i] + h * (_A41 * k[0, i] + _A42 * k[1, i] + _A43 * k[2, i])
-    _rhs(tmp, c1, c2, ah, aa, sgn, k[3])
+    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 3)
     for i in range(n):
         tmp[i] = u0[i] + h * (_A51 * k[0, i] + _A52 * k[1, i] + _A53 * k[2, i] + _A54 * k[3, i])
-    _rhs(tmp, c1, c2, ah, aa, sgn, k[4])
+    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 4)
     for i in range(n):
         tmp[i] = u0[i] + h * (
             _A61 * k[0, i] + _A62 * k[1, i] + _A63 * k[2, i] + _A64 * k[3, i] + _A65 * k[4, i]
         )
-    _rhs(tmp, c1, c2, ah, aa, sgn, k[5])
+    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 5)
     for i in range(n):
         u1[i] = u0[i] + h * (_B1 * k[0, i] + _B3 * k[2, i] + _B4 * k[3, i] + _B5 * k[4, i] + _B6 * k[5, i])
-    _rhs(u1, c1, c2, ah, aa, sgn, k[6])
+    _rhs_row(u1, c1, c2, ah, aa, sgn, k, 6)
     for i in range(n):
         err[i] = h * (
             _E1 * k[0, i] + _E3 * k[2, i] + _E4 * k[3, i] + _E5 * k[4, i] + _E6 * k[5, i] + _E7 * k[6, i]

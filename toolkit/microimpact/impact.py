@@ -13,7 +13,8 @@ import xarray as xr
 
 from . import engine
 from .coefficients import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
-from .tangential import sliding_friction_impulse, tangential_outcome, twist_stop_impulse
+from .tangential import (_sliding_impulse, _twist_stop, sliding_friction_impulse, tangential_kernel,
+                         tangential_outcome, twist_stop_impulse)
 
 __all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES"]
 
@@ -40,6 +41,10 @@ RESULT_VARIABLES: dict[str, tuple[str, str]] = {
 
 
 def _check_inputs(speed, incidence_deg, azimuth_deg, omega):
+    if all(isinstance(x, (int, float)) for x in (speed, incidence_deg, azimuth_deg, *omega)):
+        if math.isfinite(speed) and speed > 0.0 and math.isfinite(incidence_deg) and 0.0 <= incidence_deg < 90.0 \
+                and math.isfinite(azimuth_deg) and all(math.isfinite(w) for w in omega):
+            return  # the common scalar case, valid (the array checks below give the messages)
     speed = np.asarray(speed, dtype=float)
     inc = np.asarray(incidence_deg, dtype=float)
     if not np.all(np.isfinite(speed)) or np.any(speed <= 0.0):
@@ -92,18 +97,18 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
     u_t, u_tp = slip_velocity(r, v_in[1], v_in[2], w_in[1], w_in[2])
     slip = math.hypot(u_t, u_tp)
     needs_tangential = f > 0.0 and (slip > 0.0 or w_in[0] != 0.0)
-    j_star = float(sliding_friction_impulse(m, f, slip))
+    j_star = _sliding_impulse(m, f, slip)
     sol = engine.solve_normal(
         contact, -v_in[0], rtol=rtol, need_tail=needs_tangential,
         friction_impulse_target=j_star if needs_tangential and 0.0 < j_star < math.inf else None,
-        friction_impulse_stop=j_star, twist_impulse_stop=float(twist_stop_impulse(inertia, f, w_in[0])),
+        friction_impulse_stop=j_star, twist_impulse_stop=_twist_stop(inertia, f, w_in[0]),
     )
-    tan = tangential_outcome(m, inertia, r, f, v_in, w_in, sol.friction_impulse, sol.twist_impulse)
+    tan = tangential_kernel(m, inertia, r, f, v_in[1], v_in[2], *w_in, sol.friction_impulse, sol.twist_impulse)
     captured = sol.outcome == "capture"
-    v_out = (0.0 if captured else sol.e_n * -v_in[0], float(tan["v_t"]), float(tan["v_tp"]))
-    w_out = (float(tan["omega_n"]), float(tan["omega_t"]), float(tan["omega_tp"]))
+    v_out = (0.0 if captured else sol.e_n * -v_in[0], tan[0], tan[1])
+    w_out = (tan[2], tan[3], tan[4])
     coef = impact_coefficients(m, inertia, v_in, w_in, v_out, w_out, captured)
-    slip_ended = bool(tan["slip_ended"])
+    slip_ended = bool(tan[5])
     return ImpactResult(
         outcome=sol.outcome,
         **coef,
@@ -117,8 +122,7 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
         slip_ended=slip_ended,
         slip_end_time=(0.0 if slip == 0.0 else sol.slip_end_time) if slip_ended else math.nan,
         friction_impulse=sol.friction_impulse,
-        dissipated_energy=_normal_dissipation(contact, -v_in[0], captured, sol.dissipated_energy)
-        + float(tan["friction_dissipation"]),
+        dissipated_energy=float(_normal_dissipation(contact, -v_in[0], captured, sol.dissipated_energy)) + tan[7],
         final_contact_energy=settled_contact_energy(contact) if captured else 0.0,
         method="engine",
         stop_reason=sol.outcome if not captured else ("settled" if needs_tangential else "capture"),

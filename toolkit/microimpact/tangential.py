@@ -13,13 +13,93 @@ through J_a = int a |F_n| dt. Both are verified against the full 3-D reference s
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
-from .coefficients import slip_velocity
+__all__ = ["sliding_friction_impulse", "twist_stop_impulse", "tangential_outcome", "tangential_kernel"]
 
-__all__ = ["sliding_friction_impulse", "twist_stop_impulse", "tangential_outcome"]
+TWIST_TORQUE_FACTOR = 3.0 * math.pi / 16.0  # torque = factor * f * a * |F_n|
 
-TWIST_TORQUE_FACTOR = 3.0 * np.pi / 16.0  # torque = factor * f * a * |F_n|
+
+@njit(cache=True)
+def _sliding_impulse(mass, friction, slip_speed):
+    if slip_speed <= 0.0:
+        return 0.0
+    if friction == 0.0:
+        return math.inf
+    return 2.0 * mass * slip_speed / (7.0 * friction)
+
+
+@njit(cache=True)
+def _twist_stop(moment_of_inertia, friction, omega_n):
+    w0 = abs(omega_n)
+    if w0 == 0.0:
+        return 0.0
+    if friction == 0.0:
+        return math.inf
+    return w0 * moment_of_inertia / (TWIST_TORQUE_FACTOR * friction)
+
+
+@njit(cache=True)
+def tangential_kernel(mass, moment_of_inertia, radius, friction, v_t, v_tp, w_n, w_t, w_tp,
+                      friction_impulse, twist_impulse):
+    """Scalar tangential map (compiled); see :func:`tangential_outcome` for the physics and units.
+
+    Returns (v_t, v_t', omega_n, omega_t, omega_t', slip_ended, sliding_impulse,
+    friction_dissipation) after the contact.
+    """
+    f = friction
+    u_t = v_t + radius * w_tp  # slip of the contact point, coefficients.slip_velocity
+    u_tp = v_tp - radius * w_t
+    slip = math.hypot(u_t, u_tp)
+    j_star = _sliding_impulse(mass, f, slip)
+    j_s = min(friction_impulse, j_star)
+    dir_t = u_t / slip if slip > 0.0 else 0.0
+    dir_tp = u_tp / slip if slip > 0.0 else 0.0
+    p_t = -f * j_s * dir_t  # tangential impulse on the sphere [N s]
+    p_tp = -f * j_s * dir_tp
+    out_v_t = v_t + p_t / mass
+    out_v_tp = v_tp + p_tp / mass
+    out_w_tp = w_tp + radius * p_t / moment_of_inertia  # Eq. (20): I dw_t'/dt = r F_t
+    out_w_t = w_t - radius * p_tp / moment_of_inertia  # Eq. (19): I dw_t/dt = -r F_t'
+    # friction power f |F_n| |u| with |u| = |u0| - (7/2) f J / m
+    sliding_loss = f * (slip * j_s - 1.75 * f * j_s * j_s / mass)
+    # twist: |omega_n| falls by k J_a until it reaches zero
+    k = TWIST_TORQUE_FACTOR * f / moment_of_inertia
+    w0 = abs(w_n)
+    ja_s = min(twist_impulse, _twist_stop(moment_of_inertia, f, w_n))
+    out_w_n = math.copysign(max(w0 - k * ja_s, 0.0), w_n) if w0 > 0.0 else 0.0
+    twist_loss = moment_of_inertia * (w0 * w0 - out_w_n * out_w_n) / 2.0
+    slip_ended = slip == 0.0 or friction_impulse >= j_star
+    return out_v_t, out_v_tp, out_w_n, out_w_t, out_w_tp, slip_ended, j_s, sliding_loss + twist_loss
+
+
+@njit(cache=True)
+def _tangential_many(mass, inertia, radius, f, v_t, v_tp, w_n, w_t, w_tp, jn, ja, out, ended):
+    for i in range(v_t.shape[0]):
+        r = tangential_kernel(mass, inertia, radius, f[i], v_t[i], v_tp[i], w_n[i], w_t[i], w_tp[i], jn[i], ja[i])
+        out[0, i] = r[0]
+        out[1, i] = r[1]
+        out[2, i] = r[2]
+        out[3, i] = r[3]
+        out[4, i] = r[4]
+        ended[i] = r[5]
+        out[5, i] = r[6]
+        out[6, i] = r[7]
+
+
+@njit(cache=True)
+def _stops_many(mass, inertia, f, slip, w_n, j_out, ja_out):
+    for i in range(slip.shape[0]):
+        j_out[i] = _sliding_impulse(mass, f[i], slip[i])
+        ja_out[i] = _twist_stop(inertia, f[i], w_n[i])
+
+
+def _flat(*arrays):
+    b = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
+    return b[0].shape, [np.ascontiguousarray(x).ravel() for x in b]
 
 
 def sliding_friction_impulse(mass, friction, slip_speed):
@@ -27,10 +107,10 @@ def sliding_friction_impulse(mass, friction, slip_speed):
 
     Returns inf where there is no friction and 0 where there is no slip.
     """
-    mass, friction, slip_speed = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (mass, friction, slip_speed)))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        j = np.where(slip_speed > 0.0, 2.0 * mass * slip_speed / (7.0 * friction), 0.0)
-    return np.where((friction == 0.0) & (slip_speed > 0.0), np.inf, j)
+    shape, (f, slip) = _flat(friction, slip_speed)
+    j, ja = np.empty(f.size), np.empty(f.size)
+    _stops_many(float(mass), 1.0, f, slip, np.zeros(f.size), j, ja)
+    return j.reshape(shape)
 
 
 def twist_stop_impulse(moment_of_inertia, friction, omega_n):
@@ -38,11 +118,10 @@ def twist_stop_impulse(moment_of_inertia, friction, omega_n):
 
     Returns 0 where there is no twist and inf where there is twist but no friction.
     """
-    friction, omega_n = np.broadcast_arrays(np.asarray(friction, dtype=float), np.asarray(omega_n, dtype=float))
-    w0 = np.abs(omega_n)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        j = np.where(w0 > 0.0, w0 * moment_of_inertia / (TWIST_TORQUE_FACTOR * friction), 0.0)
-    return np.where((friction == 0.0) & (w0 > 0.0), np.inf, j)
+    shape, (f, w) = _flat(friction, omega_n)
+    j, ja = np.empty(f.size), np.empty(f.size)
+    _stops_many(1.0, float(moment_of_inertia), f, np.zeros(f.size), w, j, ja)
+    return ja.reshape(shape)
 
 
 def tangential_outcome(mass, moment_of_inertia, radius, friction, velocity_in, omega_in, friction_impulse, twist_impulse):
@@ -70,40 +149,13 @@ def tangential_outcome(mass, moment_of_inertia, radius, friction, velocity_in, o
     contact, ``slip_ended`` (bool), ``sliding_impulse`` (friction impulse actually transmitted,
     min(J, J*)) [N s], ``friction_dissipation`` (sliding plus twist) [J].
     """
-    _, v_t, v_tp = (np.asarray(a, dtype=float) for a in velocity_in)
-    w_n, w_t, w_tp = (np.asarray(a, dtype=float) for a in omega_in)
-    f = np.asarray(friction, dtype=float)
-    jn = np.asarray(friction_impulse, dtype=float)
-    ja = np.asarray(twist_impulse, dtype=float)
-    u_t, u_tp = slip_velocity(radius, v_t, v_tp, w_t, w_tp)
-    slip = np.hypot(u_t, u_tp)
-    j_star = sliding_friction_impulse(mass, f, slip)
-    j_s = np.minimum(jn, j_star)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        dir_t = np.where(slip > 0.0, u_t / slip, 0.0)
-        dir_tp = np.where(slip > 0.0, u_tp / slip, 0.0)
-    p_t = -f * j_s * dir_t  # tangential impulse on the sphere [N s]
-    p_tp = -f * j_s * dir_tp
-    out_v_t = v_t + p_t / mass
-    out_v_tp = v_tp + p_tp / mass
-    out_w_tp = w_tp + radius * p_t / moment_of_inertia  # Eq. (20): I dw_t'/dt = r F_t
-    out_w_t = w_t - radius * p_tp / moment_of_inertia  # Eq. (19): I dw_t/dt = -r F_t'
-    # friction power f |F_n| |u| with |u| = |u0| - (7/2) f J / m
-    sliding_loss = f * (slip * j_s - 1.75 * f * j_s**2 / mass)
-    # twist: |omega_n| falls by k J_a until it reaches zero
-    k = TWIST_TORQUE_FACTOR * f / moment_of_inertia
-    w0 = np.abs(w_n)
-    ja_s = np.minimum(ja, twist_stop_impulse(moment_of_inertia, f, w_n))
-    out_w_n = np.sign(w_n) * np.maximum(w0 - k * ja_s, 0.0)
-    twist_loss = moment_of_inertia * (w0**2 - out_w_n**2) / 2.0
-    slip_ended = (slip == 0.0) | (jn >= j_star)
-    return {
-        "v_t": out_v_t,
-        "v_tp": out_v_tp,
-        "omega_n": out_w_n,
-        "omega_t": out_w_t,
-        "omega_tp": out_w_tp,
-        "slip_ended": slip_ended,
-        "sliding_impulse": j_s,
-        "friction_dissipation": sliding_loss + twist_loss,
-    }
+    shape, (f, v_t, v_tp, w_n, w_t, w_tp, jn, ja) = _flat(
+        friction, velocity_in[1], velocity_in[2], *omega_in, friction_impulse, twist_impulse)
+    out = np.empty((7, f.size))
+    ended = np.empty(f.size, dtype=np.bool_)
+    _tangential_many(float(mass), float(moment_of_inertia), float(radius), f, v_t, v_tp, w_n, w_t, w_tp, jn, ja,
+                     out, ended)
+    names = ("v_t", "v_tp", "omega_n", "omega_t", "omega_tp", "sliding_impulse", "friction_dissipation")
+    result = {name: out[i].reshape(shape) for i, name in enumerate(names)}
+    result["slip_ended"] = ended.reshape(shape)
+    return result
