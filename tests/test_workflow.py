@@ -1,7 +1,7 @@
 """Integration tests of the Snakemake pipeline (Snakefile, workflow/).
 
 The workflow is copied into a temporary directory with a TINY configuration (two speeds per
-sweep, two phase portraits, benchmark off) and run with ``snakemake --cores 2`` as a subprocess,
+sweep, two phase portraits, benchmark off, a 20-case stress sweep) and run with ``snakemake --cores 2`` as a subprocess,
 once per test session; the outputs are then checked by content (NetCDF variables, units and
 attributes with xarray; the PDF's pages and their text with pypdf). Further tests use dry runs
 (``snakemake -n``) on the finished copy: nothing to do on a second run, only the dependants of
@@ -36,6 +36,9 @@ TINY_SWEEPS = {
     "2.5": {"speed": [0.5, 3.0], "incidence_deg": 0.0, "omega_t": 2.9e6, "omega_tp": 2.9e6, "friction": [0.1, 0.9]},
 }
 
+#: 20 cases; seed 3 because its cases 0 and 10 (those compared with the reference solver) are quick
+TINY_STRESS = {"enabled": True, "cases": 20, "seed": 3, "reference_every": 10, "case_time_limit": 30.0}
+
 #: the section titles build_report writes as text (searchable in the PDF)
 EXPECTED_TITLES = [
     "1. Damping fit",
@@ -46,6 +49,7 @@ EXPECTED_TITLES = [
     "Measurement flags",
     "Validation: oblique impacts of Kharaz",
     "Work-precision benchmark",
+    "Numerical stability (stress sweep)",
     "Reproduction of the paper",
     "Appendix: configuration",
 ]
@@ -71,6 +75,7 @@ def make_copy(root: Path) -> Path:
     cfg["sweeps"] = TINY_SWEEPS
     cfg["phase_portrait_speeds"] = [1.0e-5, 2.0]
     cfg["benchmark"] = {"enabled": False, "quick": True}
+    cfg["stress"] = dict(TINY_STRESS)
     cfg_path.write_text(yaml.safe_dump(cfg, sort_keys=False))
     return root
 
@@ -104,11 +109,11 @@ def test_outputs_logs_and_benchmarks_exist(pipeline):
     for rel in ["results/impacts_validated.csv", "results/fit.nc", "results/phase_portraits.nc",
                 "results/dynamics.nc", "results/bifurcation.nc", "results/reproduction.csv",
                 "results/reproduction.md", "results/flags.csv", "results/flags.nc", "results/kharaz.nc",
-                "reports/report.pdf", *[f"results/sweeps/case_{c}.nc" for c in TINY_SWEEPS]]:
+                "results/stress_summary.json", "results/stress.nc", "reports/report.pdf", *[f"results/sweeps/case_{c}.nc" for c in TINY_SWEEPS]]:
         assert (root / rel).stat().st_size > 0, rel
     assert not (root / "results" / "benchmark").exists()  # benchmark switched off
     for rule in ["validate_data", "fit", "flags", "phase_portraits", "dynamics_summary", "bifurcation",
-                 "reproduction", "kharaz", "report"]:
+                 "reproduction", "kharaz", "stress", "report"]:
         assert (root / "logs" / f"{rule}.log").exists(), rule
         bench = (root / "benchmarks" / f"{rule}.tsv").read_text().splitlines()
         assert bench[0].split("\t")[0] == "s" and len(bench) == 2, rule
@@ -175,6 +180,25 @@ def test_flags_kharaz_reproduction(pipeline):
 
 
 @pytest.mark.slow
+def test_stress_summary_and_netcdf(pipeline):
+    import json
+
+    root, _ = pipeline
+    summary = json.loads((root / "results" / "stress_summary.json").read_text())
+    assert summary["cases_run"] == TINY_STRESS["cases"] and summary["seed"] == TINY_STRESS["seed"]
+    assert summary["reference_cases"] == 2  # cases 0 and 10
+    assert set(summary["failures_by_kind"]) >= {"exception", "nonfinite", "restitution", "energy", "convergence",
+                                                "reference", "timeout"}
+    assert summary["cases_failed"] == len(summary["failed_cases"]) == 0, summary["failed_cases"]
+    assert 0.0 <= summary["worst_energy_error"]["value"] <= summary["tolerances"]["energy"]
+    assert summary["worst_reference_error"]["value"] is not None
+    with xr.open_dataset(root / "results" / "stress.nc") as ds:
+        assert ds.sizes["case"] == TINY_STRESS["cases"]
+        assert ds["radius"].attrs["units"] == "m"
+        assert int(np.isfinite(ds["reference_error"].values).sum()) == 2
+
+
+@pytest.mark.slow
 def test_report_pdf_pages_and_titles(pipeline):
     pypdf = pytest.importorskip("pypdf")
     root, _ = pipeline
@@ -186,6 +210,9 @@ def test_report_pdf_pages_and_titles(pipeline):
         assert title in everything, title
     assert "SYNTHETIC" in texts[0] and "Provenance" in texts[0] and "Contents" in texts[0]
     assert "switched off" in everything  # the benchmark page says why it is empty
+    stress_page = next(t for t in texts if "Numerical stability (stress sweep)" in t and "Seeded random" in t)
+    assert "all 20 cases passed every check" in stress_page and "energy balance" in stress_page
+    assert "stress sweep" in texts[0]  # provenance and contents
     assert f"page {len(texts)} of {len(texts)}" in texts[-1]
     assert reader.metadata.title.startswith("Microsphere")
 
@@ -264,6 +291,7 @@ def test_lint_is_clean(tmp_path):
         ("sweep_chunks=0", "sweep_chunks"),  # below the minimum
         ("sweepchunks=4", "sweepchunks"),  # unknown key (additionalProperties: false)
         ("benchmark={enabled: maybe}", "enabled"),  # not a flag
+        ("stress={cases: 0}", "cases"),  # no cases
     ],
 )
 def test_bad_config_is_refused_naming_the_key(tmp_path, override, key):

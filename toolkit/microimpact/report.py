@@ -4,7 +4,8 @@
 workflow (``Snakefile``, ``workflow/``): a title page with provenance, the damping fit (Fig. 3
 analogue), the nonlinear analysis (Figs. 4 and 5), the Table 2 sweeps (Figs. 7-14), the
 measurement flags, the Kharaz et al. (2001) validation, the work-precision benchmark, the
-reproduction table of the paper's claims and the configuration. Figures come from
+seeded stress sweep of the engine (:mod:`microimpact.stress`), the reproduction table of the
+paper's claims and the configuration. Figures come from
 :mod:`microimpact.plots` (one :class:`~microimpact.plots.Plot` per figure, with its caption); this
 module only lays them out on A4 pages with matplotlib's PdfPages (figures are embedded as 160 dpi
 images, captions and tables as text so the PDF is searchable).
@@ -19,6 +20,7 @@ Paper: Cheng, Brach & Dunn (2002), Aerosol Sci. Technol. 36:1081-1093, doi:10.10
 from __future__ import annotations
 
 import datetime as _dt
+import json
 import math
 import os
 import platform
@@ -117,6 +119,12 @@ def provenance(config: Mapping | None = None, *, data_path=None, data_table=None
                          if sweeps else "none")
         bench = config.get("benchmark", {})
         out["benchmark"] = ("on" + (" (quick)" if bench.get("quick", True) else " (full)")) if bench.get("enabled") else "off"
+        stress = config.get("stress")
+        if stress is not None:
+            out["stress sweep"] = (f"on ({stress.get('cases', '?')} cases, seed {stress.get('seed', '?')}"
+                                   + (f", reference solver on every {stress['reference_every']}-th case"
+                                      if stress.get("reference_every") else "") + ")"
+                                   if stress.get("enabled") else "off")
     return out
 
 
@@ -316,6 +324,13 @@ def _dataset(obj) -> xr.Dataset:
 
 def _frame(obj) -> pd.DataFrame:
     return obj if isinstance(obj, pd.DataFrame) else pd.read_csv(obj, keep_default_na=False, na_values=[""])
+
+
+def _json(obj) -> dict:
+    if isinstance(obj, Mapping):
+        return dict(obj)
+    with open(obj, encoding="utf-8") as f:
+        return json.load(f)
 
 
 def _as_list(obj) -> list:
@@ -559,6 +574,137 @@ def _benchmark_section(lay: _Layout, wp: xr.Dataset | None, number: int) -> None
             f"target {float(a.get('target_ratio', math.nan)):g}. {a.get('target_ratio_note', '')}")
 
 
+#: units and distribution of each input of the stress sweep (microimpact.stress.draw_cases)
+_STRESS_INPUTS = {
+    "radius": ("r", "m", "log-uniform"),
+    "speed": ("|v_i|", "m/s", "log-uniform"),
+    "density": ("rho", "kg/m^3", "log-uniform"),
+    "stiffness": ("K", "Pa", "log-uniform"),
+    "work_of_adhesion": ("w_A", "J/m^2", "log-uniform, or exactly 0"),
+    "zeta_hertz": ("zeta_H", "-", "log-uniform, or exactly 0"),
+    "zeta_adhesion": ("zeta_A", "-", "log-uniform, or exactly 0"),
+    "friction": ("f", "-", "uniform, or exactly 0"),
+    "incidence_deg": ("alpha", "deg", "uniform, or exactly 0"),
+    "azimuth_deg": ("theta", "deg", "uniform"),
+    "spin_ratio": ("r omega_i / v", "-", "each component uniform in +/- max, or no spin"),
+}
+
+#: failed cases listed in the report (all of them are in results/stress_summary.json)
+_STRESS_MAX_LISTED = 30
+
+
+def _stress_section(lay: _Layout, s: Mapping | None, number: int, settings: Mapping | None) -> None:
+    lay.section(f"{number}. Numerical stability (stress sweep)", new_page=True)
+    settings = dict(settings or {})
+    if s is None:
+        if settings and not settings.get("enabled", True):
+            lay.paragraph("The stress sweep was switched off in the configuration (stress.enabled: false); run "
+                          "with --config 'stress={enabled: true}' to include it.")
+        else:
+            lay.paragraph("No stress-sweep summary was given to the report (results/stress_summary.json).")
+        return
+    from .stress import ZERO_PROBABILITY
+
+    n = int(s.get("cases_run", 0))
+    tol = dict(s.get("tolerances", {}))
+    by_kind = {k: int(v) for k, v in dict(s.get("failures_by_kind", {})).items()}
+    n_ref = int(s.get("reference_cases", 0))
+    every = settings.get("reference_every")
+    limit = settings.get("case_time_limit")
+    if n_ref:
+        ref_text = (f"; {n_ref} cases" + (f" (every {every}-th)" if every else "")
+                    + " also against the full 3-D reference solver (DOP853)")
+    else:
+        ref_text = "; the 3-D reference solver was not run (stress.reference_every: 0)"
+    lay.paragraph(
+        f"Seeded random stress sweep of the impact engine (microimpact.stress.stress_sweep): {n} impacts drawn with "
+        f"seed {s.get('seed', '?')} over the input ranges below, log-uniformly over decades where the range spans "
+        f"several, with exact zeros (probability {ZERO_PROBABILITY:g}) where zero is allowed. Each impact is "
+        "simulated at rtol 1e-10 and 1e-8 and checked: no exception (the engine's step limit is its time box), "
+        "finite results, 0 <= e_n <= 1 (e_n = 0 for a capture), the energy balance KE_in = KE_out + contact "
+        "energy + dissipated energy, and agreement of the two tolerances" + ref_text + ". Errors are relative to "
+        "the case's energy scale max(KE_in, depth of the contact well), velocities to the matching speed scale "
+        f"(microimpact.stress docstring). {int(s.get('captures', 0))} of the {n} impacts were captured. The sweep took "
+        f"{float(s.get('seconds', math.nan)):.3g} s (slowest case {float(s.get('slowest_case_seconds', math.nan)):.3g} s). "
+        "Per-case inputs and results: results/stress.nc; summary with full-precision inputs: "
+        "results/stress_summary.json; microimpact.stress.draw_cases(n, seed) redraws the same cases.")
+    n_failed = int(s.get("cases_failed", 0))
+    if n_failed:
+        kinds = ", ".join(f"{k} {v}" for k, v in by_kind.items() if v)
+        lay.paragraph(f"Result: {n_failed} of {n} cases failed a check ({100 * n_failed / max(n, 1):.2g} %): {kinds}. "
+                      "The failed cases are listed below; failures are reported, not hidden.", color="#b00000")
+    else:
+        lay.paragraph(f"Result: all {n} cases passed every check.")
+
+    def worst(key):
+        w = dict(s.get(key) or {})
+        v = w.get("value")
+        case = (w.get("case") or {}).get("case")
+        return ("" if v is None else f"{float(v):.3g}"), ("" if case is None else str(case))
+
+    def tol_text(key):
+        return f"<= {float(tol[key]):.0e}" if key in tol else ""
+
+    rows = [
+        {"check": "exception raised (incl. step limit)", "tol": "none", "kind": "exception"},
+        {"check": "non-finite result", "tol": "none", "kind": "nonfinite"},
+        {"check": "e_n outside [0, 1], or != 0 for a capture", "tol": "none", "kind": "restitution"},
+        {"check": "energy balance", "tol": tol_text("energy"), "key": "worst_energy_error", "kind": "energy"},
+        {"check": "convergence: rtol 1e-8 vs 1e-10", "tol": tol_text("convergence"), "key": "worst_convergence_error",
+         "kind": "convergence"},
+        {"check": f"engine vs reference solver ({n_ref} cases)", "tol": tol_text("reference"),
+         "key": "worst_reference_error", "kind": "reference"},
+        {"check": "time per case [s]", "tol": f"<= {float(limit):g}" if limit is not None else "",
+         "kind": "timeout"},
+    ]
+    for r in rows:
+        r["worst"], r["case"] = worst(r["key"]) if "key" in r else ("", "")
+        if r["kind"] == "timeout":
+            r["worst"] = f"{float(s.get('slowest_case_seconds', math.nan)):.3g}"
+        if r["kind"] == "reference" and not n_ref:
+            r["worst"] = "not run"
+        r["failed"] = str(by_kind.get(r["kind"], 0)) if (r["kind"] != "reference" or n_ref) else "-"
+    lay.heading("Checks: worst value over all cases and number of failed cases")
+    lay.table(pd.DataFrame(rows), {"check": 42, "tol": 12, "worst": 12, "case": 8, "failed": 8},
+              headers={"tol": "tolerance", "worst": "worst", "case": "at case", "failed": "failed"}, size=7.2)
+
+    ranges = dict(s.get("input_ranges", {}))
+    if ranges:
+        t = pd.DataFrame([{"input": name, "symbol": _STRESS_INPUTS.get(name, ("", "", ""))[0],
+                           "units": _STRESS_INPUTS.get(name, ("", "", ""))[1],
+                           "min": f"{float(lo):.3g}", "max": f"{float(hi):.3g}",
+                           "drawn": _STRESS_INPUTS.get(name, ("", "", ""))[2]} for name, (lo, hi) in ranges.items()])
+        lay.heading("Input ranges (SI units; angles in degrees)")
+        lay.table(t, {"input": 18, "symbol": 14, "units": 8, "min": 9, "max": 9, "drawn": 46}, size=7.2)
+
+    failed = list(s.get("failed_cases", []))
+    if failed:
+        shown = failed[:_STRESS_MAX_LISTED]
+        cols = {"case": 6, "checks": 11, "radius": 8, "speed": 8, "incidence_deg": 6, "azimuth_deg": 6, "density": 8,
+                "stiffness": 8, "work_of_adhesion": 8, "zeta_hertz": 8, "zeta_adhesion": 8, "friction": 6,
+                "omega_n": 9, "omega_t": 9, "omega_tp": 9}
+        t = []
+        for item in shown:
+            inputs = dict(item.get("inputs", {}))
+            row = {"case": str(inputs.get("case", "")),
+                   "checks": ", ".join(dict.fromkeys(f.get("kind", "?") for f in item.get("failures", [])))}
+            for c in cols:
+                if c not in row:
+                    v = inputs.get(c)
+                    row[c] = "" if v is None else f"{float(v) + 0.0:.3g}"  # + 0.0: no "-0"
+            t.append(row)
+        lay.heading(f"Failed cases ({len(failed)}" + (f", first {len(shown)} listed" if len(shown) < len(failed) else "")
+                    + "): inputs, SI units")
+        lay.table(pd.DataFrame(t), cols,
+                  headers={"radius": "r [m]", "speed": "v [m/s]", "incidence_deg": "alpha", "azimuth_deg": "theta",
+                           "density": "rho", "stiffness": "K [Pa]", "work_of_adhesion": "w_A", "zeta_hertz": "zeta_H",
+                           "zeta_adhesion": "zeta_A", "friction": "f", "omega_n": "omega_n",
+                           "omega_t": "omega_t", "omega_tp": "omega_t'"}, size=7.0)
+        details = [f"case {dict(item.get('inputs', {})).get('case', '?')}: {f.get('kind', '?')}: {f.get('detail', '')}"
+                   for item in shown for f in item.get("failures", [])]
+        lay.paragraph("\n".join(details), mono=True, size=6.5)
+
+
 def _reproduction_section(lay: _Layout, repro: pd.DataFrame, number: int) -> None:
     lay.section(f"{number}. Reproduction of the paper's numbers and statements")
     agree = repro["agree"].astype(str).str.lower()
@@ -615,7 +761,7 @@ def _title_page(lay: _Layout, title: str, prov: Mapping[str, str], contents: lis
 
 # =============================================================================== entry point
 def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduction=None, flags=None,
-                 kharaz=None, work_precision=None, dynamics=None, data_table=None, config=None,
+                 kharaz=None, work_precision=None, stress=None, dynamics=None, data_table=None, config=None,
                  title: str | None = None) -> Path:
     """Build the PDF report from the pipeline's results.
 
@@ -639,6 +785,9 @@ def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduc
         :func:`microimpact.validation.kharaz_comparison` output.
     work_precision : path or xarray.Dataset, optional
         Benchmark Dataset; None: the page says the benchmark was switched off.
+    stress : path or mapping, optional
+        :func:`microimpact.stress.stress_sweep` summary (results/stress_summary.json or the
+        ``StressReport.summary`` dict); None: the page says the stress sweep was not run.
     dynamics : path or xarray.Dataset, optional
         :func:`dynamics_summary` output.
     data_table : path or DataFrame, optional
@@ -686,6 +835,8 @@ def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduc
         _kharaz_section(lay, _dataset(kharaz), number)
         number += 1
     _benchmark_section(lay, _dataset(work_precision) if work_precision is not None else None, number)
+    number += 1
+    _stress_section(lay, _json(stress) if stress is not None else None, number, config.get("stress"))
     number += 1
     if reproduction is not None:
         _reproduction_section(lay, _frame(reproduction), number)

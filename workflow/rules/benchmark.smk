@@ -1,5 +1,6 @@
-# Work-precision study of the fast engine against the scipy reference solvers and the paper's
-# fixed-step Runge-Kutta-Gill method (switchable: config benchmark.enabled; quick by default).
+# Numerical checks of the engine: the work-precision study against the scipy reference solvers and
+# the paper's fixed-step Runge-Kutta-Gill method (switchable: config benchmark.enabled; quick by
+# default), and the seeded random stress sweep over decades of every input (config stress).
 
 
 rule work_precision:
@@ -21,3 +22,22 @@ rule work_precision:
         "../envs/microimpact.yaml"
     script:
         "../scripts/work_precision.py"
+
+
+rule stress:
+    output:
+        summary="results/stress_summary.json",
+        netcdf="results/stress.nc",
+    params:
+        cases=config["stress"]["cases"],
+        seed=config["stress"]["seed"],
+        reference_every=config["stress"]["reference_every"],
+        case_time_limit=config["stress"]["case_time_limit"],
+    log:
+        "logs/stress.log",
+    benchmark:
+        "benchmarks/stress.tsv"
+    conda:
+        "../envs/microimpact.yaml"
+    script:
+        "../scripts/stress.py"

@@ -23,10 +23,21 @@ if config["data_synthetic"] != "auto":
 config["fit"] = {k: (as_bool(v) if k != "weights" else v) for k, v in config["fit"].items()}
 config["benchmark"] = {"quick": True, "throughput": False, **config["benchmark"]}
 config["benchmark"] = {k: as_bool(v) for k, v in config["benchmark"].items()}
+# the stress sweep section is optional; its numbers may arrive as text from snakemake --config
+config["stress"] = {"enabled": True, "cases": 30000, "seed": 0, "reference_every": 0, "case_time_limit": 30.0,
+                    **config.get("stress", {})}
+config["stress"] = {
+    "enabled": as_bool(config["stress"]["enabled"]),
+    "cases": int(config["stress"]["cases"]),
+    "seed": int(config["stress"]["seed"]),
+    "reference_every": int(config["stress"]["reference_every"]),
+    "case_time_limit": float(config["stress"]["case_time_limit"]),
+}
 
 SWEEP_CASES = list(config["sweeps"])
 SWEEP_CHUNKS = int(config["sweep_chunks"])
 BENCHMARK_ENABLED = bool(config["benchmark"]["enabled"])
+STRESS_ENABLED = config["stress"]["enabled"]
 
 
 def materials_path():
@@ -58,3 +69,8 @@ def sweep_chunk_files(wildcards):
 def benchmark_outputs(wildcards):
     """Work-precision results for the report; none when the benchmark is switched off."""
     return {"work_precision": "results/benchmark/benchmark.nc"} if BENCHMARK_ENABLED else {}
+
+
+def stress_outputs(wildcards):
+    """Stress-sweep summary for the report; none when the sweep is switched off."""
+    return {"stress": "results/stress_summary.json"} if STRESS_ENABLED else {}

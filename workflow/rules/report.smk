@@ -4,6 +4,7 @@
 rule report:
     input:
         unpack(benchmark_outputs),
+        unpack(stress_outputs),
         data_table=rules.validate_data.output.table,
         fit=rules.fit.output[0],
         phase_portraits=rules.phase_portraits.output[0],
