@@ -411,7 +411,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             if recorded:
                 _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 recorded = False
-            dj = sgn * (u1[1] - u[1])  # y is monotone within the (possibly shortened) step
+            dj = abs(u1[1] - u[1])  # y is monotone within the (possibly shortened) step
             if J < j_target and J + dj >= j_target:
                 yt = u[1] + (j_target - J) * (1.0 if u1[1] > u[1] else -1.0)
                 _locate(1, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
@@ -420,9 +420,9 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         if recorded:
             _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         # advance
-        # y is monotone on the current piece, in the direction sgn: the signed sum telescopes, so
-        # integration noise in y does not pile up in J over long captured tails as |dy| would
-        J += sgn * (u1[1] - u[1])
+        # |dy| rather than sgn * dy: robust to an extremum that falls between two steps unnoticed
+        # (a signed sum would then subtract; measured: more convergence failures in the stress sweep)
+        J += abs(u1[1] - u[1])
         for i in range(n):
             u[i] = u1[i]
         n_steps += 1

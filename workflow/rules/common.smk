@@ -24,7 +24,7 @@ config["fit"] = {k: (as_bool(v) if k != "weights" else v) for k, v in config["fi
 config["benchmark"] = {"quick": True, "throughput": False, **config["benchmark"]}
 config["benchmark"] = {k: as_bool(v) for k, v in config["benchmark"].items()}
 # the stress sweep section is optional; its numbers may arrive as text from snakemake --config
-config["stress"] = {"enabled": True, "cases": 30000, "seed": 0, "reference_every": 0, "case_time_limit": 30.0,
+config["stress"] = {"enabled": True, "cases": 20000, "seed": 0, "reference_every": 0, "case_time_limit": 30.0,
                     **config.get("stress", {})}
 config["stress"] = {
     "enabled": as_bool(config["stress"]["enabled"]),
