@@ -21,7 +21,7 @@ from microimpact.validation import (
     read_kharaz,
 )
 
-SHARED = Path("/work/shared/data/kharaz2001_oblique.csv")
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "kharaz2001_oblique.csv"  # beside the repo
 
 
 @pytest.fixture(scope="module")
