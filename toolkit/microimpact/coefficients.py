@@ -60,28 +60,25 @@ def impact_coefficients(mass, moment_of_inertia, velocity_in, omega_in, velocity
     ----------
     mass : float  [kg]
     moment_of_inertia : float  [kg m^2]
-    velocity_in, velocity_out : sequence of 3 floats
+    velocity_in, velocity_out : sequence of 3 floats or arrays
         (v_n, v_t, v_t') before and after. For a captured sphere velocity_out is the final state
         (normal component 0, tangential components of the final rolling or sliding motion). [m/s]
-    omega_in, omega_out : sequence of 3 floats
+    omega_in, omega_out : sequence of 3 floats or arrays
         (omega_n, omega_t, omega_t') before and after. [rad/s]
-    captured : bool
+    captured : bool or array of bool
 
     Returns
     -------
-    dict with e_n, mu_t, mu_tp, K_L, K_t. For a captured sphere e_n = 0 and the impulse ratios are
+    dict with e_n, mu_t, mu_tp, K_L, K_t (floats for scalar input, arrays otherwise). For a captured sphere e_n = 0 and the impulse ratios are
     NaN (there is no rebound and so no impulse ratio); K_L and K_t use the final state.
     """
     vn_i, vt_i, vtp_i = velocity_in
     vn_r, vt_r, vtp_r = velocity_out
-    if captured:
-        e_n = 0.0
-        mu_t = mu_tp = math.nan
-    else:
-        e_n = -vn_r / vn_i  # Eq. (21), both as magnitudes
-        dvn = vn_r - vn_i
-        mu_t = (vt_r - vt_i) / dvn  # Eq. (22)
-        mu_tp = (vtp_r - vtp_i) / dvn  # Eq. (23)
+    dvn = vn_r - vn_i
+    with np.errstate(invalid="ignore", divide="ignore"):
+        e_n = np.where(captured, 0.0, -vn_r / vn_i)  # Eq. (21), both as magnitudes
+        mu_t = np.where(captured, np.nan, (vt_r - vt_i) / dvn)  # Eq. (22)
+        mu_tp = np.where(captured, np.nan, (vtp_r - vtp_i) / dvn)  # Eq. (23)
     v2_i = vn_i**2 + vt_i**2 + vtp_i**2
     v2_r = vn_r**2 + vt_r**2 + vtp_r**2
     w2_i = sum(w * w for w in omega_in)
@@ -89,7 +86,10 @@ def impact_coefficients(mass, moment_of_inertia, velocity_in, omega_in, velocity
     energy_in = mass * v2_i + moment_of_inertia * w2_i
     k_t = (energy_in - mass * v2_r - moment_of_inertia * w2_r) / energy_in  # Eq. (24)
     k_l = (v2_i - v2_r) / v2_i  # Eq. (25)
-    return {"e_n": e_n, "mu_t": mu_t, "mu_tp": mu_tp, "K_L": k_l, "K_t": k_t}
+    out = {"e_n": e_n, "mu_t": mu_t, "mu_tp": mu_tp, "K_L": k_l, "K_t": k_t}
+    if np.ndim(captured) == 0:
+        return {k: float(v) for k, v in out.items()}
+    return out
 
 
 @dataclass(frozen=True)

@@ -549,12 +549,23 @@ class Scales:
     a_adhesion: float
 
 
-def nondimensional_scales(contact, normal_speed: float) -> Scales:
-    """Length and time scales used by the solvers (see the module docstring)."""
+def nondimensional_scales(contact, normal_speed) -> Scales:
+    """Length and time scales used by the solvers (see the module docstring).
+
+    ``normal_speed`` may be an array [m/s]; without adhesion the scales are then arrays too.
+    """
     if contact.adhesion_line_force > 0.0:
         return Scales(contact.length_scale, contact.time_scale, 1.0, 1.0)
     x = (5.0 * contact.mass * normal_speed**2 / (4.0 * contact.stiffness * math.sqrt(contact.radius))) ** 0.4
     return Scales(x, x / normal_speed, 1.25, 0.0)
+
+
+def _nondimensional_inputs(contact, normal_speed):
+    """(scales, speed unit X/T [m/s], y0, C1, C2) of impacts at ``normal_speed`` (scalar or array)."""
+    sc = nondimensional_scales(contact, normal_speed)
+    u = sc.length / sc.time
+    c_h, c_a = contact.damping_coefficients(normal_speed)
+    return sc, u, normal_speed / u, c_h * u, c_a * u
 
 
 @dataclass(frozen=True)
@@ -665,16 +676,13 @@ def solve_normal(
     v = _check_speed(normal_speed)
     if not (0.0 < rtol < 1.0):
         raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
-    sc = nondimensional_scales(contact, v)
-    c_h, c_a = contact.damping_coefficients(v)
-    u = sc.length / sc.time
-    y0 = v / u
+    sc, u, y0, c1, c2 = _nondimensional_inputs(contact, v)
     j_unit = contact.mass * u  # N s
     jt = 0.0 if friction_impulse_target is None else float(friction_impulse_target) / j_unit
     cap = 4096 if (trajectory or follow_capture) else 0
     while True:
         rec = np.zeros((max(cap, 1), 3))
-        r = _integrate(y0, c_h * u, c_a * u, sc.a_hertz, sc.a_adhesion, rtol, need_tail,
+        r = _integrate(y0, c1, c2, sc.a_hertz, sc.a_adhesion, rtol, need_tail,
                        rtol if tail_tolerance is None else tail_tolerance, jt, follow_capture,
                        settle_amplitude * (sc.a_adhesion / sc.a_hertz if sc.a_adhesion > 0 else 1.0),
                        max_steps, rec, cap, friction_impulse_stop / j_unit,
@@ -682,7 +690,7 @@ def solve_normal(
         if cap == 0 or r[13] < cap:
             break
         cap *= 4
-    undamped = c_h == 0.0 and c_a == 0.0
+    undamped = c1 == 0.0 and c2 == 0.0
     if undamped and jt > 0.0 and math.isnan(r[9]) and jt < r[5]:
         # time-reversible motion: J reaches jt on the way out when it reached J - jt on the way in
         r_in = _integrate(y0, 0.0, 0.0, sc.a_hertz, sc.a_adhesion, rtol, False, rtol, r[5] - jt, False, 0.0,
@@ -746,22 +754,9 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = 1e
         bad = v[~(np.isfinite(v) & (v > 0.0))][0]
         raise ValueError(f"normal speeds must be finite and > 0, got {bad!r}")
     nt = np.zeros(v.shape, dtype=np.bool_) if need_tail is None else np.ascontiguousarray(need_tail, dtype=np.bool_).ravel()
-    if contact.adhesion_line_force > 0.0:
-        length, time, ah, aa = contact.length_scale, contact.time_scale, 1.0, 1.0
-        u = np.full(v.shape, length / time)
-    else:
-        ah, aa = 1.25, 0.0
-        length = (5.0 * contact.mass * v**2 / (4.0 * contact.stiffness * math.sqrt(contact.radius))) ** 0.4
-        u = v.copy()  # x*/t* = v
-        time = length / u
-    if contact.damping_reference_speed is None:
-        vref = v
-    else:
-        vref = np.full(v.shape, contact.damping_reference_speed)
-    scale = contact.damping_speed_scale * vref**0.2
-    c1 = contact.zeta_hertz / scale * u
-    c2 = contact.zeta_adhesion / scale * u
-    y0 = v / u
+    sc, u, y0, c1, c2 = _nondimensional_inputs(contact, v)
+    u, c1, c2 = (np.ascontiguousarray(np.broadcast_to(a, v.shape), dtype=float) for a in (u, c1, c2))
+    length, time, ah, aa = sc.length, sc.time, sc.a_hertz, sc.a_adhesion
     ju = contact.mass * u
     jstop = np.broadcast_to(np.asarray(friction_impulse_stop, dtype=float), v.shape) / ju
     jastop = np.broadcast_to(np.asarray(twist_impulse_stop, dtype=float), v.shape) / (ju * np.sqrt(contact.radius * length))

@@ -13,8 +13,7 @@ import xarray as xr
 
 from . import engine
 from .coefficients import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
-from .tangential import (_sliding_impulse, _twist_stop, sliding_friction_impulse, tangential_kernel,
-                         tangential_outcome, twist_stop_impulse)
+from .tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
 
 __all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES"]
 
@@ -225,8 +224,9 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     # sliding and twisting
     j_stop = np.zeros(speeds.size)
     ja_stop = np.zeros(speeds.size)
-    np.maximum.at(j_stop, inverse, np.where(needs_tangential, sliding_friction_impulse(m, f, np.hypot(u_t, u_tp)), 0.0))
-    np.maximum.at(ja_stop, inverse, np.where(needs_tangential, twist_stop_impulse(inertia, f, w[0]), 0.0))
+    j_star, ja_star = stop_impulses(m, inertia, f, np.hypot(u_t, u_tp), w[0])
+    np.maximum.at(j_stop, inverse, np.where(needs_tangential, j_star, 0.0))
+    np.maximum.at(ja_stop, inverse, np.where(needs_tangential, ja_star, 0.0))
     sol = engine.solve_normal_many(contact, speeds, need_tail, rtol=rtol,
                                    friction_impulse_stop=j_stop, twist_impulse_stop=ja_stop)
     g = {k: val[inverse] for k, val in sol.items()}
@@ -234,23 +234,15 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
 
     tan = tangential_outcome(m, inertia, r, f, (v_n, v_t, v_tp), w, g["friction_impulse"], g["twist_impulse"])
     vn_out = np.where(captured, 0.0, -g["e_n"] * v_n)
-    # Eqs. (21)-(25), vectorised (impact_coefficients is the scalar form of the same formulas)
-    dvn = vn_out - v_n
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mu_t = np.where(captured, np.nan, (tan["v_t"] - v_t) / dvn)
-        mu_tp = np.where(captured, np.nan, (tan["v_tp"] - v_tp) / dvn)
-    v2_in = v**2
-    v2_out = vn_out**2 + tan["v_t"] ** 2 + tan["v_tp"] ** 2
-    w2_in = w[0] ** 2 + w[1] ** 2 + w[2] ** 2
-    w2_out = tan["omega_n"] ** 2 + tan["omega_t"] ** 2 + tan["omega_tp"] ** 2
-    e_in = m * v2_in + inertia * w2_in
+    coef = impact_coefficients(m, inertia, (v_n, v_t, v_tp), w, (vn_out, tan["v_t"], tan["v_tp"]),
+                               (tan["omega_n"], tan["omega_t"], tan["omega_tp"]), captured)
     results = {
         "outcome": captured.astype(np.int8),
         "e_n": g["e_n"],
-        "mu_t": mu_t,
-        "mu_tp": mu_tp,
-        "K_L": (v2_in - v2_out) / v2_in,
-        "K_t": (e_in - m * v2_out - inertia * w2_out) / e_in,
+        "mu_t": coef["mu_t"],
+        "mu_tp": coef["mu_tp"],
+        "K_L": coef["K_L"],
+        "K_t": coef["K_t"],
         "velocity_out_n": vn_out,
         "velocity_out_t": tan["v_t"],
         "velocity_out_tp": tan["v_tp"],

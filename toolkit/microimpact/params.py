@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 
+import numpy as np
+
 __all__ = ["Contact", "rolling_spin", "PAPER_REFERENCE"]
 
 #: full citation of the paper, for the ``references`` attribute of the toolkit's results
@@ -206,12 +208,16 @@ class Contact:
 
         Parameters
         ----------
-        normal_speed : float
+        normal_speed : float or numpy.ndarray
             Incident normal speed of the impact; used as v_n unless a fixed
             ``damping_reference_speed`` is set. [m/s]
         """
         v = self.reference_speed(normal_speed)
-        _check_positive("damping reference speed", v)
+        if isinstance(v, np.ndarray):
+            if not np.all(np.isfinite(v) & (v > 0.0)):
+                raise ValueError(f"damping reference speed must be finite and > 0, got {v[~(v > 0.0)].ravel()[:1]}")
+        else:
+            _check_positive("damping reference speed", v)
         scale = self.damping_speed_scale * v**0.2  # (r^3 K sqrt(v) / m)^(2/5)
         return self.zeta_hertz / scale, self.zeta_adhesion / scale
 

@@ -18,7 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["sliding_friction_impulse", "twist_stop_impulse", "tangential_outcome", "tangential_kernel"]
+__all__ = ["stop_impulses", "tangential_outcome", "tangential_kernel"]
 
 TWIST_TORQUE_FACTOR = 3.0 * math.pi / 16.0  # torque = factor * f * a * |F_n|
 
@@ -102,26 +102,16 @@ def _flat(*arrays):
     return b[0].shape, [np.ascontiguousarray(x).ravel() for x in b]
 
 
-def sliding_friction_impulse(mass, friction, slip_speed):
-    """Friction impulse J* = 2 m |u0| / (7 f) after which sliding stops. [N s]
+def stop_impulses(mass, moment_of_inertia, friction, slip_speed, omega_n):
+    """Impulses after which sliding and twisting stop, (J*, J_a*). [N s], [N m s]
 
-    Returns inf where there is no friction and 0 where there is no slip.
+    J* = 2 m |u0| / (7 f) and J_a* = |omega_n| I / ((3 pi/16) f); each is 0 where there is no
+    slip (no twist) and inf where there is slip (twist) but no friction.
     """
-    shape, (f, slip) = _flat(friction, slip_speed)
+    shape, (f, slip, w) = _flat(friction, slip_speed, omega_n)
     j, ja = np.empty(f.size), np.empty(f.size)
-    _stops_many(float(mass), 1.0, f, slip, np.zeros(f.size), j, ja)
-    return j.reshape(shape)
-
-
-def twist_stop_impulse(moment_of_inertia, friction, omega_n):
-    """Twist impulse J_a* = |omega_n| I / ((3 pi/16) f) after which the spin about n has stopped. [N m s]
-
-    Returns 0 where there is no twist and inf where there is twist but no friction.
-    """
-    shape, (f, w) = _flat(friction, omega_n)
-    j, ja = np.empty(f.size), np.empty(f.size)
-    _stops_many(1.0, float(moment_of_inertia), f, np.zeros(f.size), w, j, ja)
-    return ja.reshape(shape)
+    _stops_many(float(mass), float(moment_of_inertia), f, slip, w, j, ja)
+    return j.reshape(shape), ja.reshape(shape)
 
 
 def tangential_outcome(mass, moment_of_inertia, radius, friction, velocity_in, omega_in, friction_impulse, twist_impulse):
