@@ -1,4 +1,4 @@
-"""Tests of the work-precision benchmark (microimpact.benchmark).
+"""Tests of the work-precision benchmark (microimpact.studies.benchmark).
 
 No timing assertions: the machines are shared and noisy. What is tested: the Runge-Kutta-Gill
 implementation (its order, on problems where the order is known), the structure of the benchmark
@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from microimpact import benchmark, engine
-from microimpact.benchmark import BenchmarkConfig, ObliqueCase, rkg_restitution, rkg_state
-from microimpact.params import Contact
+from microimpact.studies import benchmark
+from microimpact.solvers import engine
+from microimpact.studies.benchmark import BenchmarkConfig, ObliqueCase, rkg_restitution, rkg_state
+from microimpact.model.contact import Contact
 from microimpact.presets import WALL_1990
 
 # Hertz contact (no adhesion, no damping) with the size and material of Table 1 row 2. With f0 = 0
@@ -109,7 +110,7 @@ def test_capture_speed_brackets_the_outcome():
 def test_engine_error_falls_as_rtol_tightens():
     """Max e_n error over a few speeds against DOP853 at rtol 1e-12 (bound ~1e-11): each tightening
     by 100x lowers the error by at least 10x until the reference floor."""
-    from microimpact.reference import simulate_reference
+    from microimpact.solvers.reference import simulate_reference
 
     speeds = [1.5, 4.0, 30.0]
     ref = np.array([simulate_reference(WALL_1990, v, rtol=1e-12, atol=1e-14).e_n for v in speeds])

@@ -1,4 +1,4 @@
-"""Tests of microimpact.diagnostics: per-measurement rotation/angle/capture flags."""
+"""Tests of microimpact.analysis.flags: per-measurement rotation/angle/capture flags."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from microimpact.diagnostics import DEFAULT_THRESHOLDS, fibonacci_sphere, flag_measurements, write_flags
-from microimpact.dynamics import capture_velocity
+from microimpact.analysis.flags import DEFAULT_THRESHOLDS, fibonacci_sphere, flag_measurements, write_flags
+from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io import default_materials_path, read_impacts, read_materials
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "synthetic_microspheres.csv"  # SYNTHETIC data

@@ -1,4 +1,4 @@
-"""Tests of microimpact.dynamics: Eqs. (33)-(38), capture velocity, phase portraits, Fig. 4 plane."""
+"""Tests of microimpact.dynamics.nonlinear: Eqs. (33)-(38), capture velocity, phase portraits, Fig. 4 plane."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from microimpact import dynamics
-from microimpact.engine import solve_normal
-from microimpact.params import Contact
+from microimpact.dynamics import nonlinear as dynamics
+from microimpact.solvers.engine import solve_normal
+from microimpact.model.contact import Contact
 from microimpact.presets import WALL_1990
 
 

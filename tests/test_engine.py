@@ -8,8 +8,8 @@ from scipy.optimize import brentq
 from scipy.special import beta
 
 import microimpact as mi
-from microimpact.engine import solve_normal, solve_normal_many
-from microimpact.forces import contact_potential_energy
+from microimpact.solvers.engine import solve_normal, solve_normal_many
+from microimpact.model.law import contact_potential_energy
 from microimpact.presets import WALL_1990
 
 HERTZ = mi.Contact(radius=5e-6, density=2500.0, stiffness=5e10, adhesion_line_force=0.0)

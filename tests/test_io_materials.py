@@ -10,7 +10,7 @@ import pytest
 
 from microimpact import Contact, presets
 from microimpact.io import MaterialPair, MaterialsError, default_materials_path, read_materials
-from microimpact.params import stiffness_from_elastic
+from microimpact.model.contact import stiffness_from_elastic
 
 REPO = Path(__file__).resolve().parents[1]
 

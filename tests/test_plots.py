@@ -9,7 +9,10 @@ import pytest  # noqa: E402
 import xarray as xr  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from microimpact import dynamics, plots, presets, sweeps  # noqa: E402
+from microimpact import presets  # noqa: E402
+from microimpact.studies import sweeps  # noqa: E402
+from microimpact.dynamics import nonlinear as dynamics
+from microimpact.report import figures as plots
 
 C = presets.WALL_1990
 SPEEDS = [0.5, 1.2, 1.6, 3.0, 10.0]
@@ -141,7 +144,7 @@ def test_work_precision(tmp_path):
 def test_kharaz(tmp_path):
     import pandas as pd
 
-    from microimpact.validation import kharaz_comparison
+    from microimpact.analysis.kharaz import kharaz_comparison
 
     df = pd.DataFrame({"quantity": ["tangential_restitution", "rebound_spin", "rebound_angle"],
                        "incidence_angle_deg": [20.0, 20.0, 20.0], "value": [0.6, 570.0, 12.0],

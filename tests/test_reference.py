@@ -1,4 +1,4 @@
-"""Tests of the reference solver (microimpact.reference) against exact results of the model.
+"""Tests of the reference solver (microimpact.solvers.reference) against exact results of the model.
 
 Tolerances are commented where they are set. The solver runs at its default rtol = 1e-10 unless
 stated; errors of the integrated quantities are then O(1e-10) relative for well-conditioned
@@ -14,9 +14,9 @@ import pytest
 from scipy.optimize import brentq
 from scipy.special import beta
 
-from microimpact.params import Contact
+from microimpact.model.contact import Contact
 from microimpact.presets import WALL_1990
-from microimpact.reference import (
+from microimpact.solvers.reference import (
     ReferenceSolverError,
     reference_trajectory,
     simulate_reference,
@@ -362,7 +362,7 @@ def test_bad_trajectory_input():
 
 
 def test_no_outcome_within_time_limit_raises_reference_solver_error(monkeypatch):
-    import microimpact.reference as reference
+    import microimpact.solvers.reference as reference
 
     assert issubclass(ReferenceSolverError, RuntimeError)
     # Shrink the generous time limit so that neither separation nor capture can be reached.
@@ -372,7 +372,7 @@ def test_no_outcome_within_time_limit_raises_reference_solver_error(monkeypatch)
 
 
 def test_solve_ivp_failure_raises_reference_solver_error(monkeypatch):
-    import microimpact.reference as reference
+    import microimpact.solvers.reference as reference
 
     class Failed:
         status = -1

@@ -1,11 +1,11 @@
-"""Tests of microimpact.reproduction: the generated reproduction table and its Markdown file."""
+"""Tests of microimpact.studies.reproduction: the generated reproduction table and its Markdown file."""
 
 from __future__ import annotations
 
 import pytest
 
 from microimpact.presets import WALL_1990
-from microimpact.reproduction import COLUMNS, reproduction_table, write_reproduction_markdown
+from microimpact.studies.reproduction import COLUMNS, reproduction_table, write_reproduction_markdown
 
 
 @pytest.fixture(scope="module")

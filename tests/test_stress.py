@@ -13,9 +13,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from microimpact import stress
-from microimpact.impact import simulate_impact
-from microimpact.params import Contact
+from microimpact.studies import stress
+from microimpact.solvers.impact import simulate_impact
+from microimpact.model.contact import Contact
 from microimpact.presets import WALL_1990
 
 # deterministic (derandomize) and fast: each example costs a few engine solves (~ms)

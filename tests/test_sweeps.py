@@ -8,8 +8,9 @@ import pytest
 import xarray as xr
 
 import microimpact
-from microimpact import presets, sweeps
-from microimpact.impact import RESULT_VARIABLES
+from microimpact import presets
+from microimpact.studies import sweeps
+from microimpact.solvers.impact import RESULT_VARIABLES
 
 C = presets.WALL_1990
 SPEEDS = [0.5, 1.2, 1.6, 3.0, 10.0]  # spans the capture velocity (about 1.45 m/s for Table 1 row 2)

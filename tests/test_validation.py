@@ -1,4 +1,4 @@
-"""Tests of microimpact.validation: the model against the Kharaz et al. (2001) oblique impacts.
+"""Tests of microimpact.analysis.kharaz: the model against the Kharaz et al. (2001) oblique impacts.
 
 This is real measured data (data/kharaz2001_oblique.csv), so the tests pin the agreement where the
 model's physics applies (rigid-body sliding, incidence above 30 deg) and the disagreement where the
@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from microimpact.validation import (
+from microimpact.analysis.kharaz import (
     default_kharaz_path,
     kharaz_comparison,
     kharaz_summary,

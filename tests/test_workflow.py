@@ -156,7 +156,7 @@ def test_sweep_and_dynamics_netcdf(pipeline):
         assert list(ds["equilibrium_type"].values) == ["sink", "spiral sink"]
     with xr.open_dataset(root / "results" / "bifurcation.nc") as ds:
         assert "case_C1" in ds and ds["case_speed"].attrs["units"] == "m/s"
-    from microimpact.dynamics import load_phase_portraits
+    from microimpact.dynamics.nonlinear import load_phase_portraits
 
     portraits = load_phase_portraits(root / "results" / "phase_portraits.nc")
     assert [p.attrs["outcome"] for p in portraits] == ["capture", "rebound"]

@@ -7,10 +7,10 @@ damping coefficients, sensitivity sweeps and a Snakemake report.
 
 from importlib.metadata import PackageNotFoundError, version
 
-from . import presets
-from .coefficients import ImpactResult
-from .impact import simulate_impact, simulate_many
-from .params import Contact
+from microimpact import presets
+from microimpact.model.kinematics import ImpactResult
+from microimpact.solvers.impact import simulate_impact, simulate_many
+from microimpact.model.contact import Contact
 
 try:
     __version__ = version("microimpact")

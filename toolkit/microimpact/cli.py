@@ -12,9 +12,9 @@ import math
 import sys
 from dataclasses import fields
 
-from . import __version__
-from .params import Contact
-from .presets import PRESETS, get_preset
+from microimpact import __version__
+from microimpact.model.contact import Contact
+from microimpact.presets import PRESETS, get_preset
 
 __all__ = ["main", "build_parser"]
 
@@ -57,7 +57,7 @@ def contact_from_args(args) -> Contact:
 
 
 def _cmd_simulate(args) -> int:
-    from .impact import simulate_impact
+    from microimpact.solvers.impact import simulate_impact
 
     contact = contact_from_args(args)
     result = simulate_impact(contact, args.speed, args.incidence_deg, args.azimuth_deg,
@@ -99,7 +99,7 @@ def build_parser() -> argparse.ArgumentParser:
 _EXTRA_COMMANDS: list = []
 
 
-# ------------------------------------------------------------------ fit, flags (microimpact.fitting, .diagnostics)
+# ------------------------------------------------------------------ fit, flags (microimpact.analysis.fitting, .diagnostics)
 def _existing_file(path: str, what: str):
     from pathlib import Path
 
@@ -119,7 +119,7 @@ def _writable(path: str, what: str):
 
 def _impacts_for_pair(args):
     """Read the impact CSV (validated against the materials config) and pick the material pair."""
-    from .io import default_materials_path, read_impacts, read_materials
+    from microimpact.io import default_materials_path, read_impacts, read_materials
 
     data = _existing_file(args.data, "data file")
     config = _existing_file(args.config, "materials config") if args.config else default_materials_path()
@@ -140,7 +140,7 @@ def _impacts_for_pair(args):
 
 
 def _cmd_fit(args) -> int:
-    from .fitting import fit_damping
+    from microimpact.analysis.fitting import fit_damping
 
     out = _writable(args.out, "--out")
     table, pair = _impacts_for_pair(args)
@@ -167,8 +167,8 @@ def register_fit(sub) -> None:
 
 
 def _cmd_flags(args) -> int:
-    from .diagnostics import flag_measurements, write_flags
-    from .fitting import DampingFit
+    from microimpact.analysis.flags import flag_measurements, write_flags
+    from microimpact.analysis.fitting import DampingFit
 
     out = _writable(args.out, "--out")
     nc = _writable(args.nc, "--nc") if args.nc else None
@@ -201,8 +201,8 @@ def register_flags(sub) -> None:
 
 
 def _cmd_sweep(args) -> int:
-    from .io.files import write_netcdf
-    from .sweeps import TABLE2_CASES, run_sweep
+    from microimpact.io.files import write_netcdf
+    from microimpact.studies.sweeps import TABLE2_CASES, run_sweep
 
     if args.case not in TABLE2_CASES:
         raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(sorted(TABLE2_CASES))}")
@@ -224,7 +224,7 @@ def register_sweep(sub) -> None:
 
 
 def _cmd_reproduce(args) -> int:
-    from .reproduction import reproduction_table, write_reproduction_markdown
+    from microimpact.studies.reproduction import reproduction_table, write_reproduction_markdown
 
     out = _writable(args.out, "--out")
     write_reproduction_markdown(reproduction_table(), out)

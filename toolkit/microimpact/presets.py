@@ -7,7 +7,7 @@ Aerosol Sci. Technol. 12:926-946, doi:10.1080/02786829008959404.
 
 from __future__ import annotations
 
-from .params import Contact
+from microimpact.model.contact import Contact
 
 __all__ = ["WALL_1990", "PRESETS", "get_preset"]
 

@@ -1,4 +1,4 @@
-# The PDF report: every result above, laid out by microimpact.report.build_report.
+# The PDF report: every result above, laid out by microimpact.report.pdf.build_report.
 
 
 rule report:

@@ -6,7 +6,7 @@ import sys
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact import Contact  # noqa: E402
-from microimpact.dynamics import bifurcation_plane, table1_cases  # noqa: E402
+from microimpact.dynamics.nonlinear import bifurcation_plane, table1_cases  # noqa: E402
 from microimpact.io import write_netcdf  # noqa: E402
 
 contact = Contact(**snakemake.params.contact)  # noqa: F821

@@ -5,7 +5,7 @@ import sys
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact import Contact  # noqa: E402
-from microimpact.dynamics import dynamics_summary  # noqa: E402
+from microimpact.dynamics.nonlinear import dynamics_summary  # noqa: E402
 from microimpact.io import write_netcdf  # noqa: E402
 
 ds = dynamics_summary(Contact(**snakemake.params.contact), snakemake.params.speeds)  # noqa: F821

@@ -4,7 +4,7 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
-from microimpact.fitting import fit_damping  # noqa: E402
+from microimpact.analysis.fitting import fit_damping  # noqa: E402
 from microimpact.io import read_impacts, read_materials  # noqa: E402
 
 table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821

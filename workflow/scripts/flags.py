@@ -5,8 +5,8 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
-from microimpact.diagnostics import flag_measurements, write_flags  # noqa: E402
-from microimpact.fitting import DampingFit  # noqa: E402
+from microimpact.analysis.flags import flag_measurements, write_flags  # noqa: E402
+from microimpact.analysis.fitting import DampingFit  # noqa: E402
 from microimpact.io import read_impacts  # noqa: E402
 
 table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821

@@ -5,7 +5,7 @@ import sys
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact.io import write_netcdf  # noqa: E402
-from microimpact.validation import kharaz_comparison  # noqa: E402
+from microimpact.analysis.kharaz import kharaz_comparison  # noqa: E402
 
 ds = kharaz_comparison(snakemake.input[0])  # noqa: F821
 write_netcdf(ds, snakemake.output[0])  # noqa: F821

@@ -3,14 +3,14 @@
     python workflow/scripts/make_synthetic_data.py [OUTPUT.csv]
 
 Thin wrapper: the generating parameters, the seed and the noise model are
-microimpact.synthetic.SYNTHETIC_DEFAULTS (documented in microimpact/synthetic.py).
+microimpact.analysis.synthetic.SYNTHETIC_DEFAULTS (documented in microimpact/synthetic.py).
 Works from the command line and as a Snakemake script (snakemake.output[0]).
 """
 
 import sys
 from pathlib import Path
 
-from microimpact.synthetic import SYNTHETIC_DEFAULTS, write_synthetic_impacts
+from microimpact.analysis.synthetic import SYNTHETIC_DEFAULTS, write_synthetic_impacts
 
 
 def main(out: str) -> None:

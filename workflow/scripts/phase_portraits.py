@@ -5,7 +5,7 @@ import sys
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact import Contact  # noqa: E402
-from microimpact.dynamics import phase_portraits, save_phase_portraits  # noqa: E402
+from microimpact.dynamics.nonlinear import phase_portraits, save_phase_portraits  # noqa: E402
 
 portraits = phase_portraits(Contact(**snakemake.params.contact), snakemake.params.speeds)  # noqa: F821
 save_phase_portraits(portraits, snakemake.output[0])  # noqa: F821

@@ -6,7 +6,7 @@ sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact import Contact  # noqa: E402
 from microimpact.io import write_csv  # noqa: E402
-from microimpact.reproduction import reproduction_table, write_reproduction_markdown  # noqa: E402
+from microimpact.studies.reproduction import reproduction_table, write_reproduction_markdown  # noqa: E402
 
 table = reproduction_table(Contact(**snakemake.params.contact))  # noqa: F821
 write_csv(table, snakemake.output.table)  # noqa: F821

@@ -8,7 +8,7 @@ sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 import json  # noqa: E402
 
 from microimpact.io.files import atomic_write, write_netcdf  # noqa: E402
-from microimpact.stress import stress_sweep  # noqa: E402
+from microimpact.studies.stress import stress_sweep  # noqa: E402
 
 params = snakemake.params  # noqa: F821
 

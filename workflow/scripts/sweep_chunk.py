@@ -5,7 +5,7 @@ import sys
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact import Contact  # noqa: E402
-from microimpact.sweeps import run_sweep, save_sweep, split_spec  # noqa: E402
+from microimpact.studies.sweeps import run_sweep, save_sweep, split_spec  # noqa: E402
 
 wc = snakemake.wildcards  # noqa: F821
 spec = split_spec(snakemake.params.spec, int(wc.nchunks))[int(wc.chunk)]  # noqa: F821

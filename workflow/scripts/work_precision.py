@@ -5,7 +5,7 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
-from microimpact.benchmark import run_benchmark, write_benchmark  # noqa: E402
+from microimpact.studies.benchmark import run_benchmark, write_benchmark  # noqa: E402
 
 params = snakemake.params  # noqa: F821
 ds = run_benchmark(quick=params.quick, throughput=params.throughput, verbose=True)

@@ -10,10 +10,10 @@
 * :mod:`microimpact.io.units` - the one table of accepted units.
 """
 
-from .files import atomic_path, atomic_write, write_csv, write_netcdf, write_netcdf_groups
-from .impacts import CANONICAL_COLUMNS, COLUMN_UNITS, ImpactDataError, ImpactDataWarning, Problem, read_impacts
-from .materials import MaterialPair, MaterialsError, default_materials_path, read_materials
-from .units import UNITS, UnitError
+from microimpact.io.files import atomic_path, atomic_write, write_csv, write_netcdf, write_netcdf_groups
+from microimpact.io.impacts import CANONICAL_COLUMNS, COLUMN_UNITS, ImpactDataError, ImpactDataWarning, Problem, read_impacts
+from microimpact.io.materials import MaterialPair, MaterialsError, default_materials_path, read_materials
+from microimpact.io.units import UNITS, UnitError
 
 __all__ = [
     "read_impacts",

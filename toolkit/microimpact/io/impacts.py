@@ -28,7 +28,7 @@ column                                  unit    meaning
 ======================================  ======  ==================================================
 
 Angles are kept in degrees in columns whose names end in ``_deg``, the convention of
-:func:`microimpact.coefficients.incident_velocity`; everything else is SI.
+:func:`microimpact.model.kinematics.incident_velocity`; everything else is SI.
 
 Derived columns (first-order propagation of independent standard uncertainties; a derived
 uncertainty is NaN unless every input it needs has an uncertainty):
@@ -61,7 +61,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .units import INTERNAL_UNIT, UnitError, accepted_units, conversion_factor, parse_header_field
+from microimpact.io.units import INTERNAL_UNIT, UnitError, accepted_units, conversion_factor, parse_header_field
 
 __all__ = [
     "read_impacts",
@@ -567,7 +567,7 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
                 int(row_arr[i]), int(line_arr[i]), columns["id"].field, labels["id"][i]))
     if materials is not None and "material_pair" in labels:
         if not isinstance(materials, Mapping):
-            from .materials import read_materials
+            from microimpact.io.materials import read_materials
 
             materials = read_materials(materials)
         known = sorted(materials)

@@ -21,7 +21,7 @@ from pathlib import Path
 import jsonschema
 import yaml
 
-from ..params import Contact, adhesion_line_force_from_work, stiffness_from_elastic
+from microimpact.model.contact import Contact, adhesion_line_force_from_work, stiffness_from_elastic
 
 __all__ = ["MaterialPair", "MaterialsError", "read_materials", "default_materials_path", "MATERIALS_SCHEMA"]
 

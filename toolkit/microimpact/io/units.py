@@ -3,7 +3,7 @@
 There is ONE table, :data:`UNITS`: for each dimension, every accepted spelling of a unit and the
 factor that converts a value in that unit to the internal unit of the dimension. Internal units are
 SI (m, m/s, [1]) except angles, which the toolkit keeps in degrees in columns whose name ends in
-``_deg`` (as in :func:`microimpact.coefficients.incident_velocity`).
+``_deg`` (as in :func:`microimpact.model.kinematics.incident_velocity`).
 
 Unit spellings are matched exactly after removing spaces (``m / s`` is ``m/s``); they are
 case-sensitive because ``mm`` and ``Mm`` are different units.

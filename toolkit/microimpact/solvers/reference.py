@@ -20,7 +20,7 @@ With s = sqrt(xi):
   ("pulling" friction); F = 0 once sliding has ended (rolling, no rolling resistance)
 * Eqs. (19)-(20) as printed: w_t'' = k F_t, w_t' = -k F_t', with k = m r^2 / I (5/2 for a
   homogeneous sphere), so that u' = (1 + k) F
-* twist, Eq. (18) in a derived form (see :func:`microimpact.forces.twist_friction_torque`):
+* twist, Eq. (18) in a derived form (see :func:`microimpact.model.law.twist_friction_torque`):
   w_n' = -k (3 pi / 16) f sqrt(L / r) s |F_n| sign(w_n) until w_n reaches 0, then w_n = 0
 * dissipation: D' = (a_H c_1 s^3 + a_A c_2 s) y^2 + f |F_n| |u| + (3 pi / 16) f sqrt(L / r) s |F_n| |w_n|
 * J' = |F_n|
@@ -47,7 +47,7 @@ rtol = 1e-10 in a conservative adhesive impact).
 Scales
 ------
 * Adhesive contact (f0 > 0): the paper's scales, Eqs. (29)-(32) with T corrected (see
-  :mod:`microimpact.params`): L = X = 2 pi f0 / K, T_c = T, so a_H = a_A = 1 and (c_1, c_2) =
+  :mod:`microimpact.model.contact`): L = X = 2 pi f0 / K, T_c = T, so a_H = a_A = 1 and (c_1, c_2) =
   (C1, C2) = ``contact.nondimensional_damping(v_n)``; Eq. (28) exactly.
 * No adhesion (f0 = 0): X = 0 and T is infinite, so the Hertz impact scales are used instead:
   L = x* = (5 m v_n^2 / (4 K sqrt(r)))^(2/5) (the undamped maximum penetration) and T_c = x* / v_n,
@@ -90,8 +90,8 @@ from typing import Sequence
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .coefficients import ImpactResult, impact_coefficients, incident_velocity
-from .params import Contact
+from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity
+from microimpact.model.contact import Contact
 
 __all__ = [
     "ReferenceSolverError",

@@ -5,7 +5,7 @@ Flat Surfaces", Aerosol Sci. Technol. 36(11):1081-1093, doi:10.1080/027868202900
 Figs. 7-14.
 
 A *sweep spec* is a plain dict (so that it can come from a YAML or JSON config). Its keys are the
-inputs of :func:`microimpact.impact.simulate_many`:
+inputs of :func:`microimpact.solvers.impact.simulate_many`:
 
 ============== ========= =====================================================================
 key            units     meaning
@@ -47,8 +47,8 @@ from datetime import datetime, timezone
 import numpy as np
 import xarray as xr
 
-from .impact import RESULT_VARIABLES as RESULT_META
-from .params import PAPER_REFERENCE
+from microimpact.solvers.impact import RESULT_VARIABLES as RESULT_META
+from microimpact.model.contact import PAPER_REFERENCE
 
 __all__ = [
     "TABLE2_CASES",
@@ -269,7 +269,7 @@ def _now() -> str:
 
 def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, rtol: float = 1e-8,
               institution: str | None = None, capture_speed: bool = True) -> xr.Dataset:
-    """Simulate every impact of a sweep grid with :func:`microimpact.impact.simulate_many`.
+    """Simulate every impact of a sweep grid with :func:`microimpact.solvers.impact.simulate_many`.
 
     Parameters
     ----------
@@ -285,7 +285,7 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
         Written to the ``institution`` attribute when given.
     capture_speed : bool
         Also compute the normal capture velocity of the contact (bisection on the outcome with
-        the same solver tolerance, :func:`microimpact.dynamics.capture_velocity`) and store it as
+        the same solver tolerance, :func:`microimpact.dynamics.nonlinear.capture_velocity`) and store it as
         the 0-d variable ``capture_normal_speed``; the figures mark it. About 1 s.
 
     Returns
@@ -294,14 +294,14 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
         One dimension per swept quantity (named after its spec key, with a coordinate of that
         name), in the order speed, incidence_deg, azimuth_deg, omega_n, omega_t, omega_tp,
         friction. Fixed inputs are 0-d variables. Result variables as in
-        :data:`microimpact.impact.RESULT_VARIABLES` (outcome, e_n, mu_t, mu_tp, K_L, K_t,
+        :data:`microimpact.solvers.impact.RESULT_VARIABLES` (outcome, e_n, mu_t, mu_tp, K_L, K_t,
         velocity_out_*, omega_out_*, contact_time, max_penetration, slip_ended, friction_impulse,
         dissipated_energy), each with ``units`` and ``long_name``; mu_t and mu_tp are NaN for a
         captured impact. CF-1.10 global attributes, the contact parameters (``contact_*``) and
         the spec as JSON (``sweep_spec``).
     """
-    from . import __version__
-    from .impact import simulate_many
+    from microimpact import __version__
+    from microimpact.solvers.impact import simulate_many
 
     if spec is None:
         if case is None or case not in TABLE2_CASES:
@@ -334,7 +334,7 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
             fixed = float(inputs[key]) if key in inputs else (contact.friction if key == "friction" else 0.0)
             ds[key] = xr.DataArray(fixed, attrs=attrs)
     if capture_speed:
-        from .dynamics import capture_velocity
+        from microimpact.dynamics.nonlinear import capture_velocity
 
         ds["capture_normal_speed"] = xr.DataArray(
             capture_velocity(contact, solver_rtol=rtol),
@@ -348,7 +348,7 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
         "Conventions": "CF-1.10",
         "title": f"Microsphere impact sweep: {label} (Cheng, Brach & Dunn 2002 model)",
         "source": f"microimpact {__version__}",
-        "history": f"{_now()} microimpact.sweeps.run_sweep(case={case!r}, rtol={rtol:g}): "
+        "history": f"{_now()} microimpact.studies.sweeps.run_sweep(case={case!r}, rtol={rtol:g}): "
         f"{n} impacts over {', '.join(f'{d}[{ds.sizes[d]}]' for d in dims) or 'a single point'}",
         "references": PAPER_REFERENCE,
         "comment": "mu_t, mu_tp are NaN for captured impacts (no rebound); K_L, K_t of a captured "
@@ -469,7 +469,7 @@ def combine_sweeps(datasets: Sequence[xr.Dataset], along: str | None = None) -> 
     dims = attrs.get("sweep_dims", "").split()
     n = int(np.prod([combined.sizes[d] for d in dims])) if dims else combined.sizes[along]
     attrs["history"] = (
-        f"{_now()} microimpact.sweeps.combine_sweeps: {len(datasets)} chunks along {along}, {n} impacts\n"
+        f"{_now()} microimpact.studies.sweeps.combine_sweeps: {len(datasets)} chunks along {along}, {n} impacts\n"
         + "\n".join(ds.attrs.get("history", "") for ds in datasets)
     )
     combined.attrs = attrs
@@ -484,7 +484,7 @@ def save_sweep(ds: xr.Dataset, path):
     -------
     pathlib.Path
     """
-    from .io.files import write_netcdf
+    from microimpact.io.files import write_netcdf
 
     return write_netcdf(ds, path)
 
@@ -502,7 +502,7 @@ def restitution_curves(fit_dataset: xr.Dataset, speed=None, *, radius=None, rtol
     Parameters
     ----------
     fit_dataset : xarray.Dataset
-        :meth:`microimpact.fitting.DampingFit.to_dataset` output.
+        :meth:`microimpact.analysis.fitting.DampingFit.to_dataset` output.
     speed : spec value, optional
         Normal speeds (a list or a range dict as in a sweep spec). [m/s] Default: 60 log-spaced
         speeds spanning the data, widened by 20 % each way.
@@ -516,8 +516,8 @@ def restitution_curves(fit_dataset: xr.Dataset, speed=None, *, radius=None, rtol
     xarray.Dataset
         ``e_n`` and ``outcome`` on dims (``radius`` [m], ``speed`` [m/s], the normal speed).
     """
-    from .fitting import DampingFit
-    from .impact import simulate_many
+    from microimpact.analysis.fitting import DampingFit
+    from microimpact.solvers.impact import simulate_many
 
     fit = DampingFit.from_dataset(fit_dataset)
     v_data = np.asarray(fit_dataset["normal_speed"].values, dtype=float)

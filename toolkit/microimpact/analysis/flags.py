@@ -32,7 +32,7 @@ Flags (thresholds recorded as Dataset attributes ``threshold_*``)
   than the measurement error cannot be seen), else ``e_n`` (default 0.02).
 * ``near_capture``: normal speed / capture velocity < ``near_capture_ratio`` (default 1.5; e_n is
   then below about a third of its high-speed value and steep in v_n). The capture velocity of each
-  radius is :func:`microimpact.dynamics.capture_velocity` (bisection on the engine outcome).
+  radius is :func:`microimpact.dynamics.nonlinear.capture_velocity` (bisection on the engine outcome).
 """
 
 from __future__ import annotations
@@ -46,8 +46,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from .impact import simulate_many
-from .params import Contact
+from microimpact.solvers.impact import simulate_many
+from microimpact.model.contact import Contact
 
 __all__ = ["flag_measurements", "write_flags", "fibonacci_sphere", "DEFAULT_THRESHOLDS"]
 
@@ -140,7 +140,7 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
         ``angle_sensitive``, ``near_capture`` (int8 0/1). Thresholds and sample counts are
         attributes. ``ds.to_dataframe()`` gives one row per impact.
     """
-    from .dynamics import capture_velocity
+    from microimpact.dynamics.nonlinear import capture_velocity
 
     th = dict(DEFAULT_THRESHOLDS)
     if thresholds:
@@ -290,7 +290,7 @@ def write_flags(ds: xr.Dataset, csv_path, nc_path=None):
     tuple of pathlib.Path
         The files written.
     """
-    from .io import write_csv, write_netcdf
+    from microimpact.io import write_csv, write_netcdf
 
     table = ds.to_dataframe().reset_index(drop=True)
     cols = ["row"] + [c for c in table.columns if c not in ("row", "impact")]

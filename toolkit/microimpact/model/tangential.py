@@ -7,7 +7,7 @@ keeps its direction and its magnitude falls linearly with the friction impulse
 J(t) = int_0^t |F_n| dt. Sliding therefore ends when J reaches J* = 2 m |u0| / (7 f), after which
 the sphere rolls with no tangential force for the rest of the contact (no rolling resistance).
 The whole tangential outcome thus depends on the normal solve only through J, and the twist
-about n (torque (3 pi/16) f a |F_n|, see :func:`microimpact.forces.twist_friction_torque`) only
+about n (torque (3 pi/16) f a |F_n|, see :func:`microimpact.model.law.twist_friction_torque`) only
 through J_a = int a |F_n| dt. Both are verified against the full 3-D reference solver in the tests.
 """
 

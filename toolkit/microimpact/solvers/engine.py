@@ -6,7 +6,7 @@ full 3-D reference solver):
 * the normal motion does not depend on the tangential or rotational state, so one 1-D solve per
   normal speed serves every incidence angle, azimuth, spin and friction coefficient;
 * the tangential and rotational outcome depends on the normal solve only through two integrals,
-  J = int |F_n| dt and J_a = int a |F_n| dt (see :mod:`microimpact.tangential`);
+  J = int |F_n| dt and J_a = int a |F_n| dt (see :mod:`microimpact.model.tangential`);
 * the contact energy E = m x'^2/2 + V(x) never increases, so E < 0 is an exact capture test.
 
 Numerical formulation

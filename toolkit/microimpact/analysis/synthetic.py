@@ -24,8 +24,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from . import engine
-from .params import Contact
+from microimpact.solvers import engine
+from microimpact.model.contact import Contact
 
 __all__ = ["SYNTHETIC_DEFAULTS", "make_synthetic_impacts", "write_synthetic_impacts"]
 
@@ -70,7 +70,7 @@ def make_synthetic_impacts(**overrides) -> pd.DataFrame:
         holds the parameters, ``attrs["true_e_n"]`` and ``attrs["true_normal_speed"]`` the
         noise-free values.
     """
-    from .dynamics import capture_velocity
+    from microimpact.dynamics.nonlinear import capture_velocity
 
     unknown = set(overrides) - set(SYNTHETIC_DEFAULTS)
     if unknown:
@@ -127,7 +127,7 @@ def write_synthetic_impacts(path, **overrides):
     pathlib.Path
         ``path``.
     """
-    from .io import write_csv
+    from microimpact.io import write_csv
 
     df = make_synthetic_impacts(**overrides)
     return write_csv(df, path, float_format="%.6g")

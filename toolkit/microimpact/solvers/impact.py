@@ -11,9 +11,9 @@ import math
 import numpy as np
 import xarray as xr
 
-from . import engine
-from .coefficients import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
-from .tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
+from microimpact.solvers import engine
+from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
+from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
 
 __all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES"]
 
@@ -85,7 +85,7 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
         raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_tp), got {omega!r}")
     _check_inputs(speed, incidence_deg, azimuth_deg, omega)
     if method == "reference":
-        from .reference import simulate_reference
+        from microimpact.solvers.reference import simulate_reference
 
         return simulate_reference(contact, speed, incidence_deg, azimuth_deg, omega, rtol=rtol)
     if method != "engine":

@@ -4,15 +4,15 @@
 workflow (``Snakefile``, ``workflow/``): a title page with provenance, the damping fit (Fig. 3
 analogue), the nonlinear analysis (Figs. 4 and 5), the Table 2 sweeps (Figs. 7-14), the
 measurement flags, the Kharaz et al. (2001) validation, the work-precision benchmark, the
-seeded stress sweep of the engine (:mod:`microimpact.stress`), the reproduction table of the
+seeded stress sweep of the engine (:mod:`microimpact.studies.stress`), the reproduction table of the
 paper's claims and the configuration. Figures come from
-:mod:`microimpact.plots` (one :class:`~microimpact.plots.Plot` per figure, with its caption); this
+:mod:`microimpact.report.figures` (one :class:`~microimpact.report.figures.Plot` per figure, with its caption); this
 module only lays them out on A4 pages with matplotlib's PdfPages (figures are embedded as 160 dpi
 images, captions and tables as text so the PDF is searchable).
 
 Also defined here: :func:`is_synthetic`, :func:`git_commit`, :func:`provenance` - what the title
 page states. :func:`phase_portraits`, :func:`save_phase_portraits`, :func:`load_phase_portraits`
-and :func:`dynamics_summary` live in :mod:`microimpact.dynamics` and are re-exported here.
+and :func:`dynamics_summary` live in :mod:`microimpact.dynamics.nonlinear` and are re-exported here.
 
 Paper: Cheng, Brach & Dunn (2002), Aerosol Sci. Technol. 36:1081-1093, doi:10.1080/02786820290092221.
 """
@@ -34,8 +34,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from .dynamics import dynamics_summary, load_phase_portraits, phase_portraits, save_phase_portraits
-from .params import PAPER_REFERENCE
+from microimpact.dynamics.nonlinear import dynamics_summary, load_phase_portraits, phase_portraits, save_phase_portraits
+from microimpact.model.contact import PAPER_REFERENCE
 
 __all__ = [
     "build_report",
@@ -87,7 +87,7 @@ def git_commit(directory=".") -> str | None:
 
 def provenance(config: Mapping | None = None, *, data_path=None, data_table=None) -> dict[str, str]:
     """The facts of the title page, as label -> text."""
-    from . import __version__
+    from microimpact import __version__
 
     config = dict(config or {})
     data_path = data_path or config.get("data")
@@ -206,7 +206,7 @@ class _Layout:
         self.page.y += gap
 
     def plot(self, plot, *, max_height: float = 5.2) -> None:
-        """A :class:`microimpact.plots.Plot`: the figure as an image, its caption below."""
+        """A :class:`microimpact.report.figures.Plot`: the figure as an image, its caption below."""
         from matplotlib.backends.backend_agg import FigureCanvasAgg
 
         fig = plot.figure
@@ -277,7 +277,7 @@ class _Layout:
     def save(self, path, metadata: Mapping[str, str]) -> None:
         from matplotlib.backends.backend_pdf import PdfPages
 
-        from .io.files import atomic_path
+        from microimpact.io.files import atomic_path
 
         n = len(self.pages)
         with atomic_path(path) as tmp:
@@ -343,8 +343,8 @@ def _as_list(obj) -> list:
 
 # =============================================================================== sections
 def _fit_section(lay: _Layout, fit_ds: xr.Dataset, data_table: pd.DataFrame | None, synthetic: bool) -> None:
-    from . import plots
-    from .fitting import PARAMETER_NAMES
+    from microimpact.report import figures as plots
+    from microimpact.analysis.fitting import PARAMETER_NAMES
 
     lay.section("1. Damping fit (analogue of Fig. 3)")
     src = fit_ds.attrs.get("fit_source", "the data")
@@ -356,7 +356,7 @@ def _fit_section(lay: _Layout, fit_ds: xr.Dataset, data_table: pd.DataFrame | No
         f"Weighting: {fit_ds.attrs.get('weighting', '?')}.")
     curves = None
     try:
-        from .sweeps import restitution_curves
+        from microimpact.studies.sweeps import restitution_curves
 
         curves = restitution_curves(fit_ds)
     except (ImportError, ValueError) as exc:  # pragma: no cover - drawn at the data points instead
@@ -414,7 +414,7 @@ def _fit_section(lay: _Layout, fit_ds: xr.Dataset, data_table: pd.DataFrame | No
 
 
 def _dynamics_section(lay: _Layout, bif: xr.Dataset, portraits: list[xr.Dataset], dyn: xr.Dataset | None) -> None:
-    from . import plots
+    from microimpact.report import figures as plots
 
     lay.section("2. Nonlinear dynamics of the normal contact (Figs. 4, 5)")
     if dyn is not None:
@@ -448,7 +448,7 @@ def _dynamics_section(lay: _Layout, bif: xr.Dataset, portraits: list[xr.Dataset]
 
 
 def _sweep_section(lay: _Layout, sweeps: list[xr.Dataset], number: int) -> None:
-    from . import plots
+    from microimpact.report import figures as plots
 
     for k, ds in enumerate(sorted(sweeps, key=lambda d: str(d.attrs.get("case", "")))):
         case = str(ds.attrs.get("case", "?"))
@@ -473,7 +473,7 @@ def _flags_section(lay: _Layout, flags: pd.DataFrame, data: pd.DataFrame | None,
     lay.paragraph(
         "Each measured impact simulated under the fitted model with plausible unmeasured initial spin (up to the "
         "rolling spin v/r, 3-D directions) and with the incidence angle moved by its uncertainty "
-        "(microimpact.diagnostics.flag_measurements). Flags: R = rotation-sensitive (an unmeasured spin changes "
+        "(microimpact.analysis.flags.flag_measurements). Flags: R = rotation-sensitive (an unmeasured spin changes "
         "mu or K_L by more than the threshold), A = angle-sensitive (the angle error changes e_n, mu or the "
         "outcome), C = near capture (normal speed below 1.5 x the capture velocity, where e_n is steep). "
         f"Of {n} impacts: {count['rotation_sensitive']} R, {count['angle_sensitive']} A, {count['near_capture']} C. "
@@ -508,7 +508,7 @@ def _flags_section(lay: _Layout, flags: pd.DataFrame, data: pd.DataFrame | None,
 
 
 def _kharaz_section(lay: _Layout, kh: xr.Dataset, number: int) -> None:
-    from . import plots
+    from microimpact.report import figures as plots
 
     lay.section(f"{number}. Validation: oblique impacts of Kharaz et al. (2001)")
     lay.paragraph(
@@ -522,7 +522,7 @@ def _kharaz_section(lay: _Layout, kh: xr.Dataset, number: int) -> None:
             f"{kh.attrs.get('sliding_threshold_deg', 30):g} deg: {float(kh['fitted_friction']):.4g} +/- "
             f"{float(kh.get('fitted_friction_stderr', np.nan)):.2g}. Model sliding/rolling transition at "
             f"{float(kh['transition_angle']):.3g} deg.")
-    from .validation import kharaz_summary
+    from microimpact.analysis.kharaz import kharaz_summary
 
     lay.heading("RMS model - measured")
     lay.table(kharaz_summary(kh), {"quantity": 24, "units": 8, "regime": 12, "rms_nominal_friction": 16,
@@ -532,7 +532,7 @@ def _kharaz_section(lay: _Layout, kh: xr.Dataset, number: int) -> None:
 
 
 def _benchmark_section(lay: _Layout, wp: xr.Dataset | None, number: int) -> None:
-    from . import plots
+    from microimpact.report import figures as plots
 
     lay.section(f"{number}. Work-precision benchmark", new_page=True)
     if wp is None:
@@ -542,7 +542,7 @@ def _benchmark_section(lay: _Layout, wp: xr.Dataset | None, number: int) -> None
     a = wp.attrs
     quick = str(a.get("quick", "")).lower() in ("1", "true")
     lay.paragraph(
-        f"{str(a.get('title', 'Work-precision benchmark')).capitalize()} (microimpact.benchmark"
+        f"{str(a.get('title', 'Work-precision benchmark')).capitalize()} (microimpact.studies.benchmark"
         f"{', quick mode: small test set, few settings' if quick else ', full study'}) on the Table 1 row 2 contact: "
         f"{a.get('n_normal_speeds', '?')} normal impacts from just above the capture speed "
         f"({float(a.get('capture_speed', math.nan)):.4g} m/s) to 100 m/s and {a.get('n_oblique_cases', '?')} oblique "
@@ -574,7 +574,7 @@ def _benchmark_section(lay: _Layout, wp: xr.Dataset | None, number: int) -> None
             f"target {float(a.get('target_ratio', math.nan)):g}. {a.get('target_ratio_note', '')}")
 
 
-#: units and distribution of each input of the stress sweep (microimpact.stress.draw_cases)
+#: units and distribution of each input of the stress sweep (microimpact.studies.stress.draw_cases)
 _STRESS_INPUTS = {
     "radius": ("r", "m", "log-uniform"),
     "speed": ("|v_i|", "m/s", "log-uniform"),
@@ -603,7 +603,7 @@ def _stress_section(lay: _Layout, s: Mapping | None, number: int, settings: Mapp
         else:
             lay.paragraph("No stress-sweep summary was given to the report (results/stress_summary.json).")
         return
-    from .stress import ZERO_PROBABILITY
+    from microimpact.studies.stress import ZERO_PROBABILITY
 
     n = int(s.get("cases_run", 0))
     tol = dict(s.get("tolerances", {}))
@@ -617,17 +617,17 @@ def _stress_section(lay: _Layout, s: Mapping | None, number: int, settings: Mapp
     else:
         ref_text = "; the 3-D reference solver was not run (stress.reference_every: 0)"
     lay.paragraph(
-        f"Seeded random stress sweep of the impact engine (microimpact.stress.stress_sweep): {n} impacts drawn with "
+        f"Seeded random stress sweep of the impact engine (microimpact.studies.stress.stress_sweep): {n} impacts drawn with "
         f"seed {s.get('seed', '?')} over the input ranges below, log-uniformly over decades where the range spans "
         f"several, with exact zeros (probability {ZERO_PROBABILITY:g}) where zero is allowed. Each impact is "
         "simulated at rtol 1e-10 and 1e-8 and checked: no exception (the engine's step limit is its time box), "
         "finite results, 0 <= e_n <= 1 (e_n = 0 for a capture), the energy balance KE_in = KE_out + contact "
         "energy + dissipated energy, and agreement of the two tolerances" + ref_text + ". Errors are relative to "
         "the case's energy scale max(KE_in, depth of the contact well), velocities to the matching speed scale "
-        f"(microimpact.stress docstring). {int(s.get('captures', 0))} of the {n} impacts were captured. The sweep took "
+        f"(microimpact.studies.stress docstring). {int(s.get('captures', 0))} of the {n} impacts were captured. The sweep took "
         f"{float(s.get('seconds', math.nan)):.3g} s (slowest case {float(s.get('slowest_case_seconds', math.nan)):.3g} s). "
         "Per-case inputs and results: results/stress.nc; summary with full-precision inputs: "
-        "results/stress_summary.json; microimpact.stress.draw_cases(n, seed) redraws the same cases.")
+        "results/stress_summary.json; microimpact.studies.stress.draw_cases(n, seed) redraws the same cases.")
     n_failed = int(s.get("cases_failed", 0))
     if n_failed:
         kinds = ", ".join(f"{k} {v}" for k, v in by_kind.items() if v)
@@ -711,7 +711,7 @@ def _reproduction_section(lay: _Layout, repro: pd.DataFrame, number: int) -> Non
     n_yes = int(agree.isin(["true", "yes"]).sum())
     n_no = int(agree.isin(["false", "no"]).sum())
     lay.paragraph(
-        f"Every toolkit value is computed when the pipeline runs (microimpact.reproduction). {len(repro)} rows: "
+        f"Every toolkit value is computed when the pipeline runs (microimpact.studies.reproduction). {len(repro)} rows: "
         f"{n_yes} agree, {n_no} disagree, {len(repro) - n_yes - n_no} not checkable (the paper's figures are "
         "missing from the available text). Disagreements are reported, not tuned away; see the notes.")
     df = repro.copy()
@@ -774,19 +774,19 @@ def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduc
     phase_portraits : path or list of xarray.Dataset
         :func:`save_phase_portraits` file or the trajectories.
     bifurcation : path or xarray.Dataset
-        :func:`microimpact.dynamics.bifurcation_plane` output.
+        :func:`microimpact.dynamics.nonlinear.bifurcation_plane` output.
     sweeps : sequence of paths or Datasets
-        :func:`microimpact.sweeps.run_sweep` outputs, one per Table 2 case (any order).
+        :func:`microimpact.studies.sweeps.run_sweep` outputs, one per Table 2 case (any order).
     reproduction : path or DataFrame, optional
-        :func:`microimpact.reproduction.reproduction_table` (CSV).
+        :func:`microimpact.studies.reproduction.reproduction_table` (CSV).
     flags : path or DataFrame, optional
         The measurement-flags table (CSV).
     kharaz : path or xarray.Dataset, optional
-        :func:`microimpact.validation.kharaz_comparison` output.
+        :func:`microimpact.analysis.kharaz.kharaz_comparison` output.
     work_precision : path or xarray.Dataset, optional
         Benchmark Dataset; None: the page says the benchmark was switched off.
     stress : path or mapping, optional
-        :func:`microimpact.stress.stress_sweep` summary (results/stress_summary.json or the
+        :func:`microimpact.studies.stress.stress_sweep` summary (results/stress_summary.json or the
         ``StressReport.summary`` dict); None: the page says the stress sweep was not run.
     dynamics : path or xarray.Dataset, optional
         :func:`dynamics_summary` output.
@@ -805,7 +805,7 @@ def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduc
     import matplotlib
 
     matplotlib.use("Agg", force=False)
-    from . import __version__
+    from microimpact import __version__
 
     config = dict(config or {})
     title = title or config.get("report_title") or "Microsphere contact/impact report"
@@ -844,7 +844,7 @@ def build_report(path, *, fit, phase_portraits, bifurcation, sweeps=(), reproduc
     if config:
         import yaml
 
-        from .sweeps import _plain
+        from microimpact.studies.sweeps import _plain
 
         lay.section(f"{number}. Appendix: configuration")
         lay.paragraph("The configuration this report was made with (workflow/config/config.yaml merged with "

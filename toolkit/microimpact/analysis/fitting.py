@@ -8,7 +8,7 @@ damping forms of Eqs. (14)-(15). Here the fit is done with lmfit and
 * JOINTLY over particle sizes: every radius r gets its own f0 from ONE shared work of adhesion
   w_A through Eq. (7), f0 = (9/(2 pi) K r w_A^2)^(1/3) (a fit per size would fit f0, which is not a
   material property; see notes/model-notes.md section 1);
-* with the model e_n(v_n) from :func:`microimpact.engine.solve_normal_many`, one call per distinct
+* with the model e_n(v_n) from :func:`microimpact.solvers.engine.solve_normal_many`, one call per distinct
   radius per evaluation (about 1 ms for 25 speeds), so a 100-point fit takes about a second;
 * from a coarse global start: chi-square on a log-spaced (zeta_H, zeta_A) grid, then
   Levenberg-Marquardt (``leastsq``) from the best grid point, with bounds zeta >= 0 (w_A > 0).
@@ -17,7 +17,7 @@ Residuals and capture
 ---------------------
 Below the capture velocity the model predicts capture and e_n = 0. The model e_n is continuous and
 tends to 0 at the capture velocity (roughly as the square root of the distance to it, see
-:func:`microimpact.dynamics.capture_bracket`), so a measured rebound that the model predicts as
+:func:`microimpact.dynamics.nonlinear.capture_bracket`), so a measured rebound that the model predicts as
 captured simply gets the residual (0 - e_n,measured) / sigma: no special case, no discontinuity
 in chi-square. A measured capture (e_n = 0) is fitted the same way.
 
@@ -49,8 +49,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from . import engine
-from .params import Contact
+from microimpact.solvers import engine
+from microimpact.model.contact import Contact
 
 __all__ = [
     "DampingFit",
@@ -381,7 +381,7 @@ class DampingFit:
 
     def save(self, path) -> Path:
         """Write :meth:`to_dataset` to NetCDF atomically (:func:`microimpact.io.write_netcdf`)."""
-        from .io import write_netcdf
+        from microimpact.io import write_netcdf
 
         return write_netcdf(self.to_dataset(), path)
 

@@ -270,7 +270,7 @@ def plot_energy_loss(ds: xr.Dataset, *, hue: str | None = None) -> Plot:
     Parameters
     ----------
     ds : xarray.Dataset
-        A sweep from :func:`microimpact.sweeps.run_sweep` with a ``speed`` dimension and at most one
+        A sweep from :func:`microimpact.studies.sweeps.run_sweep` with a ``speed`` dimension and at most one
         other dimension of size > 1 (the curve family: incidence angle, spin or friction).
     hue : str, optional
         The curve-family dimension; default the only non-speed dimension.
@@ -357,7 +357,7 @@ def plot_restitution_and_impulse(ds: xr.Dataset, *, hue: str | None = None, pane
     Parameters
     ----------
     ds : xarray.Dataset
-        A sweep from :func:`microimpact.sweeps.run_sweep` (see :func:`plot_energy_loss`).
+        A sweep from :func:`microimpact.studies.sweeps.run_sweep` (see :func:`plot_energy_loss`).
     hue : str, optional
         The curve-family dimension; default the only non-speed dimension.
     panels : "auto" or tuple of {"e_n", "mu_t", "mu_tp"}
@@ -428,7 +428,7 @@ def plot_phase_portraits(portraits) -> Plot:
     Parameters
     ----------
     portraits : sequence of xarray.Dataset
-        From :func:`microimpact.dynamics.phase_portrait`: coordinate ``time`` [s], variables
+        From :func:`microimpact.dynamics.nonlinear.phase_portrait`: coordinate ``time`` [s], variables
         ``penetration`` x = -n [m] and ``penetration_rate`` dx/dt [m/s]; attributes
         ``normal_speed`` [m/s], ``outcome``, ``motion_type`` and, if present, ``length_scale`` X
         (the equilibrium penetration) [m], ``asymptotic_frequency`` [rad/s].
@@ -492,7 +492,7 @@ def plot_bifurcation_plane(ds: xr.Dataset, *, label_points: bool = True) -> Plot
     Parameters
     ----------
     ds : xarray.Dataset
-        From :func:`microimpact.dynamics.bifurcation_plane`: coordinates ``C1``, ``C2``; variables
+        From :func:`microimpact.dynamics.nonlinear.bifurcation_plane`: coordinates ``C1``, ``C2``; variables
         ``region`` (C1, C2) with 0 spiral sink / 1 critical / 2 sink, ``critical_line_C2`` (C1)
         and, per ``case`` (label coordinate), ``case_C1``, ``case_C2``, ``case_speed`` [m/s].
     label_points : bool
@@ -558,11 +558,11 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
     Parameters
     ----------
     fit : xarray.Dataset
-        :meth:`microimpact.fitting.DampingFit.to_dataset`: along ``point``, ``radius`` [m],
+        :meth:`microimpact.analysis.fitting.DampingFit.to_dataset`: along ``point``, ``radius`` [m],
         ``normal_speed`` [m/s], ``e_n_measured``, ``sigma`` (1-sigma, drawn as error bars) and
         ``e_n_model``; scalar ``zeta_hertz``, ``zeta_adhesion``, ``work_of_adhesion`` [J/m^2].
     curves : xarray.Dataset, optional
-        Smooth model lines from :func:`microimpact.sweeps.restitution_curves` (``e_n`` on
+        Smooth model lines from :func:`microimpact.studies.sweeps.restitution_curves` (``e_n`` on
         ``radius`` x ``speed``). Without it the model is drawn at the data points, joined.
     """
     fig = _figure(WIDTH * 0.72, 3.3)
@@ -658,7 +658,7 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
     Parameters
     ----------
     ds : xarray.Dataset
-        From :func:`microimpact.validation.kharaz_comparison`: model curves ``<q>_curve`` (and
+        From :func:`microimpact.analysis.kharaz.kharaz_comparison`: model curves ``<q>_curve`` (and
         ``<q>_curve_fitted``, fitted friction, drawn dashed when present) on ``curve_incidence_deg``
         for q = ``tangential_restitution`` [1], ``rebound_spin`` [rad/s], ``rebound_angle`` [deg];
         measured ``<q>_measured`` at the angles ``<q>_incidence_deg``.

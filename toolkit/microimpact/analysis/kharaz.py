@@ -27,7 +27,7 @@ BELOW 5/7 around 10-20 deg.
 
 Spin sign convention
 --------------------
-In the toolkit frame (:mod:`microimpact.coefficients`) the slip is u_t = v_t + r omega_t', so a
+In the toolkit frame (:mod:`microimpact.model.kinematics`) the slip is u_t = v_t + r omega_t', so a
 sphere rolling forward in +t has omega_t' = -v_t / r < 0: friction from an impact with v_t > 0
 drives omega_t' negative ("forward" or top-spin rolling). The data give the angular SPEED; the
 comparison uses |omega| (the model's omega_t' is reported too, negative).
@@ -43,8 +43,8 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from . import engine
-from .impact import simulate_many
+from microimpact.solvers import engine
+from microimpact.solvers.impact import simulate_many
 
 __all__ = ["kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
            "KHARAZ_CONDITIONS"]
@@ -66,7 +66,7 @@ _UNITS_IN_FILE = {"tangential_restitution": "1", "rebound_spin": "rad s-1", "reb
 
 def default_kharaz_path() -> Path:
     """The repository copy ``data/kharaz2001_oblique.csv``."""
-    return Path(__file__).resolve().parents[2] / "data" / "kharaz2001_oblique.csv"
+    return Path(__file__).resolve().parents[3] / "data" / "kharaz2001_oblique.csv"
 
 
 def read_kharaz(path=None) -> pd.DataFrame:
@@ -100,7 +100,7 @@ def read_kharaz(path=None) -> pd.DataFrame:
 
 
 def _base_contact(normal_restitution):
-    from .io import default_materials_path, read_materials
+    from microimpact.io import default_materials_path, read_materials
 
     pair = read_materials(default_materials_path())[KHARAZ_CONDITIONS["material_pair"]]
     c = pair.contact(KHARAZ_CONDITIONS["radius"])

@@ -6,7 +6,7 @@ doi:10.1080/02786820290092221, and the capture velocity that the paper mentions 
 
 Nondimensional variables: xi = x / X (penetration x = -n over the length scale X = 2 pi f0 / K,
 Eq. (29)), time over T = sqrt(m / sqrt(2 pi r f0 K)) (Eq. (30) corrected, see
-:class:`microimpact.params.Contact`), y = d xi / d tau = x' T / X. The normal motion of Eq. (27)
+:class:`microimpact.model.contact.Contact`), y = d xi / d tau = x' T / X. The normal motion of Eq. (27)
 becomes Eq. (28)/(33)::
 
     xi' = y
@@ -37,8 +37,8 @@ import numpy as np
 import xarray as xr
 from scipy.optimize import brentq
 
-from .forces import contact_potential_energy
-from .params import PAPER_REFERENCE, Contact
+from microimpact.model.law import contact_potential_energy
+from microimpact.model.contact import PAPER_REFERENCE, Contact
 
 __all__ = [
     "nondimensional_rhs",
@@ -191,7 +191,7 @@ def equilibrium_eigenvalues(c):
 def nondimensional_energy(xi, y):
     """Nondimensional contact energy e = y^2 / 2 + (2/5) xi^(5/2) - (2/3) xi^(3/2). [-]
 
-    The dimensional energy of :func:`microimpact.forces.contact_potential_energy` plus the normal
+    The dimensional energy of :func:`microimpact.model.law.contact_potential_energy` plus the normal
     kinetic energy is e m X^2 / T^2. e < 0 means captured (the sphere can no longer reach xi = 0);
     e = -4/15 at the equilibrium (1, 0).
     """
@@ -429,7 +429,7 @@ def asymptotic_frequency(contact: Contact, speed):
 
 # ----------------------------------------------------------------------------- capture velocity
 def _solve_normal(contact: Contact, speed: float, **kwargs):
-    from .engine import solve_normal  # imported here: the engine imports nothing from this module
+    from microimpact.solvers.engine import solve_normal  # imported here: the engine imports nothing from this module
 
     return solve_normal(contact, speed, **kwargs)
 
@@ -490,7 +490,7 @@ def capture_bracket(
         Relative tolerance on the bracket width. [-] The search stops when
         rebound_speed - captured_speed <= xtol + rtol * rebound_speed.
     solver_rtol : float, optional
-        Relative tolerance passed to :func:`microimpact.engine.solve_normal`. [-]
+        Relative tolerance passed to :func:`microimpact.solvers.engine.solve_normal`. [-]
     initial_guess : float, optional
         Speed at which the search for a bracket starts; doubled/halved until the outcomes
         differ. [m/s]
@@ -559,7 +559,7 @@ def capture_bracket(
 def capture_velocity(contact: Contact, *, xtol: float = 1e-9, rtol: float = 1e-7, **kwargs) -> float:
     """Normal impact speed below which the sphere is captured (the capture velocity). [m/s]
 
-    Bisection on the outcome of :func:`microimpact.engine.solve_normal`; see
+    Bisection on the outcome of :func:`microimpact.solvers.engine.solve_normal`; see
     :func:`capture_bracket` for the parameters. The result is the bracket midpoint, within
     (xtol + rtol * v) / 2 of the outcome boundary: by default 5e-10 m/s + 5e-8 relative.
 
@@ -594,7 +594,7 @@ def phase_portrait(contact: Contact, speed: float, *, rtol: float = 1e-10, settl
     speed : float
         Incident normal speed. [m/s]
     rtol : float, optional
-        Relative tolerance of :func:`microimpact.engine.solve_normal`. [-]
+        Relative tolerance of :func:`microimpact.solvers.engine.solve_normal`. [-]
     settle_amplitude : float, optional
         A captured sphere is followed until its oscillation amplitude about the equilibrium is
         below this fraction of X (passed to the engine). [-]
@@ -665,7 +665,7 @@ def phase_portrait(contact: Contact, speed: float, *, rtol: float = 1e-10, settl
             "asymptotic_frequency": float(asymptotic_frequency(contact, float(speed))),
             "asymptotic_frequency_units": "rad/s",
             "rate_sign_changes_after_capture": sign_changes,
-            "solver": "microimpact.engine.solve_normal",
+            "solver": "microimpact.solvers.engine.solve_normal",
             "rtol": rtol,
         },
     )
@@ -808,7 +808,7 @@ def save_phase_portraits(portraits: Sequence[xr.Dataset], path) -> Path:
     coordinate and attributes); the root group lists them in the attribute ``portraits`` and
     their speeds in ``normal_speeds`` [m/s]. Written with :func:`microimpact.io.files.write_netcdf_groups`.
     """
-    from .io.files import write_netcdf_groups
+    from microimpact.io.files import write_netcdf_groups
 
     names = [f"portrait_{i}" for i in range(len(portraits))]
     root = xr.Dataset(attrs={
@@ -851,7 +851,7 @@ def dynamics_summary(contact: Contact, speeds: Sequence[float]) -> xr.Dataset:
         [m/s]: ``C1``, ``C2``, ``C`` (Eqs. (31)-(35)) [-], ``equilibrium_type`` (text) and
         ``asymptotic_frequency`` omega_f (NaN for C >= 2) [rad/s].
     """
-    from .impact import contact_attributes
+    from microimpact.solvers.impact import contact_attributes
 
     speeds = np.asarray([float(v) for v in speeds])
     c12 = np.array([contact.nondimensional_damping(v) for v in speeds]).reshape(-1, 2)

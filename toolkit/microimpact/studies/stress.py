@@ -4,7 +4,7 @@
 and checks, for each one, the invariants the engine must keep whatever the input:
 
 ``exception``
-    :func:`microimpact.impact.simulate_impact` raised (e.g. :class:`microimpact.engine.EngineError`
+    :func:`microimpact.solvers.impact.simulate_impact` raised (e.g. :class:`microimpact.solvers.engine.EngineError`
     when the step limit, the engine's time box, is reached).
 ``nonfinite``
     a result that must be finite is NaN or inf (``mu_t``, ``mu_tp`` may be NaN and
@@ -42,7 +42,7 @@ tolerated exactly when the case lies within the tolerance of the capture thresho
 
 Run from the command line::
 
-    python -m microimpact.stress --cases 2000 --seed 0 --out summary.json
+    python -m microimpact.studies.stress --cases 2000 --seed 0 --out summary.json
 """
 
 from __future__ import annotations
@@ -57,8 +57,8 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from ._timeout import TimeLimitExceeded, time_limit
-from .params import Contact
+from microimpact.studies._timeout import TimeLimitExceeded, time_limit
+from microimpact.model.contact import Contact
 
 __all__ = ["TOLERANCES", "INPUT_RANGES", "draw_cases", "check_case", "stress_sweep", "StressReport",
            "result_distance", "energy_scale", "main"]
@@ -213,7 +213,7 @@ def check_case(case: dict, *, reference: bool = False, case_time_limit: float = 
     ``reference_error`` (NaN when not run), ``seconds`` and ``failures`` (list of
     ``(kind, detail)``).
     """
-    from .impact import simulate_impact
+    from microimpact.solvers.impact import simulate_impact
 
     tol = dict(TOLERANCES, **(tolerances or {}))
     out = {"outcome": "", "e_n": math.nan, "energy_error": math.nan, "convergence_error": math.nan,
@@ -372,7 +372,7 @@ def _dataset(cases, rows) -> xr.Dataset:
 
 # ------------------------------------------------------------------------------------- CLI
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m microimpact.stress",
+    p = argparse.ArgumentParser(prog="python -m microimpact.studies.stress",
                                 description="Seeded random stress sweep of the impact engine.")
     p.add_argument("--cases", type=int, default=1000, help="number of random impacts")
     p.add_argument("--seed", type=int, default=0)
@@ -393,14 +393,14 @@ def main(argv=None) -> int:
                           case_time_limit=args.case_time_limit, progress=progress)
     text = json.dumps(report.summary, indent=2, allow_nan=False, default=str)
     if args.out:
-        from .io.files import atomic_write
+        from microimpact.io.files import atomic_write
 
         with atomic_write(args.out) as f:
             f.write(text + "\n")
     else:
         print(text)
     if args.netcdf:
-        from .io.files import write_netcdf
+        from microimpact.io.files import write_netcdf
 
         write_netcdf(report.dataset, args.netcdf)
     s = report.summary

@@ -1,0 +1,8 @@
+"""Analysis: what is learned from measurements.
+
+- :mod:`.fitting`: zeta_H, zeta_A (and optionally w_A) fitted to measured e_n(v_n) with lmfit.
+- :mod:`.flags`: which measurements unmeasured spin, angle error or closeness to capture make
+  unreliable.
+- :mod:`.kharaz`: the model against the Kharaz et al. (2001) oblique-impact measurements.
+- :mod:`.synthetic`: labelled synthetic measurements from stated parameters.
+"""
