@@ -11,32 +11,19 @@ import math
 import numpy as np
 import xarray as xr
 
+from microimpact.io.variables import attributes
 from microimpact.solvers import engine
 from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
 from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
 
 __all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES"]
 
-# name: (units, long_name) of every variable that simulate_many returns
-RESULT_VARIABLES: dict[str, tuple[str, str]] = {
-    "outcome": ("1", "impact outcome (0 rebound, 1 capture)"),
-    "e_n": ("1", "normal coefficient of restitution, Eq. (21)"),
-    "mu_t": ("1", "tangential impulse ratio in t, Eq. (22)"),
-    "mu_tp": ("1", "tangential impulse ratio in t', Eq. (23)"),
-    "K_L": ("1", "translational kinetic energy loss ratio, Eq. (25)"),
-    "K_t": ("1", "total kinetic energy loss ratio, Eq. (24)"),
-    "velocity_out_n": ("m s-1", "normal velocity after impact (final state if captured)"),
-    "velocity_out_t": ("m s-1", "tangential velocity in t after impact"),
-    "velocity_out_tp": ("m s-1", "tangential velocity in t' after impact"),
-    "omega_out_n": ("rad s-1", "spin about n after impact"),
-    "omega_out_t": ("rad s-1", "spin about t after impact"),
-    "omega_out_tp": ("rad s-1", "spin about t' after impact"),
-    "contact_time": ("s", "duration of contact (inf if captured)"),
-    "max_penetration": ("m", "largest penetration x = -n"),
-    "slip_ended": ("1", "1 if sliding ended and the sphere rolls"),
-    "friction_impulse": ("N s", "integral of |F_n| over the contact"),
-    "dissipated_energy": ("J", "energy dissipated by damping and friction (to rest if captured)"),
-}
+#: the variables that simulate_many returns (units and long names in microimpact.io.variables)
+RESULT_VARIABLES: tuple[str, ...] = (
+    "outcome", "e_n", "mu_t", "mu_tp", "K_L", "K_t", "velocity_out_n", "velocity_out_t",
+    "velocity_out_tp", "omega_out_n", "omega_out_t", "omega_out_tp", "contact_time",
+    "max_penetration", "slip_ended", "friction_impulse", "dissipated_energy",
+)
 
 
 def _check_inputs(speed, incidence_deg, azimuth_deg, omega):
@@ -258,22 +245,11 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     }
     coords = {name: c for a in arrays for name, c in a.coords.items()}
     ds = xr.Dataset(coords=coords)
-    input_meta = {
-        "speed": ("m s-1", "incident speed"),
-        "incidence_deg": ("degree", "incidence angle from the surface normal"),
-        "azimuth_deg": ("degree", "azimuth of the tangential velocity"),
-        "omega_n": ("rad s-1", "initial spin about n"),
-        "omega_t": ("rad s-1", "initial spin about t"),
-        "omega_tp": ("rad s-1", "initial spin about t'"),
-        "friction": ("1", "Coulomb friction coefficient"),
-    }
     for a in arrays:
         if a.name not in ds.coords:
-            units, long_name = input_meta[a.name]
-            ds[a.name] = xr.DataArray(a.values, dims=dims, attrs={"units": units, "long_name": long_name})
+            ds[a.name] = xr.DataArray(a.values, dims=dims, attrs=attributes(a.name))
     for name, values in results.items():
-        units, long_name = RESULT_VARIABLES[name]
-        ds[name] = xr.DataArray(values.reshape(shape), dims=dims, attrs={"units": units, "long_name": long_name})
+        ds[name] = xr.DataArray(values.reshape(shape), dims=dims, attrs=attributes(name))
     ds["outcome"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="rebound capture")
     ds["slip_ended"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="sliding rolling")
     ds.attrs.update(contact_attributes(contact))

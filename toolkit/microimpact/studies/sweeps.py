@@ -47,7 +47,7 @@ from datetime import datetime, timezone
 import numpy as np
 import xarray as xr
 
-from microimpact.solvers.impact import RESULT_VARIABLES as RESULT_META
+from microimpact.io.variables import attributes
 from microimpact.model.contact import PAPER_REFERENCE
 
 __all__ = [
@@ -532,8 +532,8 @@ def restitution_curves(fit_dataset: xr.Dataset, speed=None, *, radius=None, rtol
         outcome.append(res["outcome"].values)
     return xr.Dataset(
         {
-            "e_n": (("radius", "speed"), np.array(e_n), dict(zip(("units", "long_name"), RESULT_META["e_n"]))),
-            "outcome": (("radius", "speed"), np.array(outcome), dict(zip(("units", "long_name"), RESULT_META["outcome"]))),
+            "e_n": (("radius", "speed"), np.array(e_n), attributes("e_n")),
+            "outcome": (("radius", "speed"), np.array(outcome), attributes("outcome")),
         },
         coords={
             "radius": ("radius", radii, {"units": "m", "long_name": "sphere radius"}),

@@ -1,0 +1,70 @@
+"""One table of the toolkit's variable names, units and long names.
+
+Every NetCDF variable and every Dataset variable the toolkit writes takes its ``units`` and
+``long_name`` from :data:`VARIABLES`, so a name means the same quantity, in the same unit, in every
+file. Units are UDUNITS spellings as CF-1.8 asks (``m s-1``, not ``m/s``); ``1`` is dimensionless.
+
+Example
+-------
+>>> from microimpact.io.variables import attributes
+>>> attributes("e_n")["units"]
+'1'
+"""
+
+from __future__ import annotations
+
+__all__ = ["VARIABLES", "attributes", "variable"]
+
+#: name: (units, long_name)
+VARIABLES: dict[str, tuple[str, str]] = {
+    # ------------------------------------------------------------- impact inputs
+    "speed": ("m s-1", "incident speed v"),
+    "normal_speed": ("m s-1", "incident normal speed v_n"),
+    "incidence_deg": ("degree", "incidence angle alpha from the surface normal"),
+    "azimuth_deg": ("degree", "azimuth theta of the tangential velocity, from t towards t'"),
+    "omega_n": ("rad s-1", "initial spin omega_n about the normal n"),
+    "omega_t": ("rad s-1", "initial spin omega_t about t"),
+    "omega_tp": ("rad s-1", "initial spin omega_t' about t'"),
+    "friction": ("1", "Coulomb friction coefficient f"),
+    "radius": ("m", "sphere radius r"),
+    # ------------------------------------------------------------- impact results
+    "outcome": ("1", "impact outcome (0 rebound, 1 capture)"),
+    "e_n": ("1", "normal coefficient of restitution, Eq. (21)"),
+    "mu_t": ("1", "tangential impulse ratio in t, Eq. (22)"),
+    "mu_tp": ("1", "tangential impulse ratio in t', Eq. (23)"),
+    "K_L": ("1", "translational kinetic energy loss ratio, Eq. (25)"),
+    "K_t": ("1", "total kinetic energy loss ratio, Eq. (24)"),
+    "velocity_out_n": ("m s-1", "normal velocity after impact (final state if captured)"),
+    "velocity_out_t": ("m s-1", "tangential velocity in t after impact"),
+    "velocity_out_tp": ("m s-1", "tangential velocity in t' after impact"),
+    "omega_out_n": ("rad s-1", "spin about n after impact"),
+    "omega_out_t": ("rad s-1", "spin about t after impact"),
+    "omega_out_tp": ("rad s-1", "spin about t' after impact"),
+    "contact_time": ("s", "duration of contact (inf if captured)"),
+    "max_penetration": ("m", "largest penetration x = -n"),
+    "slip_ended": ("1", "1 if sliding ended and the sphere rolls"),
+    "friction_impulse": ("N s", "integral of |F_n| over the contact"),
+    "dissipated_energy": ("J", "energy dissipated by damping and friction (to rest if captured)"),
+    "capture_normal_speed": ("m s-1", "normal capture velocity: largest normal speed that is captured"),
+    # ------------------------------------------------------------- fitted parameters
+    "zeta_hertz": ("1", "nondimensional Hertzian damping coefficient zeta_H, Eq. (15)"),
+    "zeta_adhesion": ("1", "nondimensional adhesion damping coefficient zeta_A, Eq. (14)"),
+    "work_of_adhesion": ("J m-2", "Dupre work of adhesion w_A, f0 from Eq. (7)"),
+}
+
+
+def attributes(name: str, **extra) -> dict:
+    """``{"units": ..., "long_name": ...}`` of ``name`` from :data:`VARIABLES`, updated by ``extra``.
+
+    Raises
+    ------
+    KeyError
+        If ``name`` is not in the table (add it there, once).
+    """
+    units, long_name = VARIABLES[name]
+    return {"units": units, "long_name": long_name, **extra}
+
+
+def variable(name: str, dims, values, **extra) -> tuple:
+    """``(dims, values, attributes)``: a Dataset variable of ``name`` with its table attributes."""
+    return (dims, values, attributes(name, **extra))
