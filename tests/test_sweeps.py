@@ -108,7 +108,7 @@ def test_global_attributes(case21):
 
 def test_run_sweep_by_case_name_uses_the_default_grid():
     ds = sweeps.run_sweep(C, case="2.4", capture_speed=False)
-    assert dict(ds.sizes) == {"speed": 99, "friction": 10}
+    assert dict(ds.sizes) == {"speed": 50, "friction": 10}
     with pytest.raises(sweeps.SweepSpecError, match="case"):
         sweeps.run_sweep(C, case="9.9")
 

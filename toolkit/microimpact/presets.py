@@ -1,4 +1,4 @@
-"""Parameter sets from the literature.
+"""Named contacts from the literature (public API; the numbers live in :mod:`microimpact.model.parameters`).
 
 ``WALL_1990`` is row 2 of Table 1 of Cheng, Brach & Dunn (2002), doi:10.1080/02786820290092221:
 ammonium fluorescein microspheres on polished silicon after Wall et al. (1990),
@@ -8,20 +8,16 @@ Aerosol Sci. Technol. 12:926-946, doi:10.1080/02786829008959404.
 from __future__ import annotations
 
 from microimpact.model.contact import Contact
+from microimpact.model.parameters import TABLE1, TABLE1_ROW2
 
 __all__ = ["WALL_1990", "PRESETS", "get_preset"]
 
-WALL_1990 = Contact(
-    radius=3.45e-6,
-    density=1350.0,
-    stiffness=1.776e9,
-    adhesion_line_force=7.422,
-    zeta_hertz=0.50,
-    zeta_adhesion=29.0,
-    friction=0.15,
-)
+WALL_1990 = TABLE1_ROW2
 
-PRESETS: dict[str, Contact] = {"wall1990": WALL_1990}
+PRESETS: dict[str, Contact] = {
+    "wall1990": WALL_1990,
+    **{f"table1_{name}": contact for name, contact in TABLE1.items()},
+}
 
 
 def get_preset(name: str) -> Contact:

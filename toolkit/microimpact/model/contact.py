@@ -168,6 +168,24 @@ class Contact:
         """A copy with some fields changed (validated again)."""
         return replace(self, **changes)
 
+    def at_radius(self, radius: float, **changes) -> "Contact":
+        """The same materials with a sphere of another radius: f0 follows the radius, Eq. (7).
+
+        The work of adhesion w_A is the material property shared by all sizes, so f0 scales as
+        r^(1/3) (model notes, section 1); the damping coefficients, density, stiffness and
+        friction are kept unless given in ``changes``.
+
+        Parameters
+        ----------
+        radius : float
+            The new sphere radius. [m]
+        **changes
+            Other fields to change.
+        """
+        _check_positive("radius", radius)
+        f0 = adhesion_line_force_from_work(self.stiffness, radius, self.work_of_adhesion)
+        return replace(self, radius=float(radius), adhesion_line_force=f0, **changes)
+
     # ----------------------------------------------------------------- derived
     @property
     def mass(self) -> float:

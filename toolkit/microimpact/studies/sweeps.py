@@ -48,6 +48,7 @@ import numpy as np
 import xarray as xr
 
 from microimpact.io.variables import attributes
+from microimpact.model.parameters import TABLE2_CASES
 from microimpact.model.contact import PAPER_REFERENCE
 
 __all__ = [
@@ -82,51 +83,6 @@ _VALID = {
 }
 _META_KEYS = ("description", "chunk")
 
-_SPEED = {"start": 0.2, "stop": 10.0, "num": 99, "spacing": "linear"}  # 0.1 m/s steps
-
-#: Default grids of the five cases of Table 2. Where the paper gives no increment, the choice is
-#: stated in the description. At alpha = 0 the azimuth theta of case 2.4/2.5 has no effect.
-TABLE2_CASES: dict[str, dict] = {
-    "2.1": {
-        "description": "Table 2 case 2.1 (Figs. 7, 8): v = 0.2-10 m/s, alpha = 0-30 deg in 5 deg steps, no spin",
-        "speed": dict(_SPEED),
-        "incidence_deg": {"start": 0.0, "stop": 30.0, "step": 5.0},
-    },
-    "2.2": {
-        "description": "Table 2 case 2.2 (Figs. 9, 10): v = 0.2-10 m/s, alpha = 0, "
-        "omega_t' = 0-1.8e5 rad/s (increment not given in the paper; 6e4 rad/s used)",
-        "speed": dict(_SPEED),
-        "incidence_deg": 0.0,
-        "omega_tp": {"start": 0.0, "stop": 1.8e5, "step": 6.0e4},
-    },
-    "2.3": {
-        "description": "Table 2 case 2.3 (Figs. 11, 12): v = 0.2-10 m/s, alpha = 0-30 deg in 5 deg steps, "
-        "omega_t = 2.9e5 rad/s",
-        "speed": dict(_SPEED),
-        "incidence_deg": {"start": 0.0, "stop": 30.0, "step": 5.0},
-        "omega_t": 2.9e5,
-    },
-    "2.4": {
-        "description": "Table 2 case 2.4 (Fig. 13): v = 0.2-10 m/s, alpha = theta = 0, "
-        "omega_t = omega_t' = 2.9e5 rad/s, f = 0-0.9 (increment not given; 0.1 used as in Fig. 14)",
-        "speed": dict(_SPEED),
-        "incidence_deg": 0.0,
-        "azimuth_deg": 0.0,
-        "omega_t": 2.9e5,
-        "omega_tp": 2.9e5,
-        "friction": {"start": 0.0, "stop": 0.9, "step": 0.1},
-    },
-    "2.5": {
-        "description": "Table 2 case 2.5 (Fig. 14): v = 0.2-10 m/s, alpha = theta = 0, "
-        "omega_t = omega_t' = 2.9e6 rad/s, f = 0-0.9 in 0.1 steps",
-        "speed": dict(_SPEED),
-        "incidence_deg": 0.0,
-        "azimuth_deg": 0.0,
-        "omega_t": 2.9e6,
-        "omega_tp": 2.9e6,
-        "friction": {"start": 0.0, "stop": 0.9, "step": 0.1},
-    },
-}
 
 
 class SweepSpecError(ValueError):
