@@ -9,7 +9,6 @@ from importlib.metadata import PackageNotFoundError, version
 
 from microimpact import presets
 from microimpact.model.kinematics import ImpactResult
-from microimpact.solvers.impact import simulate_impact, simulate_many
 from microimpact.model.contact import Contact
 
 try:
@@ -18,3 +17,12 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree wi
     __version__ = "0+unknown"
 
 __all__ = ["Contact", "ImpactResult", "presets", "simulate_impact", "simulate_many", "__version__"]
+
+
+def __getattr__(name):
+    """The solvers are imported on first use (PEP 562): ``import microimpact.report`` compiles nothing."""
+    if name in ("simulate_impact", "simulate_many"):
+        from microimpact.solvers import impact
+
+        return getattr(impact, name)
+    raise AttributeError(f"module 'microimpact' has no attribute {name!r}")

@@ -210,3 +210,32 @@ def write_csv(df, path, **to_csv_kwargs) -> Path:
     with atomic_write(path, "w", newline="") as f:
         df.to_csv(f, **to_csv_kwargs)
     return Path(path)
+
+
+def read_netcdf_groups(path) -> list:
+    """Read every group of a NetCDF-4 file written by :func:`write_netcdf_groups`, in file order.
+
+    The root group is left out when it holds no variables (it then only carries attributes, as in
+    a file of phase portraits); each group is loaded into memory and the file is closed.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        NetCDF-4 file.
+
+    Returns
+    -------
+    list of xarray.Dataset
+        One Dataset per group (the root first if it has variables), with its own coordinates and
+        attributes.
+    """
+    import netCDF4
+    import xarray as xr
+
+    with netCDF4.Dataset(path, "r") as nc:
+        names = ([None] if nc.variables else []) + list(nc.groups)
+    out = []
+    for name in names:
+        with xr.open_dataset(path, group=name, engine="netcdf4", decode_timedelta=False) as ds:
+            out.append(ds.load())
+    return out
