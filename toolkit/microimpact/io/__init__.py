@@ -10,27 +10,12 @@
 * :mod:`microimpact.io.units` - the one table of accepted units.
 """
 
+from microimpact.io import files, impacts, materials, units
 from microimpact.io.files import atomic_path, atomic_write, write_csv, write_netcdf, write_netcdf_groups
 from microimpact.io.impacts import CANONICAL_COLUMNS, COLUMN_UNITS, ImpactDataError, ImpactDataWarning, Problem, read_impacts
 from microimpact.io.materials import MaterialPair, MaterialsError, default_materials_path, read_materials
 from microimpact.io.units import UNITS, UnitError
 
-__all__ = [
-    "read_impacts",
-    "ImpactDataError",
-    "ImpactDataWarning",
-    "Problem",
-    "CANONICAL_COLUMNS",
-    "COLUMN_UNITS",
-    "read_materials",
-    "default_materials_path",
-    "MaterialPair",
-    "MaterialsError",
-    "atomic_path",
-    "atomic_write",
-    "write_csv",
-    "write_netcdf",
-    "write_netcdf_groups",
-    "UNITS",
-    "UnitError",
-]
+#: the public names of the readers and writers, each module's own list (one place each)
+__all__ = [name for module in (impacts, materials, files) for name in module.__all__
+           if name not in ("MAX_LISTED_PROBLEMS", "MATERIALS_SCHEMA", "NETCDF_COMPRESSION")] + ["UNITS", "UnitError"]

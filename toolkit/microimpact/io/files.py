@@ -142,19 +142,10 @@ def _netcdf_encoding(ds) -> dict[str, dict]:
 
 
 def write_netcdf(ds, path) -> Path:
-    """Write an xarray Dataset to NetCDF-4 atomically, zlib-compressing numeric variables.
+    """Write an xarray Dataset ``ds`` to NetCDF-4 file ``path`` atomically; return ``path``.
 
-    Parameters
-    ----------
-    ds : xarray.Dataset
-        Data to write; each variable's own encoding (dtype, fill value, units of times) is kept.
-    path : str or os.PathLike
-        Output file; replaced atomically.
-
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
+    Numeric variables are zlib-compressed; each variable's own encoding (dtype, fill value, units
+    of times) is kept. The same as ``write_netcdf_groups({None: ds}, path)``.
     """
     return write_netcdf_groups({None: ds}, path)
 

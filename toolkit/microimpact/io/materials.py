@@ -1,7 +1,6 @@
 """Materials config: contact properties of named sphere/surface material pairs.
 
-The bundled config is ``toolkit/microimpact/io/materials.yaml`` (the single source of truth;
-``data/materials.yaml`` is a user-facing copy that the test suite keeps byte-identical). Its path is
+The bundled config is ``toolkit/microimpact/io/materials.yaml``, the only copy; its path is
 :func:`default_materials_path`. The format is documented in ``data/README.md``, section
 "Materials config", and enforced by :data:`MATERIALS_SCHEMA` (JSON Schema, unknown keys refused).
 
@@ -47,8 +46,8 @@ _PAIR_SCHEMA = {
         "poisson_surface": _num("Poisson ratio of the surface nu2. [-]", exclusiveMinimum=-1, exclusiveMaximum=0.5),
         "work_of_adhesion": _num("Dupre work of adhesion w_A; f0 follows from Eq. (7). [J/m^2]", minimum=0),
         "friction": _num("Coulomb friction coefficient f. [-]", minimum=0),
-        "zeta_hertz": _num("Starting value of zeta_H, Eq. (15). [-]", minimum=0),
-        "zeta_adhesion": _num("Starting value of zeta_A, Eq. (14). [-]", minimum=0),
+        "zeta_hertz": _num("zeta_H, Eq. (15), of the pair used without a fit (the fit ignores it). [-]", minimum=0),
+        "zeta_adhesion": _num("zeta_A, Eq. (14), of the pair used without a fit (the fit ignores it). [-]", minimum=0),
         "damping_reference_speed": _num("Fixed reference speed v_n of Eqs. (14)-(15). [m/s]", exclusiveMinimum=0),
     },
     # either stiffness alone, or all four elastic constants without stiffness
@@ -102,7 +101,9 @@ class MaterialPair:
     friction : float
         Coulomb friction coefficient f. [-]
     zeta_hertz, zeta_adhesion : float
-        Starting values of the damping coefficients zeta_H, zeta_A, Eqs. (14)-(15). [-]
+        Damping coefficients zeta_H, zeta_A, Eqs. (14)-(15), of :meth:`contact`: the pair used
+        without a fit. :func:`~microimpact.analysis.fitting.fit_damping` ignores them (it starts
+        from a grid) and its :class:`~microimpact.analysis.fitting.DampingFit` replaces them. [-]
     damping_reference_speed : float or None
         Fixed reference speed of Eqs. (14)-(15); None uses each impact's normal speed. [m/s]
     youngs_modulus_sphere, poisson_sphere, youngs_modulus_surface, poisson_surface : float or None
