@@ -1,0 +1,73 @@
+"""Text formatting of table cells and durations, shared by every writer of human-readable tables.
+
+:func:`format_cell` is the one formatter of a table cell (the reproduction table's Markdown, the
+PDF report's tables); :func:`format_number` and :func:`format_duration` write the numbers of the
+benchmark summary.
+
+Example
+-------
+>>> from microimpact.io.formatting import format_cell, format_duration
+>>> format_cell(True), format_cell(float("nan")), format_cell("a | b", markdown=True)
+('yes', '', 'a \\\\| b')
+>>> format_duration(2.5e-6)
+'2.5 us'
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["format_cell", "format_number", "format_duration"]
+
+
+def format_cell(value, *, markdown: bool = False, float_format: str = ".4g") -> str:
+    """One table cell as text.
+
+    Parameters
+    ----------
+    value : object
+        ``None`` -> ``""``; booleans (Python or numpy) -> ``"yes"`` / ``"no"``; floats ->
+        ``float_format`` (NaN -> ``""``); anything else -> ``str(value)``.
+    markdown : bool, optional
+        Escape ``|`` and replace line breaks by spaces, so the text fits in one cell of a
+        Markdown pipe table.
+    float_format : str, optional
+        Format spec of floats (default 4 significant digits).
+
+    Returns
+    -------
+    str
+    """
+    if value is None:
+        text = ""
+    elif isinstance(value, (bool, np.bool_)):
+        text = "yes" if value else "no"
+    elif isinstance(value, (float, np.floating)):
+        text = "" if math.isnan(value) else format(value, float_format)
+    else:
+        text = str(value)
+    if markdown:
+        text = text.replace("|", "\\|").replace("\n", " ")
+    return text
+
+
+def format_number(x, spec: str = ".2e") -> str:
+    """``x`` formatted with ``spec``; ``"-"`` for None or NaN, ``"inf"`` for infinity."""
+    if x is None or (isinstance(x, float) and math.isnan(x)):
+        return "-"
+    if isinstance(x, float) and math.isinf(x):
+        return "inf"
+    return format(x, spec)
+
+
+def format_duration(seconds: float) -> str:
+    """A duration [s] in us, ms or s to 3 significant digits; ``"-"`` for NaN, ``"> limit"`` for inf."""
+    if not math.isfinite(seconds):
+        return "-" if math.isnan(seconds) else "> limit"
+    if seconds < 1e-3:
+        return f"{seconds * 1e6:.3g} us"
+    if seconds < 1:
+        return f"{seconds * 1e3:.3g} ms"
+    return f"{seconds:.3g} s"
