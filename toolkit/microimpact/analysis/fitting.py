@@ -49,8 +49,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from microimpact.solvers import engine
+from microimpact.io.files import write_netcdf
+from microimpact.io.materials import material_contact
+from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
+
+# The engine (numba) is imported inside the two functions that solve: a fit read back from its file
+# (the report, the flags of a saved fit) then costs no numba start-up.
 
 __all__ = [
     "DampingFit",
@@ -58,17 +63,14 @@ __all__ = [
     "fit_damping",
     "damping_residual",
     "model_restitution",
+    "fit_parameter_table",
+    "format_fit",
     "PARAMETER_NAMES",
     "DEFAULT_START_GRID",
 ]
 
 #: names of the fitted parameters, in the order of the correlation matrix
 PARAMETER_NAMES = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
-_PARAM_META = {
-    "zeta_hertz": ("1", "nondimensional Hertzian damping coefficient zeta_H, Eq. (15)"),
-    "zeta_adhesion": ("1", "nondimensional adhesion damping coefficient zeta_A, Eq. (14)"),
-    "work_of_adhesion": ("J m-2", "Dupre work of adhesion w_A, f0 from Eq. (7)"),
-}
 #: default start grid: log-spaced zeta_H and zeta_A values on which chi-square is evaluated
 DEFAULT_START_GRID = (np.geomspace(0.01, 10.0, 13), np.geomspace(0.1, 1000.0, 13))
 #: sigma levels of the lmfit confidence intervals
@@ -117,11 +119,9 @@ class FitProblem:
                    float(getattr(base, "friction", 0.0) or 0.0), getattr(base, "damping_reference_speed", None))
 
     def contact(self, radius, zeta_hertz, zeta_adhesion, work_of_adhesion) -> Contact:
-        """The Contact of one radius, f0 from w_A through Eq. (7)."""
-        return Contact.from_work_of_adhesion(
-            radius, self.density, self.stiffness, work_of_adhesion, zeta_hertz=zeta_hertz,
-            zeta_adhesion=zeta_adhesion, friction=self.friction,
-            damping_reference_speed=self.damping_reference_speed)
+        """The Contact of one radius [m] at trial zetas [-] and w_A [J/m^2], f0 from Eq. (7)."""
+        return material_contact(self, radius, zeta_hertz=zeta_hertz, zeta_adhesion=zeta_adhesion,
+                                work_of_adhesion=work_of_adhesion)
 
 
 def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_adhesion, *, rtol=1e-8,
@@ -145,6 +145,8 @@ def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_ad
     numpy.ndarray
         e_n in the data order; 0 where the model predicts capture. [-]
     """
+    from microimpact.solvers import engine  # numba start-up only when solving (see the imports)
+
     out = np.empty(problem.normal_speed.size)
     for r, idx in zip(problem.radii, problem.groups):
         c = problem.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion)
@@ -265,56 +267,38 @@ class DampingFit:
         radius : float
             Sphere radius. [m]
         """
-        return Contact.from_work_of_adhesion(
-            radius, self.density, self.stiffness, self.work_of_adhesion,
-            zeta_hertz=self.zeta_hertz, zeta_adhesion=self.zeta_adhesion, friction=self.friction,
-            damping_reference_speed=self.damping_reference_speed)
+        return material_contact(self, radius)
+
+    @property
+    def radii(self) -> np.ndarray:
+        """The distinct sphere radii of the fitted points, ascending. [m]"""
+        return np.unique(self.data["radius"].to_numpy(dtype=float))
+
+    @property
+    def speed_range(self) -> tuple[float, float]:
+        """(smallest, largest) incident normal speed of the fitted points. [m/s]"""
+        v = self.data["normal_speed"].to_numpy(dtype=float)
+        return float(v.min()), float(v.max())
+
+    @property
+    def parameter_source(self) -> str:
+        """Provenance of the fitted parameters: ``"fit: <source file name> <sha256>"``.
+
+        From the ``source`` and ``sha256`` the fit recorded of its impact table (NetCDF attributes
+        ``fit_source``, ``fit_sha256``); ``unknown`` for what was not recorded (a table built in
+        memory).
+        """
+        source = self.info.get("source")
+        name = Path(str(source)).name if source else "unknown"
+        return f"fit: {name} {self.info.get('sha256') or 'unknown'}"
 
     # ------------------------------------------------------------------ report
     def report(self) -> str:
-        """Readable summary: values, errors, intervals, correlations and fit statistics."""
-        lines = ["Damping fit (Cheng, Brach & Dunn 2002, Eqs. (14)-(15), (21), (27))"]
-        src = self.info.get("source")
-        if src:
-            lines.append(f"  data        : {src}" + (f"  [{self.info['material_pair']}]" if self.info.get("material_pair") else ""))
-        radii = sorted(set(self.data["radius"]))
-        lines.append(f"  points      : {self.n_points} over {len(radii)} radii "
-                     f"({', '.join(f'{r * 1e6:.3g}' for r in radii)} um)")
-        lines.append(f"  weighting   : {self.weighting}; covariance "
-                     f"{'scaled by' if self.scale_covar else 'not scaled by'} reduced chi-square")
-        lines.append(f"  material    : density {self.density:g} kg/m3, K {self.stiffness:.4g} Pa, "
-                     f"friction {self.friction:g}, damping reference speed "
-                     f"{'per-impact normal speed' if self.damping_reference_speed is None else f'{self.damping_reference_speed:g} m/s'}")
-        lines.append("  parameters  :")
-        for name in PARAMETER_NAMES:
-            unit = "J/m2" if name == "work_of_adhesion" else "-"
-            v, s = self.values[name], self.stderr[name]
-            if name in self.varied:
-                ci = self.confidence_intervals.get(name, {})
-                rel = f" ({100 * s / abs(v):.2g} %)" if v and math.isfinite(s) else ""
-                txt = f"    {name:<17}= {v:.6g} +/- {s:.3g}{rel} [{unit}]"
-                if ci and all(math.isfinite(ci.get(k, math.nan)) for k in (-1, 1)):
-                    txt += f"; 1-sigma CI [{ci[-1]:.5g}, {ci[1]:.5g}]"
-                    if all(math.isfinite(ci.get(k, math.nan)) for k in (-2, 2)):
-                        txt += f", 2-sigma CI [{ci[-2]:.5g}, {ci[2]:.5g}]"
-                lines.append(txt)
-            else:
-                lines.append(f"    {name:<17}= {v:.6g} (fixed) [{unit}]")
-        if len(self.varied) > 1:
-            idx = [PARAMETER_NAMES.index(n) for n in self.varied]
-            lines.append("  correlations:")
-            for a in range(len(idx)):
-                for b in range(a + 1, len(idx)):
-                    lines.append(f"    {self.varied[a]} / {self.varied[b]}: "
-                                 f"{self.correlation[idx[a], idx[b]]:+.3f}")
-        lines.append(f"  chi-square  : {self.chisqr:.4g}, reduced {self.redchi:.4g} "
-                     f"({self.n_points - len(self.varied)} degrees of freedom)")
-        lines.append(f"  AIC, BIC    : {self.aic:.4g}, {self.bic:.4g}")
-        lines.append(f"  evaluations : {self.info.get('nfev', '?')} ({self.info.get('elapsed_s', math.nan):.2f} s), "
-                     f"{self.info.get('message', '')}")
-        if self.info.get("ci_message"):
-            lines.append(f"  note        : {self.info['ci_message']}")
-        return "\n".join(lines)
+        """Readable summary: values, errors, intervals, correlations and fit statistics.
+
+        The text of :func:`format_fit` (the one formatter of a fit).
+        """
+        return format_fit(self, "text")
 
     def __str__(self) -> str:  # pragma: no cover - convenience
         return self.report()
@@ -337,31 +321,21 @@ class DampingFit:
                             {"units": "1", "long_name": "confidence level in standard deviations (negative: lower limit)"}),
         })
         for name in PARAMETER_NAMES:
-            units, long_name = _PARAM_META[name]
+            units = attributes(name)["units"]
             varied = name in self.varied
-            ds[name] = xr.DataArray(self.values[name], attrs={
-                "units": units, "long_name": long_name, "varied": int(varied)})
+            ds[name] = xr.DataArray(self.values[name], attrs=attributes(name, varied=int(varied)))
             ds[f"{name}_stderr"] = xr.DataArray(self.stderr[name], attrs={
                 "units": units, "long_name": f"standard error of {name}"})
             ci = self.confidence_intervals.get(name, {})
             ds[f"{name}_confidence_limit"] = xr.DataArray(
                 np.array([ci.get(s, np.nan) for s in SIGMA_LEVELS], dtype=float), dims=("sigma_level",),
                 attrs={"units": units, "long_name": f"lmfit.conf_interval limit of {name}"})
-        ds["correlation"] = xr.DataArray(self.correlation, dims=("parameter", "parameter_b"), attrs={
-            "units": "1", "long_name": "correlation of the fitted parameters"})
-        meta = {
-            "row": ("1", "data row of the impact in the source CSV"),
-            "radius": ("m", "sphere radius"),
-            "normal_speed": ("m s-1", "incident normal speed"),
-            "e_n": ("1", "measured normal coefficient of restitution"),
-            "sigma": ("1", "uncertainty of e_n used as weight (effective variance included)"),
-            "model": ("1", "model normal coefficient of restitution at the best fit, Eq. (21)"),
-            "residual": ("1", "(model - measured) / sigma"),
-        }
-        for col, (units, long_name) in meta.items():
+        ds["correlation"] = xr.DataArray(self.correlation, dims=("parameter", "parameter_b"),
+                                         attrs=attributes("correlation"))
+        for col in ("row", "radius", "normal_speed", "e_n", "sigma", "model", "residual"):
             values = d[col].to_numpy(dtype=np.int64 if col == "row" else float)
             name = {"e_n": "e_n_measured", "model": "e_n_model"}.get(col, col)
-            ds[name] = xr.DataArray(values, dims=("point",), attrs={"units": units, "long_name": long_name})
+            ds[name] = xr.DataArray(values, dims=("point",), attrs=attributes(name))
         ds.attrs.update({
             "title": "damping fit of the microsphere impact model (Cheng, Brach & Dunn 2002)",
             "Conventions": "CF-1.8",
@@ -381,8 +355,6 @@ class DampingFit:
 
     def save(self, path) -> Path:
         """Write :meth:`to_dataset` to NetCDF atomically (:func:`microimpact.io.write_netcdf`)."""
-        from microimpact.io import write_netcdf
-
         return write_netcdf(self.to_dataset(), path)
 
     @classmethod
@@ -432,6 +404,127 @@ class DampingFit:
         except KeyError as exc:
             raise ValueError(f"{path}: not a damping-fit file written by DampingFit.save "
                              f"(missing {exc.args[0]!r})") from None
+
+
+# --------------------------------------------------------------------------- the one formatter
+#: columns of :func:`fit_parameter_table`
+PARAMETER_TABLE_COLUMNS = ("parameter", "units", "value", "stderr", "relative", "ci1", "ci2", "method")
+
+
+def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
+    """The fitted parameters as text cells, one row per parameter of :data:`PARAMETER_NAMES`.
+
+    Parameters
+    ----------
+    fit : DampingFit
+        A fit (:func:`fit_damping`, or read back with :meth:`DampingFit.load` /
+        :meth:`DampingFit.from_dataset`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`PARAMETER_TABLE_COLUMNS`: ``parameter``, ``units`` (of
+        :mod:`microimpact.io.variables`), ``value``, ``stderr`` ("fixed" for a fixed
+        parameter), ``relative`` (stderr / |value| in %), ``ci1`` and ``ci2`` (1- and 2-sigma
+        intervals ``[lo, hi]``) and ``method``: profile likelihood (:func:`lmfit.conf_interval`)
+        where it was computed, else value +/- k stderr.
+    """
+    rows = []
+    for name in PARAMETER_NAMES:
+        v, s = fit.values[name], fit.stderr[name]
+        row = dict.fromkeys(PARAMETER_TABLE_COLUMNS, "") | {
+            "parameter": name, "units": attributes(name)["units"], "value": f"{v:.6g}"}
+        if name not in fit.varied:
+            rows.append(row | {"stderr": "fixed", "method": "fixed (given material)"})
+            continue
+        ci = fit.confidence_intervals.get(name, {})
+        if all(math.isfinite(ci.get(k, math.nan)) for k in (-1, 1, -2, 2)):
+            ci1, ci2, method = (ci[-1], ci[1]), (ci[-2], ci[2]), "profile likelihood (lmfit.conf_interval)"
+        elif math.isfinite(s):
+            ci1, ci2, method = (v - s, v + s), (v - 2 * s, v + 2 * s), "covariance: value +/- k stderr"
+        else:
+            ci1 = ci2 = None
+            method = "not estimated"
+        rows.append(row | {
+            "stderr": f"{s:.3g}", "relative": f"{100 * s / abs(v):.2g} %" if v and math.isfinite(s) else "",
+            "ci1": f"[{ci1[0]:.5g}, {ci1[1]:.5g}]" if ci1 else "",
+            "ci2": f"[{ci2[0]:.5g}, {ci2[1]:.5g}]" if ci2 else "", "method": method})
+    return pd.DataFrame(rows, columns=list(PARAMETER_TABLE_COLUMNS))
+
+
+def _fit_facts(fit: "DampingFit") -> dict:
+    """Label -> text of everything but the parameters, in report order (correlations: a list)."""
+    src, pair = fit.info.get("source"), fit.info.get("material_pair")
+    vref = fit.damping_reference_speed
+    idx = [PARAMETER_NAMES.index(n) for n in fit.varied]
+    facts = {
+        "data": (f"{src}" + (f"  [{pair}]" if pair else "")) if src else None,
+        "points": f"{fit.n_points} over {len(fit.radii)} radii ({', '.join(f'{r * 1e6:.3g}' for r in fit.radii)} um)",
+        "weighting": f"{fit.weighting}; covariance {'scaled by' if fit.scale_covar else 'not scaled by'} "
+                     "reduced chi-square",
+        "material": f"density {fit.density:g} kg/m3, K {fit.stiffness:.4g} Pa, friction {fit.friction:g}, "
+                    "damping reference speed "
+                    f"{'per-impact normal speed' if vref is None else f'{vref:g} m/s'}",
+        "correlations": [f"{fit.varied[a]} / {fit.varied[b]}: {fit.correlation[idx[a], idx[b]]:+.3f}"
+                         for a in range(len(idx)) for b in range(a + 1, len(idx))],
+        "chi-square": f"{fit.chisqr:.4g}, reduced {fit.redchi:.4g} "
+                      f"({fit.n_points - len(fit.varied)} degrees of freedom)",
+        "AIC, BIC": f"{fit.aic:.4g}, {fit.bic:.4g}",
+        "evaluations": f"{fit.info.get('nfev', '?')} ({fit.info.get('elapsed_s', math.nan):.2f} s), "
+                       f"{fit.info.get('message', '')}",
+        "note": fit.info.get("ci_message") or None,
+    }
+    return {k: v for k, v in facts.items() if v is not None}
+
+
+def format_fit(fit: "DampingFit", style: str = "text") -> str:
+    """The one formatter of a damping fit: parameters, intervals, correlations, statistics.
+
+    Parameters
+    ----------
+    fit : DampingFit
+        A fit, e.g. ``DampingFit.load("results/fit.nc")``.
+    style : {"text", "markdown"}
+        "text": the plain-text report of :meth:`DampingFit.report` (the CLI prints it);
+        "markdown": a Markdown pipe table of :func:`fit_parameter_table` followed by a list of
+        the data, weighting, material, correlations and statistics (for documents).
+
+    Returns
+    -------
+    str
+    """
+    table, facts = fit_parameter_table(fit), _fit_facts(fit)
+    if style == "markdown":
+        head = ["parameter", "units", "value", "std. error", "1-sigma interval", "2-sigma interval", "method"]
+        cols = ["parameter", "units", "value", "stderr", "ci1", "ci2", "method"]
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        lines += ["| " + " | ".join(str(r[c]) for c in cols) + " |" for _, r in table.iterrows()]
+        lines.append("")
+        for label, text in facts.items():
+            text = "; ".join(text) or "n/a" if isinstance(text, list) else text
+            lines.append(f"- **{label}**: {text}")
+        return "\n".join(lines)
+    if style != "text":
+        raise ValueError(f"style must be 'text' or 'markdown', got {style!r}")
+    lines = ["Damping fit (Cheng, Brach & Dunn 2002, Eqs. (14)-(15), (21), (27))"]
+    for label in ("data", "points", "weighting", "material"):
+        if label in facts:
+            lines.append(f"  {label:<12}: {facts[label]}")
+    lines.append("  parameters  :")
+    for _, r in table.iterrows():
+        if r["stderr"] == "fixed":
+            lines.append(f"    {r['parameter']:<17}= {r['value']} (fixed) [{r['units']}]")
+            continue
+        rel = f" ({r['relative']})" if r["relative"] else ""
+        how = "" if r["method"].startswith("profile") else f" ({r['method']})"
+        ci = f"; 1-sigma CI {r['ci1']}, 2-sigma CI {r['ci2']}{how}" if r["ci1"] else ""
+        lines.append(f"    {r['parameter']:<17}= {r['value']} +/- {r['stderr']}{rel} [{r['units']}]{ci}")
+    if facts["correlations"]:
+        lines += ["  correlations:"] + [f"    {c}" for c in facts["correlations"]]
+    for label in ("chi-square", "AIC, BIC", "evaluations", "note"):
+        if label in facts:
+            lines.append(f"  {label:<12}: {facts[label]}")
+    return "\n".join(lines)
 
 
 # --------------------------------------------------------------------------- fit
@@ -577,7 +670,9 @@ def fit_damping(
     if threads is None:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
                             scale_covar)
-    import numba
+    import numba  # numba and the engine start only when solving (see the imports)
+
+    from microimpact.solvers import engine
 
     previous = numba.get_num_threads()
     engine.set_threads(threads)
@@ -589,6 +684,7 @@ def fit_damping(
 
 
 def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals, scale_covar):
+    """The fit of :func:`fit_damping`: check, start on the grid, least squares, collect the result."""
     t0 = time.perf_counter()
     density, stiffness, w_a0, friction, vref = _material(base)
     df, rows, arr, src = _table_arrays(table)
@@ -602,70 +698,15 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
         raise ValueError("fitting w_A needs a start value > 0 (base.work_of_adhesion)")
     if scale_covar is None:
         scale_covar = sigma_e is None
-    sigma = sigma_e
 
-    # coarse global start on the (zeta_H, zeta_A) grid
-    gh, ga = (np.asarray(g, dtype=float).ravel() for g in start_grid)
-    if gh.size == 0 or ga.size == 0 or np.any(gh < 0) or np.any(ga < 0):
-        raise ValueError("start_grid must be two non-empty arrays of zeta values >= 0")
-    best = (math.inf, gh[0], ga[0])
-    for zh in gh:
-        for za in ga:
-            r = damping_residual({"zeta_hertz": zh, "zeta_adhesion": za, "work_of_adhesion": w_a0},
-                                 problem, e_n, sigma, rtol=rtol)
-            chi2 = float(r @ r)
-            if chi2 < best[0]:
-                best = (chi2, zh, za)
-    nfev = gh.size * ga.size
-
+    (zh0, za0), nfev = _grid_start(problem, e_n, sigma_e, w_a0, start_grid, rtol)
     params = lmfit.Parameters()
-    params.add("zeta_hertz", value=best[1], min=0.0)
-    params.add("zeta_adhesion", value=best[2], min=0.0)
+    params.add("zeta_hertz", value=zh0, min=0.0)
+    params.add("zeta_adhesion", value=za0, min=0.0)
     params.add("work_of_adhesion", value=w_a0, min=1e-12 if fit_work_of_adhesion else 0.0, vary=fit_work_of_adhesion)
-
-    def run(params, sigma):
-        mini = lmfit.Minimizer(damping_residual, params, fcn_args=(problem,),
-                               fcn_kws={"e_n": e_n, "sigma": sigma, "rtol": rtol}, scale_covar=scale_covar)
-        return mini, mini.minimize(method="leastsq")
-
-    mini, result = run(params, sigma)
-    nfev += result.nfev
-    if effective:
-        for _ in range(2):  # re-weight with the slope at the current best fit, refit
-            sigma = _effective_sigma(problem, result.params.valuesdict(), sigma_e, arr["normal_speed_uncertainty"], rtol)
-            mini, result = run(result.params, sigma)
-            nfev += result.nfev + 2 * len(problem.radii)
-
-    varied = tuple(n for n in PARAMETER_NAMES if result.params[n].vary)
-    values = {n: float(result.params[n].value) for n in PARAMETER_NAMES}
-    stderr = {n: (float(result.params[n].stderr) if result.params[n].vary and result.params[n].stderr is not None
-                  else math.nan) for n in PARAMETER_NAMES}
-    corr = np.full((3, 3), np.nan)
-    for i, a in enumerate(PARAMETER_NAMES):
-        if a in varied:
-            corr[i, i] = 1.0
-            for j, b in enumerate(PARAMETER_NAMES):
-                cb = (result.params[a].correl or {}).get(b)
-                if cb is not None:
-                    corr[i, j] = cb
-
-    cis: dict = {}
-    ci_message = ""
-    if confidence_intervals and result.errorbars:
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                raw = lmfit.conf_interval(mini, result, p_names=list(varied), sigmas=[1, 2])
-            for name, rows_ci in raw.items():
-                # rows are (probability, value) for -2, -1, 0, +1, +2 sigma
-                lims = [v for _, v in rows_ci]
-                cis[name] = {-2: float(lims[0]), -1: float(lims[1]), 1: float(lims[3]), 2: float(lims[4])}
-        except Exception as exc:  # noqa: BLE001 - report, do not fail the fit
-            ci_message = f"confidence intervals not computed: {exc}"
-    elif confidence_intervals:
-        ci_message = "confidence intervals not computed: lmfit could not estimate the covariance"
-    if not confidence_intervals:
-        ci_message = "confidence intervals not requested"
+    sigma_v = arr["normal_speed_uncertainty"] if effective else None
+    mini, result, sigma, n = _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar)
+    cis, ci_message = _confidence_intervals(mini, result, confidence_intervals)
 
     p = result.params.valuesdict()
     model = damping_residual(p, problem, rtol=rtol)
@@ -673,16 +714,89 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
     data = pd.DataFrame({"row": rows, "radius": arr["radius"], "normal_speed": arr["normal_speed"],
                          "e_n": e_n, "sigma": sig_used if sigma is not None else np.full_like(e_n, np.nan),
                          "model": model, "residual": (model - e_n) / sig_used})
-    pair = None
-    if "material_pair" in df.columns:
-        labels = df["material_pair"].dropna().unique()
-        pair = str(labels[0]) if len(labels) == 1 else None
-    info = {"nfev": int(nfev), "success": bool(result.success), "message": str(result.message),
+    labels = df["material_pair"].dropna().unique() if "material_pair" in df.columns else ()
+    info = {"nfev": int(nfev + n), "success": bool(result.success), "message": str(result.message),
             "method": "coarse log grid + lmfit leastsq", "rtol": float(rtol),
             "elapsed_s": time.perf_counter() - t0, "source": df.attrs.get("source"),
-            "sha256": df.attrs.get("sha256"), "material_pair": pair, "ci_message": ci_message or None}
-    return DampingFit(values=values, stderr=stderr, varied=varied, correlation=corr, confidence_intervals=cis,
+            "sha256": df.attrs.get("sha256"), "material_pair": str(labels[0]) if len(labels) == 1 else None,
+            "ci_message": ci_message or None}
+    varied = tuple(n for n in PARAMETER_NAMES if result.params[n].vary)
+    return DampingFit(values={n: float(result.params[n].value) for n in PARAMETER_NAMES},
+                      stderr={n: _stderr(result.params[n]) for n in PARAMETER_NAMES}, varied=varied,
+                      correlation=_correlation(result.params, varied), confidence_intervals=cis,
                       chisqr=float(result.chisqr), redchi=float(result.redchi), aic=float(result.aic),
                       bic=float(result.bic), n_points=int(e_n.size), data=data, density=density,
                       stiffness=stiffness, friction=friction, damping_reference_speed=vref,
                       weighting=weighting, scale_covar=bool(scale_covar), info=info)
+
+
+def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol):
+    """((zeta_H, zeta_A) of least chi-square on the start grid, number of evaluations)."""
+    gh, ga = (np.asarray(g, dtype=float).ravel() for g in start_grid)
+    if gh.size == 0 or ga.size == 0 or np.any(gh < 0) or np.any(ga < 0):
+        raise ValueError("start_grid must be two non-empty arrays of zeta values >= 0")
+    best = (math.inf, gh[0], ga[0])
+    for zh in gh:
+        for za in ga:
+            r = damping_residual({"zeta_hertz": zh, "zeta_adhesion": za, "work_of_adhesion": work_of_adhesion},
+                                 problem, e_n, sigma, rtol=rtol)
+            chi2 = float(r @ r)
+            if chi2 < best[0]:
+                best = (chi2, zh, za)
+    return (best[1], best[2]), gh.size * ga.size
+
+
+def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar):
+    """Levenberg-Marquardt from ``params``; with speed uncertainties ``sigma_v`` [m/s] re-weighted
+    twice by the effective variance. Returns (minimizer, result, sigma used, evaluations)."""
+
+    def run(params, sigma):
+        mini = lmfit.Minimizer(damping_residual, params, fcn_args=(problem,),
+                               fcn_kws={"e_n": e_n, "sigma": sigma, "rtol": rtol}, scale_covar=scale_covar)
+        return mini, mini.minimize(method="leastsq")
+
+    sigma = sigma_e
+    mini, result = run(params, sigma)
+    nfev = result.nfev
+    if sigma_v is not None:
+        for _ in range(2):  # re-weight with the slope at the current best fit, refit
+            sigma = _effective_sigma(problem, result.params.valuesdict(), sigma_e, sigma_v, rtol)
+            mini, result = run(result.params, sigma)
+            nfev += result.nfev + 2 * len(problem.radii)
+    return mini, result, sigma, nfev
+
+
+def _stderr(param) -> float:
+    """Standard error of a varied lmfit parameter, NaN if fixed or not estimated."""
+    return float(param.stderr) if param.vary and param.stderr is not None else math.nan
+
+
+def _correlation(params, varied) -> np.ndarray:
+    """Correlation matrix of :data:`PARAMETER_NAMES`, NaN rows and columns for fixed parameters."""
+    corr = np.full((3, 3), np.nan)
+    for i, a in enumerate(PARAMETER_NAMES):
+        if a in varied:
+            corr[i, i] = 1.0
+            for j, b in enumerate(PARAMETER_NAMES):
+                cb = (params[a].correl or {}).get(b)
+                if cb is not None:
+                    corr[i, j] = cb
+    return corr
+
+
+def _confidence_intervals(mini, result, wanted: bool) -> tuple[dict, str]:
+    """({name: {sigma level: limit}} from lmfit.conf_interval, message why not when they are missing)."""
+    if not wanted:
+        return {}, "confidence intervals not requested"
+    if not result.errorbars:
+        return {}, "confidence intervals not computed: lmfit could not estimate the covariance"
+    varied = [n for n in PARAMETER_NAMES if result.params[n].vary]
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            raw = lmfit.conf_interval(mini, result, p_names=varied, sigmas=[1, 2])
+    except Exception as exc:  # noqa: BLE001 - report, do not fail the fit
+        return {}, f"confidence intervals not computed: {exc}"
+    # rows are (probability, value) for -2, -1, 0, +1, +2 sigma
+    return {name: dict(zip((-2, -1, 1, 2), (float(rows[k][1]) for k in (0, 1, 3, 4))))
+            for name, rows in raw.items()}, ""

@@ -22,7 +22,8 @@ import yaml
 
 from microimpact.model.contact import Contact, adhesion_line_force_from_work, stiffness_from_elastic
 
-__all__ = ["MaterialPair", "MaterialsError", "read_materials", "default_materials_path", "MATERIALS_SCHEMA"]
+__all__ = ["MaterialPair", "MaterialsError", "read_materials", "default_materials_path", "material_contact",
+           "MATERIALS_SCHEMA"]
 
 _ELASTIC = ("youngs_modulus_sphere", "poisson_sphere", "youngs_modulus_surface", "poisson_surface")
 
@@ -148,22 +149,56 @@ class MaterialPair:
         Returns
         -------
         Contact
-            Built with :meth:`Contact.from_elastic` when elastic constants are given, otherwise
-            with :meth:`Contact.from_work_of_adhesion`.
+            From :func:`material_contact` (the stiffness already follows from the elastic
+            constants when those were given).
         """
-        kwargs = dict(
-            friction=self.friction,
-            zeta_hertz=self.zeta_hertz,
-            zeta_adhesion=self.zeta_adhesion,
-            damping_reference_speed=self.damping_reference_speed,
-        )
-        if self.youngs_modulus_sphere is not None:
-            return Contact.from_elastic(
-                radius, self.density, self.youngs_modulus_sphere, self.poisson_sphere,
-                self.youngs_modulus_surface, self.poisson_surface,
-                work_of_adhesion=self.work_of_adhesion, **kwargs,
-            )
-        return Contact.from_work_of_adhesion(radius, self.density, self.stiffness, self.work_of_adhesion, **kwargs)
+        return material_contact(self, radius)
+
+
+#: fields of a material record that a :class:`~microimpact.Contact` takes (besides the radius)
+_MATERIAL_FIELDS = ("density", "stiffness", "work_of_adhesion", "friction", "zeta_hertz", "zeta_adhesion",
+                    "damping_reference_speed")
+
+
+def material_contact(material, radius: float, **changes) -> Contact:
+    """The Contact of a sphere of ``radius`` made of ``material``: f0 from w_A by Eq. (7).
+
+    The one builder of "the contact of radius r from the work of adhesion" for every material
+    record of the toolkit: :class:`MaterialPair`, :class:`~microimpact.analysis.fitting.DampingFit`,
+    :class:`~microimpact.analysis.fitting.FitProblem` or a :class:`~microimpact.Contact` (which is
+    returned unchanged at its own radius, else moved with :meth:`~microimpact.Contact.at_radius`).
+
+    Parameters
+    ----------
+    material : object
+        Has ``density`` [kg/m^3], ``stiffness`` [Pa] and ``work_of_adhesion`` [J/m^2]; optionally
+        ``friction``, ``zeta_hertz``, ``zeta_adhesion`` [-] (default 0) and
+        ``damping_reference_speed`` [m/s] (default None: each impact's own normal speed).
+    radius : float
+        Sphere radius. [m]
+    **changes
+        Values that replace the material's (e.g. trial zetas and w_A of a fit).
+
+    Returns
+    -------
+    Contact
+
+    Raises
+    ------
+    ValueError
+        If ``material`` lacks density, stiffness or work of adhesion, or a value is invalid.
+    """
+    if isinstance(material, Contact) and not changes:
+        return material if radius == material.radius else material.at_radius(radius)
+    p = {k: getattr(material, k, None) for k in _MATERIAL_FIELDS} | changes
+    missing = [k for k in ("density", "stiffness", "work_of_adhesion") if p[k] is None]
+    if missing:
+        raise ValueError(f"a material needs {', '.join(missing)} to build a contact (a MaterialPair, DampingFit "
+                         f"or Contact), got {type(material).__name__}")
+    return Contact.from_work_of_adhesion(
+        radius, p["density"], p["stiffness"], p["work_of_adhesion"], zeta_hertz=p["zeta_hertz"] or 0.0,
+        zeta_adhesion=p["zeta_adhesion"] or 0.0, friction=p["friction"] or 0.0,
+        damping_reference_speed=p["damping_reference_speed"])
 
 
 def default_materials_path() -> Path:

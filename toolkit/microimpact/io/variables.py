@@ -50,6 +50,20 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "zeta_hertz": ("1", "nondimensional Hertzian damping coefficient zeta_H, Eq. (15)"),
     "zeta_adhesion": ("1", "nondimensional adhesion damping coefficient zeta_A, Eq. (14)"),
     "work_of_adhesion": ("J m-2", "Dupre work of adhesion w_A, f0 from Eq. (7)"),
+    # --- analysis (fit points, measurement flags, Kharaz et al. 2001 validation)
+    "row": ("1", "data row of the impact in the source CSV"),
+    "e_n_measured": ("1", "measured normal coefficient of restitution"),
+    "e_n_model": ("1", "model normal coefficient of restitution at the best fit, Eq. (21)"),
+    "sigma": ("1", "uncertainty of e_n used as weight (effective variance included)"),
+    "residual": ("1", "(model - measured) / sigma"),
+    "correlation": ("1", "correlation of the fitted parameters"),
+    "capture_speed_ratio": ("1", "incident normal speed / capture velocity"),
+    "spin_bound": ("rad s-1", "largest initial spin sampled"),
+    "angle_uncertainty_deg": ("degree", "incidence-angle uncertainty used"),
+    "e_n_limit": ("1", "e_n spread limit (e_n_uncertainty, else threshold_e_n)"),
+    "tangential_restitution": ("1", "tangential restitution v_t,out / v_t,in of the centre of mass"),
+    "rebound_spin": ("rad s-1", "angular speed |omega| after impact"),
+    "rebound_angle": ("degree", "rebound angle from the surface normal"),
 }
 
 
