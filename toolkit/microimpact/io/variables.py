@@ -64,6 +64,28 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "tangential_restitution": ("1", "tangential restitution v_t,out / v_t,in of the centre of mass"),
     "rebound_spin": ("rad s-1", "angular speed |omega| after impact"),
     "rebound_angle": ("degree", "rebound angle from the surface normal"),
+    # --- studies (stress sweep, work-precision benchmark)
+    "density": ("kg m-3", "sphere density"),
+    "stiffness": ("Pa", "effective material stiffness K, Eq. (3)"),
+    "energy_error": ("1", "energy-balance residual over the energy scale of the case"),
+    "convergence_error": ("1", "distance of the results at rtol 1e-8 and 1e-10 (stress.result_distance)"),
+    "convergence_error_tight": ("1", "distance of the results at rtol 1e-10 and 1e-12 (run where "
+                                "convergence_error exceeds its tolerance)"),
+    "reference_error": ("1", "distance of the engine and 3-D reference results (stress.result_distance)"),
+    "seconds": ("s", "computing time of the case"),
+    "time_per_impact": ("s", "median computing time per impact"),
+    "time_per_impact_normal_solve": ("s", "engine row only: median time of one engine.solve_normal call "
+                                     "(the normal solve without simulate_impact's Python layer)"),
+    "max_error_e_n": ("1", "max over the normal-speed set of |e_n - e_n_ref|"),
+    "max_rel_error_e_n": ("1", "max over the normal-speed set of |e_n - e_n_ref| / e_n_ref"),
+    "max_error_mu": ("1", "max over rebounding oblique cases of |mu_t - ref| and |mu_t' - ref|"),
+    "max_error_K_L": ("1", "max over all oblique cases of |K_L - K_L_ref|"),
+    "n_impacts": ("1", "distinct impacts per timing (batch size for batch methods)"),
+    "rtol": ("1", "relative tolerance (adaptive methods)"),
+    "steps_per_contact": ("1", "fixed steps per estimated contact duration (RKG)"),
+    "mean_steps": ("1", "mean accepted steps per impact (engine, RKG)"),
+    "outcome_mismatches": ("1", "oblique cases whose outcome differs from the reference"),
+    "e_n_reference": ("1", "reference e_n (DOP853, tightest rtol)"),
 }
 
 
