@@ -3,7 +3,8 @@
     python workflow/scripts/make_synthetic_data.py [OUTPUT.csv]
 
 Thin wrapper: the generating parameters, the seed and the noise model are
-microimpact.analysis.synthetic.SYNTHETIC_DEFAULTS (documented in microimpact/synthetic.py).
+microimpact.analysis.synthetic.SYNTHETIC_DEFAULTS (documented in toolkit/microimpact/analysis/synthetic.py;
+the material is Table 1 row 2 of microimpact.model.parameters).
 Works from the command line and as a Snakemake script (snakemake.output[0]).
 """
 

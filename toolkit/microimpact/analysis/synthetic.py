@@ -2,8 +2,9 @@
 
 No digitized copy of the Wall et al. (1990) e_n(v) data that Cheng, Brach & Dunn (2002) fit in
 their Fig. 3 is public, so the bundled example data ``data/synthetic_microspheres.csv`` is made
-here, by the model itself, from Table 1 row 1 style parameters (ammonium fluorescein on polished
-silicon) plus a stated noise model. It exists to exercise and test the fit; it is not evidence for
+here, by the model itself, from the material of Table 1 row 2 (ammonium fluorescein on polished
+silicon, :data:`microimpact.model.parameters.TABLE1_ROW2`) at radii over the Table 1 row 1 range,
+plus a stated noise model. It exists to exercise and test the fit; it is not evidence for
 the model. Regenerate it with ``python workflow/scripts/make_synthetic_data.py``.
 
 Noise model (defaults)
@@ -21,23 +22,31 @@ drawn in file order):
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pandas as pd
 
+from microimpact.dynamics.nonlinear import capture_velocity
+from microimpact.io.files import write_csv
+from microimpact.io.materials import material_contact
+from microimpact.model.parameters import TABLE1, TABLE1_ROW2
 from microimpact.solvers import engine
-from microimpact.model.contact import Contact
 
 __all__ = ["SYNTHETIC_DEFAULTS", "make_synthetic_impacts", "write_synthetic_impacts"]
 
-#: generating parameters of data/synthetic_microspheres.csv
+#: generating parameters of data/synthetic_microspheres.csv; the material is Table 1 row 2
 SYNTHETIC_DEFAULTS = dict(
-    radii=(1.29e-6, 1.72e-6, 2.58e-6, 3.45e-6),  # [m], Table 1 row 1 range 1.29-3.45 um
-    density=1350.0,  # [kg/m3]
-    stiffness=1.776e9,  # [Pa]
-    work_of_adhesion=0.215834,  # [J/m2], the materials-config value (f0 = 7.422 N/m at 3.45 um)
-    zeta_hertz=0.50,  # [-]
-    zeta_adhesion=29.0,  # [-]
-    friction=0.15,  # [-] (does not affect e_n)
+    # [m]: the ends of the Table 1 row 1 range (1.29-3.45 um) and two sizes between them
+    radii=(TABLE1["row1_small"].radius, 1.72e-6, 2.58e-6, TABLE1["row1_large"].radius),
+    density=TABLE1_ROW2.density,  # [kg/m3]
+    stiffness=TABLE1_ROW2.stiffness,  # [Pa]
+    # [J/m2]: Table 1 row 2's w_A (f0 = 7.422 N/m at 3.45 um, Eq. (7)) to the 6 digits of the
+    # bundled materials config, so that a fit with that config holds the generating w_A exactly
+    work_of_adhesion=round(TABLE1_ROW2.work_of_adhesion, 6),
+    zeta_hertz=TABLE1_ROW2.zeta_hertz,  # [-]
+    zeta_adhesion=TABLE1_ROW2.zeta_adhesion,  # [-]
+    friction=TABLE1_ROW2.friction,  # [-] (does not affect e_n)
     n_per_radius=25,
     start_factor=1.1,  # first speed = 1.1 v_c(r)
     max_speed=100.0,  # [m/s]
@@ -70,8 +79,6 @@ def make_synthetic_impacts(**overrides) -> pd.DataFrame:
         holds the parameters, ``attrs["true_e_n"]`` and ``attrs["true_normal_speed"]`` the
         noise-free values.
     """
-    from microimpact.dynamics.nonlinear import capture_velocity
-
     unknown = set(overrides) - set(SYNTHETIC_DEFAULTS)
     if unknown:
         raise ValueError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(SYNTHETIC_DEFAULTS)}")
@@ -79,10 +86,9 @@ def make_synthetic_impacts(**overrides) -> pd.DataFrame:
     rng = np.random.default_rng(p["seed"])
     rows = []
     true_e, true_vn = [], []
+    material = SimpleNamespace(**p)
     for r in p["radii"]:
-        c = Contact.from_work_of_adhesion(r, p["density"], p["stiffness"], p["work_of_adhesion"],
-                                          zeta_hertz=p["zeta_hertz"], zeta_adhesion=p["zeta_adhesion"],
-                                          friction=p["friction"])
+        c = material_contact(material, r)
         vc = capture_velocity(c)
         v = np.geomspace(p["start_factor"] * vc, p["max_speed"], p["n_per_radius"])
         alpha = np.abs(rng.normal(0.0, p["angle_sd_deg"], v.size)) if p["angle_sd_deg"] > 0 else np.zeros(v.size)
@@ -127,7 +133,5 @@ def write_synthetic_impacts(path, **overrides):
     pathlib.Path
         ``path``.
     """
-    from microimpact.io import write_csv
-
     df = make_synthetic_impacts(**overrides)
     return write_csv(df, path, float_format="%.6g")
