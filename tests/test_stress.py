@@ -15,7 +15,6 @@ from hypothesis import strategies as st
 
 from microimpact.studies import stress
 from microimpact.solvers.impact import simulate_impact
-from microimpact.model.contact import Contact
 from microimpact.presets import WALL_1990
 
 # deterministic (derandomize) and fast: each example costs a few engine solves (~ms)
@@ -36,13 +35,15 @@ def impacts(draw):
     r = stress.INPUT_RANGES
     radius = draw(log_uniform(*r["radius"]))
     speed = draw(log_uniform(*r["speed"]))
-    contact = Contact.from_work_of_adhesion(
-        radius, draw(log_uniform(*r["density"])), draw(log_uniform(*r["stiffness"])),
-        draw(with_zero(log_uniform(*r["work_of_adhesion"]))),
-        zeta_hertz=draw(with_zero(log_uniform(*r["zeta_hertz"]))),
-        zeta_adhesion=draw(with_zero(log_uniform(*r["zeta_adhesion"]))),
-        friction=draw(with_zero(st.floats(0.0, 2.0))),
-    )
+    contact = stress.contact_of({
+        "radius": radius,
+        "density": draw(log_uniform(*r["density"])),
+        "stiffness": draw(log_uniform(*r["stiffness"])),
+        "work_of_adhesion": draw(with_zero(log_uniform(*r["work_of_adhesion"]))),
+        "zeta_hertz": draw(with_zero(log_uniform(*r["zeta_hertz"]))),
+        "zeta_adhesion": draw(with_zero(log_uniform(*r["zeta_adhesion"]))),
+        "friction": draw(with_zero(st.floats(0.0, 2.0))),
+    })
     inc = draw(with_zero(st.floats(0.0, 89.9)))
     az = draw(st.floats(0.0, 360.0))
     spin = tuple(draw(st.floats(-10.0, 10.0)) * speed / radius for _ in range(3))
@@ -83,9 +84,10 @@ def test_continuity_in_speed(case):
 
 
 # ------------------------------------------------------------------ known engine bugs (reproducers)
-MISSED_SEPARATION = Contact.from_work_of_adhesion(
-    0.0004436954785754723, 4733.544875582984, 94267726701.7395, 0.0011948335784818724,
-    zeta_hertz=141.12729602871758, zeta_adhesion=0.005715222866944042, friction=1.6324934088437917)
+MISSED_SEPARATION = stress.contact_of({
+    "radius": 0.0004436954785754723, "density": 4733.544875582984, "stiffness": 94267726701.7395,
+    "work_of_adhesion": 0.0011948335784818724, "zeta_hertz": 141.12729602871758,
+    "zeta_adhesion": 0.005715222866944042, "friction": 1.6324934088437917})
 
 
 # Regression (found by the stress sweep, fixed): an extremum-of-y event located in the same step as
@@ -139,3 +141,45 @@ def test_sweep_has_no_failures(sweep):
 def test_sweep_is_reproducible():
     assert stress.draw_cases(5, seed=3) == stress.draw_cases(5, seed=3)
     assert stress.draw_cases(5, seed=3) != stress.draw_cases(5, seed=4)
+
+
+# ------------------------------------------------------------------ findings that do not fail the sweep
+def test_slow_convergence_is_a_note_not_a_failure():
+    """Case 2625 of seed 0: a strongly damped capture (C ~ 88) whose omega_n differs by 1.07e-4 of
+    the speed scale between rtol 1e-8 and 1e-10 (above the 1e-4 tolerance) and by 1.08e-6 between
+    1e-10 and 1e-12: it converges (a hundredfold reduction), so it is noted, not failed."""
+    case = stress.draw_cases(2626, seed=0)[2625]
+    row = stress.check_case(case)
+    assert row["failures"] == []
+    assert [k for k, _ in row["notes"]] == ["slow_convergence"]
+    assert row["convergence_error"] > stress.TOLERANCES["convergence"]
+    assert row["convergence_error_tight"] <= row["convergence_error"] / stress.CONVERGENCE_REDUCTION
+
+
+def test_convergence_failure_when_the_error_does_not_shrink():
+    """The same case fails when the tolerance is below what rtol 1e-12 reaches (1.08e-6)."""
+    case = stress.draw_cases(2626, seed=0)[2625]
+    row = stress.check_case(case, tolerances={"convergence": 1e-7})
+    assert [k for k, _ in row["failures"]] == ["convergence"]
+    assert row["notes"] == []
+
+
+def test_reference_timeout_is_a_note_not_a_failure():
+    """A reference solve cut by the time box is reported apart and leaves the case passing."""
+    case = stress.draw_cases(1, seed=0)[0]  # a strongly damped capture: the reference needs seconds
+    row = stress.check_case(case, reference=True, case_time_limit=0.05)
+    assert [k for k, _ in row["notes"]] == ["reference_timeout"]
+    assert not [k for k, _ in row["failures"] if k != "timeout"]  # the engine itself may exceed 0.05 s
+    assert math.isnan(row["reference_error"])
+
+
+def test_summary_counts_notes_apart(tmp_path):
+    report = stress.stress_sweep(2, seed=0, reference_every=1, case_time_limit=0.05)
+    s = report.summary
+    assert s["notes_by_kind"]["reference_timeout"] >= 1
+    assert set(s["failures_by_kind"]) == set(stress.FAILURE_KINDS)
+    assert "noted" in stress.summary_line(s)
+    assert report.dataset["notes"].dims == ("case",)
+    assert report.dataset["energy_error"].attrs["units"] == "1"
+    stress.write_stress_summary(s, tmp_path / "s.json")
+    assert (tmp_path / "s.json").read_text().startswith("{")

@@ -1,7 +1,8 @@
 """Seeded random stress sweep of the impact engine over decades of every input.
 
 :func:`stress_sweep` draws ``n_cases`` impacts (log-uniform over decades, exact zeros included)
-and checks, for each one, the invariants the engine must keep whatever the input:
+and checks, for each one, the invariants the engine must keep whatever the input. A check that
+fails is a *failure* of the engine (``summary["failures_by_kind"]``; the command exits 1):
 
 ``exception``
     :func:`microimpact.solvers.impact.simulate_impact` raised (e.g. :class:`microimpact.solvers.engine.EngineError`
@@ -15,14 +16,24 @@ and checks, for each one, the invariants the engine must keep whatever the input
     the energy balance KE_in = KE_out + final_contact_energy + dissipated_energy does not close
     to :data:`TOLERANCES` ``["energy"]`` relative to the energy scale of the case (below).
 ``convergence``
-    the results at rtol 1e-8 and 1e-10 differ by more than ``TOLERANCES["convergence"]``.
+    the result does not converge as rtol is tightened (criterion below).
 ``reference``
     the engine and the full 3-D reference solver (on a subsample) differ by more than
-    ``TOLERANCES["reference"]``.
+    ``TOLERANCES["reference"]``, or the reference solver raised.
 ``timeout``
-    a case took longer than ``case_time_limit`` seconds (engine: measured, it cannot be
-    interrupted inside compiled code, its own time box is its step limit; reference solver:
-    interrupted by SIGALRM where available).
+    the engine took longer than ``case_time_limit`` seconds for the case (measured: it cannot be
+    interrupted inside compiled code; its own time box is its step limit).
+
+Two findings are reported separately (``summary["notes_by_kind"]``, ``summary["noted_cases"]``)
+and do not fail the run, because they say nothing about the engine:
+
+``reference_timeout``
+    the reference solver, the yardstick, did not finish within ``case_time_limit`` seconds
+    (interrupted by SIGALRM where available). Its pure-Python right-hand side needs tens of
+    seconds on stiff cases, more on a loaded machine; the case is then not compared.
+``slow_convergence``
+    the results at rtol 1e-8 and 1e-10 differ by more than the tolerance, but the result
+    converges: see "Convergence criterion".
 
 Energy scale
 ------------
@@ -33,12 +44,30 @@ nondimensional state, whose energy unit is m (X/T)^2.
 
 Distance between two results
 ----------------------------
-Two results of the same case (rtol 1e-8 vs 1e-10, engine vs reference) are compared by
-``result_distance``: the largest of |delta(m v_n_out^2 / 2)| / E_scale and the tangential velocity and rim-speed (r omega) differences divided by
-the speed scale sqrt(2 E_scale / m). The normal part is compared as an energy because e_n is
-ill-conditioned near the capture threshold (e_n ~ sqrt(v - v_c)); comparing energies makes a
-capture-versus-rebound disagreement count only by the rebound energy it misses, so it is
-tolerated exactly when the case lies within the tolerance of the capture threshold.
+Two results of the same case (two tolerances, engine vs reference) are compared by
+``result_distance``: the largest of |delta(m v_n_out^2 / 2)| / E_scale and the tangential velocity
+and rim-speed (r omega) differences divided by the speed scale sqrt(2 E_scale / m). The normal
+part is compared as an energy because e_n is ill-conditioned near the capture threshold
+(e_n ~ sqrt(v - v_c)); comparing energies makes a capture-versus-rebound disagreement count only
+by the rebound energy it misses, so it is tolerated exactly when the case lies within the
+tolerance of the capture threshold.
+
+Convergence criterion
+---------------------
+d_8 = distance(rtol 1e-8, rtol 1e-10) estimates the error of a result at rtol 1e-8, the default
+of every entry point (:data:`microimpact.solvers.DEFAULT_RTOL`). It is the global error, which
+grows with the number of steps: typically 1e2-1e4 x rtol, so ``TOLERANCES["convergence"]`` is
+1e-4. Strongly damped captures (C = C1 + C2 of order 1e2) creep into the equilibrium in ~C^2
+steps while the twisting moment keeps acting on omega_n; there the global error at rtol 1e-8 can
+pass 1e-4 (seed 0, 3000 cases: one case, 1.07e-4, all in omega_n) although the integration is
+sound. Such a case is solved once more at rtol 1e-12 and passes as ``slow_convergence`` when
+d_10 = distance(rtol 1e-10, rtol 1e-12) is within the same tolerance *and* at most d_8 / 10: the
+error falls at least tenfold for a hundredfold tighter rtol, i.e. the result converges (measured
+d_10 / d_8 = 0.01 on that case, first order in rtol as expected of an error dominated by where the
+creep is stopped). A bug (a missed event, a wrong branch) does not shrink with rtol and still
+fails. Loosening the tolerance instead would hide such bugs in every other case; comparing each
+quantity with its own scale would be stricter than the physics needs (omega_n of a sphere that
+rests in the well carries r omega_n ~ 1e-2 of the speed scale).
 
 Run from the command line::
 
@@ -57,11 +86,15 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from microimpact.studies._timeout import TimeLimitExceeded, time_limit
+from microimpact.io.files import atomic_write, write_netcdf
+from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
+from microimpact.solvers.impact import simulate_impact
+from microimpact.studies._timeout import TimeLimitExceeded, time_limit
 
-__all__ = ["TOLERANCES", "INPUT_RANGES", "draw_cases", "check_case", "stress_sweep", "StressReport",
-           "result_distance", "energy_scale", "main"]
+__all__ = ["TOLERANCES", "INPUT_RANGES", "FAILURE_KINDS", "NOTE_KINDS", "draw_cases", "contact_of", "check_case",
+           "stress_sweep", "StressReport", "result_distance", "energy_scale", "energy_error", "kinetic_energy",
+           "summary_line", "write_stress_summary", "main"]
 
 #: Input ranges of the sweep (SI; angles in degrees). "log" ranges are drawn log-uniformly and
 #: take the exact value 0 with probability ``ZERO_PROBABILITY`` where 0 is allowed.
@@ -87,20 +120,45 @@ TOLERANCES = {
     # (up to ~1e5 for strongly damped captures). Measured worst over 5000 seeded cases: ~1e-7.
     # 1e-6 leaves a factor 10 and is still 1e4 times below any physically visible effect.
     "energy": 1e-6,
-    # rtol 1e-8 vs 1e-10: the difference is the global error at rtol 1e-8, ~1e2-1e4 x rtol for the
-    # same reason (measured worst ~1e-6 away from the event bugs reported in the tests).
+    # rtol 1e-8 vs 1e-10 (and, for slowly converging cases, 1e-10 vs 1e-12): the difference is the
+    # global error, ~1e2-1e4 x rtol for the same reason (module docstring, "Convergence criterion").
     "convergence": 1e-4,
     # engine (DP5, rtol 1e-10) vs reference (DOP853, rtol 1e-10, atol 1e-13): both errors are at
     # the 1e-8 level; 1e-5 also absorbs the reference's capture-tail truncation (settle_tolerance).
     "reference": 1e-5,
 }
 
+#: Findings that fail the sweep (the engine is wrong or too slow).
 FAILURE_KINDS = ("exception", "nonfinite", "restitution", "energy", "convergence", "reference", "timeout")
+#: Findings reported apart that do not fail it (module docstring).
+NOTE_KINDS = ("reference_timeout", "slow_convergence")
+
+#: Error reduction that makes a case above the convergence tolerance converge "slowly" rather than
+#: fail: d(1e-10, 1e-12) <= d(1e-8, 1e-10) / CONVERGENCE_REDUCTION (module docstring).
+CONVERGENCE_REDUCTION = 10.0
+
+_RTOL_FINE, _RTOL_COARSE, _RTOL_TIGHT = 1e-10, 1e-8, 1e-12
+_MEASURES = ("e_n", "energy_error", "convergence_error", "convergence_error_tight", "reference_error", "seconds")
 
 
 # ------------------------------------------------------------------------------------- inputs
 def draw_cases(n_cases: int, seed: int = 0) -> list[dict]:
-    """Draw ``n_cases`` impact inputs (dicts of SI floats) from :data:`INPUT_RANGES`, seeded."""
+    """Draw ``n_cases`` impact inputs (dicts of SI floats) from :data:`INPUT_RANGES`, seeded.
+
+    Parameters
+    ----------
+    n_cases : int
+        Number of cases.
+    seed : int
+        Seed of :func:`numpy.random.default_rng`; the same seed gives the same cases.
+
+    Returns
+    -------
+    list of dict
+        Keys ``case`` (index), the :class:`Contact` fields except f0 (``work_of_adhesion`` [J/m^2]
+        instead), ``speed`` [m/s], ``incidence_deg``, ``azimuth_deg`` [deg] and ``omega_n``,
+        ``omega_t``, ``omega_tp`` [rad/s].
+    """
     rng = np.random.default_rng(seed)
 
     def log_uniform(name, allow_zero=False):
@@ -203,70 +261,104 @@ def _nonfinite_fields(result) -> list[str]:
 
 
 # ------------------------------------------------------------------------------------- one case
+def _result_checks(contact: Contact, fine, coarse, tol: dict, out: dict) -> None:
+    """Finite results, e_n in [0, 1] and the energy balance; findings appended to ``out``."""
+    for res, label in ((fine, f"rtol={_RTOL_FINE:g}"), (coarse, f"rtol={_RTOL_COARSE:g}")):
+        bad = _nonfinite_fields(res)
+        if bad:
+            out["failures"].append(("nonfinite", f"{label}: {', '.join(bad)}"))
+        if not (0.0 <= res.e_n <= 1.0) or (res.outcome == "capture" and res.e_n != 0.0):
+            out["failures"].append(("restitution", f"{label}: e_n = {res.e_n!r} ({res.outcome})"))
+    err = energy_error(contact, fine)
+    out["energy_error"] = err
+    if not err <= tol["energy"]:
+        out["failures"].append(("energy", f"energy balance off by {err:.3g} of the energy scale"))
+
+
+def _convergence_check(contact: Contact, args: tuple, fine, coarse, tol: dict, out: dict) -> None:
+    """The convergence criterion of the module docstring; findings appended to ``out``."""
+    conv = result_distance(contact, fine, coarse)
+    out["convergence_error"] = conv
+    if conv <= tol["convergence"]:
+        return
+    found = (f"rtol {_RTOL_COARSE:g} vs {_RTOL_FINE:g} differ by {conv:.3g} ({coarse.outcome}, e_n "
+             f"{coarse.e_n:.6g} vs {fine.outcome}, e_n {fine.e_n:.6g})")
+    if not math.isfinite(conv):
+        out["failures"].append(("convergence", found))
+        return
+    tight = simulate_impact(*args, rtol=_RTOL_TIGHT)
+    conv_tight = result_distance(contact, fine, tight)
+    out["convergence_error_tight"] = conv_tight
+    found += f"; rtol {_RTOL_FINE:g} vs {_RTOL_TIGHT:g} differ by {conv_tight:.3g}"
+    if conv_tight <= tol["convergence"] and conv_tight <= conv / CONVERGENCE_REDUCTION:
+        out["notes"].append(("slow_convergence", found))
+    else:
+        out["failures"].append(("convergence", found))
+
+
+def _reference_check(contact: Contact, args: tuple, fine, tol: dict, case_time_limit: float, out: dict) -> None:
+    """Engine against the 3-D reference solver; a timeout of the reference is a note, not a failure."""
+    try:
+        with time_limit(case_time_limit):
+            ref = simulate_impact(*args, rtol=_RTOL_FINE, method="reference")
+    except TimeLimitExceeded:
+        out["notes"].append(("reference_timeout", f"reference solver exceeded {case_time_limit:g} s"))
+        return
+    except Exception as exc:  # noqa: BLE001
+        # the reference solver is the colleague's tool; its failure is reported, not hidden
+        out["failures"].append(("reference", f"reference solver raised {type(exc).__name__}: {exc}"))
+        return
+    d = result_distance(contact, fine, ref)
+    out["reference_error"] = d
+    if not d <= tol["reference"]:
+        out["failures"].append(("reference", f"engine vs reference differ by {d:.3g} ({fine.outcome}, e_n "
+                                              f"{fine.e_n:.6g} vs {ref.outcome}, e_n {ref.e_n:.6g})"))
+
+
 def check_case(case: dict, *, reference: bool = False, case_time_limit: float = 30.0,
                tolerances: dict | None = None) -> dict:
-    """Run every check on one drawn case; return the measures and the failures.
+    """Run every check on one drawn case; return the measures, the failures and the notes.
+
+    Parameters
+    ----------
+    case : dict
+        One case of :func:`draw_cases`.
+    reference : bool
+        Also compare with the 3-D reference solver.
+    case_time_limit : float
+        Time box of the engine (measured) and of the reference solver (interrupted). [s]
+    tolerances : dict, optional
+        Overrides of :data:`TOLERANCES`.
 
     Returns
     -------
-    dict with ``outcome``, ``e_n``, ``energy_error``, ``convergence_error``,
-    ``reference_error`` (NaN when not run), ``seconds`` and ``failures`` (list of
-    ``(kind, detail)``).
+    dict
+        ``outcome``, ``e_n`` [-], ``energy_error``, ``convergence_error``,
+        ``convergence_error_tight`` and ``reference_error`` [-] (NaN when not computed),
+        ``seconds`` [s] (engine and reference), ``failures`` and ``notes`` (lists of
+        ``(kind, detail)``, kinds from :data:`FAILURE_KINDS` and :data:`NOTE_KINDS`).
     """
-    from microimpact.solvers.impact import simulate_impact
-
     tol = dict(TOLERANCES, **(tolerances or {}))
-    out = {"outcome": "", "e_n": math.nan, "energy_error": math.nan, "convergence_error": math.nan,
-           "reference_error": math.nan, "seconds": 0.0, "failures": []}
-    fail = out["failures"]
+    out = {"outcome": "", **{k: math.nan for k in _MEASURES}, "seconds": 0.0, "failures": [], "notes": []}
     contact = contact_of(case)
     args = (contact, case["speed"], case["incidence_deg"], case["azimuth_deg"], _omega(case))
     t0 = time.perf_counter()
     try:
-        fine = simulate_impact(*args, rtol=1e-10)
-        coarse = simulate_impact(*args, rtol=1e-8)
+        fine = simulate_impact(*args, rtol=_RTOL_FINE)
+        coarse = simulate_impact(*args, rtol=_RTOL_COARSE)
     except Exception as exc:  # noqa: BLE001 - any exception is a finding
-        fail.append(("exception", f"{type(exc).__name__}: {exc}"))
-        out["seconds"] = time.perf_counter() - t0
-        if out["seconds"] > case_time_limit:
-            fail.append(("timeout", f"engine took {out['seconds']:.1f} s"))
-        return out
-    out["outcome"] = fine.outcome
-    out["e_n"] = fine.e_n
-    for res, label in ((fine, "rtol=1e-10"), (coarse, "rtol=1e-8")):
-        bad = _nonfinite_fields(res)
-        if bad:
-            fail.append(("nonfinite", f"{label}: {', '.join(bad)}"))
-        if not (0.0 <= res.e_n <= 1.0) or (res.outcome == "capture" and res.e_n != 0.0):
-            fail.append(("restitution", f"{label}: e_n = {res.e_n!r} ({res.outcome})"))
-    err = energy_error(contact, fine)
-    out["energy_error"] = err
-    if not err <= tol["energy"]:
-        fail.append(("energy", f"energy balance off by {err:.3g} of the energy scale"))
-    conv = result_distance(contact, fine, coarse)
-    out["convergence_error"] = conv
-    if not conv <= tol["convergence"]:
-        fail.append(("convergence", f"rtol 1e-8 vs 1e-10 differ by {conv:.3g} ({coarse.outcome}, e_n "
-                                    f"{coarse.e_n:.6g} vs {fine.outcome}, e_n {fine.e_n:.6g})"))
+        out["failures"].append(("exception", f"{type(exc).__name__}: {exc}"))
+        fine = None
+    else:
+        out["outcome"], out["e_n"] = fine.outcome, fine.e_n
+        _result_checks(contact, fine, coarse, tol, out)
+        _convergence_check(contact, args, fine, coarse, tol, out)
     out["seconds"] = time.perf_counter() - t0
     if out["seconds"] > case_time_limit:
-        fail.append(("timeout", f"engine took {out['seconds']:.1f} s"))
-    if reference:
+        out["failures"].append(("timeout", f"engine took {out['seconds']:.1f} s"))
+    if reference and fine is not None:
         t1 = time.perf_counter()
-        try:
-            with time_limit(case_time_limit):
-                ref = simulate_impact(*args, rtol=1e-10, method="reference")
-        except TimeLimitExceeded:
-            fail.append(("timeout", f"reference solver exceeded {case_time_limit:g} s"))
-        except Exception as exc:  # noqa: BLE001
-            # the reference solver is the colleague's tool; its failure is reported, not hidden
-            fail.append(("reference", f"reference solver raised {type(exc).__name__}: {exc}"))
-        else:
-            d = result_distance(contact, fine, ref)
-            out["reference_error"] = d
-            if not d <= tol["reference"]:
-                fail.append(("reference", f"engine vs reference differ by {d:.3g} ({fine.outcome}, e_n "
-                                          f"{fine.e_n:.6g} vs {ref.outcome}, e_n {ref.e_n:.6g})"))
+        _reference_check(contact, args, fine, tol, case_time_limit, out)
         out["seconds"] += time.perf_counter() - t1
     return out
 
@@ -286,6 +378,45 @@ def _worst(values, cases):
         return {"value": None, "case": None}
     i = int(np.nanargmax(v))
     return {"value": float(v[i]), "case": cases[i]}
+
+
+def _findings(cases: list, rows: list, key: str, kinds: tuple) -> tuple[dict, list]:
+    """Cases with a finding under ``key`` ("failures" or "notes"): counts by kind, and the cases."""
+    by_kind = {k: 0 for k in kinds}
+    listed = []
+    for case, row in zip(cases, rows):
+        for kind in sorted({k for k, _ in row[key]}):
+            by_kind[kind] += 1
+        if row[key]:
+            listed.append({"inputs": case, key: [{"kind": k, "detail": d} for k, d in row[key]]})
+    return by_kind, listed
+
+
+def _summary(cases: list, rows: list, seed: int, tolerances: dict | None, seconds: float) -> dict:
+    """The JSON-ready summary of :func:`stress_sweep` (keys documented there)."""
+    by_kind, failed = _findings(cases, rows, "failures", FAILURE_KINDS)
+    notes_by_kind, noted = _findings(cases, rows, "notes", NOTE_KINDS)
+    return {
+        "cases_run": len(cases),
+        "seed": int(seed),
+        "cases_failed": len(failed),
+        "failures_by_kind": by_kind,
+        "failed_cases": failed,
+        "cases_noted": len(noted),
+        "notes_by_kind": notes_by_kind,
+        "noted_cases": noted,
+        "worst_energy_error": _worst([r["energy_error"] for r in rows], cases),
+        "worst_convergence_error": _worst([r["convergence_error"] for r in rows], cases),
+        "worst_reference_error": _worst([r["reference_error"] for r in rows], cases),
+        "reference_cases": int(sum(np.isfinite(r["reference_error"]) for r in rows)),
+        "captures": int(sum(r["outcome"] == "capture" for r in rows)),
+        "tolerances": dict(TOLERANCES, **(tolerances or {})),
+        "convergence_reduction": CONVERGENCE_REDUCTION,
+        "input_ranges": {k: list(v) for k, v in INPUT_RANGES.items()},
+        "zero_probability": ZERO_PROBABILITY,
+        "slowest_case_seconds": float(max((r["seconds"] for r in rows), default=0.0)),
+        "seconds": seconds,
+    }
 
 
 def stress_sweep(n_cases: int = 1000, seed: int = 0, *, reference_every: int = 25,
@@ -311,9 +442,11 @@ def stress_sweep(n_cases: int = 1000, seed: int = 0, *, reference_every: int = 2
     Returns
     -------
     StressReport
-        ``summary``: cases run, failures by kind, the failed cases with their inputs, the worst
-        energy, convergence and engine-vs-reference errors (with the case), tolerances, seed and
-        run time. ``dataset``: one row per case (dimension ``case``), inputs and measures.
+        ``summary``: cases run, failures by kind and the failed cases with their inputs
+        (``cases_failed``, ``failures_by_kind``, ``failed_cases``), the findings that do not fail
+        the sweep (``cases_noted``, ``notes_by_kind``, ``noted_cases``), the worst energy,
+        convergence and engine-vs-reference errors (with the case), tolerances, seed and run
+        time [s]. ``dataset``: one row per case (dimension ``case``), inputs and measures.
     """
     t0 = time.perf_counter()
     cases = draw_cases(n_cases, seed)
@@ -323,55 +456,43 @@ def stress_sweep(n_cases: int = 1000, seed: int = 0, *, reference_every: int = 2
         rows.append(check_case(case, reference=ref, case_time_limit=case_time_limit, tolerances=tolerances))
         if progress is not None:
             progress(i + 1, len(cases))
-    by_kind = {k: 0 for k in FAILURE_KINDS}
-    failed = []
-    for case, row in zip(cases, rows):
-        for kind in sorted({k for k, _ in row["failures"]}):
-            by_kind[kind] += 1
-        if row["failures"]:
-            failed.append({"inputs": case, "failures": [{"kind": k, "detail": d} for k, d in row["failures"]]})
-    summary = {
-        "cases_run": len(cases),
-        "seed": int(seed),
-        "cases_failed": len(failed),
-        "failures_by_kind": by_kind,
-        "failed_cases": failed,
-        "worst_energy_error": _worst([r["energy_error"] for r in rows], cases),
-        "worst_convergence_error": _worst([r["convergence_error"] for r in rows], cases),
-        "worst_reference_error": _worst([r["reference_error"] for r in rows], cases),
-        "reference_cases": int(sum(np.isfinite(r["reference_error"]) for r in rows)),
-        "captures": int(sum(r["outcome"] == "capture" for r in rows)),
-        "tolerances": dict(TOLERANCES, **(tolerances or {})),
-        "input_ranges": {k: list(v) for k, v in INPUT_RANGES.items()},
-        "slowest_case_seconds": float(max((r["seconds"] for r in rows), default=0.0)),
-        "seconds": time.perf_counter() - t0,
-    }
-    ds = _dataset(cases, rows)
-    return StressReport(summary=summary, dataset=ds)
-
-
-_UNITS = {"radius": "m", "density": "kg m-3", "stiffness": "Pa", "work_of_adhesion": "J m-2",
-          "zeta_hertz": "1", "zeta_adhesion": "1", "friction": "1", "speed": "m s-1",
-          "incidence_deg": "degree", "azimuth_deg": "degree", "omega_n": "rad s-1",
-          "omega_t": "rad s-1", "omega_tp": "rad s-1", "e_n": "1", "energy_error": "1",
-          "convergence_error": "1", "reference_error": "1", "seconds": "s"}
+    summary = _summary(cases, rows, seed, tolerances, time.perf_counter() - t0)
+    return StressReport(summary=summary, dataset=_dataset(cases, rows))
 
 
 def _dataset(cases, rows) -> xr.Dataset:
     n = len(cases)
     ds = xr.Dataset(coords={"case": np.arange(n)})
     for name in [k for k in (cases[0] if cases else {}) if k != "case"]:
-        ds[name] = ("case", np.array([c[name] for c in cases], dtype=float), {"units": _UNITS[name]})
-    for name in ("e_n", "energy_error", "convergence_error", "reference_error", "seconds"):
-        ds[name] = ("case", np.array([r[name] for r in rows], dtype=float), {"units": _UNITS[name]})
+        ds[name] = ("case", np.array([c[name] for c in cases], dtype=float), attributes(name))
+    for name in _MEASURES:
+        ds[name] = ("case", np.array([r[name] for r in rows], dtype=float), attributes(name))
     ds["outcome"] = ("case", np.array([r["outcome"] for r in rows], dtype=str))
-    ds["failures"] = ("case", np.array(["; ".join(f"{k}: {d}" for k, d in r["failures"]) for r in rows], dtype=str))
+    for key in ("failures", "notes"):
+        ds[key] = ("case", np.array(["; ".join(f"{k}: {d}" for k, d in r[key]) for r in rows], dtype=str))
     ds.attrs["title"] = "microimpact stress sweep"
     return ds
 
 
-# ------------------------------------------------------------------------------------- CLI
+# ------------------------------------------------------------------------------------- output
+def summary_line(summary: dict) -> str:
+    """One line for a log: cases, failures by kind, and the findings that do not fail the sweep."""
+    def kinds(counts):
+        return ", ".join(f"{k} {v}" for k, v in counts.items() if v) or "none"
+
+    return (f"{summary['cases_run']} cases (seed {summary['seed']}) in {summary['seconds']:.3g} s, "
+            f"{summary['cases_failed']} failed: {kinds(summary['failures_by_kind'])}; "
+            f"{summary['cases_noted']} noted, not failures: {kinds(summary['notes_by_kind'])}")
+
+
+def write_stress_summary(summary: dict, path) -> None:
+    """Write the summary as JSON (strict: no NaN), atomically (:func:`microimpact.io.files.atomic_write`)."""
+    with atomic_write(path) as f:
+        f.write(json.dumps(summary, indent=2, allow_nan=False, default=str) + "\n")
+
+
 def main(argv=None) -> int:
+    """Command line; exit status 1 when a case failed a check (notes do not count), else 0."""
     p = argparse.ArgumentParser(prog="python -m microimpact.studies.stress",
                                 description="Seeded random stress sweep of the impact engine.")
     p.add_argument("--cases", type=int, default=1000, help="number of random impacts")
@@ -391,22 +512,14 @@ def main(argv=None) -> int:
 
     report = stress_sweep(args.cases, args.seed, reference_every=args.reference_every,
                           case_time_limit=args.case_time_limit, progress=progress)
-    text = json.dumps(report.summary, indent=2, allow_nan=False, default=str)
     if args.out:
-        from microimpact.io.files import atomic_write
-
-        with atomic_write(args.out) as f:
-            f.write(text + "\n")
+        write_stress_summary(report.summary, args.out)
     else:
-        print(text)
+        print(json.dumps(report.summary, indent=2, allow_nan=False, default=str))
     if args.netcdf:
-        from microimpact.io.files import write_netcdf
-
         write_netcdf(report.dataset, args.netcdf)
-    s = report.summary
-    print(f"{s['cases_run']} cases, {s['cases_failed']} failed: "
-          + ", ".join(f"{k} {v}" for k, v in s["failures_by_kind"].items() if v), file=sys.stderr)
-    return 1 if s["cases_failed"] else 0
+    print(summary_line(report.summary), file=sys.stderr)
+    return 1 if report.summary["cases_failed"] else 0
 
 
 if __name__ == "__main__":  # pragma: no cover
