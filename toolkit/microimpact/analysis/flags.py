@@ -41,26 +41,26 @@ import math
 import sys
 import time
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 import xarray as xr
 
+from microimpact.dynamics.nonlinear import capture_velocity
+from microimpact.io.files import write_csv, write_netcdf
+from microimpact.io.materials import material_contact
+from microimpact.io.variables import attributes
 from microimpact.solvers.impact import simulate_many
-from microimpact.model.contact import Contact
 
 __all__ = ["flag_measurements", "write_flags", "fibonacci_sphere", "DEFAULT_THRESHOLDS"]
 
 #: default flag thresholds (see the module docstring)
 DEFAULT_THRESHOLDS = {"mu": 0.05, "K_L": 0.05, "e_n": 0.02, "near_capture_ratio": 1.5}
 _COEFS = ("e_n", "mu_t", "mu_tp", "K_L", "K_t")
-_COEF_META = {
-    "e_n": "normal coefficient of restitution, Eq. (21)",
-    "mu_t": "tangential impulse ratio in t, Eq. (22)",
-    "mu_tp": "tangential impulse ratio in t', Eq. (23)",
-    "K_L": "translational kinetic energy loss ratio, Eq. (25)",
-    "K_t": "total kinetic energy loss ratio, Eq. (24)",
-}
+#: suffix -> what the extreme is taken over ("" is the nominal value: zero spin, nominal angle)
+_SPREADS = {"_spin": "over initial spin samples at the nominal angle",
+            "_angle": "over incidence-angle samples at zero spin", "": "over all samples"}
 
 
 def fibonacci_sphere(n: int) -> np.ndarray:
@@ -74,23 +74,122 @@ def fibonacci_sphere(n: int) -> np.ndarray:
     return np.column_stack([z, rho * np.cos(phi), rho * np.sin(phi)])  # (n, t, t') components
 
 
-def _contact_for(obj, radius: float) -> Contact:
-    """Contact of this radius from a DampingFit / MaterialPair (``.contact(r)``) or a Contact."""
-    if isinstance(obj, Contact):
-        if obj.radius == radius:
-            return obj
-        return Contact.from_work_of_adhesion(
-            radius, obj.density, obj.stiffness, obj.work_of_adhesion, zeta_hertz=obj.zeta_hertz,
-            zeta_adhesion=obj.zeta_adhesion, friction=obj.friction,
-            damping_reference_speed=obj.damping_reference_speed)
-    if hasattr(obj, "contact"):
-        return obj.contact(radius)
-    raise ValueError(f"contact_or_fit must be a Contact, DampingFit or MaterialPair, got {type(obj).__name__}")
+def _contact_for(obj, radius: float):
+    """Contact of this radius from a DampingFit, MaterialPair or Contact (f0 from Eq. (7))."""
+    try:
+        return material_contact(obj, radius)
+    except ValueError:
+        raise ValueError("contact_or_fit must be a Contact, DampingFit or MaterialPair, "
+                         f"got {type(obj).__name__}") from None
 
 
 def _progress(enabled, message):
     if enabled:
         print(message, file=sys.stderr, flush=True)
+
+
+@dataclass(frozen=True)
+class _Impacts:
+    """The measured impacts to flag, checked, with the uncertainties and spin bounds to sample."""
+
+    source: str
+    rows: np.ndarray
+    radius: np.ndarray  # [m]
+    incidence_deg: np.ndarray  # [deg]
+    speed: np.ndarray  # [m/s]
+    normal_speed: np.ndarray  # [m/s]
+    angle_uncertainty_deg: np.ndarray  # [deg]
+    angle_source: str
+    spin_bound: np.ndarray  # [rad/s]
+    spin_source: str
+    e_n_uncertainty: np.ndarray  # [-], NaN where not given
+
+
+def _impacts(df, spin_bound, angle_uncertainty_deg, default_angle_uncertainty_deg) -> _Impacts:
+    """Columns of the impact table, checked; errors name the data row and column."""
+    src = df.attrs.get("source", "impact table")
+    n = len(df)
+    if n == 0:
+        raise ValueError(f"{src}: no impacts to flag")
+
+    def column(name, default):
+        return df[name].to_numpy(dtype=float) if name in df.columns else np.full(n, default)
+
+    rows = df["row"].to_numpy(dtype=np.int64) if "row" in df.columns else np.arange(1, n + 1)
+    radius = df["radius"].to_numpy(dtype=float)
+    inc = column("incidence_deg", 0.0)
+    inc = np.where(np.isfinite(inc), inc, 0.0)
+    speed = column("speed", np.nan)
+    speed = np.where(np.isfinite(speed), speed, df["normal_speed"].to_numpy(dtype=float) / np.cos(np.radians(inc)))
+    for name, x in (("radius", radius), ("speed", speed)):
+        bad = ~np.isfinite(x) | (x <= 0)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"{src}: row {rows[i]}, column {name!r}: {x[i]!r} must be finite and > 0")
+
+    if angle_uncertainty_deg is not None:
+        sig_a, angle_source = np.full(n, float(angle_uncertainty_deg)), "argument"
+    elif np.isfinite(column("incidence_deg_uncertainty", np.nan)).any():
+        sig_a = column("incidence_deg_uncertainty", np.nan)
+        sig_a = np.where(np.isfinite(sig_a), sig_a, default_angle_uncertainty_deg)
+        angle_source = "table column incidence_angle_uncertainty (default where empty)"
+    else:
+        sig_a, angle_source = np.full(n, float(default_angle_uncertainty_deg)), "default"
+    if np.any(~np.isfinite(sig_a) | (sig_a < 0)):
+        raise ValueError(f"angle uncertainty must be finite and >= 0 deg, got {angle_uncertainty_deg!r}")
+
+    if spin_bound is None:
+        bound, spin_source = speed / radius, "rolling spin speed / radius per impact"
+    else:
+        bound, spin_source = np.broadcast_to(np.asarray(spin_bound, dtype=float), (n,)).copy(), "argument"
+        if np.any(~np.isfinite(bound) | (bound < 0)):
+            raise ValueError(f"spin_bound must be finite and >= 0 rad/s, got {spin_bound!r}")
+    return _Impacts(str(src), rows, radius, inc, speed, speed * np.cos(np.radians(inc)), sig_a, angle_source,
+                    bound, spin_source, column("e_n_uncertainty", np.nan))
+
+
+def _spin_samples(n_spin, spin_fractions) -> tuple[np.ndarray, np.ndarray]:
+    """(nonzero fractions [-], unit spin samples (n, 3) [-]); sample 0 is the zero spin."""
+    fr = np.asarray([f for f in spin_fractions if f != 0], dtype=float)
+    dirs = fibonacci_sphere(n_spin)
+    return fr, np.vstack([np.zeros((1, 3)), np.repeat(dirs, fr.size, axis=0) * np.tile(fr, n_spin)[:, None]])
+
+
+def _spread(imp: _Impacts, contact_or_fit, unit, offsets, rtol, progress) -> dict:
+    """Coefficients over the samples, per radius: nominal, min/max over spin, angle and all, the
+    capture velocity [m/s] and whether the outcome switches over spin or over angle."""
+    n = imp.rows.size
+    k0 = int(np.flatnonzero(offsets == 0.0)[0])
+    out = {f"{c}{mm}{s}": np.full(n, np.nan) for c in _COEFS for s in _SPREADS for mm in ("", "_min", "_max")
+           if mm or not s}
+    out |= {"capture_velocity": np.full(n, np.nan), "switch_spin": np.zeros(n, bool), "switch_angle": np.zeros(n, bool)}
+    radii, inverse = np.unique(imp.radius, return_inverse=True)
+    t0 = time.perf_counter()
+    for gi, r in enumerate(radii):
+        idx = np.flatnonzero(inverse == gi)
+        contact = _contact_for(contact_or_fit, float(r))
+        out["capture_velocity"][idx] = capture_velocity(contact)
+        a = imp.incidence_deg[idx, None] + offsets[None, :] * imp.angle_uncertainty_deg[idx, None]  # (impact, angle)
+        alpha = xr.DataArray(np.minimum(np.abs(a), 89.9), dims=("impact", "angle_sample"))
+        azim = xr.DataArray(np.where(a < 0, 180.0, 0.0), dims=("impact", "angle_sample"))
+        w = imp.spin_bound[idx, None, None] * unit[None, :, :]  # (impact, spin, 3)
+        omega = tuple(xr.DataArray(w[:, :, k], dims=("impact", "spin_sample")) for k in range(3))
+        ds = simulate_many(contact, xr.DataArray(imp.speed[idx], dims="impact"), alpha, azim, omega, rtol=rtol)
+        ds = ds.transpose("impact", "spin_sample", "angle_sample")
+        for c in _COEFS:
+            x = ds[c].values
+            with np.errstate(invalid="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN slices (captured samples)
+                out[c][idx] = x[:, 0, k0]
+                for s, sub, axis in (("_spin", x[:, :, k0], 1), ("_angle", x[:, 0, :], 1), ("", x, (1, 2))):
+                    out[f"{c}_min{s}"][idx] = np.nanmin(sub, axis=axis)
+                    out[f"{c}_max{s}"][idx] = np.nanmax(sub, axis=axis)
+        oc = ds["outcome"].values
+        out["switch_spin"][idx] = oc[:, :, k0].min(axis=1) != oc[:, :, k0].max(axis=1)
+        out["switch_angle"][idx] = oc[:, 0, :].min(axis=1) != oc[:, 0, :].max(axis=1)
+        _progress(progress, f"flags: radius {r * 1e6:.4g} um ({gi + 1}/{radii.size}), {idx.size} impacts x "
+                  f"{unit.shape[0]} spins x {offsets.size} angles, {time.perf_counter() - t0:.1f} s")
+    return out
 
 
 def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertainty_deg=None,
@@ -140,145 +239,76 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
         ``angle_sensitive``, ``near_capture`` (int8 0/1). Thresholds and sample counts are
         attributes. ``ds.to_dataframe()`` gives one row per impact.
     """
-    from microimpact.dynamics.nonlinear import capture_velocity
-
     th = dict(DEFAULT_THRESHOLDS)
     if thresholds:
         unknown = set(thresholds) - set(th)
         if unknown:
             raise ValueError(f"unknown threshold(s) {sorted(unknown)}; known: {sorted(th)}")
         th.update({k: float(v) for k, v in thresholds.items()})
-    df = table
-    src = df.attrs.get("source", "impact table")
-    n = len(df)
-    if n == 0:
-        raise ValueError(f"{src}: no impacts to flag")
-    rows = df["row"].to_numpy(dtype=np.int64) if "row" in df.columns else np.arange(1, n + 1)
-    radius = df["radius"].to_numpy(dtype=float)
-    inc = df["incidence_deg"].to_numpy(dtype=float) if "incidence_deg" in df.columns else np.zeros(n)
-    inc = np.where(np.isfinite(inc), inc, 0.0)
-    speed = df["speed"].to_numpy(dtype=float) if "speed" in df.columns else np.full(n, np.nan)
-    vn = df["normal_speed"].to_numpy(dtype=float)
-    speed = np.where(np.isfinite(speed), speed, vn / np.cos(np.radians(inc)))
-    for name, x in (("radius", radius), ("speed", speed)):
-        bad = ~np.isfinite(x) | (x <= 0)
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            raise ValueError(f"{src}: row {rows[i]}, column {name!r}: {x[i]!r} must be finite and > 0")
-    vn = speed * np.cos(np.radians(inc))
+    imp = _impacts(table, spin_bound, angle_uncertainty_deg, default_angle_uncertainty_deg)
+    fr, unit = _spin_samples(n_spin, spin_fractions)
+    offsets = np.unique(np.append(np.asarray(angle_offsets, dtype=float), 0.0))  # 0: the nominal angle
+    out = _spread(imp, contact_or_fit, unit, offsets, rtol, progress)
 
-    if angle_uncertainty_deg is not None:
-        sig_a = np.full(n, float(angle_uncertainty_deg))
-        angle_source = "argument"
-    elif "incidence_deg_uncertainty" in df.columns and np.isfinite(df["incidence_deg_uncertainty"].to_numpy(dtype=float)).any():
-        sig_a = df["incidence_deg_uncertainty"].to_numpy(dtype=float)
-        sig_a = np.where(np.isfinite(sig_a), sig_a, default_angle_uncertainty_deg)
-        angle_source = "table column incidence_angle_uncertainty (default where empty)"
-    else:
-        sig_a = np.full(n, float(default_angle_uncertainty_deg))
-        angle_source = "default"
-    if np.any(~np.isfinite(sig_a) | (sig_a < 0)):
-        raise ValueError(f"angle uncertainty must be finite and >= 0 deg, got {angle_uncertainty_deg!r}")
-
-    if spin_bound is None:
-        bound = speed / radius
-        spin_source = "rolling spin speed / radius per impact"
-    else:
-        bound = np.broadcast_to(np.asarray(spin_bound, dtype=float), (n,)).copy()
-        spin_source = "argument"
-        if np.any(~np.isfinite(bound) | (bound < 0)):
-            raise ValueError(f"spin_bound must be finite and >= 0 rad/s, got {spin_bound!r}")
-
-    # sample sets: spin index 0 is the zero spin; angle offset 0 is the nominal angle
-    fr = np.asarray([f for f in spin_fractions if f != 0], dtype=float)
-    dirs = fibonacci_sphere(n_spin)
-    unit = np.vstack([np.zeros((1, 3)), np.repeat(dirs, fr.size, axis=0) * np.tile(fr, n_spin)[:, None]])
-    offsets = np.unique(np.append(np.asarray(angle_offsets, dtype=float), 0.0))
-    k0 = int(np.flatnonzero(offsets == 0.0)[0])
-
-    th_en = df["e_n_uncertainty"].to_numpy(dtype=float) if "e_n_uncertainty" in df.columns else np.full(n, np.nan)
-    en_limit = np.where(np.isfinite(th_en) & (th_en > 0), th_en, th["e_n"])
-
-    out = {k: np.full(n, np.nan) for k in
-           [f"{c}{s}" for c in _COEFS for s in ("", "_min_spin", "_max_spin", "_min_angle", "_max_angle", "_min", "_max")]}
-    out["capture_velocity"] = np.full(n, np.nan)
-    switch_spin = np.zeros(n, dtype=bool)
-    switch_angle = np.zeros(n, dtype=bool)
-    radii, inverse = np.unique(radius, return_inverse=True)
-    t0 = time.perf_counter()
-    for gi, r in enumerate(radii):
-        idx = np.flatnonzero(inverse == gi)
-        contact = _contact_for(contact_or_fit, float(r))
-        vc = capture_velocity(contact)
-        out["capture_velocity"][idx] = vc
-        a = inc[idx, None] + offsets[None, :] * sig_a[idx, None]  # (impact, angle)
-        alpha = xr.DataArray(np.minimum(np.abs(a), 89.9), dims=("impact", "angle_sample"))
-        azim = xr.DataArray(np.where(a < 0, 180.0, 0.0), dims=("impact", "angle_sample"))
-        w = bound[idx, None, None] * unit[None, :, :]  # (impact, spin, 3)
-        omega = tuple(xr.DataArray(w[:, :, k], dims=("impact", "spin_sample")) for k in range(3))
-        ds = simulate_many(contact, xr.DataArray(speed[idx], dims="impact"), alpha, azim, omega, rtol=rtol)
-        ds = ds.transpose("impact", "spin_sample", "angle_sample")
-        for c in _COEFS:
-            x = ds[c].values
-            with np.errstate(invalid="ignore"), warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN slices (captured samples)
-                out[c][idx] = x[:, 0, k0]
-                out[f"{c}_min_spin"][idx] = np.nanmin(x[:, :, k0], axis=1)
-                out[f"{c}_max_spin"][idx] = np.nanmax(x[:, :, k0], axis=1)
-                out[f"{c}_min_angle"][idx] = np.nanmin(x[:, 0, :], axis=1)
-                out[f"{c}_max_angle"][idx] = np.nanmax(x[:, 0, :], axis=1)
-                out[f"{c}_min"][idx] = np.nanmin(x, axis=(1, 2))
-                out[f"{c}_max"][idx] = np.nanmax(x, axis=(1, 2))
-        oc = ds["outcome"].values
-        switch_spin[idx] = oc[:, :, k0].min(axis=1) != oc[:, :, k0].max(axis=1)
-        switch_angle[idx] = oc[:, 0, :].min(axis=1) != oc[:, 0, :].max(axis=1)
-        _progress(progress, f"flags: radius {r * 1e6:.4g} um ({gi + 1}/{radii.size}), {idx.size} impacts x "
-                  f"{unit.shape[0]} spins x {offsets.size} angles, {time.perf_counter() - t0:.1f} s")
+    en_limit = np.where(np.isfinite(imp.e_n_uncertainty) & (imp.e_n_uncertainty > 0), imp.e_n_uncertainty, th["e_n"])
 
     def rng(c, s):
         return np.nan_to_num(out[f"{c}_max_{s}"] - out[f"{c}_min_{s}"], nan=0.0)
 
     rot = ((rng("mu_t", "spin") > th["mu"]) | (rng("mu_tp", "spin") > th["mu"]) | (rng("K_L", "spin") > th["K_L"])
-           | (rng("e_n", "spin") > en_limit) | switch_spin)
+           | (rng("e_n", "spin") > en_limit) | out["switch_spin"])
     ang = ((rng("e_n", "angle") > en_limit) | (rng("mu_t", "angle") > th["mu"]) | (rng("mu_tp", "angle") > th["mu"])
-           | (rng("K_L", "angle") > th["K_L"]) | switch_angle)
-    ratio = vn / out["capture_velocity"]
-    near = ratio < th["near_capture_ratio"]
-
-    res = xr.Dataset(coords={"impact": ("impact", np.arange(n), {"long_name": "impact index in the table"}),
-                             "row": ("impact", rows, {"long_name": "data row of the impact in the source CSV"})})
-    for c in _COEFS:
-        units = "1"
-        res[c] = ("impact", out[c], {"units": units, "long_name": f"{_COEF_META[c]}, zero spin, nominal angle"})
-        for s, what in (("spin", "over initial spin samples at the nominal angle"),
-                        ("angle", "over incidence-angle samples at zero spin"), ("", "over all samples")):
-            suffix = f"_{s}" if s else ""
-            for mm in ("min", "max"):
-                res[f"{c}_{mm}{suffix}"] = ("impact", out[f"{c}_{mm}{suffix}"], {
-                    "units": units, "long_name": f"{mm}imum {_COEF_META[c]} {what}"})
-    res["capture_velocity"] = ("impact", out["capture_velocity"], {"units": "m s-1", "long_name": "capture velocity of this radius"})
-    res["capture_speed_ratio"] = ("impact", ratio, {"units": "1", "long_name": "incident normal speed / capture velocity"})
-    res["spin_bound"] = ("impact", bound, {"units": "rad s-1", "long_name": f"largest initial spin sampled ({spin_source})"})
-    res["angle_uncertainty_deg"] = ("impact", sig_a, {"units": "degree", "long_name": f"incidence-angle uncertainty used ({angle_source})"})
-    res["e_n_limit"] = ("impact", en_limit, {"units": "1", "long_name": "e_n spread limit (e_n_uncertainty, else threshold_e_n)"})
-    flag_attrs = {"flag_values": np.array([0, 1], dtype=np.int8)}
-    res["rotation_sensitive"] = ("impact", rot.astype(np.int8), {**flag_attrs, "flag_meanings": "insensitive rotation_sensitive",
-        "long_name": "range over spin of mu_t or mu_t' > threshold_mu, or of K_L > threshold_K_L, or of e_n > e_n_limit, or outcome changes"})
-    res["angle_sensitive"] = ("impact", ang.astype(np.int8), {**flag_attrs, "flag_meanings": "insensitive angle_sensitive",
-        "long_name": "range over angle of e_n > e_n_limit, or of mu_t or mu_t' > threshold_mu, or of K_L > threshold_K_L, or outcome changes"})
-    res["near_capture"] = ("impact", near.astype(np.int8), {**flag_attrs, "flag_meanings": "far near_capture",
-        "long_name": "capture_speed_ratio < threshold_near_capture_ratio"})
+           | (rng("K_L", "angle") > th["K_L"]) | out["switch_angle"])
+    ratio = imp.normal_speed / out["capture_velocity"]
+    res = _flags_dataset(imp, out, ratio, en_limit, {"rotation_sensitive": rot, "angle_sensitive": ang,
+                                                     "near_capture": ratio < th["near_capture_ratio"]})
     res.attrs.update({f"threshold_{k}": v for k, v in th.items()})
     res.attrs.update({
         "title": "measurement flags: sensitivity to unmeasured spin and angle error, closeness to capture",
-        "source": str(src), "n_spin_directions": int(n_spin), "spin_fractions": fr,
+        "source": imp.source, "n_spin_directions": int(n_spin), "spin_fractions": fr,
         "angle_offsets_sigma": offsets, "spin_samples": int(unit.shape[0]), "angle_samples": int(offsets.size),
-        "spin_bound_source": spin_source, "angle_uncertainty_source": angle_source,
+        "spin_bound_source": imp.spin_source, "angle_uncertainty_source": imp.angle_source,
         "model": "Cheng, Brach & Dunn (2002); coefficients from microimpact.simulate_many",
         "Conventions": "CF-1.8",
     })
-    if "sha256" in df.attrs:
-        res.attrs["source_sha256"] = df.attrs["sha256"]
+    if "sha256" in table.attrs:
+        res.attrs["source_sha256"] = table.attrs["sha256"]
+    return res
+
+
+#: flag name -> (flag_meanings, long_name)
+_FLAGS = {
+    "rotation_sensitive": ("insensitive rotation_sensitive", "range over spin of mu_t or mu_t' > threshold_mu, or "
+                           "of K_L > threshold_K_L, or of e_n > e_n_limit, or outcome changes"),
+    "angle_sensitive": ("insensitive angle_sensitive", "range over angle of e_n > e_n_limit, or of mu_t or mu_t' > "
+                        "threshold_mu, or of K_L > threshold_K_L, or outcome changes"),
+    "near_capture": ("far near_capture", "capture_speed_ratio < threshold_near_capture_ratio"),
+}
+
+
+def _flags_dataset(imp: _Impacts, out: dict, ratio, en_limit, flags: dict) -> xr.Dataset:
+    """The Dataset of :func:`flag_measurements` along ``impact``, units and long names from
+    :mod:`microimpact.io.variables`."""
+    res = xr.Dataset(coords={"impact": ("impact", np.arange(imp.rows.size), {"long_name": "impact index in the table"}),
+                             "row": ("impact", imp.rows, attributes("row"))})
+    for c in _COEFS:
+        units, long_name = attributes(c)["units"], attributes(c)["long_name"]
+        res[c] = ("impact", out[c], attributes(c, long_name=f"{long_name}, zero spin, nominal angle"))
+        for s, what in _SPREADS.items():
+            for mm in ("min", "max"):
+                res[f"{c}_{mm}{s}"] = ("impact", out[f"{c}_{mm}{s}"], {
+                    "units": units, "long_name": f"{mm}imum {long_name} {what}"})
+    res["capture_velocity"] = ("impact", out["capture_velocity"],
+                               attributes("capture_normal_speed", long_name="capture velocity of this radius"))
+    res["capture_speed_ratio"] = ("impact", ratio, attributes("capture_speed_ratio"))
+    res["spin_bound"] = ("impact", imp.spin_bound, attributes(
+        "spin_bound", long_name=f"{attributes('spin_bound')['long_name']} ({imp.spin_source})"))
+    res["angle_uncertainty_deg"] = ("impact", imp.angle_uncertainty_deg, attributes(
+        "angle_uncertainty_deg", long_name=f"{attributes('angle_uncertainty_deg')['long_name']} ({imp.angle_source})"))
+    res["e_n_limit"] = ("impact", en_limit, attributes("e_n_limit"))
+    for name, (meanings, long_name) in _FLAGS.items():
+        res[name] = ("impact", flags[name].astype(np.int8), {
+            "flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": meanings, "long_name": long_name})
     return res
 
 
@@ -290,8 +320,6 @@ def write_flags(ds: xr.Dataset, csv_path, nc_path=None):
     tuple of pathlib.Path
         The files written.
     """
-    from microimpact.io import write_csv, write_netcdf
-
     table = ds.to_dataframe().reset_index(drop=True)
     cols = ["row"] + [c for c in table.columns if c not in ("row", "impact")]
     table = table[cols]
