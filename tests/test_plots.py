@@ -152,3 +152,17 @@ def test_kharaz(tmp_path):
     df.to_csv(tmp_path / "kharaz.csv", index=False)
     ds = kharaz_comparison(tmp_path / "kharaz.csv", fit_friction=False, curve_incidence_deg=np.arange(1.0, 80.0, 3.0))
     check(plots.plot_kharaz(ds), tmp_path, "kharaz")
+
+
+def test_size_dependence(tmp_path):
+    # a sweep with a leading radius dimension (one contact per measured size), as the analyst's sweeps
+    spec = {"speed": [0.5, 1.5, 3.0, 8.0], "incidence_deg": [0.0, 30.0]}
+    radius = xr.DataArray([1.29e-6, 3.45e-6], dims="radius", attrs={"units": "m"})
+    ds = xr.concat([sweeps.run_sweep(C.at_radius(float(r)), spec, case="2.1", capture_speed=False)
+                    for r in radius.values], dim=radius, combine_attrs="override")
+    dyn = xr.Dataset({"capture_velocity": ("radius", [1.4, 0.6]), "critical_velocity": ("radius", [1e-3, 5e-4])},
+                     coords={"radius": radius})
+    p = check(plots.plot_size_dependence(ds, dyn), tmp_path, "sizes")
+    assert len(p.figure.axes[0].get_legend().get_texts()) == 2  # one curve per diameter
+    assert "critical velocity" in p.caption and "alpha" not in p.caption.split("(b)")[1]
+    assert "incidence_deg = 0" in p.caption  # taken at normal incidence

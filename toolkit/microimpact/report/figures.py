@@ -15,6 +15,7 @@ function                             paper figure              input
 :func:`plot_phase_portraits`         Fig. 5                    list of :func:`dynamics.phase_portrait`
 :func:`plot_energy_loss`             Figs. 7, 9, 11            :func:`sweeps.run_sweep`
 :func:`plot_restitution_and_impulse` Figs. 8, 10, 12, 13, 14   :func:`sweeps.run_sweep`
+:func:`plot_size_dependence`         (none)                    sweep with a ``radius`` dimension
 :func:`plot_work_precision`          (none)                    benchmark Dataset
 :func:`plot_kharaz`                  (none)                    :func:`validation.kharaz_comparison`
 ==================================== ========================= ======================================
@@ -22,13 +23,16 @@ function                             paper figure              input
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from dataclasses import dataclass
 
+import matplotlib
 import numpy as np
 import xarray as xr
 from matplotlib import colormaps
+from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
@@ -38,6 +42,7 @@ __all__ = [
     "TABLE2_FIGURES",
     "plot_energy_loss",
     "plot_restitution_and_impulse",
+    "plot_size_dependence",
     "plot_phase_portraits",
     "plot_bifurcation_plane",
     "plot_fit",
@@ -111,9 +116,6 @@ def _figure(width: float, height: float) -> Figure:
 
 def _rc(func):
     """Run a figure function under the toolkit style (matplotlib.rc_context, no global change)."""
-    import functools
-
-    import matplotlib
 
     @functools.wraps(func)
     def wrapper(*args, **kwargs):
@@ -420,6 +422,80 @@ def plot_restitution_and_impulse(ds: xr.Dataset, *, hue: str | None = None, pane
     return Plot(fig, caption.strip(), fig_no)
 
 
+# ----------------------------------------------------------------------------- sizes of a measured material
+def _normal_incidence(ds: xr.Dataset) -> xr.Dataset:
+    """``ds`` at the grid value closest to 0 of every dimension besides radius and speed."""
+    sel = {d: int(np.argmin(np.abs(np.asarray(ds[d].values, float)))) for d in ds["e_n"].dims
+           if d not in ("radius", "speed")}
+    return ds.isel(sel)
+
+
+@_rc
+def plot_size_dependence(sweep: xr.Dataset, dynamics: xr.Dataset | None = None) -> Plot:
+    """e_n against the incident speed for each sphere size, and the capture velocity against the size.
+
+    Parameters
+    ----------
+    sweep : xarray.Dataset
+        A sweep with a leading ``radius`` dimension [m] (one fitted contact per radius), a
+        ``speed`` dimension [m/s] and ``e_n``, ``outcome``; other dimensions are taken at their grid
+        value closest to 0 (normal incidence, no spin).
+    dynamics : xarray.Dataset, optional
+        ``capture_velocity`` and ``critical_velocity`` [m/s] on ``radius`` [m]; without it panel (b)
+        shows the sweep's ``capture_normal_speed`` if it has one per radius.
+
+    Returns
+    -------
+    Plot
+        (a) e_n(v), one curve per diameter, captured impacts (e_n = 0) dotted; (b) normal capture
+        velocity (and the critical velocity of Eq. (38)) against the diameter, log-log.
+    """
+    ds = _normal_incidence(sweep)
+    radii = np.asarray(ds["radius"].values, float)
+    colors = _colors(radii.size)
+    fig = _figure(WIDTH, 2.6)
+    ax_e, ax_v = fig.subplots(1, 2)
+    for i, (r, col) in enumerate(zip(radii, colors)):
+        c = ds.isel(radius=i)
+        cap = c["outcome"].values.astype(bool)
+        y = c["e_n"].values
+        ax_e.plot(c["speed"].values, np.where(cap, np.nan, y), color=col, label=f"{2e6 * r:.3g}")
+        ax_e.plot(c["speed"].values, np.where(cap, y, np.nan), color=col, ls=":", lw=1.0)
+    ax_e.set_xscale("log")
+    ax_e.set_xlabel(r"incident speed $v$ [m/s]")
+    ax_e.set_ylabel(r"$e_n$ [-]")
+    ax_e.set_ylim(bottom=0.0)
+    _panel_label(ax_e, "(a) $e_n$, Eq. (21)")
+    ax_e.legend(title="d [µm]", frameon=False, loc="lower right")
+    fixed = ", ".join(f"{d} = {float(ds[d]):g}" for d in sweep["e_n"].dims if d not in ("radius", "speed"))
+    lines = []
+    if dynamics is not None:
+        lines = [(dynamics[k], label, m) for k, label, m in (("capture_velocity", "capture velocity", "o"),
+                                                             ("critical_velocity", "critical $v_c$, Eq. (38)", "s"))
+                 if k in dynamics]
+    elif "capture_normal_speed" in sweep and "radius" in sweep["capture_normal_speed"].dims:
+        lines = [(sweep["capture_normal_speed"], "capture velocity", "o")]
+    for var, label, marker in lines:
+        ax_v.plot(2e6 * np.asarray(var["radius"].values, float), var.values, marker=marker, ms=4, label=label)
+    ax_v.set_xscale("log")
+    ax_v.set_yscale("log")
+    ax_v.set_xlabel(r"sphere diameter $d$ [µm]")
+    ax_v.set_ylabel(r"normal speed [m/s]")
+    _panel_label(ax_v, "(b) capture velocity")
+    if lines:
+        ax_v.legend(frameon=False)
+    case = sweep.attrs.get("case", "")
+    caption = (
+        "The measured material at each measured sphere size, with the contact fitted to the data. "
+        f"(a) Normal restitution e_n against the incident speed v [m/s]{f' (Table 2 case {case}' if case else ' ('}"
+        f"{', ' + fixed if fixed else ''}), one curve per diameter; dotted: captured (e_n = 0). "
+        "(b) Normal capture velocity [m/s] (below it the sphere adheres)"
+        + (" and critical velocity v_c of Eq. (38) (C = 2)" if dynamics is not None and "critical_velocity" in dynamics
+           else "") + " against the diameter [um]." + ("" if lines else " (No capture velocities in the input.)")
+    )
+    return Plot(fig, caption, None)
+
+
 # ----------------------------------------------------------------------------- Fig. 5
 @_rc
 def plot_phase_portraits(portraits) -> Plot:
@@ -502,8 +578,6 @@ def plot_bifurcation_plane(ds: xr.Dataset, *, label_points: bool = True) -> Plot
     c2 = ds["C2"].values
     fig = _figure(WIDTH * 0.72, 3.5)
     ax = fig.subplots()
-    from matplotlib.colors import ListedColormap
-
     # colour by C < 2 / C > 2 (the exact line is drawn on top; the 'critical' cells of ``region``
     # would show as a staircase)
     cc = ds["total_damping"].transpose("C2", "C1").values if "total_damping" in ds else c1[None, :] + c2[:, None]

@@ -1,0 +1,169 @@
+"""The PDF report reads result files only: no solver is imported, the parts and their parameter sources show.
+
+The result files are made here with the library (tests may run solvers; the report may not), small
+enough to build in about a minute: a synthetic data set of two sizes fitted without confidence
+intervals, two Table 2 cases on coarse grids for the analyst (per radius) and for the paper.
+"""
+
+import hashlib
+import json
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+import pytest  # noqa: E402
+import xarray as xr  # noqa: E402
+
+from microimpact import presets  # noqa: E402
+from microimpact.analysis.fitting import fit_damping  # noqa: E402
+from microimpact.analysis.kharaz import kharaz_comparison  # noqa: E402
+from microimpact.analysis.synthetic import make_synthetic_impacts  # noqa: E402
+from microimpact.dynamics import nonlinear as dynamics  # noqa: E402
+from microimpact.io import read_impacts  # noqa: E402
+from microimpact.io.files import read_netcdf_groups, write_csv, write_netcdf  # noqa: E402
+from microimpact.report.inputs import INPUT_KEYS  # noqa: E402
+from microimpact.report.pdf import build_report  # noqa: E402
+from microimpact.solvers.impact import contact_attributes  # noqa: E402
+from microimpact.studies import sweeps  # noqa: E402
+from microimpact.studies.sweeps import restitution_curves  # noqa: E402
+
+FORBIDDEN = ("microimpact.solvers", "microimpact.dynamics", "microimpact.studies", "microimpact.analysis", "numba")
+PAPER_SOURCE = "preset: wall1990"
+SPEEDS = [0.5, 1.5, 3.0, 8.0]
+
+
+def test_report_imports_no_solver():
+    code = ("import microimpact.report.pdf, microimpact.report.figures, sys; "
+            f"print('\\n'.join(m for m in sys.modules if m.startswith({FORBIDDEN!r})))")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert proc.stdout.strip() == "", f"the report imported: {proc.stdout.split()}"
+
+
+def _case_spec(case, speeds):
+    spec = sweeps.TABLE2_CASES[case]
+    family = [k for k, v in spec.items() if k not in ("speed", "description") and isinstance(v, (list, dict))][0]
+    values = np.asarray(sweeps.resolve_spec(spec)[family])
+    return dict(spec, speed=list(speeds), **{family: [float(values[0]), float(values[-1])]})
+
+
+def _analyst_files(tmp, fit, fit_path):
+    """Per-radius dynamics and sweeps with the fitted contact (the layout the pipeline writes)."""
+    sha = hashlib.sha256(fit_path.read_bytes()).hexdigest()
+    source = f"fit: {fit_path.name} {sha}"
+    radii = np.unique(fit.to_dataset()["radius"].values)
+    contacts = [fit.contact(float(r)) for r in radii]
+    per_radius = {k: np.array([contact_attributes(c)[k] for c in contacts]) for k in contact_attributes(contacts[0])
+                  if not isinstance(contact_attributes(contacts[0])[k], str)}
+    radius = xr.DataArray(radii, dims="radius", attrs={"units": "m", "long_name": "sphere radius"})
+    dyn = xr.Dataset({
+        "capture_velocity": ("radius", [dynamics.capture_velocity(c) for c in contacts], {"units": "m s-1"}),
+        "critical_velocity": ("radius", [dynamics.critical_velocity(c) for c in contacts], {"units": "m s-1"}),
+    }, coords={"radius": radius}, attrs={"parameter_source": source, **per_radius})
+    write_netcdf(dyn, tmp / "analyst_dynamics.nc")
+    files = []
+    for case in ("2.1", "2.3"):
+        spec = _case_spec(case, np.geomspace(0.5, 20.0, 5))
+        ds = xr.concat([sweeps.run_sweep(c, spec, case=case) for c in contacts], dim=radius, combine_attrs="override")
+        ds.attrs.update(per_radius, parameter_source=source)
+        write_netcdf(ds, tmp / f"analyst_{case}.nc")
+        files.append(tmp / f"analyst_{case}.nc")
+    return source, files
+
+
+def _paper_files(tmp):
+    contact = presets.WALL_1990
+    portraits = dynamics.phase_portraits(contact, [0.5, 1e-5], rtol=1e-8)
+    for p in portraits:
+        p.attrs.setdefault("parameter_source", PAPER_SOURCE)
+    dynamics.save_phase_portraits(portraits, tmp / "portraits.nc")
+    dyn = dynamics.dynamics_summary(contact, [0.5, 1e-5])
+    dyn.attrs["parameter_source"] = PAPER_SOURCE
+    write_netcdf(dyn, tmp / "dynamics.nc")
+    write_netcdf(dynamics.bifurcation_plane(n_c1=31, n_c2=31), tmp / "bifurcation.nc")
+    files = []
+    for case in ("2.1", "2.3"):
+        ds = sweeps.run_sweep(contact, _case_spec(case, SPEEDS), case=case)
+        ds.attrs["parameter_source"] = PAPER_SOURCE
+        write_netcdf(ds, tmp / f"paper_{case}.nc")
+        files.append(tmp / f"paper_{case}.nc")
+    repro = pd.DataFrame({"id": ["vc"], "claim": ["critical velocity"], "source": ["Eq. (38)"],
+                          "paper_value": ["1.45"], "toolkit_value": ["1.45"], "agree": [True], "note": [""]})
+    write_csv(repro, tmp / "reproduction.csv")
+    return files
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("results")
+    gen = dict(radii=[1.29e-6, 3.45e-6], zeta_hertz=0.8, zeta_adhesion=20.0, n_per_radius=6, seed=3)
+    make_synthetic_impacts(**gen).to_csv(tmp / "synthetic_impacts.csv", index=False)
+    table = read_impacts(tmp / "synthetic_impacts.csv")
+    write_csv(table, tmp / "table.csv")
+    fit = fit_damping(table, presets.WALL_1990, confidence_intervals=False,
+                      start_grid=([0.5, 1.0], [10.0, 30.0]))
+    fit_ds = fit.to_dataset()
+    fit_ds.attrs.setdefault("parameter_source", "fit: synthetic_impacts.csv")
+    write_netcdf(fit_ds, tmp / "fit.nc")
+    write_netcdf(restitution_curves(fit_ds, {"start": 0.3, "stop": 30.0, "num": 12, "spacing": "log"}),
+                 tmp / "fit_curves.nc")
+    source, analyst_sweeps = _analyst_files(tmp, fit, tmp / "fit.nc")
+    kh = kharaz_comparison(fit_friction=False, curve_incidence_deg=np.arange(1.0, 80.0, 6.0))
+    write_netcdf(kh, tmp / "kharaz.nc")
+    stress = {"cases_run": 4, "cases_failed": 0, "seed": 1, "captures": 1, "failures_by_kind": {"energy": 0},
+              "tolerances": {"energy": 1e-6}, "worst_energy_error": {"value": 1e-9, "case": {"case": 2}}}
+    (tmp / "stress.json").write_text(json.dumps(stress))
+    inputs = {"data_table": tmp / "table.csv", "fit": tmp / "fit.nc", "fit_curves": tmp / "fit_curves.nc",
+              "analyst_dynamics": tmp / "analyst_dynamics.nc", "analyst_sweeps": analyst_sweeps,
+              "phase_portraits": tmp / "portraits.nc", "dynamics": tmp / "dynamics.nc",
+              "bifurcation": tmp / "bifurcation.nc", "paper_sweeps": _paper_files(tmp),
+              "reproduction": tmp / "reproduction.csv", "kharaz": tmp / "kharaz.nc", "stress": tmp / "stress.json"}
+    return tmp, inputs, source
+
+
+@pytest.fixture(scope="module")
+def report_text(results):
+    pypdf = pytest.importorskip("pypdf")
+    tmp, inputs, _ = results
+    path = build_report(tmp / "report.pdf", inputs, config={"data": "synthetic_impacts.csv", "stress": {}},
+                        title="Microsphere test report")
+    reader = pypdf.PdfReader(path)
+    return [page.extract_text() or "" for page in reader.pages]
+
+
+def test_inputs_cover_every_key(results):
+    _, inputs, _ = results
+    assert set(inputs) | {"flags", "work_precision"} == set(INPUT_KEYS)
+
+
+def test_report_has_both_parts_and_their_sources(results, report_text):
+    _, _, analyst_source = results
+    text = "\n".join(report_text[1:]).replace("\n", " ")  # after the title page and its contents
+    assert "Part A. The analyst's material" in text and "Part B. Reproduction of Cheng, Brach & Dunn" in text
+    a, b = text.index("Part A."), text.index("Part B. Reproduction")
+    assert a < text.index("Capture and critical velocity of the measured sizes") < b
+    assert text.index("Sensitivity sweeps of the measured material") < b < text.index("Table 2 case 2.3 (Figs")
+    # every section says which parameters made it: the fit's file and hash in part A, the preset in part B
+    assert text[a:b].count(f"Parameters: {analyst_source}") >= 2
+    assert text[b:].count(f"Parameters: {PAPER_SOURCE}") >= 3
+    assert "Parameters: preset" not in text[a:b]
+    assert "SYNTHETIC" in report_text[0] and "Contents" in report_text[0]
+    assert "switched off" in text  # no benchmark given
+    assert f"page {len(report_text)} of {len(report_text)}" in report_text[-1]
+
+
+def test_unknown_or_missing_inputs_are_named(tmp_path):
+    with pytest.raises(KeyError, match="sweeps"):
+        build_report(tmp_path / "r.pdf", {"fit": "fit.nc", "sweeps": []})
+    with pytest.raises(KeyError, match="fit"):
+        build_report(tmp_path / "r.pdf", {"flags": "flags.csv"})
+
+
+def test_grouped_netcdf_reader(results):
+    tmp, _, _ = results
+    portraits = read_netcdf_groups(tmp / "portraits.nc")
+    assert [p.attrs["normal_speed"] for p in portraits] == [0.5, 1e-5]

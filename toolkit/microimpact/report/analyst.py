@@ -1,0 +1,207 @@
+"""Part A of the report: the analyst's material, every result made with the parameters of the fit.
+
+Sections: the damping fit (Fig. 3 analogue, drawn from the ``fit_curves`` file), capture and
+critical velocity of each measured size, the Table 2 sweeps at the measured sizes and the
+measurement flags. Each section states the ``parameter_source`` of the files it shows.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from microimpact.report import figures
+from microimpact.report.inputs import at_radius, parameter_source, per_radius
+from microimpact.report.layout import Layout
+
+__all__ = ["fit_section", "analyst_dynamics_section", "analyst_sweeps_section", "flags_section"]
+
+_PARAMETERS = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
+
+
+# =============================================================================== fit
+def fit_section(lay: Layout, fit: xr.Dataset, curves: xr.Dataset | None, data: pd.DataFrame | None,
+                synthetic: bool) -> None:
+    """The damping fit: method, Fig. 3 analogue, parameter table, fit statistics, data by size."""
+    lay.section("Damping fit (analogue of Fig. 3)")
+    a = fit.attrs
+    src = a.get("fit_source", "the data")
+    lay.paragraph(
+        f"zeta_H and zeta_A of Eqs. (14)-(15) fitted by weighted least squares to the measured normal "
+        f"restitution e_n(v_n) of {src}"
+        + (" -- SYNTHETIC data generated with known parameters, not a measurement" if synthetic else "")
+        + ", jointly over all sphere sizes with one work of adhesion w_A (f0 per radius from Eq. (7)). "
+        f"Weighting: {a.get('weighting', '?')}."
+        + (f" Data file sha256: {a['fit_sha256']}." if a.get("fit_sha256") else ""))
+    lay.source(parameter_source(fit))
+    if curves is None:
+        lay.paragraph("(No fit_curves file was given: the model is drawn at the data points.)", color="0.4")
+    lay.plot(figures.plot_fit(fit, curves), max_height=3.8)
+    lay.heading("Fitted parameters")
+    lay.table(_parameter_rows(fit), {"parameter": 17, "units": 6, "value": 10, "stderr": 9, "ci1": 20, "ci2": 20,
+                                     "method": 34},
+              headers={"ci1": "1-sigma interval", "ci2": "2-sigma interval", "stderr": "std. error"}, size=7.2)
+    lay.paragraph(_fit_statistics(fit))
+    if data is not None and len(data):
+        lay.heading("Data by sphere size (validated table, SI units)")
+        lay.table(_data_by_size(data), {"diameter_um": 14, "n": 6, "v_min": 12, "v_max": 12, "e_min": 10, "e_max": 10},
+                  headers={"diameter_um": "diameter [um]", "n": "impacts", "v_min": "min v_n [m/s]",
+                           "v_max": "max v_n [m/s]", "e_min": "min e_n [-]", "e_max": "max e_n [-]"}, size=7.2)
+
+
+def _fit_parameters(fit: xr.Dataset) -> list[str]:
+    if "parameter" in fit.coords:
+        return [str(p) for p in fit["parameter"].values]
+    return [p for p in _PARAMETERS if p in fit]
+
+
+def _parameter_rows(fit: xr.Dataset) -> pd.DataFrame:
+    """One row per fit parameter: value, standard error, 1- and 2-sigma intervals and how they were found."""
+    rows = []
+    for name in _fit_parameters(fit):
+        units = fit[name].attrs.get("units", "")
+        v = float(fit[name])
+        se = float(fit[f"{name}_stderr"])
+        if not bool(int(fit[name].attrs.get("varied", 1))):
+            rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": "fixed",
+                         "ci1": "", "ci2": "", "method": "fixed (materials config)"})
+            continue
+        prof = {}
+        if f"{name}_confidence_limit" in fit:
+            lim = fit[f"{name}_confidence_limit"]
+            prof = dict(zip((int(s) for s in lim["sigma_level"].values), (float(x) for x in lim.values)))
+        if all(math.isfinite(prof.get(k, math.nan)) for k in (-1, 1, -2, 2)):
+            ci1, ci2, method = (prof[-1], prof[1]), (prof[-2], prof[2]), "profile likelihood (lmfit.conf_interval)"
+        else:
+            ci1, ci2, method = (v - se, v + se), (v - 2 * se, v + 2 * se), "covariance: value +/- k stderr"
+        rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": f"{se:.3g}",
+                     "ci1": f"[{ci1[0]:.5g}, {ci1[1]:.5g}]", "ci2": f"[{ci2[0]:.5g}, {ci2[1]:.5g}]", "method": method})
+    return pd.DataFrame(rows)
+
+
+def _fit_statistics(fit: xr.Dataset) -> str:
+    a = fit.attrs
+    pairs = []
+    if "correlation" in fit:
+        corr = fit["correlation"]
+        names = [str(n) for n in corr["parameter"].values]
+        varied = str(a.get("varied", "")).split()
+        pairs = [f"{p}/{q} {float(corr.sel(parameter=p, parameter_b=q)):+.3f}"
+                 for i, p in enumerate(names) for q in names[i + 1:] if p in varied and q in varied]
+    num = lambda key: float(a.get(key, math.nan))  # noqa: E731
+    return (f"{int(a.get('n_points', 0))} points; chi-square {num('chisqr'):.4g}, reduced chi-square "
+            f"{num('redchi'):.4g}; AIC {num('aic'):.4g}, BIC {num('bic'):.4g}; correlations: {', '.join(pairs) or 'n/a'}. "
+            f"Material: density {num('density'):g} kg/m^3, K = {num('stiffness'):.4g} Pa, damping reference speed: "
+            f"{a.get('damping_reference_speed', '?')}. {a.get('fit_ci_message', '')}")
+
+
+def _data_by_size(t: pd.DataFrame) -> pd.DataFrame:
+    summary = (t.assign(diameter_um=np.round(2e6 * t["radius"], 3))
+               .groupby("diameter_um")
+               .agg(n=("normal_speed", "size"), v_min=("normal_speed", "min"), v_max=("normal_speed", "max"),
+                    e_min=("e_n", "min"), e_max=("e_n", "max"))
+               .reset_index())
+    for c in ("v_min", "v_max", "e_min", "e_max"):
+        summary[c] = summary[c].map(lambda x: f"{x:.3g}")
+    return summary
+
+
+# =============================================================================== dynamics per size
+def analyst_dynamics_section(lay: Layout, dyn: xr.Dataset) -> None:
+    """Capture and critical velocity and the fitted contact of each measured sphere size."""
+    lay.section("Capture and critical velocity of the measured sizes", new_page=False)
+    lay.paragraph(
+        "For each measured sphere radius, the contact built from the fitted zeta_H, zeta_A and w_A (f0 from "
+        "Eq. (7)): the normal capture velocity (largest captured normal speed, by bisection) and the critical "
+        "velocity v_c of Eq. (38), at which the total damping C = C1 + C2 equals 2.")
+    lay.source(parameter_source(dyn))
+    t = pd.DataFrame({
+        "d": 2e6 * dyn["radius"].values,
+        "f0": per_radius(dyn, "contact_adhesion_line_force"),
+        "zh": per_radius(dyn, "contact_zeta_hertz"),
+        "za": per_radius(dyn, "contact_zeta_adhesion"),
+        "v_cap": dyn["capture_velocity"].values,
+        "v_c": dyn["critical_velocity"].values if "critical_velocity" in dyn else np.nan,
+    }).map(lambda x: f"{float(x):.4g}")
+    lay.table(t, {"d": 12, "f0": 12, "zh": 10, "za": 10, "v_cap": 16, "v_c": 16},
+              headers={"d": "d [um]", "f0": "f0 [N/m]", "zh": "zeta_H [-]", "za": "zeta_A [-]",
+                       "v_cap": "v_capture [m/s]", "v_c": "v_c, Eq. (38) [m/s]"}, size=7.2)
+
+
+# =============================================================================== sweeps at the measured sizes
+def analyst_sweeps_section(lay: Layout, sweeps: list[xr.Dataset], dyn: xr.Dataset | None) -> None:
+    """The Table 2 cases with the fitted contact: all sizes in one figure, each case at the median size."""
+    sweeps = sorted(sweeps, key=lambda d: str(d.attrs.get("case", "")))
+    radii = sweeps[0]["radius"].values
+    k = len(radii) // 2
+    lay.section("Sensitivity sweeps of the measured material (Table 2 cases)", new_page=False)
+    lay.paragraph(
+        "The initial conditions of the paper's Table 2 cases, simulated with the fitted contact of each measured "
+        "sphere size, over the measured speed range. The first figure compares the sizes; the figures of each "
+        f"case show the median size, d = {2e6 * radii[k]:.3g} um (all sizes are in the sweep files).")
+    lay.source(parameter_source(*sweeps))
+    lay.plot(figures.plot_size_dependence(sweeps[0], dyn), max_height=3.0)
+    for ds in sweeps:
+        one = at_radius(ds, k)
+        case = str(ds.attrs.get("case", "?"))
+        lay.heading(f"Table 2 case {case} at d = {2e6 * radii[k]:.3g} um")
+        if figures.TABLE2_FIGURES.get(case, (None, None))[0] is not None:
+            lay.plot(figures.plot_energy_loss(one), max_height=2.7)
+        lay.plot(figures.plot_restitution_and_impulse(one), max_height=2.9)
+
+
+# =============================================================================== flags
+def flags_section(lay: Layout, flags: pd.DataFrame, data: pd.DataFrame | None) -> None:
+    """Which measured impacts are sensitive to unmeasured spin, to the angle error, or near capture."""
+    lay.section("Measurement flags")
+    if flags.empty:
+        lay.paragraph("No impacts in the flags table.")
+        return
+    count = {k: int(flags[k].sum()) if k in flags else 0 for k in ("rotation_sensitive", "angle_sensitive", "near_capture")}
+    lay.paragraph(
+        "Each measured impact simulated under the fitted model with plausible unmeasured initial spin (up to the "
+        "rolling spin v/r, 3-D directions) and with the incidence angle moved by its uncertainty "
+        "(microimpact.analysis.flags.flag_measurements). Flags: R = rotation-sensitive (an unmeasured spin changes "
+        "mu or K_L by more than the threshold), A = angle-sensitive (the angle error changes e_n, mu or the "
+        "outcome), C = near capture (normal speed below 1.5 x the capture velocity, where e_n is steep). "
+        f"Of {len(flags)} impacts: {count['rotation_sensitive']} R, {count['angle_sensitive']} A, "
+        f"{count['near_capture']} C. Spreads are max - min over the samples; all columns are in results/flags.csv.")
+    if "parameter_source" in flags:
+        lay.source("; ".join(dict.fromkeys(str(s) for s in flags["parameter_source"])))
+    else:
+        lay.source("the fit (the flags are computed from results/fit.nc)")
+    lay.table(_flags_table(flags, data), {"row": 5, "d": 9, "v_n": 9, "alpha": 9, "e_meas": 9, "e_n": 9, "ratio": 9,
+                                          "mu_spin": 9, "KL_spin": 9, "e_angle": 9, "mu_angle": 9, "flags": 5},
+              headers={"d": "d [um]", "v_n": "v_n [m/s]", "alpha": "alpha [deg]", "e_meas": "e_n meas.",
+                       "e_n": "e_n model", "ratio": "v_n/v_cap", "mu_spin": "d mu spin", "KL_spin": "d K_L spin",
+                       "e_angle": "d e_n angle", "mu_angle": "d mu angle"}, size=7.0)
+
+
+def _flags_table(flags: pd.DataFrame, data: pd.DataFrame | None) -> pd.DataFrame:
+    def spread(q, over):
+        lo, hi = f"{q}_min_{over}", f"{q}_max_{over}"
+        return (flags[hi] - flags[lo]) if lo in flags and hi in flags else pd.Series(np.nan, index=flags.index)
+
+    def fmt(series, spec=".3g"):
+        return series.map(lambda x: "" if not np.isfinite(x) else format(x, spec))
+
+    t = pd.DataFrame({"row": flags["row"]})
+    if data is not None and "row" in data:
+        d = data.set_index("row")
+        t["d"] = fmt(flags["row"].map(2e6 * d["radius"]))
+        t["v_n"] = fmt(flags["row"].map(d["normal_speed"]))
+        t["alpha"] = fmt(flags["row"].map(d["incidence_deg"]))
+        t["e_meas"] = fmt(flags["row"].map(d["e_n"]), ".3f")
+    nan = pd.Series(np.nan, index=flags.index)
+    t["e_n"] = fmt(flags.get("e_n", nan))
+    t["ratio"] = fmt(flags.get("capture_speed_ratio", nan))
+    t["mu_spin"] = fmt(np.fmax(spread("mu_t", "spin"), spread("mu_tp", "spin")))
+    t["KL_spin"] = fmt(spread("K_L", "spin"))
+    t["e_angle"] = fmt(spread("e_n", "angle"))
+    t["mu_angle"] = fmt(np.fmax(spread("mu_t", "angle"), spread("mu_tp", "angle")))
+    t["flags"] = ["".join(c for c, k in (("R", "rotation_sensitive"), ("A", "angle_sensitive"), ("C", "near_capture"))
+                          if k in flags and int(r[k])) or "-" for _, r in flags.iterrows()]
+    return t

@@ -1,0 +1,228 @@
+"""What the report reads: result files (or objects already in memory) and the provenance facts.
+
+The report's input contract is a mapping of keys (:data:`INPUT_KEYS`) to result files; the
+readers here accept a path or the in-memory object (Dataset, DataFrame, mapping) so that tests
+and notebooks can pass results without writing them. Nothing here runs a model.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import os
+import platform
+import subprocess
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from microimpact.io.files import read_netcdf_groups
+
+__all__ = [
+    "INPUT_KEYS",
+    "check_inputs",
+    "read_dataset",
+    "read_table",
+    "read_json",
+    "read_portraits",
+    "as_list",
+    "parameter_source",
+    "per_radius",
+    "at_radius",
+    "is_synthetic",
+    "git_commit",
+    "provenance",
+]
+
+#: The keys of ``build_report(inputs=...)``: key -> (required, what it is)
+INPUT_KEYS = {
+    # the analyst's material, parameters from the fit
+    "data_table": (False, "validated impacts CSV (SI units)"),
+    "fit": (True, "damping fit NetCDF (DampingFit.to_dataset)"),
+    "fit_curves": (False, "model e_n(radius, speed) and outcome at the fit, NetCDF"),
+    "flags": (False, "measurement-flags CSV"),
+    "analyst_dynamics": (False, "critical and capture velocity per measured radius, NetCDF"),
+    "analyst_sweeps": (False, "Table 2 sweeps at the measured radii (leading dimension radius), NetCDF files"),
+    # the paper's parameters (Table 1 row 2)
+    "phase_portraits": (False, "grouped NetCDF of phase portraits"),
+    "dynamics": (False, "dynamics summary NetCDF"),
+    "bifurcation": (False, "(C1, C2) plane NetCDF"),
+    "reproduction": (False, "reproduction table CSV"),
+    "paper_sweeps": (False, "Table 2 sweeps with the paper's parameters, NetCDF files"),
+    # checks
+    "kharaz": (False, "Kharaz et al. (2001) comparison NetCDF"),
+    "work_precision": (False, "work-precision benchmark NetCDF"),
+    "stress": (False, "stress-sweep summary JSON"),
+}
+
+
+def check_inputs(inputs: Mapping) -> dict:
+    """``inputs`` as a dict without None values; raise on an unknown or a missing required key."""
+    unknown = sorted(set(inputs) - set(INPUT_KEYS))
+    if unknown:
+        raise KeyError(f"build_report: unknown input key(s) {unknown}; accepted: {', '.join(INPUT_KEYS)}")
+    out = {k: v for k, v in inputs.items() if v is not None and not (isinstance(v, (list, tuple)) and not v)}
+    missing = [k for k, (required, _) in INPUT_KEYS.items() if required and k not in out]
+    if missing:
+        raise KeyError(f"build_report: missing required input(s) {missing} "
+                       f"({'; '.join(f'{k}: {INPUT_KEYS[k][1]}' for k in missing)})")
+    return out
+
+
+# =============================================================================== readers
+def read_dataset(obj) -> xr.Dataset:
+    """A NetCDF file read into memory (file closed), or the Dataset itself."""
+    if isinstance(obj, xr.Dataset):
+        return obj
+    with xr.open_dataset(obj, engine="netcdf4", decode_timedelta=False) as ds:
+        return ds.load()
+
+
+def read_table(obj) -> pd.DataFrame:
+    """A CSV file (empty cells are NaN, "NA" stays text), or the DataFrame itself."""
+    return obj if isinstance(obj, pd.DataFrame) else pd.read_csv(obj, keep_default_na=False, na_values=[""])
+
+
+def read_json(obj) -> dict:
+    """A JSON file, or the mapping itself."""
+    if isinstance(obj, Mapping):
+        return dict(obj)
+    with open(obj, encoding="utf-8") as f:
+        return json.load(f)
+
+
+def read_portraits(obj) -> list[xr.Dataset]:
+    """Phase portraits: a grouped NetCDF file (one group per trajectory), or the list itself.
+
+    The ``parameter_source`` attribute of the file's root group is copied to each trajectory
+    that has none.
+    """
+    if not isinstance(obj, (str, os.PathLike)):
+        return list(obj)
+    source = {k: v for k, v in read_dataset(obj).attrs.items() if k == "parameter_source"}
+    portraits = read_netcdf_groups(obj)
+    for p in portraits:  # the root group's parameter_source holds for every trajectory
+        p.attrs = {**source, **p.attrs}
+    return portraits
+
+
+def as_list(obj) -> list:
+    """One path or Dataset -> a list of one; a sequence -> a list; None -> []."""
+    if obj is None:
+        return []
+    if isinstance(obj, (str, os.PathLike, xr.Dataset)):
+        return [obj]
+    return list(obj)
+
+
+# =============================================================================== attributes
+def parameter_source(*datasets) -> str:
+    """The ``parameter_source`` attribute(s) of result Datasets, distinct values joined by "; "."""
+    found = [str(ds.attrs["parameter_source"]) for ds in datasets if "parameter_source" in ds.attrs]
+    return "; ".join(dict.fromkeys(found)) or "not recorded in the result file (no parameter_source attribute)"
+
+
+def per_radius(ds: xr.Dataset, name: str) -> np.ndarray:
+    """Attribute ``name`` as one value per ``radius`` of ``ds`` (a scalar attribute is repeated)."""
+    value = np.atleast_1d(np.asarray(ds.attrs.get(name, np.nan)))
+    n = ds.sizes.get("radius", 1)
+    return np.broadcast_to(value if value.size == n else value[:1], (n,))
+
+
+def at_radius(ds: xr.Dataset, k: int) -> xr.Dataset:
+    """The ``k``-th radius of a per-radius result, its per-radius ``contact_*`` attributes made scalars."""
+    n = ds.sizes["radius"]
+    out = ds.isel(radius=k)
+    attrs = dict(ds.attrs)
+    for name, value in ds.attrs.items():
+        arr = np.asarray(value)
+        if name.startswith("contact_") and arr.ndim == 1 and arr.size == n:
+            attrs[name] = arr[k].item()
+    out.attrs = attrs
+    return out
+
+
+# =============================================================================== provenance
+def is_synthetic(data_path, flag="auto") -> bool:
+    """Whether a data file is synthetic: ``flag`` if it is a bool; for "auto", True when the file
+    name contains "synthetic" (the bundled data/synthetic_microspheres.csv does)."""
+    if isinstance(flag, bool):
+        return flag
+    if flag != "auto":
+        raise ValueError(f"data_synthetic must be true, false or 'auto', got {flag!r}")
+    return "synthetic" in Path(os.fspath(data_path)).name.lower()
+
+
+def git_commit(directory=".") -> str | None:
+    """``<commit>`` (``+ uncommitted changes`` when the tree is dirty) of the git checkout at
+    ``directory``, or None when git or the repository is not available. Read-only."""
+    try:
+        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=directory, capture_output=True, text=True,
+                              timeout=10, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=directory,
+                               capture_output=True, text=True, timeout=10, check=True).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return head + (" + uncommitted changes" if dirty else "") if head else None
+
+
+def _data_facts(t: pd.DataFrame) -> dict[str, str]:
+    radii = np.unique(np.round(t["radius"].to_numpy(float) * 1e6, 4))
+    v = t["normal_speed"].to_numpy(float)
+    return {"data content": f"{len(t)} impacts, {len(radii)} radii ({', '.join(f'{r:g}' for r in radii)} um), "
+                            f"normal speed {np.nanmin(v):.3g}-{np.nanmax(v):.3g} m/s"}
+
+
+def _config_facts(config: Mapping) -> dict[str, str]:
+    out = {"materials": f"{config.get('materials')} (pair {config.get('material_pair')})"}
+    sim = config.get("simulation", {})
+    if sim:
+        out["paper-part contact"] = ", ".join(f"{k} = {v}" for k, v in sim.items() if not isinstance(v, Mapping))
+    out["fit options"] = ", ".join(f"{k} = {v}" for k, v in config.get("fit", {}).items()) or "defaults"
+    sweeps = config.get("sweeps", {})
+    out["sweeps"] = (f"Table 2 cases {', '.join(map(str, sweeps))}; {config.get('sweep_chunks', 1)} chunk(s) per case"
+                     if sweeps else "none")
+    bench = config.get("benchmark", {})
+    out["benchmark"] = ("on" + (" (quick)" if bench.get("quick", True) else " (full)")) if bench.get("enabled") else "off"
+    stress = config.get("stress")
+    if stress is not None:
+        out["stress sweep"] = (f"on ({stress.get('cases', '?')} cases, seed {stress.get('seed', '?')}"
+                               + (f", reference solver on every {stress['reference_every']}-th case"
+                                  if stress.get("reference_every") else "") + ")"
+                               if stress.get("enabled") else "off")
+    return out
+
+
+def provenance(config: Mapping | None = None, *, version: str = "", data_path=None,
+               data_table: pd.DataFrame | None = None) -> dict[str, str]:
+    """The facts of the title page, as label -> text.
+
+    Parameters
+    ----------
+    config : mapping, optional
+        The pipeline configuration (data file, materials, switches).
+    version : str
+        Version of the toolkit.
+    data_path : str, optional
+        The analyst's data file; default ``config["data"]``.
+    data_table : pandas.DataFrame, optional
+        The validated impact table, summarised in one line.
+    """
+    config = dict(config or {})
+    data_path = data_path or config.get("data")
+    synthetic = is_synthetic(data_path or "", config.get("data_synthetic", "auto")) if data_path else False
+    out = {
+        "toolkit": f"microimpact {version}",
+        "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "git commit": git_commit() or "not available (not a git checkout)",
+        "python": f"{platform.python_version()} on {platform.system()} {platform.machine()}",
+        "data": f"{data_path}" + ("  -- SYNTHETIC data (generated, not measured)" if synthetic else "  -- measured data"),
+    }
+    if data_table is not None and len(data_table):
+        out.update(_data_facts(data_table))
+    if config:
+        out.update(_config_facts(config))
+    return out
