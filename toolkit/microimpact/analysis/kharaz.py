@@ -42,7 +42,10 @@ import lmfit
 import numpy as np
 import pandas as pd
 import xarray as xr
+from scipy.optimize import brentq
 
+from microimpact.io.materials import default_materials_path, read_materials
+from microimpact.io.variables import VARIABLES, attributes
 from microimpact.solvers import engine
 from microimpact.solvers.impact import simulate_many
 
@@ -56,12 +59,9 @@ KHARAZ_CONDITIONS = dict(
     material_pair="alumina_on_soda_lime_glass",  # density 4000, E/nu, friction 0.092, no adhesion
 )
 
-_QUANTITIES = {
-    "tangential_restitution": ("1", "tangential restitution v_t,out / v_t,in of the centre of mass"),
-    "rebound_spin": ("rad s-1", "angular speed |omega| after impact"),
-    "rebound_angle": ("degree", "rebound angle from the surface normal"),
-}
-_UNITS_IN_FILE = {"tangential_restitution": "1", "rebound_spin": "rad s-1", "rebound_angle": "degree"}
+#: the measured quantities: name -> (units, long_name) from :mod:`microimpact.io.variables`; the data
+#: file states each value's unit, which must be this one
+_QUANTITIES = {q: VARIABLES[q] for q in ("tangential_restitution", "rebound_spin", "rebound_angle")}
 
 
 def default_kharaz_path() -> Path:
@@ -88,9 +88,9 @@ def read_kharaz(path=None) -> pd.DataFrame:
         line = i + 2
         if r["quantity"] not in _QUANTITIES:
             raise ValueError(f"{path}, line {line}: unknown quantity {r['quantity']!r}; known: {', '.join(_QUANTITIES)}")
-        if str(r["units"]).strip() != _UNITS_IN_FILE[r["quantity"]]:
+        if str(r["units"]).strip() != _QUANTITIES[r["quantity"]][0]:
             raise ValueError(f"{path}, line {line}, column 'units': {r['units']!r}; expected "
-                             f"{_UNITS_IN_FILE[r['quantity']]!r} for {r['quantity']}")
+                             f"{_QUANTITIES[r['quantity']][0]!r} for {r['quantity']}")
         for c in ("incidence_angle_deg", "value"):
             if not np.isfinite(pd.to_numeric(r[c], errors="coerce")):
                 raise ValueError(f"{path}, line {line}, column {c!r}: {r[c]!r} is not a finite number")
@@ -100,8 +100,7 @@ def read_kharaz(path=None) -> pd.DataFrame:
 
 
 def _base_contact(normal_restitution):
-    from microimpact.io import default_materials_path, read_materials
-
+    """The contact of the Kharaz conditions, zeta_H chosen for ``normal_restitution`` (None: e_n = 1)."""
     pair = read_materials(default_materials_path())[KHARAZ_CONDITIONS["material_pair"]]
     c = pair.contact(KHARAZ_CONDITIONS["radius"])
     if normal_restitution is None:
@@ -111,8 +110,6 @@ def _base_contact(normal_restitution):
         raise ValueError(f"normal_restitution must lie in (0, 1], got {e!r}")
     if e == 1.0:
         return c.with_(zeta_hertz=0.0, zeta_adhesion=0.0)
-    from scipy.optimize import brentq
-
     speeds = KHARAZ_CONDITIONS["speed"] * np.cos(np.radians([0.0]))
 
     def g(z):
@@ -184,69 +181,21 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         raise ValueError(f"friction must be finite and >= 0, got {friction!r}")
     contact = contact.with_(friction=f_nom)
     src = str(path if path is not None else default_kharaz_path())
-
-    f_fit = f_err = math.nan
-    if fit_friction:
-        tr = data[data["quantity"] == "tangential_restitution"]
-        sl = tr[tr["incidence_angle_deg"] > sliding_threshold_deg]
-        if len(sl) < 2:
-            raise ValueError(f"{src}: fewer than 2 tangential_restitution points above {sliding_threshold_deg} deg")
-        a_sl, y_sl = sl["incidence_angle_deg"].to_numpy(), sl["value"].to_numpy()
-
-        def residual(params, angles, data=None):
-            m = _model(contact, angles, params["friction"].value)["tangential_restitution"]
-            return m if data is None else m - data
-
-        params = lmfit.Parameters()
-        params.add("friction", value=f_nom if f_nom > 0 else 0.1, min=0.0)
-        res = lmfit.minimize(residual, params, args=(a_sl,), kws={"data": y_sl}, method="leastsq")
-        f_fit = float(res.params["friction"].value)
-        f_err = float(res.params["friction"].stderr) if res.params["friction"].stderr is not None else math.nan
-
+    f_fit, f_err = (_fit_friction(contact, data, sliding_threshold_deg, src) if fit_friction
+                    else (math.nan, math.nan))
     e_n = float(engine.solve_normal_many(contact, np.array([KHARAZ_CONDITIONS["speed"]]), rtol=1e-10)["e_n"][0])
-    ds = xr.Dataset()
+
     grid = (np.arange(0.25, 85.0001, 0.25) if curve_incidence_deg is None
             else np.asarray(curve_incidence_deg, dtype=float).reshape(-1))
-    ds.coords["curve_incidence_deg"] = ("curve_incidence_deg", grid, {
-        "units": "degree", "long_name": "incidence angle from the surface normal (model curves)"})
+    ds = xr.Dataset(coords={"curve_incidence_deg": ("curve_incidence_deg", grid, attributes(
+        "incidence_deg", long_name="incidence angle from the surface normal (model curves)"))})
     curves = {"": (_model(contact, grid, f_nom), f"friction {f_nom:g}")}
     if fit_friction:
         curves["_fitted"] = (_model(contact, grid, f_fit), f"fitted friction {f_fit:.4g}")
-    for q, (units, long_name) in _QUANTITIES.items():
-        sub = data[data["quantity"] == q]
-        a = sub["incidence_angle_deg"].to_numpy()
-        meas = sub["value"].to_numpy()
-        mod = _model(contact, a, f_nom)
-        sliding = (a > sliding_threshold_deg).astype(np.int8)
-        for suffix, (curve, label) in curves.items():
-            ds[f"{q}_curve{suffix}"] = ("curve_incidence_deg", curve[q], {
-                "units": units, "long_name": f"model {long_name}, {label}"})
-        ds.coords[f"{q}_incidence_deg"] = ((q,), a, {"units": "degree", "long_name": "incidence angle from the surface normal"})
-        ds[f"{q}_measured"] = ((q,), meas, {"units": units, "long_name": f"measured {long_name} (Kharaz et al. 2001)"})
-        ds[f"{q}_model"] = ((q,), mod[q], {"units": units, "long_name": f"model {long_name}, friction {f_nom:g}"})
-        ds[f"{q}_difference"] = ((q,), mod[q] - meas, {"units": units, "long_name": "model - measured"})
-        ds[f"{q}_sliding"] = ((q,), sliding, {"units": "1", "long_name": f"1 if incidence > {sliding_threshold_deg:g} deg",
-                                              "flag_values": np.array([0, 1], dtype=np.int8),
-                                              "flag_meanings": "below_threshold sliding_regime"})
-        if q == "rebound_spin":
-            ds["omega_out_tp_model"] = ((q,), mod["omega_out_tp"], {
-                "units": "rad s-1", "long_name": "model spin about t' after impact (negative: forward rolling, see notes)"})
-        if fit_friction:
-            mf = _model(contact, a, f_fit)
-            ds[f"{q}_model_fitted"] = ((q,), mf[q], {"units": units, "long_name": f"model {long_name}, fitted friction"})
-            ds[f"{q}_difference_fitted"] = ((q,), mf[q] - meas, {"units": units, "long_name": "model (fitted friction) - measured"})
-        for suffix in ("", "_fitted") if fit_friction else ("",):
-            d = ds[f"{q}_difference{suffix}"].values
-            for regime, mask in (("sliding", sliding == 1), ("below", sliding == 0)):
-                ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
-    ds["friction"] = ((), f_nom, {"units": "1", "long_name": "Coulomb friction coefficient of the nominal model (source value)"})
-    ds["fitted_friction"] = ((), f_fit, {"units": "1", "long_name": f"friction fitted to tangential restitution above {sliding_threshold_deg:g} deg"})
-    ds["fitted_friction_stderr"] = ((), f_err, {"units": "1", "long_name": "standard error of fitted_friction"})
-    ds["e_n_model"] = ((), e_n, {"units": "1", "long_name": "model normal restitution at 3.9 m/s"})
-    ds["zeta_hertz"] = ((), contact.zeta_hertz, {"units": "1", "long_name": "Hertzian damping coefficient used"})
-    ds["rolling_limit"] = ((), 5.0 / 7.0, {"units": "1", "long_name": "tangential restitution of a sphere that ends rolling, no initial spin"})
-    ds["transition_angle"] = ((), math.degrees(math.atan(3.5 * f_nom * (1 + e_n))), {
-        "units": "degree", "long_name": "model sliding/rolling boundary, tan(alpha) = (7/2) f (1 + e_n), nominal friction"})
+    for q in _QUANTITIES:
+        _compare_quantity(ds, q, data[data["quantity"] == q], contact, curves,
+                          {"": f_nom, "_fitted": f_fit} if fit_friction else {"": f_nom}, sliding_threshold_deg)
+    _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg)
     ds.attrs.update({
         "title": "microimpact model vs Kharaz, Gorham & Salman (2001) oblique impacts",
         "source": src,
@@ -260,6 +209,70 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         "Conventions": "CF-1.8",
     })
     return ds
+
+
+def _fit_friction(contact, data, sliding_threshold_deg, src) -> tuple[float, float]:
+    """(friction, its standard error) fitted (lmfit, leastsq) to the tangential restitution above
+    ``sliding_threshold_deg`` [deg]. [-]"""
+    tr = data[data["quantity"] == "tangential_restitution"]
+    sl = tr[tr["incidence_angle_deg"] > sliding_threshold_deg]
+    if len(sl) < 2:
+        raise ValueError(f"{src}: fewer than 2 tangential_restitution points above {sliding_threshold_deg} deg")
+
+    def residual(params, angles, data=None):
+        m = _model(contact, angles, params["friction"].value)["tangential_restitution"]
+        return m if data is None else m - data
+
+    params = lmfit.Parameters()
+    params.add("friction", value=contact.friction if contact.friction > 0 else 0.1, min=0.0)
+    res = lmfit.minimize(residual, params, args=(sl["incidence_angle_deg"].to_numpy(),),
+                         kws={"data": sl["value"].to_numpy()}, method="leastsq")
+    err = res.params["friction"].stderr
+    return float(res.params["friction"].value), float(err) if err is not None else math.nan
+
+
+def _compare_quantity(ds, q, sub, contact, curves, frictions, sliding_threshold_deg) -> None:
+    """Add quantity ``q``'s measured values, model values, differences, curves and RMS to ``ds``.
+
+    ``frictions`` maps the suffix "" (nominal) and, when fitted, "_fitted" to a friction [-]."""
+    units, long_name = _QUANTITIES[q]
+    a = sub["incidence_angle_deg"].to_numpy()
+    meas = sub["value"].to_numpy()
+    sliding = (a > sliding_threshold_deg).astype(np.int8)
+    for suffix, (curve, label) in curves.items():
+        ds[f"{q}_curve{suffix}"] = ("curve_incidence_deg", curve[q], {
+            "units": units, "long_name": f"model {long_name}, {label}"})
+    ds.coords[f"{q}_incidence_deg"] = ((q,), a, attributes("incidence_deg", long_name="incidence angle from the surface normal"))
+    ds[f"{q}_measured"] = ((q,), meas, {"units": units, "long_name": f"measured {long_name} (Kharaz et al. 2001)"})
+    ds[f"{q}_sliding"] = ((q,), sliding, {"units": "1", "long_name": f"1 if incidence > {sliding_threshold_deg:g} deg",
+                                          "flag_values": np.array([0, 1], dtype=np.int8),
+                                          "flag_meanings": "below_threshold sliding_regime"})
+    for suffix, f in frictions.items():
+        mod = _model(contact, a, f)
+        label = f"friction {f:g}" if suffix == "" else "fitted friction"
+        ds[f"{q}_model{suffix}"] = ((q,), mod[q], {"units": units, "long_name": f"model {long_name}, {label}"})
+        ds[f"{q}_difference{suffix}"] = ((q,), mod[q] - meas, {
+            "units": units, "long_name": "model - measured" if suffix == "" else "model (fitted friction) - measured"})
+        if q == "rebound_spin" and suffix == "":
+            ds["omega_out_tp_model"] = ((q,), mod["omega_out_tp"], attributes(
+                "omega_out_tp", long_name="model spin about t' after impact (negative: forward rolling, see notes)"))
+        for regime, mask in (("sliding", sliding == 1), ("below", sliding == 0)):
+            d = ds[f"{q}_difference{suffix}"].values
+            ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
+
+
+def _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg) -> None:
+    """Add the scalar results (frictions, e_n, zeta_H, rolling limit, transition angle) to ``ds``."""
+    ds["friction"] = ((), f_nom, attributes("friction", long_name="Coulomb friction coefficient of the nominal model (source value)"))
+    ds["fitted_friction"] = ((), f_fit, attributes(
+        "friction", long_name=f"friction fitted to tangential restitution above {sliding_threshold_deg:g} deg"))
+    ds["fitted_friction_stderr"] = ((), f_err, attributes("friction", long_name="standard error of fitted_friction"))
+    ds["e_n_model"] = ((), e_n, attributes("e_n", long_name="model normal restitution at 3.9 m/s"))
+    ds["zeta_hertz"] = ((), contact.zeta_hertz, attributes("zeta_hertz", long_name="Hertzian damping coefficient used"))
+    ds["rolling_limit"] = ((), 5.0 / 7.0, attributes(
+        "tangential_restitution", long_name="tangential restitution of a sphere that ends rolling, no initial spin"))
+    ds["transition_angle"] = ((), math.degrees(math.atan(3.5 * f_nom * (1 + e_n))), attributes(
+        "incidence_deg", long_name="model sliding/rolling boundary, tan(alpha) = (7/2) f (1 + e_n), nominal friction"))
 
 
 def kharaz_summary(ds: xr.Dataset) -> pd.DataFrame:
