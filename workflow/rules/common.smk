@@ -23,6 +23,7 @@ if config["data_synthetic"] != "auto":
 config["fit"] = {k: (as_bool(v) if k != "weights" else v) for k, v in config["fit"].items()}
 config["benchmark"] = {"quick": True, "throughput": False, **config["benchmark"]}
 config["benchmark"] = {k: as_bool(v) for k, v in config["benchmark"].items()}
+config["rtol"] = float(config["rtol"])
 # the stress sweep section is optional; its numbers may arrive as text from snakemake --config
 config["stress"] = {"enabled": True, "cases": 20000, "seed": 0, "reference_every": 0, "case_time_limit": 30.0,
                     **config.get("stress", {})}
@@ -38,6 +39,7 @@ SWEEP_CASES = list(config["sweeps"])
 SWEEP_CHUNKS = int(config["sweep_chunks"])
 BENCHMARK_ENABLED = bool(config["benchmark"]["enabled"])
 STRESS_ENABLED = config["stress"]["enabled"]
+RTOL = config["rtol"]
 
 
 def materials_path():
@@ -50,19 +52,16 @@ def materials_path():
     return str(Path(spec.origin).parent / "io" / "materials.yaml")
 
 
-def simulation_contact():
-    """Contact parameters of the simulations, as keyword arguments of microimpact.Contact."""
-    return dict(config["simulation"])
+def sweep_overrides(wildcards):
+    """Keys of the config that replace those of a Table 2 case's grid ({} for none)."""
+    return dict(config["sweeps"][wildcards.case] or {})
 
 
-def sweep_file(case):
-    return f"results/sweeps/case_{case}.nc"
-
-
-def sweep_chunk_files(wildcards):
+def paper_sweep_chunk_files(wildcards):
     n = SWEEP_CHUNKS
     return [
-        f"results/sweeps/chunks/case_{wildcards.case}/chunk_{i}_of_{n}.nc" for i in range(n)
+        f"results/paper/sweeps/chunks/case_{wildcards.case}/chunk_{i}_of_{n}.nc"
+        for i in range(n)
     ]
 
 

@@ -1,13 +1,13 @@
-# Simulations with the paper's parameters (config "simulation", Table 1 row 2 by default):
-# Fig. 5 phase portraits, the numbers of the nonlinear analysis, the Fig. 4 bifurcation plane and
-# the reproduction table of the paper's claims.
+# The reproduction of the paper, from the paper's parameters (config paper_contact; Table 1 row 2
+# by default): Fig. 5 phase portraits, the numbers of the nonlinear analysis, the Fig. 4
+# bifurcation plane and the reproduction table of the paper's claims.
 
 
 rule phase_portraits:
     output:
-        "results/phase_portraits.nc",
+        "results/paper/phase_portraits.nc",
     params:
-        contact=simulation_contact(),
+        contact=config["paper_contact"],
         speeds=config["phase_portrait_speeds"],
     log:
         "logs/phase_portraits.log",
@@ -21,9 +21,9 @@ rule phase_portraits:
 
 rule dynamics_summary:
     output:
-        "results/dynamics.nc",
+        "results/paper/dynamics.nc",
     params:
-        contact=simulation_contact(),
+        contact=config["paper_contact"],
         speeds=config["phase_portrait_speeds"],
     log:
         "logs/dynamics_summary.log",
@@ -37,9 +37,9 @@ rule dynamics_summary:
 
 rule bifurcation:
     output:
-        "results/bifurcation.nc",
+        "results/paper/bifurcation.nc",
     params:
-        contact=simulation_contact(),
+        contact=config["paper_contact"],
         speeds=config["phase_portrait_speeds"],
     log:
         "logs/bifurcation.log",
@@ -53,10 +53,10 @@ rule bifurcation:
 
 rule reproduction:
     output:
-        table="results/reproduction.csv",
-        markdown="results/reproduction.md",
+        table="results/paper/reproduction.csv",
+        markdown="results/paper/reproduction.md",
     params:
-        contact=simulation_contact(),
+        contact=config["paper_contact"],
     log:
         "logs/reproduction.log",
     benchmark:

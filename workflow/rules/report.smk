@@ -1,4 +1,6 @@
-# The PDF report: every result above, laid out by microimpact.report.pdf.build_report.
+# The PDF report (microimpact.report.pdf.build_report): it reads the result files below and runs
+# no model. Keys name the parts: the analyst's material (fit and what it drives), the paper's
+# reproduction, and the checks.
 
 
 rule report:
@@ -7,12 +9,15 @@ rule report:
         unpack(stress_outputs),
         data_table=rules.validate_data.output.table,
         fit=rules.fit.output[0],
+        fit_curves=rules.fit_curves.output[0],
+        flags=rules.flags.output.csv,
+        analyst_dynamics=rules.material_dynamics.output[0],
+        analyst_sweeps=expand("results/analyst/sweeps/case_{case}.nc", case=SWEEP_CASES),
         phase_portraits=rules.phase_portraits.output[0],
         dynamics=rules.dynamics_summary.output[0],
         bifurcation=rules.bifurcation.output[0],
         reproduction=rules.reproduction.output.table,
-        sweeps=[sweep_file(case) for case in SWEEP_CASES],
-        flags=rules.flags.output.csv,
+        paper_sweeps=expand("results/paper/sweeps/case_{case}.nc", case=SWEEP_CASES),
         kharaz=rules.kharaz.output[0],
     output:
         "reports/report.pdf",

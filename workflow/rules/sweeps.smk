@@ -1,15 +1,17 @@
-# Sensitivity sweeps of Table 2 (Figs. 7-14), one NetCDF file per case. With sweep_chunks > 1
-# each case is split along the speed axis into chunk jobs (for a cluster) and gathered again;
-# the gathered file equals the unchunked one.
+# Sensitivity sweeps of Table 2 (Figs. 7-14) with the paper's parameters, one NetCDF file per
+# case. With sweep_chunks > 1 each case is split along the speed axis into chunk jobs (for a
+# cluster) and gathered again; the gathered file equals the unchunked one. The analyst's sweeps
+# (fitted material) are in fit.smk.
 
 if SWEEP_CHUNKS == 1:
 
-    rule sweep:
+    rule paper_sweep:
         output:
-            "results/sweeps/case_{case}.nc",
+            "results/paper/sweeps/case_{case}.nc",
         params:
-            contact=simulation_contact(),
-            spec=lambda wildcards: config["sweeps"][wildcards.case],
+            contact=config["paper_contact"],
+            overrides=sweep_overrides,
+            rtol=RTOL,
         log:
             "logs/sweeps/case_{case}.log",
         benchmark:
@@ -21,12 +23,13 @@ if SWEEP_CHUNKS == 1:
 
 else:
 
-    rule sweep_chunk:
+    rule paper_sweep_chunk:
         output:
-            "results/sweeps/chunks/case_{case}/chunk_{chunk}_of_{nchunks}.nc",
+            "results/paper/sweeps/chunks/case_{case}/chunk_{chunk}_of_{nchunks}.nc",
         params:
-            contact=simulation_contact(),
-            spec=lambda wildcards: config["sweeps"][wildcards.case],
+            contact=config["paper_contact"],
+            overrides=sweep_overrides,
+            rtol=RTOL,
         log:
             "logs/sweeps/case_{case}_chunk_{chunk}_of_{nchunks}.log",
         benchmark:
@@ -36,11 +39,11 @@ else:
         script:
             "../scripts/sweep_chunk.py"
 
-    rule gather_sweep:
+    rule gather_paper_sweep:
         input:
-            sweep_chunk_files,
+            paper_sweep_chunk_files,
         output:
-            "results/sweeps/case_{case}.nc",
+            "results/paper/sweeps/case_{case}.nc",
         log:
             "logs/sweeps/gather_case_{case}.log",
         benchmark:

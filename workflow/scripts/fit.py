@@ -1,4 +1,4 @@
-"""Rule fit: zeta_H, zeta_A (optionally w_A) from the measured e_n(v_n) -> results/fit.nc."""
+"""Rule fit: zeta_H, zeta_A (optionally w_A) from the measured e_n(v_n) -> results/analyst/fit.nc."""
 
 import sys
 
@@ -9,6 +9,6 @@ from microimpact.io import read_impacts, read_materials  # noqa: E402
 
 table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821
 base = read_materials(snakemake.input.materials)[snakemake.params.material_pair]  # noqa: F821
-fit = fit_damping(table, base, **snakemake.params.options)  # noqa: F821
+fit = fit_damping(table, base, rtol=snakemake.params.rtol, **snakemake.params.options)  # noqa: F821
 fit.save(snakemake.output[0])  # noqa: F821
 print(fit.report())

@@ -1,5 +1,5 @@
 """Rule flags: each measured impact's sensitivity to unmeasured spin and angle error, and whether it
-is near capture, under the fitted model -> results/flags.csv + results/flags.nc."""
+is near capture, under the fitted model -> results/analyst/flags.csv + results/analyst/flags.nc."""
 
 import sys
 
@@ -10,6 +10,6 @@ from microimpact.analysis.fitting import DampingFit  # noqa: E402
 from microimpact.io import read_impacts  # noqa: E402
 
 table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821
-ds = flag_measurements(table, DampingFit.load(snakemake.input.fit))  # noqa: F821
+ds = flag_measurements(table, DampingFit.load(snakemake.input.fit), rtol=snakemake.params.rtol)  # noqa: F821
 write_flags(ds, snakemake.output.csv, snakemake.output.nc)  # noqa: F821
 print(ds)

@@ -4,11 +4,13 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
-from microimpact import Contact  # noqa: E402
 from microimpact.io import write_csv  # noqa: E402
+from microimpact.studies.material import named_contact  # noqa: E402
 from microimpact.studies.reproduction import reproduction_table, write_reproduction_markdown  # noqa: E402
 
-table = reproduction_table(Contact(**snakemake.params.contact))  # noqa: F821
+contact, source = named_contact(snakemake.params.contact)  # noqa: F821
+table = reproduction_table(contact)
+table.attrs["parameter_source"] = source
 write_csv(table, snakemake.output.table)  # noqa: F821
 write_reproduction_markdown(table, snakemake.output.markdown)  # noqa: F821
 print(table.to_string())

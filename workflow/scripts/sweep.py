@@ -1,12 +1,15 @@
-"""Rule sweep: one Table 2 case on its grid -> results/sweeps/case_<case>.nc."""
+"""Rule paper_sweep: one Table 2 case with the paper's contact -> results/paper/sweeps/case_<case>.nc."""
 
 import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
-from microimpact import Contact  # noqa: E402
-from microimpact.studies.sweeps import run_sweep, save_sweep  # noqa: E402
+from microimpact.studies.material import named_contact, stamp_parameters  # noqa: E402
+from microimpact.studies.sweeps import case_spec, run_sweep, save_sweep  # noqa: E402
 
-ds = run_sweep(Contact(**snakemake.params.contact), snakemake.params.spec, case=snakemake.wildcards.case)  # noqa: F821
-save_sweep(ds, snakemake.output[0])  # noqa: F821
+params = snakemake.params  # noqa: F821
+contact, source = named_contact(params.contact)
+case = snakemake.wildcards.case  # noqa: F821
+ds = run_sweep(contact, case_spec(case, params.overrides), case=case, rtol=params.rtol)
+save_sweep(stamp_parameters(ds, contact, source), snakemake.output[0])  # noqa: F821
 print(ds)

@@ -48,11 +48,12 @@ import numpy as np
 import xarray as xr
 
 from microimpact.io.variables import attributes
-from microimpact.model.parameters import TABLE2_CASES
+from microimpact.model.parameters import TABLE2_CASES, table2_case
 from microimpact.model.contact import PAPER_REFERENCE
 
 __all__ = [
     "TABLE2_CASES",
+    "case_spec",
     "SWEEP_INPUTS",
     "SweepSpecError",
     "resolve_spec",
@@ -221,6 +222,29 @@ def _spec_json(spec: Mapping) -> str:
 # ----------------------------------------------------------------------------- running
 def _now() -> str:
     return datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+
+
+def case_spec(case: str, overrides: Mapping | None = None) -> dict:
+    """The grid of Table 2 case ``case`` with some of its keys replaced.
+
+    Parameters
+    ----------
+    case : str
+        "2.1" ... "2.5" (:data:`microimpact.model.parameters.TABLE2_CASES`).
+    overrides : mapping, optional
+        Spec keys (module docstring) that replace the case's; the description then says so.
+
+    Raises
+    ------
+    ValueError
+        For an unknown case (the message lists the known ones).
+    """
+    spec = table2_case(case)
+    changed = {k: v for k, v in (overrides or {}).items() if k != "description"}
+    if changed:
+        spec.update(changed)
+        spec["description"] += f" (grid changed by the configuration: {', '.join(sorted(changed))})"
+    return spec
 
 
 def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, rtol: float = 1e-8,

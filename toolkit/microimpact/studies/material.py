@@ -1,0 +1,180 @@
+"""The analyst's material: the fitted parameters drive the simulations and the sweeps.
+
+A damping fit (:mod:`microimpact.analysis.fitting`) gives zeta_H, zeta_A and one work of adhesion
+w_A for a material pair; each measured sphere size then has its own contact (f0 from w_A by
+Eq. (7), :meth:`Contact.at_radius`). This module turns a fit into the 3-D simulations of that
+material: the Table 2 sweeps at every measured size over the measured speed range, and the
+numbers of the nonlinear analysis (critical and capture velocity) per size.
+
+Every result records where its parameters came from in the ``parameter_source`` attribute:
+``"fit: <data file> <sha256>"`` for a fit, ``"preset: <name>"`` for a named parameter set of the
+paper (:mod:`microimpact.model.parameters`), ``"config"`` for numbers given in a config; and the
+contact itself in ``contact_*`` attributes (one value per size along ``radius`` for the
+analyst's results).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import xarray as xr
+
+from microimpact.analysis.fitting import DampingFit
+from microimpact.dynamics.nonlinear import capture_velocity, critical_velocity
+from microimpact.io.variables import attributes
+from microimpact.model.contact import Contact
+from microimpact.presets import get_preset
+from microimpact.solvers import DEFAULT_RTOL
+from microimpact.studies.sweeps import resolve_spec, run_sweep
+
+__all__ = [
+    "fit_parameter_source",
+    "preset_parameter_source",
+    "stamp_parameters",
+    "fitted_contacts",
+    "measured_speed_range",
+    "material_sweep",
+    "material_dynamics",
+    "named_contact",
+]
+
+
+def fit_parameter_source(fit: xr.Dataset) -> str:
+    """``"fit: <data file> <sha256>"`` of a fit Dataset (:meth:`DampingFit.to_dataset`)."""
+    source = fit.attrs.get("fit_source") or "unknown data"
+    sha = fit.attrs.get("fit_sha256") or "sha256 unknown"
+    return f"fit: {source} {sha}"
+
+
+def preset_parameter_source(name: str) -> str:
+    """``"preset: <name>"``: parameters from a named set of :mod:`microimpact.presets`."""
+    return f"preset: {name}"
+
+
+def named_contact(spec: str | Mapping) -> tuple[Contact, str]:
+    """The contact that a config names, and its ``parameter_source``.
+
+    Parameters
+    ----------
+    spec : str or mapping
+        A preset name (:data:`microimpact.presets.PRESETS`, e.g. ``"wall1990"`` = Table 1 row 2)
+        or a mapping of :class:`Contact` fields in SI units.
+
+    Returns
+    -------
+    (Contact, str)
+        The contact and ``"preset: <name>"`` or ``"config"``.
+    """
+    if isinstance(spec, str):
+        return get_preset(spec), preset_parameter_source(spec.lower())
+    return Contact(**spec), "config"
+
+
+def stamp_parameters(ds: xr.Dataset, contacts: Contact | Sequence[Contact], source: str) -> xr.Dataset:
+    """``ds`` with ``parameter_source`` and the ``contact_*`` attributes of the contact(s) used.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+    contacts : Contact or sequence of Contact
+        One contact, or one per size (the attributes are then arrays, in that order).
+    source : str
+        Provenance of the parameters (module docstring).
+    """
+    many = not isinstance(contacts, Contact)
+    group = list(contacts) if many else [contacts]
+    attrs = {}
+    for name in Contact.__dataclass_fields__:
+        values = [getattr(c, name) for c in group]
+        if any(v is None for v in values):  # damping reference speed: each impact's own
+            attrs[f"contact_{name}"] = "per-impact normal speed"
+        else:
+            attrs[f"contact_{name}"] = np.array(values, dtype=float) if many else float(values[0])
+    out = ds.copy()
+    out.attrs.update(attrs)
+    out.attrs["parameter_source"] = source
+    return out
+
+
+def fitted_contacts(fit: xr.Dataset, radii: Sequence[float] | None = None) -> dict[float, Contact]:
+    """The fitted contact of every measured sphere size (or of the given radii). [m] -> Contact"""
+    model = DampingFit.from_dataset(fit)
+    sizes = np.unique(fit["radius"].values) if radii is None else np.asarray(radii, dtype=float)
+    return {float(r): model.contact(float(r)) for r in sizes}
+
+
+def measured_speed_range(fit: xr.Dataset) -> tuple[float, float]:
+    """Smallest and largest measured normal impact speed of the fitted points. [m/s]"""
+    v = np.asarray(fit["normal_speed"].values, dtype=float)
+    return float(v.min()), float(v.max())
+
+
+def _on_measured_speeds(spec: Mapping, speed_range: tuple[float, float]) -> dict:
+    """``spec`` with its speed axis moved onto the measured range (same number of points)."""
+    n = np.size(resolve_spec({"speed": spec["speed"]})["speed"])
+    out = dict(spec)
+    out["speed"] = {"start": speed_range[0], "stop": speed_range[1], "num": max(int(n), 2)}
+    return out
+
+
+def material_sweep(fit: xr.Dataset, spec: Mapping, *, case: str | None = None,
+                   rtol: float = DEFAULT_RTOL) -> xr.Dataset:
+    """A sweep of the analyst's material: every measured size, the measured speed range.
+
+    Parameters
+    ----------
+    fit : xarray.Dataset
+        The damping fit (:meth:`DampingFit.to_dataset`, or the fit NetCDF read back).
+    spec : mapping
+        A sweep spec (:mod:`microimpact.studies.sweeps`), e.g. a Table 2 case; its speed axis is
+        replaced by as many speeds spanning the measured normal speeds.
+    case : str, optional
+        Label recorded in the attributes.
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+
+    Returns
+    -------
+    xarray.Dataset
+        The sweep with a leading ``radius`` dimension [m] (one fitted contact per size), the
+        capture speed per size, ``parameter_source`` = ``"fit: <file> <sha256>"`` and
+        ``contact_*`` attributes as arrays along ``radius``.
+    """
+    contacts = fitted_contacts(fit)
+    grid = _on_measured_speeds(spec, measured_speed_range(fit))
+    parts = [run_sweep(c, grid, case=case, rtol=rtol) for c in contacts.values()]
+    capture = [float(p["capture_normal_speed"]) for p in parts]
+    parts = [p.drop_vars("capture_normal_speed") for p in parts]
+    per_size = [name for name, var in parts[0].data_vars.items() if var.ndim > 0]  # fixed inputs stay 0-d
+    ds = xr.concat(parts, dim=xr.DataArray(list(contacts), dims="radius", name="radius"), data_vars=per_size,
+                   coords="minimal", compat="override", join="exact", combine_attrs="override")
+    ds["radius"].attrs = attributes("radius")
+    ds["capture_normal_speed"] = ("radius", capture, attributes("capture_normal_speed"))
+    ds.attrs["title"] = ds.attrs["title"].replace("sweep:", "sweep of the fitted material:", 1)
+    return stamp_parameters(ds, list(contacts.values()), fit_parameter_source(fit))
+
+
+def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL) -> xr.Dataset:
+    """Critical velocity (Eq. (38)) and capture velocity of the fitted material at every measured size.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``critical_velocity`` and ``capture_velocity`` [m/s] along ``radius`` [m], with
+        ``parameter_source`` and ``contact_*`` attributes (arrays along ``radius``).
+    """
+    contacts = fitted_contacts(fit)
+    radii = np.array(list(contacts))
+    ds = xr.Dataset(
+        {
+            "critical_velocity": ("radius", [critical_velocity(c) for c in contacts.values()],
+                                  {"units": "m s-1", "long_name": "critical velocity v_c, Eq. (38)"}),
+            "capture_velocity": ("radius", [capture_velocity(c, solver_rtol=rtol) for c in contacts.values()],
+                                 attributes("capture_normal_speed")),
+        },
+        coords={"radius": ("radius", radii, attributes("radius"))},
+        attrs={"Conventions": "CF-1.8",
+               "title": "Critical and capture velocity of the fitted material at the measured sizes"},
+    )
+    return stamp_parameters(ds, list(contacts.values()), fit_parameter_source(fit))
