@@ -220,6 +220,7 @@ def read_netcdf_groups(path) -> list:
         One Dataset per group (the root first if it has variables), with its own coordinates and
         attributes.
     """
+    # imported here: io.files serves every writer, also the CSV-only ones, which need neither
     import netCDF4
     import xarray as xr
 

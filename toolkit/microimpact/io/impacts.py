@@ -61,6 +61,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from microimpact.io.materials import read_materials
 from microimpact.io.units import INTERNAL_UNIT, UnitError, accepted_units, conversion_factor, parse_header_field
 
 __all__ = [
@@ -243,6 +244,14 @@ class _Column:
 # --------------------------------------------------------------------------- header
 def _check_header(fields: list[str]) -> tuple[dict[str, _Column], dict[str, float], list[Problem], list[str]]:
     """Columns by name, unit factors, header problems and ignored fields."""
+    columns, factors, problems, ignored, misplaced_unit = _header_columns(fields)
+    problems += _header_combinations(columns, misplaced_unit)
+    return columns, factors, problems, ignored
+
+
+def _header_columns(fields: list[str]):
+    """Each header field on its own: (columns by name, unit factors, problems, ignored fields, names
+    written with a unit in round brackets)."""
     problems: list[Problem] = []
     ignored: list[str] = []
     columns: dict[str, _Column] = {}
@@ -287,6 +296,13 @@ def _check_header(fields: list[str]) -> tuple[dict[str, _Column], dict[str, floa
             factors[name] = conversion_factor(unit, dim) * _QUANTITIES[name].scale
         except UnitError as e:
             problems.append(Problem(str(e), line=1, column=col.field))
+    return columns, factors, problems, ignored, misplaced_unit
+
+
+def _header_combinations(columns: Mapping[str, _Column], misplaced_unit: set[str]) -> list[Problem]:
+    """The header's columns together: a quantity given twice, required columns missing, an
+    uncertainty without its quantity. ``misplaced_unit`` names count as present (reported once)."""
+    problems: list[Problem] = []
 
     def have(*names):
         return [n for n in names if n in columns]
@@ -342,7 +358,7 @@ def _check_header(fields: list[str]) -> tuple[dict[str, _Column], dict[str, floa
                 problems.append(Problem(
                     f"uncertainty column without a {base!r} column; add '{base} [unit]' or drop it",
                     line=1, column=columns[name].field))
-    return columns, factors, problems, ignored
+    return problems
 
 
 def _required(columns: Mapping[str, _Column]) -> set[str]:
@@ -432,23 +448,70 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
         For columns that are not part of the format; they are ignored.
     """
     source = os.fspath(path)
-    name = Path(source).name
     data = Path(source).read_bytes()
     sha256 = hashlib.sha256(data).hexdigest()
+    header, header_line, records, problems = _read_records(source, data)
+    columns, factors, header_problems, ignored = _check_header(header)
+    if header_line != 1:
+        header_problems = [Problem(p.message, p.row, header_line, p.column, p.value) for p in header_problems]
+    problems += header_problems
+    if ignored:
+        _warn_ignored(Path(source).name, ignored)
+    if not records:
+        problems.append(Problem(
+            "the file has a header but no data rows; add one row per impact", line=header_line))
+        raise ImpactDataError(source, problems)
+
+    # rows with the wrong number of fields are reported and left out of the value checks
+    records, ragged = _drop_ragged(records, len(header))
+    problems += ragged
+    cells = _Cells(columns, records)
+    values = _numeric_values(cells, columns, factors, problems)
+    labels = _labels(cells, columns, materials, problems)
+    if any(p.row is None for p in problems):
+        raise ImpactDataError(source, _sorted(problems))  # header broken: derived checks are moot
+
+    out = _derive(values, cells.n)
+    if "rebound_normal_speed" in values:
+        _check_rebound(cells, columns["rebound_normal_speed"], out, problems)
+    if problems:
+        raise ImpactDataError(source, _sorted(problems))
+
+    frame = {"row": cells.rows, "line": cells.lines}
+    for cname in _LABELS:
+        frame[cname] = pd.array(labels.get(cname, [None] * cells.n), dtype="string")
+    frame |= {k: out[k] for k in CANONICAL_COLUMNS if k in out}
+    df = pd.DataFrame(frame, columns=list(CANONICAL_COLUMNS))
+    df.attrs["source"] = source
+    df.attrs["sha256"] = sha256
+    df.attrs["units"] = dict(COLUMN_UNITS)
+    return df
+
+
+@dataclass(frozen=True)
+class _Record:
+    """One non-blank CSV record: its fields, 1-based data row and the file line where it starts."""
+
+    fields: list
+    row: int
+    line: int
+
+
+def _read_records(source: str, data: bytes) -> tuple[list[str], int, list[_Record], list[Problem]]:
+    """(header fields, header line, data records, problems so far) of the file's bytes.
+
+    Raises :class:`ImpactDataError` for a blank file, text that is not CSV, or a delimiter other
+    than the comma."""
     if not data.strip(_BOM + b" \t\r\n"):
         what = "empty (0 bytes)" if not data else "blank (only whitespace)"
         raise ImpactDataError(source, [Problem(
             f"the file is {what}; expected a header line such as "
             "'radius [um],speed [m/s],incidence_angle [deg],e_n [1]' followed by one row per impact")])
     text, problems = _decode(data)
-
     reader = csv.reader(_stdio.StringIO(text, newline=""))
     header: list[str] | None = None
     header_line = 1
-    records: list[list[str]] = []
-    rows: list[int] = []
-    lines: list[int] = []
-    ragged: list[Problem] = []
+    records: list[_Record] = []
     prev = 0
     try:
         for rec in reader:
@@ -458,14 +521,11 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
             if header is None:
                 header, header_line = rec, start
                 continue
-            rows.append(len(rows) + 1)
-            lines.append(start)
-            records.append(rec)
+            records.append(_Record(rec, len(records) + 1, start))
     except csv.Error as e:  # e.g. NUL byte
         problems.append(Problem(f"cannot be parsed as CSV: {e}", line=reader.line_num))
         raise ImpactDataError(source, problems) from None
     assert header is not None  # the file is not blank
-
     if len(header) == 1:
         for delim, label in ((";", "';' (semicolon)"), ("\t", "tabs")):
             if delim in header[0]:
@@ -473,68 +533,68 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
                     f"the file uses {label} to separate columns; ',' (comma) is required, with '.' "
                     "as the decimal point; re-export it as comma-separated CSV", line=header_line))
                 raise ImpactDataError(source, problems)
+    return header, header_line, records, problems
 
-    columns, factors, header_problems, ignored = _check_header(header)
-    if header_line != 1:
-        header_problems = [Problem(p.message, p.row, header_line, p.column, p.value) for p in header_problems]
-    problems += header_problems
-    if ignored:
-        hints = []
-        for f in ignored:
-            close = difflib.get_close_matches(parse_header_field(f)[0], _KNOWN, n=1)
-            hints.append(f"{f!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
-        warnings.warn(
-            f"{name}: ignoring columns that are not part of the impact format: {', '.join(hints)}",
-            ImpactDataWarning, stacklevel=2)
-    if not records:
-        problems.append(Problem(
-            "the file has a header but no data rows; add one row per impact", line=header_line))
-        raise ImpactDataError(source, problems)
 
-    # rows with the wrong number of fields are reported and left out of the value checks
-    width = len(header)
-    keep = []
-    for i, rec in enumerate(records):
-        if len(rec) == width:
-            keep.append(i)
-            continue
-        hint = " (a decimal comma? use '.' as the decimal point)" if len(rec) > width else ""
-        ragged.append(Problem(
-            f"has {len(rec)} fields but the header has {width} columns{hint}",
-            row=rows[i], line=lines[i], value=",".join(rec)))
-    problems += ragged
-    if len(keep) != len(records):
-        records = [records[i] for i in keep]
-        rows = [rows[i] for i in keep]
-        lines = [lines[i] for i in keep]
-    n = len(records)
-    row_arr = np.asarray(rows, dtype=np.int64)
-    line_arr = np.asarray(lines, dtype=np.int64)
-    cells = {c.name: np.array([rec[c.index].strip() for rec in records], dtype=object) for c in columns.values()}
+def _warn_ignored(name: str, ignored: list[str]) -> None:
+    """One :class:`ImpactDataWarning` naming the ignored columns, with the closest known name."""
+    hints = []
+    for f in ignored:
+        close = difflib.get_close_matches(parse_header_field(f)[0], _KNOWN, n=1)
+        hints.append(f"{f!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
+    warnings.warn(
+        f"{name}: ignoring columns that are not part of the impact format: {', '.join(hints)}",
+        ImpactDataWarning, stacklevel=3)
 
-    def cell_problems(mask, col: _Column, message: str):
-        for i in np.flatnonzero(mask):
-            problems.append(Problem(message, int(row_arr[i]), int(line_arr[i]), col.field, cells[col.name][i]))
 
+def _drop_ragged(records: list[_Record], width: int) -> tuple[list[_Record], list[Problem]]:
+    """(records with ``width`` fields, a problem for each other record)."""
+    problems = []
+    for rec in records:
+        if len(rec.fields) != width:
+            hint = " (a decimal comma? use '.' as the decimal point)" if len(rec.fields) > width else ""
+            problems.append(Problem(f"has {len(rec.fields)} fields but the header has {width} columns{hint}",
+                                    row=rec.row, line=rec.line, value=",".join(rec.fields)))
+    return [rec for rec in records if len(rec.fields) == width], problems
+
+
+class _Cells:
+    """The cells of the known columns (stripped text) with the data row and line of each record."""
+
+    def __init__(self, columns: Mapping[str, _Column], records: list[_Record]):
+        self.n = len(records)
+        self.rows = np.asarray([r.row for r in records], dtype=np.int64)
+        self.lines = np.asarray([r.line for r in records], dtype=np.int64)
+        self.text = {c.name: np.array([r.fields[c.index].strip() for r in records], dtype=object)
+                     for c in columns.values()}
+
+    def problems(self, mask, col: _Column, message: str) -> list[Problem]:
+        """A problem of column ``col`` for every record where ``mask`` is true."""
+        return [Problem(message, int(self.rows[i]), int(self.lines[i]), col.field, self.text[col.name][i])
+                for i in np.flatnonzero(mask)]
+
+
+def _numeric_values(cells: _Cells, columns, factors, problems: list[Problem]) -> dict[str, np.ndarray]:
+    """Numeric columns in internal units under their canonical names (NaN where not a valid
+    number); appends a problem for every cell that is not a number, empty where required, not
+    finite or out of range."""
     required = _required(columns)
     values: dict[str, np.ndarray] = {}
     for cname, col in columns.items():
         if cname in _LABELS:
             continue
         q = _QUANTITIES[cname]
-        raw = cells[cname]
+        raw = cells.text[cname]
         num = pd.to_numeric(pd.Series(raw), errors="coerce").to_numpy(dtype=float)
-        missing = np.zeros(n, dtype=bool)
+        missing = np.zeros(cells.n, dtype=bool)
         nan_idx = np.flatnonzero(np.isnan(num))
         missing[nan_idx] = [raw[i].lower() in _MISSING for i in nan_idx]
         unit = col.unit if cname in factors else INTERNAL_UNIT[q.dimension]
         in_unit = " (unitless)" if q.dimension == "dimensionless" else f" in {unit}"
-        text_bad = np.isnan(num) & ~missing
-        cell_problems(text_bad, col, f"is not a number; expected a number{in_unit}")
+        problems += cells.problems(np.isnan(num) & ~missing, col, f"is not a number; expected a number{in_unit}")
         if cname in required:
-            cell_problems(missing, col, f"empty or NaN cell in a required column; give a number{in_unit}")
-        inf = np.isinf(num)
-        cell_problems(inf, col, f"is not finite; expected a finite number{in_unit}")
+            problems += cells.problems(missing, col, f"empty or NaN cell in a required column; give a number{in_unit}")
+        problems += cells.problems(np.isinf(num), col, f"is not finite; expected a finite number{in_unit}")
         if cname not in factors:
             continue  # unit unknown: range checks would be meaningless
         x = num * factors[cname]
@@ -543,65 +603,46 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
         what = "uncertainty must be" if cname.endswith("_uncertainty") else "must be"
         if q.dimension == "angle" and unit not in ("deg", "degree", "degrees", "\u00b0"):
             for i in np.flatnonzero(out_of_range):
-                problems.append(Problem(
-                    f"is {x[i]:.6g} deg; {what} {q.range_text()}",
-                    int(row_arr[i]), int(line_arr[i]), col.field, raw[i]))
+                problems.append(Problem(f"is {x[i]:.6g} deg; {what} {q.range_text()}",
+                                        int(cells.rows[i]), int(cells.lines[i]), col.field, raw[i]))
         else:
             qualifier = " (speeds are magnitudes)" if q.dimension == "speed" and q.low == 0 else ""
-            cell_problems(out_of_range, col, f"{what} {q.range_text()}{qualifier}")
-        x = np.where(np.isfinite(x), x, np.nan)
-        values[q.canonical] = x
+            problems += cells.problems(out_of_range, col, f"{what} {q.range_text()}{qualifier}")
+        values[q.canonical] = np.where(np.isfinite(x), x, np.nan)
+    return values
 
-    labels: dict[str, np.ndarray] = {}
-    for cname in _LABELS:
-        if cname in columns:
-            raw = cells[cname]
-            labels[cname] = np.where(raw == "", None, raw)
+
+def _labels(cells: _Cells, columns, materials, problems: list[Problem]) -> dict[str, np.ndarray]:
+    """Text label columns (None where empty); appends problems for repeated ids and for material
+    pairs that are not in ``materials`` (a mapping or the path of a materials config)."""
+    labels = {c: np.where(cells.text[c] == "", None, cells.text[c]) for c in _LABELS if c in columns}
     if "id" in labels:
         ids = pd.Series(labels["id"])
         dup = ids.notna() & ids.duplicated(keep="first")
         for i in np.flatnonzero(dup.to_numpy()):
-            first = int(row_arr[np.flatnonzero((ids == ids.iloc[i]).to_numpy())[0]])
+            first = int(cells.rows[np.flatnonzero((ids == ids.iloc[i]).to_numpy())[0]])
             problems.append(Problem(
                 f"id is not unique (first on row {first}); give each impact its own id",
-                int(row_arr[i]), int(line_arr[i]), columns["id"].field, labels["id"][i]))
+                int(cells.rows[i]), int(cells.lines[i]), columns["id"].field, labels["id"][i]))
     if materials is not None and "material_pair" in labels:
         if not isinstance(materials, Mapping):
-            from microimpact.io.materials import read_materials
-
             materials = read_materials(materials)
-        known = sorted(materials)
         bad = np.array([m is not None and m not in materials for m in labels["material_pair"]], dtype=bool)
-        cell_problems(bad, columns["material_pair"],
-                      f"is not a pair in the materials config; known pairs: {', '.join(known)}")
+        problems += cells.problems(bad, columns["material_pair"],
+                                   f"is not a pair in the materials config; known pairs: {', '.join(sorted(materials))}")
+    return labels
 
-    if any(p.row is None for p in problems):
-        raise ImpactDataError(source, _sorted(problems))  # header broken: derived checks are moot
 
-    out = _derive(values, n)
-    # checks that need derived values
+def _check_rebound(cells: _Cells, col: _Column, out: dict, problems: list[Problem]) -> None:
+    """Append a problem for every rebound normal speed larger than the incident one (e_n > 1)."""
     vn, r = out["normal_speed"], out["rebound_normal_speed"]
-    if "rebound_normal_speed" in values:
-        with np.errstate(invalid="ignore"):
-            too_fast = r > vn
-        col = columns["rebound_normal_speed"]
-        for i in np.flatnonzero(too_fast):
-            problems.append(Problem(
-                f"is larger than the incident normal speed ({vn[i]:.6g} m/s), so e_n = "
-                f"{r[i] / vn[i]:.4g} > 1; e_n must be in [0, 1]",
-                int(row_arr[i]), int(line_arr[i]), col.field, cells["rebound_normal_speed"][i]))
-    if problems:
-        raise ImpactDataError(source, _sorted(problems))
-
-    frame = {"row": row_arr, "line": line_arr}
-    for cname in _LABELS:
-        frame[cname] = pd.array(labels.get(cname, [None] * n), dtype="string")
-    frame |= {k: out[k] for k in CANONICAL_COLUMNS if k in out}
-    df = pd.DataFrame(frame, columns=list(CANONICAL_COLUMNS))
-    df.attrs["source"] = source
-    df.attrs["sha256"] = sha256
-    df.attrs["units"] = dict(COLUMN_UNITS)
-    return df
+    with np.errstate(invalid="ignore"):
+        too_fast = r > vn
+    for i in np.flatnonzero(too_fast):
+        problems.append(Problem(
+            f"is larger than the incident normal speed ({vn[i]:.6g} m/s), so e_n = "
+            f"{r[i] / vn[i]:.4g} > 1; e_n must be in [0, 1]",
+            int(cells.rows[i]), int(cells.lines[i]), col.field, cells.text["rebound_normal_speed"][i]))
 
 
 def _sorted(problems: list[Problem]) -> list[Problem]:
