@@ -1,7 +1,12 @@
-"""Command line: ``microimpact simulate | sweep | fit | flags | benchmark ...``.
+"""Command line: ``microimpact simulate | sweep | fit | flags | reproduce``.
 
-Bad arguments print one line ``microimpact: error: ...`` to stderr and exit with status 2; nothing
-is written then.
+Thin: parse, call the library, print or write. Bad arguments print one line
+``microimpact: error: ...`` to stderr and exit with status 2; nothing is written then.
+
+Each command imports the part of the library it runs inside its own function: ``microimpact
+--help`` or ``microimpact simulate`` then never loads lmfit, pandas or the report, which keeps the
+start-up short. Defaults (the preset, the Table 2 grids, rtol) come from the library's one home
+of each: :mod:`microimpact.model.parameters`, :data:`microimpact.solvers.DEFAULT_RTOL`.
 """
 
 from __future__ import annotations
@@ -11,10 +16,13 @@ import json
 import math
 import sys
 from dataclasses import fields
+from pathlib import Path
 
 from microimpact import __version__
 from microimpact.model.contact import Contact
+from microimpact.model.parameters import TABLE2_CASES
 from microimpact.presets import PRESETS, get_preset
+from microimpact.solvers import DEFAULT_RTOL, METHODS
 
 __all__ = ["main", "build_parser"]
 
@@ -85,32 +93,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--omega-n", type=_finite_float, default=0.0, help="initial spin about n [rad/s]")
     p.add_argument("--omega-t", type=_finite_float, default=0.0, help="initial spin about t [rad/s]")
     p.add_argument("--omega-tp", type=_finite_float, default=0.0, help="initial spin about t' [rad/s]")
-    p.add_argument("--rtol", type=_finite_float, default=1e-10, help="relative tolerance")
-    p.add_argument("--method", choices=("engine", "reference"), default="engine")
+    _add_rtol(p)
+    p.add_argument("--method", choices=METHODS, default="engine", help="solver (default engine)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_cmd_simulate)
 
-    for register in _EXTRA_COMMANDS:
+    for register in (register_sweep, register_fit, register_flags, register_reproduce):
         register(sub)
     return parser
 
 
-# Other modules add subcommands here: callables taking the subparsers object.
-_EXTRA_COMMANDS: list = []
+def _add_rtol(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--rtol", type=_finite_float, default=DEFAULT_RTOL,
+                   help=f"relative tolerance of the normal solves (default {DEFAULT_RTOL:g})")
 
 
 # ------------------------------------------------------------------ fit, flags (microimpact.analysis.fitting, .diagnostics)
 def _existing_file(path: str, what: str):
-    from pathlib import Path
-
     if not Path(path).is_file():
         raise UsageError(f"{what} {path!r} does not exist or is not a file")
     return Path(path)
 
 
 def _writable(path: str, what: str):
-    from pathlib import Path
-
     p = Path(path)
     if not (p.parent if str(p.parent) else Path(".")).is_dir():
         raise UsageError(f"{what} {path!r}: directory {str(p.parent)!r} does not exist")
@@ -146,7 +151,7 @@ def _cmd_fit(args) -> int:
     table, pair = _impacts_for_pair(args)
     print(f"fitting {len(table)} impacts of {pair.name} ...", file=sys.stderr, flush=True)
     fit = fit_damping(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
-                      confidence_intervals=not args.no_confidence_intervals)
+                      confidence_intervals=not args.no_confidence_intervals, rtol=args.rtol)
     fit.save(out)
     print(fit.report())
     print(f"wrote {out}", file=sys.stderr)
@@ -162,6 +167,7 @@ def register_fit(sub) -> None:
     p.add_argument("--fit-work-of-adhesion", action="store_true", help="also fit w_A (shared by all radii)")
     p.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto", help="weighting (default auto)")
     p.add_argument("--no-confidence-intervals", action="store_true", help="skip lmfit.conf_interval (faster)")
+    _add_rtol(p)
     p.add_argument("--out", required=True, help="output NetCDF of the fit")
     p.set_defaults(func=_cmd_fit)
 
@@ -175,7 +181,7 @@ def _cmd_flags(args) -> int:
     fit = DampingFit.load(_existing_file(args.fit, "fit file"))
     table, _ = _impacts_for_pair(args)
     ds = flag_measurements(table, fit, spin_bound=args.spin_bound, angle_uncertainty_deg=args.angle_uncertainty_deg,
-                           progress=True)
+                           rtol=args.rtol, progress=True)
     write_flags(ds, out, nc)
     n = ds.sizes["impact"]
     print(f"{n} impacts: {int(ds['rotation_sensitive'].sum())} rotation_sensitive, "
@@ -197,15 +203,16 @@ def register_flags(sub) -> None:
                    help="largest initial spin sampled [rad/s] (default: speed / radius per impact)")
     p.add_argument("--angle-uncertainty-deg", type=_finite_float, default=None, metavar="DEG",
                    help="incidence-angle uncertainty [deg] (default: the file's column, else 2)")
+    _add_rtol(p)
     p.set_defaults(func=_cmd_flags)
 
 
 def _cmd_sweep(args) -> int:
     from microimpact.io.files import write_netcdf
-    from microimpact.studies.sweeps import TABLE2_CASES, run_sweep
+    from microimpact.studies.sweeps import run_sweep
 
     if args.case not in TABLE2_CASES:
-        raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(sorted(TABLE2_CASES))}")
+        raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(TABLE2_CASES)}")
     out = _writable(args.out, "--out")
     ds = run_sweep(contact_from_args(args), case=args.case, rtol=args.rtol)
     write_netcdf(ds, out)
@@ -217,8 +224,8 @@ def register_sweep(sub) -> None:
     """``microimpact sweep --case 2.1 --out case.nc``: one Table 2 sweep to NetCDF."""
     p = sub.add_parser("sweep", help="run one of the Table 2 sweeps (2.1-2.5) and write NetCDF")
     add_contact_options(p)
-    p.add_argument("--case", required=True, help="Table 2 case: 2.1, 2.2, 2.3, 2.4 or 2.5")
-    p.add_argument("--rtol", type=_finite_float, default=1e-8, help="relative tolerance (default 1e-8)")
+    p.add_argument("--case", required=True, help=f"Table 2 case: {', '.join(TABLE2_CASES)} (grids: microimpact.model.parameters)")
+    _add_rtol(p)
     p.add_argument("--out", required=True, help="output NetCDF")
     p.set_defaults(func=_cmd_sweep)
 
@@ -239,15 +246,13 @@ def register_reproduce(sub) -> None:
     p.set_defaults(func=_cmd_reproduce)
 
 
-_EXTRA_COMMANDS += [register_fit, register_flags, register_sweep, register_reproduce]
-
 
 def main(argv=None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
         if not getattr(args, "command", None):
-            raise UsageError("a command is required: " + ", ".join(["simulate"] + [r.__name__.removeprefix("register_") for r in _EXTRA_COMMANDS]))
+            raise UsageError("a command is required: simulate, sweep, fit, flags or reproduce")
         return args.func(args)
     except (UsageError, ValueError, RuntimeError) as exc:  # RuntimeError: solver failures
         print(f"microimpact: error: {exc}", file=sys.stderr)

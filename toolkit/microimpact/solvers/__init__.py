@@ -10,3 +10,6 @@ tangential map, :mod:`.engine`), ``"reference"`` (full 3-D scipy integration, :m
 #: At 1e-8 the engine's e_n and impulse ratios are within about 5e-8 of the reference solution
 #: (docs/benchmark.md), far below any measurement's uncertainty, at half the cost of 1e-10.
 DEFAULT_RTOL = 1e-8
+
+#: The solvers behind simulate_impact(method=...).
+METHODS = ("engine", "reference", "rkg")
