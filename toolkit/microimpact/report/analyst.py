@@ -147,10 +147,11 @@ def analyst_sweeps_section(lay: Layout, sweeps: list[xr.Dataset], dyn: xr.Datase
     for ds in sweeps:
         one = at_radius(ds, k)
         case = str(ds.attrs.get("case", "?"))
-        lay.heading(f"Table 2 case {case} at d = {2e6 * radii[k]:.3g} um")
+        plots = [figures.plot_restitution_and_impulse(one)]
         if figures.TABLE2_FIGURES.get(case, (None, None))[0] is not None:
-            lay.plot(figures.plot_energy_loss(one), max_height=2.7)
-        lay.plot(figures.plot_restitution_and_impulse(one), max_height=2.9)
+            plots.insert(0, figures.plot_energy_loss(one))
+        for i, plot in enumerate(plots):
+            lay.plot(plot, max_height=2.8, heading=None if i else f"Table 2 case {case} at d = {2e6 * radii[k]:.3g} um")
 
 
 # =============================================================================== flags

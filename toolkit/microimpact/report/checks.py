@@ -89,7 +89,7 @@ def _kharaz_rms(kh: xr.Dataset) -> pd.DataFrame:
 # =============================================================================== benchmark
 def benchmark_section(lay: Layout, wp: xr.Dataset | None) -> None:
     """The work-precision diagram of the solvers and the most accurate setting of each."""
-    lay.section("Work-precision benchmark")
+    lay.section("Work-precision benchmark", new_page=False, keep=3.0)
     if wp is None:
         lay.paragraph("The work-precision benchmark was switched off in the configuration (benchmark.enabled: "
                       "false); run with --config 'benchmark={enabled: true}' to include it.")
@@ -139,7 +139,7 @@ def _most_accurate(wp: xr.Dataset) -> pd.DataFrame:
 # =============================================================================== stress sweep
 def stress_section(lay: Layout, s: Mapping | None, settings: Mapping | None) -> None:
     """The seeded stress sweep of the engine: what was checked, the worst values, the failed cases."""
-    lay.section("Numerical stability (stress sweep)")
+    lay.section("Numerical stability (stress sweep)", new_page=False, keep=2.5)
     settings = dict(settings or {})
     if s is None:
         lay.paragraph("The stress sweep was switched off in the configuration (stress.enabled: false); run "
@@ -259,7 +259,7 @@ def _plain(obj):
 
 def config_section(lay: Layout, config: Mapping) -> None:
     """The configuration the report was made with, as YAML."""
-    lay.section("Appendix: configuration")
+    lay.section("Appendix: configuration", new_page=False, keep=1.5)
     lay.paragraph("The configuration this report was made with (workflow/config/config.yaml merged with "
                   "command-line overrides), validated against workflow/config/config.schema.yaml.")
     plain = json.loads(json.dumps(dict(config), default=_plain))

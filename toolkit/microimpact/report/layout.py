@@ -76,6 +76,7 @@ class Layout:
     contents: list = field(default_factory=list)
     _number: int = 0
     _part_start: bool = False  # the next section follows the introduction of a part on its page
+    _current: str = ""  # the section being written
 
     # ------------------------------------------------------------------ pages
     def new_page(self, section: str) -> Page:
@@ -90,7 +91,7 @@ class Layout:
     def ensure(self, height: float) -> Page:
         """The current page if ``height`` [in] still fits on it, else a new page of the same section."""
         if not self.pages or self.page.y + height > PAGE_SIZE[1] - BOTTOM:
-            self.new_page(self.pages[-1].section if self.pages else "")
+            self.new_page(self._current)
         return self.page
 
     def _text(self, x_in: float, y_in: float, text: str, **kw):
@@ -99,29 +100,31 @@ class Layout:
     # ------------------------------------------------------------------ blocks
     def part(self, title: str, intro: str) -> None:
         """Start a part of the report on a new page: a large title and an introduction."""
+        self._current = title
         self.new_page(title)
         self.contents.append((title, len(self.pages) - 1))
-        lines = wrap(title, 70)
+        lines = wrap(title, 52)
         self._text(MARGIN_X, self.page.y, "\n".join(lines), fontsize=15, fontweight="bold", color=SOURCE_COLOR,
                    linespacing=1.2)
         self.page.y += 0.3 * len(lines) + 0.12
         self.paragraph(intro, size=9, gap=0.25)
         self._part_start = True
 
-    def section(self, title: str, *, new_page: bool = True, numbered: bool = True) -> str:
+    def section(self, title: str, *, new_page: bool = True, numbered: bool = True, keep: float = 0.4) -> str:
         """A section heading, numbered in order unless ``numbered`` is False; returns the full title.
 
         The section starts a new page when ``new_page`` is True, except the first section of a part,
-        which follows the part's introduction.
+        which follows the part's introduction. Otherwise it moves to the next page unless ``keep``
+        [in] of what follows fits below it.
         """
         if numbered:
             self._number += 1
             title = f"{self._number}. {title}"
+        self._current = title  # the header of the pages it starts; a page it joins keeps its own
         if (new_page and not self._part_start) or not self.pages:
             self.new_page(title)
         else:
-            self.ensure(0.8)
-            self.page.section = title
+            self.ensure(0.4 + keep)
         self._part_start = False
         self.contents.append((title, len(self.pages) - 1))
         self._text(MARGIN_X, self.page.y, title, fontsize=13, fontweight="bold")
@@ -133,8 +136,9 @@ class Layout:
         """Number of the current section."""
         return self._number
 
-    def heading(self, text: str) -> None:
-        self.ensure(0.9)
+    def heading(self, text: str, *, keep: float = 0.64) -> None:
+        """A sub-heading, moved to the next page unless ``keep`` [in] of what follows fits below it."""
+        self.ensure(0.26 + keep)
         self._text(MARGIN_X, self.page.y, text, fontsize=10, fontweight="bold")
         self.page.y += 0.26
 
@@ -156,14 +160,19 @@ class Layout:
         """The line that says which parameters made the results of a section."""
         self.paragraph(f"Parameters: {text}", size=7.8, color=SOURCE_COLOR, gap=0.12)
 
-    def plot(self, plot, *, max_height: float = 5.2) -> None:
-        """A :class:`microimpact.report.figures.Plot`: the figure as an image, its caption below."""
+    def plot(self, plot, *, max_height: float = 5.2, heading: str | None = None) -> None:
+        """A :class:`microimpact.report.figures.Plot`: the figure as an image, its caption below.
+
+        ``heading``, if given, is set above the figure on the same page.
+        """
         fig = plot.figure
         w, h = fig.get_size_inches()
         scale = min(1.0, TEXT_WIDTH / w, max_height / h)
         ww, hh = w * scale, h * scale
         cap_lines = len(wrap(plot.caption, _chars_per_line(BODY_PT)))
-        self.ensure(hh + 0.1 + cap_lines * BODY_PT * 1.32 / 72)
+        self.ensure(hh + 0.1 + cap_lines * BODY_PT * 1.32 / 72 + (0.26 if heading else 0.0))
+        if heading:
+            self.heading(heading, keep=0.0)
         canvas = FigureCanvasAgg(fig)
         fig.set_dpi(DPI)
         canvas.draw()
@@ -223,8 +232,8 @@ class Layout:
             self._text(MARGIN_X, self.page.y, "\n".join(block), fontsize=size, family="monospace", linespacing=1.3)
             self.page.y += line_h * len(block) + 0.15
             if i < len(rows):
-                self.new_page(self.page.section)
-                self._text(MARGIN_X, self.page.y, f"{self.page.section} (continued)", fontsize=10, fontweight="bold")
+                self.new_page(self._current)
+                self._text(MARGIN_X, self.page.y, f"{self._current} (continued)", fontsize=10, fontweight="bold")
                 self.page.y += 0.26
 
     # ------------------------------------------------------------------ title page and output

@@ -57,7 +57,7 @@ def _equilibria(dyn: xr.Dataset) -> pd.DataFrame:
 
 def portraits_section(lay: Layout, portraits: list[xr.Dataset]) -> None:
     """Phase portraits (Fig. 5), at most two panels per figure (four on a page width are unreadable)."""
-    lay.section("Phase portraits (analogue of Fig. 5)")
+    lay.section("Phase portraits (analogue of Fig. 5)", new_page=False, keep=3.6)
     lay.source(parameter_source(*portraits))
     for i in range(0, len(portraits), 2):
         lay.plot(figures.plot_phase_portraits(portraits[i:i + 2]), max_height=4.0)
@@ -86,7 +86,7 @@ def paper_sweeps_section(lay: Layout, sweeps: list[xr.Dataset]) -> None:
 
 def reproduction_section(lay: Layout, repro: pd.DataFrame) -> None:
     """The paper's numbers and statements against the toolkit's, with agreement."""
-    lay.section("Reproduction of the paper's numbers and statements")
+    lay.section("Reproduction of the paper's numbers and statements", new_page=False, keep=1.5)
     agree = repro["agree"].astype(str).str.lower()
     n_yes = int(agree.isin(["true", "yes"]).sum())
     n_no = int(agree.isin(["false", "no"]).sum())
