@@ -37,8 +37,10 @@ import numpy as np
 import xarray as xr
 from scipy.optimize import brentq
 
+from microimpact.model import law
+from microimpact.model.contact import PAPER_REFERENCE, Contact, check_positive
 from microimpact.model.law import contact_potential_energy
-from microimpact.model.contact import PAPER_REFERENCE, Contact
+from microimpact.solvers.engine import solve_normal
 
 __all__ = [
     "nondimensional_rhs",
@@ -73,7 +75,6 @@ __all__ = [
 SPIRAL_SINK = "spiral sink"
 CRITICAL = "critical"
 SINK = "sink"
-EQUILIBRIUM_TYPES = (SPIRAL_SINK, CRITICAL, SINK)
 
 MOTION_REBOUND = "rebound"
 MOTION_CAPTURE_OSCILLATION = "capture with oscillation"
@@ -106,10 +107,9 @@ def nondimensional_rhs(xi, y, c1, c2):
         d xi / d tau = y and d y / d tau = -xi^(3/2) (1 + C1 y) + xi^(1/2) (1 - C2 y). [-]
         For xi <= 0 (no contact) the contact force is zero and dy = 0 (free flight).
     """
-    xi = np.asarray(xi, dtype=float)
     y = np.asarray(y, dtype=float)
-    xp = np.maximum(xi, 0.0)
-    dy = -(xp**1.5) * (1.0 + c1 * y) + np.sqrt(xp) * (1.0 - c2 * y)
+    xp = np.maximum(np.asarray(xi, dtype=float), 0.0)
+    dy = law.nondimensional_acceleration(np.sqrt(xp), xp**1.5, y, c1, c2, 1.0, 1.0)
     return np.broadcast_to(y, dy.shape).copy(), dy
 
 
@@ -195,9 +195,8 @@ def nondimensional_energy(xi, y):
     kinetic energy is e m X^2 / T^2. e < 0 means captured (the sphere can no longer reach xi = 0);
     e = -4/15 at the equilibrium (1, 0).
     """
-    xp = np.maximum(np.asarray(xi, dtype=float), 0.0)
-    y = np.asarray(y, dtype=float)
-    return 0.5 * y * y + 0.4 * xp**2.5 - 2.0 / 3.0 * xp**1.5
+    s = np.sqrt(np.maximum(np.asarray(xi, dtype=float), 0.0))
+    return law.nondimensional_energy(s, np.asarray(y, dtype=float), 1.0, 1.0)
 
 
 # ----------------------------------------------------------------------------- damping vs speed
@@ -206,11 +205,6 @@ def _per_speed(func, speed):
     if speed_arr.ndim == 0:
         return func(float(speed_arr))
     return np.vectorize(func, otypes=[float])(speed_arr)
-
-
-def _check_speed(speed: float) -> None:
-    if not math.isfinite(speed) or speed <= 0.0:
-        raise ValueError(f"normal speed must be a finite number > 0 [m/s], got {speed!r}")
 
 
 def _check_adhesive(contact: Contact) -> None:
@@ -239,7 +233,7 @@ def total_damping(contact: Contact, speed):
     _check_adhesive(contact)
 
     def one(v: float) -> float:
-        _check_speed(v)
+        check_positive("normal speed [m/s]", v)
         c1, c2 = contact.nondimensional_damping(v)
         return c1 + c2
 
@@ -428,12 +422,6 @@ def asymptotic_frequency(contact: Contact, speed):
 
 
 # ----------------------------------------------------------------------------- capture velocity
-def _solve_normal(contact: Contact, speed: float, **kwargs):
-    from microimpact.solvers.engine import solve_normal  # imported here: the engine imports nothing from this module
-
-    return solve_normal(contact, speed, **kwargs)
-
-
 @dataclass(frozen=True)
 class CaptureBracket:
     """Bracket of the capture velocity found by bisection on the outcome of a normal impact.
@@ -529,7 +517,7 @@ def capture_bracket(
             evaluations += 1
             if evaluations > max_evaluations:
                 raise RuntimeError(f"capture_bracket: more than {max_evaluations} normal solves")
-            cache[v] = _solve_normal(contact, v, rtol=solver_rtol)
+            cache[v] = solve_normal(contact, v, rtol=solver_rtol)
         return cache[v]
 
     v = initial_guess
@@ -611,9 +599,9 @@ def phase_portrait(contact: Contact, speed: float, *, rtol: float = 1e-10, settl
         changed sign after the energy fell below 0: many for a spiral sink, at most one for a
         sink). A captured impact is followed until it settles at (1, 0).
     """
-    _check_speed(float(speed))
+    check_positive("normal speed [m/s]", speed)
     _check_adhesive(contact)
-    sol = _solve_normal(
+    sol = solve_normal(
         contact, float(speed), rtol=rtol, trajectory=True, follow_capture=True, settle_amplitude=settle_amplitude
     )
     t = np.asarray(sol.time, dtype=float)

@@ -21,7 +21,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-__all__ = ["Contact", "rolling_spin", "PAPER_REFERENCE"]
+__all__ = ["Contact", "PAPER_REFERENCE", "check_positive"]
 
 #: full citation of the paper, for the ``references`` attribute of the toolkit's results
 PAPER_REFERENCE = (
@@ -31,9 +31,18 @@ PAPER_REFERENCE = (
 )
 
 
-def _check_positive(name: str, value: float) -> None:
-    if not math.isfinite(value) or value <= 0.0:
+def check_positive(name: str, value) -> float:
+    """``float(value)`` if it is a finite number > 0; else a ValueError that names ``name`` and the value.
+
+    The one check of a positive input (radius, stiffness, a normal speed [m/s], ...).
+    """
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite number > 0, got {value!r}") from None
+    if not math.isfinite(v) or v <= 0.0:
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+    return v
 
 
 def _check_non_negative(name: str, value: float) -> None:
@@ -98,11 +107,11 @@ class Contact:
                     raise ValueError(f"{f.name} must be a number, got {value!r}") from None
             object.__setattr__(self, f.name, float(value))
         for name in ("radius", "density", "stiffness"):
-            _check_positive(name, getattr(self, name))
+            check_positive(name, getattr(self, name))
         for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction"):
             _check_non_negative(name, getattr(self, name))
         if self.damping_reference_speed is not None:
-            _check_positive("damping_reference_speed", self.damping_reference_speed)
+            check_positive("damping_reference_speed", self.damping_reference_speed)
 
     # ----------------------------------------------------------------- constructors
     @classmethod
@@ -134,8 +143,8 @@ class Contact:
         **kwargs
             Other :class:`Contact` fields (zetas, friction, damping_reference_speed).
         """
-        _check_positive("youngs_modulus_sphere", youngs_modulus_sphere)
-        _check_positive("youngs_modulus_surface", youngs_modulus_surface)
+        check_positive("youngs_modulus_sphere", youngs_modulus_sphere)
+        check_positive("youngs_modulus_surface", youngs_modulus_surface)
         _check_poisson("poisson_sphere", poisson_sphere)
         _check_poisson("poisson_surface", poisson_surface)
         stiffness = stiffness_from_elastic(
@@ -158,8 +167,8 @@ class Contact:
         work_of_adhesion : float
             Dupre work of adhesion w_A = gamma_1 + gamma_2 - gamma_12. [J/m^2]
         """
-        _check_positive("radius", radius)
-        _check_positive("stiffness", stiffness)
+        check_positive("radius", radius)
+        check_positive("stiffness", stiffness)
         _check_non_negative("work_of_adhesion", work_of_adhesion)
         f0 = adhesion_line_force_from_work(stiffness, radius, work_of_adhesion)
         return cls(radius, density, stiffness, f0, **kwargs)
@@ -182,7 +191,7 @@ class Contact:
         **changes
             Other fields to change.
         """
-        _check_positive("radius", radius)
+        check_positive("radius", radius)
         f0 = adhesion_line_force_from_work(self.stiffness, radius, self.work_of_adhesion)
         return replace(self, radius=float(radius), adhesion_line_force=f0, **changes)
 
@@ -235,7 +244,7 @@ class Contact:
             if not np.all(np.isfinite(v) & (v > 0.0)):
                 raise ValueError(f"damping reference speed must be finite and > 0, got {v[~(v > 0.0)].ravel()[:1]}")
         else:
-            _check_positive("damping reference speed", v)
+            check_positive("damping reference speed", v)
         scale = self.damping_speed_scale * v**0.2  # (r^3 K sqrt(v) / m)^(2/5)
         return self.zeta_hertz / scale, self.zeta_adhesion / scale
 
@@ -244,11 +253,6 @@ class Contact:
         c_h, c_a = self.damping_coefficients(normal_speed)
         u = self.length_scale / self.time_scale
         return c_h * u, c_a * u
-
-    @property
-    def rolling_spin_per_speed(self) -> float:
-        """Spin per unit centre speed for rolling without slip, 1/r. [rad/m]"""
-        return 1.0 / self.radius
 
 
 def stiffness_from_elastic(e1: float, nu1: float, e2: float, nu2: float) -> float:
@@ -265,7 +269,3 @@ def adhesion_line_force_from_work(stiffness: float, radius: float, work_of_adhes
     """
     return (9.0 / (2.0 * math.pi) * stiffness * radius * work_of_adhesion**2) ** (1.0 / 3.0)
 
-
-def rolling_spin(speed: float, radius: float) -> float:
-    """Spin of a sphere rolling without slip at centre speed ``speed``: speed / radius. [rad/s]"""
-    return speed / radius

@@ -18,9 +18,9 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["stop_impulses", "tangential_outcome", "tangential_kernel"]
+from microimpact.model.law import TWIST_TORQUE_FACTOR  # torque = factor * f * a * |F_n|
 
-TWIST_TORQUE_FACTOR = 3.0 * math.pi / 16.0  # torque = factor * f * a * |F_n|
+__all__ = ["stop_impulses", "tangential_outcome", "tangential_kernel"]
 
 
 @njit(cache=True)

@@ -39,6 +39,10 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit, prange
 
+from microimpact.model.contact import check_positive
+from microimpact.model.law import Scales, nondimensional_impact, nondimensional_scales
+from microimpact.solvers import compiled_law as law
+
 __all__ = ["NormalSolution", "EngineError", "solve_normal", "solve_normal_many", "nondimensional_scales"]
 
 # Status codes of the compiled core
@@ -79,30 +83,23 @@ class EngineError(RuntimeError):
 
 # --------------------------------------------------------------------------- compiled core
 @njit(cache=True, fastmath=True, inline="always")
-def _rhs_row(u, c1, c2, ah, aa, sgn, k, j):
-    """d/dsigma of the state u, written into row j of k (see the module docstring)."""
-    s = u[0]
-    y = u[1]
+def _derivatives(s, y, c1, c2, ah, aa, sgn):
+    """d/dsigma of the state (s, y, tau, D, J_a) at (s, y) (see the module docstring)."""
     s2 = s * s
-    g = aa * s2 * (1.0 - c2 * y) - ah * s2 * s2 * (1.0 + c1 * y)
-    k[j, 0] = 0.5 * y
-    k[j, 1] = g
-    k[j, 2] = s
-    k[j, 3] = (ah * c1 * s2 * s2 + aa * c2 * s2) * y * y
-    k[j, 4] = sgn * s * g
+    g = law.nondimensional_acceleration(s2, s2 * s2, y, c1, c2, ah, aa)  # dy/dsigma = s xi''
+    return 0.5 * y, g, s, law.nondimensional_dissipation_rate(s2, s2 * s2, y, c1, c2, ah, aa), sgn * s * g
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _rhs_row(u, c1, c2, ah, aa, sgn, k, j):
+    """d/dsigma of the state u, written into row j of k."""
+    k[j, 0], k[j, 1], k[j, 2], k[j, 3], k[j, 4] = _derivatives(u[0], u[1], c1, c2, ah, aa, sgn)
 
 
 @njit(cache=True, fastmath=True)
 def _rhs(u, c1, c2, ah, aa, sgn, out):
-    s = u[0]
-    y = u[1]
-    s2 = s * s
-    g = aa * s2 * (1.0 - c2 * y) - ah * s2 * s2 * (1.0 + c1 * y)
-    out[0] = 0.5 * y
-    out[1] = g
-    out[2] = s
-    out[3] = (ah * c1 * s2 * s2 + aa * c2 * s2) * y * y
-    out[4] = sgn * s * g
+    """d/dsigma of the state u, written into out."""
+    out[0], out[1], out[2], out[3], out[4] = _derivatives(u[0], u[1], c1, c2, ah, aa, sgn)
 
 
 @njit(cache=True, fastmath=True)
@@ -138,12 +135,6 @@ def _step(u0, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err):
 
 
 @njit(cache=True)
-def _energy(s, y, ah, aa):
-    s3 = s * s * s
-    return 0.5 * y * y + ah * 0.4 * s3 * s * s - aa * (2.0 / 3.0) * s3
-
-
-@njit(cache=True)
 def _hermite(p0, p1, d0, d1, h, th):
     """Cubic Hermite interpolant on a step of length h at the fraction th."""
     th2 = th * th
@@ -162,7 +153,7 @@ def _event_on_interpolant(code, target, th, u0, k1, u1, k7, h, ah, aa):
     y = _hermite(u0[1], u1[1], k1[1], k7[1], h, th)
     if code == 1:
         return y - target
-    return _energy(s, y, ah, aa) - target
+    return law.nondimensional_energy(s, y, ah, aa) - target
 
 
 @njit(cache=True)
@@ -400,8 +391,8 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             if recorded:
                 _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 recorded = False
-            e0 = _energy(u[0], u[1], ah, aa) - ecap
-            e1 = _energy(u1[0], u1[1], ah, aa) - ecap
+            e0 = law.nondimensional_energy(u[0], u[1], ah, aa) - ecap
+            e1 = law.nondimensional_energy(u1[0], u1[1], ah, aa) - ecap
             if e0 >= 0.0 and e1 < 0.0:
                 _locate(3, ecap, u, k1, hev, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 captured = True
@@ -514,7 +505,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         else:
             fac = min(5.0, max(0.2, 0.9 * en ** -0.2))
         h *= fac
-    e_end = _energy(u[0], u[1], ah, aa)
+    e_end = law.nondimensional_energy(u[0], u[1], ah, aa)
     return (status, outcome, u[1], u[2], u[3], J, u[4], smax * smax, tau_capture, tau_jtarget, e_end,
             n_steps, n_rej, n_rec)
 
@@ -539,35 +530,6 @@ def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_
 
 
 # --------------------------------------------------------------------------- Python interface
-@dataclass(frozen=True)
-class Scales:
-    """Nondimensional scales of one impact: length [m], time [s], a_h, a_a [-]."""
-
-    length: float
-    time: float
-    a_hertz: float
-    a_adhesion: float
-
-
-def nondimensional_scales(contact, normal_speed) -> Scales:
-    """Length and time scales used by the solvers (see the module docstring).
-
-    ``normal_speed`` may be an array [m/s]; without adhesion the scales are then arrays too.
-    """
-    if contact.adhesion_line_force > 0.0:
-        return Scales(contact.length_scale, contact.time_scale, 1.0, 1.0)
-    x = (5.0 * contact.mass * normal_speed**2 / (4.0 * contact.stiffness * math.sqrt(contact.radius))) ** 0.4
-    return Scales(x, x / normal_speed, 1.25, 0.0)
-
-
-def _nondimensional_inputs(contact, normal_speed):
-    """(scales, speed unit X/T [m/s], y0, C1, C2) of impacts at ``normal_speed`` (scalar or array)."""
-    sc = nondimensional_scales(contact, normal_speed)
-    u = sc.length / sc.time
-    c_h, c_a = contact.damping_coefficients(normal_speed)
-    return sc, u, normal_speed / u, c_h * u, c_a * u
-
-
 @dataclass(frozen=True)
 class NormalSolution:
     """Result of a normal-contact solve (SI units).
@@ -619,13 +581,6 @@ class NormalSolution:
     penetration_rate: np.ndarray | None = None
 
 
-def _check_speed(normal_speed: float) -> float:
-    v = float(normal_speed)
-    if not math.isfinite(v) or v <= 0.0:
-        raise ValueError(f"normal_speed must be a finite number > 0, got {normal_speed!r}")
-    return v
-
-
 def solve_normal(
     contact,
     normal_speed: float,
@@ -673,10 +628,11 @@ def solve_normal(
     -------
     NormalSolution
     """
-    v = _check_speed(normal_speed)
+    v = check_positive("normal_speed", normal_speed)
     if not (0.0 < rtol < 1.0):
         raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
-    sc, u, y0, c1, c2 = _nondimensional_inputs(contact, v)
+    sc, y0, c1, c2 = nondimensional_impact(contact, v)
+    u = sc.speed
     j_unit = contact.mass * u  # N s
     jt = 0.0 if friction_impulse_target is None else float(friction_impulse_target) / j_unit
     cap = 4096 if (trajectory or follow_capture) else 0
@@ -754,7 +710,8 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = 1e
         bad = v[~(np.isfinite(v) & (v > 0.0))][0]
         raise ValueError(f"normal speeds must be finite and > 0, got {bad!r}")
     nt = np.zeros(v.shape, dtype=np.bool_) if need_tail is None else np.ascontiguousarray(need_tail, dtype=np.bool_).ravel()
-    sc, u, y0, c1, c2 = _nondimensional_inputs(contact, v)
+    sc, y0, c1, c2 = nondimensional_impact(contact, v)
+    u = sc.speed
     u, c1, c2 = (np.ascontiguousarray(np.broadcast_to(a, v.shape), dtype=float) for a in (u, c1, c2))
     length, time, ah, aa = sc.length, sc.time, sc.a_hertz, sc.a_adhesion
     ju = contact.mass * u

@@ -90,6 +90,7 @@ from typing import Sequence
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from microimpact.model import law
 from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity
 from microimpact.model.contact import Contact
 
@@ -117,8 +118,6 @@ _LINEAR_RADIUS = 0.05
 #: Safety factor on the linearised tail bound, covering the O(radius) nonlinear corrections of
 #: force and damping within the radius above (at most ~10 %) with a wide margin.
 _TAIL_SAFETY = 2.0
-
-_THREE_PI_16 = 3.0 * math.pi / 16.0
 
 # State indices.
 _S, _Y, _VT, _VTP, _WN, _WT, _WTP, _D, _J, _TAU = range(10)
@@ -191,34 +190,24 @@ class _Scales:
 
 def _scales(contact: Contact, normal_speed: float) -> _Scales:
     """Scales for an impact with incident normal speed ``normal_speed`` [m/s]."""
-    m, r, k = contact.mass, contact.radius, contact.stiffness
-    c_h, c_a = contact.damping_coefficients(normal_speed)  # [s/m]
-    if contact.adhesion_line_force > 0.0:
-        length, time = contact.length_scale, contact.time_scale
-        a_h = a_a = 1.0
-    else:
-        length = (5.0 * m * normal_speed**2 / (4.0 * k * math.sqrt(r))) ** 0.4
-        time = length / normal_speed
-        a_h, a_a = 1.25, 0.0
-    v = length / time
+    base, _, c1, c2 = law.nondimensional_impact(contact, normal_speed)
     return _Scales(
-        length=length,
-        time=time,
-        a_h=a_h,
-        a_a=a_a,
-        c1=c_h * v,
-        c2=c_a * v,
-        k_rot=m * r * r / contact.moment_of_inertia,
-        twist=_THREE_PI_16 * math.sqrt(length / r),
-        mass=m,
-        radius=r,
+        length=base.length,
+        time=base.time,
+        a_h=base.a_hertz,
+        a_a=base.a_adhesion,
+        c1=c1,
+        c2=c2,
+        k_rot=contact.mass * contact.radius * contact.radius / contact.moment_of_inertia,
+        twist=law.TWIST_TORQUE_FACTOR * math.sqrt(base.length / contact.radius),
+        mass=contact.mass,
+        radius=contact.radius,
     )
 
 
 def _energy(sc: _Scales, s: float, y: float) -> float:
-    """Nondimensional normal contact energy E = y^2/2 + (2/5) a_H s^5 - (2/3) a_A s^3, s = sqrt(xi)."""
-    s2 = s * s
-    return 0.5 * y * y + 0.4 * sc.a_h * s2 * s2 * s - (2.0 / 3.0) * sc.a_a * s2 * s
+    """Nondimensional normal contact energy (:func:`microimpact.model.law.nondimensional_energy`)."""
+    return law.nondimensional_energy(s, y, sc.a_h, sc.a_a)
 
 
 def _tail_constants(c: float) -> tuple[float, float, float]:
@@ -290,9 +279,10 @@ def _make_rhs(
                 f"tau = {z[_TAU]:.6g}"
             )
         s, y = z[0], z[1]
-        acc = -a_h * s * s * s * (1.0 + c1 * y) + a_a * s * (1.0 - c2 * y)  # xi'' = -F_n
+        s3 = s * s * s
+        acc = law.nondimensional_acceleration(s, s3, y, c1, c2, a_h, a_a)  # xi'' = -F_n
         abs_fn = fn_sign * acc  # |F_n| on the physical side, smooth across the phase's end
-        d_rate = (a_h * c1 * s * s * s + a_a * c2 * s) * y * y
+        d_rate = law.nondimensional_dissipation_rate(s, s3, y, c1, c2, a_h, a_a)
         ft = fp = 0.0
         if sliding:
             ut = z[2] + z[6]
@@ -451,12 +441,11 @@ def simulate_reference(
 
     def ev_force(_t, z):
         # xi'' / s: changes sign with F_n, without the trivial root s = 0 at first contact.
-        s, y = z[_S], z[_Y]
-        return sc.a_a * (1.0 - sc.c2 * y) - sc.a_h * s * s * (1.0 + sc.c1 * y)
+        return law.nondimensional_acceleration(1.0, z[_S] * z[_S], z[_Y], sc.c1, sc.c2, sc.a_h, sc.a_a)
 
     # Sign of xi'' = -F_n just after first contact: xi''/s -> a_A (1 - c2 y0) as s -> 0; without
     # adhesion (or if that vanishes) the Hertz term -a_H s^2 (1 + c1 y0) < 0 decides.
-    g0 = sc.a_a * (1.0 - sc.c2 * z0[_Y])
+    g0 = law.nondimensional_acceleration(1.0, 0.0, z0[_Y], sc.c1, sc.c2, sc.a_h, sc.a_a)
     fn_sign = 1.0 if g0 > 0.0 else -1.0
 
     settle = None

@@ -1,7 +1,19 @@
 """The paper's integrator: fixed-step Runge-Kutta-Gill (Gill 1951) on the nondimensional Eq. (27).
 
 Cheng, Brach & Dunn (2002) integrate the normal motion with a fixed-step fourth-order
-Runge-Kutta-Gill method. Here it is numba-compiled and batched over all cores (``prange``).
+Runge-Kutta-Gill method. Here it is numba-compiled, batched over all cores (``prange``) for the
+benchmark (:func:`rkg_restitution`) and available as ``simulate_impact(..., method="rkg")``
+through :func:`solve_normal_rkg`, which also returns the friction impulses that the closed-form
+tangential map needs.
+
+The system is xi' = y, y' = xi'' of :func:`microimpact.model.law.nondimensional_acceleration` in
+tau = t / T_c (the plain form, not the engine's Sundman form), with the contact law compiled from
+:mod:`microimpact.model.law` (see :mod:`microimpact.solvers.compiled_law`). The step is
+dtau = (estimated contact duration) / N; the duration estimate comes from the engine at a loose
+rtol = 1e-6, since a fixed-step code needs some such estimate to choose its step.
+
+Accuracy: from first contact the solution has a tau^(5/2) (Hertz) or tau^(3/2) (adhesion) term, so
+the global order drops from 4 to 2.5 or lower; with adhesion N = 1600 gives e_n to about 1e-6.
 """
 
 from __future__ import annotations
@@ -11,22 +23,35 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from microimpact.model.contact import check_positive
+from microimpact.model.law import nondimensional_impact
+from microimpact.solvers import compiled_law as law
 from microimpact.solvers import engine
 
-__all__ = ["rkg_state", "rkg_restitution"]
+__all__ = ["rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
 
+#: Default steps per estimated contact duration of :func:`solve_normal_rkg` (e_n to ~1e-6 with
+#: adhesion, tests/test_benchmark.py).
+DEFAULT_STEPS = 2000
+
+#: Step limit, in units of the steps per contact, before the impact is declared unresolved.
+_MAX_CONTACTS = 20
 
 _G1 = 1.0 - 1.0 / math.sqrt(2.0)
 _G2 = 1.0 + 1.0 / math.sqrt(2.0)
 
+# Columns of the compiled impact result
+_Y_OUT, _TAU_END, _N_STEPS, _OUTCOME, _J, _J_A, _XI_MAX, _TAU_J, _E_END = range(9)
+_NCOL = 9
+
 
 @njit(cache=True)
 def _rkg_accel(xi, y, c1, c2, ah, aa):
-    """xi'' of Eq. (27) in tau: -a_h xi^(3/2) (1 + C1 y) + a_a xi^(1/2) (1 - C2 y); 0 outside contact."""
+    """xi'' of Eq. (27) in tau (:func:`microimpact.model.law.nondimensional_acceleration`); 0 outside contact."""
     if xi <= 0.0:
         return 0.0
     s = math.sqrt(xi)
-    return -ah * xi * s * (1.0 + c1 * y) + aa * s * (1.0 - c2 * y)
+    return law.nondimensional_acceleration(s, xi * s, y, c1, c2, ah, aa)
 
 
 @njit(cache=True)
@@ -52,40 +77,55 @@ def _rkg_step(xi, y, h, c1, c2, ah, aa):
 
 
 @njit(cache=True)
-def _rkg_impact(y0, c1, c2, ah, aa, h, max_steps):
+def _rkg_impact(y0, c1, c2, ah, aa, h, max_steps, j_target):
     """Fixed-step RKG from first contact (xi = 0, y = y0) to separation or capture.
 
     Separation: xi changes sign from + to -; its time is found by linear interpolation of xi. The
     exit speed is y at the end of that step: past the root the force is zero (free flight), so y is
     constant there and the step already integrates the motion through the separation point
     (linearly interpolating y as well would add an O(h^2.5) error). Capture: the contact energy
-    E = y^2/2 + (2/5) a_h xi^(5/2) - (2/3) a_a xi^(3/2) falls below 0.
+    e of :func:`microimpact.model.law.nondimensional_energy` falls below 0.
 
-    Returns (y_out, tau_sep, n_steps, outcome) with outcome 0 rebound, 1 capture, -1 step limit.
+    The nondimensional friction impulse J = int |xi''| dtau is the total variation of y, summed as
+    |dy| per step, and J_a = int s |xi''| dtau (s = sqrt(xi)) by the trapezoidal rule in y; both
+    are exact where y is monotone within a step and otherwise O(h^2) (an extremum inside a step).
+    ``j_target`` > 0: also record the time at which J reaches it (linear interpolation).
+
+    Returns (y_out, tau_end, n_steps, outcome, J, J_a, xi_max, tau_j, e_end) with outcome 0
+    rebound, 1 capture, -1 step limit; tau_end is the separation or the capture time.
     """
     xi = 0.0
     y = y0
+    jn = 0.0
+    ja = 0.0
+    xi_max = 0.0
+    tau_j = math.nan
     for n in range(1, max_steps + 1):
         xn, yn = _rkg_step(xi, y, h, c1, c2, ah, aa)
+        dj = abs(yn - y)
+        if j_target > 0.0 and math.isnan(tau_j) and jn + dj >= j_target:
+            tau_j = (n - 1 + (j_target - jn) / dj) * h
+        jn += dj
+        ja += 0.5 * (math.sqrt(max(xi, 0.0)) + math.sqrt(max(xn, 0.0))) * dj
         if xi > 0.0 and xn <= 0.0:
             theta = xi / (xi - xn)
-            return -yn, (n - 1 + theta) * h, n, 0
+            return -yn, (n - 1 + theta) * h, n, 0, jn, ja, xi_max, tau_j, 0.5 * yn * yn
         xi, y = xn, yn
+        xi_max = max(xi_max, xi)
         if aa > 0.0 and xi > 0.0:
-            s = math.sqrt(xi)
-            if 0.5 * y * y + 0.4 * ah * xi * xi * s - (2.0 / 3.0) * aa * xi * s < 0.0:
-                return 0.0, math.nan, n, 1
-    return math.nan, math.nan, max_steps, -1
+            e = law.nondimensional_energy(math.sqrt(xi), y, ah, aa)
+            if e < 0.0:
+                return 0.0, n * h, n, 1, jn, ja, xi_max, tau_j, e
+    return math.nan, math.nan, max_steps, -1, jn, ja, xi_max, tau_j, math.nan
 
 
 @njit(cache=True, parallel=True)
 def _rkg_many(y0, c1, c2, ah, aa, h, max_steps, out):
     for i in prange(y0.shape[0]):
-        r = _rkg_impact(y0[i], c1[i], c2[i], ah, aa, h[i], max_steps[i])
-        out[i, 0] = r[0]
-        out[i, 1] = r[1]
-        out[i, 2] = r[2]
-        out[i, 3] = r[3]
+        y_out, tau, n, outcome, jn, ja, xi_max, tau_j, e_end = _rkg_impact(
+            y0[i], c1[i], c2[i], ah, aa, h[i], max_steps[i], 0.0)
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3], out[i, 4] = y_out, tau, n, outcome, jn
+        out[i, 5], out[i, 6], out[i, 7], out[i, 8] = ja, xi_max, tau_j, e_end
 
 
 @njit(cache=True)
@@ -110,20 +150,14 @@ def rkg_state(y0: float, c1: float, c2: float, a_hertz: float, a_adhesion: float
 
 def _rkg_setup(contact, speeds):
     """Nondimensional y0, C1, C2, a_h, a_a and the estimated contact duration (tau) per speed."""
-    speeds = np.asarray(speeds, dtype=float)
-    y0 = np.empty_like(speeds)
-    c1 = np.empty_like(speeds)
-    c2 = np.empty_like(speeds)
-    dur = np.empty_like(speeds)
-    for i, v in enumerate(speeds):
-        sc = engine.nondimensional_scales(contact, float(v))
-        u = sc.length / sc.time
-        ch, ca = contact.damping_coefficients(float(v))
-        y0[i], c1[i], c2[i] = v / u, ch * u, ca * u
-        # Estimated contact duration: the engine's at a loose rtol = 1e-6 (computed once, not
-        # timed); a fixed-step code needs some such estimate to choose its step.
-        sol = engine.solve_normal(contact, float(v), rtol=1e-6)
-        dur[i] = sol.contact_time / sc.time if math.isfinite(sol.contact_time) else 50.0
+    speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
+    sc, y0, c1, c2 = nondimensional_impact(contact, speeds)
+    y0, c1, c2, t_c = (np.ascontiguousarray(np.broadcast_to(a, speeds.shape), dtype=float)
+                       for a in (y0, c1, c2, sc.time))
+    # Estimated contact duration: the engine's at a loose rtol = 1e-6 (computed once, not timed);
+    # 50 time units for a captured sphere.
+    t_contact = engine.solve_normal_many(contact, speeds, None, rtol=1e-6)["contact_time"]
+    dur = np.where(np.isfinite(t_contact), t_contact / t_c, 50.0)
     return y0, c1, c2, sc.a_hertz, sc.a_adhesion, dur
 
 
@@ -143,19 +177,77 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> d
     Returns
     -------
     dict with ``e_n`` [-] (0 if captured, NaN if no outcome in 20 N steps), ``captured`` (bool),
-    ``n_steps`` (int) and ``contact_time`` [s].
+    ``n_steps`` (int) and ``tau`` (nondimensional separation time; NaN if captured) [-].
     """
     y0, c1, c2, ah, aa, dur = setup if setup is not None else _rkg_setup(contact, speeds)
     h = dur / steps_per_contact
-    max_steps = np.full(y0.shape, 20 * int(steps_per_contact), dtype=np.int64)
-    out = np.empty((y0.size, 4))
+    max_steps = np.full(y0.shape, _MAX_CONTACTS * int(steps_per_contact), dtype=np.int64)
+    out = np.empty((y0.size, _NCOL))
     _rkg_many(y0, c1, c2, ah, aa, h, max_steps, out)
+    outcome = out[:, _OUTCOME]
     return {
-        "e_n": np.where(out[:, 3] == 1, 0.0, np.where(out[:, 3] < 0, np.nan, out[:, 0] / y0)),
-        "captured": out[:, 3] == 1,
-        "n_steps": out[:, 2].astype(np.int64),
-        "tau": out[:, 1],
+        "e_n": np.where(outcome == 1, 0.0, np.where(outcome < 0, np.nan, out[:, _Y_OUT] / y0)),
+        "captured": outcome == 1,
+        "n_steps": out[:, _N_STEPS].astype(np.int64),
+        "tau": np.where(outcome == 0, out[:, _TAU_END], np.nan),
     }
 
 
-# =============================================================================== timing helpers
+def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS,
+                     friction_impulse_target: float | None = None) -> engine.NormalSolution:
+    """Solve the normal contact, Eq. (27), of one impact with the paper's fixed-step RKG.
+
+    Parameters
+    ----------
+    contact : Contact
+    normal_speed : float
+        Incident normal speed, > 0. [m/s]
+    steps : int
+        Steps per estimated contact duration (the step size is duration / steps). [-]
+    friction_impulse_target : float, optional
+        Record the time at which J reaches this value (end of sliding). [N s]
+
+    Returns
+    -------
+    NormalSolution
+        As :func:`microimpact.solvers.engine.solve_normal`. A captured impact stops at the energy
+        test (E < 0): its J and J_a cover the contact up to there only, and ``dissipated_energy``
+        and ``max_penetration`` too. For a rebound the normal dissipation is m v^2 (1 - e_n^2) / 2
+        (energy balance; the RKG does not integrate it).
+
+    Raises
+    ------
+    ValueError
+        For a bad speed or a number of steps < 1.
+    EngineError
+        If no outcome is reached within 20 contact durations' worth of steps.
+    """
+    v = check_positive("normal_speed", normal_speed)
+    if int(steps) < 1:
+        raise ValueError(f"steps must be an integer >= 1, got {steps!r}")
+    y0, c1, c2, ah, aa, dur = _rkg_setup(contact, [v])
+    sc, _, _, _ = nondimensional_impact(contact, v)
+    j_unit = contact.mass * sc.speed  # N s
+    jt = 0.0 if friction_impulse_target is None else float(friction_impulse_target) / j_unit
+    r = _rkg_impact(y0[0], c1[0], c2[0], ah, aa, dur[0] / int(steps), _MAX_CONTACTS * int(steps), jt)
+    if r[_OUTCOME] < 0:
+        raise engine.EngineError(f"rkg found no outcome for normal speed {v!r} m/s within {int(r[_N_STEPS])} "
+                                 f"steps ({_MAX_CONTACTS} estimated contact durations); increase steps")
+    captured = r[_OUTCOME] == 1
+    e_n = 0.0 if captured else r[_Y_OUT] / y0[0]
+    energy_unit = contact.mass * sc.speed**2
+    return engine.NormalSolution(
+        outcome=engine.OUTCOME_NAMES[int(r[_OUTCOME])],
+        e_n=e_n,
+        contact_time=math.inf if captured else r[_TAU_END] * sc.time,
+        capture_time=r[_TAU_END] * sc.time if captured else math.nan,
+        max_penetration=r[_XI_MAX] * sc.length,
+        friction_impulse=r[_J] * j_unit,
+        twist_impulse=r[_J_A] * j_unit * math.sqrt(contact.radius * sc.length),
+        dissipated_energy=0.5 * contact.mass * v * v * (1.0 - e_n * e_n) if not captured else math.nan,
+        final_energy=r[_E_END] * energy_unit,
+        slip_end_time=r[_TAU_J] * sc.time,
+        n_steps=int(r[_N_STEPS]),
+        n_rejected=0,
+    )
+
