@@ -200,3 +200,46 @@ def test_bad_tables(table, pair):
         fit_damping(table.iloc[:2], pair)
     with pytest.raises(ValueError, match="base must give"):
         fit_damping(table, object())
+
+
+def test_fit_states_its_data_and_provenance(fit, table):
+    """What the pipeline chain needs: the fitted contact per size, the measured sizes and speed
+    range, and the parameter source recorded with every simulation of the fitted material."""
+    np.testing.assert_array_equal(fit.radii, np.unique(table["radius"]))
+    assert fit.speed_range == (table["normal_speed"].min(), table["normal_speed"].max())
+    assert fit.parameter_source == f"fit: synthetic_microspheres.csv {table.attrs['sha256']}"
+    c = fit.contact(float(fit.radii[0]))
+    assert (c.zeta_hertz, c.zeta_adhesion, c.work_of_adhesion) == pytest.approx(
+        (fit.zeta_hertz, fit.zeta_adhesion, fit.work_of_adhesion), rel=1e-12)
+
+
+def test_parameter_source_survives_the_file(fit, tmp_path):
+    back = DampingFit.load(fit.save(tmp_path / "fit.nc"))
+    assert back.parameter_source == fit.parameter_source
+    np.testing.assert_array_equal(back.radii, fit.radii)
+    assert back.speed_range == fit.speed_range
+
+
+def test_one_formatter_text_and_markdown(fit):
+    from microimpact.analysis.fitting import fit_parameter_table, format_fit
+
+    table = fit_parameter_table(fit)
+    assert list(table["parameter"]) == ["zeta_hertz", "zeta_adhesion", "work_of_adhesion"]
+    assert list(table["units"]) == ["1", "1", "J m-2"]  # from microimpact.io.variables
+    assert table.loc[2, "stderr"] == "fixed"
+    assert table.loc[0, "method"].startswith("profile likelihood")
+    assert format_fit(fit) == fit.report()
+    md = format_fit(fit, "markdown")
+    assert md.splitlines()[0].startswith("| parameter | units | value |")
+    assert table.loc[0, "ci1"] in md and "**chi-square**" in md
+    with pytest.raises(ValueError, match="style"):
+        format_fit(fit, "html")
+
+
+def test_synthetic_defaults_take_table1_row2():
+    from microimpact.model.parameters import TABLE1, TABLE1_ROW2
+
+    for name in ("density", "stiffness", "zeta_hertz", "zeta_adhesion", "friction"):
+        assert TRUE[name] == getattr(TABLE1_ROW2, name), name
+    assert TRUE["work_of_adhesion"] == pytest.approx(TABLE1_ROW2.work_of_adhesion, rel=5e-6)
+    assert (TRUE["radii"][0], TRUE["radii"][-1]) == (TABLE1["row1_small"].radius, TABLE1["row1_large"].radius)

@@ -135,3 +135,19 @@ def test_optional_fields_reach_the_contact(tmp_path):
     c = read_materials(path)["a"].contact(1e-6)
     assert (c.friction, c.zeta_hertz, c.zeta_adhesion, c.damping_reference_speed) == (0.3, 0.2, 4.0, 1.5)
     assert c.adhesion_line_force == pytest.approx((9 / (2 * math.pi) * 1e9 * 1e-6 * 0.1**2) ** (1 / 3))
+
+
+def test_material_contact_is_the_one_builder(pairs):
+    from microimpact.io import material_contact
+
+    p = pairs["ammonium_fluorescein_on_silicon"]
+    c = material_contact(p, 2.0e-6)
+    assert c == p.contact(2.0e-6)
+    assert c.adhesion_line_force == p.adhesion_line_force(2.0e-6)
+    assert material_contact(c, 2.0e-6) is c  # a Contact at its own radius is returned as it is
+    moved = material_contact(c, 3.0e-6)
+    assert moved == c.at_radius(3.0e-6)
+    trial = material_contact(p, 2.0e-6, zeta_hertz=0.1, work_of_adhesion=0.1)
+    assert (trial.zeta_hertz, trial.work_of_adhesion) == pytest.approx((0.1, 0.1), rel=1e-12)
+    with pytest.raises(ValueError, match="needs density, stiffness, work_of_adhesion"):
+        material_contact(object(), 1e-6)

@@ -90,37 +90,29 @@ class FitProblem:
         For each radius, the indices of its points in the data order.
     normal_speed : numpy.ndarray
         Incident normal speed of each point. [m/s]
-    density : float
-        Sphere density. [kg/m^3]
-    stiffness : float
-        Effective stiffness K, Eq. (3). [Pa]
-    friction : float
-        Coulomb friction coefficient (not used by e_n; kept for the fitted contact). [-]
-    damping_reference_speed : float or None
-        Fixed reference speed of Eqs. (14)-(15), None for each impact's own normal speed. [m/s]
+    material : MaterialPair, Contact or DampingFit
+        The material: density [kg/m^3], stiffness K [Pa], friction [-] (not used by e_n; kept for
+        the fitted contact) and damping reference speed [m/s] (None: each impact's own normal
+        speed). Its zetas and w_A are replaced by the trial values.
     """
 
     radii: tuple
     groups: tuple
     normal_speed: np.ndarray
-    density: float
-    stiffness: float
-    friction: float = 0.0
-    damping_reference_speed: float | None = None
+    material: object
 
     @classmethod
     def from_arrays(cls, radius, normal_speed, base) -> "FitProblem":
-        """Group points by radius; ``base`` supplies density, stiffness, friction, reference speed."""
+        """Group points by radius [m] and normal speed [m/s]; ``base`` is the material."""
         radius = np.asarray(radius, dtype=float)
         v = np.asarray(normal_speed, dtype=float)
         radii, inverse = np.unique(radius, return_inverse=True)
         groups = tuple(np.flatnonzero(inverse == i) for i in range(radii.size))
-        return cls(tuple(float(r) for r in radii), groups, v, float(base.density), float(base.stiffness),
-                   float(getattr(base, "friction", 0.0) or 0.0), getattr(base, "damping_reference_speed", None))
+        return cls(tuple(float(r) for r in radii), groups, v, base)
 
     def contact(self, radius, zeta_hertz, zeta_adhesion, work_of_adhesion) -> Contact:
         """The Contact of one radius [m] at trial zetas [-] and w_A [J/m^2], f0 from Eq. (7)."""
-        return material_contact(self, radius, zeta_hertz=zeta_hertz, zeta_adhesion=zeta_adhesion,
+        return material_contact(self.material, radius, zeta_hertz=zeta_hertz, zeta_adhesion=zeta_adhesion,
                                 work_of_adhesion=work_of_adhesion)
 
 
