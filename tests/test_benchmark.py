@@ -100,11 +100,13 @@ def test_rkg_matches_engine_on_adhesive_impact():
     assert r["n_steps"][0] == pytest.approx(1600, rel=0.01)  # the duration estimate is accurate
 
 
-def test_capture_speed_brackets_the_outcome():
-    v_cap = benchmark.capture_speed(WALL_1990)
+def test_test_set_starts_just_above_the_capture_speed():
+    """The capture speed of the test set (dynamics.capture_velocity to 1e-12) brackets the outcome."""
+    speeds, v_cap = benchmark.normal_speed_set(WALL_1990, n=4, max_speed=50.0, margin=1.02)
     assert 1.0 < v_cap < 2.0  # 1.4492 m/s for Table 1 row 2
     assert engine.solve_normal(WALL_1990, v_cap * (1 + 1e-9), rtol=1e-12).outcome == "rebound"
     assert engine.solve_normal(WALL_1990, v_cap * (1 - 1e-9), rtol=1e-12).outcome == "capture"
+    assert speeds[0] == pytest.approx(1.02 * v_cap, rel=1e-15) and speeds[-1] == pytest.approx(50.0, rel=1e-15)
 
 
 def test_engine_error_falls_as_rtol_tightens():
