@@ -117,11 +117,16 @@ def results(tmp_path_factory):
     stress = {"cases_run": 4, "cases_failed": 0, "seed": 1, "captures": 1, "failures_by_kind": {"energy": 0},
               "tolerances": {"energy": 1e-6}, "worst_energy_error": {"value": 1e-9, "case": {"case": 2}}}
     (tmp / "stress.json").write_text(json.dumps(stress))
+    flags = pd.DataFrame({"row": table["row"], "e_n": table["e_n"], "capture_speed_ratio": 2.0,
+                          "rotation_sensitive": 0, "angle_sensitive": 0, "near_capture": [1] + [0] * (len(table) - 1),
+                          "parameter_source": source})
+    write_csv(flags, tmp / "flags.csv")
     inputs = {"data_table": tmp / "table.csv", "fit": tmp / "fit.nc", "fit_curves": tmp / "fit_curves.nc",
               "analyst_dynamics": tmp / "analyst_dynamics.nc", "analyst_sweeps": analyst_sweeps,
               "phase_portraits": tmp / "portraits.nc", "dynamics": tmp / "dynamics.nc",
               "bifurcation": tmp / "bifurcation.nc", "paper_sweeps": _paper_files(tmp),
-              "reproduction": tmp / "reproduction.csv", "kharaz": tmp / "kharaz.nc", "stress": tmp / "stress.json"}
+              "reproduction": tmp / "reproduction.csv", "kharaz": tmp / "kharaz.nc", "stress": tmp / "stress.json",
+              "flags": tmp / "flags.csv"}
     return tmp, inputs, source
 
 
@@ -137,7 +142,7 @@ def report_text(results):
 
 def test_inputs_cover_every_key(results):
     _, inputs, _ = results
-    assert set(inputs) | {"flags", "work_precision"} == set(INPUT_KEYS)
+    assert set(inputs) | {"work_precision"} == set(INPUT_KEYS)
 
 
 def test_report_has_both_parts_and_their_sources(results, report_text):
@@ -148,7 +153,8 @@ def test_report_has_both_parts_and_their_sources(results, report_text):
     assert a < text.index("Capture and critical velocity of the measured sizes") < b
     assert text.index("Sensitivity sweeps of the measured material") < b < text.index("Table 2 case 2.3 (Figs")
     # every section says which parameters made it: the fit's file and hash in part A, the preset in part B
-    assert text[a:b].count(f"Parameters: {analyst_source}") >= 2
+    assert text[a:b].count(f"Parameters: {analyst_source}") >= 3  # per-size dynamics, sweeps, flags
+    assert "Measurement flags" in text[a:b] and "Of 12 impacts: 0 R, 0 A, 1 C" in text[a:b]
     assert text[b:].count(f"Parameters: {PAPER_SOURCE}") >= 3
     assert "Parameters: preset" not in text[a:b]
     assert "SYNTHETIC" in report_text[0] and "Contents" in report_text[0]

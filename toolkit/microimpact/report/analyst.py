@@ -36,7 +36,7 @@ def fit_section(lay: Layout, fit: xr.Dataset, curves: xr.Dataset | None, data: p
         + ", jointly over all sphere sizes with one work of adhesion w_A (f0 per radius from Eq. (7)). "
         f"Weighting: {a.get('weighting', '?')}."
         + (f" Data file sha256: {a['fit_sha256']}." if a.get("fit_sha256") else ""))
-    lay.source(parameter_source(fit))
+    lay.source(parameter_source(fit, *([curves] if curves is not None else [])))
     if curves is None:
         lay.paragraph("(No fit_curves file was given: the model is drawn at the data points.)", color="0.4")
     lay.plot(figures.plot_fit(fit, curves), max_height=3.8)
