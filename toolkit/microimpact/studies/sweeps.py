@@ -66,16 +66,8 @@ __all__ = [
     "PAPER_REFERENCE",
 ]
 
-#: spec key -> (units, long_name) of the sweep inputs, in dimension order
-SWEEP_INPUTS: dict[str, tuple[str, str]] = {
-    "speed": ("m s-1", "incident speed v"),
-    "incidence_deg": ("degree", "incidence angle alpha from the surface normal"),
-    "azimuth_deg": ("degree", "azimuth theta of the tangential velocity, from t towards t'"),
-    "omega_n": ("rad s-1", "initial spin omega_n about the normal n"),
-    "omega_t": ("rad s-1", "initial spin omega_t about t"),
-    "omega_tp": ("rad s-1", "initial spin omega_t' about t'"),
-    "friction": ("1", "Coulomb friction coefficient f"),
-}
+#: the sweep inputs in dimension order (units and long names: microimpact.io.variables)
+SWEEP_INPUTS: tuple[str, ...] = ("speed", "incidence_deg", "azimuth_deg", "omega_n", "omega_t", "omega_tp", "friction")
 
 _VALID = {
     "speed": (lambda a: np.all(a > 0.0), "> 0 m/s"),
@@ -306,8 +298,8 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
     )
     dims = [k for k in SWEEP_INPUTS if k in inputs and isinstance(inputs[k], xr.DataArray)]
     ds = ds.transpose(*dims)
-    for key, (units, long_name) in SWEEP_INPUTS.items():
-        attrs = {"units": units, "long_name": long_name}
+    for key in SWEEP_INPUTS:
+        attrs = attributes(key)
         if key in dims:
             ds[key].attrs = attrs
         else:  # fixed input: a 0-d variable instead of a constant array over the grid
