@@ -5,7 +5,6 @@ enough to build in about a minute: a synthetic data set of two sizes fitted with
 intervals, two Table 2 cases on coarse grids for the analyst (per radius) and for the paper.
 """
 
-import hashlib
 import json
 import subprocess
 import sys
@@ -28,12 +27,13 @@ from microimpact.io import read_impacts  # noqa: E402
 from microimpact.io.files import read_netcdf_groups, write_csv, write_netcdf  # noqa: E402
 from microimpact.report.inputs import INPUT_KEYS  # noqa: E402
 from microimpact.report.pdf import build_report  # noqa: E402
-from microimpact.solvers.impact import contact_attributes  # noqa: E402
 from microimpact.studies import sweeps  # noqa: E402
+from microimpact.studies.material import (fit_parameter_source, material_dynamics, material_sweep,  # noqa: E402
+                                          preset_parameter_source, stamp_parameters)
 from microimpact.studies.sweeps import restitution_curves  # noqa: E402
 
 FORBIDDEN = ("microimpact.solvers", "microimpact.dynamics", "microimpact.studies", "microimpact.analysis", "numba")
-PAPER_SOURCE = "preset: wall1990"
+PAPER_SOURCE = preset_parameter_source("wall1990")
 SPEEDS = [0.5, 1.5, 3.0, 8.0]
 
 
@@ -51,28 +51,14 @@ def _case_spec(case, speeds):
     return dict(spec, speed=list(speeds), **{family: [float(values[0]), float(values[-1])]})
 
 
-def _analyst_files(tmp, fit, fit_path):
-    """Per-radius dynamics and sweeps with the fitted contact (the layout the pipeline writes)."""
-    sha = hashlib.sha256(fit_path.read_bytes()).hexdigest()
-    source = f"fit: {fit_path.name} {sha}"
-    radii = np.unique(fit.to_dataset()["radius"].values)
-    contacts = [fit.contact(float(r)) for r in radii]
-    per_radius = {k: np.array([contact_attributes(c)[k] for c in contacts]) for k in contact_attributes(contacts[0])
-                  if not isinstance(contact_attributes(contacts[0])[k], str)}
-    radius = xr.DataArray(radii, dims="radius", attrs={"units": "m", "long_name": "sphere radius"})
-    dyn = xr.Dataset({
-        "capture_velocity": ("radius", [dynamics.capture_velocity(c) for c in contacts], {"units": "m s-1"}),
-        "critical_velocity": ("radius", [dynamics.critical_velocity(c) for c in contacts], {"units": "m s-1"}),
-    }, coords={"radius": radius}, attrs={"parameter_source": source, **per_radius})
-    write_netcdf(dyn, tmp / "analyst_dynamics.nc")
+def _analyst_files(tmp, fit_ds):
+    """Per-radius dynamics and sweeps of the fitted material, as the pipeline writes them."""
+    write_netcdf(material_dynamics(fit_ds), tmp / "analyst_dynamics.nc")
     files = []
     for case in ("2.1", "2.3"):
-        spec = _case_spec(case, np.geomspace(0.5, 20.0, 5))
-        ds = xr.concat([sweeps.run_sweep(c, spec, case=case) for c in contacts], dim=radius, combine_attrs="override")
-        ds.attrs.update(per_radius, parameter_source=source)
-        write_netcdf(ds, tmp / f"analyst_{case}.nc")
+        write_netcdf(material_sweep(fit_ds, _case_spec(case, SPEEDS), case=case), tmp / f"analyst_{case}.nc")
         files.append(tmp / f"analyst_{case}.nc")
-    return source, files
+    return fit_parameter_source(fit_ds), files
 
 
 def _paper_files(tmp):
@@ -81,15 +67,13 @@ def _paper_files(tmp):
     for p in portraits:
         p.attrs.setdefault("parameter_source", PAPER_SOURCE)
     dynamics.save_phase_portraits(portraits, tmp / "portraits.nc")
-    dyn = dynamics.dynamics_summary(contact, [0.5, 1e-5])
-    dyn.attrs["parameter_source"] = PAPER_SOURCE
-    write_netcdf(dyn, tmp / "dynamics.nc")
+    write_netcdf(stamp_parameters(dynamics.dynamics_summary(contact, [0.5, 1e-5]), contact, PAPER_SOURCE),
+                 tmp / "dynamics.nc")
     write_netcdf(dynamics.bifurcation_plane(n_c1=31, n_c2=31), tmp / "bifurcation.nc")
     files = []
     for case in ("2.1", "2.3"):
         ds = sweeps.run_sweep(contact, _case_spec(case, SPEEDS), case=case)
-        ds.attrs["parameter_source"] = PAPER_SOURCE
-        write_netcdf(ds, tmp / f"paper_{case}.nc")
+        write_netcdf(stamp_parameters(ds, contact, PAPER_SOURCE), tmp / f"paper_{case}.nc")
         files.append(tmp / f"paper_{case}.nc")
     repro = pd.DataFrame({"id": ["vc"], "claim": ["critical velocity"], "source": ["Eq. (38)"],
                           "paper_value": ["1.45"], "toolkit_value": ["1.45"], "agree": [True], "note": [""]})
@@ -107,11 +91,10 @@ def results(tmp_path_factory):
     fit = fit_damping(table, presets.WALL_1990, confidence_intervals=False,
                       start_grid=([0.5, 1.0], [10.0, 30.0]))
     fit_ds = fit.to_dataset()
-    fit_ds.attrs.setdefault("parameter_source", "fit: synthetic_impacts.csv")
     write_netcdf(fit_ds, tmp / "fit.nc")
     write_netcdf(restitution_curves(fit_ds, {"start": 0.3, "stop": 30.0, "num": 12, "spacing": "log"}),
                  tmp / "fit_curves.nc")
-    source, analyst_sweeps = _analyst_files(tmp, fit, tmp / "fit.nc")
+    source, analyst_sweeps = _analyst_files(tmp, fit_ds)
     kh = kharaz_comparison(fit_friction=False, curve_incidence_deg=np.arange(1.0, 80.0, 6.0))
     write_netcdf(kh, tmp / "kharaz.nc")
     stress = {"cases_run": 4, "cases_failed": 0, "seed": 1, "captures": 1, "failures_by_kind": {"energy": 0},
@@ -153,7 +136,7 @@ def test_report_has_both_parts_and_their_sources(results, report_text):
     assert a < text.index("Capture and critical velocity of the measured sizes") < b
     assert text.index("Sensitivity sweeps of the measured material") < b < text.index("Table 2 case 2.3 (Figs")
     # every section says which parameters made it: the fit's file and hash in part A, the preset in part B
-    assert text[a:b].count(f"Parameters: {analyst_source}") >= 3  # per-size dynamics, sweeps, flags
+    assert text[a:b].count(f"Parameters: {analyst_source}") >= 4  # fit, per-size dynamics, sweeps, flags
     assert "Measurement flags" in text[a:b] and "Of 12 impacts: 0 R, 0 A, 1 C" in text[a:b]
     assert text[b:].count(f"Parameters: {PAPER_SOURCE}") >= 3
     assert "Parameters: preset" not in text[a:b]

@@ -36,7 +36,7 @@ def fit_section(lay: Layout, fit: xr.Dataset, curves: xr.Dataset | None, data: p
         + ", jointly over all sphere sizes with one work of adhesion w_A (f0 per radius from Eq. (7)). "
         f"Weighting: {a.get('weighting', '?')}."
         + (f" Data file sha256: {a['fit_sha256']}." if a.get("fit_sha256") else ""))
-    lay.source(parameter_source(fit, *([curves] if curves is not None else [])))
+    lay.source(_fit_source(fit, curves))
     if curves is None:
         lay.paragraph("(No fit_curves file was given: the model is drawn at the data points.)", color="0.4")
     lay.plot(figures.plot_fit(fit, curves), max_height=3.8)
@@ -50,6 +50,16 @@ def fit_section(lay: Layout, fit: xr.Dataset, curves: xr.Dataset | None, data: p
         lay.table(_data_by_size(data), {"diameter_um": 14, "n": 6, "v_min": 12, "v_max": 12, "e_min": 10, "e_max": 10},
                   headers={"diameter_um": "diameter [um]", "n": "impacts", "v_min": "min v_n [m/s]",
                            "v_max": "max v_n [m/s]", "e_min": "min e_n [-]", "e_max": "max e_n [-]"}, size=7.2)
+
+
+def _fit_source(fit: xr.Dataset, curves: xr.Dataset | None) -> str:
+    """What made the fit section: the fit's own ``parameter_source`` if it has one, else the data it fitted."""
+    stamped = [ds for ds in (fit, curves) if ds is not None and "parameter_source" in ds.attrs]
+    if stamped:
+        return parameter_source(*stamped)
+    a = fit.attrs
+    return (f"fit: {a.get('fit_source', 'unknown data')} {a.get('fit_sha256', 'sha256 unknown')} (this fit; density "
+            "and stiffness, and w_A unless fitted, from the materials config)")
 
 
 def _fit_parameters(fit: xr.Dataset) -> list[str]:
