@@ -13,14 +13,8 @@ import microimpact as mi
 from microimpact.analysis.fitting import DampingFit
 from microimpact.model.parameters import TABLE1_ROW2, TABLE2_CASES
 from microimpact.presets import WALL_1990
-from microimpact.studies.material import (
-    fit_parameter_source,
-    material_dynamics,
-    material_sweep,
-    measured_speed_range,
-    named_contact,
-    stamp_parameters,
-)
+from microimpact.io.provenance import fit_parameter_source, stamp_parameters
+from microimpact.studies.material import material_dynamics, material_sweep, measured_speed_range, named_contact
 from microimpact.studies.sweeps import case_spec
 
 #: a fit of the bundled synthetic data, from the regression baseline (a real fit.nc file)

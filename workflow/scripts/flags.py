@@ -10,7 +10,8 @@ import xarray as xr  # noqa: E402
 from microimpact.analysis.fitting import DampingFit  # noqa: E402
 from microimpact.analysis.flags import flag_measurements, write_flags  # noqa: E402
 from microimpact.io import read_impacts  # noqa: E402
-from microimpact.studies.material import fit_parameter_source, fitted_contacts, stamp_parameters  # noqa: E402
+from microimpact.io.provenance import fit_parameter_source, stamp_parameters  # noqa: E402
+from microimpact.studies.material import fitted_contacts  # noqa: E402
 
 fit_ds = xr.load_dataset(snakemake.input.fit)  # noqa: F821
 table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821

@@ -45,6 +45,7 @@ import xarray as xr
 from scipy.optimize import brentq
 
 from microimpact.io.materials import default_materials_path, read_materials
+from microimpact.io.provenance import materials_parameter_source, stamp_parameters
 from microimpact.io.variables import VARIABLES, attributes
 from microimpact.solvers import engine
 from microimpact.solvers.impact import simulate_many
@@ -208,7 +209,7 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         "spin_convention": "omega_t' < 0 is forward rolling for v_t > 0 (slip u_t = v_t + r omega_t'); compared as |omega|",
         "Conventions": "CF-1.8",
     })
-    return ds
+    return stamp_parameters(ds, contact, materials_parameter_source(KHARAZ_CONDITIONS["material_pair"]))
 
 
 def _fit_friction(contact, data, sliding_threshold_deg, src) -> tuple[float, float]:

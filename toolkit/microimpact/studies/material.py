@@ -6,11 +6,9 @@ Eq. (7), :meth:`Contact.at_radius`). This module turns a fit into the 3-D simula
 material: the Table 2 sweeps at every measured size over the measured speed range, and the
 numbers of the nonlinear analysis (critical and capture velocity) per size.
 
-Every result records where its parameters came from in the ``parameter_source`` attribute:
-``"fit: <data file> <sha256>"`` for a fit, ``"preset: <name>"`` for a named parameter set of the
-paper (:mod:`microimpact.model.parameters`), ``"config"`` for numbers given in a config; and the
-contact itself in ``contact_*`` attributes (one value per size along ``radius`` for the
-analyst's results).
+Every result records where its parameters came from (``parameter_source``) and the contact
+itself (``contact_*``, one value per size along ``radius`` for the analyst's results); see
+:mod:`microimpact.io.provenance`.
 """
 
 from __future__ import annotations
@@ -22,6 +20,7 @@ import xarray as xr
 
 from microimpact.analysis.fitting import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity, critical_velocity
+from microimpact.io.provenance import fit_parameter_source, preset_parameter_source, stamp_parameters
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
 from microimpact.presets import get_preset
@@ -29,27 +28,12 @@ from microimpact.solvers import DEFAULT_RTOL
 from microimpact.studies.sweeps import resolve_spec, run_sweep
 
 __all__ = [
-    "fit_parameter_source",
-    "preset_parameter_source",
-    "stamp_parameters",
     "fitted_contacts",
     "measured_speed_range",
     "material_sweep",
     "material_dynamics",
     "named_contact",
 ]
-
-
-def fit_parameter_source(fit: xr.Dataset) -> str:
-    """``"fit: <data file> <sha256>"`` of a fit Dataset (:meth:`DampingFit.to_dataset`)."""
-    source = fit.attrs.get("fit_source") or "unknown data"
-    sha = fit.attrs.get("fit_sha256") or "sha256 unknown"
-    return f"fit: {source} {sha}"
-
-
-def preset_parameter_source(name: str) -> str:
-    """``"preset: <name>"``: parameters from a named set of :mod:`microimpact.presets`."""
-    return f"preset: {name}"
 
 
 def named_contact(spec: str | Mapping) -> tuple[Contact, str]:
@@ -69,32 +53,6 @@ def named_contact(spec: str | Mapping) -> tuple[Contact, str]:
     if isinstance(spec, str):
         return get_preset(spec), preset_parameter_source(spec.lower())
     return Contact(**spec), "config"
-
-
-def stamp_parameters(ds: xr.Dataset, contacts: Contact | Sequence[Contact], source: str) -> xr.Dataset:
-    """``ds`` with ``parameter_source`` and the ``contact_*`` attributes of the contact(s) used.
-
-    Parameters
-    ----------
-    ds : xarray.Dataset
-    contacts : Contact or sequence of Contact
-        One contact, or one per size (the attributes are then arrays, in that order).
-    source : str
-        Provenance of the parameters (module docstring).
-    """
-    many = not isinstance(contacts, Contact)
-    group = list(contacts) if many else [contacts]
-    attrs = {}
-    for name in Contact.__dataclass_fields__:
-        values = [getattr(c, name) for c in group]
-        if any(v is None for v in values):  # damping reference speed: each impact's own
-            attrs[f"contact_{name}"] = "per-impact normal speed"
-        else:
-            attrs[f"contact_{name}"] = np.array(values, dtype=float) if many else float(values[0])
-    out = ds.copy()
-    out.attrs.update(attrs)
-    out.attrs["parameter_source"] = source
-    return out
 
 
 def fitted_contacts(fit: xr.Dataset, radii: Sequence[float] | None = None) -> dict[float, Contact]:

@@ -1,0 +1,63 @@
+"""Which parameters made a result: the ``contact_*`` and ``parameter_source`` attributes.
+
+Every result Dataset of the toolkit records the contact it was computed with (``contact_<field>``,
+SI units; one value per size, as arrays, when a result spans several sphere sizes) and where those
+parameters came from, in ``parameter_source``:
+
+- ``"fit: <data file> <sha256>"``: fitted to measurements (:mod:`microimpact.analysis.fitting`);
+- ``"preset: <name>"``: a named set of :mod:`microimpact.presets` (the paper's Table 1 rows);
+- ``"materials: <pair>"``: a pair of a materials config (:mod:`microimpact.io.materials`);
+- ``"config"``: numbers given in a configuration.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import fields
+
+import numpy as np
+import xarray as xr
+
+from microimpact.model.contact import Contact
+
+__all__ = ["contact_attributes", "stamp_parameters", "fit_parameter_source", "preset_parameter_source",
+           "materials_parameter_source"]
+
+
+def contact_attributes(contacts: Contact | Sequence[Contact]) -> dict:
+    """``contact_<field>`` attributes of one contact (floats) or of one contact per size (arrays)."""
+    many = not isinstance(contacts, Contact)
+    group = list(contacts) if many else [contacts]
+    attrs = {}
+    for f in fields(Contact):
+        values = [getattr(c, f.name) for c in group]
+        if any(v is None for v in values):  # damping reference speed: each impact's own
+            attrs[f"contact_{f.name}"] = "per-impact normal speed"
+        else:
+            attrs[f"contact_{f.name}"] = np.array(values, dtype=float) if many else float(values[0])
+    return attrs
+
+
+def stamp_parameters(ds: xr.Dataset, contacts: Contact | Sequence[Contact], source: str) -> xr.Dataset:
+    """A copy of ``ds`` with the ``contact_*`` attributes of ``contacts`` and ``parameter_source``."""
+    out = ds.copy()
+    out.attrs.update(contact_attributes(contacts))
+    out.attrs["parameter_source"] = source
+    return out
+
+
+def fit_parameter_source(fit: xr.Dataset) -> str:
+    """``"fit: <data file> <sha256>"`` of a fit Dataset (``DampingFit.to_dataset``)."""
+    source = fit.attrs.get("fit_source") or "unknown data"
+    sha = fit.attrs.get("fit_sha256") or "sha256 unknown"
+    return f"fit: {source} {sha}"
+
+
+def preset_parameter_source(name: str) -> str:
+    """``"preset: <name>"``: parameters from a named set of :mod:`microimpact.presets`."""
+    return f"preset: {name}"
+
+
+def materials_parameter_source(pair: str) -> str:
+    """``"materials: <pair>"``: parameters from a pair of a materials config."""
+    return f"materials: {pair}"
