@@ -16,7 +16,6 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
-import xarray as xr  # noqa: E402
 
 from microimpact import presets  # noqa: E402
 from microimpact.analysis.fitting import fit_damping  # noqa: E402
