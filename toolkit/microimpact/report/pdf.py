@@ -15,7 +15,7 @@ C. checks: the Kharaz et al. (2001) validation, the work-precision benchmark, th
 Every section prints the ``parameter_source`` of the files it shows. The report imports no solver
 and runs no model; figures come from :mod:`.figures`, the page layout from :mod:`.layout`.
 
-Layout engine, decided: we keep the matplotlib page layout (:mod:`.layout`, about 250 lines), not a
+Layout engine, decided: we keep the matplotlib page layout (:mod:`.layout`, under 300 lines), not a
 document template or Snakemake's ``--report``. Snakemake's report is an HTML/zip archive made by a
 separate ``snakemake --report`` call after the run, so it cannot be the ``reports/report.pdf`` target
 of ``rule all``, and it lays out files rather than tables and captions computed from their contents.
