@@ -25,9 +25,6 @@ __all__ = [
     "impact_coefficients",
 ]
 
-OUTCOMES = ("rebound", "capture")
-
-
 def incident_velocity(speed: float, incidence_deg: float, azimuth_deg: float) -> tuple[float, float, float]:
     """Incident velocity components (v_n, v_t, v_t') from magnitude and angles. [m/s]
 
@@ -132,9 +129,11 @@ class ImpactResult:
         Normal contact energy left at the end: 0 for a rebound; for a captured sphere the energy
         V(X) = -(4/15) m (X/T)^2 of the sphere at rest at the equilibrium. [J]
     method : str
-        "engine" or "reference:<scipy method>".
+        The solver: "engine", "rkg" or "reference:<scipy method>".
     stop_reason : str
-        Why the integration stopped: "separation", "capture", ...
+        Why the integration stopped: "separation" (rebound), "capture" (the energy test, nothing
+        tangential left), "settled" or "slip and twist ended" (a captured sphere followed for its
+        tangential outcome).
     """
 
     outcome: str

@@ -40,6 +40,7 @@ import numpy as np
 from numba import njit, prange
 
 from microimpact.model.contact import check_positive
+from microimpact.solvers import DEFAULT_RTOL
 from microimpact.model.law import Scales, nondimensional_impact, nondimensional_scales
 from microimpact.solvers import compiled_law as law
 
@@ -585,7 +586,7 @@ def solve_normal(
     contact,
     normal_speed: float,
     *,
-    rtol: float = 1e-10,
+    rtol: float = DEFAULT_RTOL,
     trajectory: bool = False,
     follow_capture: bool = False,
     need_tail: bool = False,
@@ -683,7 +684,7 @@ def solve_normal(
     )
 
 
-def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = 1e-10,
+def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DEFAULT_RTOL,
                       tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT,
                       friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> dict:
     """Solve many normal impacts in parallel (both cores); arrays in, dict of SI arrays out.

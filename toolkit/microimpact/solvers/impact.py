@@ -1,7 +1,11 @@
 """Public impact API: one impact (:func:`simulate_impact`) or a broadcast batch (:func:`simulate_many`).
 
-Both use the fast engine (one compiled normal solve per distinct normal speed plus the closed-form
-tangential map); ``simulate_impact(..., method="reference")`` runs the full 3-D scipy solver instead.
+Both return the one result type: :class:`~microimpact.model.kinematics.ImpactResult` for one impact,
+an xarray Dataset of its fields for a batch. ``simulate_impact(..., method=...)`` selects the solver:
+``"engine"`` (one compiled normal solve plus the closed-form tangential map), ``"reference"`` (the
+full 3-D scipy integration) or ``"rkg"`` (the paper's fixed-step Runge-Kutta-Gill normal solve plus
+the same tangential map). ``simulate_many`` runs the engine only: one normal solve per distinct
+normal speed serves every angle, spin and friction coefficient that shares it.
 """
 
 from __future__ import annotations
@@ -12,11 +16,16 @@ import numpy as np
 import xarray as xr
 
 from microimpact.io.variables import attributes
-from microimpact.solvers import engine
+from microimpact.solvers import DEFAULT_RTOL, engine
+from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
+from microimpact.model.law import contact_potential_energy
 from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
 from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
 
-__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES"]
+__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES", "METHODS"]
+
+#: the solvers behind ``method=`` (see :mod:`microimpact.solvers`)
+METHODS = ("engine", "reference", "rkg")
 
 #: the variables that simulate_many returns (units and long names in microimpact.io.variables)
 RESULT_VARIABLES: tuple[str, ...] = (
@@ -45,7 +54,7 @@ def _check_inputs(speed, incidence_deg, azimuth_deg, omega):
 
 
 def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0, 0.0, 0.0), *,
-                    rtol: float = 1e-10, method: str = "engine") -> ImpactResult:
+                    rtol: float = DEFAULT_RTOL, method: str = "engine", steps: int | None = None) -> ImpactResult:
     """Simulate one impact of a sphere on the flat surface.
 
     Parameters
@@ -60,36 +69,69 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
     omega : tuple of 3 float
         Initial spin (omega_n, omega_t, omega_t'). [rad/s]
     rtol : float
-        Relative tolerance of the integration. [-]
-    method : {"engine", "reference"}
-        The compiled engine (default) or the full 3-D scipy reference solver.
+        Relative tolerance of the integration ("engine" and "reference"). [-]
+    method : {"engine", "reference", "rkg"}
+        ``"engine"`` (default): the compiled normal solve plus the closed-form tangential map.
+        ``"reference"``: the full 3-D scipy integration (:mod:`microimpact.solvers.reference`).
+        ``"rkg"``: the paper's fixed-step Runge-Kutta-Gill normal solve
+        (:func:`microimpact.solvers.rkg.solve_normal_rkg`), then the same tangential map.
+    steps : int, optional
+        ``"rkg"`` only: steps per estimated contact duration (default
+        :data:`microimpact.solvers.rkg.DEFAULT_STEPS`, e_n to about 1e-6). [-]
 
     Returns
     -------
     ImpactResult
+
+    Raises
+    ------
+    ValueError
+        For bad inputs or an unknown method; for ``steps`` with a method other than "rkg"; and for
+        "rkg" when the sphere is captured while the tangential outcome is needed (friction with
+        slip or twist): the RKG stops at the capture test and does not follow the captured
+        oscillation whose friction impulse the map needs (use "engine" or "reference").
     """
     if len(omega) != 3:
         raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_tp), got {omega!r}")
     _check_inputs(speed, incidence_deg, azimuth_deg, omega)
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}")
+    if steps is not None and method != "rkg":
+        raise ValueError(f"steps applies to method='rkg' only, got method={method!r}")
     if method == "reference":
+        # imported here: scipy.integrate costs ~0.7 s of import time that the engine never needs
         from microimpact.solvers.reference import simulate_reference
 
         return simulate_reference(contact, speed, incidence_deg, azimuth_deg, omega, rtol=rtol)
-    if method != "engine":
-        raise ValueError(f"method must be 'engine' or 'reference', got {method!r}")
     v_in = incident_velocity(float(speed), float(incidence_deg), float(azimuth_deg))
     w_in = tuple(float(w) for w in omega)
-    m, inertia, r, f = contact.mass, contact.moment_of_inertia, contact.radius, contact.friction
-    u_t, u_tp = slip_velocity(r, v_in[1], v_in[2], w_in[1], w_in[2])
+    u_t, u_tp = slip_velocity(contact.radius, v_in[1], v_in[2], w_in[1], w_in[2])
     slip = math.hypot(u_t, u_tp)
-    needs_tangential = f > 0.0 and (slip > 0.0 or w_in[0] != 0.0)
-    j_star = _sliding_impulse(m, f, slip)
-    sol = engine.solve_normal(
-        contact, -v_in[0], rtol=rtol, need_tail=needs_tangential,
-        friction_impulse_target=j_star if needs_tangential and 0.0 < j_star < math.inf else None,
-        friction_impulse_stop=j_star, twist_impulse_stop=_twist_stop(inertia, f, w_in[0]),
-    )
-    tan = tangential_kernel(m, inertia, r, f, v_in[1], v_in[2], *w_in, sol.friction_impulse, sol.twist_impulse)
+    needs_tangential = contact.friction > 0.0 and (slip > 0.0 or w_in[0] != 0.0)
+    j_star = _sliding_impulse(contact.mass, contact.friction, slip)
+    j_target = j_star if needs_tangential and 0.0 < j_star < math.inf else None
+    if method == "rkg":
+        sol = solve_normal_rkg(contact, -v_in[0], steps=DEFAULT_STEPS if steps is None else steps,
+                               friction_impulse_target=j_target)
+        if sol.outcome == "capture" and needs_tangential:
+            raise ValueError(
+                "method='rkg' stops a captured impact at the capture test (E < 0) and does not follow "
+                "the captured oscillation, whose friction impulse the tangential outcome needs "
+                f"(speed {speed!r} m/s, friction {contact.friction!r}); use method='engine' or 'reference'")
+    else:
+        sol = engine.solve_normal(
+            contact, -v_in[0], rtol=rtol, need_tail=needs_tangential, friction_impulse_target=j_target,
+            friction_impulse_stop=j_star,
+            twist_impulse_stop=_twist_stop(contact.moment_of_inertia, contact.friction, w_in[0]),
+        )
+    return _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential)
+
+
+def _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential) -> ImpactResult:
+    """The ImpactResult of a normal solve (engine or RKG) and the closed-form tangential map."""
+    m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
+    tan = tangential_kernel(m, inertia, r, contact.friction, v_in[1], v_in[2], *w_in, sol.friction_impulse,
+                            sol.twist_impulse)
     captured = sol.outcome == "capture"
     v_out = (0.0 if captured else sol.e_n * -v_in[0], tan[0], tan[1])
     w_out = (tan[2], tan[3], tan[4])
@@ -110,18 +152,18 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
         friction_impulse=sol.friction_impulse,
         dissipated_energy=float(_normal_dissipation(contact, -v_in[0], captured, sol.dissipated_energy)) + tan[7],
         final_contact_energy=settled_contact_energy(contact) if captured else 0.0,
-        method="engine",
-        stop_reason=sol.outcome if not captured else ("settled" if needs_tangential else "capture"),
+        method=method,
+        stop_reason="separation" if not captured else ("settled" if needs_tangential else "capture"),
     )
 
 
 def settled_contact_energy(contact) -> float:
-    """Contact energy V(X) = -(4/15) m (X/T)^2 of a sphere at rest at the equilibrium. [J]"""
-    return -4.0 / 15.0 * contact.mass * (contact.length_scale / contact.time_scale) ** 2
+    """Contact energy V(X) = -(4/15) m (X/T)^2 of a sphere at rest at the equilibrium x = X. [J]"""
+    return float(contact_potential_energy(contact, contact.length_scale))
 
 
 def _normal_dissipation(contact, normal_speed, captured, tracked):
-    """Energy dissipated by the normal damping: as tracked by the solver for a rebound; for a
+    """Energy dissipated by the normal damping [J]: as tracked by the solver for a rebound; for a
     captured sphere all of it down to rest at the equilibrium, m v_n^2/2 - V(X), which does not
     depend on how far the solver followed the captured oscillation."""
     to_rest = 0.5 * contact.mass * np.square(normal_speed) - settled_contact_energy(contact) if contact.adhesion_line_force > 0 else 0.0
@@ -139,7 +181,7 @@ def _as_dataarray(name, value):
 
 
 def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0, 0.0, 0.0), friction=None, *,
-                  rtol: float = 1e-8) -> xr.Dataset:
+                  rtol: float = DEFAULT_RTOL, method: str = "engine") -> xr.Dataset:
     """Simulate a batch of impacts, broadcasting the inputs, on both cores.
 
     Each distinct normal speed is solved once by the compiled engine; every angle, azimuth, spin
@@ -158,6 +200,8 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     rtol : float
         Relative tolerance of the normal solves. The default 1e-8 gives e_n and mu to ~5e-8
         (docs/benchmark.md) at half the cost of 1e-10, most of it saved on captured impacts. [-]
+    method : {"engine"}
+        Only the engine runs batches; for "reference" or "rkg" loop over :func:`simulate_impact`.
 
     Returns
     -------
@@ -168,10 +212,11 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         ``long_name``; the inputs are included as variables. ``outcome`` is 0 for a rebound and 1
         for a capture (CF flag attributes).
     """
+    if method != "engine":
+        raise ValueError(f"simulate_many runs method='engine' only, got {method!r}; for 'reference' or 'rkg' "
+                         "call simulate_impact in a loop")
     if len(omega) != 3:
         raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_tp), got {omega!r}")
-    if friction is None:
-        friction = contact.friction
     inputs = {
         "speed": speed,
         "incidence_deg": incidence_deg,
@@ -179,20 +224,36 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         "omega_n": omega[0],
         "omega_t": omega[1],
         "omega_tp": omega[2],
-        "friction": friction,
+        "friction": contact.friction if friction is None else friction,
     }
+    arrays, flat = _broadcast_inputs(inputs)
+    results, n_solves = _solve_batch(contact, flat, rtol)
+    ds = _batch_dataset(arrays, results)
+    ds.attrs.update(contact_attributes(contact))
+    ds.attrs["solver"] = f"microimpact engine (Dormand-Prince 5(4), rtol={rtol:g})"
+    ds.attrs["normal_solves"] = n_solves
+    return ds
+
+
+def _broadcast_inputs(inputs: dict):
+    """Broadcast the inputs (plain arrays by numpy rules, then DataArrays by dimension name) and
+    check them; returns the broadcast DataArrays and their flattened values."""
     plain = {k: np.asarray(v, dtype=float) for k, v in inputs.items() if not isinstance(v, xr.DataArray)}
-    if plain:  # plain arrays broadcast with numpy rules, then join the DataArrays by dimension name
+    if plain:
         plain = dict(zip(plain, np.broadcast_arrays(*plain.values())))
     arrays = xr.broadcast(*(_as_dataarray(k, plain.get(k, v)) for k, v in inputs.items()))
     dims = arrays[0].dims
     arrays = [a.transpose(*dims) for a in arrays]
-    shape = arrays[0].shape
     flat = {a.name: np.ascontiguousarray(a.values, dtype=float).ravel() for a in arrays}
     _check_inputs(flat["speed"], flat["incidence_deg"], flat["azimuth_deg"], (flat["omega_n"], flat["omega_t"], flat["omega_tp"]))
     if np.any(~np.isfinite(flat["friction"]) | (flat["friction"] < 0.0)):
         raise ValueError("friction must be finite and >= 0")
+    return arrays, flat
 
+
+def _solve_batch(contact, flat: dict, rtol: float):
+    """Engine normal solves (one per distinct normal speed) and the tangential map of a flat
+    batch; returns ({variable: 1-D array}, number of normal solves)."""
     alpha = np.radians(flat["incidence_deg"])
     theta = np.radians(flat["azimuth_deg"])
     v = flat["speed"]
@@ -226,10 +287,7 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     results = {
         "outcome": captured.astype(np.int8),
         "e_n": g["e_n"],
-        "mu_t": coef["mu_t"],
-        "mu_tp": coef["mu_tp"],
-        "K_L": coef["K_L"],
-        "K_t": coef["K_t"],
+        **{k: coef[k] for k in ("mu_t", "mu_tp", "K_L", "K_t")},
         "velocity_out_n": vn_out,
         "velocity_out_t": tan["v_t"],
         "velocity_out_tp": tan["v_tp"],
@@ -243,6 +301,13 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         "dissipated_energy": _normal_dissipation(contact, -v_n, captured, g["dissipated_energy"])
         + tan["friction_dissipation"],
     }
+    return results, int(speeds.size)
+
+
+def _batch_dataset(arrays, results: dict) -> xr.Dataset:
+    """The inputs and results of a batch as a Dataset with the inputs' dimensions and coordinates;
+    every variable carries the ``units`` and ``long_name`` of :mod:`microimpact.io.variables`."""
+    dims, shape = arrays[0].dims, arrays[0].shape
     coords = {name: c for a in arrays for name, c in a.coords.items()}
     ds = xr.Dataset(coords=coords)
     for a in arrays:
@@ -252,9 +317,6 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         ds[name] = xr.DataArray(values.reshape(shape), dims=dims, attrs=attributes(name))
     ds["outcome"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="rebound capture")
     ds["slip_ended"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="sliding rolling")
-    ds.attrs.update(contact_attributes(contact))
-    ds.attrs["solver"] = f"microimpact engine (Dormand-Prince 5(4), rtol={rtol:g})"
-    ds.attrs["normal_solves"] = int(speeds.size)
     return ds
 
 

@@ -91,6 +91,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from microimpact.model import law
+from microimpact.solvers import DEFAULT_RTOL
 from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity
 from microimpact.model.contact import Contact
 
@@ -321,7 +322,7 @@ def simulate_reference(
     azimuth_deg: float = 0.0,
     omega: Sequence[float] = (0.0, 0.0, 0.0),
     *,
-    rtol: float = 1e-10,
+    rtol: float = DEFAULT_RTOL,
     atol: float = 1e-13,
     method: str = "DOP853",
     max_step: float = math.inf,
@@ -669,7 +670,7 @@ def reference_trajectory(
     normal_speed: float,
     *,
     duration: float | None = None,
-    rtol: float = 1e-10,
+    rtol: float = DEFAULT_RTOL,
     atol: float = 1e-13,
     method: str = "DOP853",
     max_step: float = math.inf,
