@@ -13,7 +13,7 @@ import microimpact as mi
 from microimpact.analysis.fitting import DampingFit
 from microimpact.model.parameters import TABLE1_ROW2, TABLE2_CASES
 from microimpact.presets import WALL_1990
-from microimpact.io.provenance import fit_parameter_source, stamp_parameters
+from microimpact.io.provenance import source_of_fit, stamp_parameters
 from microimpact.studies.material import material_dynamics, material_sweep, measured_speed_range, named_contact
 from microimpact.studies.sweeps import case_spec
 
@@ -65,7 +65,7 @@ def test_material_sweep_uses_the_fitted_contact_at_every_measured_size(fit):
     lo, hi = measured_speed_range(fit)
     assert ds["speed"].values[[0, -1]].tolist() == pytest.approx([lo, hi], rel=1e-14)
     assert ds.sizes["speed"] == 50  # the case's number of speeds, moved onto the measured range
-    assert ds.attrs["parameter_source"] == fit_parameter_source(fit)
+    assert ds.attrs["parameter_source"] == source_of_fit(fit) == f"fit: synthetic_microspheres.csv {fit.attrs['fit_sha256']}"
     assert fit.attrs["fit_sha256"] in ds.attrs["parameter_source"]
     np.testing.assert_allclose(ds.attrs["contact_zeta_hertz"], model.zeta_hertz, rtol=0)
     # each size's values are those of a direct simulation of that size's fitted contact

@@ -27,8 +27,8 @@ from microimpact.io.files import read_netcdf_groups, write_csv, write_netcdf  # 
 from microimpact.report.inputs import INPUT_KEYS  # noqa: E402
 from microimpact.report.pdf import build_report  # noqa: E402
 from microimpact.studies import sweeps  # noqa: E402
-from microimpact.studies.material import (fit_parameter_source, material_dynamics, material_sweep,  # noqa: E402
-                                          preset_parameter_source, stamp_parameters)
+from microimpact.io.provenance import preset_parameter_source, source_of_fit, stamp_parameters  # noqa: E402
+from microimpact.studies.material import material_dynamics, material_sweep  # noqa: E402
 from microimpact.studies.sweeps import restitution_curves  # noqa: E402
 
 FORBIDDEN = ("microimpact.solvers", "microimpact.dynamics", "microimpact.studies", "microimpact.analysis", "numba")
@@ -57,7 +57,7 @@ def _analyst_files(tmp, fit_ds):
     for case in ("2.1", "2.3"):
         write_netcdf(material_sweep(fit_ds, _case_spec(case, SPEEDS), case=case), tmp / f"analyst_{case}.nc")
         files.append(tmp / f"analyst_{case}.nc")
-    return fit_parameter_source(fit_ds), files
+    return source_of_fit(fit_ds), files
 
 
 def _paper_files(tmp):

@@ -219,6 +219,21 @@ def test_chain_fitted_parameters_drive_the_analyst_results(pipeline):
 
 
 @pytest.mark.slow
+def test_every_result_netcdf_says_which_parameters_made_it(pipeline):
+    root, _ = pipeline
+    files = sorted(p for p in (root / "results").rglob("*.nc") if "chunks" not in p.parts)
+    assert len(files) >= 15
+    for path in files:
+        with xr.open_dataset(path) as ds:
+            if path.name == "stress.nc":  # thousands of random contacts: one per row, as variables
+                assert ds.attrs["parameter_source"].startswith("stress: "), path
+                continue
+            source = ds.attrs.get("parameter_source", "")
+            assert source.startswith(("fit: ", "preset: ", "materials: ", "config")), (path, source)
+            assert "contact_radius" in ds.attrs and "contact_zeta_hertz" in ds.attrs, path
+
+
+@pytest.mark.slow
 def test_sweep_and_dynamics_netcdf(pipeline):
     root, _ = pipeline
     with xr.open_dataset(root / "results" / "paper" / "sweeps" / "case_2.1.nc") as ds:

@@ -7,12 +7,11 @@ sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 import xarray as xr  # noqa: E402
 
 from microimpact.io import write_netcdf  # noqa: E402
-from microimpact.io.provenance import fit_parameter_source, stamp_parameters  # noqa: E402
-from microimpact.studies.material import fitted_contacts  # noqa: E402
+from microimpact.studies.material import stamp_fitted  # noqa: E402
 from microimpact.studies.sweeps import restitution_curves  # noqa: E402
 
 fit = xr.load_dataset(snakemake.input.fit)  # noqa: F821
 curves = restitution_curves(fit, rtol=snakemake.params.rtol)  # noqa: F821
-curves = stamp_parameters(curves, list(fitted_contacts(fit).values()), fit_parameter_source(fit))
+curves = stamp_fitted(curves, fit)
 write_netcdf(curves, snakemake.output[0])  # noqa: F821
 print(curves)

@@ -10,12 +10,11 @@ import xarray as xr  # noqa: E402
 from microimpact.analysis.fitting import DampingFit  # noqa: E402
 from microimpact.analysis.flags import flag_measurements, write_flags  # noqa: E402
 from microimpact.io import read_impacts  # noqa: E402
-from microimpact.io.provenance import fit_parameter_source, stamp_parameters  # noqa: E402
-from microimpact.studies.material import fitted_contacts  # noqa: E402
+from microimpact.studies.material import stamp_fitted  # noqa: E402
 
 fit_ds = xr.load_dataset(snakemake.input.fit)  # noqa: F821
 table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821
 ds = flag_measurements(table, DampingFit.from_dataset(fit_ds), rtol=snakemake.params.rtol)  # noqa: F821
-ds = stamp_parameters(ds, list(fitted_contacts(fit_ds).values()), fit_parameter_source(fit_ds))
+ds = stamp_fitted(ds, fit_ds)
 write_flags(ds, snakemake.output.csv, snakemake.output.nc)  # noqa: F821
 print(ds)

@@ -51,6 +51,7 @@ import xarray as xr
 
 from microimpact.io.files import write_netcdf
 from microimpact.io.materials import material_contact
+from microimpact.io.provenance import fit_parameter_source, stamp_parameters
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
 
@@ -280,9 +281,7 @@ class DampingFit:
         ``fit_source``, ``fit_sha256``); ``unknown`` for what was not recorded (a table built in
         memory).
         """
-        source = self.info.get("source")
-        name = Path(str(source)).name if source else "unknown"
-        return f"fit: {name} {self.info.get('sha256') or 'unknown'}"
+        return fit_parameter_source(self.info.get("source"), self.info.get("sha256"))
 
     # ------------------------------------------------------------------ report
     def report(self) -> str:
@@ -343,7 +342,7 @@ class DampingFit:
             if v is None:
                 continue
             ds.attrs[f"fit_{k}"] = int(v) if isinstance(v, (bool, np.bool_)) else (v if isinstance(v, (int, float, str)) else str(v))
-        return ds
+        return stamp_parameters(ds, [self.contact(r) for r in self.radii], self.parameter_source)
 
     def save(self, path) -> Path:
         """Write :meth:`to_dataset` to NetCDF atomically (:func:`microimpact.io.write_netcdf`)."""

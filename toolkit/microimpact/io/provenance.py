@@ -14,14 +14,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import fields
+from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
 from microimpact.model.contact import Contact
 
-__all__ = ["contact_attributes", "stamp_parameters", "fit_parameter_source", "preset_parameter_source",
-           "materials_parameter_source"]
+__all__ = ["contact_attributes", "stamp_parameters", "fit_parameter_source", "source_of_fit",
+           "preset_parameter_source", "materials_parameter_source"]
 
 
 def contact_attributes(contacts: Contact | Sequence[Contact]) -> dict:
@@ -46,11 +47,20 @@ def stamp_parameters(ds: xr.Dataset, contacts: Contact | Sequence[Contact], sour
     return out
 
 
-def fit_parameter_source(fit: xr.Dataset) -> str:
-    """``"fit: <data file> <sha256>"`` of a fit Dataset (``DampingFit.to_dataset``)."""
-    source = fit.attrs.get("fit_source") or "unknown data"
-    sha = fit.attrs.get("fit_sha256") or "sha256 unknown"
-    return f"fit: {source} {sha}"
+def fit_parameter_source(source, sha256) -> str:
+    """``"fit: <data file name> <sha256>"``: parameters fitted to the data file ``source``.
+
+    Only the file's name is kept (no directories of the machine that ran the fit); the sha256 of
+    its bytes identifies it. ``unknown`` stands for what was not recorded (a table built in memory).
+    """
+    name = Path(str(source)).name if source else "unknown"
+    return f"fit: {name} {sha256 or 'unknown'}"
+
+
+def source_of_fit(fit: xr.Dataset) -> str:
+    """The ``parameter_source`` of a fit Dataset (``DampingFit.to_dataset`` or its file)."""
+    return fit.attrs.get("parameter_source") or fit_parameter_source(fit.attrs.get("fit_source"),
+                                                                     fit.attrs.get("fit_sha256"))
 
 
 def preset_parameter_source(name: str) -> str:

@@ -20,7 +20,7 @@ import xarray as xr
 
 from microimpact.analysis.fitting import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity, critical_velocity
-from microimpact.io.provenance import fit_parameter_source, preset_parameter_source, stamp_parameters
+from microimpact.io.provenance import preset_parameter_source, source_of_fit, stamp_parameters
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
 from microimpact.presets import get_preset
@@ -30,6 +30,7 @@ from microimpact.studies.sweeps import resolve_spec, run_sweep
 __all__ = [
     "fitted_contacts",
     "measured_speed_range",
+    "stamp_fitted",
     "material_sweep",
     "material_dynamics",
     "named_contact",
@@ -60,6 +61,11 @@ def fitted_contacts(fit: xr.Dataset, radii: Sequence[float] | None = None) -> di
     model = DampingFit.from_dataset(fit)
     sizes = np.unique(fit["radius"].values) if radii is None else np.asarray(radii, dtype=float)
     return {float(r): model.contact(float(r)) for r in sizes}
+
+
+def stamp_fitted(ds: xr.Dataset, fit: xr.Dataset) -> xr.Dataset:
+    """``ds`` with the fit's ``parameter_source`` and the fitted contact of every measured size."""
+    return stamp_parameters(ds, list(fitted_contacts(fit).values()), source_of_fit(fit))
 
 
 def measured_speed_range(fit: xr.Dataset) -> tuple[float, float]:
@@ -110,7 +116,7 @@ def material_sweep(fit: xr.Dataset, spec: Mapping, *, case: str | None = None,
     ds["radius"].attrs = attributes("radius")
     ds["capture_normal_speed"] = ("radius", capture, attributes("capture_normal_speed"))
     ds.attrs["title"] = ds.attrs["title"].replace("sweep:", "sweep of the fitted material:", 1)
-    return stamp_parameters(ds, list(contacts.values()), fit_parameter_source(fit))
+    return stamp_fitted(ds, fit)
 
 
 def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL) -> xr.Dataset:
@@ -135,4 +141,4 @@ def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL) -> xr.Data
         attrs={"Conventions": "CF-1.8",
                "title": "Critical and capture velocity of the fitted material at the measured sizes"},
     )
-    return stamp_parameters(ds, list(contacts.values()), fit_parameter_source(fit))
+    return stamp_fitted(ds, fit)
