@@ -5,10 +5,8 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
-import json  # noqa: E402
-
-from microimpact.io.files import atomic_write, write_netcdf  # noqa: E402
-from microimpact.studies.stress import stress_sweep  # noqa: E402
+from microimpact.io.files import write_netcdf  # noqa: E402
+from microimpact.studies.stress import stress_sweep, summary_line, write_stress_summary  # noqa: E402
 
 params = snakemake.params  # noqa: F821
 
@@ -20,9 +18,9 @@ def progress(i, n):
 
 report = stress_sweep(params.cases, params.seed, reference_every=params.reference_every,
                       case_time_limit=params.case_time_limit, progress=progress)
-with atomic_write(snakemake.output.summary) as f:  # noqa: F821
-    f.write(json.dumps(report.summary, indent=2, allow_nan=False, default=str) + "\n")
-write_netcdf(report.dataset, snakemake.output.netcdf)  # noqa: F821
-s = report.summary
-print(f"{s['cases_run']} cases (seed {s['seed']}) in {s['seconds']:.3g} s, {s['cases_failed']} failed: "
-      + (", ".join(f"{k} {v}" for k, v in s["failures_by_kind"].items() if v) or "none"))
+write_stress_summary(report.summary, snakemake.output.summary)  # noqa: F821
+ds = report.dataset
+# every case draws its own contact (inputs are variables of the file, one row per case)
+ds.attrs["parameter_source"] = f"stress: seeded random draw, seed {params.seed}, {params.cases} cases"
+write_netcdf(ds, snakemake.output.netcdf)  # noqa: F821
+print(summary_line(report.summary))

@@ -16,6 +16,7 @@ import numba
 import numpy as np
 import xarray as xr
 
+from microimpact.io.provenance import contact_attributes, preset_parameter_source
 from microimpact.io.variables import attributes
 from microimpact.presets import WALL_1990
 from microimpact.solvers import engine
@@ -323,5 +324,7 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
         "total_seconds": time.perf_counter() - t_start,
         "machine_load_average_1min_at_end": load_average(),
         **targets,
+        **contact_attributes(contact),
+        "parameter_source": preset_parameter_source(cfg.contact_name.lower().replace("_", "")),
     })
     return _dataset(table, cfg, speeds, batch_speeds.size, attrs)
