@@ -171,7 +171,10 @@ def test_benchmark_dataset_structure(small_benchmark):
 def test_write_benchmark(small_benchmark, tmp_path):
     import xarray as xr
 
-    paths = benchmark.write_benchmark(small_benchmark, tmp_path / "out", docs_dir=tmp_path / "docs")
+    from microimpact.report.figures import plot_work_precision
+
+    figure = plot_work_precision(small_benchmark).figure
+    paths = benchmark.write_benchmark(small_benchmark, tmp_path / "out", figure=figure, docs_dir=tmp_path / "docs")
     for key in ("netcdf", "json", "markdown", "pdf", "png", "docs_markdown", "docs_png"):
         assert paths[key].is_file() and paths[key].stat().st_size > 0
     back = xr.open_dataset(paths["netcdf"])
@@ -183,3 +186,17 @@ def test_write_benchmark(small_benchmark, tmp_path):
     md = paths["markdown"].read_text()
     assert "| method |" in md and "reference" in md.lower()
     assert not list((tmp_path / "out").glob(".*.tmp"))  # atomic writes leave no temporaries
+
+
+def test_write_benchmark_without_a_figure_writes_the_data_files(small_benchmark, tmp_path):
+    paths = benchmark.write_benchmark(small_benchmark, tmp_path / "out")
+    assert set(paths) == {"netcdf", "json", "markdown"}
+    assert not list((tmp_path / "out").glob("work_precision.*"))
+
+
+def test_benchmark_command_line_help():
+    from microimpact.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["benchmark", "--help"])
+    assert exc.value.code == 0

@@ -1,4 +1,4 @@
-"""Command line: ``microimpact simulate | sweep | fit | flags | reproduce``.
+"""Command line: ``microimpact simulate | sweep | fit | flags | reproduce | benchmark``.
 
 Thin: parse, call the library, print or write. Bad arguments print one line
 ``microimpact: error: ...`` to stderr and exit with status 2; nothing is written then.
@@ -98,7 +98,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_cmd_simulate)
 
-    for register in (register_sweep, register_fit, register_flags, register_reproduce):
+    for register in (register_sweep, register_fit, register_flags, register_reproduce, register_benchmark):
         register(sub)
     return parser
 
@@ -247,12 +247,33 @@ def register_reproduce(sub) -> None:
 
 
 
+def _cmd_benchmark(args) -> int:
+    from microimpact.report.figures import plot_work_precision
+    from microimpact.studies.benchmark import run_benchmark, write_benchmark
+
+    ds = run_benchmark(quick=args.quick, verbose=True, throughput=not args.no_throughput)
+    paths = write_benchmark(ds, args.out, figure=plot_work_precision(ds).figure, docs_dir=args.docs)
+    for path in paths.values():
+        print(path)
+    return 0
+
+
+def register_benchmark(sub) -> None:
+    """``microimpact benchmark [--quick] --out DIR``: the work-precision study of the solvers."""
+    p = sub.add_parser("benchmark", help="work-precision benchmark of the solvers (minutes; --quick: under a minute)")
+    p.add_argument("--out", default="results/benchmark", help="output directory (default results/benchmark)")
+    p.add_argument("--quick", action="store_true", help="small, fast run for CI and the workflow")
+    p.add_argument("--docs", default=None, help="also write benchmark.md and work_precision.png here")
+    p.add_argument("--no-throughput", action="store_true", help="skip the 100k throughput and memory runs")
+    p.set_defaults(func=_cmd_benchmark)
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
         if not getattr(args, "command", None):
-            raise UsageError("a command is required: simulate, sweep, fit, flags or reproduce")
+            raise UsageError("a command is required: simulate, sweep, fit, flags, reproduce or benchmark")
         return args.func(args)
     except (UsageError, ValueError, RuntimeError) as exc:  # RuntimeError: solver failures
         print(f"microimpact: error: {exc}", file=sys.stderr)

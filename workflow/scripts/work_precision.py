@@ -5,9 +5,10 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
+from microimpact.report.figures import plot_work_precision  # noqa: E402
 from microimpact.studies.benchmark import run_benchmark, write_benchmark  # noqa: E402
 
 params = snakemake.params  # noqa: F821
 ds = run_benchmark(quick=params.quick, throughput=params.throughput, verbose=True)
-write_benchmark(ds, params.out_dir)
+write_benchmark(ds, params.out_dir, figure=plot_work_precision(ds).figure)
 print(ds)

@@ -51,7 +51,6 @@ command line. The Runge-Kutta-Gill integrator lives in :mod:`microimpact.solvers
 from microimpact.solvers.rkg import rkg_restitution, rkg_state
 from microimpact.studies.benchmark import cases as _cases
 from microimpact.studies.benchmark.cases import *  # noqa: F401,F403 - the test set, settings and targets
-from microimpact.studies.benchmark.cli import main
 from microimpact.studies.benchmark.harness import measure_memory, measure_throughput
 from microimpact.studies.benchmark.markdown import benchmark_json, benchmark_markdown
 from microimpact.studies.benchmark.output import write_benchmark
@@ -67,5 +66,4 @@ __all__ = [
     "write_benchmark",
     "benchmark_json",
     "benchmark_markdown",
-    "main",
 ]

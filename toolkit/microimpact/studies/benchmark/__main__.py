@@ -1,7 +1,7 @@
-"""``python -m microimpact.studies.benchmark``: runs :func:`microimpact.studies.benchmark.cli.main`."""
+"""``python -m microimpact.studies.benchmark [options]``: the same as ``microimpact benchmark [options]``."""
 
 import sys
 
-from microimpact.studies.benchmark.cli import main
+from microimpact.cli import main
 
-sys.exit(main())
+sys.exit(main(["benchmark", *sys.argv[1:]]))
