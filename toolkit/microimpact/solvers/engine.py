@@ -681,37 +681,62 @@ def solve_normal(
         if cap == 0 or r[13] < cap:
             break
         cap *= 4
-    undamped = c1 == 0.0 and c2 == 0.0
-    if undamped and jt > 0.0 and math.isnan(r[9]) and jt < r[5]:
+    if c1 == 0.0 and c2 == 0.0 and jt > 0.0 and math.isnan(r[9]) and jt < r[5]:
         # time-reversible motion: J reaches jt on the way out when it reached J - jt on the way in
         r_in = _integrate(y0, 0.0, 0.0, sc.a_hertz, sc.a_adhesion, rtol, False, rtol, r[5] - jt, False, 0.0,
                           max_steps, rec, 0, math.inf, math.inf)
         r = r[:9] + (r[3] - r_in[9],) + r[10:]
-    status, outcome = r[0], r[1]
-    if status != _OK:
-        why = "step limit reached" if status == _MAX_STEPS else "step size underflow"
+    if r[0] != _OK:
+        why = "step limit reached" if r[0] == _MAX_STEPS else "step size underflow"
         raise EngineError(f"engine failed for normal speed {v!r} m/s: {why} after {r[11]} steps")
-    energy_unit = contact.mass * u * u
+    return normal_solution(contact, sc, y0, *r[1:13], trajectory=rec[:r[13]] if cap else None)
+
+
+def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, friction_impulse, twist_impulse,
+                    max_xi, tau_capture, tau_slip_end, final_energy, n_steps, n_rejected, *,
+                    trajectory=None) -> NormalSolution:
+    """The :class:`NormalSolution` in SI units of a nondimensional normal solve (engine or RKG).
+
+    Parameters
+    ----------
+    contact : Contact
+    scales : microimpact.model.law.Scales
+        L [m], T_c [s] of the solve.
+    y0 : float
+        Nondimensional incident normal speed. [-]
+    outcome : int
+        REBOUND or CAPTURE.
+    y_end, tau_end : float
+        y and tau at the end (separation for a rebound). [-]
+    dissipated, friction_impulse, twist_impulse, max_xi, tau_capture, tau_slip_end, final_energy : float
+        D, J, J_a, the largest xi, the capture and slip-end times and e at the end, nondimensional
+        (units m (L/T_c)^2, m L/T_c, m L/T_c sqrt(r L), L, T_c). [-]
+    n_steps, n_rejected : int
+    trajectory : ndarray, shape (n, 3), optional
+        Rows (tau, s, y) at the accepted steps. [-]
+    """
+    u = scales.speed
+    j_unit = contact.mass * u  # N s
+    energy_unit = contact.mass * u * u  # J
     captured = outcome == CAPTURE
     time = pen = rate = None
-    if cap:
-        n = r[13]
-        time = rec[:n, 0] * sc.time
-        pen = rec[:n, 1] ** 2 * sc.length
-        rate = rec[:n, 2] * u
+    if trajectory is not None:
+        time = trajectory[:, 0] * scales.time
+        pen = trajectory[:, 1] ** 2 * scales.length
+        rate = trajectory[:, 2] * u
     return NormalSolution(
-        outcome=OUTCOME_NAMES[outcome],
-        e_n=0.0 if captured else -r[2] / y0,
-        contact_time=math.inf if captured else r[3] * sc.time,
-        capture_time=r[8] * sc.time,
-        max_penetration=r[7] * sc.length,
-        friction_impulse=r[5] * j_unit,
-        twist_impulse=r[6] * j_unit * math.sqrt(contact.radius * sc.length),
-        dissipated_energy=r[4] * energy_unit,
-        final_energy=r[10] * energy_unit,
-        slip_end_time=r[9] * sc.time,
-        n_steps=int(r[11]),
-        n_rejected=int(r[12]),
+        outcome=OUTCOME_NAMES[int(outcome)],
+        e_n=0.0 if captured else -y_end / y0,
+        contact_time=math.inf if captured else tau_end * scales.time,
+        capture_time=tau_capture * scales.time,
+        max_penetration=max_xi * scales.length,
+        friction_impulse=friction_impulse * j_unit,
+        twist_impulse=twist_impulse * j_unit * math.sqrt(contact.radius * scales.length),
+        dissipated_energy=dissipated * energy_unit,
+        final_energy=final_energy * energy_unit,
+        slip_end_time=tau_slip_end * scales.time,
+        n_steps=int(n_steps),
+        n_rejected=int(n_rejected),
         time=time,
         penetration=pen,
         penetration_rate=rate,

@@ -233,21 +233,9 @@ def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS
     if r[_OUTCOME] < 0:
         raise engine.EngineError(f"rkg found no outcome for normal speed {v!r} m/s within {int(r[_N_STEPS])} "
                                  f"steps ({_MAX_CONTACTS} estimated contact durations); increase steps")
-    captured = r[_OUTCOME] == 1
-    e_n = 0.0 if captured else r[_Y_OUT] / y0[0]
-    energy_unit = contact.mass * sc.speed**2
-    return engine.NormalSolution(
-        outcome=engine.OUTCOME_NAMES[int(r[_OUTCOME])],
-        e_n=e_n,
-        contact_time=math.inf if captured else r[_TAU_END] * sc.time,
-        capture_time=r[_TAU_END] * sc.time if captured else math.nan,
-        max_penetration=r[_XI_MAX] * sc.length,
-        friction_impulse=r[_J] * j_unit,
-        twist_impulse=r[_J_A] * j_unit * math.sqrt(contact.radius * sc.length),
-        dissipated_energy=0.5 * contact.mass * v * v * (1.0 - e_n * e_n) if not captured else math.nan,
-        final_energy=r[_E_END] * energy_unit,
-        slip_end_time=r[_TAU_J] * sc.time,
-        n_steps=int(r[_N_STEPS]),
-        n_rejected=0,
-    )
-
+    captured = r[_OUTCOME] == engine.CAPTURE
+    y_out = r[_Y_OUT]  # exit speed, > 0
+    dissipated = math.nan if captured else 0.5 * (y0[0] ** 2 - y_out**2)  # energy balance
+    return engine.normal_solution(
+        contact, sc, y0[0], r[_OUTCOME], -y_out, r[_TAU_END], dissipated, r[_J], r[_J_A], r[_XI_MAX],
+        r[_TAU_END] if captured else math.nan, r[_TAU_J], r[_E_END], r[_N_STEPS], 0)
