@@ -84,7 +84,7 @@ Everything at the interface is SI; everything inside is nondimensional.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
@@ -380,6 +380,27 @@ def simulate_reference(
     derived twist torque (3 pi / 16) f a |F_n|; with f0 = 0 the Hertz scales replace X, T. The
     paper used a fixed-step Runge-Kutta-Gill method; this uses adaptive solve_ivp with events.
     """
+    speed, incidence, azimuth, omega_in = _validate_impact(speed, incidence_deg, azimuth_deg, omega)
+    rtol, atol, settle_tol = _validate_common(rtol, atol, settle_tolerance)
+    max_step = float(max_step)
+    if not max_step > 0.0:
+        raise ValueError(f"max_step must be > 0, got {max_step!r}")
+    vel_in = incident_velocity(speed, incidence, azimuth)
+    sc = _scales(contact, -vel_in[0])
+    run = _Run.start(sc, contact.friction, vel_in, omega_in, settle_tol)
+    solver = {"method": method, "rtol": rtol, "atol": atol, "max_step": max_step}
+    while run.stop_reason is None:
+        run.n_phases += 1
+        if run.n_phases > _MAX_PHASES:
+            raise ReferenceSolverError(f"more than {_MAX_PHASES} restarts without an outcome")
+        fired = _run_phase(run, solver)
+        if fired is not None:
+            run.apply(fired)
+    return _reference_result(contact, sc, run, vel_in, omega_in, method)
+
+
+def _validate_impact(speed, incidence_deg, azimuth_deg, omega):
+    """(speed [m/s], incidence [deg], azimuth [deg], spin (3,) [rad/s]) as floats, checked."""
     speed = _validate_speed("speed", speed)
     incidence = _as_real("incidence_deg", incidence_deg)
     if not 0.0 <= incidence < 90.0:
@@ -391,203 +412,187 @@ def simulate_reference(
         raise ValueError(f"omega must be a sequence of 3 spins, got {omega!r}") from None
     if len(omega_list) != 3:
         raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_t'), got {omega!r}")
-    omega_in = tuple(_as_real(f"omega[{i}]", w) for i, w in enumerate(omega_list))
-    rtol, atol, settle_tol = _validate_common(rtol, atol, settle_tolerance)
-    max_step = float(max_step)
-    if not max_step > 0.0:
-        raise ValueError(f"max_step must be > 0, got {max_step!r}")
+    return speed, incidence, azimuth, tuple(_as_real(f"omega[{i}]", w) for i, w in enumerate(omega_list))
 
-    vel_in = incident_velocity(speed, incidence, azimuth)
-    vn_speed = -vel_in[0]
-    sc = _scales(contact, vn_speed)
-    V, r, m = sc.speed, sc.radius, sc.mass
-    f = contact.friction
 
-    z0 = np.array(
-        [
-            0.0,
-            vn_speed / V,
-            vel_in[1] / V,
-            vel_in[2] / V,
-            r * omega_in[0] / V,
-            r * omega_in[1] / V,
-            r * omega_in[2] / V,
-            0.0,
-            0.0,
-            0.0,
-        ]
-    )
-    u0 = (z0[_VT] + z0[_WTP], z0[_VTP] - z0[_WT])
-    u0_norm = math.hypot(*u0)
-    sliding = f > 0.0 and u0_norm > 0.0
-    e0 = (u0[0] / u0_norm, u0[1] / u0_norm) if u0_norm > 0.0 else (1.0, 0.0)
-    twisting = f > 0.0 and z0[_WN] != 0.0
-    twist_sign = math.copysign(1.0, z0[_WN]) if twisting else 0.0
+@dataclass
+class _Run:
+    """State of one reference integration across its phases (restarts at events).
 
-    # ---- events (all on the nondimensional state)
-    def ev_separation(_t, z):
-        return z[_S]
+    ``z`` is the state (s, y, v_t, v_t', w_n, w_t, w_t', D, J, tau) at the start of the next
+    phase, ``sigma0`` its integration variable; the flags say which modes are active.
+    """
 
-    def ev_capture(_t, z):
-        return _energy(sc, z[_S], z[_Y])
+    sc: _Scales
+    friction: float
+    z: np.ndarray
+    e0: tuple[float, float]  # initial slip direction
+    sliding: bool
+    twisting: bool
+    twist_sign: float  # sign(w_n(0)) while twisting
+    fn_sign: float  # sign of xi'' = -F_n in the current phase
+    settle: object  # settle event (adhesive, damped) or None
+    tail_time: float
+    sigma0: float = 0.0
+    sigma_limit: float = math.inf  # set by start() (read at run time, tests shrink it)
+    captured: bool = False
+    await_turn: bool = False
+    tau_capture: float = math.nan
+    tau_slip: float = math.nan
+    slip_ended: bool = False
+    stop_reason: str | None = None
+    n_phases: int = 0
+    counter: list = field(default_factory=lambda: [0])
+    turn_xi: list = field(default_factory=list)
 
-    def ev_turn(_t, z):
-        return z[_Y]
+    @classmethod
+    def start(cls, sc: _Scales, friction: float, vel_in, omega_in, settle_tol: float) -> "_Run":
+        """The state at first contact (nondimensional, see the module docstring)."""
+        v, r = sc.speed, sc.radius
+        z0 = np.array([0.0, -vel_in[0] / v, vel_in[1] / v, vel_in[2] / v, r * omega_in[0] / v,
+                       r * omega_in[1] / v, r * omega_in[2] / v, 0.0, 0.0, 0.0])
+        u0 = (z0[_VT] + z0[_WTP], z0[_VTP] - z0[_WT])
+        u0_norm = math.hypot(*u0)
+        twisting = friction > 0.0 and z0[_WN] != 0.0
+        # Sign of xi'' = -F_n just after first contact: xi''/s -> a_A (1 - c2 y0) as s -> 0;
+        # without adhesion (or if that vanishes) the Hertz term -a_H s^2 (1 + c1 y0) < 0 decides.
+        g0 = law.nondimensional_acceleration(1.0, 0.0, z0[_Y], sc.c1, sc.c2, sc.a_h, sc.a_a)
+        settle, tail_time = _settle_event(sc, settle_tol)
+        return cls(
+            sc=sc, friction=friction, z=z0,
+            e0=(u0[0] / u0_norm, u0[1] / u0_norm) if u0_norm > 0.0 else (1.0, 0.0),
+            sliding=friction > 0.0 and u0_norm > 0.0, twisting=twisting,
+            twist_sign=math.copysign(1.0, z0[_WN]) if twisting else 0.0,
+            fn_sign=1.0 if g0 > 0.0 else -1.0, settle=settle, tail_time=tail_time,
+            sigma_limit=_MAX_TAU_CONTACT,
+        )
 
-    def ev_slip(_t, z):
-        return (z[_VT] + z[_WTP]) * e0[0] + (z[_VTP] - z[_WT]) * e0[1]
-
-    def ev_twist(_t, z):
-        return z[_WN] * twist_sign
-
-    def ev_force(_t, z):
-        # xi'' / s: changes sign with F_n, without the trivial root s = 0 at first contact.
-        return law.nondimensional_acceleration(1.0, z[_S] * z[_S], z[_Y], sc.c1, sc.c2, sc.a_h, sc.a_a)
-
-    # Sign of xi'' = -F_n just after first contact: xi''/s -> a_A (1 - c2 y0) as s -> 0; without
-    # adhesion (or if that vanishes) the Hertz term -a_H s^2 (1 + c1 y0) < 0 decides.
-    g0 = law.nondimensional_acceleration(1.0, 0.0, z0[_Y], sc.c1, sc.c2, sc.a_h, sc.a_a)
-    fn_sign = 1.0 if g0 > 0.0 else -1.0
-
-    settle = None
-    if sc.adhesive:
-        c_tot = sc.c1 + sc.c2
-        if c_tot > 0.0:
-            b_w, sqrt_kappa, sigma = _tail_constants(c_tot)
-
-            def ev_settle(_t, z):
-                x = z[_S] * z[_S] - 1.0
-                y = z[_Y]
-                w = x * x + b_w * x * y + y * y
-                tail = _TAIL_SAFETY * sqrt_kappa * math.sqrt(max(w, 0.0)) / sigma
-                return max(tail - settle_tol * z[_J], math.hypot(x, y) - _LINEAR_RADIUS)
-
-            settle = ev_settle
-            tail_time = 10.0 * (math.log(1.0 / settle_tol) + 10.0) / sigma
-
-    turn_xi: list[float] = []
-    counter = [0]
-    sigma0 = 0.0
-    z = z0
-    captured = False
-    tau_capture = math.nan
-    tau_slip = math.nan
-    slip_ended = False
-    sigma_limit = _MAX_TAU_CONTACT
-    stop_reason = None
-    n_phases = 0
-    await_turn = False
-
-    while stop_reason is None:
-        n_phases += 1
-        if n_phases > _MAX_PHASES:
-            raise ReferenceSolverError(f"more than {_MAX_PHASES} restarts without an outcome")
-        names = ["separation", "turn"]
+    def events(self) -> dict:
+        """The events of the next phase by name (all on the nondimensional state)."""
+        sc, e0, tsign = self.sc, self.e0, self.twist_sign
         # after a capture with nothing tangential left, run on to the first turning point only:
         # the largest penetration (the energy falls afterwards)
-        events = [_event(ev_separation, True, -1.0), _event(ev_turn, await_turn, -1.0)]
-        if not captured and sc.adhesive:
-            names.append("capture")
-            events.append(_event(ev_capture, True, -1.0))
-        if sliding:
-            names.append("slip")
-            events.append(_event(ev_slip, True, -1.0))
-        if twisting:
-            names.append("twist")
-            events.append(_event(ev_twist, True, -1.0))
-        if captured and settle is not None:
-            names.append("settle")
-            events.append(_event(settle, True, -1.0))
-        names.append("force")
-        events.append(_event(ev_force, True, -fn_sign))
+        ev = {"separation": _event(lambda _t, z: z[_S], True, -1.0),
+              "turn": _event(lambda _t, z: z[_Y], self.await_turn, -1.0)}
+        if not self.captured and sc.adhesive:
+            ev["capture"] = _event(lambda _t, z: _energy(sc, z[_S], z[_Y]), True, -1.0)
+        if self.sliding:
+            ev["slip"] = _event(lambda _t, z: (z[_VT] + z[_WTP]) * e0[0] + (z[_VTP] - z[_WT]) * e0[1], True, -1.0)
+        if self.twisting:
+            ev["twist"] = _event(lambda _t, z: z[_WN] * tsign, True, -1.0)
+        if self.captured and self.settle is not None:
+            ev["settle"] = _event(self.settle, True, -1.0)
+        # xi'' / s: changes sign with F_n, without the trivial root s = 0 at first contact
+        ev["force"] = _event(lambda _t, z: law.nondimensional_acceleration(
+            1.0, z[_S] * z[_S], z[_Y], sc.c1, sc.c2, sc.a_h, sc.a_a), True, -self.fn_sign)
+        return ev
 
-        rhs = _make_rhs(sc, f, e0, sliding, twist_sign if twisting else 0.0, fn_sign, counter)
-        sol = solve_ivp(
-            rhs,
-            (sigma0, sigma_limit),
-            z,
-            method=method,
-            rtol=rtol,
-            atol=atol,
-            max_step=max_step,
-            events=events,
-        )
-        if sol.status == -1:
-            raise ReferenceSolverError(
-                f"solve_ivp ({method}) failed at tau = {sol.y[_TAU, -1]:.6g} "
-                f"(t = {sol.y[_TAU, -1] * sc.time:.6g} s): {sol.message}"
-            )
-        turn_xi.extend(float(v[_S]) ** 2 for v in sol.y_events[1])
-        if sol.status == 0 and await_turn:
-            # crept to the equilibrium without turning: the supremum of xi is its limit, 1
-            turn_xi.append(max(1.0, float(sol.y[_S, -1]) ** 2))
-            z = sol.y[:, -1]
-            stop_reason = "capture"
-            break
-        if sol.status == 0:
-            what = "captured tail did not settle" if captured else "no separation and no capture"
-            raise ReferenceSolverError(
-                f"{what} by nondimensional time {sol.y[_TAU, -1]:.6g} "
-                f"({sol.y[_TAU, -1] * sc.time:.6g} s); state {sol.y[:, -1]!r}"
-            )
-        # Which terminal event stopped the run: the one whose last event time is the end time.
-        sigma_end = sol.t[-1]
-        fired = None
-        for name, t_ev, y_ev, ev in zip(names, sol.t_events, sol.y_events, events):
-            if ev.terminal and len(t_ev) and t_ev[-1] == sigma_end:
-                fired = name
-                z = np.array(y_ev[-1], dtype=float)
-                break
-        if fired is None:  # pragma: no cover - solve_ivp guarantees a terminal event here
-            raise ReferenceSolverError(f"solve_ivp stopped without a recognised event: {sol.message}")
-        sigma0 = sigma_end
-        tau_end = z[_TAU]
-
+    def apply(self, fired: str) -> None:
+        """Update the modes after the terminal event ``fired`` (the state z is at the event)."""
+        tau_end = self.z[_TAU]
         if fired == "separation":
-            if captured:
+            if self.captured:
                 raise ReferenceSolverError(
                     "separation after capture (E < 0): numerical error exceeds the energy margin; "
                     "tighten rtol/atol"
                 )
-            stop_reason = "separation"
+            self.stop_reason = "separation"
         elif fired == "turn":
-            stop_reason = "capture"
+            self.stop_reason = "capture"
         elif fired == "capture":
-            captured = True
-            tau_capture = tau_end
-            if not (sliding or twisting) or settle is None:
-                if turn_xi or z[_Y] <= 0.0:
-                    stop_reason = "capture"
+            self.captured = True
+            self.tau_capture = tau_end
+            if not (self.sliding or self.twisting) or self.settle is None:
+                if self.turn_xi or self.z[_Y] <= 0.0:
+                    self.stop_reason = "capture"
                 else:
-                    await_turn = True
+                    self.await_turn = True
                     # an overdamped sphere may creep to the equilibrium without turning: bounded
-                    sigma_limit = sigma_end + _MAX_TAU_CONTACT
+                    self.sigma_limit = self.sigma0 + _MAX_TAU_CONTACT
             else:
                 # s = sqrt(xi) -> 1 in the tail, so sigma and tau advance alike there.
-                sigma_limit = sigma_end + tail_time + _MAX_TAU_CONTACT
+                self.sigma_limit = self.sigma0 + self.tail_time + _MAX_TAU_CONTACT
         elif fired == "slip":
-            sliding = False
-            slip_ended = True
-            tau_slip = tau_end
+            self.sliding = False
+            self.slip_ended = True
+            self.tau_slip = tau_end
         elif fired == "twist":
-            twisting = False
-            z[_WN] = 0.0
+            self.twisting = False
+            self.z[_WN] = 0.0
         elif fired == "settle":
-            stop_reason = "settled"
+            self.stop_reason = "settled"
         elif fired == "force":
-            fn_sign = -fn_sign
-        if stop_reason is None and captured and not (sliding or twisting) and not await_turn:
-            stop_reason = "slip and twist ended"
+            self.fn_sign = -self.fn_sign
+        if self.stop_reason is None and self.captured and not (self.sliding or self.twisting) and not self.await_turn:
+            self.stop_reason = "slip and twist ended"
 
-    # ---- results in SI units
-    T = sc.time
+
+def _settle_event(sc: _Scales, settle_tol: float):
+    """(settle event, time to allow for the tail) of a damped adhesive contact, else (None, nan).
+
+    The event crosses zero once the linearised bound of :func:`_tail_constants` on the friction
+    impulse still to come is below ``settle_tol`` times the impulse so far.
+    """
+    c_tot = sc.c1 + sc.c2
+    if not (sc.adhesive and c_tot > 0.0):
+        return None, math.nan
+    b_w, sqrt_kappa, sigma = _tail_constants(c_tot)
+
+    def ev_settle(_t, z):
+        x = z[_S] * z[_S] - 1.0
+        y = z[_Y]
+        w = x * x + b_w * x * y + y * y
+        tail = _TAIL_SAFETY * sqrt_kappa * math.sqrt(max(w, 0.0)) / sigma
+        return max(tail - settle_tol * z[_J], math.hypot(x, y) - _LINEAR_RADIUS)
+
+    return ev_settle, 10.0 * (math.log(1.0 / settle_tol) + 10.0) / sigma
+
+
+def _run_phase(run: _Run, solver: dict) -> str | None:
+    """Integrate one phase with solve_ivp; returns the terminal event that ended it (run.z, run.sigma0
+    then hold its state), or None when the run ends without one (run.stop_reason set)."""
+    events = run.events()
+    rhs = _make_rhs(run.sc, run.friction, run.e0, run.sliding, run.twist_sign if run.twisting else 0.0,
+                    run.fn_sign, run.counter)
+    sol = solve_ivp(rhs, (run.sigma0, run.sigma_limit), run.z, events=list(events.values()), **solver)
+    tau_last = sol.y[_TAU, -1]
+    if sol.status == -1:
+        raise ReferenceSolverError(
+            f"solve_ivp ({solver['method']}) failed at tau = {tau_last:.6g} "
+            f"(t = {tau_last * run.sc.time:.6g} s): {sol.message}"
+        )
+    run.turn_xi.extend(float(v[_S]) ** 2 for v in sol.y_events[1])
+    if sol.status == 0 and run.await_turn:
+        # crept to the equilibrium without turning: the supremum of xi is its limit, 1
+        run.turn_xi.append(max(1.0, float(sol.y[_S, -1]) ** 2))
+        run.z = sol.y[:, -1]
+        run.stop_reason = "capture"
+        return None
+    if sol.status == 0:
+        what = "captured tail did not settle" if run.captured else "no separation and no capture"
+        raise ReferenceSolverError(
+            f"{what} by nondimensional time {tau_last:.6g} ({tau_last * run.sc.time:.6g} s); state {sol.y[:, -1]!r}"
+        )
+    # Which terminal event stopped the run: the one whose last event time is the end time.
+    run.sigma0 = sol.t[-1]
+    for (name, ev), t_ev, y_ev in zip(events.items(), sol.t_events, sol.y_events):
+        if ev.terminal and len(t_ev) and t_ev[-1] == run.sigma0:
+            run.z = np.array(y_ev[-1], dtype=float)
+            return name
+    raise ReferenceSolverError(f"solve_ivp stopped without a recognised event: {sol.message}")  # pragma: no cover
+
+
+def _reference_result(contact: Contact, sc: _Scales, run: _Run, vel_in, omega_in, method: str) -> ImpactResult:
+    """The ImpactResult in SI units of a finished reference run."""
+    z, T, V, r, m = run.z, sc.time, sc.speed, sc.radius, sc.mass
     vt, vtp = z[_VT] * V, z[_VTP] * V
     omega_out = (z[_WN] * V / r, z[_WT] * V / r, z[_WTP] * V / r)
     dissipated = float(z[_D] * m * V * V)
+    captured = run.captured
     if captured:
         vel_out = (0.0, vt, vtp)
         contact_time = math.inf
-        capture_time = tau_capture * T
+        capture_time = run.tau_capture * T
         # settled at rest at the equilibrium: the normal energy left at the stop is dissipated too
         final_contact = _energy(sc, 1.0, 0.0) * m * V * V
         dissipated += (_energy(sc, z[_S], z[_Y]) - _energy(sc, 1.0, 0.0)) * m * V * V
@@ -597,14 +602,10 @@ def simulate_reference(
         capture_time = math.nan
         final_contact = 0.0
     coeffs = impact_coefficients(m, contact.moment_of_inertia, vel_in, omega_in, vel_out, omega_out, captured)
-    max_xi = max(turn_xi) if turn_xi else float(z[_S]) ** 2
+    max_xi = max(run.turn_xi) if run.turn_xi else float(z[_S]) ** 2
     return ImpactResult(
         outcome="capture" if captured else "rebound",
-        e_n=float(coeffs["e_n"]),
-        mu_t=float(coeffs["mu_t"]),
-        mu_tp=float(coeffs["mu_tp"]),
-        K_L=float(coeffs["K_L"]),
-        K_t=float(coeffs["K_t"]),
+        **{k: float(coeffs[k]) for k in ("e_n", "mu_t", "mu_tp", "K_L", "K_t")},
         velocity_in=tuple(float(v) for v in vel_in),
         omega_in=omega_in,
         velocity_out=tuple(float(v) for v in vel_out),
@@ -612,13 +613,13 @@ def simulate_reference(
         contact_time=float(contact_time),
         capture_time=float(capture_time),
         max_penetration=float(max_xi * sc.length),
-        slip_ended=slip_ended,
-        slip_end_time=float(tau_slip * T),
+        slip_ended=run.slip_ended,
+        slip_end_time=float(run.tau_slip * T),
         friction_impulse=float(z[_J] * m * V),
         dissipated_energy=dissipated,
         final_contact_energy=float(final_contact),
         method=f"reference:{method}",
-        stop_reason=stop_reason,
+        stop_reason=run.stop_reason,
     )
 
 
