@@ -295,3 +295,15 @@ def test_hertz_impact_scales():
     # x* is the largest penetration of the undamped Hertz impact: m v^2 / 2 = V(x*)
     assert float(law.contact_potential_energy(hertz, sc.length)) == pytest.approx(0.5 * hertz.mass * 4.0, rel=1e-14)
     assert sc.speed == pytest.approx(2.0, rel=1e-15)
+
+
+def test_twist_torque_is_coulomb_friction_over_the_hertz_pressure():
+    """(3 pi / 16) f a |F_n| (Eq. (18) corrected) = int f p(rho) rho dA over the Hertz pressure."""
+    from scipy.integrate import quad
+
+    from microimpact.model import law
+
+    f, a, fn = 0.3, 2e-7, 1e-6
+    p0 = 3.0 * fn / (2.0 * np.pi * a * a)
+    torque = quad(lambda rho: f * p0 * np.sqrt(1.0 - (rho / a) ** 2) * rho * 2.0 * np.pi * rho, 0.0, a)[0]
+    assert float(law.twist_friction_torque(f, a, -fn)) == pytest.approx(torque, rel=1e-10)

@@ -37,7 +37,7 @@ import os
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange
+from numba import njit, prange, set_num_threads
 
 from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL
@@ -802,6 +802,4 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
 
 def set_threads(n: int | None = None) -> None:
     """Use ``n`` threads for :func:`solve_normal_many` (default: all cores)."""
-    import numba
-
-    numba.set_num_threads(n or os.cpu_count() or 1)
+    set_num_threads(n or os.cpu_count() or 1)

@@ -653,18 +653,6 @@ class ReferenceTrajectory:
     outcome: str
     capture_time: float
 
-    def to_xarray(self):
-        """The trajectory as an :class:`xarray.Dataset` with a ``time`` coordinate."""
-        import xarray as xr
-
-        units = {"penetration": "m", "penetration_rate": "m/s", "energy": "J", "dissipated_energy": "J"}
-        ds = xr.Dataset(
-            {k: ("time", getattr(self, k), {"units": u}) for k, u in units.items()},
-            coords={"time": ("time", self.time, {"units": "s"})},
-            attrs={"outcome": self.outcome, "capture_time_s": self.capture_time},
-        )
-        return ds
-
 
 def reference_trajectory(
     contact: Contact,
