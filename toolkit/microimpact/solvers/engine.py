@@ -14,7 +14,9 @@ Numerical formulation
 Nondimensional penetration xi = x / X and time tau = t / T (Eqs. (28)-(30), T corrected), so that
 xi'' = -a_h xi^(3/2) (1 + C1 y) + a_a xi^(1/2) (1 - C2 y), y = xi'. With adhesion (f0 > 0) the
 paper's scales give a_h = a_a = 1. Without adhesion X = 0 and the Hertz impact scales
-x* = (5 m v^2 / (4 K sqrt r))^(2/5), t* = x*/v are used instead (a_h = 5/4, a_a = 0).
+x* = (5 m v^2 / (4 K sqrt r))^(2/5), t* = x*/v are used instead (a_h = 5/4, a_a = 0). The law, its
+energy, its dissipation and these scales are those of :mod:`microimpact.model.law`, compiled by
+:mod:`microimpact.solvers.compiled_law`.
 
 The xi^(1/2) terms make the force non-smooth in tau where contact starts and ends, which costs
 adaptive solvers order and steps there. With s = sqrt(xi) and the Sundman-type time change
