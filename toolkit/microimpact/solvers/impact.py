@@ -16,16 +16,13 @@ import numpy as np
 import xarray as xr
 
 from microimpact.io.variables import attributes
-from microimpact.solvers import DEFAULT_RTOL, engine
+from microimpact.solvers import DEFAULT_RTOL, METHODS, engine
 from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
 from microimpact.model.law import contact_potential_energy
 from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
 from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
 
-__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES", "METHODS"]
-
-#: the solvers behind ``method=`` (see :mod:`microimpact.solvers`)
-METHODS = ("engine", "reference", "rkg")
+__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES"]
 
 #: the variables that simulate_many returns (units and long names in microimpact.io.variables)
 RESULT_VARIABLES: tuple[str, ...] = (
