@@ -147,7 +147,8 @@ def _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential) -> 
         slip_ended=slip_ended,
         slip_end_time=(0.0 if slip == 0.0 else sol.slip_end_time) if slip_ended else math.nan,
         friction_impulse=sol.friction_impulse,
-        dissipated_energy=float(_normal_dissipation(contact, -v_in[0], captured, sol.dissipated_energy)) + tan[7],
+        dissipated_energy=(float(_normal_dissipation(contact, -v_in[0], True, 0.0)) if captured
+                           else sol.dissipated_energy) + tan[7],
         final_contact_energy=settled_contact_energy(contact) if captured else 0.0,
         method=method,
         stop_reason="separation" if not captured else ("settled" if needs_tangential else "capture"),
