@@ -43,10 +43,10 @@ from numba import njit, prange, set_num_threads
 
 from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL
-from microimpact.model.law import Scales, nondimensional_impact, nondimensional_scales
+from microimpact.model.law import nondimensional_impact, nondimensional_scales  # nondimensional_scales: re-exported
 from microimpact.solvers import compiled_law as law
 
-__all__ = ["NormalSolution", "EngineError", "solve_normal", "solve_normal_many", "nondimensional_scales"]
+__all__ = ["NormalSolution", "EngineError", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
 
 # Status codes of the compiled core
 _OK = 0
