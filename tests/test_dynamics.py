@@ -162,7 +162,7 @@ def test_fig5_phase_portraits(speed, outcome, motion):
 @pytest.mark.parametrize("speed", [1.0e-5, 0.5])
 def test_phase_portrait_matches_independent_integration(speed):
     """The engine trajectory against scipy DOP853 on Eq. (33), at the engine's time points."""
-    ds = dynamics.phase_portrait(WALL_1990, speed)
+    ds = dynamics.phase_portrait(WALL_1990, speed, rtol=1e-10)
     c1, c2 = WALL_1990.nondimensional_damping(speed)
     tau = ds.time.values / WALL_1990.time_scale
     sol = solve_ivp(
@@ -201,3 +201,4 @@ def test_bifurcation_plane_custom_cases_and_ranges():
     ds = dynamics.bifurcation_plane([("a", contact, 1.0)], c1_range=(0.0, 3.0), c2_range=(0.0, 3.0), n_c1=31, n_c2=41)
     assert ds.sizes == {"C1": 31, "C2": 41, "case": 1}
     assert float(ds.C1.max()) == 3.0
+

@@ -28,6 +28,17 @@ DATA = Path(__file__).parents[1] / "data"
 SOLVER_NOISE = 1e-9
 COEFFICIENTS = ("e_n", "mu_t", "mu_tp", "K_L", "K_t")
 
+#: Rows of the reproduction table whose text changed on purpose: row -> (start, end) of the text
+#: that both versions share. The capture bracket's solves now default to the one DEFAULT_RTOL =
+#: 1e-8 instead of 1e-10, which moves the e_n at the rebound end of the bracket (1.3e-4 -> 5.8e-5:
+#: the bracket's ends move by less than its width, 6e-8 m/s); the capture velocity itself is
+#: unchanged to its 7 printed digits. A spread that is pure round-off (1.4e-17 in the baseline; its digits differ between
+#: machines) is now printed as "below 1e-12 (round-off)".
+DELIBERATE_REPRODUCTION_CHANGES = {
+    "Capture-velocity": ("v_capture = 1.449241 m/s (+- 6.0e-08 m/s; e_n = ", "at the rebound end of the bracket)"),
+    "Fig13-one-curve": ("slip ended for every f in 0.1-0.9 and v in 2-10 m/s: True; max spread of mu_t, mu_t' over f: ", ""),
+}
+
 
 def _max_diff(a, b) -> float:
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
@@ -94,11 +105,10 @@ def test_reproduction_table_unchanged():
     assert list(new.index) == list(base.index)
     # the table prints rounded numbers: identical text means agreement to the printed digits
     mismatched = [i for i in base.index if str(new.loc[i, "toolkit_value"]) != base.loc[i, "toolkit_value"]]
-    # one deliberate change: a spread that is pure round-off (1.4e-17 in the baseline; its digits
-    # differ between machines and builds) is now printed as "below 1e-12 (round-off)"
-    assert mismatched == ["Fig13-one-curve"]
-    assert "max spread of mu_t, mu_t' over f: 1.4e-17" in base.loc["Fig13-one-curve", "toolkit_value"]
-    assert str(new.loc["Fig13-one-curve", "toolkit_value"]).endswith("over f: below 1e-12 (round-off)")
+    assert sorted(mismatched) == sorted(DELIBERATE_REPRODUCTION_CHANGES), mismatched
+    for row, (kept_start, kept_end) in DELIBERATE_REPRODUCTION_CHANGES.items():
+        for text in (base.loc[row, "toolkit_value"], str(new.loc[row, "toolkit_value"])):
+            assert text.startswith(kept_start) and text.endswith(kept_end), (row, text)
     assert [str(x) for x in new["agree"]] == [str(x) for x in base["agree"]]
 
 

@@ -193,7 +193,8 @@ def test_chain_fitted_parameters_drive_the_analyst_results(pipeline):
     analyst = root / "results" / "analyst"
     with xr.open_dataset(analyst / "fit.nc") as fit:
         zeta_h, zeta_a = float(fit["zeta_hertz"]), float(fit["zeta_adhesion"])
-        source = f"fit: {fit.attrs['fit_source']} {fit.attrs['fit_sha256']}"
+        source = fit.attrs["parameter_source"]
+        assert source == f"fit: {CHAIN_CSV} {fit.attrs['fit_sha256']}"
         speeds = fit["normal_speed"].values
     radii = np.array(CHAIN["radii_um"]) * 1e-6
     files = [analyst / "fit_curves.nc", analyst / "dynamics.nc",

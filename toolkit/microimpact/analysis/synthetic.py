@@ -89,7 +89,7 @@ def make_synthetic_impacts(**overrides) -> pd.DataFrame:
     material = SimpleNamespace(**p)
     for r in p["radii"]:
         c = material_contact(material, r)
-        vc = capture_velocity(c)
+        vc = capture_velocity(c, solver_rtol=1e-10)  # as when data/synthetic_microspheres.csv was made
         v = np.geomspace(p["start_factor"] * vc, p["max_speed"], p["n_per_radius"])
         alpha = np.abs(rng.normal(0.0, p["angle_sd_deg"], v.size)) if p["angle_sd_deg"] > 0 else np.zeros(v.size)
         vn = v * np.cos(np.radians(alpha))

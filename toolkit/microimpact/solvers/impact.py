@@ -15,6 +15,7 @@ import math
 import numpy as np
 import xarray as xr
 
+from microimpact.io.provenance import contact_attributes
 from microimpact.io.variables import attributes
 from microimpact.solvers import DEFAULT_RTOL, METHODS, engine
 from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
@@ -316,11 +317,3 @@ def _batch_dataset(arrays, results: dict) -> xr.Dataset:
     ds["outcome"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="rebound capture")
     ds["slip_ended"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="sliding rolling")
     return ds
-
-
-def contact_attributes(contact) -> dict:
-    """Contact parameters as flat NetCDF attributes (``contact_<field>``, SI units)."""
-    out = {}
-    for name, value in contact.__dict__.items():
-        out[f"contact_{name}"] = "per-impact normal speed" if value is None else value
-    return out

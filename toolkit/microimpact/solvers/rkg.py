@@ -28,7 +28,7 @@ from microimpact.model.law import nondimensional_impact
 from microimpact.solvers import compiled_law as law
 from microimpact.solvers import engine
 
-__all__ = ["rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
+__all__ = ["rkg_setup", "rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
 
 #: Default steps per estimated contact duration of :func:`solve_normal_rkg` (e_n to ~1e-6 with
 #: adhesion, tests/test_benchmark.py).
@@ -148,7 +148,7 @@ def rkg_state(y0: float, c1: float, c2: float, a_hertz: float, a_adhesion: float
                            float(dtau), int(n_steps))
 
 
-def _rkg_setup(contact, speeds):
+def rkg_setup(contact, speeds):
     """Nondimensional y0, C1, C2, a_h, a_a and the estimated contact duration (tau) per speed."""
     speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
     sc, y0, c1, c2 = nondimensional_impact(contact, speeds)
@@ -179,7 +179,7 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> d
     dict with ``e_n`` [-] (0 if captured, NaN if no outcome in 20 N steps), ``captured`` (bool),
     ``n_steps`` (int) and ``tau`` (nondimensional separation time; NaN if captured) [-].
     """
-    y0, c1, c2, ah, aa, dur = setup if setup is not None else _rkg_setup(contact, speeds)
+    y0, c1, c2, ah, aa, dur = setup if setup is not None else rkg_setup(contact, speeds)
     h = dur / steps_per_contact
     max_steps = np.full(y0.shape, _MAX_CONTACTS * int(steps_per_contact), dtype=np.int64)
     out = np.empty((y0.size, _NCOL))
@@ -225,7 +225,7 @@ def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS
     v = check_positive("normal_speed", normal_speed)
     if int(steps) < 1:
         raise ValueError(f"steps must be an integer >= 1, got {steps!r}")
-    y0, c1, c2, ah, aa, dur = _rkg_setup(contact, [v])
+    y0, c1, c2, ah, aa, dur = rkg_setup(contact, [v])
     sc, _, _, _ = nondimensional_impact(contact, v)
     j_unit = contact.mass * sc.speed  # N s
     jt = 0.0 if friction_impulse_target is None else float(friction_impulse_target) / j_unit

@@ -89,7 +89,7 @@ import xarray as xr
 from microimpact.io.files import atomic_write, write_netcdf
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
-from microimpact.solvers.impact import simulate_impact
+from microimpact.solvers.impact import settled_contact_energy, simulate_impact
 from microimpact.studies._timeout import TimeLimitExceeded, time_limit
 
 __all__ = ["TOLERANCES", "INPUT_RANGES", "FAILURE_KINDS", "NOTE_KINDS", "draw_cases", "contact_of", "check_case",
@@ -213,10 +213,8 @@ def kinetic_energy(contact: Contact, velocity, omega) -> float:
 
 
 def energy_scale(contact: Contact, ke_in: float) -> float:
-    """max(KE_in, (4/15) m (X/T)^2): incident energy or depth of the contact well. [J]"""
-    well = 0.0
-    if contact.adhesion_line_force > 0.0:
-        well = 4.0 / 15.0 * contact.mass * (contact.length_scale / contact.time_scale) ** 2
+    """max(KE_in, -V(X)): incident energy or depth of the contact well, (4/15) m (X/T)^2. [J]"""
+    well = -settled_contact_energy(contact) if contact.adhesion_line_force > 0.0 else 0.0
     return max(ke_in, well)
 
 

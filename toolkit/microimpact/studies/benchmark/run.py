@@ -21,7 +21,7 @@ from microimpact.io.variables import attributes
 from microimpact.presets import WALL_1990
 from microimpact.solvers import engine
 from microimpact.solvers.impact import simulate_impact, simulate_many
-from microimpact.solvers.rkg import _rkg_setup, rkg_restitution
+from microimpact.solvers.rkg import rkg_setup, rkg_restitution
 from microimpact.studies.benchmark.cases import (
     ALL_METHODS, SCIPY_METHODS, BenchmarkConfig, level_rtol, level_steps, normal_speed_set,
 )
@@ -121,8 +121,8 @@ def _run_engine_batch(contact, speeds, batch_speeds, cases, cfg: BenchmarkConfig
 
 def _run_rkg(contact, speeds, batch_speeds, cfg: BenchmarkConfig, table: _Table, verbose: bool) -> None:
     """``rkg``: the paper's fixed-step Runge-Kutta-Gill, numba batch; its setup is not timed."""
-    setup_batch = _rkg_setup(contact, batch_speeds)
-    setup_set = _rkg_setup(contact, speeds)
+    setup_batch = rkg_setup(contact, batch_speeds)
+    setup_set = rkg_setup(contact, speeds)
     for k in cfg.rkg_levels:
         n = level_steps(k)
         table.set("steps_per_contact", "rkg", k, n)
