@@ -54,6 +54,7 @@ from microimpact.io.materials import material_contact
 from microimpact.io.provenance import fit_parameter_source, stamp_parameters
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
+from microimpact.solvers import DEFAULT_RTOL
 
 # The engine (numba) is imported inside the two functions that solve: a fit read back from its file
 # (the report, the flags of a saved fit) then costs no numba start-up.
@@ -117,7 +118,7 @@ class FitProblem:
                                 work_of_adhesion=work_of_adhesion)
 
 
-def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_adhesion, *, rtol=1e-8,
+def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_adhesion, *, rtol=DEFAULT_RTOL,
                       speed_factor=1.0) -> np.ndarray:
     """Model e_n of every point, Eqs. (21), (27): one engine call per distinct radius.
 
@@ -147,7 +148,7 @@ def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_ad
     return out
 
 
-def damping_residual(params, problem: FitProblem, e_n=None, sigma=None, *, rtol=1e-8):
+def damping_residual(params, problem: FitProblem, e_n=None, sigma=None, *, rtol=DEFAULT_RTOL):
     """lmfit objective: (model - e_n) / sigma, or the model e_n itself when ``e_n`` is None.
 
     Parameters
@@ -602,7 +603,7 @@ def fit_damping(
     fit_work_of_adhesion: bool = False,
     weights="auto",
     start_grid=DEFAULT_START_GRID,
-    rtol: float = 1e-8,
+    rtol: float = DEFAULT_RTOL,
     confidence_intervals: bool = True,
     scale_covar: bool | None = None,
     threads: int | None = 1,

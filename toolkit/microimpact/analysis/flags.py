@@ -51,6 +51,7 @@ from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.files import write_csv, write_netcdf
 from microimpact.io.materials import material_contact
 from microimpact.io.variables import attributes
+from microimpact.solvers import DEFAULT_RTOL
 from microimpact.solvers.impact import simulate_many
 
 __all__ = ["flag_measurements", "write_flags", "fibonacci_sphere", "DEFAULT_THRESHOLDS"]
@@ -195,7 +196,7 @@ def _spread(imp: _Impacts, contact_or_fit, unit, offsets, rtol, progress) -> dic
 def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertainty_deg=None,
                       default_angle_uncertainty_deg: float = 2.0, n_spin: int = 12,
                       spin_fractions=(0.5, 1.0), angle_offsets=(-1.0, 0.0, 1.0), thresholds=None,
-                      rtol: float = 1e-8, progress: bool = False) -> xr.Dataset:
+                      rtol: float = DEFAULT_RTOL, progress: bool = False) -> xr.Dataset:
     """Spread of the impact coefficients over unmeasured spin and angle error, and flags.
 
     Parameters

@@ -47,9 +47,15 @@ from datetime import datetime, timezone
 import numpy as np
 import xarray as xr
 
+from microimpact import __version__
+from microimpact.analysis.fitting import DampingFit
+from microimpact.dynamics.nonlinear import capture_velocity
+from microimpact.io.files import write_netcdf
 from microimpact.io.variables import attributes
-from microimpact.model.parameters import TABLE2_CASES, table2_case
 from microimpact.model.contact import PAPER_REFERENCE
+from microimpact.model.parameters import TABLE2_CASES, table2_case
+from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers.impact import simulate_many
 
 __all__ = [
     "TABLE2_CASES",
@@ -239,7 +245,7 @@ def case_spec(case: str, overrides: Mapping | None = None) -> dict:
     return spec
 
 
-def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, rtol: float = 1e-8,
+def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, rtol: float = DEFAULT_RTOL,
               institution: str | None = None, capture_speed: bool = True) -> xr.Dataset:
     """Simulate every impact of a sweep grid with :func:`microimpact.solvers.impact.simulate_many`.
 
@@ -272,8 +278,6 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
         captured impact. CF-1.10 global attributes, the contact parameters (``contact_*``) and
         the spec as JSON (``sweep_spec``).
     """
-    from microimpact import __version__
-    from microimpact.solvers.impact import simulate_many
 
     if spec is None:
         if case is None or case not in TABLE2_CASES:
@@ -306,8 +310,6 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
             fixed = float(inputs[key]) if key in inputs else (contact.friction if key == "friction" else 0.0)
             ds[key] = xr.DataArray(fixed, attrs=attrs)
     if capture_speed:
-        from microimpact.dynamics.nonlinear import capture_velocity
-
         ds["capture_normal_speed"] = xr.DataArray(
             capture_velocity(contact, solver_rtol=rtol),
             attrs={"units": "m s-1", "long_name": "normal impact speed below which the sphere is captured"},
@@ -456,8 +458,6 @@ def save_sweep(ds: xr.Dataset, path):
     -------
     pathlib.Path
     """
-    from microimpact.io.files import write_netcdf
-
     return write_netcdf(ds, path)
 
 
@@ -468,7 +468,7 @@ def load_sweep(path) -> xr.Dataset:
 
 
 # ----------------------------------------------------------------------------- model curves for figures
-def restitution_curves(fit_dataset: xr.Dataset, speed=None, *, radius=None, rtol: float = 1e-8) -> xr.Dataset:
+def restitution_curves(fit_dataset: xr.Dataset, speed=None, *, radius=None, rtol: float = DEFAULT_RTOL) -> xr.Dataset:
     """Model e_n(v_n) curves at the best fit of a damping fit, one per sphere radius (Fig. 3 lines).
 
     Parameters
@@ -488,8 +488,6 @@ def restitution_curves(fit_dataset: xr.Dataset, speed=None, *, radius=None, rtol
     xarray.Dataset
         ``e_n`` and ``outcome`` on dims (``radius`` [m], ``speed`` [m/s], the normal speed).
     """
-    from microimpact.analysis.fitting import DampingFit
-    from microimpact.solvers.impact import simulate_many
 
     fit = DampingFit.from_dataset(fit_dataset)
     v_data = np.asarray(fit_dataset["normal_speed"].values, dtype=float)
