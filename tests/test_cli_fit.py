@@ -12,7 +12,7 @@ import pytest
 import xarray as xr
 
 from microimpact.cli import main
-from microimpact.analysis.fitting import DampingFit
+from microimpact.analysis.fit_result import DampingFit
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "data" / "synthetic_microspheres.csv"  # SYNTHETIC data (data/README.md)

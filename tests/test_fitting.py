@@ -221,7 +221,7 @@ def test_parameter_source_survives_the_file(fit, tmp_path):
 
 
 def test_one_formatter_text_and_markdown(fit):
-    from microimpact.analysis.fitting import fit_parameter_table, format_fit
+    from microimpact.analysis.fit_result import fit_parameter_table, format_fit
 
     table = fit_parameter_table(fit)
     assert list(table["parameter"]) == ["zeta_hertz", "zeta_adhesion", "work_of_adhesion"]

@@ -10,7 +10,7 @@ import pytest
 import xarray as xr
 
 import microimpact as mi
-from microimpact.analysis.fitting import DampingFit
+from microimpact.analysis.fit_result import DampingFit
 from microimpact.model.parameters import TABLE1_ROW2, TABLE2_CASES
 from microimpact.presets import WALL_1990
 from microimpact.io.provenance import source_of_fit, stamp_parameters

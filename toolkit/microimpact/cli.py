@@ -174,7 +174,7 @@ def register_fit(sub) -> None:
 
 def _cmd_flags(args) -> int:
     from microimpact.analysis.flags import flag_measurements, write_flags
-    from microimpact.analysis.fitting import DampingFit
+    from microimpact.analysis.fit_result import DampingFit
 
     out = _writable(args.out, "--out")
     nc = _writable(args.nc, "--nc") if args.nc else None

@@ -7,7 +7,7 @@ sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 import xarray as xr  # noqa: E402
 
-from microimpact.analysis.fitting import DampingFit  # noqa: E402
+from microimpact.analysis.fit_result import DampingFit  # noqa: E402
 from microimpact.analysis.flags import flag_measurements, write_flags  # noqa: E402
 from microimpact.io import read_impacts  # noqa: E402
 from microimpact.studies.material import stamp_fitted  # noqa: E402

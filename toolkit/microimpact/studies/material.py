@@ -18,7 +18,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import xarray as xr
 
-from microimpact.analysis.fitting import DampingFit
+from microimpact.analysis.fit_result import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity, critical_velocity
 from microimpact.io.provenance import preset_parameter_source, source_of_fit, stamp_parameters
 from microimpact.io.variables import attributes

@@ -48,7 +48,7 @@ import numpy as np
 import xarray as xr
 
 from microimpact import __version__
-from microimpact.analysis.fitting import DampingFit
+from microimpact.analysis.fit_result import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.files import write_netcdf
 from microimpact.io.variables import attributes

@@ -1,0 +1,371 @@
+"""The result of a damping fit: :class:`DampingFit`, its NetCDF form and its one formatter.
+
+Kept apart from the fitting procedure (:mod:`microimpact.analysis.fitting`, which needs lmfit) so that
+everything that only reads a fit -- the fitted material's simulations, the flags, the CLI -- starts
+without importing lmfit (about 1.8 s) or the compiled engine.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from microimpact.io.files import write_netcdf
+from microimpact.io.materials import material_contact
+from microimpact.io.provenance import fit_parameter_source, stamp_parameters
+from microimpact.io.variables import attributes
+from microimpact.model.contact import Contact
+
+__all__ = ["DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
+           "PARAMETER_TABLE_COLUMNS"]
+
+#: names of the fitted parameters, in the order of the correlation matrix
+PARAMETER_NAMES = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
+#: sigma levels of the lmfit confidence intervals
+SIGMA_LEVELS = (-2, -1, 1, 2)
+
+
+# --------------------------------------------------------------------------- result
+@dataclass(frozen=True, eq=False)
+class DampingFit:
+    """Result of :func:`fit_damping`.
+
+    Attributes
+    ----------
+    values : dict
+        Best-fit ``zeta_hertz`` [-], ``zeta_adhesion`` [-], ``work_of_adhesion`` [J/m^2] (fixed
+        parameters at their given value).
+    stderr : dict
+        Standard errors (NaN for fixed parameters), same units.
+    varied : tuple of str
+        Names of the fitted parameters.
+    correlation : numpy.ndarray
+        Correlation matrix of :data:`PARAMETER_NAMES` (NaN rows/columns for fixed ones). [-]
+    confidence_intervals : dict
+        For each varied parameter, {sigma level: limit} for levels -2, -1, 1, 2 from
+        :func:`lmfit.conf_interval` (NaN when not computed or when it failed).
+    chisqr, redchi, aic, bic : float
+        Chi-square, reduced chi-square, Akaike and Bayesian information criteria (lmfit's).
+    n_points : int
+        Number of data points fitted.
+    data : pandas.DataFrame
+        The data used: ``row`` (CSV data row), ``radius`` [m], ``normal_speed`` [m/s], ``e_n``,
+        ``sigma`` (uncertainty used, effective variance included) [-], ``model`` [-],
+        ``residual`` ((model - e_n)/sigma) [-].
+    density, stiffness, friction : float
+        Material of the fit: [kg/m^3], [Pa], [-].
+    damping_reference_speed : float or None
+        [m/s]; None = each impact's own normal speed.
+    weighting : str
+        "e_n uncertainty", "e_n uncertainty + effective variance", "given", or "none".
+    scale_covar : bool
+        Whether the covariance was scaled by the reduced chi-square.
+    info : dict
+        nfev, success, message, method, rtol, elapsed_s, source, sha256, material_pair,
+        ci_message.
+    """
+
+    values: dict
+    stderr: dict
+    varied: tuple
+    correlation: np.ndarray
+    confidence_intervals: dict
+    chisqr: float
+    redchi: float
+    aic: float
+    bic: float
+    n_points: int
+    data: pd.DataFrame
+    density: float
+    stiffness: float
+    friction: float = 0.0
+    damping_reference_speed: float | None = None
+    weighting: str = "none"
+    scale_covar: bool = True
+    info: dict = field(default_factory=dict)
+
+    # convenient accessors
+    @property
+    def zeta_hertz(self) -> float:
+        """Fitted zeta_H. [-]"""
+        return self.values["zeta_hertz"]
+
+    @property
+    def zeta_adhesion(self) -> float:
+        """Fitted zeta_A. [-]"""
+        return self.values["zeta_adhesion"]
+
+    @property
+    def work_of_adhesion(self) -> float:
+        """w_A (fitted or fixed). [J/m^2]"""
+        return self.values["work_of_adhesion"]
+
+    def contact(self, radius: float) -> Contact:
+        """The Contact of a sphere of this radius with the fitted parameters (f0 from Eq. (7)).
+
+        Parameters
+        ----------
+        radius : float
+            Sphere radius. [m]
+        """
+        return material_contact(self, radius)
+
+    @property
+    def radii(self) -> np.ndarray:
+        """The distinct sphere radii of the fitted points, ascending. [m]"""
+        return np.unique(self.data["radius"].to_numpy(dtype=float))
+
+    @property
+    def speed_range(self) -> tuple[float, float]:
+        """(smallest, largest) incident normal speed of the fitted points. [m/s]"""
+        v = self.data["normal_speed"].to_numpy(dtype=float)
+        return float(v.min()), float(v.max())
+
+    @property
+    def parameter_source(self) -> str:
+        """Provenance of the fitted parameters: ``"fit: <source file name> <sha256>"``.
+
+        From the ``source`` and ``sha256`` the fit recorded of its impact table (NetCDF attributes
+        ``fit_source``, ``fit_sha256``); ``unknown`` for what was not recorded (a table built in
+        memory).
+        """
+        return fit_parameter_source(self.info.get("source"), self.info.get("sha256"))
+
+    # ------------------------------------------------------------------ report
+    def report(self) -> str:
+        """Readable summary: values, errors, intervals, correlations and fit statistics.
+
+        The text of :func:`format_fit` (the one formatter of a fit).
+        """
+        return format_fit(self, "text")
+
+    def __str__(self) -> str:  # pragma: no cover - convenience
+        return self.report()
+
+    # ------------------------------------------------------------------ NetCDF
+    def to_dataset(self) -> xr.Dataset:
+        """The fit as an xarray Dataset with CF attributes (``units``, ``long_name``).
+
+        Parameters are scalar variables ``zeta_hertz``, ``zeta_adhesion``, ``work_of_adhesion``
+        with ``<name>_stderr`` and ``<name>_confidence_limit(sigma_level)``; the data used are along
+        dimension ``point``; the correlation matrix along ``parameter`` x ``parameter_b``.
+        """
+        d = self.data
+        point = np.arange(len(d))
+        ds = xr.Dataset(coords={
+            "point": ("point", point, {"long_name": "index of the fitted point"}),
+            "parameter": ("parameter", np.array(PARAMETER_NAMES, dtype=object), {"long_name": "fit parameter"}),
+            "parameter_b": ("parameter_b", np.array(PARAMETER_NAMES, dtype=object), {"long_name": "fit parameter"}),
+            "sigma_level": ("sigma_level", np.array(SIGMA_LEVELS, dtype=np.int8),
+                            {"units": "1", "long_name": "confidence level in standard deviations (negative: lower limit)"}),
+        })
+        for name in PARAMETER_NAMES:
+            units = attributes(name)["units"]
+            varied = name in self.varied
+            ds[name] = xr.DataArray(self.values[name], attrs=attributes(name, varied=int(varied)))
+            ds[f"{name}_stderr"] = xr.DataArray(self.stderr[name], attrs={
+                "units": units, "long_name": f"standard error of {name}"})
+            ci = self.confidence_intervals.get(name, {})
+            ds[f"{name}_confidence_limit"] = xr.DataArray(
+                np.array([ci.get(s, np.nan) for s in SIGMA_LEVELS], dtype=float), dims=("sigma_level",),
+                attrs={"units": units, "long_name": f"lmfit.conf_interval limit of {name}"})
+        ds["correlation"] = xr.DataArray(self.correlation, dims=("parameter", "parameter_b"),
+                                         attrs=attributes("correlation"))
+        for col in ("row", "radius", "normal_speed", "e_n", "sigma", "model", "residual"):
+            values = d[col].to_numpy(dtype=np.int64 if col == "row" else float)
+            name = {"e_n": "e_n_measured", "model": "e_n_model"}.get(col, col)
+            ds[name] = xr.DataArray(values, dims=("point",), attrs=attributes(name))
+        ds.attrs.update({
+            "title": "damping fit of the microsphere impact model (Cheng, Brach & Dunn 2002)",
+            "Conventions": "CF-1.8",
+            "chisqr": float(self.chisqr), "redchi": float(self.redchi), "aic": float(self.aic),
+            "bic": float(self.bic), "n_points": int(self.n_points),
+            "varied": " ".join(self.varied),
+            "density": self.density, "stiffness": self.stiffness, "friction": self.friction,
+            "damping_reference_speed": ("per-impact normal speed" if self.damping_reference_speed is None
+                                        else float(self.damping_reference_speed)),
+            "weighting": self.weighting, "scale_covar": int(self.scale_covar),
+        })
+        for k, v in self.info.items():
+            if v is None:
+                continue
+            ds.attrs[f"fit_{k}"] = int(v) if isinstance(v, (bool, np.bool_)) else (v if isinstance(v, (int, float, str)) else str(v))
+        return stamp_parameters(ds, [self.contact(r) for r in self.radii], self.parameter_source)
+
+    def save(self, path) -> Path:
+        """Write :meth:`to_dataset` to NetCDF atomically (:func:`microimpact.io.write_netcdf`)."""
+        return write_netcdf(self.to_dataset(), path)
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset) -> "DampingFit":
+        """Inverse of :meth:`to_dataset`."""
+        a = ds.attrs
+        varied = tuple(a["varied"].split()) if a.get("varied") else ()
+        values = {n: float(ds[n]) for n in PARAMETER_NAMES}
+        stderr = {n: float(ds[f"{n}_stderr"]) for n in PARAMETER_NAMES}
+        cis = {}
+        for n in varied:
+            lim = ds[f"{n}_confidence_limit"].values
+            cis[n] = {int(s): float(x) for s, x in zip(ds["sigma_level"].values, lim)}
+        data = pd.DataFrame({
+            "row": ds["row"].values.astype(np.int64), "radius": ds["radius"].values,
+            "normal_speed": ds["normal_speed"].values, "e_n": ds["e_n_measured"].values,
+            "sigma": ds["sigma"].values, "model": ds["e_n_model"].values, "residual": ds["residual"].values,
+        })
+        ref = a.get("damping_reference_speed")
+        info = {k.removeprefix("fit_"): (v.item() if hasattr(v, "item") else v) for k, v in a.items() if k.startswith("fit_")}
+        return cls(values=values, stderr=stderr, varied=varied, correlation=np.array(ds["correlation"].values, dtype=float),
+                   confidence_intervals=cis, chisqr=float(a["chisqr"]), redchi=float(a["redchi"]), aic=float(a["aic"]),
+                   bic=float(a["bic"]), n_points=int(a["n_points"]), data=data, density=float(a["density"]),
+                   stiffness=float(a["stiffness"]), friction=float(a["friction"]),
+                   damping_reference_speed=None if isinstance(ref, str) else float(ref),
+                   weighting=str(a["weighting"]), scale_covar=bool(int(a["scale_covar"])), info=info)
+
+    @classmethod
+    def load(cls, path) -> "DampingFit":
+        """Read a fit written by :meth:`save`.
+
+        Raises
+        ------
+        ValueError
+            If the file is not a damping-fit NetCDF (names the file and the missing variable).
+        """
+        path = Path(path)
+        try:
+            with xr.open_dataset(path, engine="netcdf4") as ds:
+                ds = ds.load()
+        except FileNotFoundError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - netCDF4 raises OSError/ValueError variously
+            raise ValueError(f"{path}: cannot be read as NetCDF ({exc})") from None
+        try:
+            return cls.from_dataset(ds)
+        except KeyError as exc:
+            raise ValueError(f"{path}: not a damping-fit file written by DampingFit.save "
+                             f"(missing {exc.args[0]!r})") from None
+
+
+# --------------------------------------------------------------------------- the one formatter
+#: columns of :func:`fit_parameter_table`
+PARAMETER_TABLE_COLUMNS = ("parameter", "units", "value", "stderr", "relative", "ci1", "ci2", "method")
+
+
+def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
+    """The fitted parameters as text cells, one row per parameter of :data:`PARAMETER_NAMES`.
+
+    Parameters
+    ----------
+    fit : DampingFit
+        A fit (:func:`fit_damping`, or read back with :meth:`DampingFit.load` /
+        :meth:`DampingFit.from_dataset`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`PARAMETER_TABLE_COLUMNS`: ``parameter``, ``units`` (of
+        :mod:`microimpact.io.variables`), ``value``, ``stderr`` ("fixed" for a fixed
+        parameter), ``relative`` (stderr / |value| in %), ``ci1`` and ``ci2`` (1- and 2-sigma
+        intervals ``[lo, hi]``) and ``method``: profile likelihood (:func:`lmfit.conf_interval`)
+        where it was computed, else value +/- k stderr.
+    """
+    rows = []
+    for name in PARAMETER_NAMES:
+        v, s = fit.values[name], fit.stderr[name]
+        row = dict.fromkeys(PARAMETER_TABLE_COLUMNS, "") | {
+            "parameter": name, "units": attributes(name)["units"], "value": f"{v:.6g}"}
+        if name not in fit.varied:
+            rows.append(row | {"stderr": "fixed", "method": "fixed (given material)"})
+            continue
+        ci = fit.confidence_intervals.get(name, {})
+        if all(math.isfinite(ci.get(k, math.nan)) for k in (-1, 1, -2, 2)):
+            ci1, ci2, method = (ci[-1], ci[1]), (ci[-2], ci[2]), "profile likelihood (lmfit.conf_interval)"
+        elif math.isfinite(s):
+            ci1, ci2, method = (v - s, v + s), (v - 2 * s, v + 2 * s), "covariance: value +/- k stderr"
+        else:
+            ci1 = ci2 = None
+            method = "not estimated"
+        rows.append(row | {
+            "stderr": f"{s:.3g}", "relative": f"{100 * s / abs(v):.2g} %" if v and math.isfinite(s) else "",
+            "ci1": f"[{ci1[0]:.5g}, {ci1[1]:.5g}]" if ci1 else "",
+            "ci2": f"[{ci2[0]:.5g}, {ci2[1]:.5g}]" if ci2 else "", "method": method})
+    return pd.DataFrame(rows, columns=list(PARAMETER_TABLE_COLUMNS))
+
+
+def _fit_facts(fit: "DampingFit") -> dict:
+    """Label -> text of everything but the parameters, in report order (correlations: a list)."""
+    src, pair = fit.info.get("source"), fit.info.get("material_pair")
+    vref = fit.damping_reference_speed
+    idx = [PARAMETER_NAMES.index(n) for n in fit.varied]
+    facts = {
+        "data": (f"{src}" + (f"  [{pair}]" if pair else "")) if src else None,
+        "points": f"{fit.n_points} over {len(fit.radii)} radii ({', '.join(f'{r * 1e6:.3g}' for r in fit.radii)} um)",
+        "weighting": f"{fit.weighting}; covariance {'scaled by' if fit.scale_covar else 'not scaled by'} "
+                     "reduced chi-square",
+        "material": f"density {fit.density:g} kg/m3, K {fit.stiffness:.4g} Pa, friction {fit.friction:g}, "
+                    "damping reference speed "
+                    f"{'per-impact normal speed' if vref is None else f'{vref:g} m/s'}",
+        "correlations": [f"{fit.varied[a]} / {fit.varied[b]}: {fit.correlation[idx[a], idx[b]]:+.3f}"
+                         for a in range(len(idx)) for b in range(a + 1, len(idx))],
+        "chi-square": f"{fit.chisqr:.4g}, reduced {fit.redchi:.4g} "
+                      f"({fit.n_points - len(fit.varied)} degrees of freedom)",
+        "AIC, BIC": f"{fit.aic:.4g}, {fit.bic:.4g}",
+        "evaluations": f"{fit.info.get('nfev', '?')} ({fit.info.get('elapsed_s', math.nan):.2f} s), "
+                       f"{fit.info.get('message', '')}",
+        "note": fit.info.get("ci_message") or None,
+    }
+    return {k: v for k, v in facts.items() if v is not None}
+
+
+def format_fit(fit: "DampingFit", style: str = "text") -> str:
+    """The one formatter of a damping fit: parameters, intervals, correlations, statistics.
+
+    Parameters
+    ----------
+    fit : DampingFit
+        A fit, e.g. ``DampingFit.load("results/fit.nc")``.
+    style : {"text", "markdown"}
+        "text": the plain-text report of :meth:`DampingFit.report` (the CLI prints it);
+        "markdown": a Markdown pipe table of :func:`fit_parameter_table` followed by a list of
+        the data, weighting, material, correlations and statistics (for documents).
+
+    Returns
+    -------
+    str
+    """
+    table, facts = fit_parameter_table(fit), _fit_facts(fit)
+    if style == "markdown":
+        head = ["parameter", "units", "value", "std. error", "1-sigma interval", "2-sigma interval", "method"]
+        cols = ["parameter", "units", "value", "stderr", "ci1", "ci2", "method"]
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        lines += ["| " + " | ".join(str(r[c]) for c in cols) + " |" for _, r in table.iterrows()]
+        lines.append("")
+        for label, text in facts.items():
+            text = "; ".join(text) or "n/a" if isinstance(text, list) else text
+            lines.append(f"- **{label}**: {text}")
+        return "\n".join(lines)
+    if style != "text":
+        raise ValueError(f"style must be 'text' or 'markdown', got {style!r}")
+    lines = ["Damping fit (Cheng, Brach & Dunn 2002, Eqs. (14)-(15), (21), (27))"]
+    for label in ("data", "points", "weighting", "material"):
+        if label in facts:
+            lines.append(f"  {label:<12}: {facts[label]}")
+    lines.append("  parameters  :")
+    for _, r in table.iterrows():
+        if r["stderr"] == "fixed":
+            lines.append(f"    {r['parameter']:<17}= {r['value']} (fixed) [{r['units']}]")
+            continue
+        rel = f" ({r['relative']})" if r["relative"] else ""
+        how = "" if r["method"].startswith("profile") else f" ({r['method']})"
+        ci = f"; 1-sigma CI {r['ci1']}, 2-sigma CI {r['ci2']}{how}" if r["ci1"] else ""
+        lines.append(f"    {r['parameter']:<17}= {r['value']} +/- {r['stderr']}{rel} [{r['units']}]{ci}")
+    if facts["correlations"]:
+        lines += ["  correlations:"] + [f"    {c}" for c in facts["correlations"]]
+    for label in ("chi-square", "AIC, BIC", "evaluations", "note"):
+        if label in facts:
+            lines.append(f"  {label:<12}: {facts[label]}")
+    return "\n".join(lines)
