@@ -14,7 +14,8 @@ from microimpact.analysis.fit_result import DampingFit
 from microimpact.model.parameters import TABLE1_ROW2, TABLE2_CASES
 from microimpact.presets import WALL_1990
 from microimpact.io.provenance import source_of_fit, stamp_parameters
-from microimpact.studies.material import material_dynamics, material_sweep, measured_speed_range, named_contact
+from microimpact.presets import named_contact
+from microimpact.studies.material import material_dynamics, material_sweep, measured_speed_range
 from microimpact.studies.sweeps import case_spec
 
 #: a fit of the bundled synthetic data, from the regression baseline (a real fit.nc file)

@@ -7,10 +7,13 @@ Aerosol Sci. Technol. 12:926-946, doi:10.1080/02786829008959404.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
+from microimpact.io.provenance import preset_parameter_source
 from microimpact.model.contact import Contact
 from microimpact.model.parameters import TABLE1, TABLE1_ROW2
 
-__all__ = ["WALL_1990", "PRESETS", "get_preset"]
+__all__ = ["WALL_1990", "PRESETS", "get_preset", "named_contact"]
 
 WALL_1990 = TABLE1_ROW2
 
@@ -26,3 +29,22 @@ def get_preset(name: str) -> Contact:
         return PRESETS[name.lower()]
     except KeyError:
         raise ValueError(f"unknown preset {name!r}; known presets: {', '.join(sorted(PRESETS))}") from None
+
+
+def named_contact(spec: str | Mapping) -> tuple[Contact, str]:
+    """The contact that a config names, and its ``parameter_source``.
+
+    Parameters
+    ----------
+    spec : str or mapping
+        A preset name (:data:`microimpact.presets.PRESETS`, e.g. ``"wall1990"`` = Table 1 row 2)
+        or a mapping of :class:`Contact` fields in SI units.
+
+    Returns
+    -------
+    (Contact, str)
+        The contact and ``"preset: <name>"`` or ``"config"``.
+    """
+    if isinstance(spec, str):
+        return get_preset(spec), preset_parameter_source(spec.lower())
+    return Contact(**spec), "config"

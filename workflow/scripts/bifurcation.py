@@ -8,7 +8,7 @@ sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 from microimpact.dynamics.nonlinear import bifurcation_plane, table1_cases  # noqa: E402
 from microimpact.io import write_netcdf  # noqa: E402
 from microimpact.io.provenance import stamp_parameters  # noqa: E402
-from microimpact.studies.material import named_contact  # noqa: E402
+from microimpact.presets import named_contact  # noqa: E402
 
 contact, source = named_contact(snakemake.params.contact)  # noqa: F821
 cases = [(f"simulation, v={v:g} m/s", contact, v) for v in snakemake.params.speeds] + table1_cases()  # noqa: F821

@@ -7,7 +7,7 @@ sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 from microimpact.dynamics.nonlinear import dynamics_summary  # noqa: E402
 from microimpact.io import write_netcdf  # noqa: E402
 from microimpact.io.provenance import stamp_parameters  # noqa: E402
-from microimpact.studies.material import named_contact  # noqa: E402
+from microimpact.presets import named_contact  # noqa: E402
 
 contact, source = named_contact(snakemake.params.contact)  # noqa: F821
 ds = stamp_parameters(dynamics_summary(contact, snakemake.params.speeds), contact, source)  # noqa: F821

@@ -6,7 +6,7 @@ sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact.dynamics.nonlinear import phase_portraits, save_phase_portraits  # noqa: E402
 from microimpact.io.provenance import stamp_parameters  # noqa: E402
-from microimpact.studies.material import named_contact  # noqa: E402
+from microimpact.presets import named_contact  # noqa: E402
 
 contact, source = named_contact(snakemake.params.contact)  # noqa: F821
 portraits = [stamp_parameters(ds, contact, source) for ds in phase_portraits(contact, snakemake.params.speeds)]  # noqa: F821

@@ -5,7 +5,7 @@ import sys
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact.io import write_csv  # noqa: E402
-from microimpact.studies.material import named_contact  # noqa: E402
+from microimpact.presets import named_contact  # noqa: E402
 from microimpact.studies.reproduction import reproduction_table, write_reproduction_markdown  # noqa: E402
 
 contact, source = named_contact(snakemake.params.contact)  # noqa: F821

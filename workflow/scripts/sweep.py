@@ -5,7 +5,7 @@ import sys
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact.io.provenance import stamp_parameters  # noqa: E402
-from microimpact.studies.material import named_contact  # noqa: E402
+from microimpact.presets import named_contact  # noqa: E402
 from microimpact.studies.sweeps import case_spec, run_sweep, save_sweep  # noqa: E402
 
 params = snakemake.params  # noqa: F821

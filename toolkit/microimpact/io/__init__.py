@@ -8,15 +8,31 @@
   from any material record, f0 from w_A by Eq. (7).
 * :func:`atomic_write`, :func:`atomic_path`, :func:`write_csv`, :func:`write_netcdf`,
   :func:`write_netcdf_groups` - writers that leave either the old or the complete new file, never a partial one.
-* :mod:`microimpact.io.units` - the one table of accepted units.
+* :mod:`microimpact.io.units` - the one table of accepted units; :mod:`.variables` - the one table
+  of result variable names, units and long names; :mod:`.provenance` - which parameters made a
+  result.
+
+The names above load their module on first use (PEP 562): importing a light part of io, such as
+the variables table or the provenance attributes, does not import pandas or the CSV reader.
 """
 
-from microimpact.io import files, impacts, materials, units
-from microimpact.io.files import atomic_path, atomic_write, write_csv, write_netcdf, write_netcdf_groups
-from microimpact.io.impacts import CANONICAL_COLUMNS, COLUMN_UNITS, ImpactDataError, ImpactDataWarning, Problem, read_impacts
-from microimpact.io.materials import MaterialPair, MaterialsError, default_materials_path, material_contact, read_materials
-from microimpact.io.units import UNITS, UnitError
+import importlib
 
-#: the public names of the readers and writers, each module's own list (one place each)
-__all__ = [name for module in (impacts, materials, files) for name in module.__all__
-           if name not in ("MAX_LISTED_PROBLEMS", "MATERIALS_SCHEMA", "NETCDF_COMPRESSION")] + ["UNITS", "UnitError"]
+#: public name -> the module of microimpact.io that defines it
+_HOMES = {
+    **dict.fromkeys(("read_impacts", "ImpactDataError", "ImpactDataWarning", "Problem", "CANONICAL_COLUMNS",
+                     "COLUMN_UNITS"), "impacts"),
+    **dict.fromkeys(("MaterialPair", "MaterialsError", "read_materials", "default_materials_path",
+                     "material_contact"), "materials"),
+    **dict.fromkeys(("atomic_path", "atomic_write", "write_netcdf", "write_netcdf_groups", "write_csv",
+                     "read_netcdf_groups"), "files"),
+    **dict.fromkeys(("UNITS", "UnitError"), "units"),
+}
+
+__all__ = list(_HOMES)
+
+
+def __getattr__(name: str):
+    if name in _HOMES:
+        return getattr(importlib.import_module(f"microimpact.io.{_HOMES[name]}"), name)
+    raise AttributeError(f"module 'microimpact.io' has no attribute {name!r}")

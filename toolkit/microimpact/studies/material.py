@@ -20,10 +20,9 @@ import xarray as xr
 
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity, critical_velocity
-from microimpact.io.provenance import preset_parameter_source, source_of_fit, stamp_parameters
+from microimpact.io.provenance import source_of_fit, stamp_parameters
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
-from microimpact.presets import get_preset
 from microimpact.solvers import DEFAULT_RTOL
 from microimpact.studies.sweeps import resolve_spec, run_sweep
 
@@ -33,27 +32,7 @@ __all__ = [
     "stamp_fitted",
     "material_sweep",
     "material_dynamics",
-    "named_contact",
 ]
-
-
-def named_contact(spec: str | Mapping) -> tuple[Contact, str]:
-    """The contact that a config names, and its ``parameter_source``.
-
-    Parameters
-    ----------
-    spec : str or mapping
-        A preset name (:data:`microimpact.presets.PRESETS`, e.g. ``"wall1990"`` = Table 1 row 2)
-        or a mapping of :class:`Contact` fields in SI units.
-
-    Returns
-    -------
-    (Contact, str)
-        The contact and ``"preset: <name>"`` or ``"config"``.
-    """
-    if isinstance(spec, str):
-        return get_preset(spec), preset_parameter_source(spec.lower())
-    return Contact(**spec), "config"
 
 
 def fitted_contacts(fit: xr.Dataset, radii: Sequence[float] | None = None) -> dict[float, Contact]:
