@@ -150,7 +150,7 @@ def test_outputs_logs_and_benchmarks_exist(pipeline):
                 *[f"results/{part}/sweeps/case_{c}.nc" for c in TINY_SWEEPS for part in ("paper", "analyst")]]:
         assert (root / rel).stat().st_size > 0, rel
     assert not (root / "results" / "benchmark").exists()  # benchmark switched off
-    for rule in ["validate_data", "fit", "fit_curves", "flags", "material_dynamics", "phase_portraits",
+    for rule in ["validate_data", "fit", "material_simulations", "flags", "phase_portraits",
                  "dynamics_summary", "bifurcation", "reproduction", "kharaz", "stress", "report"]:
         assert (root / "logs" / f"{rule}.log").exists(), rule
         bench = (root / "benchmarks" / f"{rule}.tsv").read_text().splitlines()
@@ -350,8 +350,7 @@ def test_changing_data_reruns_only_its_dependants(pipeline):
     assert proc.returncode == 0, proc.stdout
     jobs = job_counts(proc.stdout)
     # the analyst's part follows the fit; the paper's part and the checks do not depend on the data
-    assert set(jobs) == {"validate_data", "fit", "fit_curves", "flags", "material_dynamics", "material_sweep",
-                         "report", "all"}, jobs
+    assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "report", "all"}, jobs
 
 
 # --------------------------------------------------------------------------- profile, lint, config

@@ -1,7 +1,8 @@
 # The analyst's material: the fit of the damping coefficients to the measured e_n(v_n) (the
-# paper's Fig. 3 procedure), and everything the fitted parameters drive: the model curves, the
-# measurement flags, the critical and capture velocity per measured size and the Table 2 sweeps
-# of the fitted material over the measured sizes and speeds.
+# paper's Fig. 3 procedure), and everything the fitted parameters drive: the measurement flags,
+# and in one job (each is seconds; one job saves the start-up of six) the model curves, the
+# critical and capture velocity per measured size and the Table 2 sweeps of the fitted material
+# over the measured sizes and speeds.
 
 
 rule fit:
@@ -25,23 +26,6 @@ rule fit:
         "../scripts/fit.py"
 
 
-rule fit_curves:
-    input:
-        fit=rules.fit.output[0],
-    output:
-        "results/analyst/fit_curves.nc",
-    params:
-        rtol=RTOL,
-    log:
-        "logs/fit_curves.log",
-    benchmark:
-        "benchmarks/fit_curves.tsv"
-    conda:
-        "../envs/microimpact.yaml"
-    script:
-        "../scripts/fit_curves.py"
-
-
 rule flags:
     input:
         data=config["data"],
@@ -63,36 +47,22 @@ rule flags:
         "../scripts/flags.py"
 
 
-rule material_dynamics:
+rule material_simulations:
     input:
         fit=rules.fit.output[0],
     output:
-        "results/analyst/dynamics.nc",
+        fit_curves="results/analyst/fit_curves.nc",
+        dynamics="results/analyst/dynamics.nc",
+        sweeps=expand("results/analyst/sweeps/case_{case}.nc", case=SWEEP_CASES),
     params:
+        cases=SWEEP_CASES,
+        overrides=config["sweeps"],
         rtol=RTOL,
     log:
-        "logs/material_dynamics.log",
+        "logs/material_simulations.log",
     benchmark:
-        "benchmarks/material_dynamics.tsv"
+        "benchmarks/material_simulations.tsv"
     conda:
         "../envs/microimpact.yaml"
     script:
-        "../scripts/material_dynamics.py"
-
-
-rule material_sweep:
-    input:
-        fit=rules.fit.output[0],
-    output:
-        "results/analyst/sweeps/case_{case}.nc",
-    params:
-        overrides=sweep_overrides,
-        rtol=RTOL,
-    log:
-        "logs/analyst_sweeps/case_{case}.log",
-    benchmark:
-        "benchmarks/analyst_sweeps/case_{case}.tsv"
-    conda:
-        "../envs/microimpact.yaml"
-    script:
-        "../scripts/material_sweep.py"
+        "../scripts/material_simulations.py"
