@@ -150,12 +150,11 @@ def test_outputs_logs_and_benchmarks_exist(pipeline):
                 *[f"results/{part}/sweeps/case_{c}.nc" for c in TINY_SWEEPS for part in ("paper", "analyst")]]:
         assert (root / rel).stat().st_size > 0, rel
     assert not (root / "results" / "benchmark").exists()  # benchmark switched off
-    for rule in ["validate_data", "fit", "material_simulations", "flags", "phase_portraits",
-                 "dynamics_summary", "bifurcation", "reproduction", "kharaz", "stress", "report"]:
+    for rule in ["validate_data", "fit", "material_simulations", "flags", "paper_dynamics", "paper_sweeps",
+                 "reproduction", "kharaz", "stress", "report"]:
         assert (root / "logs" / f"{rule}.log").exists(), rule
         bench = (root / "benchmarks" / f"{rule}.tsv").read_text().splitlines()
         assert bench[0].split("\t")[0] == "s" and len(bench) == 2, rule
-    assert (root / "logs" / "sweeps" / "case_2.1.log").exists()
     # no temporary files of the atomic writers left behind
     assert not list(root.rglob(".*.tmp"))
 

@@ -1,54 +1,25 @@
 # The reproduction of the paper, from the paper's parameters (config paper_contact; Table 1 row 2
-# by default): Fig. 5 phase portraits, the numbers of the nonlinear analysis, the Fig. 4
-# bifurcation plane and the reproduction table of the paper's claims.
+# by default): in one job (each part takes a second; one job saves two start-ups) the Fig. 5
+# phase portraits, the numbers of the nonlinear analysis and the Fig. 4 bifurcation plane; and
+# the reproduction table of the paper's claims.
 
 
-rule phase_portraits:
+rule paper_dynamics:
     output:
-        "results/paper/phase_portraits.nc",
+        phase_portraits="results/paper/phase_portraits.nc",
+        dynamics="results/paper/dynamics.nc",
+        bifurcation="results/paper/bifurcation.nc",
     params:
         contact=config["paper_contact"],
         speeds=config["phase_portrait_speeds"],
     log:
-        "logs/phase_portraits.log",
+        "logs/paper_dynamics.log",
     benchmark:
-        "benchmarks/phase_portraits.tsv"
+        "benchmarks/paper_dynamics.tsv"
     conda:
         "../envs/microimpact.yaml"
     script:
-        "../scripts/phase_portraits.py"
-
-
-rule dynamics_summary:
-    output:
-        "results/paper/dynamics.nc",
-    params:
-        contact=config["paper_contact"],
-        speeds=config["phase_portrait_speeds"],
-    log:
-        "logs/dynamics_summary.log",
-    benchmark:
-        "benchmarks/dynamics_summary.tsv"
-    conda:
-        "../envs/microimpact.yaml"
-    script:
-        "../scripts/dynamics_summary.py"
-
-
-rule bifurcation:
-    output:
-        "results/paper/bifurcation.nc",
-    params:
-        contact=config["paper_contact"],
-        speeds=config["phase_portrait_speeds"],
-    log:
-        "logs/bifurcation.log",
-    benchmark:
-        "benchmarks/bifurcation.tsv"
-    conda:
-        "../envs/microimpact.yaml"
-    script:
-        "../scripts/bifurcation.py"
+        "../scripts/paper_dynamics.py"
 
 
 rule reproduction:

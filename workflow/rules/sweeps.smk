@@ -1,21 +1,23 @@
 # Sensitivity sweeps of Table 2 (Figs. 7-14) with the paper's parameters, one NetCDF file per
-# case. With sweep_chunks > 1 each case is split along the speed axis into chunk jobs (for a
-# cluster) and gathered again; the gathered file equals the unchunked one. The analyst's sweeps
+# case, all in one job (each case takes well under a second; one job saves the start-up of the
+# others). With sweep_chunks > 1 each case is instead split along the speed axis into chunk jobs
+# (for a cluster) and gathered again; the gathered file equals the unchunked one. The analyst's sweeps
 # (fitted material) are in fit.smk.
 
 if SWEEP_CHUNKS == 1:
 
-    rule paper_sweep:
+    rule paper_sweeps:
         output:
-            "results/paper/sweeps/case_{case}.nc",
+            expand("results/paper/sweeps/case_{case}.nc", case=SWEEP_CASES),
         params:
             contact=config["paper_contact"],
-            overrides=sweep_overrides,
+            cases=SWEEP_CASES,
+            overrides=config["sweeps"],
             rtol=RTOL,
         log:
-            "logs/sweeps/case_{case}.log",
+            "logs/paper_sweeps.log",
         benchmark:
-            "benchmarks/sweeps/case_{case}.tsv"
+            "benchmarks/paper_sweeps.tsv"
         conda:
             "../envs/microimpact.yaml"
         script:

@@ -1,4 +1,5 @@
-"""Rule paper_sweep: one Table 2 case with the paper's contact -> results/paper/sweeps/case_<case>.nc."""
+"""Rule paper_sweeps: every configured Table 2 case with the paper's contact
+-> results/paper/sweeps/case_<case>.nc."""
 
 import sys
 
@@ -10,7 +11,7 @@ from microimpact.studies.sweeps import case_spec, run_sweep, save_sweep  # noqa:
 
 params = snakemake.params  # noqa: F821
 contact, source = named_contact(params.contact)
-case = snakemake.wildcards.case  # noqa: F821
-ds = run_sweep(contact, case_spec(case, params.overrides), case=case, rtol=params.rtol)
-save_sweep(stamp_parameters(ds, contact, source), snakemake.output[0])  # noqa: F821
-print(ds)
+for case, path in zip(params.cases, snakemake.output):  # noqa: F821
+    ds = run_sweep(contact, case_spec(case, params.overrides[case]), case=case, rtol=params.rtol)
+    save_sweep(stamp_parameters(ds, contact, source), path)
+    print(f"case {case}: {dict(ds.sizes)}")
