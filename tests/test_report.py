@@ -155,3 +155,21 @@ def test_grouped_netcdf_reader(results):
     tmp, _, _ = results
     portraits = read_netcdf_groups(tmp / "portraits.nc")
     assert [p.attrs["normal_speed"] for p in portraits] == [0.5, 1e-5]
+
+
+def test_figures_drawn_by_two_workers_are_the_images_drawn_by_one():
+    """render_figures forks workers for speed; the images must not depend on it."""
+    from matplotlib.figure import Figure
+
+    from microimpact.report.layout import render_figures
+
+    figures = []
+    for k in range(3):
+        fig = Figure(figsize=(3, 2))
+        fig.add_subplot().plot([0, 1, 2], [0, k, 2 * k])
+        figures.append(fig)
+    serial = render_figures(figures, workers=1)
+    parallel = render_figures(figures, workers=2)
+    assert len(parallel) == 3
+    for a, b in zip(serial, parallel):
+        np.testing.assert_array_equal(a, b)

@@ -21,6 +21,7 @@ rule report:
         kharaz=rules.kharaz.output[0],
     output:
         "reports/report.pdf",
+    threads: 2  # the figures are drawn side by side (build_report(workers=...))
     params:
         config=config,
     log:

@@ -107,7 +107,8 @@ def _checks_part(lay: Layout, inputs: Mapping, config: Mapping) -> None:
         checks.config_section(lay, config)
 
 
-def build_report(path, inputs: Mapping, config: Mapping | None = None, title: str | None = None) -> Path:
+def build_report(path, inputs: Mapping, config: Mapping | None = None, title: str | None = None, *,
+                 workers: int = 1) -> Path:
     """Build the PDF report from the pipeline's result files.
 
     Parameters
@@ -126,6 +127,9 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
         The pipeline configuration (title page and appendix).
     title : str, optional
         Report title; default ``config["report_title"]`` or a generic one.
+    workers : int
+        Processes that draw the figures (the pipeline passes its rule's threads). The PDF is the
+        same for any number.
 
     Returns
     -------
@@ -158,5 +162,5 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
     path = Path(path)
     lay.save(path, {"Title": title, "Author": f"microimpact {__version__}",
                     "Subject": "Microsphere impact model of Cheng, Brach & Dunn (2002)",
-                    "Keywords": "synthetic data" if synthetic else "measured data"})
+                    "Keywords": "synthetic data" if synthetic else "measured data"}, workers=workers)
     return path
