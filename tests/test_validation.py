@@ -29,8 +29,12 @@ def ds():
     return kharaz_comparison()
 
 
-def test_uses_the_repository_copy(ds):
-    assert default_kharaz_path() == Path(__file__).resolve().parents[1] / "data" / "kharaz2001_oblique.csv"
+def test_uses_the_bundled_copy(ds):
+    # the package's copy (importlib.resources), byte-identical to the repository's data/ copy
+    # (tests/test_packaging.py), so the comparison works from an installed wheel
+    import microimpact
+
+    assert default_kharaz_path() == Path(microimpact.__file__).parent / "data" / "kharaz2001_oblique.csv"
     assert ds.attrs["source"] == str(default_kharaz_path())
     if SHARED.is_file():  # the copy is unchanged
         assert default_kharaz_path().read_bytes() == SHARED.read_bytes()
@@ -140,9 +144,11 @@ def test_model_curves_default_grid(ds):
         for name in (f"{q}_curve", f"{q}_curve_fitted"):
             assert ds[name].dims == ("curve_incidence_deg",)
             assert ds[name].attrs["units"] == ds[f"{q}_measured"].attrs["units"] and ds[name].attrs["long_name"]
-        # the curve passes through the model values at the measured angles inside the grid
+        # the curve passes through the model values at the measured angles inside the grid; linear
+        # interpolation on its 0.25 deg grid errs by ~(h^2/8)|f''| (measured: 3.4e-6 relative at
+        # most); 1e-4 keeps a 30x margin while a wrong curve would be off by percents
         a = ds[f"{q}_incidence_deg"].values
         inside = (a >= grid.values[0]) & (a <= grid.values[-1])
         assert inside.sum() >= 5
         np.testing.assert_allclose(np.interp(a[inside], grid.values, ds[f"{q}_curve"].values),
-                                   ds[f"{q}_model"].values[inside], rtol=2e-2)
+                                   ds[f"{q}_model"].values[inside], rtol=1e-4)
