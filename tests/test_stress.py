@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 from microimpact.studies import stress
 from microimpact.solvers.impact import simulate_impact
+from microimpact.solvers.reference import simulate_reference
 from microimpact.presets import WALL_1990
 
 # deterministic (derandomize) and fast: each example costs a few engine solves (~ms)
@@ -96,7 +97,11 @@ MISSED_SEPARATION = stress.contact_of({
 def test_separation_through_an_extremum_event():
     res = simulate_impact(MISSED_SEPARATION, 15.553686347910835)
     assert res.outcome == "rebound"
-    assert res.e_n == pytest.approx(0.332349, abs=1e-5)  # rtol 1e-8 and 1e-12 agree on this
+    # the independent 3-D reference solver (10 ms here) gives the expected value, not a pin of the
+    # engine's own output; at the engine's default rtol 1e-8 the two agree to 4e-9 (measured)
+    ref = simulate_reference(MISSED_SEPARATION, 15.553686347910835, rtol=1e-10)
+    assert ref.outcome == "rebound"
+    assert res.e_n == pytest.approx(ref.e_n, abs=1e-7)
 
 
 # Regression (fixed): strongly overdamped captures (C ~ 1e3) crept into the equilibrium with ~C^2
