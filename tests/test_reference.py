@@ -330,7 +330,8 @@ def test_wall_1990_normal_impact_at_1_m_per_s_is_captured():
 
 
 def test_wall_1990_capture_speed_bracket():
-    # Bisection on the outcome gives v_capture = 1.44924 m/s (see the report). Bracket at +-0.5 %.
+    # v_capture = 1.44924 m/s, from an independent scipy integration of Eq. (27) bisected on its
+    # outcome (tests/test_independent_physics.py). The reference solver agrees within +-0.5 %.
     assert simulate_reference(WALL_1990, 1.442, rtol=RTOL).outcome == "capture"
     res = simulate_reference(WALL_1990, 1.457, rtol=RTOL)
     assert res.outcome == "rebound" and 0.0 < res.e_n < 0.2
