@@ -80,6 +80,11 @@ _E1, _E3, _E4, _E5, _E6, _E7 = (
 )
 
 
+def _failure(status) -> str:
+    """What a status code of the compiled core means."""
+    return "step limit reached" if status == _MAX_STEPS else "step size underflow"
+
+
 class EngineError(RuntimeError):
     """The compiled solver could not finish an impact (step limit or step-size underflow)."""
 
@@ -689,8 +694,7 @@ def solve_normal(
                           max_steps, rec, 0, math.inf, math.inf)
         r = r[:9] + (r[3] - r_in[9],) + r[10:]
     if r[0] != _OK:
-        why = "step limit reached" if r[0] == _MAX_STEPS else "step size underflow"
-        raise EngineError(f"engine failed for normal speed {v!r} m/s: {why} after {r[11]} steps")
+        raise EngineError(f"engine failed for normal speed {v!r} m/s: {_failure(r[0])} after {r[11]} steps")
     return normal_solution(contact, sc, y0, *r[1:13], trajectory=rec[:r[13]] if cap else None)
 
 
@@ -785,7 +789,7 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     status = out[:, 0]
     if np.any(status != _OK):
         i = int(np.flatnonzero(status != _OK)[0])
-        raise EngineError(f"engine failed for normal speed {v[i]!r} m/s (status {int(status[i])})")
+        raise EngineError(f"engine failed for normal speed {float(v[i])!r} m/s: {_failure(status[i])}")
     captured = out[:, 1] == CAPTURE
     eu = contact.mass * u * u
     return {
