@@ -10,6 +10,7 @@ rule work_precision:
         markdown="results/benchmark/benchmark.md",
         pdf="results/benchmark/work_precision.pdf",
         png="results/benchmark/work_precision.png",
+    threads: 2  # the batch engine is timed on both cores
     params:
         quick=config["benchmark"]["quick"],
         throughput=config["benchmark"]["throughput"],
@@ -28,6 +29,7 @@ rule stress:
     output:
         summary="results/stress_summary.json",
         netcdf="results/stress.nc",
+    threads: 1
     params:
         cases=config["stress"]["cases"],
         seed=config["stress"]["seed"],

@@ -9,6 +9,7 @@ rule paper_dynamics:
         phase_portraits="results/paper/phase_portraits.nc",
         dynamics="results/paper/dynamics.nc",
         bifurcation="results/paper/bifurcation.nc",
+    threads: 1
     params:
         contact=config["paper_contact"],
         speeds=config["phase_portrait_speeds"],
@@ -26,6 +27,7 @@ rule reproduction:
     output:
         table="results/paper/reproduction.csv",
         markdown="results/paper/reproduction.md",
+    threads: 1
     params:
         contact=config["paper_contact"],
     log:

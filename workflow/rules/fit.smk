@@ -12,6 +12,7 @@ rule fit:
         materials=materials_path(),
     output:
         "results/analyst/fit.nc",
+    threads: 1
     params:
         material_pair=config["material_pair"],
         options=config["fit"],
@@ -35,6 +36,7 @@ rule flags:
     output:
         csv="results/analyst/flags.csv",
         nc="results/analyst/flags.nc",
+    threads: 1
     params:
         rtol=RTOL,
     log:
@@ -54,6 +56,7 @@ rule material_simulations:
         fit_curves="results/analyst/fit_curves.nc",
         dynamics="results/analyst/dynamics.nc",
         sweeps=expand("results/analyst/sweeps/case_{case}.nc", case=SWEEP_CASES),
+    threads: 1
     params:
         cases=SWEEP_CASES,
         overrides=config["sweeps"],

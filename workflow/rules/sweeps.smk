@@ -9,6 +9,7 @@ if SWEEP_CHUNKS == 1:
     rule paper_sweeps:
         output:
             expand("results/paper/sweeps/case_{case}.nc", case=SWEEP_CASES),
+        threads: 1
         params:
             contact=config["paper_contact"],
             cases=SWEEP_CASES,
@@ -28,6 +29,7 @@ else:
     rule paper_sweep_chunk:
         output:
             "results/paper/sweeps/chunks/case_{case}/chunk_{chunk}_of_{nchunks}.nc",
+        threads: 1
         params:
             contact=config["paper_contact"],
             overrides=sweep_overrides,

@@ -7,6 +7,7 @@ rule kharaz:
         config["kharaz_data"],
     output:
         "results/kharaz.nc",
+    threads: 1
     log:
         "logs/kharaz.log",
     benchmark:

@@ -4,6 +4,10 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
+from microimpact.solvers.engine import set_threads  # noqa: E402
+
+set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no more)
+
 from microimpact.analysis.fitting import fit_damping  # noqa: E402
 from microimpact.io import read_impacts, read_materials  # noqa: E402
 

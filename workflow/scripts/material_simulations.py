@@ -6,6 +6,10 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
+from microimpact.solvers.engine import set_threads  # noqa: E402
+
+set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no more)
+
 import xarray as xr  # noqa: E402
 
 from microimpact.io import write_netcdf  # noqa: E402

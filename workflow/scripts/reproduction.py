@@ -4,6 +4,10 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
+from microimpact.solvers.engine import set_threads  # noqa: E402
+
+set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no more)
+
 from microimpact.io import write_csv  # noqa: E402
 from microimpact.presets import named_contact  # noqa: E402
 from microimpact.studies.reproduction import reproduction_table, write_reproduction_markdown  # noqa: E402

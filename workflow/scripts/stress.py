@@ -5,6 +5,10 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
+from microimpact.solvers.engine import set_threads  # noqa: E402
+
+set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no more)
+
 from microimpact.io.files import write_netcdf  # noqa: E402
 from microimpact.studies.stress import stress_sweep, summary_line, write_stress_summary  # noqa: E402
 

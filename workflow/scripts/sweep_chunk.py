@@ -4,6 +4,10 @@ import sys
 
 sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
+from microimpact.solvers.engine import set_threads  # noqa: E402
+
+set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no more)
+
 from microimpact.io.provenance import stamp_parameters  # noqa: E402
 from microimpact.presets import named_contact  # noqa: E402
 from microimpact.studies.sweeps import case_spec, run_sweep, save_sweep, split_spec  # noqa: E402
