@@ -343,3 +343,114 @@ def test_unit_table_refuses_with_the_accepted_list():
         conversion_factor("km/h", "speed")
     assert parse_header_field(" Radius [ um ] ") == ("radius", "um")
     assert parse_header_field("id") == ("id", None)
+
+
+# --------------------------------------------------------------------------- hostile bytes and layout (issue 12, part 6)
+HEAD = "radius [um],normal_speed [m/s],e_n [1]\n"
+
+
+def problems_of(path, **kw):
+    with pytest.raises(ImpactDataError) as info:
+        read_impacts(path, **kw)
+    return info.value, str(info.value)
+
+
+def test_nul_byte_is_refused_naming_row_and_column_not_stripped(tmp_path):
+    p = tmp_path / "nul.csv"
+    p.write_bytes((HEAD + "38.8\x00444,1,0.5\n2,1\x07,0.5\n3,1,0.5\n").encode())
+    err, msg = problems_of(p)
+    assert len(err.problems) == 2, msg  # one each, no second "not a number"
+    assert "row 1 (line 2), column 'radius [um]'" in msg and "U+0000 (NUL)" in msg
+    assert "row 2 (line 3), column 'normal_speed [m/s]'" in msg and "U+0007" in msg
+
+
+@pytest.mark.filterwarnings("ignore::microimpact.io.ImpactDataWarning")
+def test_control_character_in_header_and_label_is_refused(tmp_path):
+    p = tmp_path / "ctl.csv"
+    p.write_bytes(("id,radius\x1b [um],normal_speed [m/s],e_n [1]\na\x0c,1,1,0.5\n").encode())
+    _, msg = problems_of(p)
+    assert "line 1, column 'radius\\x1b [um]'" in msg and "U+001B (ESC)" in msg
+    assert "row 1 (line 2), column 'id'" in msg and "U+000C (FF)" in msg
+
+
+def test_tab_cr_lf_are_not_control_problems(tmp_path):
+    p = tmp_path / "ws.csv"
+    p.write_bytes((HEAD + "1\t,1,0.5\r\n2,1,0.5\r\n").encode())
+    assert list(read_impacts(p)["radius"]) == [1e-6, 2e-6]
+
+
+def test_leading_comments_and_excel_sep_line_are_skipped_and_lines_counted(tmp_path):
+    p = write(tmp_path, "sep=,\n# lab: X, 2024\n\n  # operator: Y\n" + HEAD + "1,1,0.5\n2,x,0.5\n")
+    _, msg = problems_of(p)
+    assert "row 2 (line 7), column 'normal_speed [m/s]'" in msg and msg.count(" - ") == 1, msg
+    p = write(tmp_path, '"sep=,"\n# lab notes\n' + HEAD + "1,1,0.5\n")
+    df = read_impacts(p)
+    assert list(df["line"]) == [4] and df["radius"][0] == 1e-6
+
+
+def test_excel_sep_line_with_other_delimiter_is_refused_saying_what_it_is(tmp_path):
+    p = write(tmp_path, "sep=;\nradius [um];normal_speed [m/s];e_n [1]\n1;1;0,5\n")
+    err, msg = problems_of(p)
+    assert len(err.problems) == 1 and "line 1" in msg and "Excel's delimiter line 'sep=;'" in msg
+
+
+def test_only_comments_is_refused(tmp_path):
+    _, msg = problems_of(write(tmp_path, "# nothing here\n# at all\n"))
+    assert "only comment lines" in msg
+
+
+def test_comment_after_header_is_not_skipped(tmp_path):
+    # an id may start with '#': below the header nothing is dropped silently
+    _, msg = problems_of(write(tmp_path, HEAD + "1,1,0.5\n# note\n"))
+    assert "row 2 (line 3)" in msg
+
+
+def test_unclosed_quote_names_its_row_and_does_not_dump_the_file(tmp_path):
+    rows = "".join(f"{i},1,0.5\n" for i in range(1, 40))
+    p = write(tmp_path, HEAD + "1,1,0.5\n\"2,1,0.5\n" + rows)
+    err, msg = problems_of(p)
+    assert len(err.problems) == 1, msg
+    assert "row 2 (line 3), column 'radius [um]'" in msg and "never closed" in msg and "lines 3-42" in msg
+    assert "39,1,0.5" not in msg  # the rest of the file is not dumped
+
+
+def test_quote_closed_lines_later_names_row_and_keeps_checking_the_rest(tmp_path):
+    p = write(tmp_path, HEAD + "\"1,1,0.5\n2\",1,0.5\n3,1,x\n")
+    _, msg = problems_of(p)
+    assert "row 1 (line 2), column 'radius [um]'" in msg and "on line 3" in msg
+    assert "row 2 (line 4), column 'e_n [1]', value 'x'" in msg
+
+
+def test_unclosed_quote_in_header(tmp_path):
+    err, msg = problems_of(write(tmp_path, "\"" + HEAD + "1,1,0.5\n"))
+    assert len(err.problems) == 1 and "line 1" in msg and "header" in msg
+
+
+def test_overflow_of_a_derived_value_names_row_and_column(tmp_path):
+    p = write(tmp_path, "radius [um],normal_speed [m/s],incidence_angle [deg],e_n [1]\n"
+                        "1,1,10,0.5\n1,1e308,89.99999,0.5\n")
+    err, msg = problems_of(p)
+    assert len(err.problems) == 1, msg
+    assert "row 2 (line 3), column 'normal_speed [m/s]', value '1e308'" in msg and "derived speed" in msg
+
+
+def test_large_uncertainties_do_not_overflow_when_propagated(tmp_path):
+    # squares of 1e300 overflow; the propagation must not (hypot)
+    p = write(tmp_path, "radius [um],normal_speed [m/s],rebound_normal_speed [m/s],rebound_tangential_speed [m/s],"
+                        "rebound_normal_speed_uncertainty [m/s],rebound_tangential_speed_uncertainty [m/s]\n"
+                        "1,1.5e300,1e300,1e300,1e300,1e300\n")
+    df = read_impacts(p)
+    assert np.isfinite(df["rebound_angle_deg_uncertainty"][0])
+    assert df["rebound_angle_deg"][0] == pytest.approx(45.0)
+
+
+def test_radius_too_large_for_the_model_names_row_and_column(tmp_path):
+    pair = "ammonium_fluorescein_on_silicon"
+    p = write(tmp_path, HEAD.strip() + ",material_pair\n1,1,0.5," + pair + "\n1e308,1,0.5," + pair + "\n1e308,1,0.5,\n")
+    err, msg = problems_of(p, materials=default_materials_path())
+    assert len(err.problems) == 1, msg  # the row without a pair is not checked
+    assert "row 2 (line 3), column 'radius [um]', value '1e308'" in msg and "adhesion_line_force" in msg
+    err, msg = problems_of(p, materials=default_materials_path(), material_pair=pair)
+    assert "row 3 (line 4)" in msg and len(err.problems) == 2
+    with pytest.raises(ValueError, match="known pairs"):
+        read_impacts(p, materials=default_materials_path(), material_pair="nope")

@@ -151,3 +151,12 @@ def test_material_contact_is_the_one_builder(pairs):
     assert (trial.zeta_hertz, trial.work_of_adhesion) == pytest.approx((0.1, 0.1), rel=1e-12)
     with pytest.raises(ValueError, match="needs density, stiffness, work_of_adhesion"):
         material_contact(object(), 1e-6)
+
+
+def test_infinite_property_is_refused_naming_the_key(tmp_path):
+    from microimpact.io import MaterialsError
+
+    p = tmp_path / "m.yaml"
+    p.write_text("pairs:\n  a_on_b: {density: .inf, stiffness: 1.0e+9, work_of_adhesion: 0.1}\n")
+    with pytest.raises(MaterialsError, match=r"pairs\.a_on_b\.density: inf is not a finite number"):
+        read_materials(p)

@@ -52,6 +52,69 @@ def materials_path():
     return str(Path(spec.origin).parent / "io" / "materials.yaml")
 
 
+# ---------------------------------------------------------------- start-up checks
+# Every config value that names something outside the config (files, the materials config and its
+# pair, the paper's contact) is checked here, at start-up, before any job runs; a problem stops
+# snakemake with ONE line naming the config key and what is accepted. Reading the materials config
+# and the presets imports microimpact.io.materials and microimpact.presets (no solver, no numba).
+# Job subprocesses parse this file again; they skip the checks (the main process made them).
+
+
+def _config_file_problem(key, what):
+    """None if config[key] is a readable file, else the one-line reason."""
+    path = config[key]
+    p = Path(path)
+    how = f"--config {key}=path/to/file"
+    if not p.exists():
+        return (f"config key '{key}': {what} {path!r} does not exist (paths are relative to "
+                f"{os.getcwd()}); give an existing file, e.g. {how}")
+    if not p.is_file():
+        return f"config key '{key}': {what} {path!r} is not a file (a directory?); give a file, e.g. {how}"
+    if not os.access(p, os.R_OK):
+        return f"config key '{key}': {what} {path!r} cannot be read (permissions); make it readable or give another file"
+    return None
+
+
+def check_config_at_start():
+    """Raise WorkflowError (one line: the config key, the value, what is accepted) for the first
+    config value that cannot work: the data files, the materials config and material_pair, and
+    paper_contact."""
+    for key, what in (("data", "impact CSV (data/README.md, 'Measured-impact CSV format')"),
+                      ("kharaz_data", "Kharaz et al. (2001) CSV")):
+        problem = _config_file_problem(key, what)
+        if problem:
+            raise WorkflowError(problem)
+    path = materials_path()
+    if config["materials"] != "default":
+        problem = _config_file_problem("materials", "materials config (data/README.md, 'Materials config')")
+        if problem:
+            raise WorkflowError(problem)
+    from microimpact.io.materials import MaterialsError, read_materials
+
+    try:
+        pairs = read_materials(path)
+    except MaterialsError as e:
+        raise WorkflowError(f"config key 'materials': {path} is not a valid materials config: "
+                            + "; ".join(e.problems)) from None
+    if config["material_pair"] not in pairs:
+        raise WorkflowError(f"config key 'material_pair': {config['material_pair']!r} is not a pair of the "
+                            f"materials config {path}; accepted: {', '.join(sorted(pairs))}")
+    from microimpact.presets import PRESETS, named_contact
+
+    spec = config["paper_contact"]
+    accepted = f"a preset name ({', '.join(sorted(PRESETS))}) or a mapping of microimpact.Contact fields in SI units"
+    if isinstance(spec, str) and spec.lower() not in PRESETS:
+        raise WorkflowError(f"config key 'paper_contact': {spec!r} is not a preset; accepted: {accepted}")
+    try:
+        named_contact(spec)
+    except (ValueError, TypeError) as e:
+        raise WorkflowError(f"config key 'paper_contact': {e}; accepted: {accepted}") from None
+
+
+if getattr(workflow, "is_main_process", True):
+    check_config_at_start()
+
+
 def sweep_overrides(wildcards):
     """Keys of the config that replace those of a Table 2 case's grid ({} for none)."""
     return dict(config["sweeps"][wildcards.case] or {})

@@ -370,8 +370,16 @@ def _required(columns: Mapping[str, _Column]) -> set[str]:
 
 # --------------------------------------------------------------------------- propagation
 def _unc(*terms):
-    """sqrt(sum of squares) of the terms; NaN if any is NaN (first-order propagation)."""
-    return np.sqrt(sum(np.square(t) for t in terms))
+    """sqrt(sum of squares) of the terms; NaN if any is NaN (first-order propagation).
+
+    Summed with hypot, so that terms near the float limit do not overflow when squared."""
+    terms = [np.asarray(t, dtype=float) for t in terms]
+    out = np.zeros(np.broadcast(*terms).shape)
+    any_nan = np.zeros(out.shape, dtype=bool)
+    for t in terms:
+        out = np.hypot(out, t)
+        any_nan |= np.isnan(t)
+    return np.where(any_nan, np.nan, out)
 
 
 def _derive(v: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
@@ -388,13 +396,13 @@ def _derive(v: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
     elif "normal_speed" in v and "incidence_deg" in v:
         vn, svn = out["normal_speed"], out["normal_speed_uncertainty"]
         out["speed"] = vn / np.cos(a)
-        out["speed_uncertainty"] = _unc(svn / np.cos(a), vn * np.sin(a) / np.cos(a) ** 2 * sa)
+        out["speed_uncertainty"] = _unc(svn / np.cos(a), (vn / np.cos(a)) * np.tan(a) * sa)
     vn, svn = out["normal_speed"], out["normal_speed_uncertainty"]
     # normal rebound
     if "rebound_normal_speed" in v:
         r, sr = out["rebound_normal_speed"], out["rebound_normal_speed_uncertainty"]
         out["e_n"] = r / vn
-        out["e_n_uncertainty"] = _unc(sr / vn, r * svn / vn**2)
+        out["e_n_uncertainty"] = _unc(sr / vn, (r / vn) * (svn / vn))
     else:
         e, se = out["e_n"], out["e_n_uncertainty"]
         out["rebound_normal_speed"] = e * vn
@@ -405,16 +413,77 @@ def _derive(v: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
         t, st = out["rebound_tangential_speed"], out["rebound_tangential_speed_uncertainty"]
         with np.errstate(invalid="ignore", divide="ignore"):
             out["rebound_angle_deg"] = np.degrees(np.arctan2(t, r))
-            out["rebound_angle_deg_uncertainty"] = np.degrees(_unc(r * st, t * sr) / (r**2 + t**2))
+            h = np.hypot(r, t)
+            out["rebound_angle_deg_uncertainty"] = np.degrees(_unc(r / h * st, t / h * sr) / h)
     elif "rebound_angle_deg" in v:
         b, sb = out["rebound_angle_deg"] * rad, out["rebound_angle_deg_uncertainty"] * rad
         out["rebound_tangential_speed"] = r * np.tan(b)
-        out["rebound_tangential_speed_uncertainty"] = _unc(np.tan(b) * sr, r * sb / np.cos(b) ** 2)
+        out["rebound_tangential_speed_uncertainty"] = _unc(np.tan(b) * sr, (r / np.cos(b)) * (sb / np.cos(b)))
     return out
 
 
+#: inputs (canonical names) that each derived column can be computed from
+_INCIDENT = ("normal_speed", "speed", "incidence_deg")
+_DEPENDS: dict[str, tuple[str, ...]] = {
+    "normal_speed": ("speed", "incidence_deg"),
+    "speed": ("normal_speed", "incidence_deg"),
+    "e_n": ("rebound_normal_speed", *_INCIDENT),
+    "rebound_normal_speed": ("e_n", *_INCIDENT),
+    "rebound_angle_deg": ("rebound_tangential_speed", "rebound_normal_speed", "e_n", *_INCIDENT),
+    "rebound_tangential_speed": ("rebound_angle_deg", "rebound_normal_speed", "e_n", *_INCIDENT),
+}
+for _k, _deps in list(_DEPENDS.items()):
+    _DEPENDS[f"{_k}_uncertainty"] = (_k, *_deps, *(f"{d}_uncertainty" for d in (_k, *_deps)))
+
+
+def _check_overflow(cells: _Cells, columns, values: dict, out: dict, problems: list[Problem]) -> None:
+    """A problem for every derived value that overflowed to infinity, naming the row and the
+    input column it came from (the given value of the most extreme magnitude; all inputs are
+    listed in the message). Given values were checked finite already."""
+    by_canonical = {_QUANTITIES[n].canonical: c for n, c in columns.items() if n in _QUANTITIES}
+    for k in CANONICAL_COLUMNS:
+        if k in values or k not in out:
+            continue
+        for i in np.flatnonzero(np.isinf(out[k])):
+            given = [d for d in _DEPENDS.get(k, ()) if d in values and np.isfinite(values[d][i])]
+            if not given:
+                continue
+            col = by_canonical[max(given, key=lambda d: abs(math.log10(abs(values[d][i]) or 1.0)))]
+            fields = ", ".join(repr(by_canonical[d].field) for d in given)
+            problems.append(Problem(
+                f"the derived {k} [{COLUMN_UNITS[k]}] overflows to infinity (computed from {fields} of this "
+                "row); a value is too large or too small to compute with: check it and its unit",
+                int(cells.rows[i]), int(cells.lines[i]), col.field, cells.text[col.name][i]))
+
+
+def _check_contacts(cells: _Cells, columns, out: dict, materials, pairs, problems: list[Problem]) -> None:
+    """A problem for every row whose sphere size gives no valid contact with its material pair
+    (e.g. f0 of Eq. (7) overflowing to infinity for an absurd radius). ``pairs``: the pair of
+    each row (None: unknown, not checked)."""
+    size = columns.get("radius") or columns.get("diameter")
+    if size is None:
+        return
+    radius = out["radius"]
+    verdict: dict = {}
+    for i in range(cells.n):
+        key = (pairs[i], float(radius[i]))
+        if key[0] is None or not hasattr(materials.get(key[0]), "contact") or not np.isfinite(key[1]):
+            continue  # no pair, an unknown one (reported) or a mapping of names only
+        if key not in verdict:
+            try:
+                with np.errstate(all="ignore"):
+                    materials[key[0]].contact(key[1])
+                verdict[key] = None
+            except (ValueError, OverflowError, ArithmeticError) as e:
+                verdict[key] = str(e)
+        if verdict[key] is not None:
+            problems += cells.problems(np.arange(cells.n) == i, size, (
+                f"radius {key[1]:.6g} m gives no usable contact for material pair {key[0]!r}: {verdict[key]} "
+                "(f0 = (9/(2 pi) K r w_A^2)^(1/3), Eq. (7)); check the value and its unit"))
+
+
 # --------------------------------------------------------------------------- main entry
-def read_impacts(path, *, materials=None) -> pd.DataFrame:
+def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     """Read and validate a CSV of measured impacts; return it in canonical columns and units.
 
     Parameters
@@ -425,7 +494,12 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
     materials : mapping of str to MaterialPair, str or os.PathLike, optional
         Materials config (as returned by :func:`microimpact.io.read_materials`, or its path).
         When given, every non-empty ``material_pair`` cell must name one of its pairs. When None,
-        ``material_pair`` labels are not checked.
+        ``material_pair`` labels are not checked. When given, the size of every row whose pair
+        is known (its ``material_pair`` cell, else ``material_pair``) must give a valid contact
+        with that pair (e.g. f0 of Eq. (7) finite).
+    material_pair : str, optional
+        Pair of the rows without a ``material_pair`` cell, for the check above; a key of
+        ``materials``.
 
     Returns
     -------
@@ -435,6 +509,8 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
 
     Raises
     ------
+    ValueError
+        If ``material_pair`` is given without ``materials`` or is not one of its pairs.
     ImpactDataError
         If anything is wrong. The message lists every problem (up to
         :data:`MAX_LISTED_PROBLEMS`; all are in ``.problems``), each with file name, data row, line
@@ -448,6 +524,11 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
         For columns that are not part of the format; they are ignored.
     """
     source = os.fspath(path)
+    if materials is not None and not isinstance(materials, Mapping):
+        materials = read_materials(materials)
+    if material_pair is not None and (materials is None or material_pair not in materials):
+        known = f"known pairs: {', '.join(sorted(materials))}" if materials is not None else "materials= is not given"
+        raise ValueError(f"material_pair {material_pair!r} is not a pair of the materials config; {known}")
     data = Path(source).read_bytes()
     sha256 = hashlib.sha256(data).hexdigest()
     header, header_line, records, problems = _read_records(source, data)
@@ -458,9 +539,10 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
     if ignored:
         _warn_ignored(Path(source).name, ignored)
     if not records:
-        problems.append(Problem(
-            "the file has a header but no data rows; add one row per impact", line=header_line))
-        raise ImpactDataError(source, problems)
+        if not any(p.row is not None for p in problems):
+            problems.append(Problem(
+                "the file has a header but no data rows; add one row per impact", line=header_line))
+        raise ImpactDataError(source, _sorted(problems))
 
     # rows with the wrong number of fields are reported and left out of the value checks
     records, ragged = _drop_ragged(records, len(header))
@@ -471,9 +553,15 @@ def read_impacts(path, *, materials=None) -> pd.DataFrame:
     if any(p.row is None for p in problems):
         raise ImpactDataError(source, _sorted(problems))  # header broken: derived checks are moot
 
-    out = _derive(values, cells.n)
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        out = _derive(values, cells.n)
+    _check_overflow(cells, columns, values, out, problems)
     if "rebound_normal_speed" in values:
         _check_rebound(cells, columns["rebound_normal_speed"], out, problems)
+    if materials is not None:
+        pairs = labels.get("material_pair", np.full(cells.n, None, dtype=object))
+        pairs = np.array([p if p is not None else material_pair for p in pairs], dtype=object)
+        _check_contacts(cells, columns, out, materials, pairs, problems)
     if problems:
         raise ImpactDataError(source, _sorted(problems))
 
@@ -495,19 +583,23 @@ class _Record:
     fields: list
     row: int
     line: int
+    bad: frozenset = frozenset()  # indices of fields already reported (control characters)
 
 
 def _read_records(source: str, data: bytes) -> tuple[list[str], int, list[_Record], list[Problem]]:
     """(header fields, header line, data records, problems so far) of the file's bytes.
 
-    Raises :class:`ImpactDataError` for a blank file, text that is not CSV, or a delimiter other
-    than the comma."""
+    Leading ``# comment`` lines and Excel's ``sep=,`` first line are skipped (they count as lines).
+    Problems found here: control characters (named by row and column), a quote that is not closed
+    (named by the row where it opens; that record is left out). Raises :class:`ImpactDataError` for
+    a blank file, text that is not CSV, or a delimiter other than the comma."""
     if not data.strip(_BOM + b" \t\r\n"):
         what = "empty (0 bytes)" if not data else "blank (only whitespace)"
         raise ImpactDataError(source, [Problem(
             f"the file is {what}; expected a header line such as "
             "'radius [um],speed [m/s],incidence_angle [deg],e_n [1]' followed by one row per impact")])
     text, problems = _decode(data)
+    text, skipped = _skip_preamble(source, text, problems)
     reader = csv.reader(_stdio.StringIO(text, newline=""))
     header: list[str] | None = None
     header_line = 1
@@ -519,13 +611,18 @@ def _read_records(source: str, data: bytes) -> tuple[list[str], int, list[_Recor
             if not "".join(rec).strip():
                 continue  # blank line or a line of empty fields
             if header is None:
-                header, header_line = rec, start
+                header, header_line = rec, start + skipped
                 continue
-            records.append(_Record(rec, len(records) + 1, start))
-    except csv.Error as e:  # e.g. NUL byte
-        problems.append(Problem(f"cannot be parsed as CSV: {e}", line=reader.line_num))
+            records.append(_Record(rec, len(records) + 1, start + skipped))
+    except csv.Error as e:
+        problems.append(Problem(f"cannot be parsed as CSV: {e}", line=reader.line_num + skipped))
         raise ImpactDataError(source, problems) from None
-    assert header is not None  # the file is not blank
+    if header is None:
+        problems.append(Problem(
+            "the file has only comment lines; expected a header line such as "
+            "'radius [um],speed [m/s],incidence_angle [deg],e_n [1]' followed by one row per impact",
+            line=skipped))
+        raise ImpactDataError(source, problems)
     if len(header) == 1:
         for delim, label in ((";", "';' (semicolon)"), ("\t", "tabs")):
             if delim in header[0]:
@@ -533,7 +630,113 @@ def _read_records(source: str, data: bytes) -> tuple[list[str], int, list[_Recor
                     f"the file uses {label} to separate columns; ',' (comma) is required, with '.' "
                     "as the decimal point; re-export it as comma-separated CSV", line=header_line))
                 raise ImpactDataError(source, problems)
+    bad = next((f for f in header if "\n" in f or "\r" in f), None)
+    if bad is not None:
+        first = bad.splitlines()[0] if bad.splitlines() else ""
+        problems.append(Problem(
+            f'a quote (") opens a header field here and is not closed on this line, so the following '
+            "lines were read as part of the header; remove the stray quote or close it",
+            line=header_line, value=first[:60] + ("..." if len(first) > 60 else "")))
+        raise ImpactDataError(source, problems)
+    problems += _control_characters(header, header_line, records)
+    records, quote_problems = _drop_unclosed_quotes(header, header_line, records)
+    problems += quote_problems
     return header, header_line, records, problems
+
+
+def _skip_preamble(source: str, text: str, problems: list[Problem]) -> tuple[str, int]:
+    """(text after the leading comment and ``sep=`` lines, number of lines skipped).
+
+    Skipped: Excel's delimiter hint ``sep=,`` as the first line, and lines whose first non-blank
+    character is ``#`` above the header (blank lines between them too). A ``sep=`` line naming
+    another delimiter is refused (raises)."""
+    lines = text.splitlines(keepends=True)
+    n = 0
+    for i, line in enumerate(lines):
+        s = line.strip()
+        m = re.fullmatch(r'"?sep=(.?)"?,*', s, flags=re.IGNORECASE)
+        if i == 0 and m:
+            if m.group(1) != ",":
+                label = {";": "';' (semicolon)", "\t": "tabs", "": "nothing"}.get(m.group(1), repr(m.group(1)))
+                problems.append(Problem(
+                    f"Excel's delimiter line {s!r} says the columns are separated by {label}; ',' (comma) "
+                    "is required, with '.' as the decimal point; re-export it as comma-separated CSV", line=1))
+                raise ImpactDataError(source, problems)
+            n = i + 1
+            continue
+        if s.startswith("#"):
+            n = i + 1
+            continue
+        if s:
+            break
+    return "".join(lines[n:]), n
+
+
+_CONTROL = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f]")
+_CONTROL_NAMES = {0: "NUL", 7: "BEL", 8: "BS", 11: "VT", 12: "FF", 26: "SUB", 27: "ESC", 127: "DEL"}
+
+
+def _field_name(header: list[str], i: int) -> str:
+    return header[i].strip() if i < len(header) else f"(field {i + 1}, beyond the header)"
+
+
+def _control_characters(header, header_line: int, records: list[_Record]) -> list[Problem]:
+    """A problem for every header field or cell that holds a control character (tab, CR and LF
+    are allowed: they are whitespace or line ends). Such a cell is also marked bad in its record
+    so that it is not reported a second time (e.g. as "not a number")."""
+    problems = []
+
+    def check(fields, row, line):
+        bad = set()
+        for i, f in enumerate(fields):
+            m = _CONTROL.search(f)
+            if m:
+                code = ord(m.group())
+                name = _CONTROL_NAMES.get(code, "control character")
+                count = len(_CONTROL.findall(f))
+                more = f" (and {count - 1} more)" if count > 1 else ""
+                problems.append(Problem(
+                    f"contains the control character U+{code:04X} ({name}) at character {m.start() + 1}{more}; "
+                    "remove it: a text CSV holds none (NUL bytes often mean a UTF-16 or binary file, or a "
+                    "damaged copy), and dropping it silently could change a number",
+                    row, line, _field_name(header, i), f))
+                bad.add(i)
+        return bad
+
+    check(header, None, header_line)
+    for k, rec in enumerate(records):
+        bad = check(rec.fields, rec.row, rec.line)
+        if bad:
+            records[k] = _Record(rec.fields, rec.row, rec.line, frozenset(bad))
+    return problems
+
+
+def _drop_unclosed_quotes(header, header_line: int, records: list[_Record]):
+    """(records without those where a quoted cell runs over a line end, a problem for each).
+
+    A cell of this format never holds a line break, so a quoted cell that does means a quote
+    that is not closed where it should be: the problem names the row, line and column where the
+    quote opens, and how far the cell ran (to the end of the file when the quote never closes)."""
+    problems, kept = [], []
+    for k, rec in enumerate(records):
+        i = next((i for i, f in enumerate(rec.fields) if "\n" in f or "\r" in f), None)
+        if i is None:
+            kept.append(rec)
+            continue
+        cell = rec.fields[i]
+        body = cell.rstrip("\r\n")
+        spans = body.count("\n") + body.count("\r") - body.count("\r\n")
+        last = k == len(records) - 1 and i == len(rec.fields) - 1
+        how = ("is never closed, so the rest of the file (lines "
+               f"{rec.line}-{rec.line + spans}) was read as one cell" if last else
+               f"is closed only {spans} line(s) later, on line {rec.line + spans}, so those lines were "
+               "read as one cell")
+        first = cell.splitlines()[0] if cell.splitlines() else ""
+        problems.append(Problem(
+            f'a quote (") opens a cell here and {how}; remove the stray quote or close it on this line '
+            "(a cell cannot contain a line break)",
+            rec.row, rec.line, _field_name(header, i), first[:60] + ("..." if len(first) > 60 else "")))
+    return kept, problems
 
 
 def _warn_ignored(name: str, ignored: list[str]) -> None:
@@ -567,9 +770,14 @@ class _Cells:
         self.lines = np.asarray([r.line for r in records], dtype=np.int64)
         self.text = {c.name: np.array([r.fields[c.index].strip() for r in records], dtype=object)
                      for c in columns.values()}
+        # cells already reported (control characters): no second problem for them
+        self.reported = {c.name: np.array([c.index in r.bad for r in records], dtype=bool)
+                         for c in columns.values()}
 
     def problems(self, mask, col: _Column, message: str) -> list[Problem]:
-        """A problem of column ``col`` for every record where ``mask`` is true."""
+        """A problem of column ``col`` for every record where ``mask`` is true (cells already
+        reported left out)."""
+        mask = np.asarray(mask, dtype=bool) & ~self.reported[col.name]
         return [Problem(message, int(self.rows[i]), int(self.lines[i]), col.field, self.text[col.name][i])
                 for i in np.flatnonzero(mask)]
 

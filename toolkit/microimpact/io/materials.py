@@ -11,6 +11,7 @@ f0 = (9/(2 pi) K r w_A^2)^(1/3), so :meth:`MaterialPair.contact` takes the radiu
 
 from __future__ import annotations
 
+import math
 import os
 import re
 from dataclasses import dataclass
@@ -294,8 +295,12 @@ def read_materials(path) -> dict[str, MaterialPair]:
         raise MaterialsError(source, [f"{name}: the file is empty; expected a top-level 'pairs:' mapping"])
     validator = jsonschema.Draft202012Validator(MATERIALS_SCHEMA)
     errors = sorted(validator.iter_errors(doc), key=lambda e: [str(p) for p in e.absolute_path])
-    if errors:
-        problems = [msg for err in errors for msg in _format_error(name, err)]
+    problems = [msg for err in errors for msg in _format_error(name, err)]
+    if not errors:  # JSON Schema numbers include .inf; a material property must be finite
+        problems = [f"{name}: pairs.{key}.{k}: {v!r} is not a finite number"
+                    for key, entry in doc["pairs"].items() for k, v in entry.items()
+                    if isinstance(v, float) and not math.isfinite(v)]
+    if problems:
         raise MaterialsError(source, problems)
     pairs: dict[str, MaterialPair] = {}
     for key, entry in doc["pairs"].items():

@@ -1,0 +1,100 @@
+"""The pipeline refuses a config value that cannot work at start-up, before any job runs (issue 12,
+part 5): a dry run (``snakemake -n``) of a copy of the workflow must exit non-zero with a one-line
+reason naming the config key (and the accepted values where there is a list), and create no
+``results/`` directory. The checks live in workflow/rules/common.smk (check_config_at_start).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+
+pytestmark = pytest.mark.skipif(not (REPO / "Snakefile").exists(), reason="the Snakefile is missing")
+
+
+def make_copy(root: Path) -> Path:
+    """Snakefile, workflow/ and the bundled data files in ``root`` (config unchanged)."""
+    root.mkdir(parents=True)
+    shutil.copy(REPO / "Snakefile", root / "Snakefile")
+    shutil.copytree(REPO / "workflow", root / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+    (root / "data").mkdir()
+    for name in ("synthetic_microspheres.csv", "kharaz2001_oblique.csv"):
+        shutil.copy(REPO / "data" / name, root / "data" / name)
+    return root
+
+
+def dry_run(root: Path, *config: str) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONWARNINGS="ignore")
+    args = [sys.executable, "-m", "snakemake", "-n", "--cores", "1"] + (["--config", *config] if config else [])
+    return subprocess.run(args, cwd=root, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                          timeout=300)
+
+
+@pytest.fixture(scope="module")
+def root(tmp_path_factory):
+    return make_copy(tmp_path_factory.mktemp("early") / "wf")
+
+
+def refused(proc, root: Path, *texts: str) -> None:
+    assert proc.returncode != 0, proc.stdout
+    line = next((ln for ln in proc.stdout.splitlines() if ln.startswith("config key ")), None)
+    assert line is not None, proc.stdout  # the reason is one line
+    for t in texts:
+        assert t in line, (t, line)
+    assert not (root / "results").exists()
+    assert "Traceback" not in proc.stdout, proc.stdout
+
+
+def test_the_unchanged_config_passes(root):
+    proc = dry_run(root)
+    assert proc.returncode == 0, proc.stdout
+    assert not (root / "results").exists()
+
+
+def test_unknown_material_pair_is_refused_at_start_listing_the_pairs(root):
+    proc = dry_run(root, "material_pair=unobtainium_on_glass")
+    refused(proc, root, "'material_pair'", "'unobtainium_on_glass'", "accepted:", "ammonium_fluorescein_on_silicon")
+
+
+def test_missing_data_file_is_refused_at_start(root):
+    refused(dry_run(root, "data=data/missing.csv"), root, "'data'", "data/missing.csv", "does not exist")
+
+
+def test_data_that_is_a_directory_is_refused_at_start(root):
+    refused(dry_run(root, "data=data"), root, "'data'", "is not a file")
+
+
+def test_missing_kharaz_file_is_refused_at_start(root):
+    refused(dry_run(root, "kharaz_data=data/no_kharaz.csv"), root, "'kharaz_data'", "data/no_kharaz.csv",
+            "does not exist")
+
+
+def test_unknown_paper_contact_preset_is_refused_listing_the_presets(root):
+    refused(dry_run(root, "paper_contact=wall1991"), root, "'paper_contact'", "'wall1991'", "wall1990",
+            "table1_row2")
+
+
+def test_invalid_paper_contact_fields_are_refused(tmp_path):
+    # passes the schema (numbers > 0) but is no valid Contact: an infinite density
+    import yaml
+
+    other = make_copy(tmp_path / "wf")
+    cfg = other / "workflow" / "config" / "config.yaml"
+    data = yaml.safe_load(cfg.read_text())
+    data["paper_contact"] = {"radius": 3.45e-6, "density": float("inf"), "stiffness": 1.776e9,
+                             "adhesion_line_force": 7.422}
+    cfg.write_text(yaml.safe_dump(data, sort_keys=False))
+    refused(dry_run(other), other, "'paper_contact'", "density")
+
+
+def test_missing_and_broken_materials_config_are_refused(root):
+    refused(dry_run(root, "materials=data/none.yaml"), root, "'materials'", "does not exist")
+    (root / "data" / "bad_materials.yaml").write_text("pairs:\n  x_on_y: {density: -1}\n")
+    refused(dry_run(root, "materials=data/bad_materials.yaml"), root, "'materials'", "x_on_y")
