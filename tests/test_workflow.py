@@ -248,11 +248,11 @@ def test_sweep_and_dynamics_netcdf(pipeline):
     with xr.open_dataset(root / "results" / "paper" / "sweeps" / "case_2.4.nc") as ds:
         assert list(ds["friction"].values) == [0.0, 0.9]
     with xr.open_dataset(root / "results" / "paper" / "dynamics.nc") as ds:
-        assert ds["critical_velocity"].attrs["units"] == "m/s"
+        assert ds["critical_velocity"].attrs["units"] == "m s-1"
         assert float(ds["critical_velocity"]) == pytest.approx(2.246e-5, rel=2e-3)  # Eq. (38), paper 2.25e-5
         assert list(ds["equilibrium_type"].values) == ["sink", "spiral sink"]
     with xr.open_dataset(root / "results" / "paper" / "bifurcation.nc") as ds:
-        assert "case_C1" in ds and ds["case_speed"].attrs["units"] == "m/s"
+        assert "case_C1" in ds and ds["case_speed"].attrs["units"] == "m s-1"
     from microimpact.io.files import read_netcdf_groups
 
     portraits = read_netcdf_groups(root / "results" / "paper" / "phase_portraits.nc")
@@ -428,3 +428,30 @@ def test_bad_data_file_stops_at_validation_with_every_problem(tmp_path):
     for text in ("row 2 (line 3)", "incidence_angle", "row 3 (line 4)", "speed"):
         assert text in proc.stdout, text
     assert not (root / "results" / "analyst" / "fit.nc").exists()
+
+
+# --------------------------------------------------------------------------- interrupt and resume
+@pytest.mark.slow
+def test_an_interrupted_run_resumes_as_the_readme_says(tmp_path):
+    """SIGINT in the middle of a run, then the README's resume command finishes it."""
+    import signal
+    import time
+
+    root = make_copy(tmp_path / "interrupted")
+    env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
+    proc = subprocess.Popen([*SNAKEMAKE, "--cores", "2"], cwd=root, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 120
+    while not (root / "results" / "analyst" / "fit.nc").exists() and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert proc.poll() is None, "the run ended before it could be interrupted"
+    proc.send_signal(signal.SIGINT)
+    out, _ = proc.communicate(timeout=120)
+    assert proc.returncode != 0, out[-3000:]
+    assert not (root / "reports" / "report.pdf").exists()
+    assert not list(root.rglob(".*.tmp"))  # atomic writers leave no partial file behind
+    resumed = snakemake(root, "--cores", "2", "--rerun-incomplete")
+    assert resumed.returncode == 0, resumed.stdout[-5000:]
+    assert (root / "reports" / "report.pdf").stat().st_size > 0
+    again = snakemake(root, "-n", "--cores", "2")
+    assert "Nothing to be done" in again.stdout, again.stdout[-3000:]
