@@ -8,6 +8,8 @@ rule validate_data:
         materials=materials_path(),
     output:
         table="results/impacts_validated.csv",
+    params:
+        material_pair=config["material_pair"],
     log:
         "logs/validate_data.log",
     benchmark:

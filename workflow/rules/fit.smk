@@ -38,6 +38,7 @@ rule flags:
         nc="results/analyst/flags.nc",
     threads: 1
     params:
+        material_pair=config["material_pair"],
         rtol=RTOL,
     log:
         "logs/flags.log",

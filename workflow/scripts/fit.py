@@ -11,7 +11,8 @@ set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no
 from microimpact.analysis.fitting import fit_damping  # noqa: E402
 from microimpact.io import read_impacts, read_materials  # noqa: E402
 
-table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821
+table = read_impacts(snakemake.input.data, materials=snakemake.input.materials,  # noqa: F821
+                     material_pair=snakemake.params.material_pair)  # noqa: F821
 base = read_materials(snakemake.input.materials)[snakemake.params.material_pair]  # noqa: F821
 fit = fit_damping(table, base, rtol=snakemake.params.rtol, **snakemake.params.options)  # noqa: F821
 fit.save(snakemake.output[0])  # noqa: F821

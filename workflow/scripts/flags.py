@@ -17,7 +17,8 @@ from microimpact.io import read_impacts  # noqa: E402
 from microimpact.studies.material import stamp_fitted  # noqa: E402
 
 fit_ds = xr.load_dataset(snakemake.input.fit)  # noqa: F821
-table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821
+table = read_impacts(snakemake.input.data, materials=snakemake.input.materials,  # noqa: F821
+                     material_pair=snakemake.params.material_pair)  # noqa: F821
 ds = flag_measurements(table, DampingFit.from_dataset(fit_ds), rtol=snakemake.params.rtol)  # noqa: F821
 ds = stamp_fitted(ds, fit_ds)
 write_flags(ds, snakemake.output.csv, snakemake.output.nc)  # noqa: F821

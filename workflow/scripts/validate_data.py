@@ -10,6 +10,7 @@ sys.stdout = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 
 from microimpact.io import read_impacts, write_csv  # noqa: E402
 
-table = read_impacts(snakemake.input.data, materials=snakemake.input.materials)  # noqa: F821
+table = read_impacts(snakemake.input.data, materials=snakemake.input.materials,  # noqa: F821
+                     material_pair=snakemake.params.material_pair)  # noqa: F821
 write_csv(table, snakemake.output.table)  # noqa: F821
 print(f"{len(table)} impacts from {snakemake.input.data} (sha256 {table.attrs.get('sha256', '?')})")  # noqa: F821
