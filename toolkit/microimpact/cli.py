@@ -14,11 +14,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 from dataclasses import fields
 from pathlib import Path
 
 from microimpact import __version__
+from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,
+                                  reporting_os_errors, same_file)
 from microimpact.model.contact import Contact
 from microimpact.model.parameters import TABLE2_CASES
 from microimpact.presets import PRESETS, get_preset
@@ -31,7 +34,19 @@ class UsageError(Exception):
     """A user error: reported in one line, exit status 2."""
 
 
+#: a negative number as an option's value: ``--radius -1e-6``, ``--omega-n -.5``, ``--speed -inf``.
+#: argparse's own pattern (``^-\d+$|^-\d*\.\d+$``) misses exponents and inf/nan, so that
+#: ``--radius -1e-6`` was read as an unknown option ("expected one argument"); no option of this
+#: command line starts with a digit, so every such word is a value.
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # the one hook argparse has for this (an attribute of every parser, used by parse_args)
+        self._negative_number_matcher = NEGATIVE_NUMBER
+
     def error(self, message):  # one line, status 2, as argparse does, but without the usage dump
         raise UsageError(message)
 
@@ -43,6 +58,27 @@ def _finite_float(text: str) -> float:
         raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"not a finite number: {text!r}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    value = _finite_float(text)
+    if value <= 0.0:
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
+    return value
+
+
+def _non_negative_float(text: str) -> float:
+    value = _finite_float(text)
+    if value < 0.0:
+        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text!r}")
+    return value
+
+
+def _rtol(text: str) -> float:
+    value = _finite_float(text)
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError(f"rtol must lie in (0, 1), got {text!r}")
     return value
 
 
@@ -87,7 +123,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("simulate", help="simulate one impact")
     add_contact_options(p)
-    p.add_argument("--speed", type=_finite_float, required=True, help="incident speed [m/s]")
+    p.add_argument("--speed", type=_positive_float, required=True, help="incident speed [m/s]")
     p.add_argument("--incidence-deg", type=_finite_float, default=0.0, help="angle from the normal [deg]")
     p.add_argument("--azimuth-deg", type=_finite_float, default=0.0, help="azimuth in the tangent plane [deg]")
     p.add_argument("--omega-n", type=_finite_float, default=0.0, help="initial spin about n [rad/s]")
@@ -104,30 +140,29 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _add_rtol(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--rtol", type=_finite_float, default=DEFAULT_RTOL,
+    p.add_argument("--rtol", type=_rtol, default=DEFAULT_RTOL,
                    help=f"relative tolerance of the normal solves (default {DEFAULT_RTOL:g})")
 
 
 # ------------------------------------------------------------------ fit, flags (microimpact.analysis.fitting, .diagnostics)
-def _existing_file(path: str, what: str):
-    if not Path(path).is_file():
-        raise UsageError(f"{what} {path!r} does not exist or is not a file")
-    return Path(path)
+def _inputs(args) -> dict:
+    """The input files a command reads (option name -> path), each an existing readable file; the
+    bundled materials config counts as an input when no --config is given."""
+    from microimpact.io.materials import default_materials_path
 
-
-def _writable(path: str, what: str):
-    p = Path(path)
-    if not (p.parent if str(p.parent) else Path(".")).is_dir():
-        raise UsageError(f"{what} {path!r}: directory {str(p.parent)!r} does not exist")
-    return p
+    given = {"data file": args.data, "--config": args.config, "--fit": getattr(args, "fit", None)}
+    inputs = {name: check_input_file(name, path) for name, path in given.items() if path is not None}
+    if args.config is None:
+        inputs["the bundled materials config"] = default_materials_path()
+    return inputs
 
 
 def _impacts_for_pair(args):
     """Read the impact CSV (validated against the materials config) and pick the material pair."""
     from microimpact.io import default_materials_path, read_impacts, read_materials
 
-    data = _existing_file(args.data, "data file")
-    config = _existing_file(args.config, "materials config") if args.config else default_materials_path()
+    data = check_input_file("data file", args.data)
+    config = check_input_file("--config", args.config) if args.config else default_materials_path()
     pairs = read_materials(config)
     table = read_impacts(data, materials=pairs)
     labels = sorted({str(x) for x in table["material_pair"].dropna().unique()})
@@ -147,12 +182,13 @@ def _impacts_for_pair(args):
 def _cmd_fit(args) -> int:
     from microimpact.analysis.fitting import fit_damping
 
-    out = _writable(args.out, "--out")
+    out = check_outputs({"--out": args.out}, _inputs(args))["--out"]
     table, pair = _impacts_for_pair(args)
     print(f"fitting {len(table)} impacts of {pair.name} ...", file=sys.stderr, flush=True)
     fit = fit_damping(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
                       confidence_intervals=not args.no_confidence_intervals, rtol=args.rtol)
-    fit.save(out)
+    with reporting_os_errors({"--out": out}):
+        fit.save(out)
     print(fit.report())
     print(f"wrote {out}", file=sys.stderr)
     return 0
@@ -176,13 +212,17 @@ def _cmd_flags(args) -> int:
     from microimpact.analysis.flags import flag_measurements, write_flags
     from microimpact.analysis.fit_result import DampingFit
 
-    out = _writable(args.out, "--out")
-    nc = _writable(args.nc, "--nc") if args.nc else None
-    fit = DampingFit.load(_existing_file(args.fit, "fit file"))
+    outputs = check_outputs({"--out": args.out, "--nc": args.nc}, _inputs(args))
+    out, nc = outputs["--out"], outputs.get("--nc")
+    try:
+        fit = DampingFit.load(args.fit)
+    except ValueError as exc:
+        raise UsageError(f"--fit {args.fit!r}: {exc}") from None
     table, _ = _impacts_for_pair(args)
     ds = flag_measurements(table, fit, spin_bound=args.spin_bound, angle_uncertainty_deg=args.angle_uncertainty_deg,
                            rtol=args.rtol, progress=True)
-    write_flags(ds, out, nc)
+    with reporting_os_errors(outputs):
+        write_flags(ds, out, nc)
     n = ds.sizes["impact"]
     print(f"{n} impacts: {int(ds['rotation_sensitive'].sum())} rotation_sensitive, "
           f"{int(ds['angle_sensitive'].sum())} angle_sensitive, {int(ds['near_capture'].sum())} near_capture; "
@@ -199,9 +239,9 @@ def register_flags(sub) -> None:
     p.add_argument("--material-pair", help="material pair (default: the file's only pair)")
     p.add_argument("--out", required=True, help="output CSV, one row per impact keyed by 'row'")
     p.add_argument("--nc", help="also write the flags as NetCDF")
-    p.add_argument("--spin-bound", type=_finite_float, default=None, metavar="RAD_S",
+    p.add_argument("--spin-bound", type=_non_negative_float, default=None, metavar="RAD_S",
                    help="largest initial spin sampled [rad/s] (default: speed / radius per impact)")
-    p.add_argument("--angle-uncertainty-deg", type=_finite_float, default=None, metavar="DEG",
+    p.add_argument("--angle-uncertainty-deg", type=_non_negative_float, default=None, metavar="DEG",
                    help="incidence-angle uncertainty [deg] (default: the file's column, else 2)")
     _add_rtol(p)
     p.set_defaults(func=_cmd_flags)
@@ -213,9 +253,11 @@ def _cmd_sweep(args) -> int:
 
     if args.case not in TABLE2_CASES:
         raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(TABLE2_CASES)}")
-    out = _writable(args.out, "--out")
-    ds = run_sweep(contact_from_args(args), case=args.case, rtol=args.rtol)
-    write_netcdf(ds, out)
+    contact = contact_from_args(args)
+    out = check_outputs({"--out": args.out})["--out"]
+    ds = run_sweep(contact, case=args.case, rtol=args.rtol)
+    with reporting_os_errors({"--out": out}):
+        write_netcdf(ds, out)
     print(f"case {args.case}: {dict(ds.sizes)} impacts, {int(ds['outcome'].sum())} captured; wrote {out}")
     return 0
 
@@ -233,8 +275,10 @@ def register_sweep(sub) -> None:
 def _cmd_reproduce(args) -> int:
     from microimpact.studies.reproduction import reproduction_table, write_reproduction_markdown
 
-    out = _writable(args.out, "--out")
-    write_reproduction_markdown(reproduction_table(), out)
+    out = check_outputs({"--out": args.out})["--out"]
+    table = reproduction_table()
+    with reporting_os_errors({"--out": out}):
+        write_reproduction_markdown(table, out)
     print(f"wrote {out}")
     return 0
 
@@ -251,8 +295,14 @@ def _cmd_benchmark(args) -> int:
     from microimpact.report.figures import plot_work_precision
     from microimpact.studies.benchmark import run_benchmark, write_benchmark
 
+    out = check_output_dir("--out", args.out)
+    docs = check_output_dir("--docs", args.docs) if args.docs is not None else None
+    if docs is not None and same_file(out, docs):
+        raise PathError("--out and --docs", args.docs, "two outputs on one path (both write benchmark.md); "
+                                                       "give --docs another directory")
     ds = run_benchmark(quick=args.quick, verbose=True, throughput=not args.no_throughput)
-    paths = write_benchmark(ds, args.out, figure=plot_work_precision(ds).figure, docs_dir=args.docs)
+    with reporting_os_errors({"--out": out, "--docs": docs}):
+        paths = write_benchmark(ds, out, figure=plot_work_precision(ds).figure, docs_dir=docs)
     for path in paths.values():
         print(path)
     return 0
@@ -277,6 +327,10 @@ def main(argv=None) -> int:
         return args.func(args)
     except (UsageError, ValueError, RuntimeError) as exc:  # RuntimeError: solver failures
         print(f"microimpact: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # reading or writing a file: name it, no traceback
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"microimpact: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
 
 

@@ -17,11 +17,13 @@ All quantities are SI. Departures from the printed paper:
 from __future__ import annotations
 
 import math
+import numbers
+import sys
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-__all__ = ["Contact", "PAPER_REFERENCE", "check_positive"]
+__all__ = ["Contact", "PAPER_REFERENCE", "check_positive", "check_representable"]
 
 #: full citation of the paper, for the ``references`` attribute of the toolkit's results
 PAPER_REFERENCE = (
@@ -43,6 +45,38 @@ def check_positive(name: str, value) -> float:
     if not math.isfinite(v) or v <= 0.0:
         raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
     return v
+
+
+#: smallest positive normal double: a derived scale below it has lost its precision (or is 0)
+_TINY = sys.float_info.min
+
+
+def check_representable(what: str, value, culprits: str) -> None:
+    """ValueError unless ``value`` (a derived scale, finite and > 0 in exact arithmetic) is a
+    finite normal double; the message names the quantity and the inputs it comes from.
+
+    An input can be valid on its own (``stiffness=1e300``) yet give a scale that underflows to 0 or
+    overflows to inf, which the solvers would divide by (a ZeroDivisionError) or carry as NaN.
+    """
+    v = float(value)
+    if not (math.isfinite(v) and v >= _TINY):
+        raise ValueError(f"{culprits}: the derived {what} is {v!r}, outside the floating-point range "
+                         f"[{_TINY:.3g}, {sys.float_info.max:.3g}]; these values are too extreme together")
+
+
+def _as_number(name: str, value) -> float:
+    """``float(value)`` for a real number (or a text that reads as one, as YAML 1.1 gives for
+    ``1e-6``); TypeError naming ``name`` for anything else (bool, complex, None, a dict, an array)."""
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, str)):
+        if getattr(value, "ndim", None) == 0 and getattr(value, "dtype", None) is not None and value.dtype.kind in "iuf":
+            return float(value)  # a 0-d numpy array
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__} {value!r}")
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            raise TypeError(f"{name} must be a real number, got the text {value!r}") from None
+    return float(value)
 
 
 def _check_non_negative(name: str, value: float) -> None:
@@ -81,9 +115,14 @@ class Contact:
 
     Raises
     ------
+    TypeError
+        If a value is not a real number (a bool, None, a dict, an array, a text that is not a
+        number). The message names the field.
     ValueError
         If a value is not finite, radius, density or stiffness is not positive, or f0, a zeta or
-        the friction coefficient is negative. The message names the field and the value.
+        the friction coefficient is negative; or if the values are so extreme together that a
+        derived scale (mass, X, T, the solvers' impulse and energy units) under- or overflows the
+        floating-point range. The message names the fields and the values.
     """
 
     radius: float
@@ -100,18 +139,39 @@ class Contact:
             value = getattr(self, f.name)
             if f.name == "damping_reference_speed" and value is None:
                 continue
-            if isinstance(value, bool) or not isinstance(value, (int, float)):
-                try:
-                    value = float(value)
-                except (TypeError, ValueError):
-                    raise ValueError(f"{f.name} must be a number, got {value!r}") from None
-            object.__setattr__(self, f.name, float(value))
+            object.__setattr__(self, f.name, _as_number(f.name, value))
         for name in ("radius", "density", "stiffness"):
             check_positive(name, getattr(self, name))
         for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction"):
             _check_non_negative(name, getattr(self, name))
         if self.damping_reference_speed is not None:
             check_positive("damping_reference_speed", self.damping_reference_speed)
+        self._check_scales()
+
+    def _check_scales(self) -> None:
+        """The derived scales the solvers divide by are finite normal doubles (check_representable)."""
+        r, rho, k, f0 = self.radius, self.density, self.stiffness, self.adhesion_line_force
+        size = f"radius={r!r}, density={rho!r}"
+        with np.errstate(all="ignore"):
+            try:
+                check_representable("mass (4/3) pi r^3 rho [kg]", self.mass, size)
+                check_representable("moment of inertia (2/5) m r^2 [kg m^2]", self.moment_of_inertia, size)
+                check_representable("damping speed scale (r^3 K / m)^(2/5)", self.damping_speed_scale,
+                                    f"radius={r!r}, density={rho!r}, stiffness={k!r}")
+                if f0 > 0.0:
+                    every = f"radius={r!r}, density={rho!r}, stiffness={k!r}, adhesion_line_force={f0!r}"
+                    x, t = self.length_scale, self.time_scale
+                    check_representable("length scale X = 2 pi f0 / K [m]", x, f"stiffness={k!r}, adhesion_line_force={f0!r}")
+                    check_representable("time scale T [s]", t, every)
+                    u = x / t
+                    check_representable("speed scale X / T [m/s]", u, every)
+                    check_representable("impulse unit m X / T [N s]", self.mass * u, every)
+                    check_representable("energy unit m (X / T)^2 [J]", self.mass * u * u, every)
+                    check_representable("twist impulse unit m X / T sqrt(r X) [N m s]",
+                                        self.mass * u * math.sqrt(r * x), every)
+            except OverflowError:
+                raise ValueError(f"radius={r!r}, density={rho!r}, stiffness={k!r}, adhesion_line_force={f0!r}: "
+                                 "a derived scale overflows the floating-point range") from None
 
     # ----------------------------------------------------------------- constructors
     @classmethod

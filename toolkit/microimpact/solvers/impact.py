@@ -11,6 +11,9 @@ normal speed serves every angle, spin and friction coefficient that shares it.
 from __future__ import annotations
 
 import math
+import numbers
+import sys
+from collections.abc import Mapping
 
 import numpy as np
 import xarray as xr
@@ -19,7 +22,8 @@ from microimpact.io.provenance import contact_attributes
 from microimpact.io.variables import attributes
 from microimpact.solvers import DEFAULT_RTOL, METHODS, engine
 from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
-from microimpact.model.law import contact_potential_energy
+from microimpact.model.contact import Contact
+from microimpact.model.law import contact_potential_energy, nondimensional_scales
 from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
 from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
 
@@ -31,6 +35,57 @@ RESULT_VARIABLES: tuple[str, ...] = (
     "velocity_out_tp", "omega_out_n", "omega_out_t", "omega_out_tp", "contact_time",
     "max_penetration", "slip_ended", "friction_impulse", "dissipated_energy",
 )
+
+
+def _real_array(name: str, value) -> np.ndarray:
+    """``value`` as a float array; TypeError naming ``name`` if it is not real numbers (text, a
+    dict, None, bools, complex), ValueError if it is a ragged sequence."""
+    if isinstance(value, xr.DataArray):
+        value = value.values
+    if value is None or isinstance(value, (str, bytes, bool, dict, set)):
+        raise TypeError(f"{name} must be a real number or an array of them, got {type(value).__name__} {value!r}")
+    try:
+        a = np.asarray(value)
+    except (ValueError, TypeError) as exc:
+        raise ValueError(f"{name} must be a rectangular array of real numbers ({exc})") from None
+    if a.dtype.kind == "O":
+        try:
+            a = a.astype(float)
+        except (ValueError, TypeError):
+            raise TypeError(f"{name} must be real numbers, got {value!r}") from None
+    if a.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must be real numbers, got an array of dtype {a.dtype} ({value!r})")
+    return a.astype(float, copy=False)
+
+
+def _real_scalar(name: str, value) -> float:
+    """``float(value)`` for one real number; an array gets a TypeError that points to simulate_many."""
+    a = _real_array(name, value)
+    if a.ndim != 0:
+        raise TypeError(f"{name} must be one number in simulate_impact, got an array of shape {a.shape}; "
+                        "for a batch of impacts use simulate_many")
+    return float(a)
+
+
+def _check_call(contact, rtol) -> float:
+    """The contact's type and rtol (finite, 0 < rtol < 1): TypeError / ValueError naming them."""
+    if not isinstance(contact, Contact):
+        hint = "; for a mapping of fields use Contact(**contact)" if isinstance(contact, Mapping) else ""
+        raise TypeError(f"contact must be a microimpact Contact, got {type(contact).__name__}{hint}")
+    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real):
+        raise TypeError(f"rtol must be a real number, got {type(rtol).__name__} {rtol!r}")
+    if not (math.isfinite(rtol) and 0.0 < rtol < 1.0):
+        raise ValueError(f"rtol must be finite and lie in (0, 1), got {rtol!r}")
+    return float(rtol)
+
+
+def _check_omega(omega) -> tuple:
+    if isinstance(omega, (str, bytes, Mapping)) or not hasattr(omega, "__len__"):
+        raise TypeError(f"omega must be a sequence of 3 components (omega_n, omega_t, omega_tp), "
+                        f"got {type(omega).__name__} {omega!r}")
+    if len(omega) != 3:
+        raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_tp), got {omega!r}")
+    return tuple(omega)
 
 
 def _check_inputs(speed, incidence_deg, azimuth_deg, omega):
@@ -49,6 +104,48 @@ def _check_inputs(speed, incidence_deg, azimuth_deg, omega):
     for name, w in zip(("omega_n", "omega_t", "omega_tp"), omega):
         if not np.all(np.isfinite(np.asarray(w, dtype=float))):
             raise ValueError(f"{name} must be finite, got {w!r}")
+
+
+_TINY = sys.float_info.min
+
+
+def _check_scales(contact, speed, incidence_deg, omega) -> None:
+    """The speed-dependent quantities the solvers and Eqs. (21)-(25) divide by are finite normal
+    doubles: v^2 and m v^2, the normal speed, the Hertz scales of an impact without adhesion, and
+    the incident energy with the spin. ValueError naming the argument (speed, omega_*) otherwise:
+    ``speed=1e-300`` would give v^2 = 0 and a ZeroDivisionError in K_L."""
+    with np.errstate(all="ignore"):
+        v = np.asarray(speed, dtype=float)
+        v_n = v * np.cos(np.radians(np.asarray(incidence_deg, dtype=float)))
+        m, inertia = contact.mass, contact.moment_of_inertia
+
+        def bad(x):
+            x = np.asarray(x, dtype=float)
+            return ~(np.isfinite(x) & (np.abs(x) >= _TINY))
+
+        for what, q in (("v^2 [m^2/s^2]", v * v), ("the kinetic energy m v^2 / 2 [J]", 0.5 * m * v * v),
+                        ("the normal speed v cos(incidence) [m/s]", v_n)):
+            q, vv = np.broadcast_arrays(np.asarray(q, dtype=float), v)
+            b = bad(q)
+            if np.any(b):
+                i = np.flatnonzero(b.ravel())[0]
+                raise ValueError(f"speed={float(vv.ravel()[i])!r} m/s: {what} is {float(q.ravel()[i])!r}, "
+                                 "outside the floating-point range; give a speed whose square and kinetic "
+                                 "energy are finite normal numbers")
+        energy = 0.5 * m * v * v + 0.5 * inertia * sum(np.square(np.asarray(w, dtype=float)) for w in omega)
+        if not np.all(np.isfinite(energy)):
+            raise ValueError("omega_n, omega_t, omega_tp: the incident kinetic energy with this spin overflows "
+                             "the floating-point range; give a smaller spin")
+        if contact.adhesion_line_force == 0.0:  # Hertz scales depend on the speed
+            sc = nondimensional_scales(contact, v_n)
+            u = sc.length / sc.time
+            for what, q in (("Hertz length scale [m]", sc.length), ("Hertz time scale [s]", sc.time),
+                            ("impulse unit [N s]", m * u), ("energy unit [J]", m * u * u),
+                            ("twist impulse unit [N m s]", m * u * np.sqrt(contact.radius * sc.length))):
+                if np.any(bad(q)):
+                    raise ValueError(f"speed: the derived {what} of an impact without adhesion is outside "
+                                     f"the floating-point range for this speed and contact "
+                                     f"(radius={contact.radius!r}, stiffness={contact.stiffness!r})")
 
 
 def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0, 0.0, 0.0), *,
@@ -83,19 +180,30 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
 
     Raises
     ------
+    TypeError
+        For a ``contact`` that is not a :class:`Contact`, or an input that is not a real number
+        (an array ``speed``: use :func:`simulate_many`). The message names the argument.
     ValueError
-        For bad inputs or an unknown method; for ``steps`` with a method other than "rkg"; and for
+        For bad values (not finite, out of range, rtol outside (0, 1), a speed whose v^2 or kinetic
+        energy leaves the floating-point range) or an unknown method; for ``steps`` with a method other than "rkg"; and for
         "rkg" when the sphere is captured while the tangential outcome is needed (friction with
         slip or twist): the RKG stops at the capture test and does not follow the captured
         oscillation whose friction impulse the map needs (use "engine" or "reference").
     """
-    if len(omega) != 3:
-        raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_tp), got {omega!r}")
+    rtol = _check_call(contact, rtol)
+    omega = _check_omega(omega)
+    speed = _real_scalar("speed", speed)
+    incidence_deg = _real_scalar("incidence_deg", incidence_deg)
+    azimuth_deg = _real_scalar("azimuth_deg", azimuth_deg)
+    omega = tuple(_real_scalar(name, w) for name, w in zip(("omega_n", "omega_t", "omega_tp"), omega))
     _check_inputs(speed, incidence_deg, azimuth_deg, omega)
-    if method not in METHODS:
+    _check_scales(contact, speed, incidence_deg, omega)
+    if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}")
     if steps is not None and method != "rkg":
         raise ValueError(f"steps applies to method='rkg' only, got method={method!r}")
+    if steps is not None and (isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps < 1):
+        raise ValueError(f"steps must be a whole number >= 1, got {steps!r}")
     if method == "reference":
         # imported here: scipy.integrate costs ~0.7 s of import time that the engine never needs
         from microimpact.solvers.reference import simulate_reference
@@ -214,8 +322,8 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     if method != "engine":
         raise ValueError(f"simulate_many runs method='engine' only, got {method!r}; for 'reference' or 'rkg' "
                          "call simulate_impact in a loop")
-    if len(omega) != 3:
-        raise ValueError(f"omega must have 3 components (omega_n, omega_t, omega_tp), got {omega!r}")
+    rtol = _check_call(contact, rtol)
+    omega = _check_omega(omega)
     inputs = {
         "speed": speed,
         "incidence_deg": incidence_deg,
@@ -226,6 +334,7 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         "friction": contact.friction if friction is None else friction,
     }
     arrays, flat = _broadcast_inputs(inputs)
+    _check_scales(contact, flat["speed"], flat["incidence_deg"], (flat["omega_n"], flat["omega_t"], flat["omega_tp"]))
     results, n_solves = _solve_batch(contact, flat, rtol)
     ds = _batch_dataset(arrays, results)
     ds.attrs.update(contact_attributes(contact))
@@ -237,10 +346,17 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
 def _broadcast_inputs(inputs: dict):
     """Broadcast the inputs (plain arrays by numpy rules, then DataArrays by dimension name) and
     check them; returns the broadcast DataArrays and their flattened values."""
-    plain = {k: np.asarray(v, dtype=float) for k, v in inputs.items() if not isinstance(v, xr.DataArray)}
-    if plain:
-        plain = dict(zip(plain, np.broadcast_arrays(*plain.values())))
-    arrays = xr.broadcast(*(_as_dataarray(k, plain.get(k, v)) for k, v in inputs.items()))
+    plain = {k: _real_array(k, v) for k, v in inputs.items() if not isinstance(v, xr.DataArray)}
+    for k, v in inputs.items():
+        if isinstance(v, xr.DataArray):
+            _real_array(k, v)
+    try:
+        if plain:
+            plain = dict(zip(plain, np.broadcast_arrays(*plain.values())))
+        arrays = xr.broadcast(*(_as_dataarray(k, plain.get(k, v)) for k, v in inputs.items()))
+    except ValueError as exc:
+        shapes = ", ".join(f"{k} {np.shape(v)}" for k, v in inputs.items() if np.ndim(v))
+        raise ValueError(f"the inputs do not broadcast together ({shapes}): {exc}") from None
     dims = arrays[0].dims
     arrays = [a.transpose(*dims) for a in arrays]
     flat = {a.name: np.ascontiguousarray(a.values, dtype=float).ravel() for a in arrays}
