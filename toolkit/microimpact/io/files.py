@@ -21,7 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["atomic_path", "atomic_write", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION"]
+__all__ = ["atomic_path", "atomic_write", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
+           "CONVENTIONS", "read_netcdf_groups"]
 
 #: encoding added to every numeric, non-scalar NetCDF variable
 NETCDF_COMPRESSION = {"zlib": True, "complevel": 4}
@@ -127,40 +128,133 @@ def atomic_write(path, mode: str = "w", *, encoding: str | None = "utf-8", newli
             os.fsync(f.fileno())
 
 
-def _netcdf_encoding(ds) -> dict[str, dict]:
-    """Per-variable encoding: the variable's own (valid) encoding plus zlib for numeric arrays."""
+#: the CF version every NetCDF file of the toolkit follows (global attribute ``Conventions``)
+CONVENTIONS = "CF-1.10"
+
+
+def _history_line(path: Path) -> str:
+    from datetime import datetime, timezone
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        release = version("microimpact")
+    except PackageNotFoundError:  # pragma: no cover - running from a bare source tree
+        release = "0+unknown"
+    now = datetime.now(timezone.utc).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+    return f"{now} microimpact {release} microimpact.io.files.write_netcdf: {path.name}"
+
+
+def _conventions(existing) -> str:
+    """``Conventions`` naming :data:`CONVENTIONS`; other conventions listed in ``existing`` are kept."""
+    others = [c for c in str(existing or "").replace(",", " ").split() if not c.startswith("CF-")]
+    return " ".join([CONVENTIONS, *others])
+
+
+def _int32(value, what: str):
+    """``value`` (an int64 array or scalar) as int32; a value int32 cannot hold is an error, not wrapped."""
+    a = np.asarray(value)
+    info = np.iinfo(np.int32)
+    if a.size and (a.min() < info.min or a.max() > info.max):
+        raise ValueError(f"{what}: values outside the int32 range cannot be written as CF integers")
+    return a.astype(np.int32) if a.ndim else np.int32(a)
+
+
+def _cf_attrs(attrs: Mapping, what: str) -> dict:
+    """Attributes with units in the one UDUNITS style and int64 numbers as int32."""
+    from microimpact.io.variables import udunits
+
+    out = {}
+    for key, value in attrs.items():
+        if key == "units" or key.endswith("_units"):
+            value = udunits(value) if isinstance(value, str) else value
+        elif isinstance(value, (bool, np.bool_)):
+            value = np.int8(value)
+        elif isinstance(value, (int, np.integer)) or (isinstance(value, np.ndarray) and value.dtype.kind in "iu"
+                                                       and value.dtype.itemsize > 4):
+            value = _int32(value, f"{what} attribute {key}")
+        out[key] = value
+    return out
+
+
+def _cf_dataset(ds, *, root: bool, path: Path):
+    """A copy of ``ds`` in the CF-1.10 form of the toolkit's files, and its per-variable encoding.
+
+    - every variable has ``long_name`` (and ``units`` for a numeric quantity) from
+      :data:`microimpact.io.variables.VARIABLES` where it has none of its own, units in one UDUNITS
+      spelling (:func:`microimpact.io.variables.udunits`);
+    - coordinate variables carry no ``_FillValue`` (CF 2.5.1: they must not have missing values);
+    - 64-bit integers are written as int32 (values outside its range are an error), booleans as int8;
+    - text is written as NetCDF strings (``NC_STRING``), not as character arrays;
+    - numeric arrays are zlib-compressed; the rest of each variable's own encoding is kept;
+    - the root group has ``Conventions`` = :data:`CONVENTIONS` and a ``history`` line for this write
+      (appended to the history the Dataset already has).
+    The values are not changed.
+    """
+    from microimpact.io.variables import VARIABLES
+
     keep = {"dtype", "_FillValue", "scale_factor", "add_offset", "units", "calendar",
             "zlib", "complevel", "shuffle", "chunksizes", "fletcher32", "contiguous"}
+    out = ds.copy(deep=False)
     encoding = {}
-    for name, var in ds.variables.items():
+    for name, var in out.variables.items():
+        attrs = dict(var.attrs)
+        if name in VARIABLES:
+            units, long_name = VARIABLES[name]
+            attrs.setdefault("long_name", long_name)
+            if units is not None and var.dtype.kind in "biuf":
+                attrs.setdefault("units", units)
+        var.attrs = _cf_attrs(attrs, f"{path.name}: variable {name}")
         enc = {k: v for k, v in var.encoding.items() if k in keep}
-        if var.ndim > 0 and np.dtype(var.dtype).kind in "biuf":
+        kind = np.dtype(var.dtype).kind
+        if kind in "iu" and np.dtype(var.dtype).itemsize > 4 or enc.get("dtype") in ("int64", "uint64", np.int64):
+            _int32(var.values, f"{path.name}: variable {name}")
+            enc["dtype"] = "int32"
+        elif kind == "b":
+            enc["dtype"] = "int8"
+        elif kind in "OUS":
+            enc["dtype"] = str
+            enc.pop("_FillValue", None)
+        if name in out.dims:
+            enc["_FillValue"] = None
+        if var.ndim > 0 and kind in "biuf":
             enc.pop("contiguous", None)
             enc |= NETCDF_COMPRESSION
         encoding[name] = enc
-    return encoding
+    attrs = _cf_attrs(out.attrs, f"{path.name}: global")
+    if root:
+        attrs["Conventions"] = _conventions(attrs.get("Conventions"))
+        previous = str(attrs.get("history", "")).rstrip("\n")
+        attrs["history"] = (previous + "\n" if previous else "") + _history_line(path)
+    out.attrs = attrs
+    return out, encoding
 
 
 def write_netcdf(ds, path) -> Path:
-    """Write an xarray Dataset ``ds`` to NetCDF-4 file ``path`` atomically; return ``path``.
+    """Write an xarray Dataset ``ds`` to a CF-1.10 NetCDF-4 file ``path`` atomically; return ``path``.
 
-    Numeric variables are zlib-compressed; each variable's own encoding (dtype, fill value, units
-    of times) is kept. The same as ``write_netcdf_groups({None: ds}, path)``.
+    The file follows CF-1.10 (see :func:`write_netcdf_groups` for what the writer adds); the values
+    are written as they are. The same as ``write_netcdf_groups({None: ds}, path)``.
     """
     return write_netcdf_groups({None: ds}, path)
 
 
 def write_netcdf_groups(groups: Mapping, path) -> Path:
-    """Write several xarray Datasets to one NetCDF-4 file atomically, one group each.
+    """Write several xarray Datasets to one CF-1.10 NetCDF-4 file atomically, one group each.
 
-    Numeric variables are zlib-compressed and each variable's own encoding is kept, as in
-    :func:`write_netcdf`.
+    Every file the toolkit writes goes through here, so the CF form is made in one place:
+    ``Conventions`` = ``CF-1.10`` and a ``history`` line for this write on the root group (appended
+    to the Dataset's own ``history``); ``long_name`` and ``units`` from
+    :data:`microimpact.io.variables.VARIABLES` where a variable has none; units in one UDUNITS
+    spelling; no ``_FillValue`` on coordinate variables; int32 instead of int64, int8 for booleans;
+    text as NetCDF strings. Numeric variables are zlib-compressed and each variable's own encoding
+    (dtype, fill value, units of times) is kept. The Datasets passed in are not modified.
 
     Parameters
     ----------
     groups : mapping of str or None to xarray.Dataset
-        Group name -> contents, written in this order; the key ``None`` (or ``"/"``) is the root
-        group, written first wherever it stands in the mapping.
+        Group name (a path such as ``"a/b"`` makes nested groups) -> contents, written in this
+        order; the key ``None`` (or ``"/"``) is the root group, written first wherever it stands
+        in the mapping. Without a root entry the root group gets only the global attributes.
     path : str or os.PathLike
         Output file; replaced atomically.
 
@@ -168,15 +262,25 @@ def write_netcdf_groups(groups: Mapping, path) -> Path:
     -------
     pathlib.Path
         ``path``.
+
+    Raises
+    ------
+    ValueError
+        If no group is given, or an integer variable holds values outside the int32 range.
     """
+    import xarray as xr
+
     items = sorted(groups.items(), key=lambda item: item[0] not in (None, "/"))  # stable: root first
     if not items:
         raise ValueError(f"nothing to write to {path}: no groups given")
+    if items[0][0] not in (None, "/"):
+        items.insert(0, (None, xr.Dataset()))
     path = Path(path)
+    prepared = [(name, *_cf_dataset(ds, root=i == 0, path=path)) for i, (name, ds) in enumerate(items)]
     with atomic_path(path) as tmp:
-        for i, (name, ds) in enumerate(items):
+        for i, (name, ds, encoding) in enumerate(prepared):
             ds.to_netcdf(tmp, mode="w" if i == 0 else "a", group=None if name in (None, "/") else str(name),
-                         engine="netcdf4", format="NETCDF4", encoding=_netcdf_encoding(ds))
+                         engine="netcdf4", format="NETCDF4", encoding=encoding)
     return path
 
 
@@ -206,8 +310,9 @@ def write_csv(df, path, **to_csv_kwargs) -> Path:
 def read_netcdf_groups(path) -> list:
     """Read every group of a NetCDF-4 file written by :func:`write_netcdf_groups`, in file order.
 
-    The root group is left out when it holds no variables (it then only carries attributes, as in
-    a file of phase portraits); each group is loaded into memory and the file is closed.
+    Groups that hold no variables (the root of a file of phase portraits, which only carries
+    attributes, or a group that only holds other groups) are left out; nested groups are read
+    depth first. Each group is loaded into memory and the file is closed.
 
     Parameters
     ----------
@@ -217,15 +322,19 @@ def read_netcdf_groups(path) -> list:
     Returns
     -------
     list of xarray.Dataset
-        One Dataset per group (the root first if it has variables), with its own coordinates and
-        attributes.
+        One Dataset per group with variables (the root first if it has any), with its own
+        coordinates and attributes.
     """
     # imported here: io.files serves every writer, also the CSV-only ones, which need neither
     import netCDF4
     import xarray as xr
 
+    def walk(group, prefix):
+        here = [prefix or None] if group.variables else []
+        return here + [p for name, child in group.groups.items() for p in walk(child, f"{prefix}/{name}")]
+
     with netCDF4.Dataset(path, "r") as nc:
-        names = ([None] if nc.variables else []) + list(nc.groups)
+        names = walk(nc, "")
     out = []
     for name in names:
         with xr.open_dataset(path, group=name, engine="netcdf4", decode_timedelta=False) as ds:

@@ -2,7 +2,9 @@
 
 Every NetCDF variable and every Dataset variable the toolkit writes takes its ``units`` and
 ``long_name`` from :data:`VARIABLES`, so a name means the same quantity, in the same unit, in every
-file. Units are UDUNITS spellings as CF-1.8 asks (``m s-1``, not ``m/s``); ``1`` is dimensionless.
+file. Units are UDUNITS spellings in one style, as CF-1.10 asks (``m s-1``, not ``m/s``; ``rad s-1``,
+``J m-2``, ``degree``); ``1`` is dimensionless. :func:`udunits` turns the other spellings the toolkit
+has used into this style; :func:`microimpact.io.files.write_netcdf` applies it to every ``units``.
 
 Example
 -------
@@ -13,10 +15,10 @@ Example
 
 from __future__ import annotations
 
-__all__ = ["VARIABLES", "attributes", "variable"]
+__all__ = ["VARIABLES", "UNIT_SPELLINGS", "attributes", "variable", "udunits"]
 
-#: name: (units, long_name)
-VARIABLES: dict[str, tuple[str, str]] = {
+#: name: (units, long_name); units None for text (no ``units`` attribute)
+VARIABLES: dict[str, tuple[str | None, str]] = {
     # ------------------------------------------------------------- impact inputs
     "speed": ("m s-1", "incident speed v"),
     "normal_speed": ("m s-1", "incident normal speed v_n"),
@@ -86,7 +88,26 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "mean_steps": ("1", "mean accepted steps per impact (engine, RKG)"),
     "outcome_mismatches": ("1", "oblique cases whose outcome differs from the reference"),
     "e_n_reference": ("1", "reference e_n (DOP853, tightest rtol)"),
+    "case": ("1", "index of the case"),
+    "outcome_label": (None, "impact outcome: rebound or capture"),
+    "failures": (None, "checks the case failed, as 'kind: detail' separated by '; ' (empty: none)"),
+    "notes": (None, "findings that do not fail the case, as 'kind: detail' separated by '; ' (empty: none)"),
+    "method": (None, "integration method"),
+    "timing_mode": (None, "how the method was timed"),
 }
+
+
+#: other spellings of a unit -> the one UDUNITS style of :data:`VARIABLES`
+UNIT_SPELLINGS: dict[str, str] = {
+    "m/s": "m s-1", "m/s^2": "m s-2", "rad/s": "rad s-1", "1/s": "s-1", "N/m": "N m-1",
+    "J/m^2": "J m-2", "J/m2": "J m-2", "kg/m^3": "kg m-3", "kg/m3": "kg m-3", "N*s": "N s", "N.s": "N s",
+    "deg": "degree", "degrees": "degree", "-": "1",
+}
+
+
+def udunits(units: str) -> str:
+    """``units`` in the toolkit's one UDUNITS style (``"m/s"`` -> ``"m s-1"``); others unchanged."""
+    return UNIT_SPELLINGS.get(str(units).strip(), str(units).strip())
 
 
 def attributes(name: str, **extra) -> dict:
@@ -98,7 +119,7 @@ def attributes(name: str, **extra) -> dict:
         If ``name`` is not in the table (add it there, once).
     """
     units, long_name = VARIABLES[name]
-    return {"units": units, "long_name": long_name, **extra}
+    return {**({} if units is None else {"units": units}), "long_name": long_name, **extra}
 
 
 def variable(name: str, dims, values, **extra) -> tuple:

@@ -460,14 +460,15 @@ def stress_sweep(n_cases: int = 1000, seed: int = 0, *, reference_every: int = 2
 
 def _dataset(cases, rows) -> xr.Dataset:
     n = len(cases)
-    ds = xr.Dataset(coords={"case": np.arange(n)})
+    ds = xr.Dataset(coords={"case": ("case", np.arange(n), attributes("case"))})
     for name in [k for k in (cases[0] if cases else {}) if k != "case"]:
         ds[name] = ("case", np.array([c[name] for c in cases], dtype=float), attributes(name))
     for name in _MEASURES:
         ds[name] = ("case", np.array([r[name] for r in rows], dtype=float), attributes(name))
-    ds["outcome"] = ("case", np.array([r["outcome"] for r in rows], dtype=str))
+    ds["outcome"] = ("case", np.array([r["outcome"] for r in rows], dtype=str), attributes("outcome_label"))
     for key in ("failures", "notes"):
-        ds[key] = ("case", np.array(["; ".join(f"{k}: {d}" for k, d in r[key]) for r in rows], dtype=str))
+        ds[key] = ("case", np.array(["; ".join(f"{k}: {d}" for k, d in r[key]) for r in rows], dtype=str),
+                   attributes(key))
     ds.attrs["title"] = "microimpact stress sweep"
     return ds
 

@@ -244,10 +244,11 @@ def _dataset(table: _Table, cfg: BenchmarkConfig, speeds, batch_size: int, attrs
     dims = ("method", "setting")
     data = {k: (dims, table.values[k], attributes(k)) for k in _TABLE_VARIABLES}
     data["status"] = (dims, table.status.astype(str), {"long_name": "ok, or why a setting has no result"})
-    data["timing_mode"] = (("method",), np.array(_timing_modes(cfg, batch_size, attrs["numba_threads"])))
+    data["timing_mode"] = (("method",), np.array(_timing_modes(cfg, batch_size, attrs["numba_threads"])),
+                           attributes("timing_mode"))
     data["e_n_reference"] = (("normal_speed",), table.reference.e_n, attributes("e_n_reference"))
     ds = xr.Dataset(data, coords={
-        "method": ("method", np.array(ALL_METHODS)),
+        "method": ("method", np.array(ALL_METHODS), attributes("method")),
         "setting": ("setting", np.arange(table.n_settings), {
             "long_name": "solver setting level k",
             "description": "adaptive methods: rtol = 10^-(4+k); rkg: N = 25 * 2^k steps per contact",
