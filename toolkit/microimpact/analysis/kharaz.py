@@ -36,6 +36,7 @@ comparison uses |omega| (the model's omega_t' is reported too, negative).
 from __future__ import annotations
 
 import math
+from importlib.resources import files
 from pathlib import Path
 
 import lmfit
@@ -66,8 +67,13 @@ _QUANTITIES = {q: VARIABLES[q] for q in ("tangential_restitution", "rebound_spin
 
 
 def default_kharaz_path() -> Path:
-    """The repository copy ``data/kharaz2001_oblique.csv``."""
-    return Path(__file__).resolve().parents[3] / "data" / "kharaz2001_oblique.csv"
+    """The copy bundled with the package, ``microimpact/data/kharaz2001_oblique.csv``.
+
+    Read through :mod:`importlib.resources`, so it is found in an installed wheel as well as in a
+    clone. It is byte-identical to the repository's ``data/kharaz2001_oblique.csv``, which the
+    pipeline reads (``tests/test_packaging.py`` checks that the two copies agree).
+    """
+    return Path(str(files("microimpact") / "data" / "kharaz2001_oblique.csv"))
 
 
 def read_kharaz(path=None) -> pd.DataFrame:
@@ -145,7 +151,7 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
     Parameters
     ----------
     path : str or os.PathLike, optional
-        Data file; default the repository copy ``data/kharaz2001_oblique.csv``.
+        Data file; default the copy bundled with the package (:func:`default_kharaz_path`).
     normal_restitution : float, optional
         Choose zeta_H so that the model e_n equals this; default: no damping, e_n = 1 (see the
         module docstring). [-]
