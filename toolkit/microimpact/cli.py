@@ -79,6 +79,10 @@ def _rtol(text: str) -> float:
     value = _finite_float(text)
     if not 0.0 < value < 1.0:
         raise argparse.ArgumentTypeError(f"rtol must lie in (0, 1), got {text!r}")
+    from microimpact.solvers.impact import MIN_RTOL
+
+    if value < MIN_RTOL:
+        raise argparse.ArgumentTypeError(f"rtol must be >= {MIN_RTOL:.3g} (100 machine epsilons), got {text!r}")
     return value
 
 

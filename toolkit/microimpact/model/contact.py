@@ -169,9 +169,9 @@ class Contact:
                     check_representable("energy unit m (X / T)^2 [J]", self.mass * u * u, every)
                     check_representable("twist impulse unit m X / T sqrt(r X) [N m s]",
                                         self.mass * u * math.sqrt(r * x), every)
-            except OverflowError:
+            except (OverflowError, ZeroDivisionError):
                 raise ValueError(f"radius={r!r}, density={rho!r}, stiffness={k!r}, adhesion_line_force={f0!r}: "
-                                 "a derived scale overflows the floating-point range") from None
+                                 "a derived scale leaves the floating-point range") from None
 
     # ----------------------------------------------------------------- constructors
     @classmethod

@@ -27,7 +27,11 @@ from microimpact.model.law import contact_potential_energy, nondimensional_scale
 from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
 from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
 
-__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES"]
+__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES", "MIN_RTOL"]
+
+#: smallest relative tolerance accepted: 100 machine epsilons, as scipy's solve_ivp (below it no
+#: double-precision integration can meet the tolerance, and the engine ends at its step limit)
+MIN_RTOL = 100.0 * sys.float_info.epsilon
 
 #: the variables that simulate_many returns (units and long names in microimpact.io.variables)
 RESULT_VARIABLES: tuple[str, ...] = (
@@ -76,6 +80,9 @@ def _check_call(contact, rtol) -> float:
         raise TypeError(f"rtol must be a real number, got {type(rtol).__name__} {rtol!r}")
     if not (math.isfinite(rtol) and 0.0 < rtol < 1.0):
         raise ValueError(f"rtol must be finite and lie in (0, 1), got {rtol!r}")
+    if rtol < MIN_RTOL:
+        raise ValueError(f"rtol must be >= {MIN_RTOL:.3g} (100 machine epsilons; a smaller tolerance cannot be "
+                         f"met in double precision), got {rtol!r}")
     return float(rtol)
 
 
