@@ -80,6 +80,36 @@ _E1, _E3, _E4, _E5, _E6, _E7 = (
 )
 
 
+#: Smallest nondimensional incident speed y0 = v_n T / X (adhesive contact) the engine resolves.
+#: Below about 1e-39 the incident energy y0^2 / 2 is lost in round-off against the contact well
+#: (depth 4/15) and the Sundman-time integration from s = 0 returns wrong outcomes (negative e_n
+#: was seen at 1e-60); 1e-30 keeps nine decades of margin. Physically such a sphere is captured
+#: whenever there is any damping.
+MIN_NONDIMENSIONAL_SPEED = 1e-30
+
+
+def _check_resolvable(y0, adhesive: bool, normal_speed) -> None:
+    """ValueError for incident speeds below :data:`MIN_NONDIMENSIONAL_SPEED` (adhesive contacts)."""
+    y = np.asarray(y0, dtype=float)
+    if adhesive and np.any(y < MIN_NONDIMENSIONAL_SPEED):
+        v = float(np.asarray(normal_speed, dtype=float).ravel()[int(np.argmin(y.ravel()))]) if y.ndim else float(normal_speed)
+        raise ValueError(
+            f"normal speed {v!r} m/s is below what the engine resolves: v_n T/X = {float(y.min()):.3g} < "
+            f"{MIN_NONDIMENSIONAL_SPEED:g} (the incident energy is below round-off of the adhesive contact "
+            "well; with any damping such a sphere is captured)")
+
+
+def _check_restitution(e_n, normal_speed) -> None:
+    """EngineError if a computed e_n left [0, 1] (beyond round-off): a wrong result is never returned."""
+    e = np.asarray(e_n, dtype=float)
+    bad = ~((e >= 0.0) & (e <= 1.0 + 1e-9))
+    if np.any(bad):
+        i = int(np.flatnonzero(bad.ravel())[0])
+        v = float(np.asarray(normal_speed, dtype=float).ravel()[i]) if e.ndim else float(normal_speed)
+        raise EngineError(f"engine failed for normal speed {v!r} m/s: e_n = {float(e.ravel()[i]):.6g} "
+                          "is outside [0, 1]")
+
+
 def _failure(status) -> str:
     """What a status code of the compiled core means."""
     return "step limit reached" if status == _MAX_STEPS else "step size underflow"
@@ -674,6 +704,7 @@ def solve_normal(
     if not (0.0 < rtol < 1.0):
         raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
     sc, y0, c1, c2 = nondimensional_impact(contact, v)
+    _check_resolvable(y0, sc.a_adhesion > 0.0, v)
     u = sc.speed
     j_unit = contact.mass * u  # N s
     jt = 0.0 if friction_impulse_target is None else float(friction_impulse_target) / j_unit
@@ -695,7 +726,9 @@ def solve_normal(
         r = r[:9] + (r[3] - r_in[9],) + r[10:]
     if r[0] != _OK:
         raise EngineError(f"engine failed for normal speed {v!r} m/s: {_failure(r[0])} after {r[11]} steps")
-    return normal_solution(contact, sc, y0, *r[1:13], trajectory=rec[:r[13]] if cap else None)
+    solution = normal_solution(contact, sc, y0, *r[1:13], trajectory=rec[:r[13]] if cap else None)
+    _check_restitution(solution.e_n, v)
+    return solution
 
 
 def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, friction_impulse, twist_impulse,
@@ -777,6 +810,7 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
         raise ValueError(f"normal speeds must be finite and > 0, got {bad!r}")
     nt = np.zeros(v.shape, dtype=np.bool_) if need_tail is None else np.ascontiguousarray(need_tail, dtype=np.bool_).ravel()
     sc, y0, c1, c2 = nondimensional_impact(contact, v)
+    _check_resolvable(y0, sc.a_adhesion > 0.0, v)
     u = sc.speed
     u, c1, c2 = (np.ascontiguousarray(np.broadcast_to(a, v.shape), dtype=float) for a in (u, c1, c2))
     length, time, ah, aa = sc.length, sc.time, sc.a_hertz, sc.a_adhesion
@@ -792,9 +826,11 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
         raise EngineError(f"engine failed for normal speed {float(v[i])!r} m/s: {_failure(status[i])}")
     captured = out[:, 1] == CAPTURE
     eu = contact.mass * u * u
+    e_n = np.where(captured, 0.0, -out[:, 2] / y0)
+    _check_restitution(e_n, v)
     return {
         "captured": captured,
-        "e_n": np.where(captured, 0.0, -out[:, 2] / y0),
+        "e_n": e_n,
         "contact_time": np.where(captured, np.inf, out[:, 3] * time),
         "capture_time": out[:, 8] * time,
         "max_penetration": out[:, 7] * length,
