@@ -8,7 +8,7 @@
 # configuration (workflow/config/config.yaml) is validated against its JSON schema first.
 from snakemake.utils import min_version, validate
 
-min_version("8.0")
+min_version("8.17")
 
 
 configfile: "workflow/config/config.yaml"

@@ -15,11 +15,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import fields
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from microimpact.model.contact import Contact
+
+if TYPE_CHECKING:  # only for annotations: xarray costs 0.5 s of the CLI's start-up
+    import xarray as xr
 
 __all__ = ["contact_attributes", "stamp_parameters", "fit_parameter_source", "source_of_fit",
            "preset_parameter_source", "materials_parameter_source"]
