@@ -32,6 +32,6 @@ localrules:
 
 
 rule all:
+    default_target: True
     input:
         "reports/report.pdf",
-    default_target: True

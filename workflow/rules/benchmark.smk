@@ -10,17 +10,17 @@ rule work_precision:
         markdown="results/benchmark/benchmark.md",
         pdf="results/benchmark/work_precision.pdf",
         png="results/benchmark/work_precision.png",
-    threads: 2  # the batch engine is timed on both cores
-    params:
-        quick=config["benchmark"]["quick"],
-        throughput=config["benchmark"]["throughput"],
-        out_dir=lambda wildcards, output: os.path.dirname(output.netcdf),
     log:
         "logs/work_precision.log",
     benchmark:
         "benchmarks/work_precision.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 2  # the batch engine is timed on both cores
+    params:
+        quick=config["benchmark"]["quick"],
+        throughput=config["benchmark"]["throughput"],
+        out_dir=lambda wildcards, output: os.path.dirname(output.netcdf),
     script:
         "../scripts/work_precision.py"
 
@@ -29,17 +29,17 @@ rule stress:
     output:
         summary="results/stress_summary.json",
         netcdf="results/stress.nc",
-    threads: 1
-    params:
-        cases=config["stress"]["cases"],
-        seed=config["stress"]["seed"],
-        reference_every=config["stress"]["reference_every"],
-        case_time_limit=config["stress"]["case_time_limit"],
     log:
         "logs/stress.log",
     benchmark:
         "benchmarks/stress.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 1
+    params:
+        cases=config["stress"]["cases"],
+        seed=config["stress"]["seed"],
+        reference_every=config["stress"]["reference_every"],
+        case_time_limit=config["stress"]["case_time_limit"],
     script:
         "../scripts/stress.py"

@@ -20,13 +20,21 @@ def as_bool(value):
 config.setdefault("data_synthetic", "auto")
 if config["data_synthetic"] != "auto":
     config["data_synthetic"] = as_bool(config["data_synthetic"])
-config["fit"] = {k: (as_bool(v) if k != "weights" else v) for k, v in config["fit"].items()}
+config["fit"] = {
+    k: (as_bool(v) if k != "weights" else v) for k, v in config["fit"].items()
+}
 config["benchmark"] = {"quick": True, "throughput": False, **config["benchmark"]}
 config["benchmark"] = {k: as_bool(v) for k, v in config["benchmark"].items()}
 config["rtol"] = float(config["rtol"])
 # the stress sweep section is optional; its numbers may arrive as text from snakemake --config
-config["stress"] = {"enabled": True, "cases": 20000, "seed": 0, "reference_every": 0, "case_time_limit": 30.0,
-                    **config.get("stress", {})}
+config["stress"] = {
+    "enabled": True,
+    "cases": 20000,
+    "seed": 0,
+    "reference_every": 0,
+    "case_time_limit": 30.0,
+    **config.get("stress", {}),
+}
 config["stress"] = {
     "enabled": as_bool(config["stress"]["enabled"]),
     "cases": int(config["stress"]["cases"]),
@@ -48,7 +56,9 @@ def materials_path():
         return config["materials"]
     spec = importlib.util.find_spec("microimpact")
     if spec is None or spec.origin is None:
-        raise WorkflowError("materials: 'default' needs the microimpact package installed (pip install -e .)")
+        raise WorkflowError(
+            "materials: 'default' needs the microimpact package installed (pip install -e .)"
+        )
     return str(Path(spec.origin).parent / "io" / "materials.yaml")
 
 
@@ -66,8 +76,10 @@ def _config_file_problem(key, what):
     p = Path(path)
     how = f"--config {key}=path/to/file"
     if not p.exists():
-        return (f"config key '{key}': {what} {path!r} does not exist (paths are relative to "
-                f"{os.getcwd()}); give an existing file, e.g. {how}")
+        return (
+            f"config key '{key}': {what} {path!r} does not exist (paths are relative to "
+            f"{os.getcwd()}); give an existing file, e.g. {how}"
+        )
     if not p.is_file():
         return f"config key '{key}': {what} {path!r} is not a file (a directory?); give a file, e.g. {how}"
     if not os.access(p, os.R_OK):
@@ -79,14 +91,18 @@ def check_config_at_start():
     """Raise WorkflowError (one line: the config key, the value, what is accepted) for the first
     config value that cannot work: the data files, the materials config and material_pair, and
     paper_contact."""
-    for key, what in (("data", "impact CSV (data/README.md, 'Measured-impact CSV format')"),
-                      ("kharaz_data", "Kharaz et al. (2001) CSV")):
+    for key, what in (
+        ("data", "impact CSV (data/README.md, 'Measured-impact CSV format')"),
+        ("kharaz_data", "Kharaz et al. (2001) CSV"),
+    ):
         problem = _config_file_problem(key, what)
         if problem:
             raise WorkflowError(problem)
     path = materials_path()
     if config["materials"] != "default":
-        problem = _config_file_problem("materials", "materials config (data/README.md, 'Materials config')")
+        problem = _config_file_problem(
+            "materials", "materials config (data/README.md, 'Materials config')"
+        )
         if problem:
             raise WorkflowError(problem)
     from microimpact.io.materials import MaterialsError, read_materials
@@ -94,21 +110,29 @@ def check_config_at_start():
     try:
         pairs = read_materials(path)
     except MaterialsError as e:
-        raise WorkflowError(f"config key 'materials': {path} is not a valid materials config: "
-                            + "; ".join(e.problems)) from None
+        raise WorkflowError(
+            f"config key 'materials': {path} is not a valid materials config: "
+            + "; ".join(e.problems)
+        ) from None
     if config["material_pair"] not in pairs:
-        raise WorkflowError(f"config key 'material_pair': {config['material_pair']!r} is not a pair of the "
-                            f"materials config {path}; accepted: {', '.join(sorted(pairs))}")
+        raise WorkflowError(
+            f"config key 'material_pair': {config['material_pair']!r} is not a pair of the "
+            f"materials config {path}; accepted: {', '.join(sorted(pairs))}"
+        )
     from microimpact.presets import PRESETS, named_contact
 
     spec = config["paper_contact"]
     accepted = f"a preset name ({', '.join(sorted(PRESETS))}) or a mapping of microimpact.Contact fields in SI units"
     if isinstance(spec, str) and spec.lower() not in PRESETS:
-        raise WorkflowError(f"config key 'paper_contact': {spec!r} is not a preset; accepted: {accepted}")
+        raise WorkflowError(
+            f"config key 'paper_contact': {spec!r} is not a preset; accepted: {accepted}"
+        )
     try:
         named_contact(spec)
     except (ValueError, TypeError) as e:
-        raise WorkflowError(f"config key 'paper_contact': {e}; accepted: {accepted}") from None
+        raise WorkflowError(
+            f"config key 'paper_contact': {e}; accepted: {accepted}"
+        ) from None
 
 
 if getattr(workflow, "is_main_process", True):
@@ -130,7 +154,11 @@ def paper_sweep_chunk_files(wildcards):
 
 def benchmark_outputs(wildcards):
     """Work-precision results for the report; none when the benchmark is switched off."""
-    return {"work_precision": "results/benchmark/benchmark.nc"} if BENCHMARK_ENABLED else {}
+    return (
+        {"work_precision": "results/benchmark/benchmark.nc"}
+        if BENCHMARK_ENABLED
+        else {}
+    )
 
 
 def stress_outputs(wildcards):

@@ -8,13 +8,13 @@ rule validate_data:
         materials=materials_path(),
     output:
         table="results/impacts_validated.csv",
-    params:
-        material_pair=config["material_pair"],
     log:
         "logs/validate_data.log",
     benchmark:
         "benchmarks/validate_data.tsv"
     conda:
         "../envs/microimpact.yaml"
+    params:
+        material_pair=config["material_pair"],
     script:
         "../scripts/validate_data.py"

@@ -9,16 +9,16 @@ rule paper_dynamics:
         phase_portraits="results/paper/phase_portraits.nc",
         dynamics="results/paper/dynamics.nc",
         bifurcation="results/paper/bifurcation.nc",
-    threads: 1
-    params:
-        contact=config["paper_contact"],
-        speeds=config["phase_portrait_speeds"],
     log:
         "logs/paper_dynamics.log",
     benchmark:
         "benchmarks/paper_dynamics.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 1
+    params:
+        contact=config["paper_contact"],
+        speeds=config["phase_portrait_speeds"],
     script:
         "../scripts/paper_dynamics.py"
 
@@ -27,14 +27,14 @@ rule reproduction:
     output:
         table="results/paper/reproduction.csv",
         markdown="results/paper/reproduction.md",
-    threads: 1
-    params:
-        contact=config["paper_contact"],
     log:
         "logs/reproduction.log",
     benchmark:
         "benchmarks/reproduction.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 1
+    params:
+        contact=config["paper_contact"],
     script:
         "../scripts/reproduction.py"

@@ -12,17 +12,17 @@ rule fit:
         materials=materials_path(),
     output:
         "results/analyst/fit.nc",
-    threads: 1
-    params:
-        material_pair=config["material_pair"],
-        options=config["fit"],
-        rtol=RTOL,
     log:
         "logs/fit.log",
     benchmark:
         "benchmarks/fit.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 1
+    params:
+        material_pair=config["material_pair"],
+        options=config["fit"],
+        rtol=RTOL,
     script:
         "../scripts/fit.py"
 
@@ -36,16 +36,16 @@ rule flags:
     output:
         csv="results/analyst/flags.csv",
         nc="results/analyst/flags.nc",
-    threads: 1
-    params:
-        material_pair=config["material_pair"],
-        rtol=RTOL,
     log:
         "logs/flags.log",
     benchmark:
         "benchmarks/flags.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 1
+    params:
+        material_pair=config["material_pair"],
+        rtol=RTOL,
     script:
         "../scripts/flags.py"
 
@@ -57,16 +57,16 @@ rule material_simulations:
         fit_curves="results/analyst/fit_curves.nc",
         dynamics="results/analyst/dynamics.nc",
         sweeps=expand("results/analyst/sweeps/case_{case}.nc", case=SWEEP_CASES),
-    threads: 1
-    params:
-        cases=SWEEP_CASES,
-        overrides=config["sweeps"],
-        rtol=RTOL,
     log:
         "logs/material_simulations.log",
     benchmark:
         "benchmarks/material_simulations.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 1
+    params:
+        cases=SWEEP_CASES,
+        overrides=config["sweeps"],
+        rtol=RTOL,
     script:
         "../scripts/material_simulations.py"

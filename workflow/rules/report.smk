@@ -21,14 +21,14 @@ rule report:
         kharaz=rules.kharaz.output[0],
     output:
         "reports/report.pdf",
-    threads: 2  # the figures are drawn side by side (build_report(workers=...))
-    params:
-        config=config,
     log:
         "logs/report.log",
     benchmark:
         "benchmarks/report.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 2  # the figures are drawn side by side (build_report(workers=...))
+    params:
+        config=config,
     script:
         "../scripts/report.py"

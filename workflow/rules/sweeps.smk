@@ -9,18 +9,18 @@ if SWEEP_CHUNKS == 1:
     rule paper_sweeps:
         output:
             expand("results/paper/sweeps/case_{case}.nc", case=SWEEP_CASES),
-        threads: 1
-        params:
-            contact=config["paper_contact"],
-            cases=SWEEP_CASES,
-            overrides=config["sweeps"],
-            rtol=RTOL,
         log:
             "logs/paper_sweeps.log",
         benchmark:
             "benchmarks/paper_sweeps.tsv"
         conda:
             "../envs/microimpact.yaml"
+        threads: 1
+        params:
+            contact=config["paper_contact"],
+            cases=SWEEP_CASES,
+            overrides=config["sweeps"],
+            rtol=RTOL,
         script:
             "../scripts/sweep.py"
 
@@ -29,17 +29,17 @@ else:
     rule paper_sweep_chunk:
         output:
             "results/paper/sweeps/chunks/case_{case}/chunk_{chunk}_of_{nchunks}.nc",
-        threads: 1
-        params:
-            contact=config["paper_contact"],
-            overrides=sweep_overrides,
-            rtol=RTOL,
         log:
             "logs/sweeps/case_{case}_chunk_{chunk}_of_{nchunks}.log",
         benchmark:
             "benchmarks/sweeps/case_{case}_chunk_{chunk}_of_{nchunks}.tsv"
         conda:
             "../envs/microimpact.yaml"
+        threads: 1
+        params:
+            contact=config["paper_contact"],
+            overrides=sweep_overrides,
+            rtol=RTOL,
         script:
             "../scripts/sweep_chunk.py"
 

@@ -7,12 +7,12 @@ rule kharaz:
         config["kharaz_data"],
     output:
         "results/kharaz.nc",
-    threads: 1
     log:
         "logs/kharaz.log",
     benchmark:
         "benchmarks/kharaz.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 1
     script:
         "../scripts/kharaz.py"

@@ -782,6 +782,19 @@ class _Cells:
                 for i in np.flatnonzero(mask)]
 
 
+def _parse_numbers(raw) -> np.ndarray:
+    """Cells as floats, NaN where not a number. pandas decides what is a number; Python's float()
+    then reads each one correctly rounded (pandas' fast parser before 2.2 can be a few ulp off, so a
+    value written with repr() would not read back exactly)."""
+    num = pd.to_numeric(pd.Series(raw), errors="coerce").to_numpy(dtype=float)
+    for i in np.flatnonzero(np.isfinite(num)):
+        try:
+            num[i] = float(raw[i])
+        except ValueError:  # a form pandas reads and Python does not: keep pandas' value
+            pass
+    return num
+
+
 def _numeric_values(cells: _Cells, columns, factors, problems: list[Problem]) -> dict[str, np.ndarray]:
     """Numeric columns in internal units under their canonical names (NaN where not a valid
     number); appends a problem for every cell that is not a number, empty where required, not
@@ -793,7 +806,7 @@ def _numeric_values(cells: _Cells, columns, factors, problems: list[Problem]) ->
             continue
         q = _QUANTITIES[cname]
         raw = cells.text[cname]
-        num = pd.to_numeric(pd.Series(raw), errors="coerce").to_numpy(dtype=float)
+        num = _parse_numbers(raw)
         missing = np.zeros(cells.n, dtype=bool)
         nan_idx = np.flatnonzero(np.isnan(num))
         missing[nan_idx] = [raw[i].lower() in _MISSING for i in nan_idx]
