@@ -14,6 +14,9 @@ min_version("8.17")
 configfile: "workflow/config/config.yaml"
 
 
+include: "workflow/rules/typed_config.smk"
+
+
 validate(config, "workflow/config/config.schema.yaml")
 
 

@@ -455,3 +455,15 @@ def test_an_interrupted_run_resumes_as_the_readme_says(tmp_path):
     assert (root / "reports" / "report.pdf").stat().st_size > 0
     again = snakemake(root, "-n", "--cores", "2")
     assert "Nothing to be done" in again.stdout, again.stdout[-3000:]
+
+
+def test_nested_config_overrides_arrive_as_numbers(tmp_path):
+    """snakemake --config passes nested values as text; the Snakefile types them before the schema
+    sees them, so the overrides that config.yaml describes work (and bad ones are still refused)."""
+    root = make_copy(tmp_path / "nested")
+    contact = "paper_contact={radius: 3.0e-6, density: 1350.0, stiffness: 1.776e+9, adhesion_line_force: 7.4}"
+    proc = snakemake(root, "-n", "--cores", "1", "--config", contact, "stress={cases: 100, seed: 2}")
+    assert proc.returncode == 0, proc.stdout[-3000:]
+    assert job_counts(proc.stdout).get("paper_dynamics") == 1
+    bad = snakemake(root, "-n", "--cores", "1", "--config", contact.replace("3.0e-6", "-3.0e-6"))
+    assert bad.returncode != 0 and "paper_contact" in bad.stdout, bad.stdout[-3000:]
