@@ -17,7 +17,7 @@ configfile: "workflow/config/config.yaml"
 include: "workflow/rules/typed_config.smk"
 
 
-validate(config, "workflow/config/config.schema.yaml")
+validate(config, "workflow/schemas/config.schema.yaml")
 
 
 include: "workflow/rules/common.smk"

@@ -261,6 +261,6 @@ def config_section(lay: Layout, config: Mapping) -> None:
     """The configuration the report was made with, as YAML."""
     lay.section("Appendix: configuration", new_page=False, keep=1.5)
     lay.paragraph("The configuration this report was made with (workflow/config/config.yaml merged with "
-                  "command-line overrides), validated against workflow/config/config.schema.yaml.")
+                  "command-line overrides), validated against workflow/schemas/config.schema.yaml.")
     plain = json.loads(json.dumps(dict(config), default=_plain))
     lay.paragraph(yaml.safe_dump(plain, sort_keys=False, width=110), mono=True, size=7)
