@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from microimpact.io.files import write_netcdf
+from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.materials import material_contact
 from microimpact.io.provenance import fit_parameter_source, stamp_parameters
 from microimpact.io.variables import attributes
@@ -182,7 +182,7 @@ class DampingFit:
             ds[name] = xr.DataArray(values, dims=("point",), attrs=attributes(name))
         ds.attrs.update({
             "title": "damping fit of the microsphere impact model (Cheng, Brach & Dunn 2002)",
-            "Conventions": "CF-1.8",
+            "Conventions": CONVENTIONS,
             "chisqr": float(self.chisqr), "redchi": float(self.redchi), "aic": float(self.aic),
             "bic": float(self.bic), "n_points": int(self.n_points),
             "varied": " ".join(self.varied),

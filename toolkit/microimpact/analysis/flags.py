@@ -47,7 +47,7 @@ import numpy as np
 import xarray as xr
 
 from microimpact.dynamics.nonlinear import capture_velocity
-from microimpact.io.files import write_csv, write_netcdf
+from microimpact.io.files import CONVENTIONS, write_csv, write_netcdf
 from microimpact.io.materials import material_contact
 from microimpact.io.variables import attributes
 from microimpact.solvers import DEFAULT_RTOL
@@ -269,7 +269,7 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
         "angle_offsets_sigma": offsets, "spin_samples": int(unit.shape[0]), "angle_samples": int(offsets.size),
         "spin_bound_source": imp.spin_source, "angle_uncertainty_source": imp.angle_source,
         "model": "Cheng, Brach & Dunn (2002); coefficients from microimpact.simulate_many",
-        "Conventions": "CF-1.8",
+        "Conventions": CONVENTIONS,
     })
     if "sha256" in table.attrs:
         res.attrs["source_sha256"] = table.attrs["sha256"]

@@ -46,6 +46,7 @@ import xarray as xr
 from scipy.optimize import brentq
 
 from microimpact.io.materials import default_materials_path, read_materials
+from microimpact.io.files import CONVENTIONS
 from microimpact.io.provenance import materials_parameter_source, stamp_parameters
 from microimpact.io.variables import VARIABLES, attributes
 from microimpact.solvers import engine
@@ -213,7 +214,7 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         "impact_speed": float(KHARAZ_CONDITIONS["speed"]),
         "impact_speed_units": "m s-1",
         "spin_convention": "omega_t' < 0 is forward rolling for v_t > 0 (slip u_t = v_t + r omega_t'); compared as |omega|",
-        "Conventions": "CF-1.8",
+        "Conventions": CONVENTIONS,
     })
     return stamp_parameters(ds, contact, materials_parameter_source(KHARAZ_CONDITIONS["material_pair"]))
 

@@ -17,9 +17,13 @@ import os
 import stat
 import tempfile
 from collections.abc import Iterator, Mapping
+from datetime import datetime, timezone
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 import numpy as np
+
+from microimpact.io.variables import VARIABLES, udunits
 
 __all__ = ["atomic_path", "atomic_write", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
            "CONVENTIONS", "read_netcdf_groups"]
@@ -133,9 +137,6 @@ CONVENTIONS = "CF-1.10"
 
 
 def _history_line(path: Path) -> str:
-    from datetime import datetime, timezone
-    from importlib.metadata import PackageNotFoundError, version
-
     try:
         release = version("microimpact")
     except PackageNotFoundError:  # pragma: no cover - running from a bare source tree
@@ -161,8 +162,6 @@ def _int32(value, what: str):
 
 def _cf_attrs(attrs: Mapping, what: str) -> dict:
     """Attributes with units in the one UDUNITS style and int64 numbers as int32."""
-    from microimpact.io.variables import udunits
-
     out = {}
     for key, value in attrs.items():
         if key == "units" or key.endswith("_units"):
@@ -190,8 +189,6 @@ def _cf_dataset(ds, *, root: bool, path: Path):
       (appended to the history the Dataset already has).
     The values are not changed.
     """
-    from microimpact.io.variables import VARIABLES
-
     keep = {"dtype", "_FillValue", "scale_factor", "add_offset", "units", "calendar",
             "zlib", "complevel", "shuffle", "chunksizes", "fletcher32", "contiguous"}
     out = ds.copy(deep=False)

@@ -20,6 +20,7 @@ import xarray as xr
 
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity, critical_velocity
+from microimpact.io.files import CONVENTIONS
 from microimpact.io.provenance import source_of_fit, stamp_parameters
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
@@ -117,7 +118,7 @@ def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL) -> xr.Data
                                  attributes("capture_normal_speed")),
         },
         coords={"radius": ("radius", radii, attributes("radius"))},
-        attrs={"Conventions": "CF-1.8",
+        attrs={"Conventions": CONVENTIONS,
                "title": "Critical and capture velocity of the fitted material at the measured sizes"},
     )
     return stamp_fitted(ds, fit)

@@ -50,7 +50,7 @@ import xarray as xr
 from microimpact import __version__
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity
-from microimpact.io.files import write_netcdf
+from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.variables import attributes
 from microimpact.model.contact import PAPER_REFERENCE
 from microimpact.model.parameters import TABLE2_CASES, table2_case
@@ -319,7 +319,7 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
     n = int(np.prod([ds.sizes[d] for d in dims])) if dims else 1
     label = f"Table 2 case {case}" if case in TABLE2_CASES else (f"case {case}" if case else "parameter sweep")
     attrs = {
-        "Conventions": "CF-1.10",
+        "Conventions": CONVENTIONS,
         "title": f"Microsphere impact sweep: {label} (Cheng, Brach & Dunn 2002 model)",
         "source": f"microimpact {__version__}",
         "history": f"{_now()} microimpact.studies.sweeps.run_sweep(case={case!r}, rtol={rtol:g}): "
