@@ -22,7 +22,7 @@ from pathlib import Path
 from microimpact import __version__
 from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,
                                   reporting_os_errors, same_file)
-from microimpact.model.contact import Contact
+from microimpact.model.contact import SUB_MODELS, Contact
 from microimpact.model.parameters import TABLE2_CASES
 from microimpact.presets import PRESETS, get_preset
 from microimpact.solvers import DEFAULT_RTOL, METHODS
@@ -93,6 +93,10 @@ def add_contact_options(p: argparse.ArgumentParser) -> None:
     """--preset plus one option per Contact field (SI units) that overrides the preset."""
     p.add_argument("--preset", default="wall1990", help=f"parameter preset ({', '.join(sorted(PRESETS))}); default wall1990")
     for name in CONTACT_FIELDS:
+        if name in SUB_MODELS:
+            p.add_argument(f"--{name.replace('_', '-')}", choices=SUB_MODELS[name], default=None,
+                           help=f"sub-model (default {SUB_MODELS[name][0]}, the paper's)")
+            continue
         p.add_argument(f"--{name.replace('_', '-')}", type=_finite_float, default=None, metavar="SI",
                        help=f"override Contact.{name} (SI units)")
 

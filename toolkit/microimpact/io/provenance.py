@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from microimpact.model.contact import Contact
+from microimpact.model.contact import SUB_MODELS, Contact
 
 if TYPE_CHECKING:  # only for annotations: xarray costs 0.5 s of the CLI's start-up
     import xarray as xr
@@ -35,7 +35,11 @@ def contact_attributes(contacts: Contact | Sequence[Contact]) -> dict:
     attrs = {}
     for f in fields(Contact):
         values = [getattr(c, f.name) for c in group]
-        if any(v is None for v in values):  # damping reference speed: each impact's own
+        if f.name in SUB_MODELS:  # a sub-model name, one per file (sizes share it)
+            attrs[f"contact_{f.name}"] = ", ".join(sorted(set(values)))
+        elif f.name == "shear_modulus" and any(v is None for v in values):
+            attrs[f"contact_{f.name}"] = "not given"
+        elif any(v is None for v in values):  # damping reference speed: each impact's own
             attrs[f"contact_{f.name}"] = "per-impact normal speed"
         else:
             attrs[f"contact_{f.name}"] = np.array(values, dtype=float) if many else float(values[0])

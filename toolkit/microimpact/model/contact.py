@@ -23,7 +23,19 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-__all__ = ["Contact", "PAPER_REFERENCE", "check_positive", "check_representable"]
+__all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_representable"]
+
+#: the selectable sub-models of the one contact law: field -> accepted names, the first (the
+#: paper's model) being the default. "ring" is the paper's adhesion ring force (Eqs. 4-6); "jkr"
+#: and "dmt" are the alternative normal adhesion models; "rigid" is the paper's tangentially rigid
+#: contact (closed-form tangential map), "mindlin" an elastic tangential contact with micro-slip;
+#: "net" is the paper's Coulomb limit f |F_n|, "pulloff" an adhesion-aware limit that does not vanish
+#: at the adhesive equilibrium.
+SUB_MODELS: dict[str, tuple[str, ...]] = {
+    "normal_model": ("ring", "jkr", "dmt"),
+    "tangential_model": ("rigid", "mindlin"),
+    "friction_model": ("net", "pulloff"),
+}
 
 #: full citation of the paper, for the ``references`` attribute of the toolkit's results
 PAPER_REFERENCE = (
@@ -89,6 +101,20 @@ def _check_poisson(name: str, value: float) -> None:
         raise ValueError(f"{name} must lie in (-1, 0.5), got {value!r}")
 
 
+#: fields that may be None (not given)
+_OPTIONAL = ("damping_reference_speed", "shear_modulus")
+
+
+def _sub_model(name: str, value) -> str:
+    """The sub-model name ``value`` of field ``name``, lower-cased; ValueError/TypeError naming it."""
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be one of {', '.join(SUB_MODELS[name])}, got {type(value).__name__} {value!r}")
+    v = value.strip().lower()
+    if v not in SUB_MODELS[name]:
+        raise ValueError(f"{name} must be one of {', '.join(SUB_MODELS[name])}, got {value!r}")
+    return v
+
+
 @dataclass(frozen=True)
 class Contact:
     """Parameters of a homogeneous elastic microsphere in contact with a flat surface.
@@ -112,6 +138,17 @@ class Contact:
     damping_reference_speed : float or None
         Reference speed v_n of Eqs. (14)-(15). None (the paper's default) uses each impact's own
         incident normal speed; a float fixes it for every impact. [m/s]
+    normal_model : {"ring", "jkr", "dmt"}
+        Normal adhesion model (:data:`SUB_MODELS`); "ring" is the paper's. [-]
+    tangential_model : {"rigid", "mindlin"}
+        Tangential contact model; "rigid" is the paper's. [-]
+    friction_model : {"net", "pulloff"}
+        Coulomb friction limit; "net" (f |F_n|) is the paper's. [-]
+    rolling_friction : float
+        Rolling-resistance coefficient; 0 (the paper's, no rolling resistance) by default. [-]
+    shear_modulus : float or None
+        Effective shear modulus G* of the pair, 1/G* = (2 - nu1)/G1 + (2 - nu2)/G2, needed by the
+        "mindlin" tangential model (tangential stiffness 8 G* a); None when not given. [Pa]
 
     Raises
     ------
@@ -133,19 +170,30 @@ class Contact:
     zeta_adhesion: float = 0.0
     friction: float = 0.0
     damping_reference_speed: float | None = None
+    normal_model: str = "ring"
+    tangential_model: str = "rigid"
+    friction_model: str = "net"
+    rolling_friction: float = 0.0
+    shear_modulus: float | None = None
 
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
-            if f.name == "damping_reference_speed" and value is None:
+            if f.name in SUB_MODELS:
+                object.__setattr__(self, f.name, _sub_model(f.name, value))
+                continue
+            if f.name in _OPTIONAL and value is None:
                 continue
             object.__setattr__(self, f.name, _as_number(f.name, value))
         for name in ("radius", "density", "stiffness"):
             check_positive(name, getattr(self, name))
-        for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction"):
+        for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction", "rolling_friction"):
             _check_non_negative(name, getattr(self, name))
-        if self.damping_reference_speed is not None:
-            check_positive("damping_reference_speed", self.damping_reference_speed)
+        for name in _OPTIONAL:
+            if getattr(self, name) is not None:
+                check_positive(name, getattr(self, name))
+        if self.tangential_model == "mindlin" and self.shear_modulus is None:
+            raise ValueError("tangential_model='mindlin' needs shear_modulus (the effective shear modulus G* [Pa])")
         self._check_scales()
 
     def _check_scales(self) -> None:

@@ -20,3 +20,30 @@ DEFAULT_RTOL = 1e-8
 
 #: The solvers behind simulate_impact(method=...).
 METHODS = ("engine", "reference", "rkg")
+
+#: What each solver path covers of the selectable sub-models (microimpact.model.contact.SUB_MODELS);
+#: a contact that selects anything else is refused by :func:`check_sub_models` with a message that
+#: says which method does cover it. Extended as sub-models are implemented.
+SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
+    "engine": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
+    "reference": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
+    "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
+}
+#: solver paths that model rolling resistance (Contact.rolling_friction > 0)
+ROLLING_RESISTANCE_METHODS: tuple[str, ...] = ()
+
+
+def check_sub_models(contact, method: str) -> None:
+    """ValueError unless solver ``method`` covers every sub-model that ``contact`` selects.
+
+    The message names the field, the selection and the methods that do cover it.
+    """
+    for field, supported in SUPPORTED_SUB_MODELS[method].items():
+        choice = getattr(contact, field)
+        if choice not in supported:
+            others = [m for m, s in SUPPORTED_SUB_MODELS.items() if choice in s[field]]
+            hint = f"; use method={others[0]!r}" if others else "; no solver implements it yet"
+            raise ValueError(f"{field}={choice!r} is not covered by method={method!r}{hint}")
+    if contact.rolling_friction > 0.0 and method not in ROLLING_RESISTANCE_METHODS:
+        hint = f"; use method={ROLLING_RESISTANCE_METHODS[0]!r}" if ROLLING_RESISTANCE_METHODS else "; no solver implements it yet"
+        raise ValueError(f"rolling_friction={contact.rolling_friction!r} is not covered by method={method!r}{hint}")

@@ -20,7 +20,7 @@ import xarray as xr
 
 from microimpact.io.provenance import contact_attributes
 from microimpact.io.variables import attributes
-from microimpact.solvers import DEFAULT_RTOL, METHODS, engine
+from microimpact.solvers import DEFAULT_RTOL, METHODS, check_sub_models, engine
 from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
 from microimpact.model.contact import Contact
 from microimpact.model.law import contact_potential_energy, nondimensional_scales
@@ -211,6 +211,7 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
         raise ValueError(f"steps applies to method='rkg' only, got method={method!r}")
     if steps is not None and (isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps < 1):
         raise ValueError(f"steps must be a whole number >= 1, got {steps!r}")
+    check_sub_models(contact, method)
     if method == "reference":
         # imported here: scipy.integrate costs ~0.7 s of import time that the engine never needs
         from microimpact.solvers.reference import simulate_reference
@@ -330,6 +331,7 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         raise ValueError(f"simulate_many runs method='engine' only, got {method!r}; for 'reference' or 'rkg' "
                          "call simulate_impact in a loop")
     rtol = _check_call(contact, rtol)
+    check_sub_models(contact, "engine")
     omega = _check_omega(omega)
     inputs = {
         "speed": speed,
