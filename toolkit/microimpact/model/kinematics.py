@@ -1,4 +1,5 @@
-"""Impact kinematics, the impact coefficients of Eqs. (21)-(25) and the result record.
+"""Impact kinematics and the result record (the coefficients of Eqs. (21)-(25) are in
+:mod:`microimpact.model.coefficients`, compiled, so that importing this module loads no numba).
 
 Frame and signs (the paper's Fig. 6 is missing from the text; this is the convention of the toolkit):
 
@@ -22,7 +23,6 @@ __all__ = [
     "ImpactResult",
     "incident_velocity",
     "slip_velocity",
-    "impact_coefficients",
 ]
 
 def incident_velocity(speed: float, incidence_deg: float, azimuth_deg: float) -> tuple[float, float, float]:
@@ -48,45 +48,6 @@ def slip_velocity(radius, v_t, v_tp, omega_t, omega_tp):
     u_t = v_t + r omega_t', u_t' = v_t' - r omega_t (consistent with Eqs. (19)-(20) as printed).
     """
     return v_t + radius * omega_tp, v_tp - radius * omega_t
-
-
-def impact_coefficients(mass, moment_of_inertia, velocity_in, omega_in, velocity_out, omega_out, captured):
-    """Restitution, impulse ratios and kinetic energy loss ratios, Eqs. (21)-(25).
-
-    Parameters
-    ----------
-    mass : float  [kg]
-    moment_of_inertia : float  [kg m^2]
-    velocity_in, velocity_out : sequence of 3 floats or arrays
-        (v_n, v_t, v_t') before and after. For a captured sphere velocity_out is the final state
-        (normal component 0, tangential components of the final rolling or sliding motion). [m/s]
-    omega_in, omega_out : sequence of 3 floats or arrays
-        (omega_n, omega_t, omega_t') before and after. [rad/s]
-    captured : bool or array of bool
-
-    Returns
-    -------
-    dict with e_n, mu_t, mu_tp, K_L, K_t (floats for scalar input, arrays otherwise). For a captured sphere e_n = 0 and the impulse ratios are
-    NaN (there is no rebound and so no impulse ratio); K_L and K_t use the final state.
-    """
-    vn_i, vt_i, vtp_i = velocity_in
-    vn_r, vt_r, vtp_r = velocity_out
-    dvn = vn_r - vn_i
-    with np.errstate(invalid="ignore", divide="ignore"):
-        e_n = np.where(captured, 0.0, -vn_r / vn_i)  # Eq. (21), both as magnitudes
-        mu_t = np.where(captured, np.nan, (vt_r - vt_i) / dvn)  # Eq. (22)
-        mu_tp = np.where(captured, np.nan, (vtp_r - vtp_i) / dvn)  # Eq. (23)
-    v2_i = vn_i**2 + vt_i**2 + vtp_i**2
-    v2_r = vn_r**2 + vt_r**2 + vtp_r**2
-    w2_i = sum(w * w for w in omega_in)
-    w2_r = sum(w * w for w in omega_out)
-    energy_in = mass * v2_i + moment_of_inertia * w2_i
-    k_t = (energy_in - mass * v2_r - moment_of_inertia * w2_r) / energy_in  # Eq. (24)
-    k_l = (v2_i - v2_r) / v2_i  # Eq. (25)
-    out = {"e_n": e_n, "mu_t": mu_t, "mu_tp": mu_tp, "K_L": k_l, "K_t": k_t}
-    if np.ndim(captured) == 0:
-        return {k: float(v) for k, v in out.items()}
-    return out
 
 
 @dataclass(frozen=True)

@@ -21,17 +21,23 @@ import xarray as xr
 from microimpact.io.provenance import contact_attributes
 from microimpact.io.variables import attributes
 from microimpact.solvers import DEFAULT_RTOL, METHODS, check_sub_models, engine
+from microimpact.solvers.family import FamilyBudgetExceeded, normal_family
 from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
 from microimpact.model.contact import Contact
 from microimpact.model.law import contact_potential_energy, nondimensional_scales
-from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity, slip_velocity
+from microimpact.model.coefficients import impact_coefficients
+from microimpact.model.kinematics import ImpactResult, incident_velocity, slip_velocity
 from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
 
-__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES", "MIN_RTOL"]
+__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES", "MIN_RTOL", "FAMILY_MIN_SPEEDS"]
 
 #: smallest relative tolerance accepted: 100 machine epsilons, as scipy's solve_ivp (below it no
 #: double-precision integration can meet the tolerance, and the engine ends at its step limit)
 MIN_RTOL = 100.0 * sys.float_info.epsilon
+
+#: simulate_many considers the interpolated family from this many distinct normal speeds on (a
+#: family costs a few hundred to a few thousand normal solves, docs/benchmark.md)
+FAMILY_MIN_SPEEDS = 2000
 
 #: the variables that simulate_many returns (units and long names in microimpact.io.variables)
 RESULT_VARIABLES: tuple[str, ...] = (
@@ -296,7 +302,7 @@ def _as_dataarray(name, value):
 
 
 def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0, 0.0, 0.0), friction=None, *,
-                  rtol: float = DEFAULT_RTOL, method: str = "engine") -> xr.Dataset:
+                  rtol: float = DEFAULT_RTOL, method: str = "engine", family: bool | None = None) -> xr.Dataset:
     """Simulate a batch of impacts, broadcasting the inputs, on both cores.
 
     Each distinct normal speed is solved once by the compiled engine; every angle, azimuth, spin
@@ -317,6 +323,12 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         (docs/benchmark.md) at half the cost of 1e-10, most of it saved on captured impacts. [-]
     method : {"engine"}
         Only the engine runs batches; for "reference" or "rkg" loop over :func:`simulate_impact`.
+    family : bool or None
+        How the normal solves are done. None (default) chooses: many distinct normal speeds (at
+        least :data:`FAMILY_MIN_SPEEDS`) use the interpolated family of
+        :func:`microimpact.solvers.family.normal_family` when it costs fewer solves than solving
+        each speed, else each distinct speed is solved directly. True forces the family, False
+        the direct solves. The ``normal_solve_path`` attribute of the result records which ran.
 
     Returns
     -------
@@ -344,11 +356,14 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     }
     arrays, flat = _broadcast_inputs(inputs)
     _check_scales(contact, flat["speed"], flat["incidence_deg"], (flat["omega_n"], flat["omega_t"], flat["omega_tp"]))
-    results, n_solves = _solve_batch(contact, flat, rtol)
+    if family is not None and not isinstance(family, (bool, np.bool_)):
+        raise TypeError(f"family must be True, False or None, got {type(family).__name__} {family!r}")
+    results, n_solves, path = _solve_batch(contact, flat, rtol, family)
     ds = _batch_dataset(arrays, results)
     ds.attrs.update(contact_attributes(contact))
     ds.attrs["solver"] = f"microimpact engine (Dormand-Prince 5(4), rtol={rtol:g})"
     ds.attrs["normal_solves"] = n_solves
+    ds.attrs["normal_solve_path"] = path
     return ds
 
 
@@ -375,9 +390,50 @@ def _broadcast_inputs(inputs: dict):
     return arrays, flat
 
 
-def _solve_batch(contact, flat: dict, rtol: float):
-    """Engine normal solves (one per distinct normal speed) and the tangential map of a flat
-    batch; returns ({variable: 1-D array}, number of normal solves)."""
+def _family_of(contact, normal_speed, rtol, family):
+    """The interpolated family for these normal speeds [m/s], or None for direct solves: ``family``
+    False; or None with fewer than FAMILY_MIN_SPEEDS impacts, mostly repeated speeds (a grid), or
+    a family that would cost more than half as many solves as there are impacts."""
+    n = normal_speed.size
+    if family is False or n == 0:
+        return None
+    if family is None:
+        if n < FAMILY_MIN_SPEEDS:
+            return None
+        sample = normal_speed[:: max(1, n // 4096)]
+        if np.unique(sample).size < 0.5 * sample.size:
+            return None
+    try:
+        return normal_family(contact, float(normal_speed.min()), float(normal_speed.max()), rtol=rtol,
+                             max_solves=None if family else n // 2)
+    except FamilyBudgetExceeded:
+        return None
+
+
+def _solve_batch(contact, flat: dict, rtol: float, family=None):
+    """Normal solves and the tangential map of a flat batch; returns ({variable: 1-D array},
+    number of normal solves, normal-solve path)."""
+    normal = flat["speed"] * np.cos(np.radians(flat["incidence_deg"]))
+    fam = _family_of(contact, normal, rtol, family)
+    if fam is None:
+        return (*_direct_batch(contact, flat, rtol), "direct: one engine solve per distinct normal speed")
+    results, in_band = fam.impacts(*(flat[k] for k in ("speed", "incidence_deg", "azimuth_deg", "omega_n",
+                                                        "omega_t", "omega_tp", "friction")))
+    n_solves = fam.n_solves
+    if np.any(in_band):  # impacts in a guard band at the capture speed: solved directly
+        idx = np.flatnonzero(in_band)
+        direct, n = _direct_batch(contact, {k: v[idx] for k, v in flat.items()}, rtol)
+        n_solves += n
+        for k in results:
+            results[k][idx] = direct[k]
+    results["outcome"] = results["outcome"].astype(np.int8)
+    results["slip_ended"] = results["slip_ended"].astype(np.int8)
+    return results, n_solves, fam.describe()
+
+
+def _direct_batch(contact, flat: dict, rtol: float):
+    """One engine normal solve per distinct normal speed, then the tangential map; returns
+    ({variable: 1-D array}, number of normal solves)."""
     alpha = np.radians(flat["incidence_deg"])
     theta = np.radians(flat["azimuth_deg"])
     v = flat["speed"]

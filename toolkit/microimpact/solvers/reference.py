@@ -92,7 +92,8 @@ from scipy.integrate import solve_ivp
 
 from microimpact.model import law
 from microimpact.solvers import DEFAULT_RTOL
-from microimpact.model.kinematics import ImpactResult, impact_coefficients, incident_velocity
+from microimpact.model.coefficients import impact_coefficients
+from microimpact.model.kinematics import ImpactResult, incident_velocity
 from microimpact.model.contact import Contact
 
 __all__ = [
