@@ -20,6 +20,7 @@ import math
 import numbers
 import sys
 from dataclasses import dataclass, fields, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -304,32 +305,33 @@ class Contact:
         return replace(self, radius=float(radius), adhesion_line_force=f0, **changes)
 
     # ----------------------------------------------------------------- derived
-    @property
+    # (cached: a frozen contact's derived scales never change, and a single impact reads them often)
+    @cached_property
     def mass(self) -> float:
         """Sphere mass m = (4/3) pi r^3 rho. [kg]"""
         return 4.0 / 3.0 * math.pi * self.radius**3 * self.density
 
-    @property
+    @cached_property
     def moment_of_inertia(self) -> float:
         """Centroidal moment of inertia of a homogeneous sphere, I = (2/5) m r^2. [kg m^2]"""
         return 0.4 * self.mass * self.radius**2
 
-    @property
+    @cached_property
     def work_of_adhesion(self) -> float:
         """Work of adhesion w_A that gives this f0 through Eq. (7). [J/m^2]"""
         return math.sqrt(2.0 * math.pi * self.adhesion_line_force**3 / (9.0 * self.stiffness * self.radius))
 
-    @property
+    @cached_property
     def length_scale(self) -> float:
         """X = 2 pi f0 / K, Eq. (29): the static equilibrium penetration. [m]"""
         return 2.0 * math.pi * self.adhesion_line_force / self.stiffness
 
-    @property
+    @cached_property
     def time_scale(self) -> float:
         """T = sqrt(m / sqrt(2 pi r f0 K)), Eq. (30) corrected (printed as T^2). [s]"""
         return math.sqrt(self.mass / math.sqrt(2.0 * math.pi * self.radius * self.adhesion_line_force * self.stiffness))
 
-    @property
+    @cached_property
     def damping_speed_scale(self) -> float:
         """Speed scale (r^3 K / m)^(2/5) of Eqs. (14)-(15) without the sqrt(v_n) factor. [(m/s)^(4/5)]"""
         return (self.radius**3 * self.stiffness / self.mass) ** 0.4

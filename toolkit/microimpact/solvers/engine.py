@@ -90,6 +90,8 @@ MIN_NONDIMENSIONAL_SPEED = 1e-30
 
 def _check_resolvable(y0, adhesive: bool, normal_speed) -> None:
     """ValueError for incident speeds below :data:`MIN_NONDIMENSIONAL_SPEED` (adhesive contacts)."""
+    if isinstance(y0, float) and (y0 >= MIN_NONDIMENSIONAL_SPEED or not adhesive):
+        return
     y = np.asarray(y0, dtype=float)
     if adhesive and np.any(y < MIN_NONDIMENSIONAL_SPEED):
         v = float(np.asarray(normal_speed, dtype=float).ravel()[int(np.argmin(y.ravel()))]) if y.ndim else float(normal_speed)
@@ -101,6 +103,8 @@ def _check_resolvable(y0, adhesive: bool, normal_speed) -> None:
 
 def _check_restitution(e_n, normal_speed) -> None:
     """EngineError if a computed e_n left [0, 1] (beyond round-off): a wrong result is never returned."""
+    if isinstance(e_n, float) and 0.0 <= e_n <= 1.0 + 1e-9:
+        return
     e = np.asarray(e_n, dtype=float)
     bad = ~((e >= 0.0) & (e <= 1.0 + 1e-9))
     if np.any(bad):

@@ -25,7 +25,7 @@ from microimpact.solvers.family import FamilyBudgetExceeded, normal_family
 from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
 from microimpact.model.contact import Contact
 from microimpact.model.law import contact_potential_energy, nondimensional_scales
-from microimpact.model.coefficients import impact_coefficients
+from microimpact.model.coefficients import coefficients_kernel, impact_coefficients
 from microimpact.model.kinematics import ImpactResult, incident_velocity, slip_velocity
 from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
 
@@ -70,6 +70,8 @@ def _real_array(name: str, value) -> np.ndarray:
 
 def _real_scalar(name: str, value) -> float:
     """``float(value)`` for one real number; an array gets a TypeError that points to simulate_many."""
+    if type(value) is float or type(value) is int:  # the common case, without numpy
+        return float(value)
     a = _real_array(name, value)
     if a.ndim != 0:
         raise TypeError(f"{name} must be one number in simulate_impact, got an array of shape {a.shape}; "
@@ -122,11 +124,24 @@ def _check_inputs(speed, incidence_deg, azimuth_deg, omega):
 _TINY = sys.float_info.min
 
 
+def _scalar_scales_ok(contact, speed, incidence_deg, omega) -> bool:
+    """The common case of :func:`_check_scales` in plain floats: one impact whose scales are all
+    comfortably inside the floating-point range (False sends it to the full check)."""
+    if not (isinstance(speed, float) and isinstance(incidence_deg, float) and contact.adhesion_line_force > 0.0):
+        return False
+    v_n = speed * math.cos(math.radians(incidence_deg))
+    kinetic = 0.5 * contact.mass * speed * speed
+    energy = kinetic + 0.5 * contact.moment_of_inertia * (omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2])
+    return 1e-250 < speed * speed < 1e300 and 1e-250 < kinetic and 1e-250 < v_n and math.isfinite(energy)
+
+
 def _check_scales(contact, speed, incidence_deg, omega) -> None:
     """The speed-dependent quantities the solvers and Eqs. (21)-(25) divide by are finite normal
     doubles: v^2 and m v^2, the normal speed, the Hertz scales of an impact without adhesion, and
     the incident energy with the spin. ValueError naming the argument (speed, omega_*) otherwise:
     ``speed=1e-300`` would give v^2 = 0 and a ZeroDivisionError in K_L."""
+    if _scalar_scales_ok(contact, speed, incidence_deg, omega):
+        return
     with np.errstate(all="ignore"):
         v = np.asarray(speed, dtype=float)
         v_n = v * np.cos(np.radians(np.asarray(incidence_deg, dtype=float)))
@@ -255,7 +270,8 @@ def _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential) -> 
     captured = sol.outcome == "capture"
     v_out = (0.0 if captured else sol.e_n * -v_in[0], tan[0], tan[1])
     w_out = (tan[2], tan[3], tan[4])
-    coef = impact_coefficients(m, inertia, v_in, w_in, v_out, w_out, captured)
+    coef = dict(zip(("e_n", "mu_t", "mu_tp", "K_L", "K_t"),
+                    coefficients_kernel(m, inertia, *v_in, *w_in, *v_out, *w_out, captured)))
     slip_ended = bool(tan[5])
     return ImpactResult(
         outcome=sol.outcome,
