@@ -14,23 +14,22 @@ between two elastic bodies has the tangential stiffness (Mindlin 1949; Johnson 1
     k_t = 8 G* a,    1/G* = (2 - nu_1)/G_1 + (2 - nu_2)/G_2,
 
 so that, for identical Poisson ratios, k_t / k_n = 2 (1 - nu) / (2 - nu) with k_n = 2 E* a the normal
-contact stiffness. The tangential force F_t (a vector in the tangent plane) is a state with the
-incremental law
+contact stiffness. Micro-slip -- the annulus of the contact that slips before the whole contact
+does -- softens the contact as the tangential force approaches the Coulomb limit F_lim. Mindlin's
+load-displacement relation of a sphere under a normal load and a growing tangential displacement
+delta (Mindlin 1949; Johnson 1985, Eqs. (7.40)-(7.42)) gives the force
 
-    dF_t/dt = -k_t theta u,    |F_t| <= F_lim,
+    F_t = -F_lim [1 - (1 - |delta| / delta*)^(3/2)] delta / |delta|,   delta* = 3 F_lim / (2 k_t),
 
-u the slip velocity of the contact point. Micro-slip -- the annulus of the contact that slips before
-the whole contact does -- softens the contact as |F_t| approaches the Coulomb limit. Its
-loading form (Thornton 1991; Thornton & Yin 1991; in DEM form Di Renzo & Di Maio 2004) is
-
-    theta = (1 - |F_t| / F_lim)^(1/3)  while |F_t| grows (F_t . u < 0),
-    theta = 1                          while it falls (unloading at the initial stiffness,
-                                       the simplification of Walton & Braun 1986),
-
-and theta reaches 0 at |F_t| = F_lim: gross sliding, F_t = -F_lim u / |u|. When the limit falls
-below |F_t| (the normal force decreasing) F_t is scaled back onto it. This drops the turning-point
-memory of the full Mindlin-Deresiewicz (1953) unloading/reloading curves; see the README section
-"Contact models beyond the paper".
+which is -k_t delta for small displacements, reaches the limit with zero slope at |delta| =
+delta* (micro-slip has spread over the whole contact) and is F_lim in gross sliding, where the
+displacement is held at delta* (the slip beyond it is not stored). The state is the tangential
+displacement of the contact, d delta / dt = u (the contact-point slip velocity); F_lim and k_t
+follow the normal solve at every instant. This is the monotonic-loading curve of
+Mindlin & Deresiewicz (1953), without their unloading/reloading memory (it is elastic below
+gross slip); a simplification like that of the DEM forms compared by Di Renzo & Di Maio (2004).
+With micro-slip switched off (F_t = -k_t delta up to the limit) it is their "no-slip" Mindlin
+model; as k_t grows without bound it becomes the rigid contact of the paper.
 
 Adhesion-aware friction ("pulloff")
 -----------------------------------
@@ -81,8 +80,8 @@ __all__ = [
     "nondimensional_pulloff_force",
     "nondimensional_tangential_stiffness",
     "friction_load",
-    "microslip_factor",
-    "mindlin_force_rate",
+    "mindlin_force",
+    "mindlin_stuck_displacement",
     "maw_incidence_parameter",
 ]
 
@@ -238,40 +237,39 @@ def friction_load(normal_force, pulloff, adhesion_aware):
     return abs(normal_force)
 
 
-def microslip_factor(force_t, force_tp, slip_t, slip_tp, limit):
-    """Stiffness factor theta of the micro-slip law (Thornton 1991 loading form). [-]
-
-    theta = (1 - |F_t| / F_lim)^(1/3) while |F_t| grows (F_t . u < 0), 1 while it falls, 0 at or
-    beyond the limit (and when there is no limit, F_lim = 0).
-
-    Parameters
-    ----------
-    force_t, force_tp : float
-        Tangential force components (already within the limit). [N] or nondimensional
-    slip_t, slip_tp : float
-        Slip velocity of the contact point. [m/s] or nondimensional
-    limit : float
-        Coulomb limit F_lim, same unit as the force.
-    """
-    if force_t * slip_t + force_tp * slip_tp >= 0.0:
-        return 1.0  # unloading (or no load): the initial stiffness
-    if limit <= 0.0:
-        return 0.0
-    q = 1.0 - math.sqrt(force_t * force_t + force_tp * force_tp) / limit
-    if q <= 0.0:
-        return 0.0
-    return q ** (1.0 / 3.0)
-
-
-def mindlin_force_rate(stiffness, force_t, force_tp, slip_t, slip_tp, limit):
-    """dF_t/dt = -k_t theta u of the Mindlin contact with micro-slip, as the pair (t, t'). [N/s]
+def mindlin_stuck_displacement(stiffness, limit):
+    """delta* = 3 F_lim / (2 k_t): the displacement at which the whole contact slips. [m] or [-]
 
     Parameters
     ----------
     stiffness : float
         k_t = 8 G* a (:func:`tangential_stiffness`). [N/m] or nondimensional
-    force_t, force_tp, slip_t, slip_tp, limit : float
-        As :func:`microslip_factor`.
+    limit : float
+        Coulomb limit F_lim. [N] or nondimensional
     """
-    k = stiffness * microslip_factor(force_t, force_tp, slip_t, slip_tp, limit)
-    return -k * slip_t, -k * slip_tp
+    if stiffness <= 0.0:
+        return 0.0
+    return 1.5 * limit / stiffness
+
+
+def mindlin_force(delta_t, delta_tp, stuck_displacement, limit):
+    """Tangential force (F_t, F_t') of Mindlin's micro-slip contact at the displacement delta. [N]
+
+    F = -F_lim [1 - (1 - |delta| / delta*)^(3/2)] delta / |delta| for |delta| < delta*, and
+    -F_lim delta / |delta| beyond (gross slip); see the module docstring.
+
+    Parameters
+    ----------
+    delta_t, delta_tp : float
+        Tangential displacement of the contact (integral of the slip velocity). [m] or nondimensional
+    stuck_displacement : float
+        delta* of :func:`mindlin_stuck_displacement`. [m] or nondimensional
+    limit : float
+        Coulomb limit F_lim >= 0. [N] or nondimensional
+    """
+    d = math.sqrt(delta_t * delta_t + delta_tp * delta_tp)
+    if d == 0.0 or limit <= 0.0:
+        return 0.0, 0.0
+    q = d / stuck_displacement if stuck_displacement > 0.0 else math.inf
+    magnitude = limit if q >= 1.0 else limit * (1.0 - (1.0 - q) ** 1.5)
+    return -magnitude * delta_t / d, -magnitude * delta_tp / d

@@ -71,8 +71,8 @@ def kharaz_section(lay: Layout, kh: xr.Dataset) -> None:
             "(tangential_model = mindlin) adds the Mindlin tangential stiffness 8 G* a with micro-slip and the "
             f"same Coulomb limit; G* = {float(kh['effective_shear_modulus']) / 1e9:.4g} GPa comes from the shear "
             "moduli and Poisson ratios of the materials config and the friction is the nominal one: nothing is "
-            "fitted. Below the sliding threshold it reproduces the dip of the tangential restitution under 5/7 "
-            "and the rebound spin and angle; at the two smallest angles it stays above the measurements.")
+            "fitted. The table gives the RMS of each model per angle range; the figure shows where each departs "
+            "from the measurements.")
     lay.heading("RMS model - measured")
     lay.table(_kharaz_rms(kh), {"quantity": 24, "units": 8, "regime": 12, "nominal": 14, "fitted": 14, "compliant": 14},
               headers={"nominal": "rigid, nominal f", "fitted": "rigid, fitted f", "compliant": "compliant, nominal f"},

@@ -15,12 +15,12 @@ solver is used only where a scene selects something else, so the paper's model p
 
 Formulation: as the engine, nondimensional (xi = x / L, tau = t / T_c) in the Sundman variable
 sigma, d tau = s d sigma with s = sqrt(xi), which keeps the right-hand side smooth where contact
-starts and ends. State (s, y, tau, D, J, J_a, v_t, v_t', w_t, w_t', F_t, F_t') with v the
-centre velocity and w = r omega the rim speeds in units of L / T_c, F the tangential force in
-m L / T_c^2, J = int load dtau and J_a = int s load dtau (load = :func:`friction_load`).
-Dormand-Prince 5(4) with error control on every state; the kinks of the load and of the
-stick/slip switch are resolved by step rejection. After every accepted step the tangential force
-is projected back onto its Coulomb limit. Separation (s = 0, y < 0) is located by secant
+starts and ends. State (s, y, tau, D, J, J_a, v_t, v_t', w_t, w_t', delta_t, delta_t') with v the
+centre velocity and w = r omega the rim speeds in units of L / T_c, delta the tangential
+displacement of the contact in L, J = int load dtau and J_a = int s load dtau (load =
+:func:`friction_load`). Dormand-Prince 5(4) with error control on every state; the kinks of the
+load are resolved by step rejection (the Mindlin force reaches its limit with zero slope, so gross
+slip starts smoothly). After every accepted step the displacement is held at delta* in gross slip. Separation (s = 0, y < 0) is located by secant
 iteration on the step length; capture is the exact energy test of the engine.
 """
 
@@ -41,7 +41,8 @@ _acc = compiled(_law.nondimensional_acceleration)
 _energy = compiled(_law.nondimensional_energy)
 _dissipation = compiled(_law.nondimensional_dissipation_rate)
 _load = compiled(_tc.friction_load)
-_theta = compiled(_tc.microslip_factor)
+_force = compiled(_tc.mindlin_force)
+_dstar = compiled(_tc.mindlin_stuck_displacement)
 
 _N = 12
 _S, _Y, _TAU, _D, _J, _JA, _VT, _VTP, _WT, _WTP, _FT, _FTP = range(_N)
@@ -83,20 +84,13 @@ def _rhs(z, p, out):
         out[i] = 0.0
     if mindlin:
         lim = f * load
-        ft, fp = z[_FT], z[_FTP]
-        mag = math.sqrt(ft * ft + fp * fp)
-        if mag > lim:
-            if mag > 0.0:
-                ft, fp = ft * lim / mag, fp * lim / mag
-        ut = z[_VT] + z[_WTP]
-        up = z[_VTP] - z[_WT]
-        k = kappa * s * _theta(ft, fp, ut, up, lim)
+        ft, fp = _force(z[_FT], z[_FTP], _dstar(kappa * s, lim), lim)
         out[_VT] = s * ft
         out[_VTP] = s * fp
         out[_WTP] = s * krot * ft
         out[_WT] = -s * krot * fp
-        out[_FT] = -s * k * ut
-        out[_FTP] = -s * k * up
+        out[_FT] = s * (z[_VT] + z[_WTP])  # d delta / d tau = u, the slip of the contact point
+        out[_FTP] = s * (z[_VTP] - z[_WT])
 
 
 @njit(cache=True, fastmath=True)
@@ -126,18 +120,15 @@ def _step(z, k1, h, p, k, tmp, z1, err):
 
 @njit(cache=True)
 def _project(z, p):
-    """Scale the tangential force back onto its Coulomb limit f * load at the state z."""
+    """Hold the tangential displacement at delta* (gross slip: the slip beyond it is not stored)."""
     s = max(z[_S], 0.0)
     xi_dd = _acc(s, s * s * s, z[_Y], p[0], p[1], p[2], p[3])
     lim = p[4] * (_load(-xi_dd, p[5], p[6] > 0.5) if s > 0.0 else 0.0)
+    dstar = _dstar(p[7] * s, lim)
     mag = math.sqrt(z[_FT] * z[_FT] + z[_FTP] * z[_FTP])
-    if mag > lim:
-        if lim > 0.0:
-            z[_FT] *= lim / mag
-            z[_FTP] *= lim / mag
-        else:
-            z[_FT] = 0.0
-            z[_FTP] = 0.0
+    if mag > dstar:
+        z[_FT] *= dstar / mag
+        z[_FTP] *= dstar / mag
 
 
 @njit(cache=True)
@@ -174,7 +165,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     atol[_JA] = rtol * sref * sref * yref
     for i in range(_VT, _FT):
         atol[i] = rtol * vref
-    atol[_FT] = atol[_FTP] = rtol * yref * yref / sref
+    atol[_FT] = atol[_FTP] = rtol * sref
     damped = p[0] > 0.0 or p[1] > 0.0
     xe = aa / ah if ah > 0.0 else 0.0
     omega0 = math.sqrt(ah * math.sqrt(xe)) if aa > 0.0 else 1.0
@@ -224,7 +215,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 tau_j = z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
             for i in range(_N):
                 z[i] = z1[i]
-            z[_FT] = z[_FTP] = 0.0  # out of contact: no tangential force
+            z[_FT] = z[_FTP] = 0.0  # out of contact: nothing stored
             break
         if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
             tau_j = z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
