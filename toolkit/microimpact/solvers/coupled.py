@@ -143,6 +143,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
 
     Returns (status, outcome, state at the end (12,), largest xi, tau at capture, tau at which J
     reached j_stop, n_steps).
+
+    Length: set-up, step control, separation, capture and the stop test of one compiled loop;
+    as in the engine, splitting the per-step work into compiled helpers costs speed.
     """
     z = np.zeros(_N)
     z[_Y], z[_VT], z[_VTP], z[_WT], z[_WTP] = y0, vt0, vtp0, wt0, wtp0
@@ -296,6 +299,8 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     ------
     CoupledError
         If an impact reaches the step limit or the step size underflows.
+
+    Length: the SI <-> nondimensional conversion of every input and output in one place.
     """
     from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form map
 
