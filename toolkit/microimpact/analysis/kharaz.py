@@ -25,6 +25,11 @@ deformation, microslip, Maw et al.), which the model does not contain, shows: me
 restitution ABOVE 5/7 at the smallest angles (the elastic tangential spring returns energy) and
 BELOW 5/7 around 10-20 deg.
 
+The tangentially compliant model (``tangential_model="mindlin"``,
+:mod:`microimpact.model.tangential_compliance`) is compared beside it: Mindlin stiffness 8 G* a
+with G* from the shear moduli of the materials config, micro-slip and the same Coulomb friction
+0.092, nothing fitted.
+
 Spin sign convention
 --------------------
 In the toolkit frame (:mod:`microimpact.model.kinematics`) the slip is u_t = v_t + r omega_t', so a
@@ -204,6 +209,7 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         _compare_quantity(ds, q, data[data["quantity"] == q], contact, curves,
                           {"": f_nom, "_fitted": f_fit} if fit_friction else {"": f_nom}, sliding_threshold_deg)
     _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg)
+    _compare_compliant(ds, data, contact.with_(tangential_model="mindlin"), grid, f_nom, sliding_threshold_deg)
     ds.attrs.update({
         "title": "microimpact model vs Kharaz, Gorham & Salman (2001) oblique impacts",
         "source": src,
@@ -269,6 +275,33 @@ def _compare_quantity(ds, q, sub, contact, curves, frictions, sliding_threshold_
             ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
 
 
+def _compare_compliant(ds, data, compliant, grid, friction, sliding_threshold_deg) -> None:
+    """Add the tangentially compliant model (Mindlin stiffness 8 G* a with micro-slip, G* from the
+    materials config, the source's friction: nothing fitted) beside the rigid one.
+
+    Variables ``q_model_compliant``, ``q_difference_compliant`` (per measured angle) and
+    ``q_curve_compliant`` (on the curve grid); attributes ``rms_<q>_<sliding|below|all>_compliant``
+    and, for the rigid model with the nominal friction, ``rms_<q>_all``.
+    """
+    curve = _model(compliant, grid, friction)
+    for q, (units, long_name) in _QUANTITIES.items():
+        sub = data[data["quantity"] == q]
+        a = sub["incidence_angle_deg"].to_numpy()
+        mod = _model(compliant, a, friction)[q]
+        label = f"tangentially compliant (Mindlin, G* = {compliant.shear_modulus / 1e9:.4g} GPa), friction {friction:g}"
+        ds[f"{q}_curve_compliant"] = ("curve_incidence_deg", curve[q], {"units": units, "long_name": f"model {long_name}, {label}"})
+        ds[f"{q}_model_compliant"] = ((q,), mod, {"units": units, "long_name": f"model {long_name}, {label}"})
+        d = mod - sub["value"].to_numpy()
+        ds[f"{q}_difference_compliant"] = ((q,), d, {"units": units, "long_name": "compliant model - measured"})
+        sliding = a > sliding_threshold_deg
+        for regime, mask in (("sliding", sliding), ("below", ~sliding), ("all", np.ones_like(sliding))):
+            ds.attrs[f"rms_{q}_{regime}_compliant"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
+        rigid = ds[f"{q}_difference"].values
+        ds.attrs[f"rms_{q}_all"] = float(np.sqrt(np.mean(rigid**2)))
+    ds["effective_shear_modulus"] = ((), compliant.shear_modulus, {
+        "units": "Pa", "long_name": "effective shear modulus G* of the compliant model (materials config)"})
+
+
 def _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg) -> None:
     """Add the scalar results (frictions, e_n, zeta_H, rolling limit, transition angle) to ``ds``."""
     ds["friction"] = ((), f_nom, attributes("friction", long_name="Coulomb friction coefficient of the nominal model (source value)"))
@@ -284,14 +317,17 @@ def _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg) -> No
 
 
 def kharaz_summary(ds: xr.Dataset) -> pd.DataFrame:
-    """RMS model - measured per quantity and regime (nominal and fitted friction) as a table."""
+    """RMS model - measured per quantity and regime as a table: the rigid model with the nominal
+    and the fitted friction, and the tangentially compliant model (nominal friction)."""
     rows = []
+    th = ds.attrs["sliding_threshold_deg"]
     for q, (units, _) in _QUANTITIES.items():
-        for regime in ("sliding", "below"):
+        for regime in ("sliding", "below", "all"):
             rows.append({"quantity": q, "units": units,
-                         "regime": f"> {ds.attrs['sliding_threshold_deg']:g} deg" if regime == "sliding" else f"<= {ds.attrs['sliding_threshold_deg']:g} deg",
-                         "rms_nominal_friction": ds.attrs[f"rms_{q}_{regime}"],
-                         "rms_fitted_friction": ds.attrs.get(f"rms_{q}_{regime}_fitted", math.nan)})
+                         "regime": {"sliding": f"> {th:g} deg", "below": f"<= {th:g} deg", "all": "all"}[regime],
+                         "rms_nominal_friction": ds.attrs.get(f"rms_{q}_{regime}", math.nan),
+                         "rms_fitted_friction": ds.attrs.get(f"rms_{q}_{regime}_fitted", math.nan),
+                         "rms_compliant": ds.attrs.get(f"rms_{q}_{regime}_compliant", math.nan)})
     return pd.DataFrame(rows)
 
 
@@ -307,5 +343,8 @@ def kharaz_table(ds: xr.Dataset) -> pd.DataFrame:
         if f"{q}_model_fitted" in ds:
             t["model_fitted"] = ds[f"{q}_model_fitted"].values
             t["difference_fitted"] = ds[f"{q}_difference_fitted"].values
+        if f"{q}_model_compliant" in ds:
+            t["model_compliant"] = ds[f"{q}_model_compliant"].values
+            t["difference_compliant"] = ds[f"{q}_difference_compliant"].values
         out.append(t)
     return pd.concat(out, ignore_index=True)

@@ -22,6 +22,7 @@ import jsonschema
 import yaml
 
 from microimpact.model.contact import Contact, adhesion_line_force_from_work, stiffness_from_elastic
+from microimpact.model.tangential_compliance import effective_shear_modulus, shear_modulus_from_elastic
 
 __all__ = ["MaterialPair", "MaterialsError", "read_materials", "default_materials_path", "material_contact",
            "MATERIALS_SCHEMA"]
@@ -51,7 +52,13 @@ _PAIR_SCHEMA = {
         "zeta_hertz": _num("zeta_H, Eq. (15), of the pair used without a fit (the fit ignores it). [-]", minimum=0),
         "zeta_adhesion": _num("zeta_A, Eq. (14), of the pair used without a fit (the fit ignores it). [-]", minimum=0),
         "damping_reference_speed": _num("Fixed reference speed v_n of Eqs. (14)-(15). [m/s]", exclusiveMinimum=0),
+        "shear_modulus_sphere": _num("Shear modulus of the sphere G1 (default E1 / (2 (1 + nu1))). [Pa]",
+                                     exclusiveMinimum=0),
+        "shear_modulus_surface": _num("Shear modulus of the surface G2 (default E2 / (2 (1 + nu2))). [Pa]",
+                                      exclusiveMinimum=0),
     },
+    # the shear moduli need the Poisson ratios (G* = 1 / ((2 - nu1)/G1 + (2 - nu2)/G2))
+    "dependentRequired": {"shear_modulus_sphere": list(_ELASTIC), "shear_modulus_surface": list(_ELASTIC)},
     # either stiffness alone, or all four elastic constants without stiffness
     "oneOf": [
         {"required": ["stiffness"], "not": {"anyOf": [{"required": [k]} for k in _ELASTIC]}},
@@ -110,6 +117,9 @@ class MaterialPair:
         Fixed reference speed of Eqs. (14)-(15); None uses each impact's normal speed. [m/s]
     youngs_modulus_sphere, poisson_sphere, youngs_modulus_surface, poisson_surface : float or None
         Elastic constants E1 [Pa], nu1 [-], E2 [Pa], nu2 [-], when the pair was given that way.
+    shear_modulus_sphere, shear_modulus_surface : float or None
+        Shear moduli G1, G2 when given; else, with the elastic constants, the isotropic
+        E / (2 (1 + nu)) (:attr:`effective_shear_modulus`). [Pa]
     description, reference : str
         Free text.
     """
@@ -126,8 +136,24 @@ class MaterialPair:
     poisson_sphere: float | None = None
     youngs_modulus_surface: float | None = None
     poisson_surface: float | None = None
+    shear_modulus_sphere: float | None = None
+    shear_modulus_surface: float | None = None
     description: str = ""
     reference: str = ""
+
+    @property
+    def effective_shear_modulus(self) -> float | None:
+        """G* = 1 / ((2 - nu1)/G1 + (2 - nu2)/G2) of the Mindlin tangential stiffness 8 G* a. [Pa]
+
+        G1, G2 are the configured shear moduli, or the isotropic E / (2 (1 + nu)) of each material
+        (:mod:`microimpact.model.tangential_compliance`); None for a pair given by its stiffness K
+        alone (no Poisson ratios).
+        """
+        if self.poisson_sphere is None or self.poisson_surface is None:
+            return None
+        g1 = self.shear_modulus_sphere or float(shear_modulus_from_elastic(self.youngs_modulus_sphere, self.poisson_sphere))
+        g2 = self.shear_modulus_surface or float(shear_modulus_from_elastic(self.youngs_modulus_surface, self.poisson_surface))
+        return float(effective_shear_modulus(g1, self.poisson_sphere, g2, self.poisson_surface))
 
     def adhesion_line_force(self, radius: float) -> float:
         """f0 for a sphere of this radius, Eq. (7). [N/m]
@@ -158,7 +184,7 @@ class MaterialPair:
 
 #: fields of a material record that a :class:`~microimpact.Contact` takes (besides the radius)
 _MATERIAL_FIELDS = ("density", "stiffness", "work_of_adhesion", "friction", "zeta_hertz", "zeta_adhesion",
-                    "damping_reference_speed")
+                    "damping_reference_speed", "shear_modulus")
 
 
 def material_contact(material, radius: float, **changes) -> Contact:
@@ -192,6 +218,8 @@ def material_contact(material, radius: float, **changes) -> Contact:
     if isinstance(material, Contact) and not changes:
         return material if radius == material.radius else material.at_radius(radius)
     p = {k: getattr(material, k, None) for k in _MATERIAL_FIELDS} | changes
+    if p["shear_modulus"] is None:  # a MaterialPair holds G1, G2 and the Poisson ratios: G*
+        p["shear_modulus"] = getattr(material, "effective_shear_modulus", None)
     missing = [k for k in ("density", "stiffness", "work_of_adhesion") if p[k] is None]
     if missing:
         raise ValueError(f"a material needs {', '.join(missing)} to build a contact (a MaterialPair, DampingFit "
@@ -199,7 +227,8 @@ def material_contact(material, radius: float, **changes) -> Contact:
     return Contact.from_work_of_adhesion(
         radius, p["density"], p["stiffness"], p["work_of_adhesion"], zeta_hertz=p["zeta_hertz"] or 0.0,
         zeta_adhesion=p["zeta_adhesion"] or 0.0, friction=p["friction"] or 0.0,
-        damping_reference_speed=p["damping_reference_speed"])
+        damping_reference_speed=p["damping_reference_speed"], shear_modulus=p["shear_modulus"],
+        **{k: v for k, v in changes.items() if k not in _MATERIAL_FIELDS})
 
 
 def default_materials_path() -> Path:

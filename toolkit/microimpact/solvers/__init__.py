@@ -4,7 +4,9 @@
 :class:`~microimpact.model.kinematics.ImpactResult` whatever the method:
 
 - ``"engine"``: compiled 1-D normal solve (Dormand-Prince 5(4) in the Sundman form, :mod:`.engine`)
-  plus the closed-form tangential map of :mod:`microimpact.model.tangential`;
+  plus the closed-form tangential map of :mod:`microimpact.model.tangential`; a contact that
+  selects tangential compliance or adhesion-aware friction runs the compiled coupled solver
+  (:mod:`.coupled`) instead, so the paper's model pays nothing for them;
 - ``"reference"``: the full 3-D equations integrated by scipy (:mod:`.reference`);
 - ``"rkg"``: the paper's fixed-step Runge-Kutta-Gill normal solve (:mod:`.rkg`) plus the same map.
 
@@ -25,7 +27,9 @@ METHODS = ("engine", "reference", "rkg")
 #: a contact that selects anything else is refused by :func:`check_sub_models` with a message that
 #: says which method does cover it. Extended as sub-models are implemented.
 SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
-    "engine": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
+    # the engine runs the paper's model (rigid, net) as one normal solve plus the closed-form map and
+    # every other tangential/friction choice with the compiled coupled solver (.coupled)
+    "engine": {"normal_model": ("ring",), "tangential_model": ("rigid", "mindlin"), "friction_model": ("net", "pulloff")},
     "reference": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
     "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
 }

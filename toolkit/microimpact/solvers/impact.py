@@ -233,6 +233,11 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
     if steps is not None and (isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps < 1):
         raise ValueError(f"steps must be a whole number >= 1, got {steps!r}")
     check_sub_models(contact, method)
+    if method == "engine" and _needs_coupled(contact):
+        v_in = incident_velocity(float(speed), float(incidence_deg), float(azimuth_deg))
+        res = _coupled_results(contact, tuple(np.array([x]) for x in v_in), tuple(np.array([w]) for w in omega),
+                               np.array([contact.friction]), rtol)
+        return _coupled_impact_result(contact, v_in, omega, res)
     if method == "reference":
         # imported here: scipy.integrate costs ~0.7 s of import time that the engine never needs
         from microimpact.solvers.reference import simulate_reference
@@ -291,6 +296,56 @@ def _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential) -> 
         final_contact_energy=settled_contact_energy(contact) if captured else 0.0,
         method=method,
         stop_reason="separation" if not captured else ("settled" if needs_tangential else "capture"),
+    )
+
+
+def _needs_coupled(contact) -> bool:
+    """Whether the contact selects a sub-model that the closed-form map alone does not cover."""
+    return contact.tangential_model != "rigid" or contact.friction_model != "net"
+
+
+def _coupled_results(contact, v_in, w_in, f, rtol) -> dict:
+    """The batch results (as :func:`_solve_batch`) of the compiled coupled solver."""
+    from microimpact.solvers.coupled import solve_coupled
+
+    m, inertia = contact.mass, contact.moment_of_inertia
+    c = solve_coupled(contact, v_in, w_in, f, rtol=rtol)
+    captured = c["captured"]
+    vn_out = np.where(captured, 0.0, -c["e_n"] * v_in[0])
+    v_out = (vn_out, c["v_t"], c["v_tp"])
+    w_out = (c["omega_n"], c["omega_t"], c["omega_tp"])
+    coef = impact_coefficients(m, inertia, v_in, w_in, v_out, w_out, captured)
+    kinetic = lambda v, w: 0.5 * m * sum(np.square(x) for x in v) + 0.5 * inertia * sum(np.square(x) for x in w)
+    settled = settled_contact_energy(contact) if contact.adhesion_line_force > 0 else 0.0
+    return {
+        "outcome": captured.astype(np.int8), "e_n": c["e_n"], **{k: coef[k] for k in ("mu_t", "mu_tp", "K_L", "K_t")},
+        "velocity_out_n": vn_out, "velocity_out_t": c["v_t"], "velocity_out_tp": c["v_tp"],
+        "omega_out_n": c["omega_n"], "omega_out_t": c["omega_t"], "omega_out_tp": c["omega_tp"],
+        "contact_time": c["contact_time"], "max_penetration": c["max_penetration"],
+        "slip_ended": c["slip_ended"].astype(np.int8), "friction_impulse": c["friction_impulse"],
+        # everything the sphere lost: kinetic energy in - out, less the contact energy it keeps when captured
+        "dissipated_energy": kinetic(v_in, w_in) - kinetic(v_out, w_out) - np.where(captured, settled, 0.0),
+        "capture_time": c["capture_time"], "slip_end_time": c["slip_end_time"],
+    }
+
+
+def _coupled_impact_result(contact, v_in, w_in, res) -> ImpactResult:
+    """The ImpactResult of one impact of the coupled solver."""
+    one = {k: (v.item() if isinstance(v, np.ndarray) else v) for k, v in res.items()}
+    captured = bool(one["outcome"])
+    return ImpactResult(
+        outcome="capture" if captured else "rebound",
+        **{k: float(one[k]) for k in ("e_n", "mu_t", "mu_tp", "K_L", "K_t")},
+        velocity_in=tuple(float(x) for x in v_in), omega_in=tuple(float(w) for w in w_in),
+        velocity_out=(float(one["velocity_out_n"]), float(one["velocity_out_t"]), float(one["velocity_out_tp"])),
+        omega_out=(float(one["omega_out_n"]), float(one["omega_out_t"]), float(one["omega_out_tp"])),
+        contact_time=float(one["contact_time"]), capture_time=float(one["capture_time"]),
+        max_penetration=float(one["max_penetration"]), slip_ended=bool(one["slip_ended"]),
+        slip_end_time=float(one["slip_end_time"]), friction_impulse=float(one["friction_impulse"]),
+        dissipated_energy=float(one["dissipated_energy"]),
+        final_contact_energy=settled_contact_energy(contact) if captured else 0.0,
+        method=f"engine:coupled ({contact.tangential_model}, {contact.friction_model})",
+        stop_reason="separation" if not captured else "settled",
     )
 
 
@@ -374,7 +429,16 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     _check_scales(contact, flat["speed"], flat["incidence_deg"], (flat["omega_n"], flat["omega_t"], flat["omega_tp"]))
     if family is not None and not isinstance(family, (bool, np.bool_)):
         raise TypeError(f"family must be True, False or None, got {type(family).__name__} {family!r}")
-    results, n_solves, path = _solve_batch(contact, flat, rtol, family)
+    if _needs_coupled(contact):  # one coupled solve per impact
+        alpha, theta = np.radians(flat["incidence_deg"]), np.radians(flat["azimuth_deg"])
+        v = flat["speed"]
+        v_in = (-v * np.cos(alpha), v * np.sin(alpha) * np.cos(theta), v * np.sin(alpha) * np.sin(theta))
+        results = _coupled_results(contact, v_in, (flat["omega_n"], flat["omega_t"], flat["omega_tp"]),
+                                   flat["friction"], rtol)
+        results = {k: results[k] for k in RESULT_VARIABLES}
+        n_solves, path = int(v.size), "coupled: one normal-tangential solve per impact"
+    else:
+        results, n_solves, path = _solve_batch(contact, flat, rtol, family)
     ds = _batch_dataset(arrays, results)
     ds.attrs.update(contact_attributes(contact))
     ds.attrs["solver"] = f"microimpact engine (Dormand-Prince 5(4), rtol={rtol:g})"

@@ -261,6 +261,9 @@ def _dataset(table: _Table, cfg: BenchmarkConfig, speeds, batch_size: int, attrs
 
 
 # =============================================================================== the benchmark
+from microimpact.studies.benchmark.sub_models import sub_model_costs  # noqa: E402
+
+
 def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkConfig | None = None,
                   verbose: bool = False, throughput: bool = True) -> xr.Dataset:
     """Run the work-precision benchmark and return its results.
@@ -306,6 +309,9 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
     _run_scipy(contact, speeds, cases, cfg, table, notes, verbose)
     diag = _engine_diagnostics(contact, batch_speeds, cfg)
     log(f"engine diagnostics: {diag}", verbose)
+    sub_costs = sub_model_costs(contact, np.geomspace(speeds[0], speeds[-1], 8 if cfg.quick else 32),
+                                np.linspace(0.0, 85.0, 8 if cfg.quick else 18), repeats=2 if cfg.quick else 3)
+    log(f"sub-model costs: {sub_costs}", verbose)
 
     targets = accuracy_targets(table.values["time_per_impact"], table.values["max_error_e_n"], cfg, b["e_n"])
     if throughput:
@@ -322,6 +328,7 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
         **_reference_attrs(cfg, reference),
         "notes": json.dumps(notes),
         "engine_diagnostics": json.dumps(diag),
+        "sub_model_costs": json.dumps(sub_costs),
         "total_seconds": time.perf_counter() - t_start,
         "machine_load_average_1min_at_end": load_average(),
         **targets,

@@ -1,0 +1,191 @@
+"""Sub-models beyond the paper: tangential compliance ("mindlin") and adhesion-aware friction
+("pulloff"), :mod:`microimpact.model.tangential_compliance` and :mod:`microimpact.solvers.coupled`.
+
+Checks: the analytic limits (rigid limit of an infinitely stiff tangential contact, the rigid
+gross-sliding line of Maw, Barber & Fawcett (1976) at large non-dimensional incidence, the coupled
+solver against the engine's closed form for the paper's model), an independent scipy integration
+of the compliant equations, the captured sphere with adhesion-aware friction, the materials config
+and the Kharaz et al. (2001) comparison.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from microimpact.analysis.kharaz import KHARAZ_CONDITIONS, _base_contact, kharaz_comparison
+from microimpact.io import default_materials_path, read_materials
+from microimpact.model import tangential_compliance as tc
+from microimpact.presets import WALL_1990
+from microimpact.solvers import check_sub_models
+from microimpact.solvers.impact import simulate_impact, simulate_many
+
+V = KHARAZ_CONDITIONS["speed"]
+
+
+@pytest.fixture(scope="module")
+def alumina():
+    return _base_contact(None)  # Kharaz conditions, e_n = 1, G* from the materials config
+
+
+def test_effective_shear_modulus_from_the_materials_config():
+    pair = read_materials(default_materials_path())["alumina_on_soda_lime_glass"]
+    g1, g2 = 380e9 / (2 * 1.23), 70e9 / (2 * 1.25)  # G = E / (2 (1 + nu))
+    expected = 1.0 / ((2 - 0.23) / g1 + (2 - 0.25) / g2)
+    # the config stores G1 rounded to 5 digits (154.47 GPa): relative 1e-5
+    assert pair.effective_shear_modulus == pytest.approx(expected, rel=1e-5)
+    assert pair.contact(2.5e-3).shear_modulus == pytest.approx(expected, rel=1e-5)
+    # a pair given by its stiffness alone has no Poisson ratios, hence no G*
+    assert read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"].effective_shear_modulus is None
+
+
+def test_mindlin_force_curve():
+    # small displacement: -k_t delta (to first order; relative error ~ (3/4) q = 7.5e-7 at q = 1e-6)
+    k, lim = 2.0, 3.0
+    dstar = tc.mindlin_stuck_displacement(k, lim)
+    assert dstar == 1.5 * lim / k
+    ft, fp = tc.mindlin_force(1e-6 * dstar, 0.0, dstar, lim)
+    assert ft == pytest.approx(-k * 1e-6 * dstar, rel=1e-6) and fp == 0.0
+    # gross slip: the limit, against the displacement (exact)
+    assert tc.mindlin_force(0.0, 2 * dstar, dstar, lim) == (-0.0, -lim)
+    # no limit, no force
+    assert tc.mindlin_force(1.0, 1.0, 0.0, 0.0) == (0.0, 0.0)
+
+
+def test_pulloff_force_is_the_largest_tension_of_the_static_law():
+    c = WALL_1990
+    x = np.linspace(1e-4, 1.0, 200001) * c.length_scale
+    static = math.sqrt(c.radius) * (c.stiffness * x**1.5 - 2 * math.pi * c.adhesion_line_force * np.sqrt(x))
+    # grid spacing 5e-6 X around a quadratic minimum: relative error ~1e-10
+    assert tc.pulloff_force(c) == pytest.approx(-static.min(), rel=1e-8)
+    assert tc.nondimensional_pulloff_force(1.0, 1.0) == pytest.approx(2 / (3 * math.sqrt(3)), rel=1e-15)
+
+
+def test_stiff_tangential_contact_gives_the_rigid_closed_form(alumina):
+    angles = np.array([5.0, 20.0, 45.0])
+    rigid = simulate_many(alumina, V, angles)
+    stiff = simulate_many(alumina.with_(tangential_model="mindlin", shear_modulus=1e3 * alumina.shear_modulus), V, angles)
+    ratio = lambda ds: ds["velocity_out_t"].values / (V * np.sin(np.radians(angles)))  # noqa: E731
+    # the elastic energy still stored at the end of stick scales as 1/sqrt(stiffness ratio): at
+    # 1000 x G* the rolling limit 5/7 is reached to 1e-3 (measured 7e-4); sliding throughout
+    # (45 deg) is the same Coulomb impulse, to the solver tolerance
+    np.testing.assert_allclose(ratio(stiff), ratio(rigid), atol=1.5e-3)
+    assert ratio(stiff)[2] == pytest.approx(ratio(rigid)[2], abs=1e-6)
+    assert ratio(rigid)[0] == pytest.approx(5 / 7, abs=1e-9)
+
+
+def test_maw_barber_fawcett_shape(alumina):
+    """Contact-point rebound u_out / u_in against psi = tan(alpha) / (f (1 + e_n)) * k_t/k_n."""
+    c = alumina.with_(tangential_model="mindlin")
+    ratio_kt_kn = 4 * c.shear_modulus / (0.75 * c.stiffness)  # 8 G* a / (2 E* a), E* = 3 K / 4
+    f = c.friction
+    psi = np.array([0.05, 1.0, 5.0, 10.0])
+    alpha = np.degrees(np.arctan(psi * f * 2 / ratio_kt_kn))
+    assert tc.maw_incidence_parameter(alpha, f, 0.25) == pytest.approx(psi * tc.stiffness_ratio(0.25) / ratio_kt_kn, rel=1e-12)
+    ds = simulate_many(c, V, alpha)
+    u_in = V * np.sin(np.radians(alpha))
+    u_out = (ds["velocity_out_t"] + c.radius * ds["omega_out_tp"]).values
+    r = u_out / u_in
+    # small psi: the contact sticks and the tangential spring returns the contact point forward
+    # (u_out / u_in close to 1: the rebound spin is below the rolling spin)
+    assert r[0] > 0.9
+    # psi ~ 1: the elastic recoil reverses the contact point (spin reversal relative to rolling)
+    assert r[1] < -0.3
+    # large psi: gross sliding all through, the rigid line 1 - (7/2) f (1 + e_n) / tan(alpha),
+    # to the solver tolerance (rtol 1e-8)
+    rigid_line = 1 - 3.5 * f * 2 / np.tan(np.radians(alpha))
+    np.testing.assert_allclose(r[2:], rigid_line[2:], atol=1e-6)
+
+
+def test_compliant_equations_against_an_independent_scipy_integration(alumina):
+    """Hertz normal force, Mindlin tangential force, rigid-body tangential motion, integrated in
+    time with scipy (no Sundman form, no projection) for an impact that sticks (f = 10)."""
+    c = alumina.with_(tangential_model="mindlin", friction=10.0)
+    alpha = math.radians(10.0)
+    m, r, inertia = c.mass, c.radius, c.moment_of_inertia
+    k_h = math.sqrt(r) * c.stiffness
+
+    def rhs(_t, z):
+        x, xd, vt, wtp, d = z
+        xp = max(x, 0.0)
+        fn = k_h * xp**1.5
+        a = math.sqrt(r * xp)
+        kt = float(tc.tangential_stiffness(c.shear_modulus, a))
+        ft, _ = tc.mindlin_force(d, 0.0, tc.mindlin_stuck_displacement(kt, c.friction * fn), c.friction * fn)
+        return [xd, -fn / m, ft / m, r * ft / inertia, vt + r * wtp]
+
+    def sep(_t, z):
+        return z[0]
+
+    sep.terminal, sep.direction = True, -1
+    z0 = [0.0, V * math.cos(alpha), V * math.sin(alpha), 0.0, 0.0]
+    sol = solve_ivp(rhs, (0.0, 1e-3), z0, method="DOP853", rtol=1e-11, atol=1e-15, events=sep)
+    vt_ref = sol.y[2, -1]
+    res = simulate_impact(c, V, 10.0, rtol=1e-10)
+    # both to ~1e-9 relative; 1e-6 allows for the non-smooth start of contact in the scipy run
+    assert res.velocity_out[1] == pytest.approx(vt_ref, rel=1e-6)
+    assert res.e_n == pytest.approx(1.0, abs=1e-6)
+
+
+def test_coupled_solver_reproduces_the_engine_for_the_paper_model():
+    """The coupled path with the paper's friction law, forced, against the closed form."""
+    from microimpact.solvers.impact import _coupled_results
+
+    v_in = (np.array([-3.0, -0.5]), np.array([2.0, 4.0]), np.array([0.5, 0.0]))
+    w_in = (np.array([1e5, 0.0]), np.array([0.0, 0.0]), np.array([0.0, 0.0]))
+    got = _coupled_results(WALL_1990, v_in, w_in, np.array([0.15, 0.15]), 1e-10)
+    for i in range(2):
+        v = float(np.sqrt(sum(x[i] ** 2 for x in v_in)))
+        inc = math.degrees(math.acos(-v_in[0][i] / v))
+        az = math.degrees(math.atan2(v_in[2][i], v_in[1][i]))
+        ref = simulate_impact(WALL_1990, v, inc, az, omega=tuple(w[i] for w in w_in), rtol=1e-10)
+        assert bool(got["outcome"][i]) == (ref.outcome == "capture")
+        # two integrators at rtol 1e-10 each: 1e-7 on e_n; a captured sphere is stopped by the
+        # coupled solver at an oscillation amplitude of 1e-6 X (SETTLE_AMPLITUDE), whose friction
+        # impulse still to come is of that relative order: 1e-6 on the tangential outcome
+        assert got["e_n"][i] == pytest.approx(ref.e_n, abs=1e-7)
+        assert got["velocity_out_t"][i] == pytest.approx(ref.velocity_out[1], rel=1e-6)
+        assert got["omega_out_n"][i] == pytest.approx(ref.omega_out[0], rel=1e-6, abs=1e-3)
+
+
+@pytest.mark.parametrize("incidence", [82.0, 87.0, 89.9])  # captured: v_n < 1.45 m/s
+def test_adhesion_aware_friction_stops_a_captured_sphere(incidence):
+    paper = simulate_impact(WALL_1990, 10.0, incidence, omega=(2.6e5, 0.0, 0.0))
+    aware = simulate_impact(WALL_1990.with_(friction_model="pulloff"), 10.0, incidence, omega=(2.6e5, 0.0, 0.0))
+    assert aware.outcome == "capture"
+    v_t0 = 10.0 * math.sin(math.radians(incidence))
+    # slip ended: rolling at 5/7 of the incident tangential speed (exact for a rigid contact), no twist
+    assert aware.slip_ended
+    assert aware.velocity_out[1] == pytest.approx(5 / 7 * v_t0, rel=1e-9)
+    # twist stopped: zero up to the round-off of omega_0 - k J_a at the stop (2.6e5 rad/s x 1e-16)
+    assert abs(aware.omega_out[0]) < 1e-9
+    assert aware.omega_out[2] == pytest.approx(-5 / 7 * v_t0 / WALL_1990.radius, rel=1e-9)
+    if incidence == 89.9:  # the paper's law leaves the grazing sphere sliding and twisting
+        assert paper.velocity_out[1] == pytest.approx(9.66, abs=0.01)
+        assert not paper.slip_ended and paper.omega_out[0] > 1e5
+
+
+def test_sub_model_coverage():
+    c = WALL_1990.with_(tangential_model="mindlin", shear_modulus=1e9)
+    check_sub_models(c, "engine")
+    with pytest.raises(ValueError, match="method='engine'"):
+        check_sub_models(c, "reference")
+
+
+def test_kharaz_rigid_and_compliant():
+    ds = kharaz_comparison(fit_friction=False, curve_incidence_deg=[10.0, 45.0])
+    rms = {k: v for k, v in ds.attrs.items() if k.startswith("rms_tangential_restitution")}
+    # the rigid model's figures of issue 14 (0.075 RMS below 30 deg with the fitted friction; 0.054
+    # over all angles with the nominal friction); compliant above 30 deg within the target 0.03
+    assert rms["rms_tangential_restitution_sliding_compliant"] < 0.03
+    d = ds["tangential_restitution_difference_compliant"].values
+    a = ds["tangential_restitution_incidence_deg"].values
+    # from 9 deg on the compliant model is within 0.08 of every measurement (measured: 0.075 at 9.5 deg)
+    assert np.all(np.abs(d[a > 9.0]) < 0.08)
+    # rebound spin and angle: the compliant model is closer than the rigid one below 30 deg
+    for q in ("rebound_spin", "rebound_angle"):
+        assert ds.attrs[f"rms_{q}_below_compliant"] < ds.attrs[f"rms_{q}_below"]
+    assert float(ds["effective_shear_modulus"]) == pytest.approx(1.352e10, rel=1e-3)

@@ -1,0 +1,275 @@
+"""Contact models beyond the paper: tangential compliance (Mindlin) and adhesion-aware friction.
+
+Each formula is written here once. The SI functions take arrays; the nondimensional ones
+(:func:`friction_load`, :func:`microslip_factor`, :func:`mindlin_force_rate`) are scalar arithmetic
+that numba compiles into the coupled solver (:mod:`microimpact.solvers.coupled`) and that the scipy
+reference solver calls as they are.
+
+Tangential compliance ("mindlin")
+---------------------------------
+The paper's contact is tangentially rigid: friction f |F_n| acts against the slip of the contact
+point and stops when the slip does. Real contacts deform tangentially: a Hertz contact of radius a
+between two elastic bodies has the tangential stiffness (Mindlin 1949; Johnson 1985, Sec. 7.2)
+
+    k_t = 8 G* a,    1/G* = (2 - nu_1)/G_1 + (2 - nu_2)/G_2,
+
+so that, for identical Poisson ratios, k_t / k_n = 2 (1 - nu) / (2 - nu) with k_n = 2 E* a the normal
+contact stiffness. Micro-slip -- the annulus of the contact that slips before the whole contact
+does -- softens the contact as the tangential force approaches the Coulomb limit F_lim. Mindlin's
+load-displacement relation of a sphere under a normal load and a growing tangential displacement
+delta (Mindlin 1949; Johnson 1985, Eqs. (7.40)-(7.42)) gives the force
+
+    F_t = -F_lim [1 - (1 - |delta| / delta*)^(3/2)] delta / |delta|,   delta* = 3 F_lim / (2 k_t),
+
+which is -k_t delta for small displacements, reaches the limit with zero slope at |delta| =
+delta* (micro-slip has spread over the whole contact) and is F_lim in gross sliding, where the
+displacement is held at delta* (the slip beyond it is not stored). The state is the tangential
+displacement of the contact, d delta / dt = u (the contact-point slip velocity); F_lim and k_t
+follow the normal solve at every instant. This is the monotonic-loading curve of
+Mindlin & Deresiewicz (1953), without their unloading/reloading memory (it is elastic below
+gross slip); a simplification like that of the DEM forms compared by Di Renzo & Di Maio (2004).
+With micro-slip switched off (F_t = -k_t delta up to the limit) it is their "no-slip" Mindlin
+model; as k_t grows without bound it becomes the rigid contact of the paper.
+
+Adhesion-aware friction ("pulloff")
+-----------------------------------
+The paper's Coulomb limit is f |F_n| with F_n the NET normal force (Hertz plus adhesion plus
+damping). At the adhesive equilibrium F_n = 0, so a captured sphere slides and spins without
+friction for ever. In an adhesive contact the friction is set by the contact area, which the
+adhesion keeps finite; Thornton & Yin (1991) therefore take the Coulomb limit relative to the
+pull-off force F_po,
+
+    F_lim = f |F_n + 2 F_po|,
+
+which equals f F_n-like sliding friction for a large compressive load and 2 f F_po at the adhesive
+equilibrium. For the paper's ring force the pull-off force is the largest tension of the static
+law F_H + F_A = sqrt(r) (K x^(3/2) - 2 pi f0 x^(1/2)), reached at x = X/3:
+
+    F_po = (4 pi / 3) f0 sqrt(r X / 3)      (:func:`pulloff_force`).
+
+References
+----------
+.. [1] Mindlin, R. D. (1949), Compliance of elastic bodies in contact, J. Appl. Mech. 16:259-268.
+.. [2] Mindlin, R. D. and Deresiewicz, H. (1953), Elastic spheres in contact under varying oblique
+   forces, J. Appl. Mech. 20:327-344.
+.. [3] Johnson, K. L. (1985), Contact Mechanics, Cambridge University Press, Sec. 7.2.
+.. [4] Maw, N., Barber, J. R. and Fawcett, J. N. (1976), The oblique impact of elastic spheres,
+   Wear 38:101-114, doi:10.1016/0043-1648(76)90201-7.
+.. [5] Walton, O. R. and Braun, R. L. (1986), Viscosity, granular-temperature, and stress
+   calculations for shearing assemblies of inelastic, frictional disks, J. Rheol. 30:949-980.
+.. [6] Thornton, C. (1991), Interparticle sliding in the presence of adhesion, J. Phys. D 24:1942-1946.
+.. [7] Thornton, C. and Yin, K. K. (1991), Impact of elastic spheres with and without adhesion,
+   Powder Technol. 65:153-166, doi:10.1016/0032-5910(91)80178-L.
+.. [8] Di Renzo, A. and Di Maio, F. P. (2004), Comparison of contact-force models for the
+   simulation of collisions in DEM-based granular flow codes, Chem. Eng. Sci. 59:525-541,
+   doi:10.1016/j.ces.2003.09.037.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "shear_modulus_from_elastic",
+    "effective_shear_modulus",
+    "tangential_stiffness",
+    "stiffness_ratio",
+    "pulloff_force",
+    "nondimensional_pulloff_force",
+    "nondimensional_tangential_stiffness",
+    "friction_load",
+    "mindlin_force",
+    "mindlin_stuck_displacement",
+    "maw_incidence_parameter",
+]
+
+
+# =============================================================================== SI forms
+def shear_modulus_from_elastic(youngs_modulus, poisson):
+    """Shear modulus of an isotropic material, G = E / (2 (1 + nu)). [Pa]
+
+    Parameters
+    ----------
+    youngs_modulus : array_like
+        Young's modulus E. [Pa]
+    poisson : array_like
+        Poisson ratio nu. [-]
+
+    References
+    ----------
+    Timoshenko, S. P. and Goodier, J. N. (1970), Theory of Elasticity, 3rd ed., McGraw-Hill, Sec. 6.
+    """
+    return np.asarray(youngs_modulus, dtype=float) / (2.0 * (1.0 + np.asarray(poisson, dtype=float)))
+
+
+def effective_shear_modulus(shear_sphere, poisson_sphere, shear_surface, poisson_surface):
+    """Effective shear modulus G* = 1 / ((2 - nu_1)/G_1 + (2 - nu_2)/G_2). [Pa]
+
+    Parameters
+    ----------
+    shear_sphere, shear_surface : float
+        Shear moduli G_1, G_2. [Pa]
+    poisson_sphere, poisson_surface : float
+        Poisson ratios nu_1, nu_2. [-]
+
+    Notes
+    -----
+    With it the Mindlin (1949) tangential stiffness of a contact of radius a is k_t = 8 G* a
+    (Johnson 1985, Eq. 7.42 summed over both bodies; Di Renzo & Di Maio 2004, Table 1).
+    """
+    return 1.0 / ((2.0 - poisson_sphere) / shear_sphere + (2.0 - poisson_surface) / shear_surface)
+
+
+def tangential_stiffness(shear_modulus, contact_radius):
+    """Mindlin tangential stiffness of a contact without slip, k_t = 8 G* a. [N/m]
+
+    Parameters
+    ----------
+    shear_modulus : float
+        Effective shear modulus G*, :func:`effective_shear_modulus`. [Pa]
+    contact_radius : array_like
+        Contact radius a. [m]
+    """
+    return 8.0 * shear_modulus * np.asarray(contact_radius, dtype=float)
+
+
+def stiffness_ratio(poisson):
+    """k_t / k_n = 2 (1 - nu) / (2 - nu) of a Hertz-Mindlin contact of like materials. [-]
+
+    k_n = dF_H/dx = 2 E* a is the normal contact stiffness (Johnson 1985, Sec. 7.2).
+
+    Parameters
+    ----------
+    poisson : array_like
+        Poisson ratio nu. [-]
+    """
+    nu = np.asarray(poisson, dtype=float)
+    return 2.0 * (1.0 - nu) / (2.0 - nu)
+
+
+def maw_incidence_parameter(incidence_deg, friction, poisson, normal_restitution=1.0):
+    """Non-dimensional incidence psi = tan(alpha) / (f (1 + e_n)) * 2 (1 - nu) / (2 - nu). [-]
+
+    Maw, Barber & Fawcett (1976) and Thornton & Yin (1991) plot the rebound against this
+    parameter (their Psi_1 for e_n = 1 is 2 psi): below about 1 the contact sticks over most of
+    the impact and the tangential elasticity reverses the contact-point velocity; at large psi the
+    sphere slides throughout and follows rigid-body Coulomb theory.
+
+    Parameters
+    ----------
+    incidence_deg : array_like
+        Incidence angle from the surface normal. [deg]
+    friction : float
+        Coulomb coefficient f. [-]
+    poisson : float
+        Poisson ratio nu (like materials). [-]
+    normal_restitution : float
+        e_n of the impact. [-]
+    """
+    t = np.tan(np.radians(np.asarray(incidence_deg, dtype=float)))
+    return t / (friction * (1.0 + normal_restitution)) * stiffness_ratio(poisson)
+
+
+def pulloff_force(contact):
+    """Pull-off force of the paper's ring adhesion, F_po = (4 pi / 3) f0 sqrt(r X / 3). [N]
+
+    The largest tension of the static normal law F_H + F_A = sqrt(r) (K x^(3/2) - 2 pi f0 x^(1/2))
+    (Eqs. (2), (5)), at x = X/3 with X = 2 pi f0 / K (Eq. (29)). Zero without adhesion.
+
+    Parameters
+    ----------
+    contact : Contact
+    """
+    x = contact.length_scale / 3.0
+    return 4.0 * math.pi / 3.0 * contact.adhesion_line_force * math.sqrt(contact.radius * x)
+
+
+def nondimensional_pulloff_force(a_h, a_a):
+    """F_po in the solvers' force unit m L / T_c^2: the largest tension of a_h xi^(3/2) - a_a xi^(1/2). [-]
+
+    Reached at xi = a_a / (3 a_h): F_po = (2 / (3 sqrt(3))) a_a^(3/2) / a_h^(1/2); 0 without
+    adhesion. In the paper's scales (a_h = a_a = 1) it is 0.3849.
+
+    Parameters
+    ----------
+    a_h, a_a : float
+        Hertz and adhesion coefficients of :func:`microimpact.model.law.nondimensional_acceleration`. [-]
+    """
+    if a_a <= 0.0:
+        return 0.0
+    return 2.0 / (3.0 * math.sqrt(3.0)) * a_a**1.5 / math.sqrt(a_h)
+
+
+def nondimensional_tangential_stiffness(contact, scales) -> float:
+    """kappa = 8 G* sqrt(r L) T_c^2 / m: the Mindlin stiffness in the solvers' units is kappa s. [-]
+
+    With xi = x / L and s = sqrt(xi) the contact radius is a = sqrt(r L) s (Eq. (6)), so
+    k_t T_c^2 / m = kappa s.
+
+    Parameters
+    ----------
+    contact : Contact
+        Must have ``shear_modulus`` (G*). [Pa]
+    scales : microimpact.model.law.Scales
+        L [m] and T_c [s] of the impact.
+    """
+    return 8.0 * contact.shear_modulus * math.sqrt(contact.radius * scales.length) * scales.time**2 / contact.mass
+
+
+# =============================================================================== nondimensional forms
+# Scalar arithmetic (numba compiles them into the coupled solver; see the module docstring).
+def friction_load(normal_force, pulloff, adhesion_aware):
+    """The load L with Coulomb limit F_lim = f L: |F_n| (the paper's) or |F_n + 2 F_po|. [N] or [-]
+
+    Parameters
+    ----------
+    normal_force : float
+        Net normal force F_n (positive pushes the sphere off the surface). [N] or nondimensional
+    pulloff : float
+        Pull-off force F_po in the same unit.
+    adhesion_aware : bool
+        True for the "pulloff" friction model (Thornton & Yin 1991), False for the paper's "net".
+    """
+    if adhesion_aware:
+        return abs(normal_force + 2.0 * pulloff)
+    return abs(normal_force)
+
+
+def mindlin_stuck_displacement(stiffness, limit):
+    """delta* = 3 F_lim / (2 k_t): the displacement at which the whole contact slips. [m] or [-]
+
+    Parameters
+    ----------
+    stiffness : float
+        k_t = 8 G* a (:func:`tangential_stiffness`). [N/m] or nondimensional
+    limit : float
+        Coulomb limit F_lim. [N] or nondimensional
+    """
+    if stiffness <= 0.0:
+        return 0.0
+    return 1.5 * limit / stiffness
+
+
+def mindlin_force(delta_t, delta_tp, stuck_displacement, limit):
+    """Tangential force (F_t, F_t') of Mindlin's micro-slip contact at the displacement delta. [N]
+
+    F = -F_lim [1 - (1 - |delta| / delta*)^(3/2)] delta / |delta| for |delta| < delta*, and
+    -F_lim delta / |delta| beyond (gross slip); see the module docstring.
+
+    Parameters
+    ----------
+    delta_t, delta_tp : float
+        Tangential displacement of the contact (integral of the slip velocity). [m] or nondimensional
+    stuck_displacement : float
+        delta* of :func:`mindlin_stuck_displacement`. [m] or nondimensional
+    limit : float
+        Coulomb limit F_lim >= 0. [N] or nondimensional
+    """
+    d = math.sqrt(delta_t * delta_t + delta_tp * delta_tp)
+    if d == 0.0 or limit <= 0.0:
+        return 0.0, 0.0
+    q = d / stuck_displacement if stuck_displacement > 0.0 else math.inf
+    magnitude = limit if q >= 1.0 else limit * (1.0 - (1.0 - q) ** 1.5)
+    return -magnitude * delta_t / d, -magnitude * delta_tp / d

@@ -1,0 +1,378 @@
+"""Compiled coupled solver for the sub-models beyond the paper: tangential compliance and
+adhesion-aware friction (:mod:`microimpact.model.tangential_compliance`).
+
+The paper's model (tangentially rigid, friction f |F_n|) needs one normal solve and the closed-form
+tangential map (:mod:`microimpact.solvers.engine`, :mod:`microimpact.model.tangential`). This
+solver is used only where a scene selects something else, so the paper's model pays nothing:
+
+* ``friction_model="pulloff"`` with the rigid contact: the slip still falls linearly with the
+  friction impulse, now f int |F_n + 2 F_po| dt, so the closed-form map still applies; the normal
+  solve here accumulates that impulse (and int a |F_n + 2 F_po| dt for the twist) instead of the
+  total variation of the normal rate that the engine uses.
+* ``tangential_model="mindlin"``: the tangential force is a state (elastic, with micro-slip and a
+  Coulomb limit), integrated together with the normal motion, the tangential velocity and the
+  spins. The twist about n keeps its closed form (its torque depends on the normal solve only).
+
+Formulation: as the engine, nondimensional (xi = x / L, tau = t / T_c) in the Sundman variable
+sigma, d tau = s d sigma with s = sqrt(xi), which keeps the right-hand side smooth where contact
+starts and ends. State (s, y, tau, D, J, J_a, v_t, v_t', w_t, w_t', delta_t, delta_t') with v the
+centre velocity and w = r omega the rim speeds in units of L / T_c, delta the tangential
+displacement of the contact in L, J = int load dtau and J_a = int s load dtau (load =
+:func:`friction_load`). Dormand-Prince 5(4) with error control on every state; the kinks of the
+load are resolved by step rejection (the Mindlin force reaches its limit with zero slope, so gross
+slip starts smoothly). After every accepted step the displacement is held at delta* in gross slip. Separation (s = 0, y < 0) is located by secant
+iteration on the step length; capture is the exact energy test of the engine.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from microimpact.model import law as _law
+from microimpact.model import tangential_compliance as _tc
+from microimpact.solvers.compiled_law import compiled
+
+__all__ = ["coupled_kernel", "coupled_many", "CoupledError"]
+
+_acc = compiled(_law.nondimensional_acceleration)
+_energy = compiled(_law.nondimensional_energy)
+_dissipation = compiled(_law.nondimensional_dissipation_rate)
+_load = compiled(_tc.friction_load)
+_force = compiled(_tc.mindlin_force)
+_dstar = compiled(_tc.mindlin_stuck_displacement)
+
+_N = 12
+_S, _Y, _TAU, _D, _J, _JA, _VT, _VTP, _WT, _WTP, _FT, _FTP = range(_N)
+_OK, _MAX_STEPS, _UNDERFLOW = 0, 1, 2
+
+_A = np.array([
+    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
+    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
+])
+_B = np.array([35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0])
+_E = np.array([71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0])
+
+
+class CoupledError(RuntimeError):
+    """The coupled solver could not finish an impact (step limit or step-size underflow)."""
+
+
+@njit(cache=True, fastmath=True)
+def _rhs(z, p, out):
+    """d/dsigma of the state z; p = (c1, c2, a_h, a_a, f, F_po, adhesion_aware, kappa, k_rot, mindlin)."""
+    c1, c2, ah, aa, f, fpo, aware, kappa, krot, mindlin = p[0], p[1], p[2], p[3], p[4], p[5], p[6] > 0.5, p[7], p[8], p[9] > 0.5
+    s = z[_S]
+    y = z[_Y]
+    if s < 0.0:
+        s = 0.0
+    xi_dd = _acc(s, s * s * s, y, c1, c2, ah, aa)  # xi'' = -F_n
+    load = _load(-xi_dd, fpo, aware) if s > 0.0 else 0.0
+    out[_S] = 0.5 * y
+    out[_Y] = s * xi_dd
+    out[_TAU] = s
+    out[_D] = s * _dissipation(s, s * s * s, y, c1, c2, ah, aa)
+    out[_J] = s * load
+    out[_JA] = s * s * load
+    for i in range(_VT, _N):
+        out[i] = 0.0
+    if mindlin:
+        lim = f * load
+        ft, fp = _force(z[_FT], z[_FTP], _dstar(kappa * s, lim), lim)
+        out[_VT] = s * ft
+        out[_VTP] = s * fp
+        out[_WTP] = s * krot * ft
+        out[_WT] = -s * krot * fp
+        out[_FT] = s * (z[_VT] + z[_WTP])  # d delta / d tau = u, the slip of the contact point
+        out[_FTP] = s * (z[_VTP] - z[_WT])
+
+
+@njit(cache=True, fastmath=True)
+def _step(z, k1, h, p, k, tmp, z1, err):
+    """One Dormand-Prince 5(4) step of length h from z (derivative k1); k[6] = f(z1)."""
+    for i in range(_N):
+        k[0, i] = k1[i]
+    for st in range(1, 6):
+        for i in range(_N):
+            acc = 0.0
+            for j in range(st):
+                acc += _A[st, j] * k[j, i]
+            tmp[i] = z[i] + h * acc
+        _rhs(tmp, p, k[st])
+    for i in range(_N):
+        acc = 0.0
+        for j in range(6):
+            acc += _B[j] * k[j, i]
+        z1[i] = z[i] + h * acc
+    _rhs(z1, p, k[6])
+    for i in range(_N):
+        acc = 0.0
+        for j in range(7):
+            acc += _E[j] * k[j, i]
+        err[i] = h * acc
+
+
+@njit(cache=True)
+def _project(z, p):
+    """Hold the tangential displacement at delta* (gross slip: the slip beyond it is not stored)."""
+    s = max(z[_S], 0.0)
+    xi_dd = _acc(s, s * s * s, z[_Y], p[0], p[1], p[2], p[3])
+    lim = p[4] * (_load(-xi_dd, p[5], p[6] > 0.5) if s > 0.0 else 0.0)
+    dstar = _dstar(p[7] * s, lim)
+    mag = math.sqrt(z[_FT] * z[_FT] + z[_FTP] * z[_FTP])
+    if mag > dstar:
+        z[_FT] *= dstar / mag
+        z[_FTP] *= dstar / mag
+
+
+@njit(cache=True)
+def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max_steps):
+    """Integrate one impact of the coupled model (nondimensional; see the module docstring).
+
+    Parameters (all nondimensional): y0 incident normal rate; vt0, vtp0 tangential velocity;
+    wt0, wtp0 rim speeds r omega_t, r omega_t'; p the law's parameters (see :func:`_rhs`); j_stop,
+    ja_stop the impulses after which a captured sphere's sliding and twist are over (rigid
+    contact); settle the oscillation amplitude (relative to the equilibrium) at which a captured
+    sphere is taken to be at rest.
+
+    Returns (status, outcome, state at the end (12,), largest xi, tau at capture, tau at which J
+    reached j_stop, n_steps).
+
+    Length: set-up, step control, separation, capture and the stop test of one compiled loop;
+    as in the engine, splitting the per-step work into compiled helpers costs speed.
+    """
+    z = np.zeros(_N)
+    z[_Y], z[_VT], z[_VTP], z[_WT], z[_WTP] = y0, vt0, vtp0, wt0, wtp0
+    k = np.zeros((7, _N))
+    tmp = np.zeros(_N)
+    z1 = np.zeros(_N)
+    err = np.zeros(_N)
+    k1 = np.zeros(_N)
+    _rhs(z, p, k1)
+    ah, aa = p[2], p[3]
+    yref = max(1.0, y0)
+    sref = max(1.0, y0 ** 0.4)
+    vref = max(yref, abs(vt0) + abs(wtp0), abs(vtp0) + abs(wt0))
+    atol = np.empty(_N)
+    atol[_S] = rtol * sref
+    atol[_Y] = rtol * yref
+    atol[_TAU] = rtol * sref
+    atol[_D] = rtol * 0.5 * yref * yref
+    atol[_J] = rtol * sref * yref
+    atol[_JA] = rtol * sref * sref * yref
+    for i in range(_VT, _FT):
+        atol[i] = rtol * vref
+    atol[_FT] = atol[_FTP] = rtol * sref
+    damped = p[0] > 0.0 or p[1] > 0.0
+    xe = aa / ah if ah > 0.0 else 0.0
+    omega0 = math.sqrt(ah * math.sqrt(xe)) if aa > 0.0 else 1.0
+    ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
+    h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
+    if y0 < 1.0:
+        h = min(1e-3 * (12.0 / y0) ** (1.0 / 3.0), 1e-2)
+    captured = False
+    tau_cap = math.nan
+    tau_j = math.nan
+    smax = 0.0
+    n = 0
+    status = _OK
+    outcome = 0
+    while True:
+        if n >= max_steps:
+            status = _MAX_STEPS
+            break
+        _step(z, k1, h, p, k, tmp, z1, err)
+        en = 0.0
+        for i in range(_N):
+            en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
+        en = math.sqrt(en / _N)
+        n += 1
+        if en > 1.0:
+            h *= max(0.2, 0.9 * en ** -0.2)
+            if h < 1e-300:
+                status = _UNDERFLOW
+                break
+            continue
+        if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: secant on the step length
+            a, fa, b, fb = 0.0, z[_S], h, z1[_S]
+            for _ in range(60):
+                hs = b - fb * (b - a) / (fb - fa)
+                if not (a < hs < b):
+                    hs = 0.5 * (a + b)
+                _step(z, k1, hs, p, k, tmp, z1, err)
+                if abs(z1[_S]) <= 1e-14 * sref or (b - a) < 1e-14 * h:
+                    break
+                if z1[_S] > 0.0:
+                    a, fa = hs, z1[_S]
+                else:
+                    b, fb = hs, z1[_S]
+            z1[_S] = 0.0
+            outcome = 0
+            if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
+                tau_j = z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
+            for i in range(_N):
+                z[i] = z1[i]
+            z[_FT] = z[_FTP] = 0.0  # out of contact: nothing stored
+            break
+        if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
+            tau_j = z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
+        for i in range(_N):
+            z[i] = z1[i]
+        if p[9] > 0.5:
+            _project(z, p)
+            _rhs(z, p, k1)
+        else:
+            for i in range(_N):
+                k1[i] = k[6, i]
+        smax = max(smax, z[_S])
+        if not captured and damped and aa > 0.0 and _energy(z[_S], z[_Y], ah, aa) < ecap:
+            captured = True
+            tau_cap = z[_TAU]
+        if captured:
+            dx = z[_S] * z[_S] - xe
+            amp = math.sqrt(dx * dx + (z[_Y] / omega0) ** 2) / xe
+            if (z[_J] >= j_stop and z[_JA] >= ja_stop) or amp < settle:
+                outcome = 1
+                break
+        h *= 5.0 if en == 0.0 else min(5.0, max(0.2, 0.9 * en ** -0.2))
+    return status, outcome, z, smax * smax, tau_cap, tau_j, n
+
+
+@njit(cache=True, parallel=True)
+def coupled_many(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max_steps, out_state, out_info):
+    """:func:`coupled_kernel` for many impacts in parallel; p has one row per impact.
+
+    Writes the end states into ``out_state`` (n, 12) and (status, outcome, largest xi, tau at
+    capture, tau at slip end, n_steps) into ``out_info`` (n, 6).
+    """
+    for i in prange(y0.shape[0]):
+        r = coupled_kernel(y0[i], vt0[i], vtp0[i], wt0[i], wtp0[i], p[i], rtol, j_stop[i], ja_stop[i], settle,
+                           max_steps)
+        for j in range(_N):
+            out_state[i, j] = r[2][j]
+        out_info[i, 0] = r[0]
+        out_info[i, 1] = r[1]
+        out_info[i, 2] = r[3]
+        out_info[i, 3] = r[4]
+        out_info[i, 4] = r[5]
+        out_info[i, 5] = r[6]
+
+
+#: amplitude of the captured normal oscillation, relative to the equilibrium penetration, below
+#: which a captured sphere is taken to be at rest (its tangential state no longer changes by more
+#: than this fraction of the friction impulse of one period)
+SETTLE_AMPLITUDE = 1e-6
+
+_MAX_STEPS = 2_000_000
+
+
+def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _MAX_STEPS) -> dict:
+    """Impacts of a contact that selects tangential compliance or adhesion-aware friction.
+
+    Parameters
+    ----------
+    contact : Contact
+        ``tangential_model`` "rigid" or "mindlin", ``friction_model`` "net" or "pulloff".
+    velocity_in : tuple of 3 arrays
+        (v_n, v_t, v_t') before contact, v_n < 0, broadcast to one shape. [m/s]
+    omega_in : tuple of 3 arrays
+        (omega_n, omega_t, omega_t') before contact. [rad/s]
+    friction : array
+        Coulomb coefficient f per impact. [-]
+    rtol : float
+        Relative tolerance of the integration. [-]
+
+    Returns
+    -------
+    dict of 1-D arrays (SI): ``captured``, ``e_n``, ``v_t``, ``v_tp`` [m/s], ``omega_n``,
+    ``omega_t``, ``omega_tp`` [rad/s], ``contact_time``, ``capture_time``, ``slip_end_time`` [s],
+    ``max_penetration`` [m], ``friction_impulse`` (int of the friction load, |F_n| or
+    |F_n + 2 F_po|) [N s], ``slip_ended`` (bool), ``n_steps``.
+
+    Raises
+    ------
+    CoupledError
+        If an impact reaches the step limit or the step size underflows.
+
+    Length: the SI <-> nondimensional conversion of every input and output in one place.
+    """
+    from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form map
+
+    v_n, v_t, v_tp = (np.ascontiguousarray(a, dtype=float).ravel() for a in np.broadcast_arrays(*velocity_in))
+    w_n, w_t, w_tp = (np.ascontiguousarray(np.broadcast_to(a, v_n.shape), dtype=float) for a in omega_in)
+    f = np.ascontiguousarray(np.broadcast_to(friction, v_n.shape), dtype=float)
+    speed = -v_n
+    sc, y0, c1, c2 = _law.nondimensional_impact(contact, speed)
+    u = np.broadcast_to(sc.speed, speed.shape)
+    length = np.broadcast_to(sc.length, speed.shape)
+    time = np.broadcast_to(sc.time, speed.shape)
+    m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
+    mindlin = contact.tangential_model == "mindlin"
+    aware = contact.friction_model == "pulloff"
+    fpo = _tc.nondimensional_pulloff_force(sc.a_hertz, sc.a_adhesion)
+    p = np.empty((speed.size, 10))
+    p[:, 0] = np.broadcast_to(c1, speed.shape)
+    p[:, 1] = np.broadcast_to(c2, speed.shape)
+    p[:, 2], p[:, 3] = sc.a_hertz, sc.a_adhesion
+    p[:, 4] = f
+    p[:, 5] = fpo
+    p[:, 6] = 1.0 if aware else 0.0
+    p[:, 7] = (8.0 * contact.shear_modulus * np.sqrt(r * length) * time**2 / m) if mindlin else 0.0
+    p[:, 8] = m * r * r / inertia
+    p[:, 9] = 1.0 if mindlin else 0.0
+    slip = np.hypot(v_t + r * w_tp, v_tp - r * w_t)
+    if mindlin:
+        j_stop = np.full(speed.size, np.inf)
+        ja_stop = np.zeros(speed.size)
+    else:
+        j_star, ja_star = stop_impulses(m, inertia, f, slip, w_n)
+        j_stop, ja_stop = j_star / (m * u), ja_star / (m * u * np.sqrt(r * length))
+    j_unit = m * u
+    ja_unit = j_unit * np.sqrt(r * length)
+    states = np.empty((speed.size, _N))
+    info = np.empty((speed.size, 6))
+    coupled_many(np.ascontiguousarray(y0 * np.ones(speed.shape)), v_t / u, v_tp / u, r * w_t / u, r * w_tp / u,
+                 p, float(rtol), np.ascontiguousarray(j_stop), np.ascontiguousarray(ja_stop), SETTLE_AMPLITUDE,
+                 int(max_steps), states, info)
+    bad = info[:, 0] != _OK
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        what = "step limit reached" if info[i, 0] == _MAX_STEPS else "step size underflow"
+        raise CoupledError(f"coupled solver failed for normal speed {float(speed[i])!r} m/s: {what} "
+                           f"after {int(info[i, 5])} steps")
+    captured = info[:, 1] == 1
+    jl = states[:, _J] * j_unit
+    jal = states[:, _JA] * ja_unit
+    if mindlin:
+        # the twist keeps its closed form (torque (3 pi/16) f a load); the tangential state is integrated
+        tw = tangential_outcome(m, inertia, r, f, (v_n, v_t, v_tp), (w_n, w_t, w_tp), 0.0, jal)
+        out = {"v_t": states[:, _VT] * u, "v_tp": states[:, _VTP] * u, "omega_n": tw["omega_n"],
+               "omega_t": states[:, _WT] * u / r, "omega_tp": states[:, _WTP] * u / r}
+        slip_out = np.hypot(out["v_t"] + r * out["omega_tp"], out["v_tp"] - r * out["omega_t"])
+        slip_ended = slip_out <= 1e-9 * np.maximum(slip, 1e-300)
+        slip_end_time = np.full(speed.size, np.nan)
+    else:
+        tan = tangential_outcome(m, inertia, r, f, (v_n, v_t, v_tp), (w_n, w_t, w_tp), jl, jal)
+        out = {k: tan[k] for k in ("v_t", "v_tp", "omega_n", "omega_t", "omega_tp")}
+        slip_ended = tan["slip_ended"]
+        slip_end_time = np.where(slip == 0.0, 0.0, info[:, 4] * time)
+        slip_end_time = np.where(slip_ended, slip_end_time, np.nan)
+    return {
+        "captured": captured,
+        "e_n": np.where(captured, 0.0, -states[:, _Y] / (y0 * np.ones(speed.shape))),
+        **out,
+        "contact_time": np.where(captured, np.inf, states[:, _TAU] * time),
+        "capture_time": info[:, 3] * time,
+        "slip_end_time": slip_end_time,
+        "max_penetration": info[:, 2] * length,
+        "friction_impulse": jl,
+        "dissipated_normal": states[:, _D] * j_unit * u,
+        "slip_ended": np.asarray(slip_ended, dtype=bool),
+        "n_steps": info[:, 5].astype(np.int64),
+    }
