@@ -105,6 +105,13 @@ class FitProblem:
         groups = tuple(np.flatnonzero(inverse == i) for i in range(radii.size))
         return cls(tuple(float(r) for r in radii), groups, v, base)
 
+    def subset(self, rows) -> "FitProblem":
+        """The problem restricted to the points ``rows`` (indices in the data order)."""
+        radius = np.empty(self.normal_speed.size)
+        for r, idx in zip(self.radii, self.groups):
+            radius[idx] = r
+        return FitProblem.from_arrays(radius[rows], self.normal_speed[rows], self.material)
+
     def contact(self, radius, zeta_hertz, zeta_adhesion, work_of_adhesion) -> Contact:
         """The Contact of one radius [m] at trial zetas [-] and w_A [J/m^2], f0 from Eq. (7)."""
         return material_contact(self.material, radius, zeta_hertz=zeta_hertz, zeta_adhesion=zeta_adhesion,
@@ -113,7 +120,9 @@ class FitProblem:
 
 def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_adhesion, *, rtol=DEFAULT_RTOL,
                       speed_factor=1.0) -> np.ndarray:
-    """Model e_n of every point, Eqs. (21), (27): one engine call per distinct radius.
+    """Model e_n of every point, Eqs. (21), (27): one engine call per distinct radius (a
+    restitution family of the normal speed when a radius has thousands of distinct speeds,
+    :func:`microimpact.solvers.family.normal_restitution`).
 
     Parameters
     ----------
@@ -132,12 +141,12 @@ def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_ad
     numpy.ndarray
         e_n in the data order; 0 where the model predicts capture. [-]
     """
-    from microimpact.solvers import engine  # numba start-up only when solving (see the imports)
+    from microimpact.solvers.family import normal_restitution  # numba start-up only when solving
 
     out = np.empty(problem.normal_speed.size)
     for r, idx in zip(problem.radii, problem.groups):
         c = problem.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion)
-        out[idx] = engine.solve_normal_many(c, problem.normal_speed[idx] * speed_factor, rtol=rtol)["e_n"]
+        out[idx] = normal_restitution(c, problem.normal_speed[idx] * speed_factor, rtol=rtol)
     return out
 
 
@@ -374,11 +383,23 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
                       weighting=weighting, scale_covar=bool(scale_covar), info=info)
 
 
+#: points of a large data set that represent it on the start grid (:func:`_grid_start`)
+GRID_START_POINTS = 400
+
+
 def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol):
-    """((zeta_H, zeta_A) of least chi-square on the start grid, number of evaluations)."""
+    """((zeta_H, zeta_A) of least chi-square on the start grid, number of evaluations).
+
+    The grid only picks the basin the least-squares fit starts in, so a large data set is
+    represented by GRID_START_POINTS points spread evenly over it (a 100,000-row fit would
+    otherwise spend most of its time here)."""
     gh, ga = (np.asarray(g, dtype=float).ravel() for g in start_grid)
     if gh.size == 0 or ga.size == 0 or np.any(gh < 0) or np.any(ga < 0):
         raise ValueError("start_grid must be two non-empty arrays of zeta values >= 0")
+    if e_n.size > GRID_START_POINTS:
+        rows = np.unique(np.linspace(0, e_n.size - 1, GRID_START_POINTS).round().astype(int))
+        problem, e_n = problem.subset(rows), e_n[rows]
+        sigma = sigma[rows] if np.ndim(sigma) else sigma
     best = (math.inf, gh[0], ga[0])
     for zh in gh:
         for za in ga:

@@ -52,7 +52,13 @@ from microimpact.model.coefficients import coefficients_kernel
 from microimpact.model.tangential import tangential_kernel
 from microimpact.solvers import DEFAULT_RTOL, engine
 
-__all__ = ["NormalFamily", "normal_family", "FamilyBudgetExceeded", "DEGREE", "GUARD"]
+__all__ = ["NormalFamily", "normal_family", "normal_restitution", "FamilyBudgetExceeded", "DEGREE", "GUARD",
+           "FAMILY_MIN_SPEEDS"]
+
+#: from this many distinct normal speeds on, :func:`normal_restitution` and
+#: :func:`microimpact.simulate_many` consider the interpolated family (a family costs a few hundred
+#: to a few thousand normal solves, docs/benchmark.md)
+FAMILY_MIN_SPEEDS = 2000
 
 #: degree of the Chebyshev interpolant on each piece
 DEGREE = 16
@@ -215,6 +221,8 @@ class NormalFamily:
     max_check_error : float
         Largest error found at the check points of the accepted pieces, in tolerance units
         (absolute or relative as above). [-]
+    restitution_only : bool
+        Only e_n (and the outcome) is interpolated; the other outputs are NaN.
     """
 
     contact: object
@@ -228,6 +236,7 @@ class NormalFamily:
     coefficients: np.ndarray = field(repr=False)
     n_solves: int = 0
     max_check_error: float = 0.0
+    restitution_only: bool = False
 
     @property
     def n_pieces(self) -> int:
@@ -261,6 +270,8 @@ class NormalFamily:
         """Whole impacts (flat float arrays; speed [m/s], angles [deg], spins [rad/s], friction [-])
         in one compiled pass; returns ({BATCH_VARIABLES name: array}, mask of the impacts in a
         guard band, whose rows the caller must fill by direct solves)."""
+        if self.restitution_only:
+            raise ValueError("a restitution_only family has no impulses for the tangential map")
         c = self.contact
         n = speed.size
         out = np.empty((len(BATCH_VARIABLES), n))
@@ -289,6 +300,10 @@ class NormalFamily:
             "final_energy": np.where(captured, settled, kinetic * e_n * e_n),
             "n_steps": np.zeros(v.size, dtype=np.int64),
         }
+        if self.restitution_only:  # not interpolated
+            for k in ("contact_time", "max_penetration", "friction_impulse", "twist_impulse", "dissipated_energy",
+                      "final_energy"):
+                out[k] = np.full(v.size, np.nan)
         if np.any(use_direct):
             idx = np.flatnonzero(use_direct)
             # guard bands lie at capture speeds, where the nodes use the tightest tolerance too
@@ -329,7 +344,7 @@ def _capture_brackets(contact, lo: float, hi: float, rtol: float) -> list[tuple[
 
 
 def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = DEFAULT_RTOL,
-                  max_solves: int | None = None) -> NormalFamily:
+                  max_solves: int | None = None, restitution_only: bool = False) -> NormalFamily:
     """Build the interpolated family of normal solves of ``contact`` over [speed_min, speed_max].
 
     Parameters
@@ -341,6 +356,9 @@ def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = 
         Interpolation tolerance, verified at non-node points (see the module docstring). [-]
     max_solves : int, optional
         Budget of normal solves; :class:`FamilyBudgetExceeded` when building needs more.
+    restitution_only : bool
+        Interpolate e_n only (a fit): the other outputs are not checked (NaN from
+        :meth:`NormalFamily.evaluate`), and capture branches, where e_n = 0, cost no solves.
 
     Returns
     -------
@@ -360,7 +378,7 @@ def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = 
     # the capture speed at the tightest tolerance: e_n ~ (v_n - v_c)^(1/2) makes the e_n of a
     # rebound just above v_c as sensitive to v_c as 1 / (v_n - v_c)
     brackets = _capture_brackets(contact, lo, hi, NODE_RTOL_FLOOR)
-    builder = _Builder(contact, rtol, node_rtol, max_solves)
+    builder = _Builder(contact, rtol, node_rtol, max_solves, restitution_only)
     starts = [lo] + [b for _, b in brackets]
     ends = [a for a, _ in brackets] + [hi]
     for a, b in zip(starts, ends):
@@ -376,14 +394,15 @@ def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = 
         edges=edges, captured=np.array([p[2] for p in pieces], dtype=bool),
         direct=np.array([p[3] for p in pieces], dtype=bool),
         coefficients=np.stack([p[4] for p in pieces]),
-        n_solves=builder.n_solves + 0, max_check_error=builder.worst)
+        n_solves=builder.n_solves + 0, max_check_error=builder.worst, restitution_only=restitution_only)
 
 
 class _Builder:
     """Adaptive refinement of the pieces, one batch of normal solves per level (both cores)."""
 
-    def __init__(self, contact, rtol, node_rtol, max_solves):
+    def __init__(self, contact, rtol, node_rtol, max_solves, restitution_only=False):
         self.contact, self.rtol, self.node_rtol, self.max_solves = contact, rtol, node_rtol, max_solves
+        self.checked = [0] if restitution_only else list(range(len(_OUTPUTS)))  # rows held to rtol
         self.todo = []  # (left, right, captured) in ln v
         self.done = []  # (left, right, captured, direct, coefficients)
         self.n_solves = 0
@@ -395,6 +414,9 @@ class _Builder:
         captured = bool(engine.solve_normal_many(self.contact, np.array([mid]), rtol=self.node_rtol)["captured"][0])
         self.n_solves += 1
         xa, xb = math.log(a), math.log(b)
+        if captured and self.checked == [0]:  # e_n = 0 on a capture branch: nothing to solve
+            self.done.append((xa, xb, True, False, np.zeros((len(_OUTPUTS), DEGREE + 1))))
+            return
         n = max(1, math.ceil((xb - xa) / PIECE_WIDTH))
         cuts = np.linspace(xa, xb, n + 1)
         self.todo += [(cuts[i], cuts[i + 1], captured) for i in range(n)]
@@ -439,7 +461,7 @@ class _Builder:
         at_checks = at_checks.copy()
         at_checks[0] = np.sqrt(at_checks[0])
         finite = np.isfinite(at_checks) & np.isfinite(predicted)
-        err = np.where(finite, np.abs(predicted - at_checks), np.where(at_checks == predicted, 0.0, np.inf))
+        err = np.where(finite, np.abs(predicted - at_checks), np.where(at_checks == predicted, 0.0, np.inf))[self.checked]
         worst = math.inf if mixed else float(err.max()) / self.rtol
         if worst <= 0.5:
             self.worst = max(self.worst, worst)
@@ -449,3 +471,20 @@ class _Builder:
         else:
             m = 0.5 * (a + b)
             self.todo += [(a, m, captured), (m, b, captured)]
+
+
+def normal_restitution(contact, normal_speed, *, rtol: float = DEFAULT_RTOL, family: bool | None = None) -> np.ndarray:
+    """e_n at many normal speeds [m/s] (a fit's model): one direct engine solve per distinct speed,
+    or, for many distinct speeds, a restitution-only family (``family`` None chooses, True/False
+    force) when it costs fewer than half as many solves. [-]"""
+    v = np.asarray(normal_speed, dtype=float).ravel()
+    if family or (family is None and v.size >= FAMILY_MIN_SPEEDS):
+        speeds, inverse = np.unique(v, return_inverse=True)
+        if family or speeds.size >= FAMILY_MIN_SPEEDS:
+            try:
+                fam = normal_family(contact, float(speeds[0]), float(speeds[-1]), rtol=rtol, restitution_only=True,
+                                    max_solves=None if family else speeds.size // 2)
+                return fam.evaluate(speeds)["e_n"][inverse]
+            except FamilyBudgetExceeded:
+                pass
+    return engine.solve_normal_many(contact, v, rtol=rtol)["e_n"]

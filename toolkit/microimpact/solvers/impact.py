@@ -21,7 +21,7 @@ import xarray as xr
 from microimpact.io.provenance import contact_attributes
 from microimpact.io.variables import attributes
 from microimpact.solvers import DEFAULT_RTOL, METHODS, check_sub_models, engine
-from microimpact.solvers.family import FamilyBudgetExceeded, normal_family
+from microimpact.solvers.family import FAMILY_MIN_SPEEDS, FamilyBudgetExceeded, normal_family
 from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
 from microimpact.model.contact import Contact
 from microimpact.model.law import contact_potential_energy, nondimensional_scales
@@ -34,10 +34,6 @@ __all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES", "MIN_RTOL", "
 #: smallest relative tolerance accepted: 100 machine epsilons, as scipy's solve_ivp (below it no
 #: double-precision integration can meet the tolerance, and the engine ends at its step limit)
 MIN_RTOL = 100.0 * sys.float_info.epsilon
-
-#: simulate_many considers the interpolated family from this many distinct normal speeds on (a
-#: family costs a few hundred to a few thousand normal solves, docs/benchmark.md)
-FAMILY_MIN_SPEEDS = 2000
 
 #: the variables that simulate_many returns (units and long names in microimpact.io.variables)
 RESULT_VARIABLES: tuple[str, ...] = (

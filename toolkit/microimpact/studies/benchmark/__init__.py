@@ -19,6 +19,9 @@ What is measured (all in one run, on one machine, side by side)
   ``engine``          :func:`microimpact.simulate_impact` one call per impact (Python overhead incl.)
   ``engine_batch``    :func:`microimpact.solvers.engine.solve_normal_many` on a batch of distinct speeds
                       (both cores); oblique errors through :func:`microimpact.simulate_many`
+  ``engine_family``   :func:`microimpact.solvers.family.normal_family` built over the test set's
+                      speeds and evaluated on many distinct speeds (build included in the time per
+                      impact); oblique errors through :func:`microimpact.simulate_many` on the family path
   ``rkg``             fixed-step Runge-Kutta-Gill (Gill 1951) on the plain Eq. (27) in tau, the
                       paper's method, numba-compiled, batch over both cores (``prange``)
   ``RK45``, ``DOP853``, ``LSODA``, ``Radau``

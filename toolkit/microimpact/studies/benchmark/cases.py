@@ -26,7 +26,7 @@ __all__ = [
 ]
 
 SCIPY_METHODS = ("RK45", "DOP853", "LSODA", "Radau")
-ALL_METHODS = ("engine", "engine_batch", "rkg") + SCIPY_METHODS
+ALL_METHODS = ("engine", "engine_batch", "engine_family", "rkg") + SCIPY_METHODS
 
 #: Targets of the brief (evaluated, not assumed)
 TARGET_ERROR = 1e-8  # at this max e_n error ...
@@ -102,6 +102,11 @@ class BenchmarkConfig:
     memory_sizes: tuple
     time_limit: float
     reference_rtols: tuple = (1e-12, 1e-13)
+    #: engine_family: distinct normal speeds per evaluation; impacts of the family target and how
+    #: many of them are checked against tight direct solves
+    family_size: int = 100_000
+    family_impacts: int = 1_000_000
+    family_check: int = 20_000
     contact_name: str = "WALL_1990"
     notes: tuple = field(default_factory=tuple)
 
@@ -123,7 +128,7 @@ class BenchmarkConfig:
             engine_levels=(0, 2, 4, 6, 8), scipy_levels=(0, 2, 4), rkg_levels=(0, 2, 4, 6),
             oblique=_OBLIQUE_QUICK, repeats_single=5, repeats_scipy=1, repeats_batch=3, batch_size=1000,
             throughput_impacts=20_000, throughput_repeats=1, memory_sizes=(2_000, 20_000), time_limit=1.0,
-            reference_rtols=(1e-11, 1e-12),
+            reference_rtols=(1e-11, 1e-12), family_size=20_000, family_impacts=100_000, family_check=3_000,
         )
 
     @property

@@ -210,6 +210,8 @@ def _timing_modes(cfg: BenchmarkConfig, batch_size: int, threads: int) -> list[s
         "engine": f"single call: simulate_impact, median over repeats ({cfg.repeats_single}) and speeds",
         "engine_batch": f"batch of {batch_size} distinct speeds: engine.solve_normal_many, "
                         f"{threads} threads, median of {cfg.repeats_batch}",
+        "engine_family": f"family built over the test speeds and evaluated at {cfg.family_size} distinct speeds "
+                         f"(build included), {threads} threads, median of {cfg.repeats_batch}",
         "rkg": f"batch of {batch_size} distinct speeds: numba prange, {threads} threads, median of {cfg.repeats_batch}",
         **{m: f"single call: simulate_reference(method={m!r}, atol=rtol), median over repeats "
               f"({cfg.repeats_scipy}) and speeds" for m in SCIPY_METHODS},
@@ -261,6 +263,7 @@ def _dataset(table: _Table, cfg: BenchmarkConfig, speeds, batch_size: int, attrs
 
 
 # =============================================================================== the benchmark
+from microimpact.studies.benchmark.family import family_targets, run_engine_family  # noqa: E402
 from microimpact.studies.benchmark.sub_models import sub_model_costs  # noqa: E402
 
 
@@ -305,6 +308,7 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
     batch_speeds = np.geomspace(speeds[0], speeds[-1], cfg.batch_size)
     _run_engine(contact, speeds, cases, cfg, table, verbose)
     _run_engine_batch(contact, speeds, batch_speeds, cases, cfg, table, verbose)
+    run_engine_family(contact, speeds, cases, cfg, table, verbose)
     _run_rkg(contact, speeds, batch_speeds, cfg, table, verbose)
     _run_scipy(contact, speeds, cases, cfg, table, notes, verbose)
     diag = _engine_diagnostics(contact, batch_speeds, cfg)
@@ -316,6 +320,8 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
     targets = accuracy_targets(table.values["time_per_impact"], table.values["max_error_e_n"], cfg, b["e_n"])
     if throughput:
         targets.update(throughput_targets(contact, cfg, verbose))
+        targets.update(family_targets(contact, cfg, table.values["time_per_impact"], table.values["max_error_e_n"],
+                                      verbose))
     attrs.update({
         "title": "work-precision benchmark of the microimpact solvers",
         "contact": cfg.contact_name,

@@ -1,0 +1,139 @@
+"""The family path in the benchmark: its own method line and the million-impact target.
+
+``engine_family`` builds :func:`microimpact.solvers.family.normal_family` over the test set's speed
+range at each rtol and evaluates it on ``cfg.family_size`` distinct normal speeds; its time per
+impact includes the build. :func:`family_targets` runs ``cfg.family_impacts`` oblique impacts with
+distinct normal speeds through :func:`microimpact.simulate_many` (family path), measures the
+largest e_n error against tight direct engine solves on a random subset, and compares the wall
+time with 100 scipy DOP853 impacts at the target error, taken from the same run's table.
+"""
+
+from __future__ import annotations
+
+import gc
+import math
+import tracemalloc
+
+import numpy as np
+
+from microimpact.solvers import engine
+from microimpact.solvers.family import normal_family
+from microimpact.solvers.impact import simulate_many
+from microimpact.studies.benchmark.cases import ALL_METHODS, BenchmarkConfig, level_rtol
+from microimpact.studies.benchmark.harness import ObliqueResults, log, timed
+
+__all__ = ["run_engine_family", "family_targets", "FAMILY_TARGET_ERROR", "FAMILY_TARGET_DOP853_IMPACTS"]
+
+#: the million impacts must reach this largest e_n error ...
+FAMILY_TARGET_ERROR = 1e-9
+#: ... in at most the time of this many DOP853 impacts at the same or looser error
+FAMILY_TARGET_DOP853_IMPACTS = 100
+#: tolerance of the direct solves that judge the family (10,000x tighter than the family's)
+_JUDGE_RTOL = 1e-13
+
+
+def _family_oblique(contact, cases, rtol) -> ObliqueResults:
+    """The oblique cases in one simulate_many call on the family path."""
+    om = np.array([case.omega(contact.radius) for case in cases])
+    ds = simulate_many(contact, [c.speed for c in cases], [c.incidence_deg for c in cases],
+                       [c.azimuth_deg for c in cases], (om[:, 0], om[:, 1], om[:, 2]),
+                       [c.friction for c in cases], rtol=rtol, family=True)
+    obl = ObliqueResults(len(cases))
+    obl.captured = ds["outcome"].values == 1
+    obl.mu_t, obl.mu_tp, obl.K_L = ds["mu_t"].values, ds["mu_tp"].values, ds["K_L"].values
+    return obl
+
+
+def run_engine_family(contact, speeds, cases, cfg: BenchmarkConfig, table, verbose: bool) -> None:
+    """``engine_family``: build the family and evaluate it on ``cfg.family_size`` distinct speeds."""
+    family_speeds = np.geomspace(speeds[0], speeds[-1], cfg.family_size)
+    for k in cfg.engine_levels:
+        rt = level_rtol(k)
+        table.set("rtol", "engine_family", k, rt)
+
+        def build_and_evaluate(rt=rt):
+            fam = normal_family(contact, speeds[0], speeds[-1], rtol=rt)
+            fam.evaluate(family_speeds)
+            return fam
+
+        t, fam = timed(build_and_evaluate, cfg.repeats_batch)
+        table.record("engine_family", k, t / family_speeds.size, fam.evaluate(speeds)["e_n"],
+                     _family_oblique(contact, cases, rt), family_speeds.size, steps=fam.n_solves)
+        log(f"engine_family rtol {rt:g}: {t / family_speeds.size * 1e6:.3f} us/impact, {fam.n_solves} solves",
+            verbose)
+
+
+def _dop853_time(tpi, err) -> tuple[float, float, str]:
+    """DOP853's time per impact [s] and error at the loosest setting that reaches
+    FAMILY_TARGET_ERROR (the cheapest at that error), or its most accurate (a lower bound)."""
+    i = ALL_METHODS.index("DOP853")
+    ok = np.isfinite(tpi[i]) & (err[i] <= FAMILY_TARGET_ERROR)
+    if ok.any():
+        j = int(np.flatnonzero(ok)[np.argmin(tpi[i][ok])])
+        return float(tpi[i, j]), float(err[i, j]), ""
+    fin = np.flatnonzero(np.isfinite(tpi[i]) & np.isfinite(err[i]))
+    if not fin.size:
+        return math.nan, math.nan, "DOP853 gave no result"
+    j = int(fin[np.argmin(err[i][fin])])
+    return float(tpi[i, j]), float(err[i, j]), "DOP853 did not reach 1e-9: its most accurate setting, a lower bound"
+
+
+def _million_batch(contact, n, seed=2026):
+    rng = np.random.default_rng(seed)
+    speed = np.exp(rng.uniform(np.log(0.3), np.log(30.0), n))
+    inc = rng.uniform(0.0, 85.0, n)
+    az = rng.uniform(0.0, 360.0, n)
+    w = speed * np.sin(np.radians(inc)) / contact.radius
+    om = (rng.uniform(-1, 1, n) * w, rng.uniform(-5, 5, n) * w, rng.uniform(-5, 5, n) * w)
+    fric = rng.uniform(0.05, 0.6, n)
+    return speed, inc, az, om, fric
+
+
+def _peak_bytes(contact, n) -> tuple[int, int]:
+    """(tracemalloc peak, output bytes) of simulate_many on the family path for ``n`` impacts."""
+    speed, inc, az, om, fric = _million_batch(contact, n, seed=7)
+    gc.collect()
+    tracemalloc.start()
+    base = tracemalloc.get_traced_memory()[0]
+    ds = simulate_many(contact, speed, inc, az, om, fric, rtol=FAMILY_TARGET_ERROR, family=True)
+    peak = tracemalloc.get_traced_memory()[1] - base
+    tracemalloc.stop()
+    return int(peak), int(ds.nbytes)
+
+
+def family_targets(contact, cfg: BenchmarkConfig, tpi, err, verbose: bool = False) -> dict:
+    """The million-impact target of the family path, its e_n error and memory growth."""
+    n = cfg.family_impacts
+    speed, inc, az, om, fric = _million_batch(contact, n)
+    simulate_many(contact, speed[:3000], inc[:3000], az[:3000], tuple(o[:3000] for o in om), fric[:3000],
+                  rtol=FAMILY_TARGET_ERROR, family=True)  # compiled before timing
+    t, ds = timed(lambda: simulate_many(contact, speed, inc, az, om, fric, rtol=FAMILY_TARGET_ERROR, family=True),
+                  cfg.throughput_repeats)
+    idx = np.random.default_rng(1).choice(n, min(n, cfg.family_check), replace=False)
+    judge = simulate_many(contact, speed[idx], inc[idx], az[idx], tuple(o[idx] for o in om), fric[idx],
+                          rtol=_JUDGE_RTOL, family=False)
+    e_err = float(np.max(np.abs(ds["e_n"].values[idx] - judge["e_n"].values)))
+    t_dop, e_dop, note = _dop853_time(tpi, err)
+    budget = FAMILY_TARGET_DOP853_IMPACTS * t_dop
+    (p0, o0), (p1, o1) = (_peak_bytes(contact, m) for m in cfg.memory_sizes)
+    log(f"family: {n:,} oblique impacts in {t:.2f} s, e_n error {e_err:.2e}; 100 DOP853 impacts {budget:.2f} s",
+        verbose)
+    return {
+        "family_impacts": n,
+        "family_seconds": t,
+        "family_seconds_per_impact": t / n,
+        "family_max_error_e_n": e_err,
+        "family_error_checked_on": int(idx.size),
+        "family_normal_solves": int(ds.attrs["normal_solves"]),
+        "family_path": ds.attrs["normal_solve_path"],
+        "family_dop853_time_per_impact": t_dop,
+        "family_dop853_error_e_n": e_dop,
+        "family_dop853_note": note,
+        "family_ratio_per_impact": t_dop / (t / n),
+        "family_target_error": FAMILY_TARGET_ERROR,
+        "family_target_dop853_impacts": FAMILY_TARGET_DOP853_IMPACTS,
+        "family_target_met": bool(t <= budget and e_err <= FAMILY_TARGET_ERROR),
+        "family_memory_peak_growth": p1 / p0,
+        "family_memory_output_growth": o1 / o0,
+        "family_memory_target_met": bool(p1 / p0 <= 1.1 * o1 / o0),
+    }
