@@ -133,7 +133,7 @@ def small_benchmark():
         oblique=(ObliqueCase(5.0, 30.0, 0.0, 0.0, 0.0, 1.0, 0.5), ObliqueCase(2.0, 45.0, 0.0, 0.0, 0.0, 0.0, 0.5)),
         repeats_single=1, repeats_scipy=1, repeats_batch=1, batch_size=100,
         throughput_impacts=2000, throughput_repeats=1, memory_sizes=(500, 2000), time_limit=5.0,
-        reference_rtols=(1e-10, 1e-11),
+        reference_rtols=(1e-10, 1e-11), family_size=3000, family_impacts=5000, family_check=300, fit_rows=300,
     )
     return benchmark.run_benchmark(config=cfg)
 
@@ -166,6 +166,16 @@ def test_benchmark_dataset_structure(small_benchmark):
     # engine errors fall with tolerance
     e = ds["max_error_e_n"].sel({"method": "engine"}).isel(setting=[0, 2, 4]).values
     assert e[0] > e[1] > e[2]
+    # the family line: its interpolation error (tolerance rtol, checked at rtol / 2) stays within
+    # the direct engine's own error at the same rtol plus rtol, and falls with it
+    fam = ds["max_error_e_n"].sel({"method": "engine_family"}).isel(setting=[0, 2, 4]).values
+    rt = ds["rtol"].sel({"method": "engine_family"}).isel(setting=[0, 2, 4]).values
+    assert np.all(fam <= e + rt) and fam[0] > fam[1] > fam[2]
+    for key in ("family_seconds", "family_max_error_e_n", "family_ratio_per_impact", "family_target_met",
+                "family_memory_target_met", "fit_time_ratio", "fit_target_met"):
+        assert key in ds.attrs, key
+    assert ds.attrs["family_max_error_e_n"] <= 1e-9  # the family target's error, at its rtol 1e-9
+    assert ds.attrs["family_path"].startswith("family")
 
 
 def test_write_benchmark(small_benchmark, tmp_path):

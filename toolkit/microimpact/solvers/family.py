@@ -435,9 +435,10 @@ class _Builder:
                     self._solve_pieces(pieces, captured, NODE_RTOL_FLOOR if near else self.node_rtol)
 
     def _near_capture(self, piece) -> bool:
-        """Whether a piece lies within NEAR_CAPTURE (in ln v_n) of a capture speed, where e_n's
-        sensitivity to the capture speed, 1 / (v_n - v_c), calls for the tightest node solves."""
-        return any(piece[0] - NEAR_CAPTURE <= x <= piece[1] + NEAR_CAPTURE for x in self.capture_logs)
+        """Whether a rebound piece lies within NEAR_CAPTURE (in ln v_n) of a capture speed, where
+        e_n's sensitivity to the capture speed, 1 / (v_n - v_c), calls for the tightest node solves
+        (e_n is 0 on the capture side)."""
+        return not piece[2] and any(piece[0] - NEAR_CAPTURE <= x <= piece[1] + NEAR_CAPTURE for x in self.capture_logs)
 
     def _solve_pieces(self, pieces, captured, node_rtol) -> None:
         left = np.array([p[0] for p in pieces])[:, None]

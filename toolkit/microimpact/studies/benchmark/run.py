@@ -263,7 +263,7 @@ def _dataset(table: _Table, cfg: BenchmarkConfig, speeds, batch_size: int, attrs
 
 
 # =============================================================================== the benchmark
-from microimpact.studies.benchmark.family import family_targets, run_engine_family  # noqa: E402
+from microimpact.studies.benchmark.family import family_targets, fit_scaling, run_engine_family  # noqa: E402
 from microimpact.studies.benchmark.sub_models import sub_model_costs  # noqa: E402
 
 
@@ -322,6 +322,7 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
         targets.update(throughput_targets(contact, cfg, verbose))
         targets.update(family_targets(contact, cfg, table.values["time_per_impact"], table.values["max_error_e_n"],
                                       verbose))
+        targets.update(fit_scaling((100, cfg.fit_rows), verbose=verbose))
     attrs.update({
         "title": "work-precision benchmark of the microimpact solvers",
         "contact": cfg.contact_name,
