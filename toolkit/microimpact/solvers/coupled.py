@@ -12,6 +12,12 @@ solver is used only where a scene selects something else, so the paper's model p
 * ``tangential_model="mindlin"``: the tangential force is a state (elastic, with micro-slip and a
   Coulomb limit), integrated together with the normal motion, the tangential velocity and the
   spins. The twist about n keeps its closed form (its torque depends on the normal solve only).
+* ``tangential_model="mindlin_deresiewicz"``: the hysteretic law; the state z[10] is the branch
+  coordinate p (smooth right-hand side), the branch (s, c) and the slip direction e are carried
+  beside the state, and each turning point (s u.e changes sign) is located by secant iteration on
+  the step length, where the branch switches with the force continuous.
+* ``rolling_friction > 0`` (with either compliant model): the torque mu_r r |F_n| against
+  (omega_t, omega_t').
 
 Formulation: as the engine, nondimensional (xi = x / L, tau = t / T_c) in the Sundman variable
 sigma, d tau = s d sigma with s = sqrt(xi), which keeps the right-hand side smooth where contact
@@ -378,16 +384,18 @@ def coupled_many(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max
 #: than this fraction of the friction impulse of one period)
 SETTLE_AMPLITUDE = 1e-6
 
-_MAX_STEPS = 2_000_000
+#: default step limit of one impact (the status code _MAX_STEPS is a different name)
+_DEFAULT_MAX_STEPS = 2_000_000
 
 
-def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _MAX_STEPS) -> dict:
+def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _DEFAULT_MAX_STEPS) -> dict:
     """Impacts of a contact that selects tangential compliance or adhesion-aware friction.
 
     Parameters
     ----------
     contact : Contact
-        ``tangential_model`` "rigid" or "mindlin", ``friction_model`` "net" or "pulloff".
+        ``tangential_model`` "rigid", "mindlin" or "mindlin_deresiewicz", ``friction_model`` "net" or
+        "pulloff", ``rolling_friction`` mu_r >= 0 (compliant models only).
     velocity_in : tuple of 3 arrays
         (v_n, v_t, v_t') before contact, v_n < 0, broadcast to one shape. [m/s]
     omega_in : tuple of 3 arrays
@@ -401,7 +409,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     -------
     dict of 1-D arrays (SI): ``captured``, ``e_n``, ``v_t``, ``v_tp`` [m/s], ``omega_n``,
     ``omega_t``, ``omega_tp`` [rad/s], ``contact_time``, ``capture_time``, ``slip_end_time`` [s],
-    ``max_penetration`` [m], ``friction_impulse`` (int of the friction load, |F_n| or
+    ``max_penetration`` [m], ``turning_points`` (hysteretic law), ``friction_impulse`` (int of the friction load, |F_n| or
     |F_n + 2 F_po|) [N s], ``slip_ended`` (bool), ``n_steps``.
 
     Raises
