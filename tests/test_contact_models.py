@@ -189,3 +189,154 @@ def test_kharaz_rigid_and_compliant():
     for q in ("rebound_spin", "rebound_angle"):
         assert ds.attrs[f"rms_{q}_below_compliant"] < ds.attrs[f"rms_{q}_below"]
     assert float(ds["effective_shear_modulus"]) == pytest.approx(1.352e10, rel=1e-3)
+
+
+# =============================================================================== hysteretic law
+def test_md_branch_is_mindlin_deresiewicz_at_constant_load():
+    """At constant F_lim the branch coordinate grows as u / (c delta*), so the force of a branch
+    from gross slip (c = 2) is the Mindlin-Deresiewicz unloading curve
+    T = -F_lim + 2 F_lim [1 - (1 - Delta / (2 delta*))^(3/2)] (Johnson 1985, Eq. 7.56)."""
+    k, lim = 2.0, 3.0
+    dstar = tc.mindlin_stuck_displacement(k, lim)
+    c = tc.md_turning_span(-1.0, 1.0)  # turning point at the limit -F_lim, new branch s = +1
+    assert c == 2.0
+    rate = tc.md_branch_rate(0.3, c, 1.0, k, lim, 0.0)
+    assert rate == pytest.approx(1.0 / (c * dstar), rel=1e-15)  # exact arithmetic, round-off only
+    delta = np.linspace(0.0, 2 * dstar, 9)
+    md = [-lim + 2 * lim * (1 - (1 - d / (2 * dstar)) ** 1.5) for d in delta]
+    ours = [lim * tc.md_force_ratio(d * rate, 1.0, c) for d in delta]
+    np.testing.assert_allclose(ours, md, rtol=1e-12, atol=1e-12)  # same formula, round-off only
+    # full stiffness at the turning point: dT/ddelta = k_t (finite difference, relative step 1e-7)
+    e = 1e-7 * dstar
+    assert (lim * tc.md_force_ratio(e * rate, 1.0, c) + lim) / e == pytest.approx(k, rel=1e-6)
+    # held in gross slip and at the turning point
+    assert tc.md_branch_rate(1.0, 2.0, 1.0, k, lim, 0.0) == 0.0
+    assert tc.md_branch_rate(0.0, 2.0, -1.0, k, lim, 0.0) == 0.0
+
+
+def _scipy_hysteretic(c, alpha_deg):
+    """Independent time integration (scipy, in seconds) of Hertz + the hysteretic law, with the
+    turning points as terminal events: returns v_t after separation."""
+    m, r, inertia = c.mass, c.radius, c.moment_of_inertia
+    k_h = math.sqrt(r) * c.stiffness
+    f = c.friction
+    alpha = math.radians(alpha_deg)
+    branch = {"s": 1.0, "c": 1.0}
+
+    def rhs(_t, z):
+        x, xd, vt, wtp, p = z
+        xp = max(x, 0.0)
+        fn = k_h * xp**1.5
+        lim = f * fn
+        dlim = f * 1.5 * k_h * math.sqrt(xp) * xd
+        kt = float(tc.tangential_stiffness(c.shear_modulus, math.sqrt(r * xp)))
+        t = lim * tc.md_force_ratio(p, branch["s"], branch["c"])
+        u = vt + r * wtp
+        dp = tc.md_branch_rate(p, branch["c"], branch["s"] * u, kt, lim, dlim)
+        return [xd, -fn / m, -t / m, -r * t / inertia, dp]
+
+    def sep(_t, z):
+        return z[0]
+
+    def turn(_t, z):
+        return branch["s"] * (z[2] + r * z[3])
+
+    sep.terminal, sep.direction = True, -1
+    turn.terminal, turn.direction = True, -1
+    # start just inside contact (x = 1e-6 of the maximum penetration, in gross slip, p = 1)
+    xmax = (1.25 * m * (V * math.cos(alpha)) ** 2 / k_h) ** 0.4
+    t0, z = 0.0, [1e-6 * xmax, V * math.cos(alpha), V * math.sin(alpha), 0.0, 1.0]
+    while True:
+        sol = solve_ivp(rhs, (t0, 1e-3), z, method="DOP853", rtol=1e-11, atol=1e-14, events=(sep, turn))
+        z, t0 = list(sol.y[:, -1]), sol.t[-1]
+        if sol.t_events[0].size or sol.status == 0:
+            return z[2]
+        ratio = tc.md_force_ratio(z[4], branch["s"], branch["c"])
+        branch["s"] = -branch["s"]
+        branch["c"] = tc.md_turning_span(ratio, branch["s"])
+        z[4] = 0.0
+
+
+@pytest.mark.parametrize("alpha", [9.5, 20.0])  # one and two turning points... and gross slip at the start
+def test_hysteretic_law_against_an_independent_scipy_integration(alumina, alpha):
+    c = alumina.with_(tangential_model="mindlin_deresiewicz")
+    ref = _scipy_hysteretic(c, alpha)
+    res = simulate_impact(c, V, alpha, rtol=1e-10)
+    # both integrations to ~1e-9; the scipy run starts at x = 1e-6 x_max (gross slip, where the
+    # missed part of the impulse is ~(1e-6)^(5/2) of it) and locates turning points in seconds:
+    # 1e-6 relative
+    assert res.velocity_out[1] == pytest.approx(ref, rel=1e-6)
+    assert res.e_n == pytest.approx(1.0, abs=1e-6)
+
+
+def test_stiff_hysteretic_contact_gives_the_rigid_closed_form(alumina):
+    angles = np.array([5.0, 20.0, 45.0])
+    rigid = simulate_many(alumina, V, angles)
+    stiff = simulate_many(alumina.with_(tangential_model="mindlin_deresiewicz", shear_modulus=1e3 * alumina.shear_modulus),
+                          V, angles)
+    ratio = lambda ds: ds["velocity_out_t"].values / (V * np.sin(np.radians(angles)))  # noqa: E731
+    # as for the elastic law: the energy still stored at the end of stick scales as
+    # 1/sqrt(stiffness ratio), 1e-3 at 1000 x G*; sliding throughout is the same Coulomb impulse
+    np.testing.assert_allclose(ratio(stiff), ratio(rigid), atol=1.5e-3)
+    assert ratio(stiff)[2] == pytest.approx(ratio(rigid)[2], abs=1e-6)
+
+
+def test_hysteretic_maw_barber_fawcett_shape(alumina):
+    """As test_maw_barber_fawcett_shape; hysteresis only removes energy: at small psi the
+    contact point comes back with less speed than with the elastic micro-slip law."""
+    ratio_kt_kn = 4 * alumina.shear_modulus / (0.75 * alumina.stiffness)
+    f = alumina.friction
+    psi = np.array([0.05, 1.0, 5.0, 10.0])
+    alpha = np.degrees(np.arctan(psi * f * 2 / ratio_kt_kn))
+    u_in = V * np.sin(np.radians(alpha))
+    r = {}
+    for tm in ("mindlin", "mindlin_deresiewicz"):
+        c = alumina.with_(tangential_model=tm)
+        ds = simulate_many(c, V, alpha)
+        r[tm] = (ds["velocity_out_t"] + c.radius * ds["omega_out_tp"]).values / u_in
+    h = r["mindlin_deresiewicz"]
+    assert 0.5 < h[0] < r["mindlin"][0]
+    assert h[1] < -0.2  # recoil of the contact point near psi = 1
+    rigid_line = 1 - 3.5 * f * 2 / np.tan(np.radians(alpha))
+    np.testing.assert_allclose(h[2:], rigid_line[2:], atol=1e-6)  # gross sliding: solver tolerance
+
+
+def test_hysteretic_kharaz_target():
+    ds = kharaz_comparison(fit_friction=False, curve_incidence_deg=[10.0, 45.0],
+                           contact_models={"tangential_model": "mindlin_deresiewicz"})
+    # issue 14's target: within 0.03 RMS over all measured angles, material constants and the
+    # source's friction (nothing fitted); measured 0.0271
+    assert ds.attrs["rms_tangential_restitution_all_hysteretic"] < 0.03
+    assert ds.attrs["rms_tangential_restitution_all_selected"] == ds.attrs["rms_tangential_restitution_all_hysteretic"]
+    # and better than the elastic micro-slip law and the rigid model over all angles
+    assert ds.attrs["rms_tangential_restitution_all_hysteretic"] < ds.attrs["rms_tangential_restitution_all"]
+    assert ds.attrs["rms_tangential_restitution_all_hysteretic"] < ds.attrs["rms_tangential_restitution_all_compliant"]
+
+
+# =============================================================================== rolling resistance
+def test_rolling_resistance_zero_gives_the_existing_result(alumina):
+    c = alumina.with_(tangential_model="mindlin_deresiewicz")
+    a = simulate_many(c, V, [5.0, 40.0])
+    b = simulate_many(c.with_(rolling_friction=0.0), V, [5.0, 40.0])
+    np.testing.assert_array_equal(a["velocity_out_t"].values, b["velocity_out_t"].values)
+    with pytest.raises(ValueError, match="compliant tangential model"):
+        check_sub_models(alumina.with_(rolling_friction=0.01), "engine")
+    with pytest.raises(ValueError, match="method='engine'"):
+        check_sub_models(c.with_(rolling_friction=0.01), "reference")
+
+
+@pytest.mark.parametrize("model", ["mindlin", "mindlin_deresiewicz"])
+def test_rolling_sphere_decelerates_at_the_analytic_rate(alumina, model):
+    """A sphere arriving rolling (omega_t' = -v_t / r) keeps rolling; the torque mu_r r |F_n|
+    takes (5/7) mu_r |F_n| / m off v_t, so over the impact Delta v_t = (5/7) mu_r (1 + e_n) v_n."""
+    mu_r = 0.01
+    c = alumina.with_(tangential_model=model, rolling_friction=mu_r, shear_modulus=1e3 * alumina.shear_modulus)
+    alpha = 45.0
+    vt, vn = V * math.sin(math.radians(alpha)), V * math.cos(math.radians(alpha))
+    res = simulate_impact(c, V, alpha, omega=(0.0, 0.0, -vt / c.radius), rtol=1e-10)
+    dv = float(tc.rolling_deceleration(mu_r, 1.0, 1.0)) * (1 + res.e_n) * vn
+    assert dv == pytest.approx(5 / 7 * mu_r * 2 * vn, rel=1e-12)
+    # stiff tangential contact (1000 x G*): the lag of the tangential spring behind the rolling
+    # torque stores ~ (F_t / k_t) energy; measured relative error well below 1e-3
+    assert vt - res.velocity_out[1] == pytest.approx(dv, rel=2e-3)
+    assert res.velocity_out[1] + c.radius * res.omega_out[2] == pytest.approx(0.0, abs=1e-3 * vt)

@@ -11,6 +11,6 @@ set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no
 from microimpact.io import write_netcdf  # noqa: E402
 from microimpact.analysis.kharaz import kharaz_comparison  # noqa: E402
 
-ds = kharaz_comparison(snakemake.input[0])  # noqa: F821
+ds = kharaz_comparison(snakemake.input[0], contact_models=dict(snakemake.params.contact_models))  # noqa: F821
 write_netcdf(ds, snakemake.output[0])  # noqa: F821
 print(ds)

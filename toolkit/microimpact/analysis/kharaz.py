@@ -25,10 +25,12 @@ deformation, microslip, Maw et al.), which the model does not contain, shows: me
 restitution ABOVE 5/7 at the smallest angles (the elastic tangential spring returns energy) and
 BELOW 5/7 around 10-20 deg.
 
-The tangentially compliant model (``tangential_model="mindlin"``,
-:mod:`microimpact.model.tangential_compliance`) is compared beside it: Mindlin stiffness 8 G* a
-with G* from the shear moduli of the materials config, micro-slip and the same Coulomb friction
-0.092, nothing fitted.
+Two tangentially compliant models (:mod:`microimpact.model.tangential_compliance`) are compared
+beside it: Mindlin stiffness 8 G* a with G* from the shear moduli of the materials config, micro-slip
+and the same Coulomb friction 0.092, nothing fitted; "mindlin" (elastic micro-slip, no memory:
+variables ``*_compliant``) and "mindlin_deresiewicz" (the loading/unloading hysteresis of
+Mindlin & Deresiewicz 1953: ``*_hysteretic``). Only the hysteretic one loses energy to micro-slip
+when the tangential force reverses, which is what the measured rebound below 10 deg shows.
 
 Spin sign convention
 --------------------
@@ -151,7 +153,7 @@ def _model(contact, angles, friction):
 
 
 def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, sliding_threshold_deg: float = 30.0,
-                      fit_friction: bool = True, curve_incidence_deg=None) -> xr.Dataset:
+                      fit_friction: bool = True, curve_incidence_deg=None, contact_models=None) -> xr.Dataset:
     """Compare the model's tangential restitution, rebound spin and rebound angle with Kharaz (2001).
 
     Parameters
@@ -171,6 +173,11 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         angles above ``sliding_threshold_deg``.
     curve_incidence_deg : sequence of float, optional
         Incidence angles of the model curves. [deg] Default 0.25-85 deg in 0.25 deg steps.
+    contact_models : dict, optional
+        Sub-model selection of a "selected" model added beside the others (pipeline config key
+        ``contact_models``): any of ``tangential_model``, ``friction_model``, ``rolling_friction``
+        (:class:`~microimpact.model.contact.Contact` fields). Its variables and RMS attributes have
+        the suffix ``_selected``; the attribute ``selected_contact_models`` records the choice.
 
     Returns
     -------
@@ -209,7 +216,15 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         _compare_quantity(ds, q, data[data["quantity"] == q], contact, curves,
                           {"": f_nom, "_fitted": f_fit} if fit_friction else {"": f_nom}, sliding_threshold_deg)
     _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg)
-    _compare_compliant(ds, data, contact.with_(tangential_model="mindlin"), grid, f_nom, sliding_threshold_deg)
+    for suffix in COMPLIANT_MODELS:
+        _compare_compliant(ds, data, contact, grid, f_nom, sliding_threshold_deg, suffix)
+    if contact_models:
+        allowed = {"tangential_model", "friction_model", "rolling_friction"}
+        unknown = set(contact_models) - allowed
+        if unknown:
+            raise ValueError(f"contact_models: unknown key(s) {', '.join(sorted(unknown))}; accepted: {', '.join(sorted(allowed))}")
+        _compare_compliant(ds, data, contact.with_(**contact_models), grid, f_nom, sliding_threshold_deg, "_selected")
+        ds.attrs["selected_contact_models"] = ", ".join(f"{k}={v}" for k, v in sorted(contact_models.items()))
     ds.attrs.update({
         "title": "microimpact model vs Kharaz, Gorham & Salman (2001) oblique impacts",
         "source": src,
@@ -275,27 +290,42 @@ def _compare_quantity(ds, q, sub, contact, curves, frictions, sliding_threshold_
             ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
 
 
-def _compare_compliant(ds, data, compliant, grid, friction, sliding_threshold_deg) -> None:
-    """Add the tangentially compliant model (Mindlin stiffness 8 G* a with micro-slip, G* from the
+#: the tangentially compliant models compared: suffix of their variables -> (tangential_model, label)
+COMPLIANT_MODELS = {
+    "_compliant": ("mindlin", "tangentially compliant, elastic micro-slip (Mindlin)"),
+    "_hysteretic": ("mindlin_deresiewicz", "tangentially compliant, hysteretic (Mindlin-Deresiewicz)"),
+}
+
+
+def _compare_compliant(ds, data, compliant, grid, friction, sliding_threshold_deg, suffix="_compliant") -> None:
+    """Add a tangentially compliant model (Mindlin stiffness 8 G* a with micro-slip, G* from the
     materials config, the source's friction: nothing fitted) beside the rigid one.
 
-    Variables ``q_model_compliant``, ``q_difference_compliant`` (per measured angle) and
-    ``q_curve_compliant`` (on the curve grid); attributes ``rms_<q>_<sliding|below|all>_compliant``
-    and, for the rigid model with the nominal friction, ``rms_<q>_all``.
+    Variables ``q_model<suffix>``, ``q_difference<suffix>`` (per measured angle) and
+    ``q_curve<suffix>`` (on the curve grid); attributes ``rms_<q>_<sliding|below|all><suffix>``
+    and, for the rigid model with the nominal friction, ``rms_<q>_all``. ``suffix`` is a key of
+    :data:`COMPLIANT_MODELS`: "_compliant" (elastic micro-slip, "mindlin") or "_hysteretic"
+    ("mindlin_deresiewicz"), whose tangential model it sets; or "_selected", ``compliant`` as given.
     """
+    if suffix in COMPLIANT_MODELS:
+        compliant = compliant.with_(tangential_model=COMPLIANT_MODELS[suffix][0])
+        what = COMPLIANT_MODELS[suffix][1]
+    else:
+        what = (f"selected sub-models ({compliant.tangential_model}, {compliant.friction_model}, "
+                f"mu_r = {compliant.rolling_friction:g})")
     curve = _model(compliant, grid, friction)
     for q, (units, long_name) in _QUANTITIES.items():
         sub = data[data["quantity"] == q]
         a = sub["incidence_angle_deg"].to_numpy()
         mod = _model(compliant, a, friction)[q]
-        label = f"tangentially compliant (Mindlin, G* = {compliant.shear_modulus / 1e9:.4g} GPa), friction {friction:g}"
-        ds[f"{q}_curve_compliant"] = ("curve_incidence_deg", curve[q], {"units": units, "long_name": f"model {long_name}, {label}"})
-        ds[f"{q}_model_compliant"] = ((q,), mod, {"units": units, "long_name": f"model {long_name}, {label}"})
+        label = f"{what} (G* = {compliant.shear_modulus / 1e9:.4g} GPa), friction {friction:g}"
+        ds[f"{q}_curve{suffix}"] = ("curve_incidence_deg", curve[q], {"units": units, "long_name": f"model {long_name}, {label}"})
+        ds[f"{q}_model{suffix}"] = ((q,), mod, {"units": units, "long_name": f"model {long_name}, {label}"})
         d = mod - sub["value"].to_numpy()
-        ds[f"{q}_difference_compliant"] = ((q,), d, {"units": units, "long_name": "compliant model - measured"})
+        ds[f"{q}_difference{suffix}"] = ((q,), d, {"units": units, "long_name": f"{what} model - measured"})
         sliding = a > sliding_threshold_deg
         for regime, mask in (("sliding", sliding), ("below", ~sliding), ("all", np.ones_like(sliding))):
-            ds.attrs[f"rms_{q}_{regime}_compliant"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
+            ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
         rigid = ds[f"{q}_difference"].values
         ds.attrs[f"rms_{q}_all"] = float(np.sqrt(np.mean(rigid**2)))
     ds["effective_shear_modulus"] = ((), compliant.shear_modulus, {
@@ -318,7 +348,8 @@ def _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg) -> No
 
 def kharaz_summary(ds: xr.Dataset) -> pd.DataFrame:
     """RMS model - measured per quantity and regime as a table: the rigid model with the nominal
-    and the fitted friction, and the tangentially compliant model (nominal friction)."""
+    and the fitted friction, and the tangentially compliant models, elastic micro-slip
+    ("compliant") and hysteretic ("hysteretic"), with the nominal friction."""
     rows = []
     th = ds.attrs["sliding_threshold_deg"]
     for q, (units, _) in _QUANTITIES.items():
@@ -327,7 +358,8 @@ def kharaz_summary(ds: xr.Dataset) -> pd.DataFrame:
                          "regime": {"sliding": f"> {th:g} deg", "below": f"<= {th:g} deg", "all": "all"}[regime],
                          "rms_nominal_friction": ds.attrs.get(f"rms_{q}_{regime}", math.nan),
                          "rms_fitted_friction": ds.attrs.get(f"rms_{q}_{regime}_fitted", math.nan),
-                         "rms_compliant": ds.attrs.get(f"rms_{q}_{regime}_compliant", math.nan)})
+                         "rms_compliant": ds.attrs.get(f"rms_{q}_{regime}_compliant", math.nan),
+                         "rms_hysteretic": ds.attrs.get(f"rms_{q}_{regime}_hysteretic", math.nan)})
     return pd.DataFrame(rows)
 
 
@@ -343,8 +375,9 @@ def kharaz_table(ds: xr.Dataset) -> pd.DataFrame:
         if f"{q}_model_fitted" in ds:
             t["model_fitted"] = ds[f"{q}_model_fitted"].values
             t["difference_fitted"] = ds[f"{q}_difference_fitted"].values
-        if f"{q}_model_compliant" in ds:
-            t["model_compliant"] = ds[f"{q}_model_compliant"].values
-            t["difference_compliant"] = ds[f"{q}_difference_compliant"].values
+        for suffix in COMPLIANT_MODELS:
+            if f"{q}_model{suffix}" in ds:
+                t[f"model{suffix}"] = ds[f"{q}_model{suffix}"].values
+                t[f"difference{suffix}"] = ds[f"{q}_difference{suffix}"].values
         out.append(t)
     return pd.concat(out, ignore_index=True)

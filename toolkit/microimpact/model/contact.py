@@ -29,12 +29,13 @@ __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_
 #: the selectable sub-models of the one contact law: field -> accepted names, the first (the
 #: paper's model) being the default. "ring" is the paper's adhesion ring force (Eqs. 4-6); "jkr"
 #: and "dmt" are the alternative normal adhesion models; "rigid" is the paper's tangentially rigid
-#: contact (closed-form tangential map), "mindlin" an elastic tangential contact with micro-slip;
+#: contact (closed-form tangential map), "mindlin" an elastic tangential contact with micro-slip,
+#: "mindlin_deresiewicz" the same with the loading/unloading/reloading memory (hysteresis);
 #: "net" is the paper's Coulomb limit f |F_n|, "pulloff" an adhesion-aware limit that does not vanish
 #: at the adhesive equilibrium.
 SUB_MODELS: dict[str, tuple[str, ...]] = {
     "normal_model": ("ring", "jkr", "dmt"),
-    "tangential_model": ("rigid", "mindlin"),
+    "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
     "friction_model": ("net", "pulloff"),
 }
 
@@ -141,12 +142,15 @@ class Contact:
         incident normal speed; a float fixes it for every impact. [m/s]
     normal_model : {"ring", "jkr", "dmt"}
         Normal adhesion model (:data:`SUB_MODELS`); "ring" is the paper's. [-]
-    tangential_model : {"rigid", "mindlin"}
-        Tangential contact model; "rigid" is the paper's. [-]
+    tangential_model : {"rigid", "mindlin", "mindlin_deresiewicz"}
+        Tangential contact model; "rigid" is the paper's; "mindlin_deresiewicz" adds the hysteresis
+        of micro-slip (:mod:`microimpact.model.tangential_compliance`). [-]
     friction_model : {"net", "pulloff"}
         Coulomb friction limit; "net" (f |F_n|) is the paper's. [-]
     rolling_friction : float
-        Rolling-resistance coefficient; 0 (the paper's, no rolling resistance) by default. [-]
+        Rolling-resistance coefficient mu_r of the torque mu_r r |F_n| against the rolling (Zhou et
+        al. 1999); 0 (the paper's, no rolling resistance) by default. Needs a compliant tangential
+        model (:mod:`microimpact.model.tangential_compliance`). [-]
     shear_modulus : float or None
         Effective shear modulus G* of the pair, 1/G* = (2 - nu1)/G1 + (2 - nu2)/G2, needed by the
         "mindlin" tangential model (tangential stiffness 8 G* a); None when not given. [Pa]
@@ -193,8 +197,9 @@ class Contact:
         for name in _OPTIONAL:
             if getattr(self, name) is not None:
                 check_positive(name, getattr(self, name))
-        if self.tangential_model == "mindlin" and self.shear_modulus is None:
-            raise ValueError("tangential_model='mindlin' needs shear_modulus (the effective shear modulus G* [Pa])")
+        if self.tangential_model != "rigid" and self.shear_modulus is None:
+            raise ValueError(f"tangential_model={self.tangential_model!r} needs shear_modulus "
+                             "(the effective shear modulus G* [Pa])")
         self._check_scales()
 
     def _check_scales(self) -> None:

@@ -31,6 +31,58 @@ gross slip); a simplification like that of the DEM forms compared by Di Renzo & 
 With micro-slip switched off (F_t = -k_t delta up to the limit) it is their "no-slip" Mindlin
 model; as k_t grows without bound it becomes the rigid contact of the paper.
 
+Hysteretic tangential contact ("mindlin_deresiewicz")
+----------------------------------------------------
+The "mindlin" force above is a function of the displacement: unloading retraces the loading curve
+and the energy of micro-slip is returned. Mindlin & Deresiewicz (1953) showed that it is not:
+after a turning point the contact first sticks again everywhere (full stiffness k_t) and the
+unloading curve is the loading curve scaled by two (Masing's rule). Thornton (1991) and Thornton &
+Yin (1991) wrote this as an incremental law for a varying normal load,
+
+    dT = k_t theta d delta + s f dL (1 - theta),   theta^3 = 1 - s (T - T_r) / (c F_lim),
+
+with T the tangential force resisting the displacement delta (along the slip direction), s = +-1
+the direction of the current branch, T_r the force at its turning point, L the friction load
+(F_lim = f L) and c = 1 on the first (virgin) loading, c = 2 on unloading and reloading from gross
+slip. The second term (theirs) lets a contact near gross slip follow the changing limit: it slips
+when the normal load falls and sticks when it rises.
+
+Here the branch is written so that it always ends, with zero stiffness, at the opposite Coulomb
+limit: c = 1 + |T_r| / F_lim at the turning point (c = 2 from gross slip, Mindlin-Deresiewicz's
+case; c = 1 on the virgin curve), and the turning point moves with the limit, T_r = s F_lim (1 - c)
+(Thornton's T* <- T* +- f dL). This replaces Masing's loop-closure bookkeeping (a stack of turning
+points) for turning points below the limit, where it is an interpolation between the virgin (c = 1)
+and the Mindlin-Deresiewicz (c = 2) curves. With the branch coordinate p in [0, 1],
+
+    T = s F_lim [1 - c (1 - p)^(3/2)],    theta = (1 - p)^(1/2),
+
+the incremental law becomes (:func:`md_branch_rate`)
+
+    dp/dt = s u k_t / (1.5 c F_lim) + (2/3) (dF_lim/dt / F_lim) (1 - p - 1/c),
+
+whose right-hand side is smooth in p (the force law in T has the non-Lipschitz theta = (1 - ...)^(1/3)
+that made the incremental form stiff), with p held at 1 in gross slip. Turning points (the slip
+along the branch, s u, changes sign) are located as events; there p restarts at 0 with s -> -s,
+which keeps the force continuous. At constant normal load and from gross slip this is exactly the
+Mindlin-Deresiewicz curve; for small displacements it is k_t delta (no-slip Mindlin) like the
+"mindlin" model, so both share the rigid limit as G* grows. The tangential dynamics of a sphere on a
+flat is isotropic and starts from zero force, so the force stays along the initial slip direction e
+and a scalar law along e is exact (with rolling resistance about another axis, only the slip along
+e is resisted).
+
+Rolling resistance
+------------------
+Optional (``Contact.rolling_friction`` mu_r > 0, off by default): the constant directional torque
+(Zhou et al. 1999; model A of Ai et al. 2011)
+
+    M_r = -mu_r r |F_n| omega_r / |omega_r|,
+
+with omega_r = (omega_t, omega_t') the rolling angular velocity relative to the fixed surface. A
+sphere rolling without slip on the flat then decelerates at (5/7) mu_r |F_n| / m
+(I = (2/5) m r^2: the friction force (5/7) M_r / r keeps the contact point at rest). Model A has
+no viscous part and is not locked at omega_r = 0 (Ai et al. 2011 discuss the oscillation at rest),
+which an impact that does not stop the rolling never reaches.
+
 Adhesion-aware friction ("pulloff")
 -----------------------------------
 The paper's Coulomb limit is f |F_n| with F_n the NET normal force (Hertz plus adhesion plus
@@ -63,6 +115,15 @@ References
 .. [8] Di Renzo, A. and Di Maio, F. P. (2004), Comparison of contact-force models for the
    simulation of collisions in DEM-based granular flow codes, Chem. Eng. Sci. 59:525-541,
    doi:10.1016/j.ces.2003.09.037.
+.. [9] Di Renzo, A. and Di Maio, F. P. (2005), An improved integral non-linear model for the contact
+   of particles in distinct element simulations, Chem. Eng. Sci. 60:1303-1312,
+   doi:10.1016/j.ces.2004.10.004.
+.. [10] Zhou, Y. C., Wright, B. D., Yang, R. Y., Xu, B. H. and Yu, A. B. (1999), Rolling friction in
+   the dynamic simulation of sandpile formation, Physica A 269:536-553,
+   doi:10.1016/S0378-4371(99)00183-1.
+.. [11] Ai, J., Chen, J.-F., Rotter, J. M. and Ooi, J. Y. (2011), Assessment of rolling resistance
+   models in discrete element simulations, Powder Technol. 206:269-282,
+   doi:10.1016/j.powtec.2010.09.030.
 """
 
 from __future__ import annotations
@@ -83,6 +144,10 @@ __all__ = [
     "mindlin_force",
     "mindlin_stuck_displacement",
     "maw_incidence_parameter",
+    "md_force_ratio",
+    "md_branch_rate",
+    "md_turning_span",
+    "rolling_deceleration",
 ]
 
 
@@ -273,3 +338,87 @@ def mindlin_force(delta_t, delta_tp, stuck_displacement, limit):
     q = d / stuck_displacement if stuck_displacement > 0.0 else math.inf
     magnitude = limit if q >= 1.0 else limit * (1.0 - (1.0 - q) ** 1.5)
     return -magnitude * delta_t / d, -magnitude * delta_tp / d
+
+
+def md_force_ratio(branch_coordinate, branch_sign, branch_span):
+    """T / F_lim = s [1 - c (1 - p)^(3/2)] of the hysteretic (Mindlin-Deresiewicz) contact. [-]
+
+    T is the force resisting the displacement along the initial slip direction (the force on the
+    sphere is -T e). See the module docstring.
+
+    Parameters
+    ----------
+    branch_coordinate : float
+        p, 0 at the turning point, 1 at gross slip (clipped to [0, 1]). [-]
+    branch_sign : float
+        s = +1 or -1, the direction of the current branch. [-]
+    branch_span : float
+        c = 1 + |T_r| / F_lim of the branch (1 virgin, 2 from gross slip). [-]
+    """
+    p = min(max(branch_coordinate, 0.0), 1.0)
+    return branch_sign * (1.0 - branch_span * (1.0 - p) ** 1.5)
+
+
+def md_branch_rate(branch_coordinate, branch_span, branch_slip, stiffness, limit, limit_rate):
+    """dp/dt = s u k_t / (1.5 c F_lim) + (2/3) (dF_lim/dt / F_lim) (1 - p - 1/c). [1/s] or [-]
+
+    The Thornton (1991) incremental law dT = k_t theta d delta + s dF_lim (1 - theta) in the branch
+    coordinate p (module docstring), held in [0, 1]: 0 when p >= 1 and the rate is positive (gross
+    slip) or p <= 0 and it is negative; 0 without a Coulomb limit.
+
+    Parameters
+    ----------
+    branch_coordinate : float
+        p. [-]
+    branch_span : float
+        c of the branch. [-]
+    branch_slip : float
+        s u, the slip velocity of the contact point along the branch direction. [m/s] or nondimensional
+    stiffness : float
+        k_t = 8 G* a, :func:`tangential_stiffness`. [N/m] or nondimensional
+    limit : float
+        F_lim = f L. [N] or nondimensional
+    limit_rate : float
+        dF_lim / dt. [N/s] or nondimensional
+    """
+    if limit <= 0.0:
+        return 0.0
+    rate = (branch_slip * stiffness / (1.5 * branch_span)
+            + (2.0 / 3.0) * limit_rate * (1.0 - branch_coordinate - 1.0 / branch_span)) / limit
+    if (branch_coordinate >= 1.0 and rate > 0.0) or (branch_coordinate <= 0.0 and rate < 0.0):
+        return 0.0
+    return rate
+
+
+def md_turning_span(force_ratio, new_sign):
+    """c = 1 - s' T / F_lim of the branch that starts at a turning point with force ratio T / F_lim. [-]
+
+    s' is the new branch direction; c = 2 from gross slip (T / F_lim = -s'), the
+    Mindlin-Deresiewicz unloading curve. Kept >= 1e-9 (c = 0 only at the limit in the new direction).
+
+    Parameters
+    ----------
+    force_ratio : float
+        T / F_lim at the turning point, :func:`md_force_ratio`. [-]
+    new_sign : float
+        s' = +1 or -1. [-]
+    """
+    return max(1.0 - new_sign * force_ratio, 1e-9)
+
+
+def rolling_deceleration(rolling_friction, normal_force, mass):
+    """(5/7) mu_r |F_n| / m: deceleration of a homogeneous sphere rolling without slip. [m/s^2]
+
+    From m dv/dt = F_t, (2/5) m r^2 d omega/dt = r F_t - mu_r r |F_n| and v = r omega (module
+    docstring, "Rolling resistance").
+
+    Parameters
+    ----------
+    rolling_friction : float
+        mu_r. [-]
+    normal_force : array_like
+        F_n. [N]
+    mass : float
+        m. [kg]
+    """
+    return 5.0 / 7.0 * rolling_friction * np.abs(np.asarray(normal_force, dtype=float)) / mass

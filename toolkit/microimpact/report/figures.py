@@ -734,7 +734,8 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
     ds : xarray.Dataset
         From :func:`microimpact.analysis.kharaz.kharaz_comparison`: model curves ``<q>_curve`` (and
         ``<q>_curve_fitted``, fitted friction, drawn dashed when present; ``<q>_curve_compliant``, the
-        tangentially compliant model, drawn green when present) on ``curve_incidence_deg``
+        tangentially compliant model, drawn green, and ``<q>_curve_hysteretic``, the hysteretic one,
+        drawn orange, when present) on ``curve_incidence_deg``
         for q = ``tangential_restitution`` [1], ``rebound_spin`` [rad/s], ``rebound_angle`` [deg];
         measured ``<q>_measured`` at the angles ``<q>_incidence_deg``.
     """
@@ -759,6 +760,9 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
         if f"{name}_curve_compliant" in ds:
             ax.plot(angles, ds[f"{name}_curve_compliant"].values, color="C2", lw=1.1,
                     label="compliant (Mindlin)" + (f", f = {f:.3g}" if f is not None else ""))
+        if f"{name}_curve_hysteretic" in ds:
+            ax.plot(angles, ds[f"{name}_curve_hysteretic"].values, color="C1", lw=1.1,
+                    label="hysteretic (Mindlin-Deresiewicz)" + (f", f = {f:.3g}" if f is not None else ""))
         if f"{name}_measured" in ds:
             ax.plot(ds[f"{name}_incidence_deg"].values, ds[f"{name}_measured"].values, "o", ms=4,
                     color="C3", mfc="none", mew=1.0, label="Kharaz et al. (2001)")

@@ -29,12 +29,16 @@ METHODS = ("engine", "reference", "rkg")
 SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
     # the engine runs the paper's model (rigid, net) as one normal solve plus the closed-form map and
     # every other tangential/friction choice with the compiled coupled solver (.coupled)
-    "engine": {"normal_model": ("ring",), "tangential_model": ("rigid", "mindlin"), "friction_model": ("net", "pulloff")},
+    "engine": {"normal_model": ("ring",), "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
+               "friction_model": ("net", "pulloff")},
     "reference": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
     "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
 }
-#: solver paths that model rolling resistance (Contact.rolling_friction > 0)
-ROLLING_RESISTANCE_METHODS: tuple[str, ...] = ()
+#: solver paths that model rolling resistance (Contact.rolling_friction > 0): the engine's coupled
+#: solver (.coupled), with a compliant tangential model (ROLLING_RESISTANCE_TANGENTIAL_MODELS)
+ROLLING_RESISTANCE_METHODS: tuple[str, ...] = ("engine",)
+#: tangential models with which rolling resistance is integrated (the tangential force is a state)
+ROLLING_RESISTANCE_TANGENTIAL_MODELS: tuple[str, ...] = ("mindlin", "mindlin_deresiewicz")
 
 
 def check_sub_models(contact, method: str) -> None:
@@ -51,3 +55,7 @@ def check_sub_models(contact, method: str) -> None:
     if contact.rolling_friction > 0.0 and method not in ROLLING_RESISTANCE_METHODS:
         hint = f"; use method={ROLLING_RESISTANCE_METHODS[0]!r}" if ROLLING_RESISTANCE_METHODS else "; no solver implements it yet"
         raise ValueError(f"rolling_friction={contact.rolling_friction!r} is not covered by method={method!r}{hint}")
+    if contact.rolling_friction > 0.0 and contact.tangential_model not in ROLLING_RESISTANCE_TANGENTIAL_MODELS:
+        raise ValueError(f"rolling_friction={contact.rolling_friction!r} needs a compliant tangential model "
+                         f"(tangential_model one of {', '.join(map(repr, ROLLING_RESISTANCE_TANGENTIAL_MODELS))}), "
+                         f"got tangential_model={contact.tangential_model!r}")

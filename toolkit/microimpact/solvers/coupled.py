@@ -12,6 +12,12 @@ solver is used only where a scene selects something else, so the paper's model p
 * ``tangential_model="mindlin"``: the tangential force is a state (elastic, with micro-slip and a
   Coulomb limit), integrated together with the normal motion, the tangential velocity and the
   spins. The twist about n keeps its closed form (its torque depends on the normal solve only).
+* ``tangential_model="mindlin_deresiewicz"``: the hysteretic law; the state z[10] is the branch
+  coordinate p (smooth right-hand side), the branch (s, c) and the slip direction e are carried
+  beside the state, and each turning point (s u.e changes sign) is located by secant iteration on
+  the step length, where the branch switches with the force continuous.
+* ``rolling_friction > 0`` (with either compliant model): the torque mu_r r |F_n| against
+  (omega_t, omega_t').
 
 Formulation: as the engine, nondimensional (xi = x / L, tau = t / T_c) in the Sundman variable
 sigma, d tau = s d sigma with s = sqrt(xi), which keeps the right-hand side smooth where contact
@@ -43,6 +49,9 @@ _dissipation = compiled(_law.nondimensional_dissipation_rate)
 _load = compiled(_tc.friction_load)
 _force = compiled(_tc.mindlin_force)
 _dstar = compiled(_tc.mindlin_stuck_displacement)
+_md_ratio = compiled(_tc.md_force_ratio)
+_md_rate = compiled(_tc.md_branch_rate)
+_md_span = compiled(_tc.md_turning_span)
 
 _N = 12
 _S, _Y, _TAU, _D, _J, _JA, _VT, _VTP, _WT, _WTP, _FT, _FTP = range(_N)
@@ -64,10 +73,34 @@ class CoupledError(RuntimeError):
     """The coupled solver could not finish an impact (step limit or step-size underflow)."""
 
 
+@njit(cache=True)
+def _branch_slip(z, hist):
+    """s u.e: the contact-point slip along the current branch of the hysteretic law."""
+    return hist[0] * ((z[_VT] + z[_WTP]) * hist[2] + (z[_VTP] - z[_WT]) * hist[3])
+
+
+@njit(cache=True, fastmath=True, inline="always")
+def _md_terms(z, p, hist, s, xi_dd, load):
+    """(F_lim, dF_lim/dsigma, s s_b u.e) of the hysteretic law at the state z (nondimensional)."""
+    c1, c2, ah, aa, f, fpo, aware = p[0], p[1], p[2], p[3], p[4], p[5], p[6] > 0.5
+    y = z[_Y]
+    # dF_n/dsigma of F_n = a_h s^3 (1 + c1 y) - a_a s (1 - c2 y), with ds = y/2, dy = s xi''
+    dfn = (3.0 * ah * s * s * (1.0 + c1 * y) - aa * (1.0 - c2 * y)) * 0.5 * y + (ah * c1 * s * s * s + aa * c2 * s) * s * xi_dd
+    fn_aw = -xi_dd + 2.0 * fpo if aware else -xi_dd
+    dlim = f * dfn * (1.0 if fn_aw >= 0.0 else -1.0)
+    return f * load, dlim, s * _branch_slip(z, hist)
+
+
 @njit(cache=True, fastmath=True)
-def _rhs(z, p, out):
-    """d/dsigma of the state z; p = (c1, c2, a_h, a_a, f, F_po, adhesion_aware, kappa, k_rot, mindlin)."""
-    c1, c2, ah, aa, f, fpo, aware, kappa, krot, mindlin = p[0], p[1], p[2], p[3], p[4], p[5], p[6] > 0.5, p[7], p[8], p[9] > 0.5
+def _rhs(z, p, hist, out):
+    """d/dsigma of the state z.
+
+    p = (c1, c2, a_h, a_a, f, F_po, adhesion_aware, kappa, k_rot, tangential mode (0 rigid,
+    1 mindlin, 2 mindlin_deresiewicz), mu_r); hist = (s, c, e_t, e_t') the branch of the hysteretic
+    law and the initial slip direction.
+    """
+    c1, c2, ah, aa, f, fpo, aware, kappa, krot = p[0], p[1], p[2], p[3], p[4], p[5], p[6] > 0.5, p[7], p[8]
+    mode = p[9]
     s = z[_S]
     y = z[_Y]
     if s < 0.0:
@@ -82,7 +115,16 @@ def _rhs(z, p, out):
     out[_JA] = s * s * load
     for i in range(_VT, _N):
         out[i] = 0.0
-    if mindlin:
+    if mode > 1.5:  # hysteretic Mindlin-Deresiewicz law along e, state p in z[_FT]
+        lim, dlim, drive = _md_terms(z, p, hist, s, xi_dd, load)
+        et, etp = hist[2], hist[3]
+        t = lim * _md_ratio(z[_FT], hist[0], hist[1])
+        out[_VT] = -s * t * et
+        out[_VTP] = -s * t * etp
+        out[_WTP] = -s * krot * t * et
+        out[_WT] = s * krot * t * etp
+        out[_FT] = _md_rate(z[_FT], hist[1], drive, kappa * s, lim, dlim)
+    elif mode > 0.5:
         lim = f * load
         ft, fp = _force(z[_FT], z[_FTP], _dstar(kappa * s, lim), lim)
         out[_VT] = s * ft
@@ -91,10 +133,16 @@ def _rhs(z, p, out):
         out[_WT] = -s * krot * fp
         out[_FT] = s * (z[_VT] + z[_WTP])  # d delta / d tau = u, the slip of the contact point
         out[_FTP] = s * (z[_VTP] - z[_WT])
+    if p[10] > 0.0 and s > 0.0:  # rolling resistance: torque mu_r r |F_n| against (omega_t, omega_t')
+        wm = math.sqrt(z[_WT] * z[_WT] + z[_WTP] * z[_WTP])
+        if wm > 0.0:
+            g = s * krot * p[10] * abs(xi_dd) / wm
+            out[_WT] -= g * z[_WT]
+            out[_WTP] -= g * z[_WTP]
 
 
 @njit(cache=True, fastmath=True)
-def _step(z, k1, h, p, k, tmp, z1, err):
+def _step(z, k1, h, p, hist, k, tmp, z1, err):
     """One Dormand-Prince 5(4) step of length h from z (derivative k1); k[6] = f(z1)."""
     for i in range(_N):
         k[0, i] = k1[i]
@@ -104,13 +152,13 @@ def _step(z, k1, h, p, k, tmp, z1, err):
             for j in range(st):
                 acc += _A[st, j] * k[j, i]
             tmp[i] = z[i] + h * acc
-        _rhs(tmp, p, k[st])
+        _rhs(tmp, p, hist, k[st])
     for i in range(_N):
         acc = 0.0
         for j in range(6):
             acc += _B[j] * k[j, i]
         z1[i] = z[i] + h * acc
-    _rhs(z1, p, k[6])
+    _rhs(z1, p, hist, k[6])
     for i in range(_N):
         acc = 0.0
         for j in range(7):
@@ -129,6 +177,43 @@ def _project(z, p):
     if mag > dstar:
         z[_FT] *= dstar / mag
         z[_FTP] *= dstar / mag
+
+
+@njit(cache=True)
+def _initial_branch(z, p):
+    """(s, c, e_t, e_t') at first contact, and p in z[_FT], for the hysteretic law.
+
+    e is the initial slip direction; the contact starts in gross slip (p = 1: F_lim = 0 at first
+    contact). Without slip, e is the slip that a rolling-resistance torque would start, and the
+    contact starts stuck (p = 0, no force).
+    """
+    hist = np.zeros(4)
+    hist[0] = hist[1] = 1.0
+    ut, utp = z[_VT] + z[_WTP], z[_VTP] - z[_WT]
+    um = math.sqrt(ut * ut + utp * utp)
+    wm = math.sqrt(z[_WT] * z[_WT] + z[_WTP] * z[_WTP])
+    if um > 0.0:
+        hist[2], hist[3] = ut / um, utp / um
+        if p[9] > 1.5:
+            # gross slip at first contact, unless the slip is too slow for it: then the contact
+            # sticks from the start at the self-similar value of p where dp/dsigma = 0 as s -> 0
+            # (the rate is linear in p, A + B (1 - p - 1/c), c = 1); starting on it avoids a
+            # transient of rate ~ y / s at s -> 0 that would force steps of ~1e-100
+            zp = z.copy()
+            sp = 1e-6 * max(1.0, z[_Y] ** 0.4)
+            zp[_S] = sp
+            xi_dd = _acc(sp, sp * sp * sp, zp[_Y], p[0], p[1], p[2], p[3])
+            lim, dlim, drive = _md_terms(zp, p, hist, sp, xi_dd, _load(-xi_dd, p[5], p[6] > 0.5))
+            a_term = drive * p[7] * sp / 1.5
+            b_term = (2.0 / 3.0) * dlim
+            z[_FT] = 1.0
+            if b_term > 0.0 and a_term < b_term:
+                z[_FT] = max(a_term / b_term, 0.0)
+    elif wm > 0.0:
+        hist[2], hist[3] = -z[_WTP] / wm, z[_WT] / wm
+    else:
+        hist[2] = 1.0
+    return hist
 
 
 @njit(cache=True)
@@ -154,7 +239,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     z1 = np.zeros(_N)
     err = np.zeros(_N)
     k1 = np.zeros(_N)
-    _rhs(z, p, k1)
+    hist = _initial_branch(z, p)
+    _rhs(z, p, hist, k1)
     ah, aa = p[2], p[3]
     yref = max(1.0, y0)
     sref = max(1.0, y0 ** 0.4)
@@ -168,7 +254,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     atol[_JA] = rtol * sref * sref * yref
     for i in range(_VT, _FT):
         atol[i] = rtol * vref
-    atol[_FT] = atol[_FTP] = rtol * sref
+    atol[_FT] = atol[_FTP] = rtol * (1.0 if p[9] > 1.5 else sref)
+    n_turn = 0
     damped = p[0] > 0.0 or p[1] > 0.0
     xe = aa / ah if ah > 0.0 else 0.0
     omega0 = math.sqrt(ah * math.sqrt(xe)) if aa > 0.0 else 1.0
@@ -187,7 +274,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         if n >= max_steps:
             status = _MAX_STEPS
             break
-        _step(z, k1, h, p, k, tmp, z1, err)
+        _step(z, k1, h, p, hist, k, tmp, z1, err)
         en = 0.0
         for i in range(_N):
             en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
@@ -205,7 +292,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 hs = b - fb * (b - a) / (fb - fa)
                 if not (a < hs < b):
                     hs = 0.5 * (a + b)
-                _step(z, k1, hs, p, k, tmp, z1, err)
+                _step(z, k1, hs, p, hist, k, tmp, z1, err)
                 if abs(z1[_S]) <= 1e-14 * sref or (b - a) < 1e-14 * h:
                     break
                 if z1[_S] > 0.0:
@@ -220,13 +307,40 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 z[i] = z1[i]
             z[_FT] = z[_FTP] = 0.0  # out of contact: nothing stored
             break
+        turned = False
+        if p[9] > 1.5 and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
+            # turning point of the hysteretic law within the step: secant on the step length
+            a, fa, b, fb = 0.0, _branch_slip(z, hist), h, _branch_slip(z1, hist)
+            gref = abs(fa) + abs(fb)
+            for _ in range(60):
+                hs = b - fb * (b - a) / (fb - fa)
+                if not (a < hs < b):
+                    hs = 0.5 * (a + b)
+                _step(z, k1, hs, p, hist, k, tmp, z1, err)
+                g = _branch_slip(z1, hist)
+                if abs(g) <= 1e-13 * gref or (b - a) < 1e-14 * h:
+                    break
+                if g > 0.0:
+                    a, fa = hs, g
+                else:
+                    b, fb = hs, g
+            turned = True
         if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
             tau_j = z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
         for i in range(_N):
             z[i] = z1[i]
-        if p[9] > 0.5:
+        if turned:  # new branch: s -> -s, c from the force ratio, p = 0 (force continuous)
+            ratio = _md_ratio(z[_FT], hist[0], hist[1])
+            hist[0] = -hist[0]
+            hist[1] = _md_span(ratio, hist[0])
+            z[_FT] = 0.0
+            n_turn += 1
+        if p[9] > 1.5:
+            z[_FT] = min(max(z[_FT], 0.0), 1.0)
+            _rhs(z, p, hist, k1)
+        elif p[9] > 0.5:
             _project(z, p)
-            _rhs(z, p, k1)
+            _rhs(z, p, hist, k1)
         else:
             for i in range(_N):
                 k1[i] = k[6, i]
@@ -241,7 +355,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 outcome = 1
                 break
         h *= 5.0 if en == 0.0 else min(5.0, max(0.2, 0.9 * en ** -0.2))
-    return status, outcome, z, smax * smax, tau_cap, tau_j, n
+    return status, outcome, z, smax * smax, tau_cap, tau_j, n, n_turn
 
 
 @njit(cache=True, parallel=True)
@@ -249,7 +363,7 @@ def coupled_many(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max
     """:func:`coupled_kernel` for many impacts in parallel; p has one row per impact.
 
     Writes the end states into ``out_state`` (n, 12) and (status, outcome, largest xi, tau at
-    capture, tau at slip end, n_steps) into ``out_info`` (n, 6).
+    capture, tau at slip end, n_steps, turning points of the hysteretic law) into ``out_info`` (n, 7).
     """
     for i in prange(y0.shape[0]):
         r = coupled_kernel(y0[i], vt0[i], vtp0[i], wt0[i], wtp0[i], p[i], rtol, j_stop[i], ja_stop[i], settle,
@@ -262,6 +376,7 @@ def coupled_many(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max
         out_info[i, 3] = r[4]
         out_info[i, 4] = r[5]
         out_info[i, 5] = r[6]
+        out_info[i, 6] = r[7]
 
 
 #: amplitude of the captured normal oscillation, relative to the equilibrium penetration, below
@@ -269,16 +384,18 @@ def coupled_many(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max
 #: than this fraction of the friction impulse of one period)
 SETTLE_AMPLITUDE = 1e-6
 
-_MAX_STEPS = 2_000_000
+#: default step limit of one impact (the status code _MAX_STEPS is a different name)
+_DEFAULT_MAX_STEPS = 2_000_000
 
 
-def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _MAX_STEPS) -> dict:
+def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _DEFAULT_MAX_STEPS) -> dict:
     """Impacts of a contact that selects tangential compliance or adhesion-aware friction.
 
     Parameters
     ----------
     contact : Contact
-        ``tangential_model`` "rigid" or "mindlin", ``friction_model`` "net" or "pulloff".
+        ``tangential_model`` "rigid", "mindlin" or "mindlin_deresiewicz", ``friction_model`` "net" or
+        "pulloff", ``rolling_friction`` mu_r >= 0 (compliant models only).
     velocity_in : tuple of 3 arrays
         (v_n, v_t, v_t') before contact, v_n < 0, broadcast to one shape. [m/s]
     omega_in : tuple of 3 arrays
@@ -292,7 +409,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     -------
     dict of 1-D arrays (SI): ``captured``, ``e_n``, ``v_t``, ``v_tp`` [m/s], ``omega_n``,
     ``omega_t``, ``omega_tp`` [rad/s], ``contact_time``, ``capture_time``, ``slip_end_time`` [s],
-    ``max_penetration`` [m], ``friction_impulse`` (int of the friction load, |F_n| or
+    ``max_penetration`` [m], ``turning_points`` (hysteretic law), ``friction_impulse`` (int of the friction load, |F_n| or
     |F_n + 2 F_po|) [N s], ``slip_ended`` (bool), ``n_steps``.
 
     Raises
@@ -313,10 +430,11 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     length = np.broadcast_to(sc.length, speed.shape)
     time = np.broadcast_to(sc.time, speed.shape)
     m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
-    mindlin = contact.tangential_model == "mindlin"
+    mode = {"rigid": 0.0, "mindlin": 1.0, "mindlin_deresiewicz": 2.0}[contact.tangential_model]
+    mindlin = mode > 0.0
     aware = contact.friction_model == "pulloff"
     fpo = _tc.nondimensional_pulloff_force(sc.a_hertz, sc.a_adhesion)
-    p = np.empty((speed.size, 10))
+    p = np.empty((speed.size, 11))
     p[:, 0] = np.broadcast_to(c1, speed.shape)
     p[:, 1] = np.broadcast_to(c2, speed.shape)
     p[:, 2], p[:, 3] = sc.a_hertz, sc.a_adhesion
@@ -325,7 +443,8 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     p[:, 6] = 1.0 if aware else 0.0
     p[:, 7] = (8.0 * contact.shear_modulus * np.sqrt(r * length) * time**2 / m) if mindlin else 0.0
     p[:, 8] = m * r * r / inertia
-    p[:, 9] = 1.0 if mindlin else 0.0
+    p[:, 9] = mode
+    p[:, 10] = contact.rolling_friction
     slip = np.hypot(v_t + r * w_tp, v_tp - r * w_t)
     if mindlin:
         j_stop = np.full(speed.size, np.inf)
@@ -336,7 +455,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     j_unit = m * u
     ja_unit = j_unit * np.sqrt(r * length)
     states = np.empty((speed.size, _N))
-    info = np.empty((speed.size, 6))
+    info = np.empty((speed.size, 7))
     coupled_many(np.ascontiguousarray(y0 * np.ones(speed.shape)), v_t / u, v_tp / u, r * w_t / u, r * w_tp / u,
                  p, float(rtol), np.ascontiguousarray(j_stop), np.ascontiguousarray(ja_stop), SETTLE_AMPLITUDE,
                  int(max_steps), states, info)
@@ -375,4 +494,5 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
         "dissipated_normal": states[:, _D] * j_unit * u,
         "slip_ended": np.asarray(slip_ended, dtype=bool),
         "n_steps": info[:, 5].astype(np.int64),
+        "turning_points": info[:, 6].astype(np.int64),
     }
