@@ -23,6 +23,9 @@ SUB_MODEL_SELECTIONS = {
     "pulloff friction (rigid, pulloff)": {"friction_model": "pulloff"},
     "tangential compliance (mindlin, net)": {"tangential_model": "mindlin"},
     "compliance + pulloff (mindlin, pulloff)": {"tangential_model": "mindlin", "friction_model": "pulloff"},
+    "hysteretic compliance (mindlin_deresiewicz, net)": {"tangential_model": "mindlin_deresiewicz"},
+    "hysteretic + rolling resistance (mu_r 0.01)": {"tangential_model": "mindlin_deresiewicz",
+                                                    "rolling_friction": 0.01},
 }
 
 
