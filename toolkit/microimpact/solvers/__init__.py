@@ -3,9 +3,12 @@
 :func:`microimpact.simulate_impact` takes a ``method=`` switch and returns one
 :class:`~microimpact.model.kinematics.ImpactResult` whatever the method:
 
-- ``"engine"``: compiled 1-D normal solve (Dormand-Prince 5(4) in the Sundman form, :mod:`.engine`)
-  plus the closed-form tangential map of :mod:`microimpact.model.tangential`;
-- ``"reference"``: the full 3-D equations integrated by scipy (:mod:`.reference`);
+- ``"engine"``: compiled 1-D normal solve (Dormand-Prince 5(4) in the Sundman form, :mod:`.engine`;
+  for the JKR and DMT normal models :mod:`.normal_models`) plus the closed-form tangential map of
+  :mod:`microimpact.model.tangential`;
+- ``"reference"``: the full 3-D equations integrated by scipy (:mod:`.reference`); for the JKR and
+  DMT normal models their normal law integrated by scipy in physical time
+  (:func:`.normal_models.solve_normal_reference`) plus the same tangential map;
 - ``"rkg"``: the paper's fixed-step Runge-Kutta-Gill normal solve (:mod:`.rkg`) plus the same map.
 
 :func:`microimpact.simulate_many` (a broadcast batch, :mod:`.impact`) runs the engine only. Every
@@ -25,8 +28,8 @@ METHODS = ("engine", "reference", "rkg")
 #: a contact that selects anything else is refused by :func:`check_sub_models` with a message that
 #: says which method does cover it. Extended as sub-models are implemented.
 SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
-    "engine": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
-    "reference": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
+    "engine": {"normal_model": ("ring", "jkr", "dmt"), "tangential_model": ("rigid",), "friction_model": ("net",)},
+    "reference": {"normal_model": ("ring", "jkr", "dmt"), "tangential_model": ("rigid",), "friction_model": ("net",)},
     "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
 }
 #: solver paths that model rolling resistance (Contact.rolling_friction > 0)

@@ -212,11 +212,13 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
     if steps is not None and (isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps < 1):
         raise ValueError(f"steps must be a whole number >= 1, got {steps!r}")
     check_sub_models(contact, method)
-    if method == "reference":
+    normal = _normal_solver(contact)
+    if method == "reference" and (contact.normal_model == "ring" or contact.adhesion_line_force == 0.0):
         # imported here: scipy.integrate costs ~0.7 s of import time that the engine never needs
         from microimpact.solvers.reference import simulate_reference
 
-        return simulate_reference(contact, speed, incidence_deg, azimuth_deg, omega, rtol=rtol)
+        # without adhesion JKR and DMT are the Hertz law of the paper's model
+        return simulate_reference(contact.with_(normal_model="ring"), speed, incidence_deg, azimuth_deg, omega, rtol=rtol)
     v_in = incident_velocity(float(speed), float(incidence_deg), float(azimuth_deg))
     w_in = tuple(float(w) for w in omega)
     u_t, u_tp = slip_velocity(contact.radius, v_in[1], v_in[2], w_in[1], w_in[2])
@@ -232,8 +234,12 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
                 "method='rkg' stops a captured impact at the capture test (E < 0) and does not follow "
                 "the captured oscillation, whose friction impulse the tangential outcome needs "
                 f"(speed {speed!r} m/s, friction {contact.friction!r}); use method='engine' or 'reference'")
+    elif method == "reference":  # JKR or DMT: the scipy integration of their normal law, then the map
+        sol = normal.solve_normal_reference(
+            contact, -v_in[0], rtol=min(rtol, 1e-10), need_tail=needs_tangential, friction_impulse_stop=j_star,
+            twist_impulse_stop=_twist_stop(contact.moment_of_inertia, contact.friction, w_in[0]))
     else:
-        sol = engine.solve_normal(
+        sol = normal.solve_normal(
             contact, -v_in[0], rtol=rtol, need_tail=needs_tangential, friction_impulse_target=j_target,
             friction_impulse_stop=j_star,
             twist_impulse_stop=_twist_stop(contact.moment_of_inertia, contact.friction, w_in[0]),
@@ -272,8 +278,26 @@ def _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential) -> 
     )
 
 
+def _normal_solver(contact):
+    """The module that solves the contact's normal law: the paper's engine for the ring force, else
+    :mod:`microimpact.solvers.normal_models` (JKR, DMT), after checking the Tabor regime
+    (:func:`microimpact.model.adhesion_models.check_adhesion_regime`, an AdhesionRegimeWarning)."""
+    if contact.normal_model == "ring":
+        return engine
+    from microimpact.model.adhesion_models import check_adhesion_regime
+    from microimpact.solvers import normal_models
+
+    check_adhesion_regime(contact, stacklevel=4)
+    return normal_models
+
+
 def settled_contact_energy(contact) -> float:
-    """Contact energy V(X) = -(4/15) m (X/T)^2 of a sphere at rest at the equilibrium x = X. [J]"""
+    """Contact energy of a sphere at rest at its equilibrium: V(X) = -(4/15) m (X/T)^2 for the
+    paper's law, :func:`microimpact.solvers.normal_models.settled_contact_energy` for JKR, DMT. [J]"""
+    if contact.normal_model != "ring":
+        from microimpact.solvers.normal_models import settled_contact_energy as settled
+
+        return settled(contact)
     return float(contact_potential_energy(contact, contact.length_scale))
 
 
@@ -348,6 +372,11 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     ds = _batch_dataset(arrays, results)
     ds.attrs.update(contact_attributes(contact))
     ds.attrs["solver"] = f"microimpact engine (Dormand-Prince 5(4), rtol={rtol:g})"
+    if contact.normal_model != "ring":
+        from microimpact.model.adhesion_models import tabor_parameter
+
+        ds.attrs["normal_model"] = contact.normal_model
+        ds.attrs["tabor_parameter"] = float(tabor_parameter(contact.radius, contact.stiffness, contact.work_of_adhesion))
     ds.attrs["normal_solves"] = n_solves
     return ds
 
@@ -399,8 +428,8 @@ def _solve_batch(contact, flat: dict, rtol: float):
     j_star, ja_star = stop_impulses(m, inertia, f, np.hypot(u_t, u_tp), w[0])
     np.maximum.at(j_stop, inverse, np.where(needs_tangential, j_star, 0.0))
     np.maximum.at(ja_stop, inverse, np.where(needs_tangential, ja_star, 0.0))
-    sol = engine.solve_normal_many(contact, speeds, need_tail, rtol=rtol,
-                                   friction_impulse_stop=j_stop, twist_impulse_stop=ja_stop)
+    sol = _normal_solver(contact).solve_normal_many(contact, speeds, need_tail, rtol=rtol,
+                                                    friction_impulse_stop=j_stop, twist_impulse_stop=ja_stop)
     g = {k: val[inverse] for k, val in sol.items()}
     captured = g["captured"]
 
