@@ -219,3 +219,16 @@ def test_tabor_parameter_value_and_regime_warnings():
     stiff_small = c.with_(normal_model="jkr", radius=1e-8, stiffness=4e11)
     with pytest.warns(am.AdhesionRegimeWarning, match="outside the JKR regime"):
         am.check_adhesion_regime(stiff_small)
+
+
+# ----------------------------------------------------------------------------- work-precision lines
+def test_normal_model_work_precision_lines():
+    from microimpact.studies.benchmark.normal_models import normal_model_work_precision
+
+    ds = normal_model_work_precision(speeds=np.geomspace(0.5, 20.0, 6), rtols=(1e-6, 1e-9), repeats=1)
+    assert list(ds.normal_model.values) == ["ring", "jkr", "dmt"]
+    # each solver meets its tolerance against its own reference, within a factor 50 (global error of
+    # an adaptive solver is a small multiple of its local tolerance)
+    assert np.all(ds.max_error_e_n.values <= 50 * ds.rtol.values[None, :])
+    assert np.all(ds.max_error_e_n.isel(rtol=1) < ds.max_error_e_n.isel(rtol=0))
+    assert np.all(np.isfinite(ds.cost_ratio)) and np.all(ds.cost_ratio.sel(normal_model="ring") == 1.0)
