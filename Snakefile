@@ -23,6 +23,7 @@ validate(config, "workflow/schemas/config.schema.yaml")
 include: "workflow/rules/common.smk"
 include: "workflow/rules/data.smk"
 include: "workflow/rules/fit.smk"
+include: "workflow/rules/models.smk"
 include: "workflow/rules/dynamics.smk"
 include: "workflow/rules/sweeps.smk"
 include: "workflow/rules/validation.smk"

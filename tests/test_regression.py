@@ -37,7 +37,14 @@ COEFFICIENTS = ("e_n", "mu_t", "mu_tp", "K_L", "K_t")
 DELIBERATE_REPRODUCTION_CHANGES = {
     "Capture-velocity": ("v_capture = 1.449241 m/s (+- 6.0e-08 m/s; e_n = ", "at the rebound end of the bracket)"),
     "Fig13-one-curve": ("slip ended for every f in 0.1-0.9 and v in 2-10 m/s: True; max spread of mu_t, mu_t' over f: ", ""),
+    # issue 14: the fixed damping reference speed that makes 1 m/s rebound is appended; the numbers kept
+    "Capture-velocity-variants": ("v_capture: f0 = 7.390 N/m: 1.4371 m/s; r = 6.89 um with f0 = 7.422 N/m: 0.3937 m/s; "
+                                  "r = 6.89 um with w_A fixed (f0 = 9.347 N/m): 0.6030 m/s", ""),
 }
+#: issue 14: rows added to the reproduction table (claims it missed), after the baseline was taken
+ADDED_REPRODUCTION_ROWS = ("Fig5-nmax", "Spin-to-change-K", "T1-T2-friction-range", "Eq18-torque")
+#: issue 14: verdicts made stricter on the same numbers (they were too generous); row -> new verdict
+CHANGED_REPRODUCTION_VERDICTS = {"Fig12-mu-gt-f": "False", "Summary2-spin": "False"}
 
 
 def _max_diff(a, b) -> float:
@@ -102,6 +109,8 @@ def test_reproduction_table_unchanged():
 
     new = reproduction_table(WALL_1990).set_index("id")
     base = pd.read_csv(BASELINE / "reproduction.csv", keep_default_na=False).set_index("id")
+    assert sorted(set(new.index) - set(base.index)) == sorted(ADDED_REPRODUCTION_ROWS)
+    new = new.loc[[i for i in new.index if i not in ADDED_REPRODUCTION_ROWS]]
     assert list(new.index) == list(base.index)
     # the table prints rounded numbers: identical text means agreement to the printed digits
     mismatched = [i for i in base.index if str(new.loc[i, "toolkit_value"]) != base.loc[i, "toolkit_value"]]
@@ -109,7 +118,8 @@ def test_reproduction_table_unchanged():
     for row, (kept_start, kept_end) in DELIBERATE_REPRODUCTION_CHANGES.items():
         for text in (base.loc[row, "toolkit_value"], str(new.loc[row, "toolkit_value"])):
             assert text.startswith(kept_start) and text.endswith(kept_end), (row, text)
-    assert [str(x) for x in new["agree"]] == [str(x) for x in base["agree"]]
+    expected = [CHANGED_REPRODUCTION_VERDICTS.get(i, str(x)) for i, x in zip(base.index, base["agree"])]
+    assert [str(x) for x in new["agree"]] == expected
 
 
 def test_kharaz_comparison_unchanged():

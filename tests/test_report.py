@@ -20,6 +20,7 @@ import pytest  # noqa: E402
 from microimpact import presets  # noqa: E402
 from microimpact.analysis.fitting import fit_damping  # noqa: E402
 from microimpact.analysis.kharaz import kharaz_comparison  # noqa: E402
+from microimpact.analysis.model_comparison import compare_normal_models  # noqa: E402
 from microimpact.analysis.synthetic import make_synthetic_impacts  # noqa: E402
 from microimpact.dynamics import nonlinear as dynamics  # noqa: E402
 from microimpact.io import read_impacts  # noqa: E402
@@ -94,6 +95,8 @@ def results(tmp_path_factory):
     write_netcdf(restitution_curves(fit_ds, {"start": 0.3, "stop": 30.0, "num": 12, "spacing": "log"}),
                  tmp / "fit_curves.nc")
     source, analyst_sweeps = _analyst_files(tmp, fit_ds)
+    write_netcdf(compare_normal_models(table, presets.WALL_1990, ("ring", "jkr"), curve_points=12,
+                                       start_grid=([0.5, 1.0], [10.0, 30.0])), tmp / "model_comparison.nc")
     kh = kharaz_comparison(fit_friction=False, curve_incidence_deg=np.arange(1.0, 80.0, 6.0))
     write_netcdf(kh, tmp / "kharaz.nc")
     stress = {"cases_run": 4, "cases_failed": 0, "seed": 1, "captures": 1, "failures_by_kind": {"energy": 0},
@@ -108,7 +111,7 @@ def results(tmp_path_factory):
               "phase_portraits": tmp / "portraits.nc", "dynamics": tmp / "dynamics.nc",
               "bifurcation": tmp / "bifurcation.nc", "paper_sweeps": _paper_files(tmp),
               "reproduction": tmp / "reproduction.csv", "kharaz": tmp / "kharaz.nc", "stress": tmp / "stress.json",
-              "flags": tmp / "flags.csv"}
+              "flags": tmp / "flags.csv", "model_comparison": tmp / "model_comparison.nc"}
     return tmp, inputs, source
 
 
@@ -136,6 +139,7 @@ def test_report_has_both_parts_and_their_sources(results, report_text):
     assert text.index("Sensitivity sweeps of the measured material") < b < text.index("Table 2 case 2.3 (Figs")
     # every section says which parameters made it: the fit's file and hash in part A, the preset in part B
     assert text[a:b].count(f"Parameters: {analyst_source}") >= 4  # fit, per-size dynamics, sweeps, flags
+    assert "Normal contact models compared on the data" in text[a:b] and "Delta AIC" in text[a:b]
     assert "Measurement flags" in text[a:b] and "Of 12 impacts: 0 R, 0 A, 1 C" in text[a:b]
     assert text[b:].count(f"Parameters: {PAPER_SOURCE}") >= 3
     assert "Parameters: preset" not in text[a:b]

@@ -349,7 +349,9 @@ def test_changing_data_reruns_only_its_dependants(pipeline):
     assert proc.returncode == 0, proc.stdout
     jobs = job_counts(proc.stdout)
     # the analyst's part follows the fit; the paper's part and the checks do not depend on the data
-    assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "report", "all"}, jobs
+    # (and the normal models compared on the same data)
+    assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "model_comparison", "report",
+                         "all"}, jobs
 
 
 # --------------------------------------------------------------------------- profile, lint, config

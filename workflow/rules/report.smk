@@ -10,6 +10,7 @@ rule report:
         data_table=rules.validate_data.output.table,
         fit=rules.fit.output[0],
         fit_curves=rules.material_simulations.output.fit_curves,
+        model_comparison=rules.model_comparison.output[0],
         flags=rules.flags.output.csv,
         analyst_dynamics=rules.material_simulations.output.dynamics,
         analyst_sweeps=rules.material_simulations.output.sweeps,

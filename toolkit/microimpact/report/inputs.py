@@ -46,6 +46,7 @@ INPUT_KEYS = {
     "flags": (False, "measurement-flags CSV"),
     "analyst_dynamics": (False, "critical and capture velocity per measured radius, NetCDF"),
     "analyst_sweeps": (False, "Table 2 sweeps at the measured radii (leading dimension radius), NetCDF files"),
+    "model_comparison": (False, "normal models (ring, JKR, DMT) fitted to the data with AIC/BIC, NetCDF"),
     # the paper's parameters (Table 1 row 2)
     "phase_portraits": (False, "grouped NetCDF of phase portraits"),
     "dynamics": (False, "dynamics summary NetCDF"),

@@ -4,8 +4,9 @@
 Snakemake workflow (keys in :data:`microimpact.report.inputs.INPUT_KEYS`) in three parts:
 
 A. the analyst's material, with the parameters of the fit: the damping fit (Fig. 3 analogue),
-   capture and critical velocity per measured size, the Table 2 sweeps at the measured sizes and
-   the measurement flags (:mod:`.analyst`);
+   the normal contact models compared on the data (:mod:`.models`), capture and critical velocity
+   per measured size, the Table 2 sweeps at the measured sizes and the measurement flags
+   (:mod:`.analyst`);
 B. the reproduction of the paper with the paper's parameters (Table 1 row 2): the nonlinear
    dynamics (Figs. 4, 5), the Table 2 sweeps (Figs. 7-14) and the table of the paper's claims
    (:mod:`.paper`);
@@ -38,7 +39,7 @@ import pandas as pd
 
 from microimpact import __version__
 from microimpact.model.contact import PAPER_REFERENCE
-from microimpact.report import analyst, checks, paper
+from microimpact.report import analyst, checks, models, paper
 from microimpact.report.inputs import (INPUT_KEYS, as_list, check_inputs, git_commit, is_synthetic, provenance,
                                        read_dataset, read_json, read_portraits, read_table)
 from microimpact.report.layout import PAGE_SIZE, Layout
@@ -62,6 +63,8 @@ def _analyst_part(lay: Layout, inputs: Mapping, data: pd.DataFrame | None, synth
         "fitted) come from the fit in section 1; every simulation in this part uses them, at the measured sphere "
         "sizes and over the measured speed range.")
     analyst.fit_section(lay, fit, _optional(inputs, "fit_curves", read_dataset), data, synthetic)
+    if "model_comparison" in inputs:
+        models.model_comparison_section(lay, read_dataset(inputs["model_comparison"]), synthetic)
     dyn = _optional(inputs, "analyst_dynamics", read_dataset)
     if dyn is not None:
         analyst.analyst_dynamics_section(lay, dyn)
@@ -119,7 +122,7 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
         Result files by key; ``fit`` is required, every other key may be missing (its section is
         left out or says why it is empty). Keys (see :data:`microimpact.report.inputs.INPUT_KEYS`):
         analyst part ``data_table`` (CSV), ``fit``, ``fit_curves``, ``flags`` (CSV),
-        ``analyst_dynamics``, ``analyst_sweeps`` (list); paper part ``phase_portraits``,
+        ``analyst_dynamics``, ``analyst_sweeps`` (list), ``model_comparison``; paper part ``phase_portraits``,
         ``dynamics``, ``bifurcation``, ``reproduction`` (CSV), ``paper_sweeps`` (list); checks
         ``kharaz``, ``work_precision``, ``stress`` (JSON). NetCDF unless stated. In-memory
         objects (Dataset, DataFrame, dict, list of Datasets) are accepted in place of files.

@@ -3,11 +3,14 @@
 :func:`microimpact.simulate_impact` takes a ``method=`` switch and returns one
 :class:`~microimpact.model.kinematics.ImpactResult` whatever the method:
 
-- ``"engine"``: compiled 1-D normal solve (Dormand-Prince 5(4) in the Sundman form, :mod:`.engine`)
-  plus the closed-form tangential map of :mod:`microimpact.model.tangential`; a contact that
-  selects tangential compliance or adhesion-aware friction runs the compiled coupled solver
-  (:mod:`.coupled`) instead, so the paper's model pays nothing for them;
-- ``"reference"``: the full 3-D equations integrated by scipy (:mod:`.reference`);
+- ``"engine"``: compiled 1-D normal solve (Dormand-Prince 5(4) in the Sundman form, :mod:`.engine`;
+  for the JKR and DMT normal models :mod:`.normal_models`) plus the closed-form tangential map of
+  :mod:`microimpact.model.tangential`; a contact that selects tangential compliance or
+  adhesion-aware friction runs the compiled coupled solver (:mod:`.coupled`) instead, so the
+  paper's model pays nothing for them;
+- ``"reference"``: the full 3-D equations integrated by scipy (:mod:`.reference`); for the JKR and
+  DMT normal models their normal law integrated by scipy in physical time
+  (:func:`.normal_models.solve_normal_reference`) plus the same tangential map;
 - ``"rkg"``: the paper's fixed-step Runge-Kutta-Gill normal solve (:mod:`.rkg`) plus the same map.
 
 :func:`microimpact.simulate_many` (a broadcast batch, :mod:`.impact`) runs the engine only. Every
@@ -28,10 +31,12 @@ METHODS = ("engine", "reference", "rkg")
 #: says which method does cover it. Extended as sub-models are implemented.
 SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
     # the engine runs the paper's model (rigid, net) as one normal solve plus the closed-form map and
-    # every other tangential/friction choice with the compiled coupled solver (.coupled)
-    "engine": {"normal_model": ("ring",), "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
+    # every other tangential/friction choice with the compiled coupled solver (.coupled), which
+    # integrates the ring normal law only (check_sub_models refuses jkr/dmt with it)
+    "engine": {"normal_model": ("ring", "jkr", "dmt"),
+               "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
                "friction_model": ("net", "pulloff")},
-    "reference": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
+    "reference": {"normal_model": ("ring", "jkr", "dmt"), "tangential_model": ("rigid",), "friction_model": ("net",)},
     "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
 }
 #: solver paths that model rolling resistance (Contact.rolling_friction > 0): the engine's coupled
@@ -59,3 +64,8 @@ def check_sub_models(contact, method: str) -> None:
         raise ValueError(f"rolling_friction={contact.rolling_friction!r} needs a compliant tangential model "
                          f"(tangential_model one of {', '.join(map(repr, ROLLING_RESISTANCE_TANGENTIAL_MODELS))}), "
                          f"got tangential_model={contact.tangential_model!r}")
+    if contact.normal_model != "ring" and (contact.tangential_model != "rigid" or contact.friction_model != "net"):
+        raise ValueError(f"normal_model={contact.normal_model!r} runs with the paper's tangential map only "
+                         "(tangential_model='rigid', friction_model='net'): the coupled solver of tangential "
+                         f"compliance and adhesion-aware friction integrates the ring normal law; got "
+                         f"tangential_model={contact.tangential_model!r}, friction_model={contact.friction_model!r}")

@@ -370,6 +370,8 @@ def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = 
     >>> fam = normal_family(get_preset("wall1990"), 0.2, 10.0)
     >>> out = fam.evaluate([0.5, 2.0, 7.5])
     """
+    if contact.normal_model != "ring":
+        raise ValueError(f"normal_family interpolates the paper's ring normal law, got normal_model={contact.normal_model!r}")
     lo, hi = float(speed_min), float(speed_max)
     if not (0.0 < lo <= hi and math.isfinite(hi)):
         raise ValueError(f"need 0 < speed_min <= speed_max (finite), got {speed_min!r}, {speed_max!r}")
@@ -479,6 +481,10 @@ def normal_restitution(contact, normal_speed, *, rtol: float = DEFAULT_RTOL, fam
     or, for many distinct speeds, a restitution-only family (``family`` None chooses, True/False
     force) when it costs fewer than half as many solves. [-]"""
     v = np.asarray(normal_speed, dtype=float).ravel()
+    if contact.normal_model != "ring":  # JKR, DMT: their own solver, one solve per speed
+        from microimpact.solvers import normal_models  # imported on use: it compiles its own kernels
+
+        return normal_models.solve_normal_many(contact, v, rtol=rtol)["e_n"]
     if family or (family is None and v.size >= FAMILY_MIN_SPEEDS):
         speeds, inverse = np.unique(v, return_inverse=True)
         if family or speeds.size >= FAMILY_MIN_SPEEDS:

@@ -234,11 +234,13 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
         res = _coupled_results(contact, tuple(np.array([x]) for x in v_in), tuple(np.array([w]) for w in omega),
                                np.array([contact.friction]), rtol)
         return _coupled_impact_result(contact, v_in, omega, res)
-    if method == "reference":
+    normal = _normal_solver(contact)
+    if method == "reference" and (contact.normal_model == "ring" or contact.adhesion_line_force == 0.0):
         # imported here: scipy.integrate costs ~0.7 s of import time that the engine never needs
         from microimpact.solvers.reference import simulate_reference
 
-        return simulate_reference(contact, speed, incidence_deg, azimuth_deg, omega, rtol=rtol)
+        # without adhesion JKR and DMT are the Hertz law of the paper's model
+        return simulate_reference(contact.with_(normal_model="ring"), speed, incidence_deg, azimuth_deg, omega, rtol=rtol)
     v_in = incident_velocity(float(speed), float(incidence_deg), float(azimuth_deg))
     w_in = tuple(float(w) for w in omega)
     u_t, u_tp = slip_velocity(contact.radius, v_in[1], v_in[2], w_in[1], w_in[2])
@@ -254,8 +256,12 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
                 "method='rkg' stops a captured impact at the capture test (E < 0) and does not follow "
                 "the captured oscillation, whose friction impulse the tangential outcome needs "
                 f"(speed {speed!r} m/s, friction {contact.friction!r}); use method='engine' or 'reference'")
+    elif method == "reference":  # JKR or DMT: the scipy integration of their normal law, then the map
+        sol = normal.solve_normal_reference(
+            contact, -v_in[0], rtol=min(rtol, 1e-10), need_tail=needs_tangential, friction_impulse_stop=j_star,
+            twist_impulse_stop=_twist_stop(contact.moment_of_inertia, contact.friction, w_in[0]))
     else:
-        sol = engine.solve_normal(
+        sol = normal.solve_normal(
             contact, -v_in[0], rtol=rtol, need_tail=needs_tangential, friction_impulse_target=j_target,
             friction_impulse_stop=j_star,
             twist_impulse_stop=_twist_stop(contact.moment_of_inertia, contact.friction, w_in[0]),
@@ -345,8 +351,26 @@ def _coupled_impact_result(contact, v_in, w_in, res) -> ImpactResult:
     )
 
 
+def _normal_solver(contact):
+    """The module that solves the contact's normal law: the paper's engine for the ring force, else
+    :mod:`microimpact.solvers.normal_models` (JKR, DMT), after checking the Tabor regime
+    (:func:`microimpact.model.adhesion_models.check_adhesion_regime`, an AdhesionRegimeWarning)."""
+    if contact.normal_model == "ring":
+        return engine
+    from microimpact.model.adhesion_models import check_adhesion_regime
+    from microimpact.solvers import normal_models
+
+    check_adhesion_regime(contact, stacklevel=4)
+    return normal_models
+
+
 def settled_contact_energy(contact) -> float:
-    """Contact energy V(X) = -(4/15) m (X/T)^2 of a sphere at rest at the equilibrium x = X. [J]"""
+    """Contact energy of a sphere at rest at its equilibrium: V(X) = -(4/15) m (X/T)^2 for the
+    paper's law, :func:`microimpact.solvers.normal_models.settled_contact_energy` for JKR, DMT. [J]"""
+    if contact.normal_model != "ring":
+        from microimpact.solvers.normal_models import settled_contact_energy as settled
+
+        return settled(contact)
     return float(contact_potential_energy(contact, contact.length_scale))
 
 
@@ -438,6 +462,11 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     ds = _batch_dataset(arrays, results)
     ds.attrs.update(contact_attributes(contact))
     ds.attrs["solver"] = f"microimpact engine (Dormand-Prince 5(4), rtol={rtol:g})"
+    if contact.normal_model != "ring":
+        from microimpact.model.adhesion_models import tabor_parameter
+
+        ds.attrs["normal_model"] = contact.normal_model
+        ds.attrs["tabor_parameter"] = float(tabor_parameter(contact.radius, contact.stiffness, contact.work_of_adhesion))
     ds.attrs["normal_solves"] = n_solves
     ds.attrs["normal_solve_path"] = path
     return ds
@@ -472,6 +501,10 @@ def _family_of(contact, normal_speed, rtol, family):
     a family that would cost more than half as many solves as there are impacts."""
     n = normal_speed.size
     if family is False or n == 0:
+        return None
+    if contact.normal_model != "ring":  # the family interpolates the paper's engine
+        if family:
+            raise ValueError(f"family=True covers normal_model='ring' only, got {contact.normal_model!r}")
         return None
     if family is None:
         if n < FAMILY_MIN_SPEEDS:
@@ -531,8 +564,8 @@ def _direct_batch(contact, flat: dict, rtol: float):
     j_star, ja_star = stop_impulses(m, inertia, f, np.hypot(u_t, u_tp), w[0])
     np.maximum.at(j_stop, inverse, np.where(needs_tangential, j_star, 0.0))
     np.maximum.at(ja_stop, inverse, np.where(needs_tangential, ja_star, 0.0))
-    sol = engine.solve_normal_many(contact, speeds, need_tail, rtol=rtol,
-                                   friction_impulse_stop=j_stop, twist_impulse_stop=ja_stop)
+    sol = _normal_solver(contact).solve_normal_many(contact, speeds, need_tail, rtol=rtol,
+                                                    friction_impulse_stop=j_stop, twist_impulse_stop=ja_stop)
     g = {k: val[inverse] for k, val in sol.items()}
     captured = g["captured"]
 

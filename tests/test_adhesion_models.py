@@ -1,0 +1,234 @@
+"""JKR and DMT normal models: their closed forms, the sticking velocity, the Tabor parameter, the solvers.
+
+The closed forms checked are those of Johnson, Kendall & Roberts (1971) (force and approach at
+contact formation, break and equilibrium), Thornton & Ning (1998) (sticking velocity of an elastic
+JKR sphere, v_s = 1.84 (w^5 / (rho^3 E*^2 R^5))^(1/6)) and Johnson & Pollock (1994) (the adhesion
+hysteresis of one JKR contact cycle, which gives the exact v_s; no hysteresis in the DMT limit).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+import microimpact as mi
+from microimpact.model import adhesion_models as am
+from microimpact.model.parameters import TABLE1_ROW2
+from microimpact.solvers import check_sub_models, normal_models
+
+ELASTIC = {"zeta_hertz": 0.0, "zeta_adhesion": 0.0}  # the damping of the sticking-velocity comparison
+
+
+def _contact(model, **kw):
+    return TABLE1_ROW2.with_(normal_model=model, **kw)
+
+
+def _bisect_sticking(contact, lo, hi, method="engine", rel=1e-7):
+    """Largest captured normal speed, by bisection on the outcome of simulate_impact. [m/s]"""
+    assert mi.simulate_impact(contact, lo, method=method).outcome == "capture"
+    assert mi.simulate_impact(contact, hi, method=method).outcome == "rebound"
+    while hi - lo > rel * hi:
+        mid = 0.5 * (lo + hi)
+        if mi.simulate_impact(contact, mid, method=method).outcome == "capture":
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+# ----------------------------------------------------------------------------- closed forms
+def test_jkr_force_and_approach_at_formation_break_and_equilibrium():
+    c = TABLE1_ROW2
+    r, k, w = c.radius, c.stiffness, c.work_of_adhesion
+    e_star = 0.75 * k
+    f_c = 1.5 * math.pi * w * r  # JKR pull-off force under load control
+    a_c = (math.pi * w * r * r / (8 * e_star)) ** (1 / 3)
+    a_zero = (2 * math.pi * w * r * r / e_star) ** (1 / 3)  # delta = 0
+    a0 = (9 * math.pi * w * r * r / (2 * e_star)) ** (1 / 3)  # zero load
+    # 1e-12: the closed forms are algebraic identities, equal to round-off
+    assert am.jkr_approach(r, k, w, a_zero) == pytest.approx(0.0, abs=1e-12 * r)
+    assert am.jkr_force(r, k, w, a_zero) == pytest.approx(-8 / 9 * f_c, rel=1e-12)
+    assert am.jkr_force(r, k, w, a_c) == pytest.approx(-5 / 9 * f_c, rel=1e-12)
+    assert am.jkr_approach(r, k, w, a_c) == pytest.approx(am.jkr_critical_approach(r, k, w), rel=1e-12)
+    assert am.jkr_force(r, k, w, a0) == pytest.approx(0.0, abs=1e-12 * f_c)
+    # the contact radius of the stable branch inverts the approach (Newton to round-off)
+    a = np.array([a_c * 1.0001, a_zero, a0, 3 * a0])
+    assert am.jkr_contact_radius(r, k, w, am.jkr_approach(r, k, w, a)) == pytest.approx(a, rel=1e-9)
+    # Eq. (7) makes the ring model's equilibrium radius sqrt(r X) the JKR zero-load radius
+    assert math.sqrt(r * c.length_scale) == pytest.approx(a0, rel=1e-12)
+
+
+@pytest.mark.parametrize("model", ["jkr", "dmt"])
+def test_nondimensional_potential_is_the_integral_of_the_force(model):
+    z = np.linspace(1.05 if model == "jkr" else 0.05, 3.0, 40)
+    h = 1e-6
+    if model == "jkr":
+        du = (am.jkr_nondimensional_potential(z + h) - am.jkr_nondimensional_potential(z - h)) / (2 * h)
+        dd = 4 * (z**3 - 1)  # d(delta/L)/dq
+        f = am.jkr_nondimensional_force(z, 0.0, 0.0, 0.0)
+    else:
+        du = (am.dmt_nondimensional_potential(z + h) - am.dmt_nondimensional_potential(z - h)) / (2 * h)
+        dd = 2 * z
+        f = am.dmt_nondimensional_force(z, 0.0, 0.0, 0.0)
+    # central differences of a polynomial: error ~ h^2 U''' ~ 1e-10
+    assert du / dd == pytest.approx(f, rel=1e-7, abs=1e-8)
+
+
+def test_jkr_hysteresis_matches_the_energy_integral():
+    """Johnson & Pollock (1994): the cycle loses int_{delta_c}^0 |F| d delta (quadrature here)."""
+    c = TABLE1_ROW2
+    r, k, w = c.radius, c.stiffness, c.work_of_adhesion
+    a_c = (math.pi * w * r * r / (8 * 0.75 * k)) ** (1 / 3)
+    a_zero = (2 * math.pi * w * r * r / (0.75 * k)) ** (1 / 3)
+    a = np.linspace(a_c, a_zero, 200001)
+    d = am.jkr_approach(r, k, w, a)
+    f = am.jkr_force(r, k, w, a)
+    loss = float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(d)))  # F d(delta) along a; F < 0, d grows
+    sc = am.adhesion_scales(c.with_(normal_model="jkr"))
+    # trapezoid rule with 2e5 panels on a smooth parametrisation: ~1e-9 relative
+    assert -loss == pytest.approx(am.JKR_HYSTERESIS * sc.force * sc.length, rel=1e-7)
+
+
+# ----------------------------------------------------------------------------- sticking velocity
+def test_jkr_sticking_velocity_from_simulation_agrees_with_thornton_ning():
+    """Elastic JKR (zeta_H = zeta_A = 0, the case the closed forms treat): bisection on capture."""
+    c = _contact("jkr", **ELASTIC)
+    exact = am.jkr_sticking_velocity(c)
+    v_s = _bisect_sticking(c, 0.5 * exact, 2.0 * exact)
+    tn = am.thornton_ning_sticking_velocity(c.radius, c.density, c.stiffness, c.work_of_adhesion)
+    # the issue's target: within 2 % of the published closed form (its coefficient has 3 digits,
+    # 1.84 vs 1.8405: the two differ by 0.03 %)
+    assert abs(v_s / tn - 1) < 0.02
+    assert abs(v_s / tn - 1) < 5e-4
+    # against the exact hysteresis: bisection to 1e-7 and rtol 1e-8 in the energy
+    assert v_s == pytest.approx(exact, rel=1e-6)
+
+
+def test_jkr_sticking_velocity_reference_solver_agrees():
+    c = _contact("jkr", **ELASTIC)
+    exact = am.jkr_sticking_velocity(c)
+    v_s = _bisect_sticking(c, 0.5 * exact, 2.0 * exact, method="reference", rel=1e-5)
+    assert v_s == pytest.approx(exact, rel=2e-5)  # bisection stopped at 1e-5
+
+
+@pytest.mark.parametrize("factor", [1.05, 2.0, 20.0])
+def test_elastic_jkr_restitution_closed_form(factor):
+    """Above v_s an elastic JKR sphere keeps m v^2/2 - Delta_E: e_n = sqrt(1 - v_s^2 / v^2)."""
+    c = _contact("jkr", **ELASTIC)
+    v_s = am.jkr_sticking_velocity(c)
+    r = mi.simulate_impact(c, factor * v_s)
+    assert r.outcome == "rebound"
+    assert r.e_n == pytest.approx(math.sqrt(1 - factor**-2), abs=2e-7)  # rtol 1e-8 of the engine
+    # the energy lost is the hysteresis, whatever the speed
+    assert r.dissipated_energy == pytest.approx(0.5 * c.mass * v_s**2, rel=1e-6)
+
+
+@pytest.mark.parametrize("speed", [0.01, 0.3, 3.0, 30.0])
+def test_elastic_dmt_has_no_hysteresis(speed):
+    """Johnson & Pollock (1994): in the DMT limit the cycle loses nothing; no capture without damping."""
+    r = mi.simulate_impact(_contact("dmt", **ELASTIC), speed)
+    assert r.outcome == "rebound"
+    assert r.e_n == pytest.approx(1.0, abs=1e-6)  # rtol 1e-8, error accumulated over the contact
+
+
+def test_damped_dmt_sticking_velocity_engine_and_reference_agree():
+    c = _contact("dmt")
+    v_e = _bisect_sticking(c, 0.05, 1.0, rel=1e-6)
+    v_r = _bisect_sticking(c, 0.05, 1.0, method="reference", rel=1e-6)
+    assert v_e == pytest.approx(v_r, rel=5e-6)  # two bisections to 1e-6 each
+
+
+# ----------------------------------------------------------------------------- solvers
+@pytest.mark.parametrize("model", ["jkr", "dmt"])
+@pytest.mark.parametrize("speed,incidence", [(2.0, 40.0), (10.0, 10.0), (1.0, 80.0), (30.0, 60.0)])
+def test_engine_agrees_with_reference(model, speed, incidence):
+    c = _contact(model)
+    a = mi.simulate_impact(c, speed, incidence, 0.0, (1e5, 0.0, 2e5))
+    b = mi.simulate_impact(c, speed, incidence, 0.0, (1e5, 0.0, 2e5), method="reference")
+    assert a.outcome == b.outcome
+    # the compiled solver at rtol 1e-8 against DOP853 at 1e-10: impulses to ~1e-6 (the |F_n| kinks)
+    assert a.e_n == pytest.approx(b.e_n, abs=1e-7)
+    assert np.allclose(a.velocity_out, b.velocity_out, rtol=1e-6, atol=1e-7 * speed)
+    assert a.max_penetration == pytest.approx(b.max_penetration, rel=1e-6)
+    if a.outcome == "rebound":
+        assert a.friction_impulse == pytest.approx(b.friction_impulse, rel=1e-5)
+        assert a.contact_time == pytest.approx(b.contact_time, rel=1e-6)
+
+
+@pytest.mark.parametrize("model", ["jkr", "dmt"])
+def test_simulate_many_matches_simulate_impact(model):
+    import xarray as xr
+
+    c = _contact(model)
+    speed = xr.DataArray([0.5, 2.0, 8.0], dims="speed")
+    inc = xr.DataArray([0.0, 45.0], dims="incidence")
+    ds = mi.simulate_many(c, speed, inc)
+    assert ds.attrs["normal_model"] == model
+    for i, v in enumerate(speed.values):
+        for j, a in enumerate(inc.values):
+            r = mi.simulate_impact(c, float(v), float(a))
+            # the same compiled solve: identical up to the batch's parallel scheduling (bitwise)
+            assert float(ds.e_n[i, j]) == pytest.approx(r.e_n, abs=1e-12)
+            assert float(ds.velocity_out_t[i, j]) == pytest.approx(r.velocity_out[1], rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.parametrize("model", ["jkr", "dmt"])
+def test_without_adhesion_jkr_and_dmt_are_the_hertz_law(model):
+    c = TABLE1_ROW2.with_(adhesion_line_force=0.0)
+    a = mi.simulate_impact(c, 3.0, 30.0)
+    b = mi.simulate_impact(c.with_(normal_model=model), 3.0, 30.0)
+    # the same engine call: every field equal (NaN fields, e.g. capture_time of a rebound, as NaN)
+    for name, x in vars(a).items():
+        y = vars(b)[name]
+        assert x == y or (isinstance(x, float) and math.isnan(x) and math.isnan(y)), name
+
+
+def test_rkg_refuses_jkr():
+    with pytest.raises(ValueError, match="normal_model='jkr'.*method='engine'"):
+        check_sub_models(_contact("jkr"), "rkg")
+
+
+def test_settled_energy_is_the_well_depth():
+    for model, q in (("jkr", 6 ** (1 / 3)), ("dmt", 1.0)):
+        c = _contact(model)
+        sc = am.adhesion_scales(c)
+        if model == "jkr":
+            u = am.jkr_nondimensional_potential(q) - am.jkr_nondimensional_potential(4 ** (1 / 3))
+        else:
+            u = 0.4 - 1.0  # (2/5) s^5 - s^2 at s = 1
+        assert normal_models.settled_contact_energy(c) == pytest.approx(u * sc.force * sc.length, rel=1e-14)
+
+
+# ----------------------------------------------------------------------------- Tabor parameter
+def test_tabor_parameter_value_and_regime_warnings():
+    c = TABLE1_ROW2
+    e_star = 0.75 * c.stiffness
+    z0 = 0.4e-9
+    mu = (c.radius * c.work_of_adhesion**2 / (e_star**2 * z0**3)) ** (1 / 3)
+    assert am.tabor_parameter(c.radius, c.stiffness, c.work_of_adhesion) == pytest.approx(mu, rel=1e-14)
+    assert mu > am.JKR_REGIME_MIN_TABOR  # ammonium fluorescein microspheres: a JKR contact
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert am.check_adhesion_regime(c.with_(normal_model="jkr")) == pytest.approx(mu, rel=1e-14)
+        am.check_adhesion_regime(c)  # the paper's model is not checked
+    with pytest.warns(am.AdhesionRegimeWarning, match="outside the DMT regime"):
+        mi.simulate_impact(c.with_(normal_model="dmt"), 2.0)
+    stiff_small = c.with_(normal_model="jkr", radius=1e-8, stiffness=4e11)
+    with pytest.warns(am.AdhesionRegimeWarning, match="outside the JKR regime"):
+        am.check_adhesion_regime(stiff_small)
+
+
+# ----------------------------------------------------------------------------- work-precision lines
+def test_normal_model_work_precision_lines():
+    from microimpact.studies.benchmark.normal_models import normal_model_work_precision
+
+    ds = normal_model_work_precision(speeds=np.geomspace(0.5, 20.0, 6), rtols=(1e-6, 1e-9), repeats=1)
+    assert list(ds.normal_model.values) == ["ring", "jkr", "dmt"]
+    # each solver meets its tolerance against its own reference, within a factor 50 (global error of
+    # an adaptive solver is a small multiple of its local tolerance)
+    assert np.all(ds.max_error_e_n.values <= 50 * ds.rtol.values[None, :])
+    assert np.all(ds.max_error_e_n.isel(rtol=1) < ds.max_error_e_n.isel(rtol=0))
+    assert np.all(np.isfinite(ds.cost_ratio)) and np.all(ds.cost_ratio.sel(normal_model="ring") == 1.0)

@@ -1,0 +1,199 @@
+"""Compare normal contact models on the same e_n(v_n) data: a fit of each, with AIC and BIC side by side.
+
+Each normal model (the paper's adhesion ring force, "ring"; JKR; DMT; see
+:mod:`microimpact.model.adhesion_models`) is fitted to the same measured normal restitution with
+the residual convention of :func:`microimpact.analysis.fitting.damping_residual`:
+(model e_n - measured e_n) / sigma, sigma the stated e_n uncertainty (or 1 when a row has none),
+model e_n = 0 where the model predicts capture, jointly over the particle sizes with one work of
+adhesion (f0 or the JKR/DMT scales per radius from it). The free parameters are the same for every
+model: zeta_H, zeta_A (Eqs. (14)-(15)) and w_A, so that the information criteria compare the laws,
+not their parameter counts. Each fit starts from the best point of a log grid of the zetas at the
+material's w_A and ends with Levenberg-Marquardt (lmfit ``leastsq``).
+
+Information criteria (lmfit's definitions, for Gaussian residuals):
+AIC = N ln(chi^2 / N) + 2 k, BIC = N ln(chi^2 / N) + k ln N, N points, k = 3 varied parameters.
+Differences matter, not values: Delta AIC > ~10 is strong support for the lower (Burnham & Anderson
+2002).
+
+References
+----------
+Akaike, H. (1974), A new look at the statistical model identification, IEEE Trans. Autom. Control
+19:716-723, doi:10.1109/TAC.1974.1100705.
+Schwarz, G. (1978), Estimating the dimension of a model, Ann. Stat. 6:461-464, doi:10.1214/aos/1176344136.
+Burnham, K. P. and Anderson, D. R. (2002), Model Selection and Multimodel Inference, 2nd ed., Springer.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import lmfit
+import numpy as np
+import xarray as xr
+
+from microimpact.analysis.fitting import FitProblem
+from microimpact.io.variables import attributes
+from microimpact.model.adhesion_models import AdhesionRegimeWarning, tabor_parameter
+from microimpact.solvers import DEFAULT_RTOL
+
+__all__ = ["compare_normal_models", "normal_model_restitution", "DEFAULT_MODELS", "DEFAULT_START_GRID"]
+
+#: the models compared by default: the paper's ring force and JKR (and DMT)
+DEFAULT_MODELS = ("ring", "jkr", "dmt")
+#: start grid of every fit: log-spaced zeta_H and zeta_A at the material's w_A
+DEFAULT_START_GRID = (np.geomspace(0.01, 10.0, 7), np.geomspace(0.1, 1000.0, 7))
+
+
+def normal_model_restitution(problem: FitProblem, normal_model: str, zeta_hertz, zeta_adhesion, work_of_adhesion,
+                             *, rtol=DEFAULT_RTOL, normal_speed=None, radius=None) -> np.ndarray:
+    """Model e_n of ``normal_model`` at the points of ``problem`` (or at given speeds and radii). [-]
+
+    Parameters
+    ----------
+    problem : FitProblem
+        Data grouped by radius and the material (density, stiffness, damping reference speed).
+    normal_model : {"ring", "jkr", "dmt"}
+    zeta_hertz, zeta_adhesion : float
+        Eqs. (14)-(15). [-]
+    work_of_adhesion : float
+        w_A shared by every radius. [J/m^2]
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+    normal_speed, radius : array_like, optional
+        Evaluate at these (broadcast) instead of the data points. [m/s], [m]
+    """
+    from microimpact.solvers import engine, normal_models
+
+    solver = engine if normal_model == "ring" else normal_models
+    if normal_speed is None:
+        radii, groups, speeds = problem.radii, problem.groups, problem.normal_speed
+    else:
+        sp, rr = np.broadcast_arrays(np.asarray(normal_speed, dtype=float), np.asarray(radius, dtype=float))
+        speeds = sp.ravel()
+        radii_arr, inverse = np.unique(rr.ravel(), return_inverse=True)
+        radii = tuple(float(r) for r in radii_arr)
+        groups = tuple(np.flatnonzero(inverse == i) for i in range(radii_arr.size))
+    out = np.empty(speeds.size)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", AdhesionRegimeWarning)  # the regime is reported per fit instead
+        for r, idx in zip(radii, groups):
+            c = problem.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion).with_(normal_model=normal_model)
+            out[idx] = solver.solve_normal_many(c, speeds[idx], rtol=rtol)["e_n"]
+    return out if normal_speed is None else out.reshape(sp.shape)
+
+
+def _fit_one(problem, model, e_n, sigma, w0, rtol, grid):
+    """lmfit result of one normal model: grid start, then leastsq over zeta_H, zeta_A, w_A."""
+    def residual(params):
+        p = params.valuesdict()
+        return (normal_model_restitution(problem, model, p["zeta_hertz"], p["zeta_adhesion"],
+                                         p["work_of_adhesion"], rtol=rtol) - e_n) / sigma
+
+    best = (np.inf, 0.5, 30.0)
+    for zh in grid[0]:
+        for za in grid[1]:
+            chi2 = float(np.sum(((normal_model_restitution(problem, model, zh, za, w0, rtol=rtol) - e_n) / sigma) ** 2))
+            if chi2 < best[0]:
+                best = (chi2, zh, za)
+    params = lmfit.Parameters()
+    params.add("zeta_hertz", value=best[1], min=0.0)
+    params.add("zeta_adhesion", value=best[2], min=0.0)
+    params.add("work_of_adhesion", value=w0, min=1e-6 * w0)
+    return lmfit.minimize(residual, params, method="leastsq", scale_covar=False)
+
+
+def compare_normal_models(table, base, models=DEFAULT_MODELS, *, rtol: float = DEFAULT_RTOL,
+                          curve_points: int = 60, start_grid=DEFAULT_START_GRID) -> xr.Dataset:
+    """Fit each normal model to the same e_n(v_n) data; AIC, BIC and the fitted curves.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Impacts as read by :func:`microimpact.io.read_impacts`: ``radius`` [m], ``normal_speed``
+        [m/s], ``e_n`` [-], optionally ``e_n_uncertainty`` [-] (used as sigma when every row has
+        one > 0; else unweighted).
+    base : MaterialPair, Contact or DampingFit
+        Density [kg/m^3], stiffness [Pa], the starting w_A [J/m^2] and the damping reference speed.
+    models : sequence of {"ring", "jkr", "dmt"}
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+    curve_points : int
+        Speeds of the fitted curves, log-spaced over the data range. [-]
+    start_grid : (array_like, array_like)
+        zeta_H and zeta_A values whose best pair (chi-square at the material's w_A) starts each fit. [-]
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimension ``normal_model``: ``aic``, ``bic``, ``chi_square``, ``delta_aic``, ``delta_bic``
+        (to the best model), the fitted ``zeta_hertz``, ``zeta_adhesion``, ``work_of_adhesion`` and
+        their standard errors, the ``tabor_parameter`` at each radius; curves ``e_n_curve``
+        (normal_model, radius, curve_speed); the data (``point``). Attributes: number of points and
+        of varied parameters, the weighting.
+    """
+    radius = table["radius"].to_numpy(float)
+    speed = table["normal_speed"].to_numpy(float)
+    e_n = table["e_n"].to_numpy(float)
+    sig = table["e_n_uncertainty"].to_numpy(float) if "e_n_uncertainty" in table else np.full(e_n.size, np.nan)
+    weighted = bool(np.all(np.isfinite(sig) & (sig > 0)))
+    sigma = sig if weighted else np.ones_like(e_n)
+    problem = FitProblem.from_arrays(radius, speed, base)
+    w0 = float(base.work_of_adhesion)
+    radii = np.asarray(problem.radii)
+    curve_speed = np.geomspace(speed.min() * 0.8, speed.max() * 1.2, curve_points)
+    rows = {k: [] for k in ("aic", "bic", "chi_square", "zeta_hertz", "zeta_adhesion", "work_of_adhesion",
+                            "zeta_hertz_stderr", "zeta_adhesion_stderr", "work_of_adhesion_stderr")}
+    curves, tabor = [], []
+    for model in models:
+        res = _fit_one(problem, model, e_n, sigma, w0, rtol, start_grid)
+        p = res.params
+        rows["aic"].append(res.aic)
+        rows["bic"].append(res.bic)
+        rows["chi_square"].append(res.chisqr)
+        for name in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion"):
+            rows[name].append(p[name].value)
+            rows[f"{name}_stderr"].append(np.nan if p[name].stderr is None else p[name].stderr)
+        curves.append(normal_model_restitution(problem, model, p["zeta_hertz"].value, p["zeta_adhesion"].value,
+                                                p["work_of_adhesion"].value, rtol=rtol,
+                                                normal_speed=curve_speed[None, :], radius=radii[:, None]))
+        tabor.append(tabor_parameter(radii, base.stiffness, p["work_of_adhesion"].value))
+    return _comparison_dataset(models, rows, curves, tabor, radii, curve_speed, radius, speed, e_n, sig,
+                               weighted, res.ndata, res.nvarys)
+
+
+def _comparison_dataset(models, rows, curves, tabor, radii, curve_speed, radius, speed, e_n, sig, weighted,
+                        ndata, nvarys) -> xr.Dataset:
+    """The Dataset of :func:`compare_normal_models` with units and long names."""
+    units = {"aic": ("1", "Akaike information criterion"), "bic": ("1", "Bayesian information criterion"),
+             "chi_square": ("1", "weighted sum of squared residuals"),
+             "delta_aic": ("1", "AIC minus the lowest AIC of the compared models"),
+             "delta_bic": ("1", "BIC minus the lowest BIC of the compared models"),
+             "zeta_hertz_stderr": ("1", "standard error of zeta_H"),
+             "zeta_adhesion_stderr": ("1", "standard error of zeta_A"),
+             "work_of_adhesion_stderr": ("J m-2", "standard error of w_A"),
+             "tabor_parameter": ("1", "Tabor parameter (R w^2 / (E*^2 z0^3))^(1/3), z0 = 0.4 nm"),
+             "e_n_curve": ("1", "fitted model normal coefficient of restitution")}
+
+    def attrs(name):
+        if name in units:
+            return {"units": units[name][0], "long_name": units[name][1]}
+        return attributes(name)
+
+    ds = xr.Dataset(coords={"normal_model": list(models), "radius": ("radius", radii, attributes("radius")),
+                            "curve_speed": ("curve_speed", curve_speed, {"units": "m s-1", "long_name": "normal speed of the curves"})})
+    for name, vals in rows.items():
+        ds[name] = xr.DataArray(np.asarray(vals, dtype=float), dims="normal_model", attrs=attrs(name))
+    for name in ("aic", "bic"):
+        ds[f"delta_{name}"] = xr.DataArray(ds[name].values - ds[name].values.min(), dims="normal_model", attrs=attrs(f"delta_{name}"))
+    ds["tabor_parameter"] = xr.DataArray(np.asarray(tabor), dims=("normal_model", "radius"), attrs=attrs("tabor_parameter"))
+    ds["e_n_curve"] = xr.DataArray(np.asarray(curves), dims=("normal_model", "radius", "curve_speed"), attrs=attrs("e_n_curve"))
+    ds["data_radius"] = xr.DataArray(radius, dims="point", attrs={"units": "m", "long_name": "sphere radius of the measurement"})
+    ds["data_normal_speed"] = xr.DataArray(speed, dims="point", attrs={"units": "m s-1", "long_name": "measured incident normal speed"})
+    ds["data_e_n"] = xr.DataArray(e_n, dims="point", attrs={"units": "1", "long_name": "measured normal coefficient of restitution"})
+    ds["data_e_n_uncertainty"] = xr.DataArray(sig, dims="point", attrs={"units": "1", "long_name": "stated standard uncertainty of e_n"})
+    ds.attrs.update(title="Normal contact models fitted to the same e_n(v_n) data",
+                    parameter_source="each normal model fitted to the analyst's data (zeta_H, zeta_A, w_A)",
+                    number_of_points=int(ndata), varied_parameters=int(nvarys),
+                    weighting="stated e_n uncertainties" if weighted else "none (sigma = 1)",
+                    free_parameters="zeta_hertz zeta_adhesion work_of_adhesion")
+    return ds

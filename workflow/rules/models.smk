@@ -1,0 +1,25 @@
+# Contact models beyond the paper: the normal models (the paper's adhesion ring force, JKR, DMT)
+# fitted to the same e_n(v_n) data, with AIC and BIC side by side
+# (microimpact.analysis.model_comparison.compare_normal_models).
+
+
+rule model_comparison:
+    input:
+        data=config["data"],
+        validated=rules.validate_data.output.table,
+        materials=materials_path(),
+    output:
+        "results/analyst/model_comparison.nc",
+    log:
+        "logs/model_comparison.log",
+    benchmark:
+        "benchmarks/model_comparison.tsv"
+    conda:
+        "../envs/microimpact.yaml"
+    threads: 1
+    params:
+        material_pair=config["material_pair"],
+        models=["ring", "jkr", "dmt"],
+        rtol=RTOL,
+    script:
+        "../scripts/model_comparison.py"
