@@ -34,11 +34,13 @@ Hook for tangential compliance
 the oblique data. The paper's rigid model has ``("friction",)``; a compliant model adds its
 stiffness field there and the fit varies it too (start values and bounds in
 :data:`PARAMETER_BOUNDS`) -- the model is always built with ``Contact.with_(**parameters)`` and solved
-by :func:`microimpact.simulate_many`.
+by :func:`microimpact.solvers.engine.solve_normal_many` plus the closed-form tangential map
+(:func:`rebound_state`, the two halves of :func:`microimpact.simulate_many`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -51,9 +53,8 @@ from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.impacts import OBLIQUE_COLUMNS
 from microimpact.io.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL
-from microimpact.solvers.impact import simulate_many
 
-__all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "TANGENTIAL_PARAMETERS",
+__all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
            "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"]
 
 #: Contact.tangential_model -> the Contact fields fitted from oblique data (the compliance hook)
@@ -143,26 +144,60 @@ class ObliqueProblem:
         return int(self.rows.size)
 
 
-def _observables(ds: xr.Dataset, speed, incidence_deg, quantity) -> np.ndarray:
-    """The model value of each entry's quantity from a simulate_many result (dimension ``entry``)."""
+def _observables(out: dict, speed, incidence_deg, quantity) -> np.ndarray:
+    """The model value of each entry's quantity from the rebound velocity and spin ``out``."""
     vt_in = speed * np.sin(np.radians(incidence_deg))
-    vt, vn = ds["velocity_out_t"].values, ds["velocity_out_n"].values
+    vt, vn = out["velocity_out_t"], out["velocity_out_n"]
     values = {
         "tangential_restitution": vt / vt_in,
         "rebound_tangential_speed": vt,
         "rebound_angle_deg": np.degrees(np.arctan2(vt, vn)),
-        "rebound_spin": np.sqrt(sum(ds[k].values ** 2 for k in ("omega_out_n", "omega_out_t", "omega_out_tp"))),
+        "rebound_spin": np.sqrt(out["omega_out_n"] ** 2 + out["omega_out_t"] ** 2 + out["omega_out_tp"] ** 2),
     }
-    out = np.full(speed.shape, np.nan)
+    res = np.full(speed.shape, np.nan)
     for q, v in values.items():
         m = quantity == q
-        out[m] = v[m]
-    return out
+        res[m] = v[m]
+    return res
+
+
+def rebound_state(contact, speed, incidence_deg, spin, rtol: float = DEFAULT_RTOL) -> dict:
+    """Rebound velocity and spin of impacts in the incidence plane, as :func:`microimpact.simulate_many`.
+
+    The fast path of the fits: one :func:`microimpact.solvers.engine.solve_normal_many` call (the
+    impulses J, J_a) and the closed-form tangential map :func:`microimpact.model.tangential.tangential_outcome`
+    -- the two halves of ``simulate_many`` without its Dataset (a test checks they agree).
+
+    Parameters
+    ----------
+    contact : Contact
+    speed, incidence_deg, spin : numpy.ndarray
+        Incident speed [m/s], angle from the normal [deg] and top-spin (omega_t' = -spin) [rad/s].
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+
+    Returns
+    -------
+    dict of arrays: ``captured`` (bool), ``velocity_out_n``, ``velocity_out_t`` [m/s],
+    ``omega_out_n``, ``omega_out_t``, ``omega_out_tp`` [rad/s].
+    """
+    from microimpact.model.tangential import tangential_outcome
+    from microimpact.solvers import engine
+
+    a = np.radians(incidence_deg)
+    vn, vt = speed * np.cos(a), speed * np.sin(a)
+    sol = engine.solve_normal_many(contact, vn, rtol=rtol)
+    zero = np.zeros_like(vn)
+    tan = tangential_outcome(contact.mass, contact.moment_of_inertia, contact.radius, contact.friction,
+                             (-vn, vt, zero), (zero, zero, -spin), sol["friction_impulse"], sol["twist_impulse"])
+    return {"captured": sol["captured"], "velocity_out_n": np.where(sol["captured"], 0.0, sol["e_n"] * vn),
+            "velocity_out_t": tan["v_t"], "omega_out_n": tan["omega_n"], "omega_out_t": tan["omega_t"],
+            "omega_out_tp": tan["omega_tp"]}
 
 
 def oblique_model(problem: ObliqueProblem, contact_of, parameters: dict, *, speed=None, incidence_deg=None,
                   rtol: float = DEFAULT_RTOL) -> np.ndarray:
-    """Model value of every entry's measured quantity, one :func:`simulate_many` call per radius.
+    """Model value of every entry's measured quantity, one normal solve batch per radius.
 
     Parameters
     ----------
@@ -187,11 +222,8 @@ def oblique_model(problem: ObliqueProblem, contact_of, parameters: dict, *, spee
     for r in np.unique(problem.radius):
         idx = np.flatnonzero(problem.radius == r)
         c = contact_of(float(r)).with_(**parameters)
-        dim = xr.DataArray
-        ds = simulate_many(c, dim(v[idx], dims="entry"), dim(np.clip(a[idx], 0.0, 89.9), dims="entry"),
-                           omega=(0.0, 0.0, dim(-problem.spin[idx], dims="entry")), rtol=rtol)
-        model = _observables(ds, v[idx], a[idx], problem.quantity[idx])
-        out[idx] = np.where(ds["outcome"].values == 1, np.nan, model)
+        st = rebound_state(c, v[idx], np.clip(a[idx], 0.0, 89.9), problem.spin[idx], rtol=rtol)
+        out[idx] = np.where(st["captured"], np.nan, _observables(st, v[idx], a[idx], problem.quantity[idx]))
     return out
 
 
@@ -299,6 +331,30 @@ class FrictionFit:
         return write_netcdf(self.to_dataset(), path)
 
 
+@contextlib.contextmanager
+def engine_threads(threads: int | None = 1):
+    """Run the engine on ``threads`` threads inside the block (None: unchanged), restored after.
+
+    One thread for the fits and the sampler: they make thousands of small engine calls, for which
+    thread start-up and, on a shared machine, waiting for the second thread cost more than the
+    second core gains (measured on the 2-core machine under load: 4 ms per posterior evaluation on
+    one thread against 50 ms on two; see also :func:`microimpact.analysis.fitting.fit_damping`).
+    """
+    if threads is None:
+        yield
+        return
+    import numba
+
+    from microimpact.solvers import engine
+
+    previous = numba.get_num_threads()
+    engine.set_threads(threads)
+    try:
+        yield
+    finally:
+        engine.set_threads(previous)
+
+
 def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rtol: float = DEFAULT_RTOL,
                  propagate_damping: bool = True, progress: bool = False) -> FrictionFit:
     """Fit the tangential parameters (friction f) to the oblique columns, after the damping fit.
@@ -339,7 +395,7 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
     names = TANGENTIAL_PARAMETERS[model_name]
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
     n_var = len(damping_fit.varied) if propagate_damping else 0
-    with progress_bar(3 + 2 * n_var, "friction fit", progress) as advance:
+    with progress_bar(3 + 2 * n_var, "friction fit", progress) as advance, engine_threads(1):
         best, sigma, nfev = _fit_tangential(problem, contact_of, names, weighted, rtol, lmfit)
         advance(3)
         gradient = {}
