@@ -148,8 +148,10 @@ def _observables(out: dict, speed, incidence_deg, quantity) -> np.ndarray:
     """The model value of each entry's quantity from the rebound velocity and spin ``out``."""
     vt_in = speed * np.sin(np.radians(incidence_deg))
     vt, vn = out["velocity_out_t"], out["velocity_out_n"]
+    with np.errstate(divide="ignore", invalid="ignore"):  # e_t is undefined at normal incidence
+        e_t = np.where(vt_in > 0, vt / np.where(vt_in > 0, vt_in, 1.0), np.nan)
     values = {
-        "tangential_restitution": vt / vt_in,
+        "tangential_restitution": e_t,
         "rebound_tangential_speed": vt,
         "rebound_angle_deg": np.degrees(np.arctan2(vt, vn)),
         "rebound_spin": np.sqrt(out["omega_out_n"] ** 2 + out["omega_out_t"] ** 2 + out["omega_out_tp"] ** 2),

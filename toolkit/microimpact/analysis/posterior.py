@@ -436,14 +436,10 @@ def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int =
     v = np.geomspace(lo, hi, n_speeds)
     draws = posterior.draws(n_draws)
     out = {q: np.empty((len(cases), len(draws), v.size)) for q in ("e_n", "mu_t", "K_L")}
-    for i, case in enumerate(cases):
-        cond = {k: _largest(val) for k, val in TABLE2_CASES[case].items()
-                if k in ("incidence_deg", "azimuth_deg", "omega_n", "omega_t", "omega_tp")}
-        for j, d in enumerate(draws):
-            ds = simulate_many(_contact(damping_fit, r, d), v, cond.get("incidence_deg", 0.0), cond.get("azimuth_deg", 0.0),
-                               (cond.get("omega_n", 0.0), cond.get("omega_t", 0.0), cond.get("omega_tp", 0.0)), rtol=rtol)
-            for q in out:
-                out[q][i, j] = ds[q].values
+    from microimpact.analysis.oblique import engine_threads
+
+    with engine_threads(1):
+        _sweep_draws(cases, draws, damping_fit, r, v, out, rtol)
     names = {"e_n": "normal coefficient of restitution e_n", "mu_t": "tangential impulse ratio mu_t",
              "K_L": "kinetic energy loss coefficient K_L"}
     ds = xr.Dataset(coords={
@@ -458,6 +454,21 @@ def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int =
     ds.attrs["sweep_radius"] = r
     ds.attrs["sweep_conditions"] = "each case at the largest value of each of its axes other than the speed"
     return ds
+
+
+def _sweep_draws(cases, draws, damping_fit, r, v, out, rtol):
+    """Fill ``out[q][case, draw, speed]`` by simulate_many (see :func:`sweep_bands`)."""
+    from microimpact.model.parameters import TABLE2_CASES
+    from microimpact.solvers.impact import simulate_many
+
+    for i, case in enumerate(cases):
+        cond = {k: _largest(val) for k, val in TABLE2_CASES[case].items()
+                if k in ("incidence_deg", "azimuth_deg", "omega_n", "omega_t", "omega_tp")}
+        for j, d in enumerate(draws):
+            ds = simulate_many(_contact(damping_fit, r, d), v, cond.get("incidence_deg", 0.0), cond.get("azimuth_deg", 0.0),
+                               (cond.get("omega_n", 0.0), cond.get("omega_t", 0.0), cond.get("omega_tp", 0.0)), rtol=rtol)
+            for q in out:
+                out[q][i, j] = ds[q].values
 
 
 def _largest(spec):

@@ -119,7 +119,7 @@ def _curve(e_n, speed, target, n_points):
     """(zeta_H, zeta_A) arrays of the curve e_n(speed; zeta_H, zeta_A) = target."""
     za_max = _root(lambda za: e_n(speed, 0.0, za), 0.0, target)
     zh_max = _root(lambda zh: e_n(speed, zh, 0.0), 0.0, target)
-    za = za_max * (1.0 - np.cos(np.linspace(0.0, math.pi / 2, n_points)))  # denser near zeta_A = 0... and even
+    za = za_max * (1.0 - np.cos(np.linspace(0.0, math.pi / 2, n_points)))  # denser near zeta_A = 0, where zeta_H turns
     za[-1] = za_max
     zh = np.empty(n_points)
     zh[0], zh[-1] = zh_max, 0.0
@@ -166,10 +166,10 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
         raise ValueError(f"e_n and speed must have the same length, got {e.size} and {v.size}")
     for i in range(e.size):
         if not (np.isfinite(e[i]) and 0.0 < e[i] < 1.0):
-            raise ValueError(f"target {i + 1}: e_n = {e[i]!r} must lie in (0, 1) (e_n = 1 needs no damping; "
+            raise ValueError(f"target {i + 1}: e_n = {float(e[i])!r} must lie in (0, 1) (e_n = 1 needs no damping; "
                              "e_n = 0 is any capture)")
         if not (np.isfinite(v[i]) and v[i] > 0.0):
-            raise ValueError(f"target {i + 1}: speed = {v[i]!r} m/s must be finite and > 0")
+            raise ValueError(f"target {i + 1}: speed = {float(v[i])!r} m/s must be finite and > 0")
     if n_points < 3:
         raise ValueError(f"n_points must be >= 3, got {n_points}")
     r = float(radius if radius is not None else getattr(material, "radius", math.nan))
@@ -177,11 +177,14 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
         raise ValueError("give the sphere radius (radius=..., or a Contact that has one)")
     se = (np.full(e.size, np.nan) if e_n_uncertainty is None
           else np.broadcast_to(np.asarray(e_n_uncertainty, dtype=float), e.shape).copy())
+    from microimpact.analysis.oblique import engine_threads
+
     model = _model(material, r, rtol)
     zh = np.empty((e.size, n_points))
     za = np.empty((e.size, n_points))
-    for i in range(e.size):
-        zh[i], za[i] = _curve(model, v[i], e[i], n_points)
+    with engine_threads(1):  # hundreds of one-speed solves
+        for i in range(e.size):
+            zh[i], za[i] = _curve(model, v[i], e[i], n_points)
     curves = xr.Dataset(
         {"zeta_hertz": (("target", "curve_point"), zh, {"units": "1", "long_name": "zeta_H on the curve that "
                                                         "reproduces the target e_n, Eq. (15)"}),
