@@ -279,14 +279,11 @@ def _load_posterior(path):
     """The Posterior of a ``microimpact fit --posterior`` file, or None."""
     if path is None:
         return None
-    import xarray as xr
-
-    from microimpact.analysis.posterior import posterior_from_dataset
+    from microimpact.analysis.posterior import load_posterior
 
     check_input_file("--posterior", path)
     try:
-        with xr.open_dataset(path, engine="netcdf4") as ds:
-            return posterior_from_dataset(ds.load())
+        return load_posterior(path)
     except (KeyError, ValueError, OSError) as exc:
         raise UsageError(f"--posterior {path!r}: not a posterior written by 'microimpact fit --posterior' ({exc})") from None
 

@@ -55,7 +55,8 @@ from microimpact.io.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL
 
 __all__ = ["Posterior", "sample_posterior", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
-           "sweep_bands", "posterior_dataset", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"]
+           "sweep_bands", "posterior_dataset", "posterior_from_dataset", "load_posterior", "save_posterior",
+           "summary_table", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"]
 
 #: units of the sampled parameters
 PARAMETER_UNITS = {"zeta_hertz": "1", "zeta_adhesion": "1", "work_of_adhesion": "J m-2", "friction": "1"}
@@ -534,6 +535,14 @@ def posterior_from_dataset(ds: xr.Dataset) -> Posterior:
                      acceptance_fraction=ds["acceptance_fraction"].values, seed=int(ds.attrs["seed"]),
                      info={"converged": bool(int(ds.attrs["converged"])), "convergence": ds.attrs.get("convergence", ""),
                            "errors_in_variables": ds.attrs.get("errors_in_variables", "")})
+
+
+def load_posterior(path) -> Posterior | None:
+    """The :class:`Posterior` of a posterior NetCDF, or None when the file holds none (posterior disabled)."""
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        if "sampled" not in ds.attrs:
+            return None
+        return posterior_from_dataset(ds.load())
 
 
 def save_posterior(ds: xr.Dataset, path):
