@@ -286,14 +286,20 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
     if "sha256" in table.attrs:
         res.attrs["source_sha256"] = table.attrs["sha256"]
     if explain and hasattr(contact_or_fit, "varied"):
-        from microimpact.analysis.spin import spin_explanation
+        res = _with_explanation(res, table, contact_or_fit, posterior=posterior, friction=friction, n_draws=n_draws,
+                                spin_bound=spin_bound, angle_uncertainty_deg=angle_uncertainty_deg,
+                                default_angle_uncertainty_deg=default_angle_uncertainty_deg, rtol=rtol,
+                                progress=progress)
+    return res
 
-        extra = spin_explanation(table, contact_or_fit, posterior=posterior, friction=friction, n_draws=n_draws,
-                                 spin_bound=spin_bound, angle_uncertainty_deg=angle_uncertainty_deg,
-                                 default_angle_uncertainty_deg=default_angle_uncertainty_deg, rtol=rtol,
-                                 progress=progress)
-        res = res.merge(extra.drop_vars("spin_scan_bound"), combine_attrs="no_conflicts")
-        res.attrs["explanation_draws"] = "posterior draws" if posterior is not None else "point estimate"
+
+def _with_explanation(res: xr.Dataset, table, fit, *, posterior, **options) -> xr.Dataset:
+    """The flags with the explanation of :func:`microimpact.analysis.spin.spin_explanation` merged in."""
+    from microimpact.analysis.spin import spin_explanation
+
+    extra = spin_explanation(table, fit, posterior=posterior, **options)
+    res = res.merge(extra.drop_vars("spin_scan_bound"), combine_attrs="no_conflicts")
+    res.attrs["explanation_draws"] = "posterior draws" if posterior is not None else "point estimate"
     return res
 
 
