@@ -109,7 +109,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     from microimpact.analysis.oblique import ObliqueProblem, fit_friction
 
     damping = fit_damping(table, base, fit_work_of_adhesion=fit_work_of_adhesion, weights=weights,
-                          confidence_intervals=confidence_intervals, rtol=rtol)
+                          confidence_intervals=confidence_intervals, rtol=rtol, progress=progress)
     ff = None
     if friction:
         try:
