@@ -122,3 +122,20 @@ def test_fit_cli_wrote_friction_into_the_fit(oblique_run):
     fit = DampingFit.load(d / "fit.nc")
     assert fit.friction != 0.15 and abs(fit.friction - 0.15) < 0.02  # fitted, not the config's 0.15
     assert "friction_stderr" in fit.info
+
+
+def test_report_shows_posterior_oblique_fit_and_spin_ranges(oblique_run):
+    # the analyst section of the PDF from the CLI's files: posterior table and figures, measured vs
+    # fitted per angle, and the per-row spin ranges naming the spun row
+    pypdf = pytest.importorskip("pypdf")
+    from microimpact.report.pdf import build_report
+
+    _, spun_row, d = oblique_run
+    path = build_report(d / "report.pdf", {"fit": d / "fit.nc", "posterior": d / "post.nc", "oblique": d / "obl.nc",
+                                           "flags": d / "flags.csv"})
+    text = "\n".join(p.extract_text() or "" for p in pypdf.PdfReader(path).pages)
+    for heading in ("Posterior of the fitted parameters", "Capture velocity with its credible interval",
+                    "Friction from the oblique columns", "Which rows were probably spun"):
+        assert heading in text, heading
+    assert "95 % credible band" in text and "Corner plot" in text and "per incidence angle" in text
+    assert "1 P" in text  # one probably-spun row counted in the spin-range paragraph
