@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import xarray as xr
 
 from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.provenance import stamp_parameters
 from microimpact.solvers import DEFAULT_RTOL
 
 __all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS", "POSTERIOR_FULL"]
@@ -70,10 +71,16 @@ class AnalystFit:
             ds = self.posterior_dataset if self.posterior_dataset is not None else xr.Dataset(attrs={
                 "title": "posterior of the fitted parameters", "Conventions": CONVENTIONS,
                 "comment": "posterior not computed"})
-            written.append(write_netcdf(ds, posterior_path))
+            written.append(write_netcdf(self._stamped(ds), posterior_path))
         if oblique_path is not None:
-            written.append(write_netcdf(self.oblique_dataset(), oblique_path))
+            written.append(write_netcdf(self._stamped(self.oblique_dataset()), oblique_path))
         return tuple(written)
+
+    def _stamped(self, ds: xr.Dataset) -> xr.Dataset:
+        """``ds`` with the fit's ``parameter_source`` and the fitted contact of every measured size
+        (:func:`microimpact.io.provenance.stamp_parameters`), like every result file."""
+        fit = self.damping
+        return stamp_parameters(ds, [fit.contact(float(r)) for r in fit.radii], fit.parameter_source)
 
 
 def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights="auto", confidence_intervals: bool = False,
