@@ -188,7 +188,8 @@ def rebound_state(contact, speed, incidence_deg, spin, rtol: float = DEFAULT_RTO
 
     a = np.radians(incidence_deg)
     vn, vt = speed * np.cos(a), speed * np.sin(a)
-    sol = engine.solve_normal_many(contact, vn, rtol=rtol)
+    speeds, inverse = np.unique(vn, return_inverse=True)  # one solve per distinct normal speed
+    sol = {k: v[inverse] for k, v in engine.solve_normal_many(contact, speeds, rtol=rtol).items()}
     zero = np.zeros_like(vn)
     tan = tangential_outcome(contact.mass, contact.moment_of_inertia, contact.radius, contact.friction,
                              (-vn, vt, zero), (zero, zero, -spin), sol["friction_impulse"], sol["twist_impulse"])
