@@ -110,7 +110,11 @@ class ObliqueProblem:
             the file and the columns looked for).
         """
         src = str(table.attrs.get("source", "impact table"))
-        measured = table.attrs.get("measured") or tuple(c for c in OBLIQUE_COLUMNS if c in table.columns)
+        measured = table.attrs.get("measured")
+        if measured is None:  # a table built in memory: the first oblique column with values (the
+            # canonical table derives the others from it; fitting them too would count a row twice)
+            measured = tuple(c for c in OBLIQUE_COLUMNS if c in table.columns
+                             and np.isfinite(table[c].to_numpy(dtype=float)).any())[:1]
         names = [c for c in OBLIQUE_COLUMNS if c in measured and c in table.columns]
         n = len(table)
 
