@@ -233,7 +233,7 @@ def _add_posterior_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--walkers", type=_positive_int, default=None, help="emcee walkers (default 12)")
     p.add_argument("--steps", type=_positive_int, default=None, help="emcee steps (default 80: seconds; see --full-chain)")
     p.add_argument("--seed", type=int, default=None, help="seed of the sampler (default 2002)")
-    p.add_argument("--full-chain", action="store_true", help="a chain long enough to converge (24 x 1500; about a minute)")
+    p.add_argument("--full-chain", action="store_true", help="a chain long enough to converge (24 x 2000; about 1.5 minutes)")
     p.add_argument("--errors-in-variables", choices=("auto", "effective", "latent"), default="auto",
                    help="speed errors in the posterior: effective variance, latent true speeds, or auto (latent near "
                         "capture)")
