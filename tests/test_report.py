@@ -106,12 +106,20 @@ def results(tmp_path_factory):
                           "rotation_sensitive": 0, "angle_sensitive": 0, "near_capture": [1] + [0] * (len(table) - 1),
                           "parameter_source": source})
     write_csv(flags, tmp / "flags.csv")
+    from microimpact.analysis.analyst_fit import AnalystFit
+    from microimpact.analysis.posterior import capture_velocity_interval, posterior_dataset, restitution_bands, sample_posterior
+
+    post = sample_posterior(table, fit, walkers=6, steps=10, seed=1)  # the form of the file, not its numbers
+    AnalystFit(fit, posterior_dataset=posterior_dataset(post, restitution_bands(post, fit, n_draws=4),
+                                                        capture_velocity_interval(post, fit, n_draws=3))).save(
+        tmp / "fit_again.nc", tmp / "posterior.nc", tmp / "oblique.nc")
     inputs = {"data_table": tmp / "table.csv", "fit": tmp / "fit.nc", "fit_curves": tmp / "fit_curves.nc",
               "analyst_dynamics": tmp / "analyst_dynamics.nc", "analyst_sweeps": analyst_sweeps,
               "phase_portraits": tmp / "portraits.nc", "dynamics": tmp / "dynamics.nc",
               "bifurcation": tmp / "bifurcation.nc", "paper_sweeps": _paper_files(tmp),
               "reproduction": tmp / "reproduction.csv", "kharaz": tmp / "kharaz.nc", "stress": tmp / "stress.json",
-              "flags": tmp / "flags.csv", "model_comparison": tmp / "model_comparison.nc"}
+              "flags": tmp / "flags.csv", "model_comparison": tmp / "model_comparison.nc",
+              "posterior": tmp / "posterior.nc", "oblique": tmp / "oblique.nc"}
     return tmp, inputs, source
 
 

@@ -1,4 +1,4 @@
-"""Command line: ``microimpact simulate | sweep | fit | flags | reproduce | benchmark``.
+"""Command line: ``microimpact simulate | sweep | fit | flags | target | reproduce | benchmark``.
 
 Thin: parse, call the library, print or write. Bad arguments print one line
 ``microimpact: error: ...`` to stderr and exit with status 2; nothing is written then.
@@ -142,7 +142,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_cmd_simulate)
 
-    for register in (register_sweep, register_fit, register_flags, register_reproduce, register_benchmark):
+    for register in (register_sweep, register_fit, register_flags, register_target, register_reproduce,
+                     register_benchmark):
         register(sub)
     return parser
 
@@ -188,17 +189,24 @@ def _impacts_for_pair(args):
 
 
 def _cmd_fit(args) -> int:
-    from microimpact.analysis.fitting import fit_damping
+    from microimpact.analysis.analyst_fit import analyse_impacts
 
-    out = check_outputs({"--out": args.out}, _inputs(args))["--out"]
+    outputs = check_outputs({"--out": args.out, "--posterior": args.posterior, "--oblique-out": args.oblique_out},
+                            _inputs(args))
+    out = outputs["--out"]
     table, pair = _impacts_for_pair(args)
     print(f"fitting {len(table)} impacts of {pair.name} ...", file=sys.stderr, flush=True)
-    fit = fit_damping(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
-                      confidence_intervals=not args.no_confidence_intervals, rtol=args.rtol)
-    with reporting_os_errors({"--out": out}):
-        fit.save(out)
-    print(fit.report())
-    print(f"wrote {out}", file=sys.stderr)
+    posterior = False
+    if outputs.get("--posterior") is not None:
+        posterior = {"walkers": args.walkers, "steps": args.steps, "seed": args.seed, "full": args.full_chain}
+        posterior = {k: v for k, v in posterior.items() if v is not None}
+    result = analyse_impacts(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
+                             confidence_intervals=not args.no_confidence_intervals, posterior=posterior,
+                             errors_in_variables=args.errors_in_variables, rtol=args.rtol, progress=True)
+    with reporting_os_errors(outputs):
+        written = result.save(out, outputs.get("--posterior"), outputs.get("--oblique-out"))
+    print(result.report())
+    print("wrote " + ", ".join(map(str, written)), file=sys.stderr)
     return 0
 
 
@@ -213,7 +221,34 @@ def register_fit(sub) -> None:
     p.add_argument("--no-confidence-intervals", action="store_true", help="skip lmfit.conf_interval (faster)")
     _add_rtol(p)
     p.add_argument("--out", required=True, help="output NetCDF of the fit")
+    _add_posterior_options(p)
     p.set_defaults(func=_cmd_fit)
+
+
+def _add_posterior_options(p: argparse.ArgumentParser) -> None:
+    """The posterior and oblique options of ``microimpact fit`` (microimpact.analysis.analyst_fit)."""
+    p.add_argument("--posterior", default=None, metavar="NC",
+                   help="also sample the posterior (lmfit Minimizer.emcee, seeded) and write chain, diagnostics and "
+                        "bands to this NetCDF")
+    p.add_argument("--walkers", type=_positive_int, default=None, help="emcee walkers (default 12)")
+    p.add_argument("--steps", type=_positive_int, default=None, help="emcee steps (default 80: seconds; see --full-chain)")
+    p.add_argument("--seed", type=int, default=None, help="seed of the sampler (default 2002)")
+    p.add_argument("--full-chain", action="store_true", help="a chain long enough to converge (24 x 2000; about 1.5 minutes)")
+    p.add_argument("--errors-in-variables", choices=("auto", "effective", "latent"), default="auto",
+                   help="speed errors in the posterior: effective variance, latent true speeds, or auto (latent near "
+                        "capture)")
+    p.add_argument("--oblique-out", default=None, metavar="NC",
+                   help="write the friction fit (oblique columns: measured vs fitted per row) to this NetCDF")
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
+    return value
 
 
 def _cmd_flags(args) -> int:
@@ -227,15 +262,30 @@ def _cmd_flags(args) -> int:
     except ValueError as exc:
         raise UsageError(f"--fit {args.fit!r}: {exc}") from None
     table, _ = _impacts_for_pair(args)
+    posterior = _load_posterior(args.posterior)
     ds = flag_measurements(table, fit, spin_bound=args.spin_bound, angle_uncertainty_deg=args.angle_uncertainty_deg,
-                           rtol=args.rtol, progress=True)
+                           rtol=args.rtol, progress=True, posterior=posterior)
     with reporting_os_errors(outputs):
         write_flags(ds, out, nc)
     n = ds.sizes["impact"]
     print(f"{n} impacts: {int(ds['rotation_sensitive'].sum())} rotation_sensitive, "
-          f"{int(ds['angle_sensitive'].sum())} angle_sensitive, {int(ds['near_capture'].sum())} near_capture; "
-          f"wrote {out}" + (f" and {nc}" if nc else ""))
+          f"{int(ds['angle_sensitive'].sum())} angle_sensitive, {int(ds['near_capture'].sum())} near_capture"
+          + (f", {int(ds['probably_spun'].sum())} probably_spun" if "probably_spun" in ds else "")
+          + f"; wrote {out}" + (f" and {nc}" if nc else ""))
     return 0
+
+
+def _load_posterior(path):
+    """The Posterior of a ``microimpact fit --posterior`` file, or None."""
+    if path is None:
+        return None
+    from microimpact.analysis.posterior import load_posterior
+
+    check_input_file("--posterior", path)
+    try:
+        return load_posterior(path)
+    except (KeyError, ValueError, OSError) as exc:
+        raise UsageError(f"--posterior {path!r}: not a posterior written by 'microimpact fit --posterior' ({exc})") from None
 
 
 def register_flags(sub) -> None:
@@ -251,8 +301,53 @@ def register_flags(sub) -> None:
                    help="largest initial spin sampled [rad/s] (default: speed / radius per impact)")
     p.add_argument("--angle-uncertainty-deg", type=_non_negative_float, default=None, metavar="DEG",
                    help="incidence-angle uncertainty [deg] (default: the file's column, else 2)")
+    p.add_argument("--posterior", default=None, metavar="NC",
+                   help="posterior NetCDF of 'microimpact fit --posterior': flags and spin ranges over its draws")
     _add_rtol(p)
     p.set_defaults(func=_cmd_flags)
+
+
+# ------------------------------------------------------------------ target (microimpact.analysis.target)
+def _cmd_target(args) -> int:
+    from microimpact.analysis.target import damping_from_target
+
+    if len(args.e_n) != len(args.speed):
+        raise UsageError(f"give as many --speed as --e-n values (got {len(args.speed)} and {len(args.e_n)})")
+    out = check_outputs({"--out": args.out})["--out"] if args.out else None
+    if out is not None and not str(out).endswith((".csv", ".nc")):
+        raise UsageError(f"--out {args.out!r}: the output must end in .csv or .nc")
+    contact = contact_from_args(args)
+    res = damping_from_target(args.e_n, args.speed, contact, e_n_uncertainty=args.e_n_uncertainty,
+                              n_points=args.points, rtol=args.rtol)
+    c = res.curves
+    for i, row in res.targets.iterrows():
+        zh, za = c["zeta_hertz"].values[i], c["zeta_adhesion"].values[i]
+        print(f"target {i + 1}: e_n = {row['e_n']:g} at v_n = {row['speed']:g} m/s (r = {row['radius']:.4g} m): "
+              f"zeta_H from {zh[0]:.5g} (zeta_A = 0) to 0 (zeta_A = {za[-1]:.5g}); {len(zh)} curve points")
+    if res.best is not None:
+        print("least squares over the targets: " + ", ".join(
+            f"{k} = {v:.6g} +/- {res.stderr[k]:.3g}" for k, v in res.best.items()))
+    if out is not None:
+        with reporting_os_errors({"--out": out}):
+            res.save(out)
+        print(f"wrote {out}", file=sys.stderr)
+    else:
+        print(res.to_frame().to_csv(index=False, float_format="%.8g"), end="")
+    return 0
+
+
+def register_target(sub) -> None:
+    """``microimpact target --e-n 0.6 --speed 2.0 [--out curve.csv]``: damping that reproduces a measured e_n."""
+    p = sub.add_parser("target", help="zeta_H, zeta_A that reproduce measured e_n at given speeds (a curve for one point)")
+    add_contact_options(p)
+    p.add_argument("--e-n", type=_finite_float, nargs="+", required=True, help="target e_n value(s), each in (0, 1)")
+    p.add_argument("--speed", type=_positive_float, nargs="+", required=True, help="normal speed of each target [m/s]")
+    p.add_argument("--e-n-uncertainty", type=_positive_float, nargs="+", default=None,
+                   help="standard uncertainty of each target e_n (weights of the least-squares point)")
+    p.add_argument("--points", type=_positive_int, default=41, help="points per curve (default 41, >= 3)")
+    _add_rtol(p)
+    p.add_argument("--out", default=None, help="write the curve(s): .csv (one row per point) or .nc; default: print CSV")
+    p.set_defaults(func=_cmd_target)
 
 
 def _cmd_sweep(args) -> int:

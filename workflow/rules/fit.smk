@@ -1,5 +1,6 @@
 # The analyst's material: the fit of the damping coefficients to the measured e_n(v_n) (the
-# paper's Fig. 3 procedure), and everything the fitted parameters drive: the measurement flags,
+# paper's Fig. 3 procedure), the friction from the oblique columns (when the data have them), the
+# posterior of the fitted parameters with its bands (config key posterior), and everything the fitted parameters drive: the measurement flags,
 # and in one job (each is seconds; one job saves the start-up of six) the model curves, the
 # critical and capture velocity per measured size and the Table 2 sweeps of the fitted material
 # over the measured sizes and speeds.
@@ -12,6 +13,8 @@ rule fit:
         materials=materials_path(),
     output:
         "results/analyst/fit.nc",
+        posterior="results/analyst/posterior.nc",
+        oblique="results/analyst/oblique.nc",
     log:
         "logs/fit.log",
     benchmark:
@@ -22,6 +25,7 @@ rule fit:
     params:
         material_pair=config["material_pair"],
         options=config["fit"],
+        posterior=config["posterior"],
         rtol=RTOL,
     script:
         "../scripts/fit.py"
@@ -33,6 +37,7 @@ rule flags:
         validated=rules.validate_data.output.table,
         materials=materials_path(),
         fit=rules.fit.output[0],
+        posterior=rules.fit.output.posterior,
     output:
         csv="results/analyst/flags.csv",
         nc="results/analyst/flags.nc",
@@ -45,6 +50,7 @@ rule flags:
     threads: 1
     params:
         material_pair=config["material_pair"],
+        n_draws=config["posterior"]["n_draws"],
         rtol=RTOL,
     script:
         "../scripts/flags.py"

@@ -9,6 +9,8 @@ rule report:
         unpack(stress_outputs),
         data_table=rules.validate_data.output.table,
         fit=rules.fit.output[0],
+        posterior=rules.fit.output.posterior,
+        oblique=rules.fit.output.oblique,
         fit_curves=rules.material_simulations.output.fit_curves,
         model_comparison=rules.model_comparison.output[0],
         flags=rules.flags.output.csv,

@@ -1,4 +1,5 @@
-"""Rule fit: zeta_H, zeta_A (optionally w_A) from the measured e_n(v_n) -> results/analyst/fit.nc."""
+"""Rule fit: zeta_H, zeta_A (optionally w_A) from the measured e_n(v_n), the friction from the oblique
+columns when present, and the posterior with its bands -> results/analyst/{fit,posterior,oblique}.nc."""
 
 import sys
 
@@ -8,12 +9,15 @@ from microimpact.solvers.engine import set_threads  # noqa: E402
 
 set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no more)
 
-from microimpact.analysis.fitting import fit_damping  # noqa: E402
+from microimpact.analysis.analyst_fit import analyse_impacts  # noqa: E402
 from microimpact.io import read_impacts, read_materials  # noqa: E402
 
 table = read_impacts(snakemake.input.data, materials=snakemake.input.materials,  # noqa: F821
                      material_pair=snakemake.params.material_pair)  # noqa: F821
 base = read_materials(snakemake.input.materials)[snakemake.params.material_pair]  # noqa: F821
-fit = fit_damping(table, base, rtol=snakemake.params.rtol, **snakemake.params.options)  # noqa: F821
-fit.save(snakemake.output[0])  # noqa: F821
-print(fit.report())
+opts = dict(snakemake.params.posterior)  # noqa: F821
+enabled, eiv = opts.pop("enabled"), opts.pop("errors_in_variables")
+result = analyse_impacts(table, base, rtol=snakemake.params.rtol, posterior=opts if enabled else False,  # noqa: F821
+                         errors_in_variables=eiv, **snakemake.params.options)  # noqa: F821
+result.save(snakemake.output[0], snakemake.output.posterior, snakemake.output.oblique)  # noqa: F821
+print(result.report())

@@ -1,5 +1,6 @@
-"""Rule flags: each measured impact's sensitivity to unmeasured spin and angle error, and whether it
-is near capture, under the fitted model -> results/analyst/flags.csv + results/analyst/flags.nc."""
+"""Rule flags: each measured impact's sensitivity to unmeasured spin and angle error, whether it
+is near capture, and the spin consistent with it (over the posterior draws), under the fitted model
+-> results/analyst/flags.csv + results/analyst/flags.nc."""
 
 import sys
 
@@ -13,13 +14,16 @@ import xarray as xr  # noqa: E402
 
 from microimpact.analysis.fit_result import DampingFit  # noqa: E402
 from microimpact.analysis.flags import flag_measurements, write_flags  # noqa: E402
+from microimpact.analysis.posterior import load_posterior  # noqa: E402
 from microimpact.io import read_impacts  # noqa: E402
 from microimpact.studies.material import stamp_fitted  # noqa: E402
 
 fit_ds = xr.load_dataset(snakemake.input.fit)  # noqa: F821
 table = read_impacts(snakemake.input.data, materials=snakemake.input.materials,  # noqa: F821
                      material_pair=snakemake.params.material_pair)  # noqa: F821
-ds = flag_measurements(table, DampingFit.from_dataset(fit_ds), rtol=snakemake.params.rtol)  # noqa: F821
+ds = flag_measurements(table, DampingFit.from_dataset(fit_ds), rtol=snakemake.params.rtol,  # noqa: F821
+                       posterior=load_posterior(snakemake.input.posterior),  # noqa: F821
+                       n_draws=snakemake.params.n_draws)  # noqa: F821
 ds = stamp_fitted(ds, fit_ds)
 write_flags(ds, snakemake.output.csv, snakemake.output.nc)  # noqa: F821
 print(ds)

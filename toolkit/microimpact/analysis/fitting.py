@@ -49,6 +49,7 @@ import pandas as pd
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit, fit_parameter_table, format_fit
 from microimpact.io.materials import material_contact
+from microimpact.io.progress import progress_bar
 from microimpact.model.contact import Contact
 from microimpact.solvers import DEFAULT_RTOL
 
@@ -268,6 +269,7 @@ def fit_damping(
     confidence_intervals: bool = True,
     scale_covar: bool | None = None,
     threads: int | None = 1,
+    progress: bool = False,
 ) -> DampingFit:
     """Fit zeta_H, zeta_A (and optionally w_A) to measured e_n(v_n), jointly over particle sizes.
 
@@ -302,6 +304,9 @@ def fit_damping(
         for which thread start-up and, on a busy machine, waiting for the second thread cost more
         than the second core gains (measured: 0.6 ms per call on one thread versus up to 40 ms on
         two threads under load).
+    progress : bool
+        A progress bar on stderr (a terminal only; :func:`microimpact.io.progress.progress_bar`):
+        the start grid, then each least-squares round.
 
     Returns
     -------
@@ -322,7 +327,7 @@ def fit_damping(
     """
     if threads is None:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
-                            scale_covar)
+                            scale_covar, progress)
     import numba  # numba and the engine start only when solving (see the imports)
 
     from microimpact.solvers import engine
@@ -331,12 +336,13 @@ def fit_damping(
     engine.set_threads(threads)
     try:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
-                            scale_covar)
+                            scale_covar, progress)
     finally:
         engine.set_threads(previous)
 
 
-def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals, scale_covar):
+def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals, scale_covar,
+                 progress=False):
     """The fit of :func:`fit_damping`: check, start on the grid, least squares, collect the result."""
     t0 = time.perf_counter()
     density, stiffness, w_a0, friction, vref = _material(base)
@@ -352,14 +358,18 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
     if scale_covar is None:
         scale_covar = sigma_e is None
 
-    (zh0, za0), nfev = _grid_start(problem, e_n, sigma_e, w_a0, start_grid, rtol)
-    params = lmfit.Parameters()
-    params.add("zeta_hertz", value=zh0, min=0.0)
-    params.add("zeta_adhesion", value=za0, min=0.0)
-    params.add("work_of_adhesion", value=w_a0, min=1e-12 if fit_work_of_adhesion else 0.0, vary=fit_work_of_adhesion)
-    sigma_v = arr["normal_speed_uncertainty"] if effective else None
-    mini, result, sigma, n = _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar)
-    cis, ci_message = _confidence_intervals(mini, result, confidence_intervals)
+    n_grid = np.size(start_grid[0]) * np.size(start_grid[1])
+    rounds = 3 if effective else 1
+    with progress_bar(n_grid + rounds + int(bool(confidence_intervals)), f"fit of {e_n.size} impacts", progress) as advance:
+        (zh0, za0), nfev = _grid_start(problem, e_n, sigma_e, w_a0, start_grid, rtol, advance)
+        params = lmfit.Parameters()
+        params.add("zeta_hertz", value=zh0, min=0.0)
+        params.add("zeta_adhesion", value=za0, min=0.0)
+        params.add("work_of_adhesion", value=w_a0, min=1e-12 if fit_work_of_adhesion else 0.0, vary=fit_work_of_adhesion)
+        sigma_v = arr["normal_speed_uncertainty"] if effective else None
+        mini, result, sigma, n = _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, advance)
+        cis, ci_message = _confidence_intervals(mini, result, confidence_intervals)
+        advance(1)
 
     p = result.params.valuesdict()
     model = damping_residual(p, problem, rtol=rtol)
@@ -387,7 +397,7 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
 GRID_START_POINTS = 400
 
 
-def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol):
+def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol, advance=lambda n=1: None):
     """((zeta_H, zeta_A) of least chi-square on the start grid, number of evaluations).
 
     The grid only picks the basin the least-squares fit starts in, so a large data set is
@@ -408,10 +418,11 @@ def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol):
             chi2 = float(r @ r)
             if chi2 < best[0]:
                 best = (chi2, zh, za)
+            advance(1)
     return (best[1], best[2]), gh.size * ga.size
 
 
-def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar):
+def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, advance=lambda n=1: None):
     """Levenberg-Marquardt from ``params``; with speed uncertainties ``sigma_v`` [m/s] re-weighted
     twice by the effective variance. Returns (minimizer, result, sigma used, evaluations)."""
 
@@ -422,11 +433,13 @@ def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar):
 
     sigma = sigma_e
     mini, result = run(params, sigma)
+    advance(1)
     nfev = result.nfev
     if sigma_v is not None:
         for _ in range(2):  # re-weight with the slope at the current best fit, refit
             sigma = _effective_sigma(problem, result.params.valuesdict(), sigma_e, sigma_v, rtol)
             mini, result = run(result.params, sigma)
+            advance(1)
             nfev += result.nfev + 2 * len(problem.radii)
     return mini, result, sigma, nfev
 

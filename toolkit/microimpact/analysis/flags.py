@@ -195,7 +195,8 @@ def _spread(imp: _Impacts, contact_or_fit, unit, offsets, rtol, progress) -> dic
 def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertainty_deg=None,
                       default_angle_uncertainty_deg: float = 2.0, n_spin: int = 12,
                       spin_fractions=(0.5, 1.0), angle_offsets=(-1.0, 0.0, 1.0), thresholds=None,
-                      rtol: float = DEFAULT_RTOL, progress: bool = False) -> xr.Dataset:
+                      rtol: float = DEFAULT_RTOL, progress: bool = False, posterior=None, friction=None,
+                      n_draws: int = 8, explain: bool = True) -> xr.Dataset:
     """Spread of the impact coefficients over unmeasured spin and angle error, and flags.
 
     Parameters
@@ -227,6 +228,17 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
         Engine tolerance. [-]
     progress : bool
         Print progress to stderr.
+    posterior : Posterior, optional
+        Posterior draws for the flags that explain (:func:`microimpact.analysis.spin.spin_explanation`);
+        None: the point estimate of ``contact_or_fit``.
+    friction : float, optional
+        Coulomb f of the explanation when the posterior does not sample it (e.g. a friction fit's). [-]
+    n_draws : int
+        Posterior draws of the explanation.
+    explain : bool
+        Add the explanation (needs a DampingFit or MaterialPair as ``contact_or_fit``): per-row
+        ``spin_low``/``spin_high`` (the unmeasured spin consistent with the measurement),
+        ``spin_moves_prediction``, ``angle_moves_prediction``, ``probably_spun``, ``spin_unexplained``.
 
     Returns
     -------
@@ -273,6 +285,21 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
     })
     if "sha256" in table.attrs:
         res.attrs["source_sha256"] = table.attrs["sha256"]
+    if explain and hasattr(contact_or_fit, "varied"):
+        res = _with_explanation(res, table, contact_or_fit, posterior=posterior, friction=friction, n_draws=n_draws,
+                                spin_bound=spin_bound, angle_uncertainty_deg=angle_uncertainty_deg,
+                                default_angle_uncertainty_deg=default_angle_uncertainty_deg, rtol=rtol,
+                                progress=progress)
+    return res
+
+
+def _with_explanation(res: xr.Dataset, table, fit, *, posterior, **options) -> xr.Dataset:
+    """The flags with the explanation of :func:`microimpact.analysis.spin.spin_explanation` merged in."""
+    from microimpact.analysis.spin import spin_explanation
+
+    extra = spin_explanation(table, fit, posterior=posterior, **options)
+    res = res.merge(extra.drop_vars("spin_scan_bound"), combine_attrs="no_conflicts")
+    res.attrs["explanation_draws"] = "posterior draws" if posterior is not None else "point estimate"
     return res
 
 

@@ -33,7 +33,8 @@ from microimpact.io.materials import material_contact
 from microimpact.model.parameters import TABLE1, TABLE1_ROW2
 from microimpact.solvers import engine
 
-__all__ = ["SYNTHETIC_DEFAULTS", "make_synthetic_impacts", "write_synthetic_impacts"]
+__all__ = ["SYNTHETIC_DEFAULTS", "SYNTHETIC_OBLIQUE_DEFAULTS", "make_synthetic_impacts", "make_synthetic_oblique",
+           "write_synthetic_impacts"]
 
 #: generating parameters of data/synthetic_microspheres.csv; the material is Table 1 row 2
 SYNTHETIC_DEFAULTS = dict(
@@ -135,3 +136,89 @@ def write_synthetic_impacts(path, **overrides):
     """
     df = make_synthetic_impacts(**overrides)
     return write_csv(df, path, float_format="%.6g")
+
+
+#: generating parameters of the synthetic OBLIQUE table (:func:`make_synthetic_oblique`); Table 1 row 2
+SYNTHETIC_OBLIQUE_DEFAULTS = dict(
+    radii=(1.72e-6, 3.45e-6),  # [m]
+    density=TABLE1_ROW2.density,  # [kg/m3]
+    stiffness=TABLE1_ROW2.stiffness,  # [Pa]
+    work_of_adhesion=round(TABLE1_ROW2.work_of_adhesion, 6),  # [J/m2]
+    zeta_hertz=TABLE1_ROW2.zeta_hertz,  # [-]
+    zeta_adhesion=TABLE1_ROW2.zeta_adhesion,  # [-]
+    friction=TABLE1_ROW2.friction,  # [-]
+    speeds=(15.0, 30.0, 60.0, 100.0),  # [m/s]
+    incidence_deg=(20.0, 35.0, 50.0, 60.0, 70.0),  # [deg]
+    e_n_rel_sd=0.03,
+    tangential_sd=0.02,  # [-] standard uncertainty of e_t (or of the column's quantity, scaled)
+    speed_rel_sd=0.01,
+    angle_sd_deg=0.5,  # [deg]
+    tangential_column="tangential_restitution",  # or rebound_angle, rebound_spin
+    seed=20020102,
+    material_pair="ammonium_fluorescein_on_silicon",
+)
+
+
+def make_synthetic_oblique(**overrides) -> pd.DataFrame:
+    """SYNTHETIC oblique impacts (not measurements): e_n and one tangential column per impact.
+
+    Every radius x speed x incidence angle of :data:`SYNTHETIC_OBLIQUE_DEFAULTS` (overridable),
+    without initial spin; captured impacts (no rebound) are left out. Per impact, one ``numpy.random.default_rng(seed)`` stream: the true speed
+    and angle are the nominal ones; the RECORDED speed and angle carry Gaussian errors
+    (``speed_rel_sd`` relative, ``angle_sd_deg``), stated as uncertainties; e_n gets relative noise
+    ``e_n_rel_sd``; the tangential column (``tangential_column``: ``tangential_restitution`` [1],
+    ``rebound_angle`` [deg] or ``rebound_spin`` [rad/s]) gets Gaussian noise of standard deviation
+    ``tangential_sd`` x its scale (1 for e_t, 10 deg for the angle, v_t,in / r for the spin).
+
+    Returns
+    -------
+    pandas.DataFrame
+        In the measured-impact CSV format (units in the header); ``attrs["generating"]`` holds the
+        parameters.
+    """
+    from microimpact.solvers.impact import simulate_many  # the batch API (tangential map)
+
+    unknown = set(overrides) - set(SYNTHETIC_OBLIQUE_DEFAULTS)
+    if unknown:
+        raise ValueError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(SYNTHETIC_OBLIQUE_DEFAULTS)}")
+    p = {**SYNTHETIC_OBLIQUE_DEFAULTS, **overrides}
+    col = p["tangential_column"]
+    if col not in ("tangential_restitution", "rebound_angle", "rebound_spin"):
+        raise ValueError(f"tangential_column must be tangential_restitution, rebound_angle or rebound_spin, got {col!r}")
+    rng = np.random.default_rng(p["seed"])
+    material = SimpleNamespace(**p)
+    rows = []
+    for r in p["radii"]:
+        c = material_contact(material, r)
+        v, a = np.meshgrid(np.asarray(p["speeds"], float), np.asarray(p["incidence_deg"], float), indexing="ij")
+        v, a = v.ravel(), a.ravel()
+        ds = simulate_many(c, v, a, rtol=1e-10)
+        vt_in = v * np.sin(np.radians(a))
+        truth = {"tangential_restitution": (ds["velocity_out_t"].values / vt_in, 1.0, "1"),
+                 "rebound_angle": (np.degrees(np.arctan2(ds["velocity_out_t"].values, ds["velocity_out_n"].values)),
+                                   10.0, "deg"),
+                 "rebound_spin": (np.sqrt(sum(ds[k].values ** 2 for k in ("omega_out_n", "omega_out_t", "omega_out_tp"))),
+                                  vt_in / r, "rad/s")}[col]
+        e = ds["e_n"].values
+        for i in range(v.size):
+            if ds["outcome"].values[i]:
+                continue  # captured: no rebound to measure
+            sd_t = p["tangential_sd"] * (truth[1] if np.isscalar(truth[1]) else truth[1][i])
+            t_rec = truth[0][i] + sd_t * rng.normal()
+            if col == "rebound_spin":
+                t_rec = abs(t_rec)
+            rows.append({
+                "id": f"obl-r{r * 1e6:.2f}-{i + 1:02d}", "material_pair": p["material_pair"],
+                "radius [um]": round(r * 1e6, 6),
+                "speed [m/s]": float(f"{v[i] * (1.0 + p['speed_rel_sd'] * rng.normal()):.6g}"),
+                "incidence_angle [deg]": float(f"{a[i] + p['angle_sd_deg'] * rng.normal():.5g}"),
+                "e_n [1]": float(f"{np.clip(e[i] * (1.0 + p['e_n_rel_sd'] * rng.normal()), 0.0, 1.0):.6g}"),
+                f"{col} [{truth[2]}]": float(f"{t_rec:.6g}"),
+                "speed_uncertainty [m/s]": float(f"{p['speed_rel_sd'] * v[i]:.3g}"),
+                "incidence_angle_uncertainty [deg]": p["angle_sd_deg"],
+                "e_n_uncertainty [1]": float(f"{p['e_n_rel_sd'] * e[i]:.3g}"),
+                f"{col}_uncertainty [{truth[2]}]": float(f"{sd_t:.3g}"),
+            })
+    df = pd.DataFrame(rows)
+    df.attrs["generating"] = {k: (list(v) if isinstance(v, tuple) else v) for k, v in p.items()}
+    return df

@@ -24,6 +24,9 @@ column                                  unit    meaning
 ``e_n``                                 [1]     normal coefficient of restitution, [0, 1]
 ``rebound_tangential_speed``            [m/s]   rebound tangential speed of the centre, >= 0
 ``rebound_angle_deg``                   [deg]   rebound angle from the surface normal
+``tangential_restitution``              [1]     e_t = v_t,out / v_t,in (in the incidence plane)
+``rebound_spin``                        [rad/s] angular speed |omega| after the impact, >= 0
+``spin``                                [rad/s] stated incident spin about t', + = top-spin
 ``<quantity>_uncertainty``              as qty  for each quantity above from ``radius`` on
 ======================================  ======  ==================================================
 
@@ -39,6 +42,13 @@ uncertainty is NaN unless every input it needs has an uncertainty):
 * ``e_n = rebound_normal_speed / normal_speed`` or ``rebound_normal_speed = e_n normal_speed``.
 * ``rebound_angle = atan(rebound_tangential_speed / rebound_normal_speed)`` or
   ``rebound_tangential_speed = rebound_normal_speed tan(rebound_angle)``.
+* ``tangential_restitution = rebound_tangential_speed / (speed sin(incidence))`` (NaN at normal
+  incidence), or from a given ``tangential_restitution`` the (signed) rebound tangential speed and
+  the rebound angle.
+
+Possible but implausible values warn (:class:`ImpactDataWarning`, naming the rows): a tangential
+restitution above 1 without a stated ``spin``. ``df.attrs["measured"]`` lists the canonical
+columns the file gave (not derived), so a fit uses what was measured.
 
 ``df.attrs`` holds ``source`` (the path as given, str), ``sha256`` (of the file's bytes) and
 ``units`` (column -> unit string), so later flags and writers can point back to the file.
@@ -71,6 +81,7 @@ __all__ = [
     "Problem",
     "CANONICAL_COLUMNS",
     "COLUMN_UNITS",
+    "OBLIQUE_COLUMNS",
     "MAX_LISTED_PROBLEMS",
 ]
 
@@ -117,6 +128,11 @@ _BASE: dict[str, _Quantity] = {
     "e_n": _Quantity("dimensionless", "e_n", low_open=False, high=1.0, high_open=False),
     "rebound_tangential_speed": _Quantity("speed", "rebound_tangential_speed", low_open=False),
     "rebound_angle": _Quantity("angle", "rebound_angle_deg", low_open=False, high=90.0),
+    # e_t = v_t,out / v_t,in: negative (reversed) or above 1 only with incident spin
+    "tangential_restitution": _Quantity("dimensionless", "tangential_restitution", low=-math.inf),
+    "rebound_spin": _Quantity("angular_speed", "rebound_spin", low_open=False),
+    # stated incident spin about t' in the forward-rolling sense (+: top-spin, -: back-spin)
+    "spin": _Quantity("angular_speed", "spin", low=-math.inf),
 }
 _QUANTITIES: dict[str, _Quantity] = dict(_BASE)
 for _name, _q in _BASE.items():
@@ -132,8 +148,12 @@ CANONICAL_COLUMNS: tuple[str, ...] = (
     "line",
     *_LABELS,
     *(c for q in ("radius", "speed", "incidence_deg", "normal_speed", "rebound_normal_speed", "e_n",
-                  "rebound_tangential_speed", "rebound_angle_deg") for c in (q, f"{q}_uncertainty")),
+                  "rebound_tangential_speed", "rebound_angle_deg", "tangential_restitution", "rebound_spin",
+                  "spin") for c in (q, f"{q}_uncertainty")),
 )
+#: the oblique (tangential and rotational) measurement columns a friction fit can use
+OBLIQUE_COLUMNS: tuple[str, ...] = ("tangential_restitution", "rebound_tangential_speed", "rebound_angle_deg",
+                                    "rebound_spin")
 #: unit of each numeric column of the returned DataFrame
 COLUMN_UNITS: dict[str, str] = {"row": "1", "line": "1"} | {
     q.canonical: INTERNAL_UNIT[q.dimension] for q in _QUANTITIES.values()
@@ -318,10 +338,11 @@ def _header_combinations(columns: Mapping[str, _Column], misplaced_unit: set[str
         (("radius", "diameter"), "the particle size"),
         (("radius_uncertainty", "diameter_uncertainty"), "the particle size uncertainty"),
         (("rebound_normal_speed", "e_n"), "the normal rebound"),
-        (("rebound_tangential_speed", "rebound_angle"), "the tangential rebound"),
+        (("rebound_tangential_speed", "rebound_angle", "tangential_restitution"), "the tangential rebound"),
     ):
         if len(have(*group)) > 1:
-            problems.append(Problem(f"columns {fields_of(group)} both give {what}; keep one", line=1))
+            both = "both" if len(have(*group)) == 2 else "all"
+            problems.append(Problem(f"columns {fields_of(have(*group))} {both} give {what}; keep one", line=1))
     incident = set(have("speed", "incidence_angle", "normal_speed"))
     if incident == {"speed", "incidence_angle", "normal_speed"} or incident == {"speed", "normal_speed"}:
         problems.append(Problem(
@@ -419,7 +440,33 @@ def _derive(v: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
         b, sb = out["rebound_angle_deg"] * rad, out["rebound_angle_deg_uncertainty"] * rad
         out["rebound_tangential_speed"] = r * np.tan(b)
         out["rebound_tangential_speed_uncertainty"] = _unc(np.tan(b) * sr, (r / np.cos(b)) * (sb / np.cos(b)))
+    _derive_tangential_restitution(v, out, a, sa)
     return out
+
+
+def _derive_tangential_restitution(v: dict, out: dict, a, sa) -> None:
+    """e_t = v_t,out / v_t,in with v_t,in = speed sin(incidence), or the rebound tangential speed
+    (signed: negative when the rebound reverses) and angle from a given e_t. [1], [m/s], [deg]"""
+    sp, ssp = out["speed"], out["speed_uncertainty"]
+    vt_in = sp * np.sin(a)
+    s_vt_in = _unc(np.sin(a) * ssp, sp * np.cos(a) * sa)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        if "tangential_restitution" in v:
+            e, se = out["tangential_restitution"], out["tangential_restitution_uncertainty"]
+            t = e * vt_in
+            out["rebound_tangential_speed"] = t
+            out["rebound_tangential_speed_uncertainty"] = _unc(vt_in * se, e * s_vt_in)
+            r, sr = out["rebound_normal_speed"], out["rebound_normal_speed_uncertainty"]
+            out["rebound_angle_deg"] = np.degrees(np.arctan2(t, r))
+            h = np.hypot(r, t)
+            out["rebound_angle_deg_uncertainty"] = np.degrees(
+                _unc(r / h * out["rebound_tangential_speed_uncertainty"], t / h * sr) / h)
+        elif np.any(np.isfinite(out["rebound_tangential_speed"])):
+            t, st = out["rebound_tangential_speed"], out["rebound_tangential_speed_uncertainty"]
+            ok = vt_in > 0
+            out["tangential_restitution"] = np.where(ok, t / vt_in, np.nan)
+            out["tangential_restitution_uncertainty"] = np.where(
+                ok, _unc(st / vt_in, (t / vt_in) * (s_vt_in / vt_in)), np.nan)
 
 
 #: inputs (canonical names) that each derived column can be computed from
@@ -430,7 +477,10 @@ _DEPENDS: dict[str, tuple[str, ...]] = {
     "e_n": ("rebound_normal_speed", *_INCIDENT),
     "rebound_normal_speed": ("e_n", *_INCIDENT),
     "rebound_angle_deg": ("rebound_tangential_speed", "rebound_normal_speed", "e_n", *_INCIDENT),
-    "rebound_tangential_speed": ("rebound_angle_deg", "rebound_normal_speed", "e_n", *_INCIDENT),
+    "rebound_tangential_speed": ("rebound_angle_deg", "rebound_normal_speed", "e_n", "tangential_restitution",
+                                 *_INCIDENT),
+    "tangential_restitution": ("rebound_tangential_speed", "rebound_angle_deg", "rebound_normal_speed", "e_n",
+                               *_INCIDENT),
 }
 for _k, _deps in list(_DEPENDS.items()):
     _DEPENDS[f"{_k}_uncertainty"] = (_k, *_deps, *(f"{d}_uncertainty" for d in (_k, *_deps)))
@@ -565,6 +615,7 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     if problems:
         raise ImpactDataError(source, _sorted(problems))
 
+    _warn_implausible(Path(source).name, cells, columns, out)
     frame = {"row": cells.rows, "line": cells.lines}
     for cname in _LABELS:
         frame[cname] = pd.array(labels.get(cname, [None] * cells.n), dtype="string")
@@ -573,7 +624,31 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     df.attrs["source"] = source
     df.attrs["sha256"] = sha256
     df.attrs["units"] = dict(COLUMN_UNITS)
+    df.attrs["measured"] = tuple(_QUANTITIES[n].canonical for n in columns if n in _QUANTITIES)
     return df
+
+
+def _warn_implausible(name: str, cells: _Cells, columns, out: dict) -> None:
+    """One :class:`ImpactDataWarning` naming the rows whose values are possible but implausible.
+
+    A tangential restitution above 1 (the rebound faster along the surface than the incidence)
+    needs an incident top-spin; without a stated ``spin`` it is more likely noise or a sign
+    error, so the row is kept and named."""
+    e = out["tangential_restitution"]
+    spin = out["spin"]
+    with np.errstate(invalid="ignore"):
+        bad = (e > 1.0) & ~np.isfinite(spin)
+    if not bad.any():
+        return
+    col = columns.get("tangential_restitution") or columns.get("rebound_tangential_speed") or columns.get("rebound_angle")
+    field = col.field if col is not None else "tangential_restitution"
+    listed = ", ".join(f"row {int(cells.rows[i])} (line {int(cells.lines[i])}, e_t = {e[i]:.4g})"
+                       for i in np.flatnonzero(bad)[:20])
+    more = f" and {int(bad.sum()) - 20} more" if bad.sum() > 20 else ""
+    warnings.warn(
+        f"{name}: column {field!r}: tangential restitution above 1 without a stated 'spin' in {listed}{more}; "
+        "possible only with incident top-spin, so it may be noise (the rows are kept; state the spin in a "
+        "'spin [rad/s]' column if it was measured)", ImpactDataWarning, stacklevel=3)
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 
 There is ONE table, :data:`UNITS`: for each dimension, every accepted spelling of a unit and the
 factor that converts a value in that unit to the internal unit of the dimension. Internal units are
-SI (m, m/s, [1]) except angles, which the toolkit keeps in degrees in columns whose name ends in
+SI (m, m/s, rad/s, [1]) except angles, which the toolkit keeps in degrees in columns whose name ends in
 ``_deg`` (as in :func:`microimpact.model.kinematics.incident_velocity`).
 
 Unit spellings are matched exactly after removing spaces (``m / s`` is ``m/s``); they are
@@ -47,12 +47,13 @@ UNITS: MappingProxyType = MappingProxyType(
         "speed": MappingProxyType({"m/s": 1.0, "cm/s": 1e-2, "mm/s": 1e-3}),
         "angle": MappingProxyType({"deg": 1.0, "degree": 1.0, "degrees": 1.0, "\u00b0": 1.0, "rad": _DEG}),
         "dimensionless": MappingProxyType({"1": 1.0, "-": 1.0}),
+        "angular_speed": MappingProxyType({"rad/s": 1.0, "1/s": 1.0, "rpm": 2.0 * math.pi / 60.0}),
     }
 )
 
 #: dimension -> internal unit written in docs, messages and NetCDF ``units`` attributes
 INTERNAL_UNIT: MappingProxyType = MappingProxyType(
-    {"length": "m", "speed": "m/s", "angle": "deg", "dimensionless": "1"}
+    {"length": "m", "speed": "m/s", "angle": "deg", "dimensionless": "1", "angular_speed": "rad/s"}
 )
 
 
@@ -65,7 +66,7 @@ def _normalise(unit: str) -> str:
 
 
 def accepted_units(dimension: str) -> tuple[str, ...]:
-    """The accepted spellings of units of ``dimension`` ('length', 'speed', 'angle', 'dimensionless')."""
+    """The accepted spellings of units of ``dimension`` ('length', 'speed', 'angle', 'dimensionless', 'angular_speed')."""
     return tuple(UNITS[dimension])
 
 

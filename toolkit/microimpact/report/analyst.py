@@ -1,8 +1,10 @@
 """Part A of the report: the analyst's material, every result made with the parameters of the fit.
 
-Sections: the damping fit (Fig. 3 analogue, drawn from the ``fit_curves`` file), capture and
-critical velocity of each measured size, the Table 2 sweeps at the measured sizes and the
-measurement flags. Each section states the ``parameter_source`` of the files it shows.
+Sections: the damping fit (Fig. 3 analogue, drawn from the ``fit_curves`` file), its posterior
+(bands on e_n(v), corner plot, capture velocity with credible interval, bands on the sweeps), the
+friction fit from the oblique columns (measured against fitted per angle), capture and critical
+velocity of each measured size, the Table 2 sweeps at the measured sizes and the measurement flags
+with the per-row spin ranges. Each section states the ``parameter_source`` of the files it shows.
 """
 
 from __future__ import annotations
@@ -14,10 +16,12 @@ import pandas as pd
 import xarray as xr
 
 from microimpact.report import figures
+from microimpact.report import posterior_figures as pfig
 from microimpact.report.inputs import at_radius, parameter_source, per_radius
 from microimpact.report.layout import Layout
 
-__all__ = ["fit_section", "analyst_dynamics_section", "analyst_sweeps_section", "flags_section"]
+__all__ = ["fit_section", "posterior_section", "oblique_section", "analyst_dynamics_section", "analyst_sweeps_section",
+           "flags_section"]
 
 _PARAMETERS = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
 
@@ -119,6 +123,63 @@ def _data_by_size(t: pd.DataFrame) -> pd.DataFrame:
     return summary
 
 
+# =============================================================================== posterior
+def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset) -> None:
+    """The posterior: summary table, e_n bands, corner plot, capture velocity interval, sweep bands."""
+    lay.section("Posterior of the fitted parameters", new_page=False)
+    if "sampled" not in post.attrs:
+        lay.paragraph(f"(No posterior: {post.attrs.get('comment', 'not computed')}.)", color="0.4")
+        return
+    lay.paragraph(
+        "The fitted parameters sampled with emcee (affine-invariant ensemble sampler) through lmfit's "
+        f"Minimizer.emcee, seeded (seed {post.attrs.get('seed')}), flat priors within the bounds, walkers started "
+        "around the least-squares fit. Speed errors: " + str(post.attrs.get("errors_in_variables", "")) + ". "
+        + str(post.attrs.get("convergence", "")) + ".")
+    lay.table(_posterior_rows(post), {"parameter": 17, "median": 11, "ci95": 26, "tau": 11, "units": 7},
+              headers={"ci95": "95 % credible interval", "tau": "autocorr. [steps]"}, size=7.2)
+    if "e_n_band" in post:
+        lay.plot(pfig.plot_fit_bands(fit, post), max_height=3.6)
+    lay.plot(pfig.plot_corner(post), max_height=4.6)
+    if "capture_velocity_quantile" in post:
+        lay.heading("Capture velocity with its credible interval")
+        cv = post["capture_velocity_quantile"]
+        t = pd.DataFrame({"d": [f"{2e6 * r:.4g}" for r in cv["radius"].values],
+                          "median": [f"{float(cv.sel(radius=r, quantile=0.5, method='nearest')):.4g}" for r in cv["radius"].values],
+                          "ci": [f"[{float(cv.sel(radius=r, quantile=0.025, method='nearest')):.4g}, "
+                                 f"{float(cv.sel(radius=r, quantile=0.975, method='nearest')):.4g}]" for r in cv["radius"].values]})
+        lay.table(t, {"d": 12, "median": 16, "ci": 28}, headers={"d": "d [um]", "median": "v_capture [m/s]",
+                                                                 "ci": "95 % credible interval [m/s]"}, size=7.2)
+    if "sweep_e_n_band" in post:
+        lay.plot(pfig.plot_sweep_bands(post), max_height=2.8)
+
+
+def _posterior_rows(post: xr.Dataset) -> pd.DataFrame:
+    rows = []
+    for n in pfig.posterior_names(post):
+        q = post[f"{n}_quantile"]
+        at = lambda x: float(q.sel(quantile=x, method="nearest"))  # noqa: E731
+        rows.append({"parameter": n, "median": f"{at(0.5):.5g}", "ci95": f"[{at(0.025):.5g}, {at(0.975):.5g}]",
+                     "tau": f"{float(post[f'{n}_autocorr_time']):.1f}", "units": q.attrs.get("units", "")})
+    return pd.DataFrame(rows)
+
+
+# =============================================================================== oblique
+def oblique_section(lay: Layout, obl: xr.Dataset) -> None:
+    """The friction fit from the oblique columns: measured against fitted per angle."""
+    lay.section("Friction from the oblique columns", new_page=False)
+    if "friction" not in obl:
+        lay.paragraph(f"({obl.attrs.get('comment', 'no friction fit')}.)", color="0.4")
+        return
+    lay.paragraph(
+        f"Coulomb friction f fitted to the measured {', '.join(dict.fromkeys(str(q) for q in obl['quantity'].values))} "
+        "with the paper's rigid tangential model (Eqs. (16)-(20)), AFTER the damping fit: the normal motion does not "
+        "depend on f, and the tangential outcome depends on the damping only through the friction impulse, which the "
+        "e_n data fix; the damping covariance is propagated into the standard error "
+        f"(f = {float(obl['friction']):.5g} +- {float(obl['friction_stderr']):.3g}; "
+        f"{float(obl['friction_stderr_conditional']):.3g} at fixed damping).")
+    lay.plot(pfig.plot_oblique(obl), max_height=4.0)
+
+
 # =============================================================================== dynamics per size
 def analyst_dynamics_section(lay: Layout, dyn: xr.Dataset) -> None:
     """Capture and critical velocity and the fitted contact of each measured sphere size."""
@@ -189,6 +250,45 @@ def flags_section(lay: Layout, flags: pd.DataFrame, data: pd.DataFrame | None) -
               headers={"d": "d [um]", "v_n": "v_n [m/s]", "alpha": "alpha [deg]", "e_meas": "e_n meas.",
                        "e_n": "e_n model", "ratio": "v_n/v_cap", "mu_spin": "d mu spin", "KL_spin": "d K_L spin",
                        "e_angle": "d e_n angle", "mu_angle": "d mu angle"}, size=7.0)
+    if "spin_low" in flags:
+        _spin_ranges(lay, flags)
+
+
+def _spin_ranges(lay: Layout, flags: pd.DataFrame) -> None:
+    """Per-row spin consistent with the measurement (the inverse problem) and the flags that explain."""
+    lay.heading("Which rows were probably spun, and by how much")
+    n = {k: int(flags[k].sum()) for k in ("spin_moves_prediction", "angle_moves_prediction", "probably_spun",
+                                          "spin_unexplained") if k in flags}
+    oblique = flags["predicted_quantity"].astype(str) != "e_n"
+    lay.paragraph(
+        "For each row, the prediction of the quantity it measured (its oblique column, else e_n) under the "
+        f"posterior ({flags.get('explanation_draws', pd.Series(['posterior draws'])).iloc[0] if 'explanation_draws' in flags else 'posterior draws or the point estimate'}): "
+        "S = an unmeasured top-/back-spin up to the rolling spin v/r moves it by more than the measurement "
+        "uncertainty in at least half the draws, A = the angle error does; the spin range is the incident top-spin "
+        "(back-spin negative) [rad/s] whose prediction lies within 2 sigma of the measurement (measurement, speed "
+        "and angle errors and posterior spread). P = zero spin is outside that range (probably spun), U = no spin "
+        f"explains the row. Of {len(flags)} rows: {n.get('spin_moves_prediction', 0)} S, "
+        f"{n.get('angle_moves_prediction', 0)} A, {n.get('probably_spun', 0)} P, {n.get('spin_unexplained', 0)} U; "
+        f"{int(oblique.sum())} rows have an oblique measurement. e_n does not depend on spin (the normal motion "
+        "decouples), so a row that measured only e_n admits every spin scanned.")
+    show = flags[oblique | (flags["probably_spun"] == 1) | (flags["spin_unexplained"] == 1)]
+    if show.empty:
+        lay.paragraph("No row constrains the spin (no oblique measurements) and none is unexplained.", color="0.4")
+        return
+
+    def fmt(x):
+        return "" if not np.isfinite(x) else f"{x:.3g}"
+
+    t = pd.DataFrame({
+        "row": show["row"].astype(int).astype(str), "quantity": show["predicted_quantity"].astype(str),
+        "low": show["spin_low"].map(fmt), "high": show["spin_high"].map(fmt),
+        "s_spin": show["spin_shift"].map(lambda x: f"{x:.2g}"), "s_angle": show["angle_shift"].map(lambda x: f"{x:.2g}"),
+        "flags": ["".join(c for c, k in (("S", "spin_moves_prediction"), ("A", "angle_moves_prediction"),
+                                         ("P", "probably_spun"), ("U", "spin_unexplained")) if int(r[k])) or "-"
+                  for _, r in show.iterrows()]})
+    lay.table(t, {"row": 5, "quantity": 24, "low": 12, "high": 12, "s_spin": 10, "s_angle": 10, "flags": 6},
+              headers={"low": "spin low [rad/s]", "high": "spin high [rad/s]", "s_spin": "spin shift [sigma]",
+                       "s_angle": "angle shift [sigma]"}, size=7.0)
 
 
 def _flags_table(flags: pd.DataFrame, data: pd.DataFrame | None) -> pd.DataFrame:

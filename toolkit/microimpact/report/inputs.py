@@ -44,6 +44,8 @@ INPUT_KEYS = {
     "fit": (True, "damping fit NetCDF (DampingFit.to_dataset)"),
     "fit_curves": (False, "model e_n(radius, speed) and outcome at the fit, NetCDF"),
     "flags": (False, "measurement-flags CSV"),
+    "posterior": (False, "posterior NetCDF: chain, diagnostics and bands (microimpact.analysis.posterior)"),
+    "oblique": (False, "friction fit NetCDF from the oblique columns (FrictionFit.to_dataset)"),
     "analyst_dynamics": (False, "critical and capture velocity per measured radius, NetCDF"),
     "analyst_sweeps": (False, "Table 2 sweeps at the measured radii (leading dimension radius), NetCDF files"),
     "model_comparison": (False, "normal models (ring, JKR, DMT) fitted to the data with AIC/BIC, NetCDF"),

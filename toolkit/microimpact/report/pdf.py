@@ -63,6 +63,12 @@ def _analyst_part(lay: Layout, inputs: Mapping, data: pd.DataFrame | None, synth
         "fitted) come from the fit in section 1; every simulation in this part uses them, at the measured sphere "
         "sizes and over the measured speed range.")
     analyst.fit_section(lay, fit, _optional(inputs, "fit_curves", read_dataset), data, synthetic)
+    post = _optional(inputs, "posterior", read_dataset)
+    if post is not None:
+        analyst.posterior_section(lay, fit, post)
+    obl = _optional(inputs, "oblique", read_dataset)
+    if obl is not None:
+        analyst.oblique_section(lay, obl)
     if "model_comparison" in inputs:
         models.model_comparison_section(lay, read_dataset(inputs["model_comparison"]), synthetic)
     dyn = _optional(inputs, "analyst_dynamics", read_dataset)
@@ -121,7 +127,7 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
     inputs : mapping of str to path (or list of paths)
         Result files by key; ``fit`` is required, every other key may be missing (its section is
         left out or says why it is empty). Keys (see :data:`microimpact.report.inputs.INPUT_KEYS`):
-        analyst part ``data_table`` (CSV), ``fit``, ``fit_curves``, ``flags`` (CSV),
+        analyst part ``data_table`` (CSV), ``fit``, ``fit_curves``, ``posterior``, ``oblique``, ``flags`` (CSV),
         ``analyst_dynamics``, ``analyst_sweeps`` (list), ``model_comparison``; paper part ``phase_portraits``,
         ``dynamics``, ``bifurcation``, ``reproduction`` (CSV), ``paper_sweeps`` (list); checks
         ``kharaz``, ``work_precision``, ``stress`` (JSON). NetCDF unless stated. In-memory

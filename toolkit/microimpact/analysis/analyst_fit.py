@@ -1,0 +1,159 @@
+"""The analyst's whole fit in one call: damping, friction from oblique columns, posterior and bands.
+
+:func:`analyse_impacts` is what the CLI's ``fit`` command and the pipeline's fit rule run:
+
+1. :func:`~microimpact.analysis.fitting.fit_damping` (zeta_H, zeta_A, optionally w_A, from e_n(v_n));
+2. when the table has oblique columns, :func:`~microimpact.analysis.oblique.fit_friction` after it
+   (why after: :mod:`microimpact.analysis.oblique`); the fitted friction replaces the material's in
+   the returned :class:`DampingFit` (so flags and simulations of the fitted material use it);
+3. optionally the posterior (:func:`~microimpact.analysis.posterior.sample_posterior`), with the
+   e_n bands, the capture velocity interval and the sweep bands of the analyst's material.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import xarray as xr
+
+from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.provenance import stamp_parameters
+from microimpact.solvers import DEFAULT_RTOL
+
+__all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS", "POSTERIOR_FULL"]
+
+#: the posterior of the pipeline and CLI by default: short (seconds), its convergence stated
+POSTERIOR_DEFAULTS = dict(walkers=12, steps=80, burn=None, seed=2002, n_draws=24)
+#: ``full: true``: a chain long enough for the 50-autocorrelation-times rule on the bundled data
+#: (tau about 29 steps: 1700 post-burn-in steps = 59 tau; about 1.5 minutes)
+POSTERIOR_FULL = dict(walkers=24, steps=2000, burn=300, seed=2002, n_draws=64)
+
+
+@dataclass(frozen=True, eq=False)
+class AnalystFit:
+    """Result of :func:`analyse_impacts`.
+
+    Attributes
+    ----------
+    damping : DampingFit
+        The damping fit (friction: the fitted one when oblique data were fitted).
+    friction : FrictionFit or None
+    posterior : Posterior or None
+    posterior_dataset : xarray.Dataset or None
+        Chain, summary, diagnostics and bands (:func:`~microimpact.analysis.posterior.posterior_dataset`).
+    """
+
+    damping: object
+    friction: object = None
+    posterior: object = None
+    posterior_dataset: xr.Dataset | None = None
+
+    def report(self) -> str:
+        """The text reports of the parts that were computed."""
+        parts = [self.damping.report()]
+        if self.friction is not None:
+            parts.append(self.friction.report())
+        if self.posterior is not None:
+            parts.append(self.posterior.report())
+        return "\n".join(parts)
+
+    def oblique_dataset(self) -> xr.Dataset:
+        """The friction fit's Dataset, or an empty one that says there were no oblique columns."""
+        if self.friction is not None:
+            return self.friction.to_dataset()
+        return xr.Dataset(attrs={"title": "friction fit from oblique impacts", "Conventions": CONVENTIONS,
+                                 "comment": "the impact table has no oblique columns: no friction fit"})
+
+    def save(self, fit_path, posterior_path=None, oblique_path=None) -> tuple:
+        """Write the fit, and where given the posterior and the oblique fit, as NetCDF (atomically)."""
+        written = [self.damping.save(fit_path)]
+        if posterior_path is not None:
+            ds = self.posterior_dataset if self.posterior_dataset is not None else xr.Dataset(attrs={
+                "title": "posterior of the fitted parameters", "Conventions": CONVENTIONS,
+                "comment": "posterior not computed"})
+            written.append(write_netcdf(self._stamped(ds), posterior_path))
+        if oblique_path is not None:
+            written.append(write_netcdf(self._stamped(self.oblique_dataset()), oblique_path))
+        return tuple(written)
+
+    def _stamped(self, ds: xr.Dataset) -> xr.Dataset:
+        """``ds`` with the fit's ``parameter_source`` and the fitted contact of every measured size
+        (:func:`microimpact.io.provenance.stamp_parameters`), like every result file."""
+        fit = self.damping
+        return stamp_parameters(ds, [fit.contact(float(r)) for r in fit.radii], fit.parameter_source)
+
+
+def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights="auto", confidence_intervals: bool = False,
+                    friction: bool = True, posterior: bool | dict = False, errors_in_variables: str = "auto",
+                    rtol: float = DEFAULT_RTOL, progress: bool = False) -> AnalystFit:
+    """Fit the damping, the friction (if oblique columns) and optionally sample the posterior.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        From :func:`microimpact.io.read_impacts` (one material pair).
+    base : MaterialPair, Contact or DampingFit
+        The material (density, stiffness, w_A, friction start, damping reference speed).
+    fit_work_of_adhesion, weights, confidence_intervals
+        As :func:`~microimpact.analysis.fitting.fit_damping`.
+    friction : bool
+        Fit the friction when the table has oblique columns.
+    posterior : bool or dict
+        False: no posterior; True: :data:`POSTERIOR_DEFAULTS`; a dict overrides them (``walkers``,
+        ``steps``, ``burn``, ``seed``, ``n_draws``; ``full: true`` starts from :data:`POSTERIOR_FULL`).
+    errors_in_variables : {"auto", "effective", "latent"}
+        Speed-error treatment of the posterior (:mod:`microimpact.analysis.posterior`).
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+    progress : bool
+        Progress bars on stderr (a terminal only).
+
+    Returns
+    -------
+    AnalystFit
+    """
+    from microimpact.analysis.fitting import fit_damping
+    from microimpact.analysis.oblique import ObliqueProblem, fit_friction
+
+    damping = fit_damping(table, base, fit_work_of_adhesion=fit_work_of_adhesion, weights=weights,
+                          confidence_intervals=confidence_intervals, rtol=rtol, progress=progress)
+    ff = None
+    if friction:
+        try:
+            ObliqueProblem.from_table(table)
+        except ValueError:
+            pass
+        else:
+            ff = fit_friction(table, damping, rtol=rtol, progress=progress)
+            damping = dataclasses.replace(damping, friction=ff.friction, info=damping.info | {
+                "friction_stderr": ff.stderr["friction"], "friction_source": "fit to the oblique columns (after the "
+                "damping fit, microimpact.analysis.oblique)", "friction_n_points": ff.n_points})
+    if not posterior:
+        return AnalystFit(damping, ff)
+    opts = _posterior_options(posterior)
+    from microimpact.analysis.posterior import (capture_velocity_interval, posterior_dataset, restitution_bands,
+                                                sample_posterior, sweep_bands)
+
+    post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], burn=opts["burn"],
+                            seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol, progress=progress)
+    nd = opts["n_draws"]
+    ds = posterior_dataset(post, restitution_bands(post, damping, n_draws=nd, rtol=rtol),
+                           capture_velocity_interval(post, damping, n_draws=nd),
+                           sweep_bands(post, damping, n_draws=max(nd // 2, 4), rtol=rtol))
+    return AnalystFit(damping, ff, post, ds)
+
+
+def _posterior_options(posterior) -> dict:
+    """The sampler settings from ``True`` or a dict (see :func:`analyse_impacts`)."""
+    if posterior is True:
+        return dict(POSTERIOR_DEFAULTS)
+    opts = dict(posterior)
+    full = str(opts.pop("full", False)).lower() in ("true", "1")
+    opts.pop("enabled", None)
+    unknown = set(opts) - set(POSTERIOR_DEFAULTS)
+    if unknown:
+        raise ValueError(f"unknown posterior option(s) {sorted(unknown)}; known: {sorted(POSTERIOR_DEFAULTS)} and full")
+    base = dict(POSTERIOR_FULL if full else POSTERIOR_DEFAULTS)
+    base.update({k: (None if v is None else int(v)) for k, v in opts.items()})
+    return base

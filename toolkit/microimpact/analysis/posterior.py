@@ -1,0 +1,560 @@
+"""Posterior of the fitted parameters by MCMC (lmfit's ``Minimizer.emcee``), and what it implies.
+
+:func:`sample_posterior` samples (zeta_H, zeta_A[, w_A][, friction]) with the affine-invariant
+ensemble sampler of emcee (Foreman-Mackey et al. 2013, doi:10.1086/670067) through
+:meth:`lmfit.Minimizer.emcee`, from walkers started in a small ball around the least-squares fit,
+seeded (``seed``): the same inputs give the same chain. Priors are flat within the bounds
+zeta >= 0, w_A > 0, 0 <= f <= 10.
+
+Likelihood
+----------
+Normal part: each measured e_n is Gaussian about the model e_n(v_n) of Eq. (21) with the measured
+uncertainty. The incident speed is itself measured (errors in variables), handled per row:
+
+* **effective variance** (Orear 1982, doi:10.1119/1.12972) where the model is close to linear over
+  the speed uncertainty: sigma^2 = sigma_e^2 + (de/dv)^2 sigma_v^2, the slope at the best fit;
+* **latent true speed, integrated out** where it is not: near the capture velocity e_n rises like
+  the square root of the distance to it, and the tangent line misstates the likelihood (a speed
+  draw below capture gives e_n = 0). There the row's likelihood is
+  int N(e | e_model(u), sigma_e) N(u | v, sigma_v) du, by 9-point Gauss-Hermite quadrature (exact for
+  a model polynomial of degree <= 17 in u; the latent speeds are marginalised, not sampled, so the
+  walkers keep 2-4 dimensions). ``errors_in_variables="auto"`` picks the latent form for rows where
+  the second-order term at +/- 2 sigma_v exceeds a quarter of sigma_eff, or where v_n - 3 sigma_v
+  falls below the capture velocity; ``"effective"`` or ``"latent"`` force one form for every row.
+
+The incidence-angle uncertainty enters v_n = v cos(alpha) through the reader's propagated
+``normal_speed_uncertainty`` (first order; at alpha = 0 the second-order bias, v sigma_alpha^2 / 2, is
+below 2e-4 v for sigma_alpha <= 1 deg and is neglected). Tangential part (with a friction fit): the
+oblique entries with the effective variance of :mod:`microimpact.analysis.oblique`.
+
+Diagnostics: the integrated autocorrelation time of each parameter (``emcee.autocorr``), the
+acceptance fraction of each walker, and ``converged`` = the post-burn-in chain is longer than 50
+autocorrelation times (emcee's guidance). Short pipeline chains say so.
+
+Every model evaluation goes through :func:`microimpact.solvers.engine.solve_normal_many` (e_n) or
+:func:`microimpact.simulate_many` (tangential), so faster solvers speed up the sampler too.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io as _stdio
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from microimpact.analysis.fit_result import PARAMETER_NAMES
+from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.materials import material_contact
+from microimpact.io.progress import progress_bar
+from microimpact.solvers import DEFAULT_RTOL
+
+__all__ = ["Posterior", "sample_posterior", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
+           "sweep_bands", "posterior_dataset", "posterior_from_dataset", "load_posterior", "save_posterior",
+           "summary_table", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"]
+
+#: units of the sampled parameters
+PARAMETER_UNITS = {"zeta_hertz": "1", "zeta_adhesion": "1", "work_of_adhesion": "J m-2", "friction": "1"}
+#: errors-in-variables treatments of the measured speed
+EIV_METHODS = ("auto", "effective", "latent")
+#: Gauss-Hermite nodes of the latent-speed integral
+GAUSS_HERMITE_NODES = 9
+#: quantiles stored in summaries and bands (2.5 %, 16 %, 50 %, 84 %, 97.5 %)
+QUANTILES = (0.025, 0.16, 0.5, 0.84, 0.975)
+
+
+@dataclass(frozen=True, eq=False)
+class Posterior:
+    """An MCMC sample of the fitted parameters.
+
+    Attributes
+    ----------
+    names : tuple of str
+        Sampled parameters (subset of :data:`PARAMETER_UNITS`).
+    chain : numpy.ndarray
+        Full chain, shape (steps, walkers, parameters), in the parameters' units.
+    log_probability : numpy.ndarray
+        Log posterior of each chain point, shape (steps, walkers).
+    burn : int
+        Steps discarded as burn-in.
+    fixed : dict
+        Parameters held fixed (e.g. w_A when not fitted, the friction of the material).
+    autocorr_time : dict
+        Integrated autocorrelation time of each parameter. [steps]
+    acceptance_fraction : numpy.ndarray
+        Per walker. [-]
+    seed : int
+    info : dict
+        ``errors_in_variables``, ``latent_rows`` (CSV rows with the latent-speed likelihood),
+        ``elapsed_s``, ``converged`` (bool), ``convergence`` (text), ``source``.
+    """
+
+    names: tuple
+    chain: np.ndarray
+    log_probability: np.ndarray
+    burn: int
+    fixed: dict
+    autocorr_time: dict
+    acceptance_fraction: np.ndarray
+    seed: int
+    info: dict = field(default_factory=dict)
+
+    @property
+    def samples(self) -> np.ndarray:
+        """Post-burn-in samples, flattened: shape (n, parameters)."""
+        return self.chain[self.burn:].reshape(-1, len(self.names))
+
+    def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
+        """Equal-tailed credible interval of ``name`` at ``level`` (e.g. 0.95)."""
+        x = self.samples[:, self.names.index(name)]
+        lo, hi = np.quantile(x, [(1 - level) / 2, (1 + level) / 2])
+        return float(lo), float(hi)
+
+    def median(self) -> dict:
+        """Posterior median of each sampled parameter, plus the fixed ones."""
+        return {n: float(np.median(self.samples[:, i])) for i, n in enumerate(self.names)} | dict(self.fixed)
+
+    def draws(self, n: int, seed: int | None = None) -> list[dict]:
+        """``n`` parameter sets drawn from the post-burn-in samples (seeded), fixed ones included."""
+        s = self.samples
+        rng = np.random.default_rng(self.seed if seed is None else seed)
+        idx = rng.choice(s.shape[0], size=min(n, s.shape[0]), replace=False)
+        return [dict(zip(self.names, map(float, s[i]))) | dict(self.fixed) for i in idx]
+
+    @property
+    def converged(self) -> bool:
+        """Post-burn-in chain longer than 50 autocorrelation times."""
+        return bool(self.info.get("converged", False))
+
+    def report(self) -> str:
+        """Plain-text summary: medians, 95 % intervals, autocorrelation, acceptance."""
+        steps, walkers, _ = self.chain.shape
+        lines = [f"Posterior (emcee via lmfit.Minimizer.emcee, {walkers} walkers x {steps} steps, burn-in {self.burn}, "
+                 f"seed {self.seed})"]
+        for i, n in enumerate(self.names):
+            lo, hi = self.interval(n)
+            lines.append(f"  {n:<17}= {np.median(self.samples[:, i]):.6g}  95 % [{lo:.6g}, {hi:.6g}] "
+                         f"[{PARAMETER_UNITS[n]}]  tau {self.autocorr_time[n]:.1f} steps")
+        af = self.acceptance_fraction
+        lines.append(f"  acceptance  : mean {af.mean():.3f} (walkers {af.min():.3f}-{af.max():.3f})")
+        lines.append(f"  convergence : {self.info.get('convergence', '')}")
+        lines.append(f"  speed errors: {self.info.get('errors_in_variables', '')}")
+        return "\n".join(lines)
+
+
+# =============================================================================== likelihood
+class _Likelihood:
+    """log p(data | parameters): the normal part (effective variance or latent speed per row) and
+    the tangential part. Each evaluation: one model_restitution call (one engine call per radius)
+    and, with oblique data, one simulate_many call per radius."""
+
+    def __init__(self, damping_fit, table, friction_fit, eiv, rtol):
+        from microimpact.analysis.fitting import FitProblem
+
+        self.fit, self.rtol = damping_fit, rtol
+        d = damping_fit.data
+        e, v, r = (d[c].to_numpy(dtype=float) for c in ("e_n", "normal_speed", "radius"))
+        sig = d["sigma"].to_numpy(dtype=float)
+        if not np.all(np.isfinite(sig)):  # unweighted fit: the residual scatter is the uncertainty
+            sig = np.full(e.size, math.sqrt(damping_fit.chisqr / max(damping_fit.n_points - len(damping_fit.varied), 1)))
+        sig_e, sig_v = self._stated(table, d, sig)
+        latent = self._latent_rows(eiv, r, v, sig, sig_v, FitProblem)
+        x, w = np.polynomial.hermite.hermgauss(GAUSS_HERMITE_NODES)
+        self.e, self.sig_eff, self.sig_e = e, sig, sig_e
+        self.latent = latent
+        self.weights = w / math.sqrt(math.pi)
+        li = np.flatnonzero(latent)
+        speeds = np.concatenate([v[~latent], (v[li, None] + math.sqrt(2.0) * sig_v[li, None] * x[None, :]).ravel()])
+        radii = np.concatenate([r[~latent], np.repeat(r[li], x.size)])
+        self.n_plain = int((~latent).sum())
+        self.problem = FitProblem.from_arrays(radii, np.maximum(speeds, 1e-12), damping_fit)
+        self.latent_rows = d["row"].to_numpy()[li]
+        self.oblique = None
+        if friction_fit is not None:
+            from microimpact.analysis.oblique import ObliqueProblem
+
+            self.oblique = ObliqueProblem.from_table(table)
+            self.oblique_sigma = friction_fit.data["sigma"].to_numpy(dtype=float)
+
+    @staticmethod
+    def _stated(table, d, sig):
+        """(sigma_e, sigma_v) of the fitted rows: stated e_n and normal-speed uncertainties (0 if absent)."""
+        if table is not None and "row" in table.columns:
+            t = table.set_index("row")
+            se = d["row"].map(t["e_n_uncertainty"]).to_numpy(dtype=float)
+            sv = d["row"].map(t["normal_speed_uncertainty"]).to_numpy(dtype=float)
+        else:
+            se, sv = np.full(len(d), np.nan), np.full(len(d), np.nan)
+        se = np.where(np.isfinite(se) & (se > 0), se, sig)
+        return se, np.nan_to_num(sv)
+
+    def _latent_rows(self, eiv, r, v, sig, sig_v, FitProblem):
+        """Which rows get the latent-speed likelihood (module docstring)."""
+        if eiv not in EIV_METHODS:
+            raise ValueError(f"errors_in_variables must be one of {', '.join(EIV_METHODS)}, got {eiv!r}")
+        has = sig_v > 0
+        if eiv != "auto":
+            return has & (eiv == "latent")
+        from microimpact.analysis.fitting import model_restitution
+        from microimpact.dynamics.nonlinear import capture_velocity
+
+        p = self.fit.values
+        ev = [model_restitution(FitProblem.from_arrays(r, np.maximum(v + k * 2 * sig_v, 1e-12), self.fit), p["zeta_hertz"],
+                                p["zeta_adhesion"], p["work_of_adhesion"], rtol=self.rtol) for k in (-1, 0, 1)]
+        curvature = np.abs(ev[0] + ev[2] - 2 * ev[1]) / 2
+        v_cap = {float(rr): capture_velocity(self.fit.contact(float(rr))) for rr in np.unique(r)}
+        near = v - 3 * sig_v < np.array([v_cap[float(rr)] for rr in r])
+        return has & ((curvature > 0.25 * sig) | near)
+
+    def __call__(self, p: dict) -> float:
+        from microimpact.analysis.fitting import model_restitution
+
+        m = model_restitution(self.problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=self.rtol)
+        plain = ~self.latent
+        res = (m[: self.n_plain] - self.e[plain]) / self.sig_eff[plain]
+        logl = -0.5 * float(res @ res)
+        if self.latent.any():
+            k = GAUSS_HERMITE_NODES
+            ml = m[self.n_plain:].reshape(-1, k)
+            e, s = self.e[self.latent, None], self.sig_e[self.latent, None]
+            like = (np.exp(-0.5 * ((ml - e) / s) ** 2) * self.weights[None, :]).sum(axis=1)
+            logl += float(np.sum(np.log(np.maximum(like, 1e-300))))
+        if self.oblique is not None:
+            from microimpact.analysis.oblique import oblique_model
+
+            values = {n: p[n] for n in PARAMETER_NAMES}
+            mo = oblique_model(self.oblique, lambda r: _contact(self.fit, r, values), {"friction": p["friction"]},
+                               rtol=self.rtol)
+            r2 = np.nan_to_num((mo - self.oblique.measured) / self.oblique_sigma, nan=1e3)
+            logl -= 0.5 * float(r2 @ r2)
+        return logl
+
+
+def _contact(fit, radius, values: dict):
+    """Contact of ``radius`` [m] with damping ``values`` (f0 from Eq. (7) with values' w_A)."""
+    c = material_contact(fit, radius, zeta_hertz=values["zeta_hertz"], zeta_adhesion=values["zeta_adhesion"],
+                         work_of_adhesion=values["work_of_adhesion"])
+    return c.with_(friction=values["friction"]) if "friction" in values else c
+
+
+# =============================================================================== sampling
+def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int = 16, steps: int = 300,
+                     burn: int | None = None, seed: int = 2002, errors_in_variables: str = "auto",
+                     rtol: float = DEFAULT_RTOL, progress: bool = False) -> Posterior:
+    """Sample the posterior of the fitted parameters with lmfit's ``Minimizer.emcee`` (seeded).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame or None
+        The impact table that was fitted (for the stated uncertainties and the oblique columns);
+        None uses the fit's own data (effective variance only).
+    damping_fit : DampingFit
+        The least-squares fit: start of the walkers, material, fitted rows.
+    friction_fit : FrictionFit, optional
+        Also sample the friction under the tangential likelihood.
+    walkers, steps : int
+        Ensemble size (>= 2 x parameters) and chain length.
+    burn : int, optional
+        Steps discarded; default a third of ``steps``.
+    seed : int
+        Seeds the start ball and the sampler.
+    errors_in_variables : {"auto", "effective", "latent"}
+        Treatment of the speed uncertainty (module docstring).
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+    progress : bool
+        Progress bar on stderr (a terminal only).
+
+    Returns
+    -------
+    Posterior
+    """
+    import lmfit  # only when sampling
+
+    t0 = time.perf_counter()
+    like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol)
+    names = list(damping_fit.varied) + (["friction"] if friction_fit is not None else [])
+    best = dict(damping_fit.values) | ({"friction": friction_fit.friction} if friction_fit is not None else {})
+    stderr = dict(damping_fit.stderr) | ({"friction": friction_fit.stderr["friction"]} if friction_fit is not None else {})
+    if walkers < 2 * len(names) or steps < 2:
+        raise ValueError(f"walkers must be >= {2 * len(names)} (twice the {len(names)} parameters) and steps >= 2, "
+                         f"got walkers={walkers}, steps={steps}")
+    burn = steps // 3 if burn is None else int(burn)
+    if not 0 <= burn < steps:
+        raise ValueError(f"burn must lie in [0, steps), got {burn}")
+    params = lmfit.Parameters()
+    bounds = {"zeta_hertz": (0.0, np.inf), "zeta_adhesion": (0.0, np.inf), "work_of_adhesion": (1e-12, np.inf),
+              "friction": (0.0, 10.0)}
+    for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion", "friction"):
+        if n in best:
+            params.add(n, value=best[n], min=bounds[n][0], max=bounds[n][1], vary=n in names)
+    rng = np.random.default_rng(seed)
+    scale = np.array([stderr[n] if math.isfinite(stderr[n]) and stderr[n] > 0 else 1e-3 * abs(best[n]) for n in names])
+    pos = np.array([best[n] for n in names])[None, :] + 0.3 * scale[None, :] * rng.standard_normal((walkers, len(names)))
+    lo = np.array([bounds[n][0] for n in names])
+    pos = np.where(pos <= lo, lo + 0.01 * scale, pos)
+
+    calls = [0]
+    from microimpact.analysis.oblique import engine_threads
+
+    with progress_bar(steps, "posterior", progress) as advance, engine_threads(1):
+        def log_probability(pars):
+            calls[0] += 1
+            if calls[0] % walkers == 0:
+                advance(1)
+            return like(pars.valuesdict())
+
+        mini = lmfit.Minimizer(log_probability, params, nan_policy="propagate")
+        with contextlib.redirect_stdout(_stdio.StringIO()):  # lmfit prints emcee's AutocorrError
+            mini.emcee(params=params, steps=steps, nwalkers=walkers, burn=0, thin=1, pos=pos, seed=seed,
+                       float_behavior="posterior", progress=False)
+    chain = mini.sampler.get_chain()
+    logp = mini.sampler.get_log_prob()
+    tau = _autocorr(chain[burn:])
+    n_post = steps - burn
+    converged = bool(np.all(np.isfinite(tau)) and n_post > 50 * max(tau))
+    text = (f"post-burn-in chain {n_post} steps = {n_post / max(tau):.0f} x the longest autocorrelation time "
+            f"({max(tau):.1f} steps); " + ("converged (> 50)" if converged else
+                                           "NOT converged by the 50 tau rule: run more steps for quoted intervals"))
+    fixed = {n: best[n] for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion") if n not in names}
+    if friction_fit is None:
+        fixed["friction"] = float(damping_fit.friction)
+    eiv = (f"{errors_in_variables}: latent true speed (Gauss-Hermite, {GAUSS_HERMITE_NODES} nodes) for "
+           f"{int(like.latent.sum())} row(s), effective variance for {like.n_plain}")
+    return Posterior(names=tuple(names), chain=np.asarray(chain), log_probability=np.asarray(logp), burn=burn,
+                     fixed=fixed, autocorr_time=dict(zip(names, map(float, tau))),
+                     acceptance_fraction=np.asarray(mini.sampler.acceptance_fraction, dtype=float), seed=int(seed),
+                     info={"errors_in_variables": eiv, "latent_rows": tuple(int(r) for r in like.latent_rows),
+                           "elapsed_s": time.perf_counter() - t0, "converged": converged, "convergence": text,
+                           "source": str(damping_fit.info.get("source") or "")})
+
+
+def _autocorr(chain: np.ndarray) -> np.ndarray:
+    """Integrated autocorrelation time per parameter [steps] (emcee.autocorr, without its length check)."""
+    import logging
+
+    import emcee
+
+    log = logging.getLogger("emcee.autocorr")
+    level = log.level
+    log.setLevel(logging.ERROR)  # the length warning: the caller states convergence itself
+    try:
+        return np.asarray(emcee.autocorr.integrated_time(chain, quiet=True), dtype=float)
+    finally:
+        log.setLevel(level)
+
+
+# =============================================================================== what it implies
+def posterior_contacts(posterior: Posterior, damping_fit, radius: float, n_draws: int = 64, seed=None) -> list:
+    """Contacts of one radius [m] for ``n_draws`` posterior draws (f0 from Eq. (7) per draw)."""
+    return [_contact(damping_fit, radius, d) for d in posterior.draws(n_draws, seed)]
+
+
+def restitution_bands(posterior: Posterior, damping_fit, speeds=None, *, n_draws: int = 64,
+                      rtol: float = DEFAULT_RTOL) -> xr.Dataset:
+    """Posterior bands of the model e_n(v_n) at every fitted radius.
+
+    Parameters
+    ----------
+    speeds : array_like, optional
+        Normal speeds [m/s]; default 60 log-spaced over the measured range (down to 0.9 x the
+        smallest measured speed).
+    n_draws : int
+        Posterior draws pushed through :func:`solve_normal_many`.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``e_n_band(radius, band_speed, quantile)`` [1]; the credible band of the model e_n (the
+        spread of the curve over the posterior, without the measurement noise).
+    """
+    from microimpact.solvers import engine
+
+    lo, hi = damping_fit.speed_range
+    v = np.geomspace(0.9 * lo, hi, 60) if speeds is None else np.asarray(speeds, dtype=float)
+    radii = damping_fit.radii
+    draws = posterior.draws(n_draws)
+    e = np.empty((radii.size, len(draws), v.size))
+    from microimpact.analysis.oblique import engine_threads
+
+    with engine_threads(1):
+        for i, r in enumerate(radii):
+            for j, d in enumerate(draws):
+                e[i, j] = engine.solve_normal_many(_contact(damping_fit, float(r), d), v, rtol=rtol)["e_n"]
+    return xr.Dataset({"e_n_band": (("radius", "band_speed", "quantile"), np.moveaxis(np.quantile(e, QUANTILES, axis=1), 0, -1),
+                                    {"units": "1", "long_name": "posterior quantiles of the model normal coefficient "
+                                                                "of restitution e_n"})},
+                      coords=_coords(radii, QUANTILES) | {"band_speed": ("band_speed", v, {
+                          "units": "m s-1", "long_name": "incident normal speed of the band"})})
+
+
+def capture_velocity_interval(posterior: Posterior, damping_fit, *, n_draws: int = 64) -> xr.Dataset:
+    """Capture velocity of each fitted radius with its posterior quantiles (credible interval).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``capture_velocity_quantile(radius, quantile)`` [m/s] over ``n_draws`` draws.
+    """
+    from microimpact.dynamics.nonlinear import capture_velocity
+
+    radii = damping_fit.radii
+    draws = posterior.draws(n_draws)
+    from microimpact.analysis.oblique import engine_threads
+
+    with engine_threads(1):
+        v = np.array([[capture_velocity(_contact(damping_fit, float(r), d), rtol=1e-5) for d in draws] for r in radii])
+    return xr.Dataset({"capture_velocity_quantile": (("radius", "quantile"), np.quantile(v, QUANTILES, axis=1).T, {
+        "units": "m s-1", "long_name": "posterior quantiles of the normal capture velocity"})},
+        coords=_coords(radii, QUANTILES))
+
+
+def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int = 16, n_speeds: int = 20,
+                rtol: float = DEFAULT_RTOL) -> xr.Dataset:
+    """Posterior bands of the analyst's Table 2 sweeps along the measured speeds, at the median radius.
+
+    Each case of :data:`microimpact.model.parameters.TABLE2_CASES` is run at its conditions with the
+    largest value of each axis other than the speed (the sweep's most demanding corner), for
+    ``n_draws`` posterior draws (with their friction), through :func:`microimpact.simulate_many`.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``sweep_e_n_band``, ``sweep_mu_t_band``, ``sweep_K_L_band`` (case, sweep_speed, quantile) [1].
+    """
+    from microimpact.model.parameters import TABLE2_CASES
+    from microimpact.solvers.impact import simulate_many
+
+    cases = list(TABLE2_CASES) if cases is None else list(cases)
+    radii = damping_fit.radii
+    r = float(radii[len(radii) // 2])
+    lo, hi = damping_fit.speed_range
+    v = np.geomspace(lo, hi, n_speeds)
+    draws = posterior.draws(n_draws)
+    out = {q: np.empty((len(cases), len(draws), v.size)) for q in ("e_n", "mu_t", "K_L")}
+    from microimpact.analysis.oblique import engine_threads
+
+    with engine_threads(1):
+        _sweep_draws(cases, draws, damping_fit, r, v, out, rtol)
+    names = {"e_n": "normal coefficient of restitution e_n", "mu_t": "tangential impulse ratio mu_t",
+             "K_L": "kinetic energy loss coefficient K_L"}
+    ds = xr.Dataset(coords={
+        "case": ("case", np.array(cases, dtype=object), {"long_name": "Table 2 case"}),
+        "sweep_speed": ("sweep_speed", v, {"units": "m s-1", "long_name": "incident speed of the sweep band"}),
+        "quantile": ("quantile", np.array(QUANTILES), {"units": "1", "long_name": "posterior quantile"})})
+    for q, x in out.items():
+        with np.errstate(invalid="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # mu_t is undefined (NaN) without tangential motion
+            ds[f"sweep_{q}_band"] = (("case", "sweep_speed", "quantile"), np.moveaxis(np.nanquantile(x, QUANTILES, axis=1), 0, -1),
+                                     {"units": "1", "long_name": f"posterior quantiles of {names[q]} along the sweep"})
+    ds.attrs["sweep_radius"] = r
+    ds.attrs["sweep_conditions"] = "each case at the largest value of each of its axes other than the speed"
+    return ds
+
+
+def _sweep_draws(cases, draws, damping_fit, r, v, out, rtol):
+    """Fill ``out[q][case, draw, speed]`` by simulate_many (see :func:`sweep_bands`)."""
+    from microimpact.model.parameters import TABLE2_CASES
+    from microimpact.solvers.impact import simulate_many
+
+    for i, case in enumerate(cases):
+        cond = {k: _largest(val) for k, val in TABLE2_CASES[case].items()
+                if k in ("incidence_deg", "azimuth_deg", "omega_n", "omega_t", "omega_tp")}
+        for j, d in enumerate(draws):
+            ds = simulate_many(_contact(damping_fit, r, d), v, cond.get("incidence_deg", 0.0), cond.get("azimuth_deg", 0.0),
+                               (cond.get("omega_n", 0.0), cond.get("omega_t", 0.0), cond.get("omega_tp", 0.0)), rtol=rtol)
+            for q in out:
+                out[q][i, j] = ds[q].values
+
+
+def _largest(spec):
+    """Largest value of a sweep-axis spec (a number, a list or a range mapping)."""
+    if isinstance(spec, dict):
+        return float(spec.get("stop", spec.get("start", 0.0)))
+    if isinstance(spec, (list, tuple)):
+        return float(max(spec))
+    return float(spec)
+
+
+def _coords(radii, quantiles) -> dict:
+    return {"radius": ("radius", np.asarray(radii, dtype=float), {"units": "m", "long_name": "sphere radius"}),
+            "quantile": ("quantile", np.array(quantiles), {"units": "1", "long_name": "posterior quantile"})}
+
+
+# =============================================================================== NetCDF
+def posterior_dataset(posterior: Posterior, *extra: xr.Dataset) -> xr.Dataset:
+    """The chain, its summary and diagnostics (and any band Datasets) as one CF Dataset.
+
+    Variables: ``chain_<name>(step, walker)``, ``log_probability(step, walker)``,
+    ``<name>_quantile(quantile)``, ``<name>_autocorr_time``, ``acceptance_fraction(walker)``;
+    attributes ``burn_in``, ``seed``, ``converged``, ``convergence``, ``errors_in_variables``,
+    ``fixed_<name>``.
+    """
+    steps, walkers, _ = posterior.chain.shape
+    ds = xr.Dataset(coords={
+        "step": ("step", np.arange(steps), {"long_name": "MCMC step"}),
+        "walker": ("walker", np.arange(walkers), {"long_name": "emcee walker"}),
+        "quantile": ("quantile", np.array(QUANTILES), {"units": "1", "long_name": "posterior quantile"})})
+    s = posterior.samples
+    for i, n in enumerate(posterior.names):
+        u = PARAMETER_UNITS[n]
+        ds[f"chain_{n}"] = (("step", "walker"), posterior.chain[:, :, i], {"units": u, "long_name": f"MCMC chain of {n}"})
+        ds[f"{n}_quantile"] = ("quantile", np.quantile(s[:, i], QUANTILES), {
+            "units": u, "long_name": f"posterior quantiles of {n} (after burn-in)"})
+        ds[f"{n}_autocorr_time"] = ((), posterior.autocorr_time[n], {
+            "units": "1", "long_name": f"integrated autocorrelation time of {n} in steps"})
+    ds["log_probability"] = (("step", "walker"), posterior.log_probability, {
+        "units": "1", "long_name": "log posterior probability (up to a constant)"})
+    ds["acceptance_fraction"] = ("walker", posterior.acceptance_fraction, {
+        "units": "1", "long_name": "fraction of accepted proposals per walker"})
+    for e in extra:
+        ds = ds.merge(e, combine_attrs="drop_conflicts")
+    ds.attrs.update({
+        "title": "posterior of the fitted parameters (emcee via lmfit.Minimizer.emcee)", "Conventions": CONVENTIONS,
+        "sampled": " ".join(posterior.names), "burn_in": int(posterior.burn), "seed": int(posterior.seed),
+        "converged": int(posterior.converged), "convergence": str(posterior.info.get("convergence", "")),
+        "errors_in_variables": str(posterior.info.get("errors_in_variables", "")),
+        "latent_speed_rows": " ".join(map(str, posterior.info.get("latent_rows", ()))),
+        "source": str(posterior.info.get("source", "")),
+        **{f"fixed_{k}": float(v) for k, v in posterior.fixed.items()}})
+    return ds
+
+
+def posterior_from_dataset(ds: xr.Dataset) -> Posterior:
+    """Inverse of :func:`posterior_dataset` (the chain part)."""
+    names = tuple(str(ds.attrs["sampled"]).split())
+    chain = np.stack([ds[f"chain_{n}"].values for n in names], axis=-1)
+    fixed = {k.removeprefix("fixed_"): float(v) for k, v in ds.attrs.items() if k.startswith("fixed_")}
+    return Posterior(names=names, chain=chain, log_probability=ds["log_probability"].values, burn=int(ds.attrs["burn_in"]),
+                     fixed=fixed, autocorr_time={n: float(ds[f"{n}_autocorr_time"]) for n in names},
+                     acceptance_fraction=ds["acceptance_fraction"].values, seed=int(ds.attrs["seed"]),
+                     info={"converged": bool(int(ds.attrs["converged"])), "convergence": ds.attrs.get("convergence", ""),
+                           "errors_in_variables": ds.attrs.get("errors_in_variables", "")})
+
+
+def load_posterior(path) -> Posterior | None:
+    """The :class:`Posterior` of a posterior NetCDF, or None when the file holds none (posterior disabled)."""
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        if "sampled" not in ds.attrs:
+            return None
+        return posterior_from_dataset(ds.load())
+
+
+def save_posterior(ds: xr.Dataset, path):
+    """Write a :func:`posterior_dataset` atomically."""
+    return write_netcdf(ds, path)
+
+
+def summary_table(posterior: Posterior) -> pd.DataFrame:
+    """One row per sampled parameter: median, 95 % interval, autocorrelation time."""
+    rows = []
+    for n in posterior.names:
+        lo, hi = posterior.interval(n)
+        rows.append({"parameter": n, "units": PARAMETER_UNITS[n], "median": posterior.median()[n], "low95": lo,
+                     "high95": hi, "autocorr_time": posterior.autocorr_time[n]})
+    return pd.DataFrame(rows)
