@@ -28,6 +28,23 @@ displacement of the contact in L, J = int load dtau and J_a = int s load dtau (l
 load are resolved by step rejection (the Mindlin force reaches its limit with zero slope, so gross
 slip starts smoothly). After every accepted step the displacement is held at delta* in gross slip. Separation (s = 0, y < 0) is located by secant
 iteration on the step length; capture is the exact energy test of the engine.
+
+Hysteretic law where the Coulomb limit vanishes: the rate of p is ~ 1 / F_lim, and F_lim = f |F_n|
+passes through zero twice in every impact with adhesion (and twice in every period of a captured
+sphere's oscillation about the adhesive equilibrium, where F_n = 0). There T = 0 whatever p, so
+(i) the error of p is measured as that of the force it makes, scaled by F_lim / F_ref (F_ref =
+f max(1, a_a, y0^1.2), the order of the largest limit), and (ii) a zero of the limit within a step
+is located (secant on the step length, on the normal state alone, which does not depend on p) and
+the branch restarts there as at first contact (:func:`_restart_branch`). Without them the steps
+shrank geometrically towards each zero of F_lim and a captured impact reached the step limit.
+
+End of a captured impact, hysteretic law: the normal oscillation has decayed below
+``SETTLE_AMPLITUDE`` of the equilibrium penetration AND the tangential state no longer changes:
+either the friction law has no limit at rest ("net": F_lim = f |F_n| = 0 at the adhesive
+equilibrium, so the sphere keeps its slip and spins for ever, up to a friction impulse of order
+``SETTLE_AMPLITUDE`` of that of one period) or the contact is stuck (p < 1, |T| < F_lim; at the
+constant load of rest the hysteretic spring only loses energy, so it never slips again). A stuck
+sphere is reported at its rolling mean (:func:`_roll_stuck`).
 """
 
 from __future__ import annotations
@@ -70,7 +87,11 @@ _E = np.array([71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 3
 
 
 class CoupledError(RuntimeError):
-    """The coupled solver could not finish an impact (step limit or step-size underflow)."""
+    """The coupled solver could not finish an impact (step limit or step-size underflow).
+
+    Not expected for valid input: every impact ends by separation or by the settle criterion of
+    the module docstring; this error reports a solver defect, with the normal speed of the impact.
+    """
 
 
 @njit(cache=True)
@@ -180,6 +201,41 @@ def _project(z, p):
 
 
 @njit(cache=True)
+def _load_argument(z, p):
+    """F_n (paper's friction) or F_n + 2 F_po ("pulloff"): the signed load whose zeros are those of F_lim."""
+    s = max(z[_S], 0.0)
+    fn = -_acc(s, s * s * s, z[_Y], p[0], p[1], p[2], p[3])
+    return fn + 2.0 * p[5] if p[6] > 0.5 else fn
+
+
+@njit(cache=True)
+def _restart_branch(z, p, hist):
+    """Restart the hysteretic law where the Coulomb limit F_lim passes through zero.
+
+    There T = s F_lim [1 - c (1 - p)^(3/2)] = 0 whatever the branch, so the contact keeps no
+    memory: as the limit grows again it starts a virgin branch (c = 1, s = +1) along the slip
+    direction at that instant, e = u / |u|, exactly as at first contact (:func:`_initial_branch`).
+    Its branch coordinate is the only bounded solution of dp/dsigma = [A - (2/3) dF_lim/dsigma p]
+    / F_lim as F_lim -> 0 (A = s |u| k_t / 1.5): p = A / ((2/3) dF_lim/dsigma), gross slip (p = 1)
+    if that exceeds 1. Any other p has a rate ~ 1 / F_lim, which an explicit integrator can only
+    follow with steps that shrink geometrically towards the zero of the limit.
+    """
+    c1, c2, ah, aa, f = p[0], p[1], p[2], p[3], p[4]
+    s, y = max(z[_S], 0.0), z[_Y]
+    ut, utp = z[_VT] + z[_WTP], z[_VTP] - z[_WT]
+    um = math.sqrt(ut * ut + utp * utp)
+    hist[0] = hist[1] = 1.0
+    z[_FT] = 0.0
+    if um > 0.0:
+        hist[2], hist[3] = ut / um, utp / um
+        xi_dd = _acc(s, s * s * s, y, c1, c2, ah, aa)
+        dfn = (3.0 * ah * s * s * (1.0 + c1 * y) - aa * (1.0 - c2 * y)) * 0.5 * y + (ah * c1 * s * s * s + aa * c2 * s) * s * xi_dd
+        a_term = s * um * p[7] * s / 1.5
+        b_term = (2.0 / 3.0) * f * abs(dfn)
+        z[_FT] = a_term / b_term if a_term < b_term else 1.0
+
+
+@njit(cache=True)
 def _initial_branch(z, p):
     """(s, c, e_t, e_t') at first contact, and p in z[_FT], for the hysteretic law.
 
@@ -224,7 +280,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     wt0, wtp0 rim speeds r omega_t, r omega_t'; p the law's parameters (see :func:`_rhs`); j_stop,
     ja_stop the impulses after which a captured sphere's sliding and twist are over (rigid
     contact); settle the oscillation amplitude (relative to the equilibrium) at which a captured
-    sphere is taken to be at rest.
+    sphere is taken to be at rest (with the hysteretic law, only once its tangential state no longer
+    changes: see the module docstring).
 
     Returns (status, outcome, state at the end (12,), largest xi, tau at capture, tau at which J
     reached j_stop, n_steps).
@@ -256,6 +313,10 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         atol[i] = rtol * vref
     atol[_FT] = atol[_FTP] = rtol * (1.0 if p[9] > 1.5 else sref)
     n_turn = 0
+    n_restart = 0
+    hysteretic = p[9] > 1.5
+    lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
+    lim_rest = p[4] * 2.0 * p[5] if p[6] > 0.5 else 0.0  # F_lim at the adhesive equilibrium
     damped = p[0] > 0.0 or p[1] > 0.0
     xe = aa / ah if ah > 0.0 else 0.0
     omega0 = math.sqrt(ah * math.sqrt(xe)) if aa > 0.0 else 1.0
@@ -275,11 +336,38 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             status = _MAX_STEPS
             break
         _step(z, k1, h, p, hist, k, tmp, z1, err)
+        if hysteretic:  # the error of p as that of the force T = F_lim ratio(p) it makes
+            err[_FT] *= min(1.0, p[4] * abs(_load_argument(z1, p)) / lim_ref)
         en = 0.0
         for i in range(_N):
             en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
-        en = math.sqrt(en / _N)
         n += 1
+        restart = False
+        if hysteretic and z[_S] > 0.0 and z1[_S] > 0.0:
+            # the Coulomb limit passes through zero within the step: if the normal motion is
+            # accurate, end the step there (secant on the step length) and restart the branch
+            en_n = 0.0
+            for i in range(_VT):
+                en_n += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
+            ga, gb = _load_argument(z, p), _load_argument(z1, p)
+            if en_n <= _VT and ga * gb < 0.0:
+                a, fa, b, fb = 0.0, ga, h, gb
+                gref = abs(ga) + abs(gb)
+                for _ in range(60):
+                    hs = b - fb * (b - a) / (fb - fa)
+                    if not (a < hs < b):
+                        hs = 0.5 * (a + b)
+                    _step(z, k1, hs, p, hist, k, tmp, z1, err)
+                    g = _load_argument(z1, p)
+                    if abs(g) <= 1e-13 * gref or (b - a) < 1e-14 * h:
+                        break
+                    if (g > 0.0) == (ga > 0.0):
+                        a, fa = hs, g
+                    else:
+                        b, fb = hs, g
+                restart = True
+                en = float(_N)  # accepted; the next step keeps the length h
+        en = math.sqrt(en / _N)
         if en > 1.0:
             h *= max(0.2, 0.9 * en ** -0.2)
             if h < 1e-300:
@@ -308,7 +396,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             z[_FT] = z[_FTP] = 0.0  # out of contact: nothing stored
             break
         turned = False
-        if p[9] > 1.5 and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
+        if not restart and hysteretic and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
             # turning point of the hysteretic law within the step: secant on the step length
             a, fa, b, fb = 0.0, _branch_slip(z, hist), h, _branch_slip(z1, hist)
             gref = abs(fa) + abs(fb)
@@ -335,7 +423,10 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             hist[1] = _md_span(ratio, hist[0])
             z[_FT] = 0.0
             n_turn += 1
-        if p[9] > 1.5:
+        if restart:
+            _restart_branch(z, p, hist)
+            n_restart += 1
+        if hysteretic:
             z[_FT] = min(max(z[_FT], 0.0), 1.0)
             _rhs(z, p, hist, k1)
         elif p[9] > 0.5:
@@ -351,7 +442,13 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         if captured:
             dx = z[_S] * z[_S] - xe
             amp = math.sqrt(dx * dx + (z[_Y] / omega0) ** 2) / xe
-            if (z[_J] >= j_stop and z[_JA] >= ja_stop) or amp < settle:
+            if hysteretic:
+                # settled normal motion, and a tangential state that no longer changes: no friction
+                # at rest ("net" friction), or a stuck contact (p < 1, |T| < F_lim) at constant load
+                if amp < settle and (lim_rest == 0.0 or z[_FT] < 1.0):
+                    outcome = 1
+                    break
+            elif (z[_J] >= j_stop and z[_JA] >= ja_stop) or amp < settle:
                 outcome = 1
                 break
         h *= 5.0 if en == 0.0 else min(5.0, max(0.2, 0.9 * en ** -0.2))
@@ -386,6 +483,24 @@ SETTLE_AMPLITUDE = 1e-6
 
 #: default step limit of one impact (the status code _MAX_STEPS is a different name)
 _DEFAULT_MAX_STEPS = 2_000_000
+
+
+def _roll_stuck(states, captured, krot):
+    """Replace the tangential state of captured spheres held stuck (p < 1) by its rolling mean.
+
+    A stuck contact at the constant load of rest keeps a small elastic vibration of the contact
+    point (energy below F_lim^2 / k_t, lost only slowly to micro-slip). The tangential force acts at
+    the contact point, so the angular momentum about it, m v_t - I omega_t' / r and
+    m v_t' + I omega_t / r, is conserved; the vibration averages to the rolling state of the same
+    angular momentum (u = 0), v = (k v - w) / (k + 1), w = -v with k = m r^2 / I (2.5 for a
+    homogeneous sphere: the 5/7 rule), which is also the state of least kinetic energy at that
+    angular momentum. Edits ``states`` (n, 12) in place for the rows where ``captured``.
+    """
+    stuck = captured & (states[:, _FT] < 1.0)
+    vt = (krot * states[stuck, _VT] - states[stuck, _WTP]) / (krot + 1.0)
+    vtp = (krot * states[stuck, _VTP] + states[stuck, _WT]) / (krot + 1.0)
+    states[stuck, _VT], states[stuck, _WTP] = vt, -vt
+    states[stuck, _VTP], states[stuck, _WT] = vtp, vtp
 
 
 def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _DEFAULT_MAX_STEPS) -> dict:
@@ -471,6 +586,8 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     if mindlin:
         # the twist keeps its closed form (torque (3 pi/16) f a load); the tangential state is integrated
         tw = tangential_outcome(m, inertia, r, f, (v_n, v_t, v_tp), (w_n, w_t, w_tp), 0.0, jal)
+        if mode > 1.5 and aware:
+            _roll_stuck(states, captured, p[0, 8])
         out = {"v_t": states[:, _VT] * u, "v_tp": states[:, _VTP] * u, "omega_n": tw["omega_n"],
                "omega_t": states[:, _WT] * u / r, "omega_tp": states[:, _WTP] * u / r}
         slip_out = np.hypot(out["v_t"] + r * out["omega_tp"], out["v_tp"] - r * out["omega_t"])
