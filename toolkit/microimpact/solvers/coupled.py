@@ -536,14 +536,15 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     """
     from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form map
 
-    v_n, v_t, v_tp = (np.ascontiguousarray(a, dtype=float).ravel() for a in np.broadcast_arrays(*velocity_in))
-    w_n, w_t, w_tp = (np.ascontiguousarray(np.broadcast_to(a, v_n.shape), dtype=float) for a in omega_in)
-    f = np.ascontiguousarray(np.broadcast_to(friction, v_n.shape), dtype=float)
+    # np.array copies: numba must not be handed the read-only views that broadcasting makes
+    v_n, v_t, v_tp = (np.array(a, dtype=float).ravel() for a in np.broadcast_arrays(*velocity_in))
+    w_n, w_t, w_tp = (np.array(np.broadcast_to(a, v_n.shape), dtype=float) for a in omega_in)
+    f = np.array(np.broadcast_to(friction, v_n.shape), dtype=float)
     speed = -v_n
     sc, y0, c1, c2 = _law.nondimensional_impact(contact, speed)
-    u = np.broadcast_to(sc.speed, speed.shape)
-    length = np.broadcast_to(sc.length, speed.shape)
-    time = np.broadcast_to(sc.time, speed.shape)
+    u = np.array(np.broadcast_to(sc.speed, speed.shape))
+    length = np.array(np.broadcast_to(sc.length, speed.shape))
+    time = np.array(np.broadcast_to(sc.time, speed.shape))
     m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
     mode = {"rigid": 0.0, "mindlin": 1.0, "mindlin_deresiewicz": 2.0}[contact.tangential_model]
     mindlin = mode > 0.0

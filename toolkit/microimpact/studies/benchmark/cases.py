@@ -107,6 +107,8 @@ class BenchmarkConfig:
     family_size: int = 100_000
     family_impacts: int = 1_000_000
     family_check: int = 20_000
+    #: also judge the engine_family line on the oblique cases (a family over their range: seconds)
+    family_oblique: bool = True
     #: rows of the large fit compared with a 100-row fit
     fit_rows: int = 100_000
     contact_name: str = "WALL_1990"
@@ -130,7 +132,7 @@ class BenchmarkConfig:
             engine_levels=(0, 2, 4, 6, 8), scipy_levels=(0, 2, 4), rkg_levels=(0, 2, 4, 6),
             oblique=_OBLIQUE_QUICK, repeats_single=5, repeats_scipy=1, repeats_batch=3, batch_size=1000,
             throughput_impacts=20_000, throughput_repeats=1, memory_sizes=(2_000, 20_000), time_limit=1.0,
-            reference_rtols=(1e-11, 1e-12), family_size=20_000, family_impacts=100_000, family_check=3_000, fit_rows=10_000,
+            reference_rtols=(1e-11, 1e-12), family_size=20_000, family_impacts=100_000, family_check=3_000, fit_rows=10_000, family_oblique=False,
         )
 
     @property

@@ -313,8 +313,8 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
     _run_scipy(contact, speeds, cases, cfg, table, notes, verbose)
     diag = _engine_diagnostics(contact, batch_speeds, cfg)
     log(f"engine diagnostics: {diag}", verbose)
-    sub_costs = sub_model_costs(contact, np.geomspace(speeds[0], speeds[-1], 8 if cfg.quick else 32),
-                                np.linspace(0.0, 85.0, 8 if cfg.quick else 18), repeats=2 if cfg.quick else 3)
+    sub_costs = sub_model_costs(contact, np.geomspace(speeds[0], speeds[-1], 4 if cfg.quick else 32),
+                                np.linspace(0.0, 85.0, 5 if cfg.quick else 18), repeats=1 if cfg.quick else 3)
     log(f"sub-model costs: {sub_costs}", verbose)
 
     targets = accuracy_targets(table.values["time_per_impact"], table.values["max_error_e_n"], cfg, b["e_n"])
