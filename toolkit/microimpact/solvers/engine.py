@@ -43,10 +43,10 @@ from numba import njit, prange, set_num_threads
 
 from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL
-from microimpact.model.law import nondimensional_impact, nondimensional_scales  # nondimensional_scales: re-exported
+from microimpact.model.law import Scales, hertz_impact_scales, nondimensional_impact, nondimensional_scales  # nondimensional_scales: re-exported
 from microimpact.solvers import compiled_law as law
 
-__all__ = ["NormalSolution", "EngineError", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
+__all__ = ["NormalSolution", "EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
 
 # Status codes of the compiled core
 _OK = 0
@@ -86,6 +86,45 @@ _E1, _E3, _E4, _E5, _E6, _E7 = (
 #: was seen at 1e-60); 1e-30 keeps nine decades of margin. Physically such a sphere is captured
 #: whenever there is any damping.
 MIN_NONDIMENSIONAL_SPEED = 1e-30
+
+
+#: Largest nondimensional incident speed y0 = v_n T / X (adhesive contact) integrated in the paper's
+#: scales X, T. Beyond it the penetration reaches ~y0^(4/5) X and its powers approach the
+#: floating-point range (at y0 ~ 1e148, a density of 1e300 kg/m^3, the states overflowed): the
+#: engine then integrates in the Hertz impact scales x*, t* = x*/v, where adhesion enters as the small
+#: coefficient a_a = (5/4) X / x* (:func:`engine_scales`). Both forms are the same Eq. (27); the
+#: switch point lies far above the stress domain (y0 <= ~1e10), so its results do not move.
+MAX_ADHESIVE_SPEED = 1e12
+
+
+def engine_scales(contact, normal_speed):
+    """Scales of the engine's solve of each impact: (Scales, y0, C1, C2), per element for arrays.
+
+    :func:`microimpact.model.law.nondimensional_impact`, except that an adhesive impact with
+    y0 > :data:`MAX_ADHESIVE_SPEED` uses the Hertz impact scales (a_h = 5/4, a_a = (5/4) X / x*).
+
+    Parameters
+    ----------
+    contact : Contact
+    normal_speed : float or ndarray
+        Incident normal speed, > 0. [m/s]
+    """
+    sc, y0, c1, c2 = nondimensional_impact(contact, normal_speed)
+    if not (sc.a_adhesion > 0.0 and np.any(np.asarray(y0) > MAX_ADHESIVE_SPEED)):
+        return sc, y0, c1, c2
+    v = np.asarray(normal_speed, dtype=float)
+    shape = np.broadcast(v, y0).shape
+    big = np.broadcast_to(np.asarray(y0) > MAX_ADHESIVE_SPEED, shape)
+    length, time, ah, aa, y0, c1, c2 = (np.array(np.broadcast_to(a, shape), dtype=float)
+                                        for a in (sc.length, sc.time, sc.a_hertz, sc.a_adhesion, y0, c1, c2))
+    vb = np.broadcast_to(v, shape)[big]
+    xs, ts = hertz_impact_scales(contact.mass, contact.stiffness, contact.radius, vb)
+    c_h, c_a = contact.damping_coefficients(vb)
+    length[big], time[big], ah[big], aa[big] = xs, ts, 1.25, 1.25 * contact.length_scale / xs
+    y0[big], c1[big], c2[big] = 1.0, c_h * vb, c_a * vb
+    if not shape:
+        return Scales(float(length), float(time), float(ah), float(aa)), float(y0), float(c1), float(c2)
+    return Scales(length, time, ah, aa), y0, c1, c2
 
 
 def _check_resolvable(y0, adhesive: bool, normal_speed) -> None:
@@ -285,6 +324,127 @@ def _linear_tail_variation(dx, y, omega0, c):
     return abs(y)
 
 
+# ------------------------------------------------------------------ the inertia-free (overdamped) limit
+#: Inertia ratio below which the engine leaves the explicit integration for the inertia-free limit
+#: (see :func:`_inertia_free`). Below it the explicit solver would need more than ~1/sqrt(ratio)
+#: steps per unit of slow time (its stability bound), and the limit is exact to the ratio.
+INERTIA_FREE_ENTER = 1e-6
+#: Inertia ratio at which a jump along the inertia-free path that cannot reach the equilibrium
+#: hands the motion back to the explicit integration (hysteresis against INERTIA_FREE_ENTER).
+INERTIA_FREE_RESUME = 1e-4
+
+
+@njit(cache=True, inline="always")
+def _slow_speed(xi, c1, c2, ah, aa):
+    """Inertia-free speed y_m(xi) = (a_a - a_h xi) / (a_h C1 xi + a_a C2): xi'' = 0 in Eq. (27)."""
+    return (aa - ah * xi) / (ah * c1 * xi + aa * c2)
+
+
+@njit(cache=True, inline="always")
+def _inertia_ratio(xi, c1, c2, ah, aa):
+    """|xi''| / |static force| on the inertia-free path at xi, |y_m'| / (sqrt(xi) (a_h C1 xi + a_a C2)).
+
+    It decreases with xi, so along a path towards smaller xi its largest value is at the end."""
+    d = ah * c1 * xi + aa * c2
+    return ah * aa * (c1 + c2) / (math.sqrt(xi) * d * d * d)
+
+
+@njit(cache=True, inline="always")
+def _slow_time(xi0, xi1, c1, c2, ah, aa):
+    """tau from xi0 to xi1 along the inertia-free path: int dxi / y_m, in closed form."""
+    t = -c1 * (xi1 - xi0)
+    if aa > 0.0:
+        t -= aa * (c1 + c2) / ah * math.log(abs(aa - ah * xi1) / abs(aa - ah * xi0))
+    return t
+
+
+@njit(cache=True)
+def _slow_twist(xi0, xi1, c1, c2, ah, aa):
+    """int s |dy_m| from xi0 to xi1 along the inertia-free path (Gauss-Legendre in ln xi, panels of
+    at most a factor e^2 in xi)."""
+    if aa == 0.0 or xi0 == xi1:
+        return 0.0
+    lo, hi = math.log(min(xi0, xi1)), math.log(max(xi0, xi1))
+    panels = min(200, max(1, int(math.ceil((hi - lo) / 2.0))))
+    width = (hi - lo) / panels
+    total = 0.0
+    for p in range(panels):
+        mid = lo + (p + 0.5) * width
+        for i in range(_GL_X.shape[0]):
+            x = math.exp(mid + 0.5 * width * _GL_X[i])
+            d = ah * c1 * x + aa * c2
+            total += _GL_W[i] * x * math.sqrt(x) * ah * aa * (c1 + c2) / (d * d)
+    return 0.5 * width * total
+
+
+@njit(cache=True, inline="always")
+def _inertia_free(u, atol_y, c1, c2, ah, aa, xe):
+    """Whether the motion follows the inertia-free (overdamped) path: returns (yes, target xi).
+
+    When the damping force is so large that inertia is negligible (inertia ratio below
+    INERTIA_FREE_ENTER), Eq. (27) reduces to the first-order law xi' = y_m(xi): the sphere creeps
+    towards the equilibrium xi_e = a_a / a_h (towards 0 without adhesion, where y_m = -1/C1 exactly
+    and the exit speed follows). An explicit solver would need ~(damping rate x duration) steps,
+    the stiffness, to follow it. Conditions: strongly damped here, and on the path within twice the
+    inertia correction (|y - y_m| ~ ratio |y_m|) plus ten absolute tolerances; without adhesion
+    (the path is then exact and invariant) also at least 100 explicit steps saved. The target is
+    xi_e (a capture), 0 (a rebound without adhesion) or, when the ratio would rise above
+    INERTIA_FREE_RESUME before xi_e, the point where it does (the integration resumes there).
+    """
+    s = u[0]
+    xi = s * s
+    d = ah * c1 * xi + aa * c2
+    # cheapest test first (it runs at every step): strong damping, without divisions
+    if aa == 0.0:
+        if not ah * c1 * c1 * xi * xi * s >= 100.0:
+            return False, 0.0
+    elif not ah * aa * (c1 + c2) <= INERTIA_FREE_ENTER * s * d * d * d:
+        return False, 0.0
+    ym = (aa - ah * xi) / d
+    if aa == 0.0:
+        return abs(u[1] - ym) <= 10.0 * atol_y, 0.0
+    eps = _inertia_ratio(xi, c1, c2, ah, aa)
+    if abs(u[1] - ym) > 2.0 * eps * abs(ym) + 10.0 * atol_y:
+        return False, 0.0
+    if xi <= xe or _inertia_ratio(xe, c1, c2, ah, aa) <= INERTIA_FREE_RESUME:
+        return True, xe
+    lo, hi = math.log(xe), math.log(xi)  # bisection for the ratio INERTIA_FREE_RESUME
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        if _inertia_ratio(math.exp(mid), c1, c2, ah, aa) > INERTIA_FREE_RESUME:
+            lo = mid
+        else:
+            hi = mid
+    return True, math.exp(hi)
+
+
+@njit(cache=True)
+def _slow_event_time(u, xi_end, target, kind, c1, c2, ah, aa):
+    """tau at which, along the inertia-free path from the state u towards xi_end, the energy
+    (kind 0) or y (kind 1) reaches ``target``; NaN if it does not."""
+    xi0 = u[0] * u[0]
+    a, b = xi0, xi_end
+    if kind == 1:
+        # invert y_m: xi = a_a (1 - y C2) / (a_h (1 + y C1))
+        if aa == 0.0:
+            return u[2]
+        x = aa * (1.0 - target * c2) / (ah * (1.0 + target * c1))
+        if not (min(a, b) <= x <= max(a, b)):
+            return math.nan
+        return u[2] + _slow_time(xi0, x, c1, c2, ah, aa)
+    fa = law.nondimensional_energy(math.sqrt(a), _slow_speed(a, c1, c2, ah, aa), ah, aa) - target
+    fb = law.nondimensional_energy(math.sqrt(b), _slow_speed(b, c1, c2, ah, aa), ah, aa) - target
+    if fa < 0.0 or fb >= 0.0:
+        return math.nan if fa >= 0.0 else u[2]
+    for _ in range(200):
+        m = 0.5 * (a + b)
+        if law.nondimensional_energy(math.sqrt(m), _slow_speed(m, c1, c2, ah, aa), ah, aa) >= target:
+            a = m
+        else:
+            b = m
+    return u[2] + _slow_time(xi0, a, c1, c2, ah, aa)
+
+
 # ------------------------------------------------------------------ pieces of one impact
 @njit(cache=True, inline="always")
 def _first_sign(y0, c1, c2, ah, aa):
@@ -471,7 +631,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             sc = atol[i] + rtol * max(abs(u[i]), abs(u1[i]))
             en += (err[i] / sc) ** 2
         en = math.sqrt(en / _NSTATE)
-        if en > 1.0:
+        if not en <= 1.0:  # (a NaN error norm, from an overflowing trial step, is a rejection too)
             n_rej += 1
             h *= max(0.2, 0.9 * en ** -0.2)
             if h < 1e-300:
@@ -566,6 +726,58 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         if code == 0:
             outcome = REBOUND
             break
+        if damped and u[0] > 0.0:
+            slow, xi_t = _inertia_free(u, atol[1], c1, c2, ah, aa, xe)
+            if slow:  # the inertia-free limit: finish (or jump) in closed form
+                xi0 = u[0] * u[0]
+                e_now = law.nondimensional_energy(u[0], u[1], ah, aa)
+                if aa > 0.0 and xi_t == xe:
+                    y_t = 0.0
+                elif aa == 0.0:
+                    y_t = -1.0 / c1
+                else:  # the slow path and its first inertia correction, y_m - y_m' y_m / damping
+                    y_t = _slow_speed(xi_t, c1, c2, ah, aa)
+                    dd = ah * c1 * xi_t + aa * c2
+                    y_t += ah * aa * (c1 + c2) / (dd * dd) * y_t / (math.sqrt(xi_t) * dd)
+                dj = abs(u[1] - y_t)
+                if math.isnan(tau_jtarget) and j_target > 0.0 and J < j_target <= J + dj:
+                    tau_jtarget = _slow_event_time(u, xi_t, u[1] + (j_target - J) * (1.0 if y_t > u[1] else -1.0),
+                                                   1, c1, c2, ah, aa)
+                if not captured and aa > 0.0:
+                    tc = _slow_event_time(u, xi_t, ecap, 0, c1, c2, ah, aa)
+                    if not math.isnan(tc):
+                        captured = True
+                        tau_capture = tc
+                J += dj
+                if aa == 0.0:
+                    u[4] += u[0] * dj
+                    u[2] += c1 * xi0
+                else:
+                    u[4] += _slow_twist(xi0, xi_t, c1, c2, ah, aa)
+                    if xi_t != xe:
+                        u[2] += _slow_time(xi0, xi_t, c1, c2, ah, aa)
+                u[0] = math.sqrt(xi_t)
+                u[1] = y_t
+                u[3] += e_now - law.nondimensional_energy(u[0], u[1], ah, aa)
+                smax = max(smax, u[0])
+                if rec_cap > 0 and n_rec < rec_cap and not (aa > 0.0 and xi_t == xe):
+                    rec[n_rec, 0], rec[n_rec, 1], rec[n_rec, 2] = u[2], u[0], u[1]
+                    n_rec += 1
+                if aa == 0.0:
+                    outcome = REBOUND
+                    break
+                if xi_t == xe:
+                    outcome = CAPTURE
+                    break
+                # resume the explicit integration where inertia matters again
+                s2 = xi_t
+                g = law.nondimensional_acceleration(s2, s2 * s2, u[1], c1, c2, ah, aa)
+                if g != 0.0:
+                    sgn = 1.0 if g > 0.0 else -1.0
+                _rhs(u, c1, c2, ah, aa, sgn, kend)
+                for i in range(_NSTATE):
+                    k1[i] = kend[i]
+                continue
         if captured:
             done, dj, dja = _capture_finished(u, kend, J, turned, follow, need_tail, settle_amp, tail_tol, j_stop,
                                               ja_stop, noise, atol[1], c1, c2, ah, aa, xe, omega0, ceq)
@@ -586,7 +798,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
 def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_stop, ja_stop, out):
     dummy = np.zeros((1, 3))
     for i in prange(y0.shape[0]):
-        r = _integrate(y0[i], c1[i], c2[i], ah, aa, rtol, need_tail[i], tail_tol, 0.0, False, 0.0,
+        r = _integrate(y0[i], c1[i], c2[i], ah[i], aa[i], rtol, need_tail[i], tail_tol, 0.0, False, 0.0,
                        max_steps, dummy, 0, j_stop[i], ja_stop[i])
         out[i, 0] = r[0]
         out[i, 1] = r[1]
@@ -703,7 +915,7 @@ def solve_normal(
     v = check_positive("normal_speed", normal_speed)
     if not (0.0 < rtol < 1.0):
         raise ValueError(f"rtol must lie in (0, 1), got {rtol!r}")
-    sc, y0, c1, c2 = nondimensional_impact(contact, v)
+    sc, y0, c1, c2 = engine_scales(contact, v)
     _check_resolvable(y0, sc.a_adhesion > 0.0, v)
     u = sc.speed
     j_unit = contact.mass * u  # N s
@@ -809,11 +1021,12 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
         bad = v[~(np.isfinite(v) & (v > 0.0))][0]
         raise ValueError(f"normal speeds must be finite and > 0, got {bad!r}")
     nt = np.zeros(v.shape, dtype=np.bool_) if need_tail is None else np.ascontiguousarray(need_tail, dtype=np.bool_).ravel()
-    sc, y0, c1, c2 = nondimensional_impact(contact, v)
-    _check_resolvable(y0, sc.a_adhesion > 0.0, v)
+    sc, y0, c1, c2 = engine_scales(contact, v)
+    _check_resolvable(y0, np.any(np.asarray(sc.a_adhesion) > 0.0), v)
     u = sc.speed
-    u, c1, c2 = (np.ascontiguousarray(np.broadcast_to(a, v.shape), dtype=float) for a in (u, c1, c2))
-    length, time, ah, aa = sc.length, sc.time, sc.a_hertz, sc.a_adhesion
+    u, c1, c2, y0 = (np.ascontiguousarray(np.broadcast_to(a, v.shape), dtype=float) for a in (u, c1, c2, y0))
+    length, time = sc.length, sc.time
+    ah, aa = (np.ascontiguousarray(np.broadcast_to(a, v.shape), dtype=float) for a in (sc.a_hertz, sc.a_adhesion))
     ju = contact.mass * u
     jstop = np.broadcast_to(np.asarray(friction_impulse_stop, dtype=float), v.shape) / ju
     jastop = np.broadcast_to(np.asarray(twist_impulse_stop, dtype=float), v.shape) / (ju * np.sqrt(contact.radius * length))
