@@ -47,7 +47,8 @@ def impacts(draw):
     })
     inc = draw(with_zero(st.floats(0.0, 89.9)))
     az = draw(st.floats(0.0, 360.0))
-    spin = tuple(draw(st.floats(-10.0, 10.0)) * speed / radius for _ in range(3))
+    spin_max = r["spin_ratio"][1]  # 100 x the rolling spin
+    spin = tuple(draw(st.floats(-spin_max, spin_max)) * speed / radius for _ in range(3))
     return contact, speed, inc, az, spin
 
 

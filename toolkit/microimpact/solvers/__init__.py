@@ -18,6 +18,12 @@ solver evaluates the contact law of :mod:`microimpact.model.law`; the compiled o
 #: (docs/benchmark.md), far below any measurement's uncertainty, at half the cost of 1e-10.
 DEFAULT_RTOL = 1e-8
 
+
+class TimeBudgetExceeded(RuntimeError):
+    """A computation ran past the time budget [s] its caller gave it (``time_budget=`` of
+    :func:`microimpact.solvers.reference.simulate_reference`, ``case_time_limit`` of the stress
+    sweep). The message says which computation, the budget and how far it got."""
+
 #: The solvers behind simulate_impact(method=...).
 METHODS = ("engine", "reference", "rkg")
 

@@ -550,9 +550,14 @@ def _is_creeping(u, kend, atol_y, need_tail, c1, c2, ah, aa, xe, omega0, ceq):
 
 @njit(cache=True, inline="always")
 def _capture_finished(u, kend, J, turned, follow, need_tail, settle_amp, tail_tol, j_stop, ja_stop,
-                      noise, atol_y, c1, c2, ah, aa, xe, omega0, ceq):
+                      noise, atol_y, c1, c2, ah, aa, xe, omega0, ceq, long_tail):
     """Whether the integration of a captured sphere can stop; returns (done, dJ, dJ_a), the
-    friction and twist impulses still to come that are added in closed form."""
+    friction and twist impulses still to come that are added in closed form.
+
+    ``long_tail``: half the step budget is spent on a weakly damped captured oscillation (its
+    amplitude falls by exp(-pi C / omega) per cycle; C ~ 1e-7 needs ~1e8 cycles). The tail is then
+    the closed-form linear one whatever the amplitude, with relative error of the order of the
+    amplitude over the equilibrium penetration, instead of a step limit."""
     # linearised amplitude about the equilibrium, from the state itself (E - E_min would cancel
     # to round-off long before the tail is negligible); below a few absolute tolerances it is
     # integration noise, not motion
@@ -574,7 +579,7 @@ def _capture_finished(u, kend, J, turned, follow, need_tail, settle_amp, tail_to
         # motion; in the linear regime it has a closed form, whose relative error is of the order
         # of the amplitude over the equilibrium penetration
         tail = _linear_tail_variation(dx, u[1], omega0, ceq)
-        if (amp / xe) * tail <= tail_tol * J:
+        if (amp / xe) * tail <= tail_tol * J or long_tail:
             return True, tail, math.sqrt(xe) * tail
         return False, 0.0, 0.0
     return True, 0.0, 0.0  # captured and past the largest penetration
@@ -780,7 +785,8 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 continue
         if captured:
             done, dj, dja = _capture_finished(u, kend, J, turned, follow, need_tail, settle_amp, tail_tol, j_stop,
-                                              ja_stop, noise, atol[1], c1, c2, ah, aa, xe, omega0, ceq)
+                                              ja_stop, noise, atol[1], c1, c2, ah, aa, xe, omega0, ceq,
+                                              2 * (n_steps + n_rej) >= max_steps)
             if done:
                 J += dj
                 u[4] += dja

@@ -28,9 +28,10 @@ Two findings are reported separately (``summary["notes_by_kind"]``, ``summary["n
 and do not fail the run, because they say nothing about the engine:
 
 ``reference_timeout``
-    the reference solver, the yardstick, did not finish within ``case_time_limit`` seconds
-    (interrupted by SIGALRM where available). Its pure-Python right-hand side needs tens of
-    seconds on stiff cases, more on a loaded machine; the case is then not compared.
+    the reference solver, the yardstick, did not finish within ``case_time_limit`` seconds (its
+    ``time_budget``; it raises :class:`microimpact.solvers.TimeBudgetExceeded`, in any thread).
+    Its pure-Python right-hand side needs tens of seconds on stiff cases, more on a loaded
+    machine; the case is then not compared.
 ``slow_convergence``
     the results at rtol 1e-8 and 1e-10 differ by more than the tolerance, but the result
     converges: see "Convergence criterion".
@@ -87,10 +88,13 @@ import numpy as np
 import xarray as xr
 
 from microimpact.io.files import atomic_write, write_netcdf
+from microimpact.io.progress import progress_bar
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
 from microimpact.solvers.impact import settled_contact_energy, simulate_impact
-from microimpact.studies._timeout import TimeLimitExceeded, time_limit
+from microimpact.solvers import TimeBudgetExceeded
+from microimpact.solvers.reference import simulate_reference
+from microimpact.studies._timeout import time_limit
 
 __all__ = ["TOLERANCES", "INPUT_RANGES", "FAILURE_KINDS", "NOTE_KINDS", "draw_cases", "contact_of", "check_case",
            "stress_sweep", "StressReport", "result_distance", "energy_scale", "energy_error", "kinetic_energy",
@@ -116,10 +120,11 @@ ZERO_PROBABILITY = 0.15
 #: Tolerances of the checks, each relative to the energy scale (or speed scale) of the case.
 TOLERANCES = {
     # The engine integrates the damping dissipation D as a state with local error control at
-    # rtol = 1e-10 in the nondimensional energy unit; global error grows with the number of steps
-    # (up to ~1e5 for strongly damped captures). Measured worst over 5000 seeded cases: ~1e-7.
-    # 1e-6 leaves a factor 10 and is still 1e4 times below any physically visible effect.
-    "energy": 1e-6,
+    # rtol = 1e-10 in the nondimensional energy unit; a capture's dissipation is closed-form, and
+    # the inertia-free limit books the energy it skips as dissipated. Measured worst over the
+    # 20,000 seeded cases of the extended domain: 4.7e-10; 1e-8 (the issue's target) leaves a
+    # factor 20.
+    "energy": 1e-8,
     # rtol 1e-8 vs 1e-10 (and, for slowly converging cases, 1e-10 vs 1e-12): the difference is the
     # global error, ~1e2-1e4 x rtol for the same reason (module docstring, "Convergence criterion").
     "convergence": 1e-4,
@@ -301,9 +306,10 @@ def _convergence_check(contact: Contact, args: tuple, fine, coarse, tol: dict, o
 def _reference_check(contact: Contact, args: tuple, fine, tol: dict, case_time_limit: float, out: dict) -> None:
     """Engine against the 3-D reference solver; a timeout of the reference is a note, not a failure."""
     try:
-        with time_limit(case_time_limit):
-            ref = simulate_impact(*args, rtol=_RTOL_FINE, method="reference")
-    except TimeLimitExceeded:
+        # the solver's own budget works in any thread; SIGALRM (time_limit) stays as a backstop
+        with time_limit(2.0 * case_time_limit):
+            ref = simulate_reference(*args, rtol=_RTOL_FINE, time_budget=case_time_limit)
+    except TimeBudgetExceeded:
         out["notes"].append(("reference_timeout", f"reference solver exceeded {case_time_limit:g} s"))
         return
     except Exception as exc:  # noqa: BLE001
@@ -505,16 +511,14 @@ def main(argv=None) -> int:
     p.add_argument("--case-time-limit", type=float, default=30.0, help="time box per case [s]")
     p.add_argument("--out", default=None, help="write the summary as JSON here (atomically)")
     p.add_argument("--netcdf", default=None, help="write the per-case dataset as NetCDF here (atomically)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar (drawn only on a terminal anyway)")
     args = p.parse_args(argv)
     if args.cases < 0 or args.reference_every < 0 or not args.case_time_limit > 0:
         p.error("--cases and --reference-every must be >= 0 and --case-time-limit > 0")
 
-    def progress(i, n):
-        if i % 100 == 0 or i == n:
-            print(f"{i}/{n} cases", file=sys.stderr, flush=True)
-
-    report = stress_sweep(args.cases, args.seed, reference_every=args.reference_every,
-                          case_time_limit=args.case_time_limit, progress=progress)
+    with progress_bar(args.cases, "stress", enabled=not args.no_progress) as advance:
+        report = stress_sweep(args.cases, args.seed, reference_every=args.reference_every,
+                              case_time_limit=args.case_time_limit, progress=lambda i, n: advance())
     if args.out:
         write_stress_summary(report.summary, args.out)
     else:
