@@ -705,7 +705,7 @@ def reference_trajectory(
     rtol, atol, _ = _validate_common(rtol, atol, None)
     sc = _scales(contact, normal_speed)
     tau_end = math.inf if duration is None else _validate_speed("duration", duration) / sc.time
-    rhs10 = _make_rhs(sc, 0.0, (1.0, 0.0), False, 0.0, 1.0, [0])
+    rhs10 = _make_rhs(sc, 0.0, (1.0, 0.0), False, 0.0, 1.0, [0, math.inf, math.inf])
 
     # State (s, y, D, tau), independent variable sigma (dtau/dsigma = s), as in simulate_reference.
     def rhs(t, z):
