@@ -775,7 +775,9 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
     compiled helpers (above). The work done at every step -- error norm, the events that shorten
     the step, the advance -- stays in this loop: as compiled helpers (numba ``inline="always"`` or
     not) they made the engine 1.5 times slower (measured: 20,000 impacts through
-    ``solve_normal_many`` on one thread, 0.057 s -> 0.085 s).
+    ``solve_normal_many`` on one thread, 0.057 s -> 0.085 s). The inertia-free jump is here too:
+    its test (:func:`_inertia_free`, a few multiplications at every step) is a helper, but the jump
+    rewrites the loop's own state (u, J, sgn, k1, the recorded events) and may continue the loop.
     """
     u = np.zeros(_NSTATE)
     u[1] = y0
