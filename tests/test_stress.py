@@ -47,7 +47,8 @@ def impacts(draw):
     })
     inc = draw(with_zero(st.floats(0.0, 89.9)))
     az = draw(st.floats(0.0, 360.0))
-    spin = tuple(draw(st.floats(-10.0, 10.0)) * speed / radius for _ in range(3))
+    spin_max = r["spin_ratio"][1]  # 100 x the rolling spin
+    spin = tuple(draw(st.floats(-spin_max, spin_max)) * speed / radius for _ in range(3))
     return contact, speed, inc, az, spin
 
 
@@ -55,7 +56,8 @@ def impacts(draw):
 @given(impacts())
 def test_invariants(case):
     contact, speed, inc, az, spin = case
-    res = simulate_impact(contact, speed, inc, az, spin)
+    # rtol 1e-10 as in the sweep, whose energy tolerance (1e-8) is set for it
+    res = simulate_impact(contact, speed, inc, az, spin, rtol=1e-10)
     assert stress._nonfinite_fields(res) == []
     assert 0.0 <= res.e_n <= 1.0
     if res.outcome == "capture":
@@ -150,10 +152,11 @@ def test_sweep_is_reproducible():
 
 # ------------------------------------------------------------------ findings that do not fail the sweep
 def test_slow_convergence_is_a_note_not_a_failure():
-    """Case 2625 of seed 0: a strongly damped capture (C ~ 88) whose omega_n differs by 1.07e-4 of
-    the speed scale between rtol 1e-8 and 1e-10 (above the 1e-4 tolerance) and by 1.08e-6 between
-    1e-10 and 1e-12: it converges (a hundredfold reduction), so it is noted, not failed."""
-    case = stress.draw_cases(2626, seed=0)[2625]
+    """Case 12612 of seed 0 (extended domain): a strongly damped capture whose result differs by
+    2.9e-4 of the speed scale between rtol 1e-8 and 1e-10 (above the 1e-4 tolerance) and by 2.9e-6
+    between 1e-10 and 1e-12 (measured): it converges (a hundredfold reduction), so it is noted, not
+    failed."""
+    case = stress.draw_cases(12613, seed=0)[12612]
     row = stress.check_case(case)
     assert row["failures"] == []
     assert [k for k, _ in row["notes"]] == ["slow_convergence"]
@@ -162,8 +165,8 @@ def test_slow_convergence_is_a_note_not_a_failure():
 
 
 def test_convergence_failure_when_the_error_does_not_shrink():
-    """The same case fails when the tolerance is below what rtol 1e-12 reaches (1.08e-6)."""
-    case = stress.draw_cases(2626, seed=0)[2625]
+    """The same case fails when the tolerance is below what rtol 1e-12 reaches (2.9e-6)."""
+    case = stress.draw_cases(12613, seed=0)[12612]
     row = stress.check_case(case, tolerances={"convergence": 1e-7})
     assert [k for k, _ in row["failures"]] == ["convergence"]
     assert row["notes"] == []

@@ -23,6 +23,19 @@ solver evaluates the contact law of :mod:`microimpact.model.law`; the compiled o
 #: (docs/benchmark.md), far below any measurement's uncertainty, at half the cost of 1e-10.
 DEFAULT_RTOL = 1e-8
 
+
+class ModelDomainError(ValueError):
+    """Valid numbers whose impact leaves the domain of the model: a result in SI units would not be
+    representable (e.g. a twist impulse beyond 1.8e308 N m s at a penetration 1e64 m into a 3 um
+    sphere, where Hertz contact, x << r, no longer applies). The message says which quantity and
+    gives the penetration over the radius."""
+
+
+class TimeBudgetExceeded(RuntimeError):
+    """A computation ran past the time budget [s] its caller gave it (``time_budget=`` of
+    :func:`microimpact.solvers.reference.simulate_reference`, ``case_time_limit`` of the stress
+    sweep). The message says which computation, the budget and how far it got."""
+
 #: The solvers behind simulate_impact(method=...).
 METHODS = ("engine", "reference", "rkg")
 

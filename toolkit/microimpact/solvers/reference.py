@@ -84,6 +84,7 @@ Everything at the interface is SI; everything inside is nondimensional.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Sequence
 
@@ -91,13 +92,14 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from microimpact.model import law
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, TimeBudgetExceeded
 from microimpact.model.coefficients import impact_coefficients
 from microimpact.model.kinematics import ImpactResult, incident_velocity
 from microimpact.model.contact import Contact
 
 __all__ = [
     "ReferenceSolverError",
+    "TimeBudgetExceeded",
     "simulate_reference",
     "reference_trajectory",
     "ReferenceTrajectory",
@@ -266,7 +268,8 @@ def _make_rhs(
     ``twist_sign`` is sign(w_n(0)) while twisting, else 0; ``fn_sign`` is the sign of xi'' = -F_n
     in this phase, so that |F_n| = fn_sign * xi'' is smooth within the phase. The state is
     (s, y, v_t, v_t', w_n, w_t, w_t', D, J, tau) with s = sqrt(xi) and dtau/dsigma = s.
-    ``counter`` is a one-element list counting evaluations across phases.
+    ``counter`` is [evaluations so far across phases, deadline (time.perf_counter) [s], budget [s]];
+    past the deadline the right-hand side raises :class:`TimeBudgetExceeded`.
     """
     a_h, a_a, c1, c2, k = sc.a_h, sc.a_a, sc.c1, sc.c2, sc.k_rot
     tw = f * sc.twist
@@ -275,6 +278,11 @@ def _make_rhs(
 
     def rhs(_sigma, z):
         counter[0] += 1
+        if counter[0] % 512 == 0 and time.perf_counter() > counter[1]:
+            raise TimeBudgetExceeded(
+                f"reference solver exceeded its time budget of {counter[2]:g} s after {counter[0]} "
+                f"right-hand-side evaluations, at tau = {z[_TAU]:.6g} (a stiff case: the engine's "
+                "inertia-free limit covers it)")
         if counter[0] > _MAX_RHS_EVALS:
             raise ReferenceSolverError(
                 f"more than {_MAX_RHS_EVALS} right-hand-side evaluations (stalled step size?) at "
@@ -328,6 +336,7 @@ def simulate_reference(
     method: str = "DOP853",
     max_step: float = math.inf,
     settle_tolerance: float | None = None,
+    time_budget: float | None = None,
 ) -> ImpactResult:
     """Integrate one impact with the full 3-D equations (reference solution).
 
@@ -357,6 +366,8 @@ def simulate_reference(
         After capture with sliding or twisting still going on: stop when the friction impulse
         still to come is bounded by ``settle_tolerance`` times the impulse so far. Default
         ``rtol``. [-]
+    time_budget : float, optional
+        Wall-clock budget of the integration; None: no budget. [s]
 
     Returns
     -------
@@ -374,6 +385,9 @@ def simulate_reference(
         azimuth or spin, or bad tolerances; the message names the argument and the value.
     ReferenceSolverError
         If solve_ivp fails or no outcome is reached within a generous time.
+    TimeBudgetExceeded
+        If the integration runs past ``time_budget`` seconds (checked every 512 right-hand-side
+        evaluations, i.e. every few milliseconds); the message gives the budget and the progress.
 
     Notes
     -----
@@ -388,7 +402,11 @@ def simulate_reference(
         raise ValueError(f"max_step must be > 0, got {max_step!r}")
     vel_in = incident_velocity(speed, incidence, azimuth)
     sc = _scales(contact, -vel_in[0])
+    if time_budget is not None and not (isinstance(time_budget, (int, float)) and time_budget > 0.0):
+        raise ValueError(f"time_budget must be a number of seconds > 0 (or None), got {time_budget!r}")
     run = _Run.start(sc, contact.friction, vel_in, omega_in, settle_tol)
+    if time_budget is not None:
+        run.counter[1:] = [time.perf_counter() + float(time_budget), float(time_budget)]
     solver = {"method": method, "rtol": rtol, "atol": atol, "max_step": max_step}
     while run.stop_reason is None:
         run.n_phases += 1
@@ -443,7 +461,7 @@ class _Run:
     slip_ended: bool = False
     stop_reason: str | None = None
     n_phases: int = 0
-    counter: list = field(default_factory=lambda: [0])
+    counter: list = field(default_factory=lambda: [0, math.inf, math.inf])
     turn_xi: list = field(default_factory=list)
 
     @classmethod
@@ -688,7 +706,7 @@ def reference_trajectory(
     rtol, atol, _ = _validate_common(rtol, atol, None)
     sc = _scales(contact, normal_speed)
     tau_end = math.inf if duration is None else _validate_speed("duration", duration) / sc.time
-    rhs10 = _make_rhs(sc, 0.0, (1.0, 0.0), False, 0.0, 1.0, [0])
+    rhs10 = _make_rhs(sc, 0.0, (1.0, 0.0), False, 0.0, 1.0, [0, math.inf, math.inf])
 
     # State (s, y, D, tau), independent variable sigma (dtau/dsigma = s), as in simulate_reference.
     def rhs(t, z):

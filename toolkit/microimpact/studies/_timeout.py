@@ -6,11 +6,14 @@ import contextlib
 import signal
 import threading
 
+from microimpact.solvers import TimeBudgetExceeded
+
 __all__ = ["TimeLimitExceeded", "time_limit"]
 
 
-class TimeLimitExceeded(Exception):
-    """Raised inside a :func:`time_limit` block that ran out of time."""
+class TimeLimitExceeded(TimeBudgetExceeded):
+    """Raised inside a :func:`time_limit` block that ran out of time (a
+    :class:`microimpact.solvers.TimeBudgetExceeded`, so one type covers every time budget)."""
 
 
 @contextlib.contextmanager
