@@ -6,12 +6,16 @@
 #
 # Every rule runs a thin script in workflow/scripts/ that calls one microimpact function; the
 # configuration (workflow/config/config.yaml) is validated against its JSON schema first.
+import os
+
 from snakemake.utils import min_version, validate
 
 min_version("8.17")
 
 
-configfile: "workflow/config/config.yaml"
+# the workflow's own files are found from the Snakefile's directory, so that it also runs as
+# `snakemake -s path/to/Snakefile -d elsewhere` and from the installed package (`microimpact workflow`)
+configfile: os.path.join(workflow.basedir, "workflow", "config", "config.yaml")
 
 
 include: "workflow/rules/typed_config.smk"

@@ -50,6 +50,22 @@ STRESS_ENABLED = config["stress"]["enabled"]
 RTOL = config["rtol"]
 
 
+def workflow_path(path):
+    """A relative path of the config: from the working directory if it is there, else from the
+    Snakefile's directory (the repository, or the workflow inside the installed package, which
+    carries the bundled data/); unchanged when found in neither (the start-up check names it)."""
+    if os.path.isabs(path) or os.path.exists(path):
+        return path
+    bundled = os.path.join(workflow.basedir, path)
+    return bundled if os.path.exists(bundled) else path
+
+
+for _key in ("data", "kharaz_data"):
+    config[_key] = workflow_path(config[_key])
+if config["materials"] != "default":
+    config["materials"] = workflow_path(config["materials"])
+
+
 def materials_path():
     """Materials config: the bundled one for "default" (located without importing the package)."""
     if config["materials"] != "default":
@@ -77,8 +93,8 @@ def _config_file_problem(key, what):
     how = f"--config {key}=path/to/file"
     if not p.exists():
         return (
-            f"config key '{key}': {what} {path!r} does not exist (paths are relative to "
-            f"{os.getcwd()}); give an existing file, e.g. {how}"
+            f"config key '{key}': {what} {path!r} does not exist (relative paths are taken from "
+            f"{os.getcwd()}, else from {workflow.basedir}); give an existing file, e.g. {how}"
         )
     if not p.is_file():
         return f"config key '{key}': {what} {path!r} is not a file (a directory?); give a file, e.g. {how}"
