@@ -24,6 +24,10 @@ include: "workflow/rules/typed_config.smk"
 validate(config, "workflow/schemas/config.schema.yaml")
 
 
+# the HTML report (snakemake --report report.html, after a run): every report() output of the rules
+report: "workflow/report/workflow.rst"
+
+
 include: "workflow/rules/common.smk"
 include: "workflow/rules/data.smk"
 include: "workflow/rules/fit.smk"
@@ -32,6 +36,7 @@ include: "workflow/rules/sweeps.smk"
 include: "workflow/rules/validation.smk"
 include: "workflow/rules/benchmark.smk"
 include: "workflow/rules/report.smk"
+include: "workflow/rules/figures.smk"
 
 
 localrules:
@@ -42,3 +47,4 @@ rule all:
     default_target: True
     input:
         "reports/report.pdf",
+        report_figures(),

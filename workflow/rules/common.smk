@@ -1,6 +1,7 @@
 # Helpers shared by the rules (no rules here). The config was validated by the Snakefile.
 import importlib.util
 import os
+import re
 from snakemake.exceptions import WorkflowError
 from pathlib import Path
 
@@ -53,7 +54,8 @@ RTOL = config["rtol"]
 def workflow_path(path):
     """A relative path of the config: from the working directory if it is there, else from the
     Snakefile's directory (the repository, or the workflow inside the installed package, which
-    carries the bundled data/); unchanged when found in neither (the start-up check names it)."""
+    carries the bundled data/); unchanged when found in neither (the start-up check names it).
+    """
     if os.path.isabs(path) or os.path.exists(path):
         return path
     bundled = os.path.join(workflow.basedir, path)
@@ -180,3 +182,25 @@ def benchmark_outputs(wildcards):
 def stress_outputs(wildcards):
     """Stress-sweep summary for the report; none when the sweep is switched off."""
     return {"stress": "results/stress_summary.json"} if STRESS_ENABLED else {}
+
+
+# ---------------------------------------------------------------- figures of the HTML report
+#: result files (under results/, without .nc) that have a figure in reports/figures/ (figures.smk);
+#: the fit's figure (with its model curves) is made by rule fit_figure
+FIGURE_RESULTS = (
+    ["analyst/flags"]
+    + [f"analyst/sweeps/case_{case}" for case in SWEEP_CASES]
+    + ["paper/bifurcation", "paper/phase_portraits"]
+    + [f"paper/sweeps/case_{case}" for case in SWEEP_CASES]
+    + ["kharaz"]
+)
+FIGURE_RESULT_PATTERN = "|".join(re.escape(r) for r in FIGURE_RESULTS)
+
+
+def report_figures(wildcards=None):
+    """Every figure of the HTML report (the benchmark's is an output of rule work_precision)."""
+    figures = ["reports/figures/analyst/fit.png"]
+    figures += [f"reports/figures/{r}.png" for r in FIGURE_RESULTS]
+    if BENCHMARK_ENABLED:
+        figures.append("results/benchmark/work_precision.png")
+    return figures

@@ -34,7 +34,11 @@ rule flags:
         materials=materials_path(),
         fit=rules.fit.output[0],
     output:
-        csv="results/analyst/flags.csv",
+        csv=report(
+            "results/analyst/flags.csv",
+            caption="../report/flags_table.rst",
+            category="Tables",
+        ),
         nc="results/analyst/flags.nc",
     log:
         "logs/flags.log",
