@@ -264,7 +264,7 @@ def _cmd_sweep(args) -> int:
         raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(TABLE2_CASES)}")
     contact = contact_from_args(args)
     out = check_outputs({"--out": args.out})["--out"]
-    ds = run_sweep(contact, case=args.case, rtol=args.rtol)
+    ds = run_sweep(contact, case=args.case, rtol=args.rtol, progress=True)
     with reporting_os_errors({"--out": out}):
         write_netcdf(ds, out)
     print(f"case {args.case}: {dict(ds.sizes)} impacts, {int(ds['outcome'].sum())} captured; wrote {out}")
@@ -309,7 +309,11 @@ def _cmd_benchmark(args) -> int:
     if docs is not None and same_file(out, docs):
         raise PathError("--out and --docs", args.docs, "two outputs on one path (both write benchmark.md); "
                                                        "give --docs another directory")
-    ds = run_benchmark(quick=args.quick, verbose=True, throughput=not args.no_throughput)
+    from microimpact.io.progress import wants_progress
+
+    # on a terminal a bar of the stages; elsewhere (a pipe, a log) one line per stage
+    ds = run_benchmark(quick=args.quick, verbose=not wants_progress(True), throughput=not args.no_throughput,
+                       progress=True)
     with reporting_os_errors({"--out": out, "--docs": docs}):
         paths = write_benchmark(ds, out, figure=plot_work_precision(ds).figure, docs_dir=docs)
     for path in paths.values():
