@@ -57,6 +57,9 @@ HOW = {
     "snakemake --report report.html": "ci",
     "python -m microimpact.studies.benchmark": "ci",
     "python -m microimpact.studies.stress": "ci",
+    "python .ci/startup.py": "ci",
+    'python -c "import numpy"': "run",
+    "microimpact --help": "run",
     # data/README.md
     "python workflow/scripts/make_synthetic_data.py": "run",
     # docs/cluster.md

@@ -349,7 +349,9 @@ def test_changing_data_reruns_only_its_dependants(pipeline):
     assert proc.returncode == 0, proc.stdout
     jobs = job_counts(proc.stdout)
     # the analyst's part follows the fit; the paper's part and the checks do not depend on the data
-    assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "report", "all"}, jobs
+    assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "report", "fit_figure", "figure",
+                         "all"}, jobs
+    assert jobs["figure"] == 1 + len(TINY_SWEEPS), jobs  # the analyst's figures: flags and its sweeps, not the paper's
 
 
 # --------------------------------------------------------------------------- profile, lint, config
