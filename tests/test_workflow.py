@@ -478,6 +478,7 @@ def test_html_report_has_a_captioned_figure_of_every_result_file(pipeline):
     is in the archive as a PNG, with its caption, and so are the PDF and the key tables."""
     from collections import Counter
 
+    from microimpact.report.figures import TABLE2_FIGURES
     from microimpact.report.standard import FIGURE_KINDS, result_kind
 
     root, _ = pipeline
@@ -492,6 +493,10 @@ def test_html_report_has_a_captioned_figure_of_every_result_file(pipeline):
     drawn = [p for p in results if result_kind(p) in FIGURE_KINDS]
     assert len(drawn) >= 2 * len(TINY_SWEEPS) + 5  # flags, fit, bifurcation, portraits, kharaz, the sweeps
     expected = Counter(f"{p.stem}.png" for p in drawn)
+    # the sweeps' further figures of the PDF: the analyst's cases at the median size, and the
+    # energy-loss ratios of the cases that have an energy-loss figure in the paper (both parts)
+    expected.update(f"case_{c}.restitution.png" for c in TINY_SWEEPS)
+    expected.update(f"case_{c}.energy_loss.png" for c in TINY_SWEEPS if TABLE2_FIGURES[c][0] for _ in range(2))
     found = Counter(Path(n).name for n in names if n.endswith(".png"))
     assert found == expected, (found, expected)
     for p in drawn:  # each figure's caption names its result file (the fit's is its own caption)
@@ -534,6 +539,13 @@ def test_plot_draws_every_result_file_or_says_why_not(pipeline, tmp_path, capsys
         else:
             assert kind in NO_FIGURE
             assert status == 2 and str(path) in err and not out.exists(), err
+    sweep = root / "results" / "analyst" / "sweeps" / "case_2.1.nc"
+    for variant in ("sizes", "restitution", "energy_loss"):
+        assert main(["plot", str(sweep), "--variant", variant, "--out", str(tmp_path / f"{variant}.svg")]) == 0
+        assert b"<svg" in (tmp_path / f"{variant}.svg").read_bytes()[:500]
+    assert main(["plot", str(root / "results" / "kharaz.nc"), "--variant", "energy_loss",
+                 "--out", str(tmp_path / "k.png")]) == 2
+    assert "kharaz.nc" in capsys.readouterr().err and not (tmp_path / "k.png").exists()
     fit = root / "results" / "analyst" / "fit.nc"
     pdf = tmp_path / "fit.pdf"
     assert main(["plot", str(fit), "--curves", str(fit.with_name("fit_curves.nc")), "--out", str(pdf)]) == 0
@@ -567,3 +579,13 @@ def test_microimpact_workflow_runs_the_packaged_pipeline(tmp_path):
     table = (work / "results" / "impacts_validated.csv").read_text()
     assert table.count("\n") > 10  # the bundled synthetic data, found next to the packaged Snakefile
     assert not (tmp_path / "results").exists()  # nothing in the directory it was started from
+
+
+def test_energy_loss_cases_of_the_workflow_are_the_papers():
+    """common.smk lists the cases with an energy-loss figure (parsing it needs no matplotlib); they
+    must be those of microimpact.report.figures.TABLE2_FIGURES."""
+    from microimpact.report.figures import TABLE2_FIGURES
+
+    text = (REPO / "workflow" / "rules" / "common.smk").read_text()
+    listed = re.search(r"^ENERGY_LOSS_CASES = \((.*)\)$", text, flags=re.M).group(1)
+    assert sorted(re.findall(r'"([\d.]+)"', listed)) == sorted(c for c, (e, _) in TABLE2_FIGURES.items() if e)

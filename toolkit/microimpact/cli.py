@@ -348,7 +348,7 @@ def _cmd_plot(args) -> int:
     if fmt not in FIGURE_FORMATS:
         raise PathError("--out", args.out, f"has no figure suffix; give a file ending in "
                                            f"{', '.join('.' + f for f in FIGURE_FORMATS)}")
-    plot = standard_figure(inputs["RESULT"], curves=inputs.get("--curves"))
+    plot = standard_figure(inputs["RESULT"], curves=inputs.get("--curves"), variant=args.variant)
     with reporting_os_errors({"--out": out}), atomic_path(out) as tmp:
         plot.figure.savefig(tmp, format=fmt, dpi=args.dpi)
     print(plot.caption)
@@ -363,6 +363,9 @@ def register_plot(sub) -> None:
     p.add_argument("result", metavar="RESULT", help="result NetCDF written by microimpact or the pipeline")
     p.add_argument("--out", required=True, help=f"figure file ({', '.join('.' + f for f in FIGURE_FORMATS)})")
     p.add_argument("--curves", default=None, help="with a fit file: its model curves (results/analyst/fit_curves.nc)")
+    p.add_argument("--variant", default=None, metavar="NAME",
+                   help="for a sweep file, which of its figures: restitution (e_n, impulse ratios), energy_loss "
+                        "(K_L, K_t), sizes (per size; a sweep at several sizes)")
     p.add_argument("--dpi", type=_positive_float, default=200.0, help="resolution of a .png [dots per inch] (default 200)")
     p.set_defaults(func=_cmd_plot)
 

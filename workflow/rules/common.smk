@@ -195,12 +195,26 @@ FIGURE_RESULTS = (
     + ["kharaz"]
 )
 FIGURE_RESULT_PATTERN = "|".join(re.escape(r) for r in FIGURE_RESULTS)
+#: Table 2 cases with an energy-loss figure in the paper (Figs. 7, 9, 11; the first entries of
+#: microimpact.report.figures.TABLE2_FIGURES, which a test compares with this list)
+ENERGY_LOSS_CASES = ("2.1", "2.2", "2.3")
 
 
 def report_figures(wildcards=None):
     """Every figure of the HTML report (the benchmark's is an output of rule work_precision)."""
     figures = ["reports/figures/analyst/fit.png"]
     figures += [f"reports/figures/{r}.png" for r in FIGURE_RESULTS]
+    # the sweeps' further figures, as in the PDF (rule sweep_figure): the analyst's cases at the
+    # median size, and the energy-loss ratios of the cases that have them in the paper
+    figures += [
+        f"reports/figures/analyst/sweeps/case_{c}.restitution.png" for c in SWEEP_CASES
+    ]
+    figures += [
+        f"reports/figures/{part}/sweeps/case_{c}.energy_loss.png"
+        for c in SWEEP_CASES
+        if c in ENERGY_LOSS_CASES
+        for part in ("analyst", "paper")
+    ]
     if BENCHMARK_ENABLED:
         figures.append("results/benchmark/work_precision.png")
     return figures

@@ -41,3 +41,27 @@ rule figure:
     threads: 1
     script:
         "../scripts/figure.py"
+
+
+rule sweep_figure:
+    input:
+        result="results/{part}/sweeps/case_{case}.nc",
+    output:
+        report(
+            "reports/figures/{part}/sweeps/case_{case}.{variant}.png",
+            caption="../report/sweep_figure.rst",
+            category="Figures",
+            subcategory="{part}/sweeps/case_{case}",
+        ),
+    log:
+        "logs/figures/{part}/sweeps/case_{case}.{variant}.log",
+    wildcard_constraints:
+        part="analyst|paper",
+        variant="restitution|energy_loss",
+    conda:
+        "../envs/microimpact.yaml"
+    threads: 1
+    params:
+        variant=lambda wildcards: wildcards.variant,
+    script:
+        "../scripts/figure.py"

@@ -17,6 +17,10 @@ kind                recognised by                                   figure
 ``kharaz``          ``tangential_restitution_curve``                :func:`.plot_kharaz`
 =================== =============================================== ==========================
 
+A sweep has further figures, as in the PDF report (``variant``, :data:`VARIANTS`): the energy-loss
+ratios (Figs. 7, 9, 11), and for a sweep of the fitted material at several sizes e_n and the
+impulse ratios at the median size.
+
 Files of the pipeline that hold numbers rather than curves (``fit_curves``, the dynamics summaries,
 the stress sweep) are recognised too, and refused with a message that says where they are drawn.
 """
@@ -29,9 +33,9 @@ from pathlib import Path
 import xarray as xr
 
 from microimpact.report import figures
-from microimpact.report.inputs import read_dataset, read_portraits
+from microimpact.report.inputs import at_radius, read_dataset, read_portraits
 
-__all__ = ["FIGURE_KINDS", "UnknownResultError", "result_kind", "standard_figure"]
+__all__ = ["FIGURE_KINDS", "VARIANTS", "UnknownResultError", "result_kind", "standard_figure"]
 
 #: kinds that have a standard figure, and what it shows
 FIGURE_KINDS = {
@@ -43,6 +47,12 @@ FIGURE_KINDS = {
     "bifurcation": "bifurcation plane (C1, C2) (Fig. 4)",
     "benchmark": "work-precision diagram of the solvers",
     "kharaz": "model against the oblique impacts of Kharaz et al. (2001)",
+}
+
+#: kind -> its figures; the first is the standard one (``microimpact plot --variant``)
+VARIANTS = {
+    "sweep": ("restitution", "energy_loss"),
+    "material_sweep": ("sizes", "restitution", "energy_loss"),
 }
 
 #: result files without a figure of their own -> where their numbers are shown
@@ -110,7 +120,7 @@ def result_kind(path) -> str:
                              f"{', '.join(FIGURE_KINDS)})")
 
 
-def standard_figure(path, *, curves=None) -> figures.Plot:
+def standard_figure(path, *, curves=None, variant: str | None = None) -> figures.Plot:
     """The standard figure of a result file, drawn by the report's figure functions.
 
     Parameters
@@ -120,6 +130,11 @@ def standard_figure(path, *, curves=None) -> figures.Plot:
     curves : str or os.PathLike, optional
         For a ``fit``: its smooth model curves (``fit_curves.nc`` of the pipeline); without them
         the model is drawn through the data points.
+    variant : str, optional
+        For a sweep, which of its figures (:data:`VARIANTS`): ``restitution`` (e_n and the
+        impulse ratios, the standard figure of a paper sweep), ``energy_loss`` (K_L, K_t), or
+        ``sizes`` (e_n per size and the capture velocity, the standard figure of a sweep at several
+        sizes); a sweep at several sizes is drawn at its median size for the first two.
 
     Returns
     -------
@@ -137,6 +152,9 @@ def standard_figure(path, *, curves=None) -> figures.Plot:
         raise UnknownResultError(f"{path}: a '{kind}' result file has no standard figure ({NO_FIGURE[kind]})")
     if curves is not None and kind != "fit":
         raise UnknownResultError(f"{curves}: model curves go with a fit file, but {path} is a '{kind}' file")
+    if variant is not None and variant not in VARIANTS.get(kind, ()):
+        choices = f"its figures: {', '.join(VARIANTS[kind])}" if kind in VARIANTS else "it has one figure"
+        raise UnknownResultError(f"{path}: a '{kind}' result file has no figure {variant!r} ({choices})")
     if kind == "phase_portraits":
         return figures.plot_phase_portraits(read_portraits(path))
     ds = _open(path)
@@ -147,10 +165,15 @@ def standard_figure(path, *, curves=None) -> figures.Plot:
                 raise UnknownResultError(f"{curves}: not a file of model curves (e_n on radius x speed)")
             curve_ds = _open(curves)
         return figures.plot_fit(ds, curve_ds)
+    if kind in VARIANTS:
+        variant = variant or VARIANTS[kind][0]
+        if variant == "sizes":
+            return figures.plot_size_dependence(ds)
+        if kind == "material_sweep":
+            ds = at_radius(ds, ds.sizes["radius"] // 2)
+        return figures.plot_energy_loss(ds) if variant == "energy_loss" else figures.plot_restitution_and_impulse(ds)
     draw = {
         "flags": figures.plot_flags,
-        "material_sweep": figures.plot_size_dependence,
-        "sweep": figures.plot_restitution_and_impulse,
         "bifurcation": figures.plot_bifurcation_plane,
         "benchmark": figures.plot_work_precision,
         "kharaz": figures.plot_kharaz,
