@@ -350,8 +350,10 @@ def test_changing_data_reruns_only_its_dependants(pipeline):
     jobs = job_counts(proc.stdout)
     # the analyst's part follows the fit; the paper's part and the checks do not depend on the data
     assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "report", "fit_figure", "figure",
-                         "all"}, jobs
-    assert jobs["figure"] == 1 + len(TINY_SWEEPS), jobs  # the analyst's figures: flags and its sweeps, not the paper's
+                         "sweep_figure", "all"}, jobs
+    # the analyst's figures (flags, its sweeps and their further figures), not the paper's
+    assert jobs["figure"] == 1 + len(TINY_SWEEPS), jobs
+    assert jobs["sweep_figure"] == len(TINY_SWEEPS) + 3, jobs  # restitution per case, energy loss of 2.1-2.3
 
 
 # --------------------------------------------------------------------------- profile, lint, config

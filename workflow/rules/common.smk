@@ -186,7 +186,7 @@ def stress_outputs(wildcards):
 
 # ---------------------------------------------------------------- figures of the HTML report
 #: result files (under results/, without .nc) that have a figure in reports/figures/ (figures.smk);
-#: the fit's figure (with its model curves) is made by rule fit_figure
+#: the fit's figure (with its model curves) is made by the fit_figure rule
 FIGURE_RESULTS = (
     ["analyst/flags"]
     + [f"analyst/sweeps/case_{case}" for case in SWEEP_CASES]
@@ -201,10 +201,10 @@ ENERGY_LOSS_CASES = ("2.1", "2.2", "2.3")
 
 
 def report_figures(wildcards=None):
-    """Every figure of the HTML report (the benchmark's is an output of rule work_precision)."""
+    """Every figure of the HTML report (the benchmark's is an output of the work_precision rule)."""
     figures = ["reports/figures/analyst/fit.png"]
     figures += [f"reports/figures/{r}.png" for r in FIGURE_RESULTS]
-    # the sweeps' further figures, as in the PDF (rule sweep_figure): the analyst's cases at the
+    # the sweeps' further figures, as in the PDF (the sweep_figure rule): the analyst's cases at the
     # median size, and the energy-loss ratios of the cases that have them in the paper
     figures += [
         f"reports/figures/analyst/sweeps/case_{c}.restitution.png" for c in SWEEP_CASES

@@ -62,6 +62,6 @@ rule sweep_figure:
         "../envs/microimpact.yaml"
     threads: 1
     params:
-        variant=lambda wildcards: wildcards.variant,
+        variant="{variant}",
     script:
         "../scripts/figure.py"
