@@ -6,18 +6,26 @@
 #
 # Every rule runs a thin script in workflow/scripts/ that calls one microimpact function; the
 # configuration (workflow/config/config.yaml) is validated against its JSON schema first.
+import os
+
 from snakemake.utils import min_version, validate
 
 min_version("8.17")
 
 
-configfile: "workflow/config/config.yaml"
+# the workflow's own files are found from the Snakefile's directory, so that it also runs as
+# `snakemake -s path/to/Snakefile -d elsewhere` and from the installed package (`microimpact workflow`)
+configfile: os.path.join(workflow.basedir, "workflow", "config", "config.yaml")
 
 
 include: "workflow/rules/typed_config.smk"
 
 
 validate(config, "workflow/schemas/config.schema.yaml")
+
+
+# the HTML report (snakemake --report report.html, after a run): every report() output of the rules
+report: "workflow/report/workflow.rst"
 
 
 include: "workflow/rules/common.smk"
@@ -29,6 +37,7 @@ include: "workflow/rules/sweeps.smk"
 include: "workflow/rules/validation.smk"
 include: "workflow/rules/benchmark.smk"
 include: "workflow/rules/report.smk"
+include: "workflow/rules/figures.smk"
 
 
 localrules:
@@ -39,3 +48,4 @@ rule all:
     default_target: True
     input:
         "reports/report.pdf",
+        report_figures(),

@@ -351,7 +351,10 @@ def test_changing_data_reruns_only_its_dependants(pipeline):
     # the analyst's part follows the fit; the paper's part and the checks do not depend on the data
     # (and the normal models compared on the same data)
     assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "model_comparison", "report",
-                         "all"}, jobs
+                         "fit_figure", "figure", "sweep_figure", "all"}, jobs
+    # the analyst's figures (flags, its sweeps and their further figures), not the paper's
+    assert jobs["figure"] == 1 + len(TINY_SWEEPS), jobs
+    assert jobs["sweep_figure"] == len(TINY_SWEEPS) + 3, jobs  # restitution per case, energy loss of 2.1-2.3
 
 
 # --------------------------------------------------------------------------- profile, lint, config
@@ -469,3 +472,123 @@ def test_nested_config_overrides_arrive_as_numbers(tmp_path):
     assert job_counts(proc.stdout).get("paper_dynamics") == 1
     bad = snakemake(root, "-n", "--cores", "1", "--config", contact.replace("3.0e-6", "-3.0e-6"))
     assert bad.returncode != 0 and "paper_contact" in bad.stdout, bad.stdout[-3000:]
+
+
+# --------------------------------------------------------------------------- HTML report, CF, plot
+@pytest.mark.slow
+def test_html_report_has_a_captioned_figure_of_every_result_file(pipeline):
+    """snakemake --report: every result file with a standard figure (microimpact.report.standard)
+    is in the archive as a PNG, with its caption, and so are the PDF and the key tables."""
+    from collections import Counter
+
+    from microimpact.report.figures import TABLE2_FIGURES
+    from microimpact.report.standard import FIGURE_KINDS, result_kind
+
+    root, _ = pipeline
+    proc = snakemake(root, "--report", "report.zip")
+    assert proc.returncode == 0, proc.stdout[-3000:]
+    import zipfile
+
+    with zipfile.ZipFile(root / "report.zip") as z:
+        names = z.namelist()
+        html = next(z.read(n).decode() for n in names if n.endswith("report.html"))
+    results = sorted((root / "results").rglob("*.nc"))
+    drawn = [p for p in results if result_kind(p) in FIGURE_KINDS]
+    assert len(drawn) >= 2 * len(TINY_SWEEPS) + 5  # flags, fit, bifurcation, portraits, kharaz, the sweeps
+    expected = Counter(f"{p.stem}.png" for p in drawn)
+    # the sweeps' further figures of the PDF: the analyst's cases at the median size, and the
+    # energy-loss ratios of the cases that have an energy-loss figure in the paper (both parts)
+    expected.update(f"case_{c}.restitution.png" for c in TINY_SWEEPS)
+    expected.update(f"case_{c}.energy_loss.png" for c in TINY_SWEEPS if TABLE2_FIGURES[c][0] for _ in range(2))
+    found = Counter(Path(n).name for n in names if n.endswith(".png"))
+    assert found == expected, (found, expected)
+    for p in drawn:  # each figure's caption names its result file (the fit's is its own caption)
+        rel = p.relative_to(root).as_posix()
+        assert rel in html or p.stem == "fit", rel
+    assert "Damping fit (analogue of the paper's Fig. 3)" in html
+    for table in ("report.pdf", "reproduction.csv", "flags.csv"):
+        assert any(n.endswith("/" + table) for n in names), table
+
+
+@pytest.mark.slow
+def test_every_netcdf_the_pipeline_writes_passes_the_cf_checker(pipeline):
+    """compliance-checker cf:1.10 on every .nc under results/ of a real run (test_cf.py checks one of
+    each kind made by the library; this catches a file the pipeline writes that it does not list)."""
+    from test_cf import _failures
+
+    root, _ = pipeline
+    files = sorted((root / "results").rglob("*.nc"))
+    assert len(files) >= 2 * len(TINY_SWEEPS) + 8
+    failed = {str(p.relative_to(root)): f for p in files if (f := _failures(p))}
+    assert not failed, failed
+
+
+@pytest.mark.slow
+def test_plot_draws_every_result_file_or_says_why_not(pipeline, tmp_path, capsys):
+    """microimpact plot on each result file of a run: a PNG for each kind with a figure; exit 2
+    naming the file, and nothing written, for the others."""
+    from microimpact.cli import main
+    from microimpact.report.standard import FIGURE_KINDS, NO_FIGURE, result_kind
+
+    root, _ = pipeline
+    for path in sorted((root / "results").rglob("*.nc")):
+        out = tmp_path / f"{path.stem}_{path.parent.name}.png"
+        kind = result_kind(path)
+        status = main(["plot", str(path), "--out", str(out)])
+        err = capsys.readouterr().err
+        if kind in FIGURE_KINDS:
+            assert status == 0, err
+            assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", path
+        else:
+            assert kind in NO_FIGURE
+            assert status == 2 and str(path) in err and not out.exists(), err
+    sweep = root / "results" / "analyst" / "sweeps" / "case_2.1.nc"
+    for variant in ("sizes", "restitution", "energy_loss"):
+        assert main(["plot", str(sweep), "--variant", variant, "--out", str(tmp_path / f"{variant}.svg")]) == 0
+        assert b"<svg" in (tmp_path / f"{variant}.svg").read_bytes()[:500]
+    assert main(["plot", str(root / "results" / "kharaz.nc"), "--variant", "energy_loss",
+                 "--out", str(tmp_path / "k.png")]) == 2
+    assert "kharaz.nc" in capsys.readouterr().err and not (tmp_path / "k.png").exists()
+    fit = root / "results" / "analyst" / "fit.nc"
+    pdf = tmp_path / "fit.pdf"
+    assert main(["plot", str(fit), "--curves", str(fit.with_name("fit_curves.nc")), "--out", str(pdf)]) == 0
+    assert pdf.read_bytes()[:5] == b"%PDF-"
+
+
+# --------------------------------------------------------------------------- run from elsewhere
+def test_snakefile_runs_from_another_working_directory(tmp_path):
+    """snakemake -s REPO/Snakefile -d elsewhere: config, schema and bundled data are found from the
+    Snakefile's directory (a dry run, started in a third directory)."""
+    elsewhere = tmp_path / "elsewhere"
+    proc = snakemake(tmp_path, "-s", str(REPO / "Snakefile"), "-d", str(elsewhere), "-n", "--cores", "1")
+    assert proc.returncode == 0, proc.stdout[-3000:]
+    counts = job_counts(proc.stdout)
+    assert counts.get("report") == 1 and counts.get("fit_figure") == 1, counts
+    assert not (elsewhere / "results").exists()  # a dry run writes no result
+
+
+def test_microimpact_workflow_runs_the_packaged_pipeline(tmp_path):
+    """microimpact workflow --directory DIR: a dry run of the whole pipeline with the config
+    defaults, then one real job (the validation of the bundled data) in DIR."""
+    env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
+    work = tmp_path / "run here"  # a space in the path, and a directory that does not exist yet
+    cli = [sys.executable, "-m", "microimpact.cli", "workflow", "--directory", str(work)]
+    dry = subprocess.run([*cli, "-n"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+    assert dry.returncode == 0, (dry.stdout + dry.stderr)[-3000:]
+    assert job_counts(dry.stdout).get("report") == 1, dry.stdout[-3000:]
+    real = subprocess.run([*cli, "--cores", "1", "results/impacts_validated.csv"], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert real.returncode == 0, (real.stdout + real.stderr)[-3000:]
+    table = (work / "results" / "impacts_validated.csv").read_text()
+    assert table.count("\n") > 10  # the bundled synthetic data, found next to the packaged Snakefile
+    assert not (tmp_path / "results").exists()  # nothing in the directory it was started from
+
+
+def test_energy_loss_cases_of_the_workflow_are_the_papers():
+    """common.smk lists the cases with an energy-loss figure (parsing it needs no matplotlib); they
+    must be those of microimpact.report.figures.TABLE2_FIGURES."""
+    from microimpact.report.figures import TABLE2_FIGURES
+
+    text = (REPO / "workflow" / "rules" / "common.smk").read_text()
+    listed = re.search(r"^ENERGY_LOSS_CASES = \((.*)\)$", text, flags=re.M).group(1)
+    assert sorted(re.findall(r'"([\d.]+)"', listed)) == sorted(c for c, (e, _) in TABLE2_FIGURES.items() if e)

@@ -1,4 +1,4 @@
-"""Command line: ``microimpact simulate | sweep | fit | flags | target | reproduce | benchmark``.
+"""Command line: ``microimpact simulate | sweep | fit | flags | target | reproduce | benchmark | plot | workflow``.
 
 Thin: parse, call the library, print or write. Bad arguments print one line
 ``microimpact: error: ...`` to stderr and exit with status 2; nothing is written then.
@@ -143,7 +143,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_simulate)
 
     for register in (register_sweep, register_fit, register_flags, register_target, register_reproduce,
-                     register_benchmark):
+                     register_benchmark, register_plot, register_workflow):
         register(sub)
     return parser
 
@@ -358,7 +358,7 @@ def _cmd_sweep(args) -> int:
         raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(TABLE2_CASES)}")
     contact = contact_from_args(args)
     out = check_outputs({"--out": args.out})["--out"]
-    ds = run_sweep(contact, case=args.case, rtol=args.rtol)
+    ds = run_sweep(contact, case=args.case, rtol=args.rtol, progress=True)
     with reporting_os_errors({"--out": out}):
         write_netcdf(ds, out)
     print(f"case {args.case}: {dict(ds.sizes)} impacts, {int(ds['outcome'].sum())} captured; wrote {out}")
@@ -403,7 +403,11 @@ def _cmd_benchmark(args) -> int:
     if docs is not None and same_file(out, docs):
         raise PathError("--out and --docs", args.docs, "two outputs on one path (both write benchmark.md); "
                                                        "give --docs another directory")
-    ds = run_benchmark(quick=args.quick, verbose=True, throughput=not args.no_throughput)
+    from microimpact.io.progress import wants_progress
+
+    # on a terminal a bar of the stages; elsewhere (a pipe, a log) one line per stage
+    ds = run_benchmark(quick=args.quick, verbose=not wants_progress(True), throughput=not args.no_throughput,
+                       progress=True)
     with reporting_os_errors({"--out": out, "--docs": docs}):
         paths = write_benchmark(ds, out, figure=plot_work_precision(ds).figure, docs_dir=docs)
     for path in paths.values():
@@ -421,12 +425,124 @@ def register_benchmark(sub) -> None:
     p.set_defaults(func=_cmd_benchmark)
 
 
+# ------------------------------------------------------------------ plot (microimpact.report.standard)
+#: figure formats of ``microimpact plot --out`` (matplotlib writers)
+FIGURE_FORMATS = ("png", "pdf", "svg")
+
+
+def _cmd_plot(args) -> int:
+    from microimpact.io.files import atomic_path
+    from microimpact.report.standard import standard_figure
+
+    inputs = {"RESULT": check_input_file("RESULT", args.result)}
+    if args.curves is not None:
+        inputs["--curves"] = check_input_file("--curves", args.curves)
+    out = check_outputs({"--out": args.out}, inputs)["--out"]
+    fmt = out.suffix.lower().lstrip(".")
+    if fmt not in FIGURE_FORMATS:
+        raise PathError("--out", args.out, f"has no figure suffix; give a file ending in "
+                                           f"{', '.join('.' + f for f in FIGURE_FORMATS)}")
+    plot = standard_figure(inputs["RESULT"], curves=inputs.get("--curves"), variant=args.variant)
+    with reporting_os_errors({"--out": out}), atomic_path(out) as tmp:
+        plot.figure.savefig(tmp, format=fmt, dpi=args.dpi)
+    print(plot.caption)
+    print(f"wrote {out}", file=sys.stderr)
+    return 0
+
+
+def register_plot(sub) -> None:
+    """``microimpact plot RESULT.nc --out fig.png``: the standard figure of a result file."""
+    p = sub.add_parser("plot", help="draw the standard figure of a result NetCDF (fit, sweep, phase portraits, "
+                                    "flags, bifurcation, benchmark, Kharaz)")
+    p.add_argument("result", metavar="RESULT", help="result NetCDF written by microimpact or the pipeline")
+    p.add_argument("--out", required=True, help=f"figure file ({', '.join('.' + f for f in FIGURE_FORMATS)})")
+    p.add_argument("--curves", default=None, help="with a fit file: its model curves (results/analyst/fit_curves.nc)")
+    p.add_argument("--variant", default=None, metavar="NAME",
+                   help="for a sweep file, which of its figures: restitution (e_n, impulse ratios), energy_loss "
+                        "(K_L, K_t), sizes (per size; a sweep at several sizes)")
+    p.add_argument("--dpi", type=_positive_float, default=200.0, help="resolution of a .png [dots per inch] (default 200)")
+    p.set_defaults(func=_cmd_plot)
+
+
+# ------------------------------------------------------------------ workflow (the packaged Snakefile)
+#: snakemake options that set the cores or jobs (else ``microimpact workflow`` passes ``--cores all``)
+_CORES_OPTIONS = ("--cores", "-c", "--jobs", "-j", "--profile", "--workflow-profile")
+#: snakemake options that ``microimpact workflow`` sets itself
+_OWN_OPTIONS = ("--snakefile", "-s", "--directory", "-d")
+
+
+def workflow_snakefile() -> Path:
+    """The Snakefile of the pipeline: the copy inside the installed package (``microimpact/_workflow``,
+    put there by the wheel's build), else the repository's own (an editable install or a clone).
+
+    Raises
+    ------
+    UsageError
+        Neither is there.
+    """
+    package = Path(__file__).resolve().parent
+    for snakefile in (package / "_workflow" / "Snakefile", package.parents[1] / "Snakefile"):
+        if snakefile.is_file() and (snakefile.parent / "workflow" / "rules").is_dir():
+            return snakefile
+    raise UsageError(f"no workflow next to {package}: reinstall microimpact from its wheel or its repository")
+
+
+def _snakemake_command(args) -> list[str]:
+    """The snakemake command line of ``microimpact workflow``; UsageError for options it sets itself."""
+    import importlib.util
+
+    extra = list(args.snakemake_args)
+    if extra[:1] == ["--"]:
+        extra = extra[1:]
+    for word in extra:
+        if word.split("=", 1)[0] in _OWN_OPTIONS or (word[:2] in ("-s", "-d") and not word.startswith("--")):
+            raise UsageError(f"snakemake option {word!r}: microimpact workflow sets the Snakefile and the "
+                             "directory itself; give the directory as --directory DIR")
+    if importlib.util.find_spec("snakemake") is None:
+        raise UsageError("the workflow needs Snakemake: pip install 'microimpact[workflow]'")
+    if not any(w.split("=", 1)[0] in _CORES_OPTIONS or (w[:2] in ("-c", "-j") and not w.startswith("--"))
+               for w in extra):
+        extra = ["--cores", "all", *extra]
+    return [sys.executable, "-m", "snakemake", "--snakefile", str(workflow_snakefile()),
+            "--directory", str(args.directory), *extra]
+
+
+def _cmd_workflow(args) -> int:
+    import subprocess
+
+    command = _snakemake_command(args)
+    directory = Path(args.directory)
+    if directory.exists() and not directory.is_dir():
+        raise PathError("--directory", args.directory, "is not a directory")
+    with reporting_os_errors({"--directory": directory}):
+        directory.mkdir(parents=True, exist_ok=True)
+    print(f"microimpact: running the pipeline ({command[4]}) in {directory}", file=sys.stderr, flush=True)
+    return subprocess.call(command)
+
+
+def register_workflow(sub) -> None:
+    """``microimpact workflow [--directory DIR] [snakemake options]``: the pipeline of the installed package."""
+    p = sub.add_parser(
+        "workflow", help="run the Snakemake pipeline shipped with the package in a directory",
+        description="Run the report pipeline (the packaged Snakefile, its config defaults and bundled data) in "
+                    "DIRECTORY with Snakemake. Every other option goes to snakemake, e.g. -n (dry run), "
+                    "--config data=my_impacts.csv, --rerun-incomplete, --report report.html; --cores defaults to all. "
+                    "Needs the [workflow] extra.")
+    p.add_argument("--directory", "-d", default=".", help="working directory: results/, reports/ and logs go here "
+                                                          "(created if missing; default: the current directory)")
+    p.set_defaults(func=_cmd_workflow, snakemake_args=[])
+
+
 def main(argv=None) -> int:
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
+        args, rest = parser.parse_known_args(argv)
+        if rest and getattr(args, "command", None) == "workflow":
+            args.snakemake_args = rest  # everything microimpact does not know goes to snakemake
+        elif rest:
+            raise UsageError(f"unrecognized arguments: {' '.join(rest)}")
         if not getattr(args, "command", None):
-            raise UsageError("a command is required: simulate, sweep, fit, flags, reproduce or benchmark")
+            raise UsageError("a command is required: simulate, sweep, fit, flags, reproduce, benchmark, plot or workflow")
         return args.func(args)
     except (UsageError, ValueError, RuntimeError) as exc:  # RuntimeError: solver failures
         print(f"microimpact: error: {exc}", file=sys.stderr)

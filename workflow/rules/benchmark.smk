@@ -7,9 +7,17 @@ rule work_precision:
     output:
         netcdf="results/benchmark/benchmark.nc",
         json="results/benchmark/benchmark.json",
-        markdown="results/benchmark/benchmark.md",
+        markdown=report(
+            "results/benchmark/benchmark.md",
+            caption="../report/benchmark_table.rst",
+            category="Tables",
+        ),
         pdf="results/benchmark/work_precision.pdf",
-        png="results/benchmark/work_precision.png",
+        png=report(
+            "results/benchmark/work_precision.png",
+            caption="../report/work_precision.rst",
+            category="C. Checks",
+        ),
     log:
         "logs/work_precision.log",
     benchmark:

@@ -1,6 +1,7 @@
 # Helpers shared by the rules (no rules here). The config was validated by the Snakefile.
 import importlib.util
 import os
+import re
 from snakemake.exceptions import WorkflowError
 from pathlib import Path
 
@@ -55,6 +56,23 @@ STRESS_ENABLED = config["stress"]["enabled"]
 RTOL = config["rtol"]
 
 
+def workflow_path(path):
+    """A relative path of the config: from the working directory if it is there, else from the
+    Snakefile's directory (the repository, or the workflow inside the installed package, which
+    carries the bundled data/); unchanged when found in neither (the start-up check names it).
+    """
+    if os.path.isabs(path) or os.path.exists(path):
+        return path
+    bundled = os.path.join(workflow.basedir, path)
+    return bundled if os.path.exists(bundled) else path
+
+
+for _key in ("data", "kharaz_data"):
+    config[_key] = workflow_path(config[_key])
+if config["materials"] != "default":
+    config["materials"] = workflow_path(config["materials"])
+
+
 def materials_path():
     """Materials config: the bundled one for "default" (located without importing the package)."""
     if config["materials"] != "default":
@@ -82,8 +100,8 @@ def _config_file_problem(key, what):
     how = f"--config {key}=path/to/file"
     if not p.exists():
         return (
-            f"config key '{key}': {what} {path!r} does not exist (paths are relative to "
-            f"{os.getcwd()}); give an existing file, e.g. {how}"
+            f"config key '{key}': {what} {path!r} does not exist (relative paths are taken from "
+            f"{os.getcwd()}, else from {workflow.basedir}); give an existing file, e.g. {how}"
         )
     if not p.is_file():
         return f"config key '{key}': {what} {path!r} is not a file (a directory?); give a file, e.g. {how}"
@@ -169,3 +187,39 @@ def benchmark_outputs(wildcards):
 def stress_outputs(wildcards):
     """Stress-sweep summary for the report; none when the sweep is switched off."""
     return {"stress": "results/stress_summary.json"} if STRESS_ENABLED else {}
+
+
+# ---------------------------------------------------------------- figures of the HTML report
+#: result files (under results/, without .nc) that have a figure in reports/figures/ (figures.smk);
+#: the fit's figure (with its model curves) is made by the fit_figure rule
+FIGURE_RESULTS = (
+    ["analyst/flags"]
+    + [f"analyst/sweeps/case_{case}" for case in SWEEP_CASES]
+    + ["paper/bifurcation", "paper/phase_portraits"]
+    + [f"paper/sweeps/case_{case}" for case in SWEEP_CASES]
+    + ["kharaz"]
+)
+FIGURE_RESULT_PATTERN = "|".join(re.escape(r) for r in FIGURE_RESULTS)
+#: Table 2 cases with an energy-loss figure in the paper (Figs. 7, 9, 11; the first entries of
+#: microimpact.report.figures.TABLE2_FIGURES, which a test compares with this list)
+ENERGY_LOSS_CASES = ("2.1", "2.2", "2.3")
+
+
+def report_figures(wildcards=None):
+    """Every figure of the HTML report (the benchmark's is an output of the work_precision rule)."""
+    figures = ["reports/figures/analyst/fit.png"]
+    figures += [f"reports/figures/{r}.png" for r in FIGURE_RESULTS]
+    # the sweeps' further figures, as in the PDF (the sweep_figure rule): the analyst's cases at the
+    # median size, and the energy-loss ratios of the cases that have them in the paper
+    figures += [
+        f"reports/figures/analyst/sweeps/case_{c}.restitution.png" for c in SWEEP_CASES
+    ]
+    figures += [
+        f"reports/figures/{part}/sweeps/case_{c}.energy_loss.png"
+        for c in SWEEP_CASES
+        if c in ENERGY_LOSS_CASES
+        for part in ("analyst", "paper")
+    ]
+    if BENCHMARK_ENABLED:
+        figures.append("results/benchmark/work_precision.png")
+    return figures

@@ -25,7 +25,11 @@ rule paper_dynamics:
 
 rule reproduction:
     output:
-        table="results/paper/reproduction.csv",
+        table=report(
+            "results/paper/reproduction.csv",
+            caption="../report/reproduction.rst",
+            category="Tables",
+        ),
         markdown="results/paper/reproduction.md",
     log:
         "logs/reproduction.log",

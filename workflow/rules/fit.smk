@@ -39,7 +39,11 @@ rule flags:
         fit=rules.fit.output[0],
         posterior=rules.fit.output.posterior,
     output:
-        csv="results/analyst/flags.csv",
+        csv=report(
+            "results/analyst/flags.csv",
+            caption="../report/flags_table.rst",
+            category="Tables",
+        ),
         nc="results/analyst/flags.nc",
     log:
         "logs/flags.log",

@@ -23,7 +23,11 @@ rule report:
         paper_sweeps=expand("results/paper/sweeps/case_{case}.nc", case=SWEEP_CASES),
         kharaz=rules.kharaz.output[0],
     output:
-        "reports/report.pdf",
+        report(
+            "reports/report.pdf",
+            caption="../report/report_pdf.rst",
+            category="Report",
+        ),
     log:
         "logs/report.log",
     benchmark:

@@ -18,6 +18,7 @@ function                             paper figure              input
 :func:`plot_size_dependence`         (none)                    sweep with a ``radius`` dimension
 :func:`plot_work_precision`          (none)                    benchmark Dataset
 :func:`plot_kharaz`                  (none)                    :func:`validation.kharaz_comparison`
+:func:`plot_flags`                   (none)                    :func:`analysis.flags.flag_measurements`
 ==================================== ========================= ======================================
 """
 
@@ -36,6 +37,7 @@ from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.ticker import NullFormatter
 
 __all__ = [
     "Plot",
@@ -48,6 +50,7 @@ __all__ = [
     "plot_fit",
     "plot_work_precision",
     "plot_kharaz",
+    "plot_flags",
 ]
 
 #: Table 2 case -> (energy-loss figure, e_n/mu figure) of the paper (case 2.4/2.5 only have the latter)
@@ -792,3 +795,59 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
         "Coulomb contact does not have."
     )
     return Plot(fig, caption, None)
+
+
+# ----------------------------------------------------------------------------- measurement flags
+#: flag variable -> (marker colour, legend text)
+_FLAG_STYLE = {
+    "rotation_sensitive": ("tab:red", "rotation-sensitive"),
+    "angle_sensitive": ("tab:orange", "angle-sensitive"),
+    "near_capture": ("tab:blue", "near capture"),
+}
+
+
+@_rc
+def plot_flags(ds: xr.Dataset) -> Plot:
+    """The model e_n of each measured impact with its range under unmeasured spin and angle error.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        From :func:`microimpact.analysis.flags.flag_measurements`: along ``impact``, ``e_n`` [1],
+        ``e_n_min``, ``e_n_max`` [1] (range over spin and angle), ``capture_speed_ratio`` [1]
+        (normal speed over the capture velocity) and the 0/1 flags ``rotation_sensitive``,
+        ``angle_sensitive``, ``near_capture``.
+
+    Returns
+    -------
+    Plot
+        e_n against the speed ratio (log axis), a vertical bar for each impact's range, rings in
+        the colour of each flag raised.
+    """
+    missing = [k for k in ("e_n", "e_n_min", "e_n_max", "capture_speed_ratio", *_FLAG_STYLE) if k not in ds]
+    if missing:
+        raise ValueError(f"plot_flags needs the variables {', '.join(missing)} of a flags file")
+    fig = _figure(WIDTH * 0.72, 3.0)
+    ax = fig.subplots()
+    x = ds["capture_speed_ratio"].values
+    e = ds["e_n"].values
+    ax.vlines(x, ds["e_n_min"].values, ds["e_n_max"].values, color="0.55", lw=0.9)
+    ax.plot(x, e, "o", ms=3.0, color="0.2", label="model e_n, range over spin and angle")
+    counts = []
+    for k, (name, (color, text)) in enumerate(_FLAG_STYLE.items()):
+        raised = ds[name].values.astype(bool)
+        counts.append(f"{int(raised.sum())} {text}")
+        ax.plot(x[raised], e[raised], "o", ms=6.0 + 2.5 * k, mfc="none", mec=color, mew=1.0, label=text)
+    ax.set_xscale("log")
+    ax.xaxis.set_minor_formatter(NullFormatter())  # a short log range: label the decades only
+    ax.set_xlabel(r"normal speed / capture velocity [-]")
+    ax.set_ylabel(r"$e_n$ [-]")
+    ax.set_ylim(bottom=0.0)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
+    caption = (
+        f"Measurement flags of {ds.sizes.get('impact', len(e))} impacts ({str(ds.attrs.get('source', '')) or 'the data'}): "
+        "the model's e_n at each measured impact against its normal speed over the capture velocity, with a bar "
+        "from the lowest to the highest e_n under unmeasured spin and the incidence-angle uncertainty; rings "
+        f"mark the flags raised ({', '.join(counts)}; thresholds in the file's attributes)."
+    )
+    return Plot(fig, caption)

@@ -51,6 +51,7 @@ from microimpact import __version__
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.progress import progress_bar, wants_progress
 from microimpact.io.variables import attributes
 from microimpact.model.contact import PAPER_REFERENCE
 from microimpact.model.parameters import TABLE2_CASES, table2_case
@@ -246,7 +247,7 @@ def case_spec(case: str, overrides: Mapping | None = None) -> dict:
 
 
 def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, rtol: float = DEFAULT_RTOL,
-              institution: str | None = None, capture_speed: bool = True) -> xr.Dataset:
+              institution: str | None = None, capture_speed: bool = True, progress=None) -> xr.Dataset:
     """Simulate every impact of a sweep grid with :func:`microimpact.solvers.impact.simulate_many`.
 
     Parameters
@@ -265,6 +266,10 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
         Also compute the normal capture velocity of the contact (bisection on the outcome with
         the same solver tolerance, :func:`microimpact.dynamics.nonlinear.capture_velocity`) and store it as
         the 0-d variable ``capture_normal_speed``; the figures mark it. About 1 s.
+    progress : bool, optional
+        Draw a progress bar on stderr (:func:`microimpact.io.progress.progress_bar`) when stderr is
+        a terminal; the speeds are then solved in blocks to advance it (same values as one batch).
+        Default: silent.
 
     Returns
     -------
@@ -290,16 +295,13 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
             inputs[key] = float(val)
         else:
             inputs[key] = xr.DataArray(val, dims=(key,), coords={key: val}, name=key)
-    get = lambda k, default=0.0: inputs.get(k, default)  # noqa: E731
-    ds = simulate_many(
-        contact,
-        inputs["speed"],
-        get("incidence_deg"),
-        get("azimuth_deg"),
-        omega=(get("omega_n"), get("omega_t"), get("omega_tp")),
-        friction=get("friction", None),
-        rtol=rtol,
-    )
+    label = f"Table 2 case {case}" if case in TABLE2_CASES else (f"case {case}" if case else "parameter sweep")
+    n_speeds = inputs["speed"].size if isinstance(inputs["speed"], xr.DataArray) else 1
+    with progress_bar(n_speeds + int(capture_speed), f"sweep {label}", progress) as advance:
+        ds = _simulate_grid(contact, inputs, rtol, advance, in_blocks=wants_progress(progress))
+        if capture_speed:
+            v_capture = capture_velocity(contact, solver_rtol=rtol)
+            advance(1)
     dims = [k for k in SWEEP_INPUTS if k in inputs and isinstance(inputs[k], xr.DataArray)]
     ds = ds.transpose(*dims)
     for key in SWEEP_INPUTS:
@@ -311,13 +313,12 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
             ds[key] = xr.DataArray(fixed, attrs=attrs)
     if capture_speed:
         ds["capture_normal_speed"] = xr.DataArray(
-            capture_velocity(contact, solver_rtol=rtol),
+            v_capture,
             attrs={"units": "m s-1", "long_name": "normal impact speed below which the sphere is captured"},
         )
     order = [k for k in SWEEP_INPUTS if k not in dims] + [k for k in ds.data_vars if k not in SWEEP_INPUTS]
     ds = ds[order]
     n = int(np.prod([ds.sizes[d] for d in dims])) if dims else 1
-    label = f"Table 2 case {case}" if case in TABLE2_CASES else (f"case {case}" if case else "parameter sweep")
     attrs = {
         "Conventions": CONVENTIONS,
         "title": f"Microsphere impact sweep: {label} (Cheng, Brach & Dunn 2002 model)",
@@ -337,6 +338,34 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
     attrs["sweep_dims"] = " ".join(dims)
     ds.attrs = attrs
     return ds
+
+
+#: blocks of speeds a sweep is solved in when it shows a progress bar
+PROGRESS_BLOCKS = 20
+
+
+def _simulate_grid(contact, inputs: Mapping, rtol: float, advance, *, in_blocks: bool = False) -> xr.Dataset:
+    """simulate_many over the sweep grid ``inputs``; ``in_blocks``: along speed in up to
+    :data:`PROGRESS_BLOCKS` blocks, calling ``advance(n)`` after each (every impact is solved on
+    its own, so the values equal those of one batch; the test suite checks it)."""
+    get = lambda k, default=0.0: inputs.get(k, default)  # noqa: E731
+
+    def solve(speed):
+        return simulate_many(contact, speed, get("incidence_deg"), get("azimuth_deg"),
+                             omega=(get("omega_n"), get("omega_t"), get("omega_tp")),
+                             friction=get("friction", None), rtol=rtol)
+
+    speed = inputs["speed"]
+    if not (in_blocks and isinstance(speed, xr.DataArray) and speed.size > 1):
+        ds = solve(speed)
+        advance(speed.size if isinstance(speed, xr.DataArray) else 1)
+        return ds
+    parts = []
+    for block in np.array_split(np.arange(speed.size), min(speed.size, PROGRESS_BLOCKS)):
+        parts.append(solve(speed.isel(speed=block)))
+        advance(block.size)
+    return xr.concat(parts, dim="speed", data_vars="minimal", coords="minimal", compat="override",
+                     combine_attrs="override")
 
 
 # ----------------------------------------------------------------------------- chunking

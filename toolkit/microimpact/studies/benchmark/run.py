@@ -16,6 +16,7 @@ import numba
 import numpy as np
 import xarray as xr
 
+from microimpact.io.progress import progress_bar
 from microimpact.io.provenance import contact_attributes, preset_parameter_source
 from microimpact.io.variables import attributes
 from microimpact.presets import WALL_1990
@@ -266,9 +267,13 @@ def _dataset(table: _Table, cfg: BenchmarkConfig, speeds, batch_size: int, attrs
 from microimpact.studies.benchmark.family import family_targets, fit_scaling, run_engine_family  # noqa: E402
 from microimpact.studies.benchmark.sub_models import sub_model_costs  # noqa: E402
 
+#: stages of the progress bar of run_benchmark (speed set, reference, engine, engine batch, engine
+#: family, RKG, scipy, engine diagnostics and sub-model costs; the throughput runs add one)
+_STAGES = 8
+
 
 def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkConfig | None = None,
-                  verbose: bool = False, throughput: bool = True) -> xr.Dataset:
+                  verbose: bool = False, throughput: bool = True, progress=None) -> xr.Dataset:
     """Run the work-precision benchmark and return its results.
 
     Parameters
@@ -283,6 +288,9 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
         Progress on stderr.
     throughput : bool
         Also measure the 100,000-impact throughput and the memory scaling.
+    progress : bool, optional
+        A progress bar of the stages on stderr (:func:`microimpact.io.progress.progress_bar`),
+        drawn only when stderr is a terminal. Default: none.
 
     Returns
     -------
@@ -296,33 +304,40 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
     attrs = machine_attrs()
     t_start = time.perf_counter()
     notes: list[str] = []
-    _warm_up(contact)
-    speeds, v_cap = normal_speed_set(contact, cfg.n_speeds, cfg.max_speed, cfg.capture_margin)
-    cases = cfg.oblique
-    log(f"capture speed {v_cap:.10g} m/s; {len(speeds)} normal speeds, {len(cases)} oblique cases", verbose)
-    reference = reference_set(contact, speeds, cases, cfg, verbose)
-    b = reference.bound
-    log(f"reference bound: e_n {b['e_n']:.3g}, mu {b['mu']:.3g}, K_L {b['K_L']:.3g}", verbose)
+    with progress_bar(_STAGES + int(throughput), "benchmark", progress) as advance:
+        _warm_up(contact)
+        speeds, v_cap = normal_speed_set(contact, cfg.n_speeds, cfg.max_speed, cfg.capture_margin)
+        cases = cfg.oblique
+        log(f"capture speed {v_cap:.10g} m/s; {len(speeds)} normal speeds, {len(cases)} oblique cases", verbose)
+        advance()
+        reference = reference_set(contact, speeds, cases, cfg, verbose)
+        b = reference.bound
+        log(f"reference bound: e_n {b['e_n']:.3g}, mu {b['mu']:.3g}, K_L {b['K_L']:.3g}", verbose)
+        advance()
 
-    table = _Table(reference, cfg.n_settings)
-    batch_speeds = np.geomspace(speeds[0], speeds[-1], cfg.batch_size)
-    _run_engine(contact, speeds, cases, cfg, table, verbose)
-    _run_engine_batch(contact, speeds, batch_speeds, cases, cfg, table, verbose)
-    run_engine_family(contact, speeds, cases, cfg, table, verbose)
-    _run_rkg(contact, speeds, batch_speeds, cfg, table, verbose)
-    _run_scipy(contact, speeds, cases, cfg, table, notes, verbose)
-    diag = _engine_diagnostics(contact, batch_speeds, cfg)
-    log(f"engine diagnostics: {diag}", verbose)
-    sub_costs = sub_model_costs(contact, np.geomspace(speeds[0], speeds[-1], 4 if cfg.quick else 32),
-                                np.linspace(0.0, 85.0, 5 if cfg.quick else 18), repeats=1 if cfg.quick else 3)
-    log(f"sub-model costs: {sub_costs}", verbose)
+        table = _Table(reference, cfg.n_settings)
+        batch_speeds = np.geomspace(speeds[0], speeds[-1], cfg.batch_size)
+        for stage in (lambda: _run_engine(contact, speeds, cases, cfg, table, verbose),
+                      lambda: _run_engine_batch(contact, speeds, batch_speeds, cases, cfg, table, verbose),
+                      lambda: run_engine_family(contact, speeds, cases, cfg, table, verbose),
+                      lambda: _run_rkg(contact, speeds, batch_speeds, cfg, table, verbose),
+                      lambda: _run_scipy(contact, speeds, cases, cfg, table, notes, verbose)):
+            stage()
+            advance()
+        diag = _engine_diagnostics(contact, batch_speeds, cfg)
+        log(f"engine diagnostics: {diag}", verbose)
+        sub_costs = sub_model_costs(contact, np.geomspace(speeds[0], speeds[-1], 4 if cfg.quick else 32),
+                                    np.linspace(0.0, 85.0, 5 if cfg.quick else 18), repeats=1 if cfg.quick else 3)
+        log(f"sub-model costs: {sub_costs}", verbose)
+        advance()
 
-    targets = accuracy_targets(table.values["time_per_impact"], table.values["max_error_e_n"], cfg, b["e_n"])
-    if throughput:
-        targets.update(throughput_targets(contact, cfg, verbose))
-        targets.update(family_targets(contact, cfg, table.values["time_per_impact"], table.values["max_error_e_n"],
-                                      verbose))
-        targets.update(fit_scaling((100, cfg.fit_rows), verbose=verbose))
+        targets = accuracy_targets(table.values["time_per_impact"], table.values["max_error_e_n"], cfg, b["e_n"])
+        if throughput:
+            targets.update(throughput_targets(contact, cfg, verbose))
+            targets.update(family_targets(contact, cfg, table.values["time_per_impact"],
+                                          table.values["max_error_e_n"], verbose))
+            targets.update(fit_scaling((100, cfg.fit_rows), verbose=verbose))
+            advance()
     attrs.update({
         "title": "work-precision benchmark of the microimpact solvers",
         "contact": cfg.contact_name,

@@ -1,0 +1,120 @@
+"""``microimpact plot`` and ``microimpact workflow``: their refusals (exit status 2, the culprit named,
+nothing written, inputs unchanged) and how ``workflow`` builds the Snakemake command.
+
+The drawing of every kind of result file and real runs of the packaged workflow are in
+tests/test_workflow.py (they need the files of a pipeline run).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from microimpact import cli
+from microimpact.cli import main
+
+
+def _sha(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.fixture
+def foreign_nc(tmp_path) -> Path:
+    """A valid NetCDF file that no microimpact command wrote."""
+    path = tmp_path / "foreign.nc"
+    xr.Dataset({"temperature": ("time", np.arange(3.0))}).to_netcdf(path)
+    return path
+
+
+def test_plot_refuses_a_netcdf_it_does_not_know(foreign_nc, tmp_path, capsys):
+    out = tmp_path / "fig.png"
+    assert main(["plot", str(foreign_nc), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert str(foreign_nc) in err and "not a microimpact result file" in err, err
+    assert not out.exists()
+
+
+def test_plot_refuses_a_file_that_is_not_netcdf(tmp_path, capsys):
+    csv = tmp_path / "impacts.csv"
+    csv.write_text("a,b\n1,2\n")
+    out = tmp_path / "fig.pdf"
+    assert main(["plot", str(csv), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert str(csv) in err and "NetCDF" in err, err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("name", ["fig.jpg", "fig", "fig.nc"])
+def test_plot_refuses_an_output_without_a_figure_suffix(foreign_nc, tmp_path, capsys, name):
+    out = tmp_path / name
+    assert main(["plot", str(foreign_nc), "--out", str(out)]) == 2
+    assert "--out" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_plot_never_overwrites_its_input(foreign_nc, capsys):
+    before = _sha(foreign_nc)
+    assert main(["plot", str(foreign_nc), "--out", str(foreign_nc)]) == 2
+    assert "input" in capsys.readouterr().err
+    assert _sha(foreign_nc) == before
+
+
+def test_plot_names_a_missing_file(tmp_path, capsys):
+    assert main(["plot", str(tmp_path / "absent.nc"), "--out", str(tmp_path / "f.png")]) == 2
+    assert "absent.nc" in capsys.readouterr().err
+
+
+def test_workflow_passes_unknown_options_to_snakemake_in_order(tmp_path):
+    args, rest = cli.build_parser().parse_known_args(
+        ["workflow", "-n", "--config", "data=x.csv", "rtol=1.0e-9", "--directory", str(tmp_path), "results/kharaz.nc"])
+    args.snakemake_args = rest
+    command = cli._snakemake_command(args)
+    assert command[:3] == [sys.executable, "-m", "snakemake"]
+    assert command[command.index("--directory") + 1] == str(tmp_path)
+    snakefile = Path(command[command.index("--snakefile") + 1])
+    assert snakefile.name == "Snakefile" and (snakefile.parent / "workflow" / "config" / "config.yaml").is_file()
+    assert command[-7:] == ["--cores", "all", "-n", "--config", "data=x.csv", "rtol=1.0e-9", "results/kharaz.nc"]
+
+
+@pytest.mark.parametrize("cores", [["--cores", "1"], ["-c2"], ["--jobs=4"], ["--profile", "workflow/profiles/slurm"]])
+def test_workflow_keeps_the_cores_the_user_gives(cores):
+    args = cli.build_parser().parse_args(["workflow"])
+    args.snakemake_args = cores
+    command = cli._snakemake_command(args)
+    assert "all" not in command and command[-len(cores):] == cores
+
+
+@pytest.mark.parametrize("option", [["-s", "Snakefile"], ["--snakefile=x"], ["-d", "elsewhere"], ["--directory=x"]])
+def test_workflow_refuses_the_options_it_sets_itself(tmp_path, capsys, option):
+    work = tmp_path / "w"
+    assert main(["workflow", "--directory", str(work), "--", *option]) == 2
+    assert "sets the Snakefile and the directory itself" in capsys.readouterr().err
+    assert not work.exists()
+
+
+def test_workflow_refuses_a_file_as_directory(tmp_path, capsys):
+    file = tmp_path / "a_file"
+    file.write_text("x")
+    assert main(["workflow", "--directory", str(file), "-n"]) == 2
+    assert "a_file" in capsys.readouterr().err and file.read_text() == "x"
+
+
+def test_workflow_without_snakemake_asks_for_the_extra(tmp_path, capsys, monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "snakemake" else real(name, *a))
+    work = tmp_path / "w"
+    assert main(["workflow", "--directory", str(work), "-n"]) == 2
+    assert "pip install 'microimpact[workflow]'" in capsys.readouterr().err
+    assert not work.exists()
+
+
+def test_other_commands_still_refuse_unknown_arguments(capsys):
+    assert main(["simulate", "--speed", "2", "--no-such-option"]) == 2
+    assert "unrecognized arguments: --no-such-option" in capsys.readouterr().err

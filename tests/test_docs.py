@@ -1,0 +1,189 @@
+"""The documentation is true (issue 13, part 7): every command in README.md, data/README.md and
+docs/*.md is run - here, or by ``.ci/run`` when it takes minutes or installs packages.
+
+Commands are found in fenced code blocks (bash, console, sh, or unlabelled) and in inline code
+spans, as every line or span that starts with ``microimpact``, ``snakemake``, ``python``, ``pip``
+or ``pytest``. Each one must be listed in :data:`HOW` with the way it is exercised, so a command
+added to the documentation without a test fails here:
+
+- ``run``: run by :func:`test_documented_command_runs`, in order, in a scratch directory holding a
+  copy of data/ and docs/ (placeholders such as ``path/to/impacts.csv`` replaced by bundled files);
+- ``dry``: a Snakemake command, run as a dry run (``-n``) on a copy of the workflow;
+- ``ci``: run by ``.ci/run`` (the test checks that the CI script contains it).
+
+The Python examples (``python`` blocks) run too, and the example CSV of data/README.md is read by
+its own snippet.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+DOCS = [REPO / "README.md", REPO / "data" / "README.md", *sorted((REPO / "docs").glob("*.md"))]
+PROGRAMS = ("microimpact", "snakemake", "python", "pip", "pytest")
+CI = (REPO / ".ci" / "run").read_text()
+
+#: command -> how it is exercised ("run", "dry", or "ci")
+HOW = {
+    # README.md: set-up (the CI runs exactly these two lines; the first one as a full run)
+    'pip install -e ".[workflow]" && snakemake --cores 2': "ci",
+    'pip install -e ".[test]" && pytest': "ci",
+    "pip install .": "ci",
+    "microimpact simulate --preset wall1990 --speed 1.0 --incidence-deg 10 --json": "run",
+    "microimpact simulate --speed 3 --zeta-adhesion 10 --friction 0.3 --omega-tp 2e5": "run",
+    "microimpact sweep --case 2.1 --out case_2.1.nc": "run",
+    "microimpact fit data/synthetic_microspheres.csv --out fit.nc": "run",
+    "microimpact reproduce --out docs/reproduction.md": "run",
+    "microimpact fit data/synthetic_microspheres.csv --out fit.nc --posterior post.nc": "run",
+    "microimpact flags data/synthetic_microspheres.csv --fit fit.nc --posterior post.nc --out flags.csv --nc flags.nc": "run",
+    "microimpact target --e-n 0.6 --speed 2.0 --out curve.csv": "run",
+    # docs/posterior_coverage.md: 50 seeded data sets (minutes)
+    "python -m microimpact.analysis.coverage --out docs/posterior_coverage.json": "ci",
+    "microimpact benchmark --quick --out results/benchmark": "ci",
+    "python -m microimpact.studies.stress --cases 3000 --out stress.json": "ci",
+    "microimpact plot case_2.1.nc --out case_2.1.png": "run",
+    "microimpact plot fit.nc --out fit.pdf": "run",
+    "microimpact workflow --directory my_run -n": "run",
+    "microimpact workflow --directory my_run": "ci",
+    "snakemake -s path/to/microimpact/Snakefile -d my_run --cores 2": "dry",
+    "snakemake --cores 2 --config data=path/to/impacts.csv": "dry",
+    "snakemake --cores 2": "ci",
+    "snakemake --cores 2 --rerun-incomplete": "dry",
+    "snakemake --report report.html": "ci",
+    "python -m microimpact.studies.benchmark": "ci",
+    "python -m microimpact.studies.stress": "ci",
+    "python .ci/startup.py": "ci",
+    'python -c "import numpy"': "run",
+    "microimpact --help": "run",
+    # data/README.md
+    "python workflow/scripts/make_synthetic_data.py": "run",
+    # docs/cluster.md
+    'pip install -e ".[slurm]"': "ci",
+    "snakemake -n --profile workflow/profiles/slurm": "dry",
+    "snakemake -n --profile workflow/profiles/slurm --config sweep_chunks=4": "dry",
+    "snakemake --profile workflow/profiles/slurm": "dry",
+    "snakemake --profile workflow/profiles/slurm --config sweep_chunks=32 data=path/to/impacts.csv": "dry",
+}
+
+#: placeholders of the documentation -> files that exist in the scratch directory
+PLACEHOLDERS = {"path/to/impacts.csv": "data/synthetic_microspheres.csv",
+                "path/to/microimpact/Snakefile": str(REPO / "Snakefile")}
+
+
+def _commands_in(text: str) -> list[str]:
+    """Command lines of fenced shell blocks and inline code spans, in document order."""
+    found = []
+    for lang, body in re.findall(r"^```(\w*)\n(.*?)^```", text, flags=re.M | re.S):
+        if lang not in ("", "bash", "console", "sh", "shell"):
+            continue
+        for line in body.splitlines():
+            line = re.sub(r"^\$ ", "", line.strip())
+            line = re.sub(r"\s+#.*$", "", line).strip()
+            if line.split(" ", 1)[0] in PROGRAMS and " " in line:
+                found.append(line)
+    text_outside = re.sub(r"^```.*?^```", "", text, flags=re.M | re.S)
+    for span in re.findall(r"`([^`]+)`", text_outside):
+        span = " ".join(span.split())
+        if span.split(" ", 1)[0] in PROGRAMS and " " in span:
+            found.append(span)
+    return found
+
+
+def documented_commands() -> list[tuple[str, str]]:
+    """(document, command) of every command of the documentation."""
+    return [(p.relative_to(REPO).as_posix(), c) for p in DOCS for c in _commands_in(p.read_text())]
+
+
+def test_every_documented_command_is_exercised():
+    unlisted = sorted({f"{doc}: {c}" for doc, c in documented_commands() if c not in HOW})
+    assert not unlisted, "add these commands to HOW (how they are tested):\n" + "\n".join(unlisted)
+    stale = sorted(set(HOW) - {c for _, c in documented_commands()})
+    assert not stale, f"HOW lists commands that no document has any more: {stale}"
+
+
+@pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "ci"])
+def test_ci_runs_the_commands_left_to_it(command):
+    parts = [p.strip() for p in command.split("&&")]
+    for part in parts:
+        assert part in CI, f".ci/run does not run {part!r}"
+
+
+@pytest.fixture(scope="module")
+def scratch(tmp_path_factory) -> Path:
+    """A directory with copies of data/, docs/, workflow/ and the Snakefile (commands write into it)."""
+    root = tmp_path_factory.mktemp("docs")
+    shutil.copytree(REPO / "data", root / "data")
+    shutil.copytree(REPO / "docs", root / "docs")
+    shutil.copytree(REPO / "workflow", root / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copy(REPO / "Snakefile", root / "Snakefile")
+    return root
+
+
+def _argv(command: str) -> list[str]:
+    words = shlex.split(command)
+    for i, w in enumerate(words):
+        for placeholder, real in PLACEHOLDERS.items():
+            words[i] = words[i].replace(placeholder, real)
+    if words[0] == "microimpact":  # the CLI of the package under test (not a console script elsewhere)
+        return [sys.executable, "-m", "microimpact.cli", *words[1:]]
+    if words[0] == "python":
+        return [sys.executable, *words[1:]]
+    if words[0] == "snakemake":
+        return [sys.executable, "-m", "snakemake", *words[1:]]
+    raise AssertionError(f"no way to run {command!r}")
+
+
+def _run(argv, cwd) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
+    return subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True, timeout=600)
+
+
+@pytest.mark.slow
+def test_documented_command_runs(scratch):
+    """The "run" commands, in the order of the documents (fit.nc before flags, a sweep before its plot)."""
+    ran = []
+    for doc, command in documented_commands():
+        if HOW.get(command) != "run" or command in ran:
+            continue
+        proc = _run(_argv(command), scratch)
+        assert proc.returncode == 0, f"{doc}: {command}\n{proc.stdout[-2000:]}{proc.stderr[-3000:]}"
+        ran.append(command)
+    assert len(ran) == sum(how == "run" for how in HOW.values())
+    for made in ("case_2.1.nc", "case_2.1.png", "fit.nc", "fit.pdf", "flags.csv", "flags.nc", "docs/reproduction.md",
+                 "my_run/.snakemake"):
+        assert (scratch / made).exists(), made
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "dry"])
+def test_documented_snakemake_command_dry_run(scratch, command):
+    if "profiles/slurm" in command:
+        pytest.importorskip("snakemake_executor_plugin_slurm")
+    argv = _argv(command)
+    if "-n" not in argv:
+        argv.append("-n")
+    proc = _run(argv, scratch)
+    assert proc.returncode == 0, f"{command}\n{proc.stdout[-3000:]}{proc.stderr[-3000:]}"
+
+
+@pytest.mark.slow
+def test_python_examples_run(tmp_path):
+    """The ``python`` blocks of README.md and data/README.md; the data/README.md snippet reads the
+    example CSV of the same document (saved as the my_impacts.csv it names)."""
+    data_readme = (REPO / "data" / "README.md").read_text()
+    (csv_example,) = re.findall(r"^```csv\n(.*?)^```", data_readme, flags=re.M | re.S)
+    (tmp_path / "my_impacts.csv").write_text(csv_example)
+    blocks = [b for p in DOCS for b in re.findall(r"^```python\n(.*?)^```", p.read_text(), flags=re.M | re.S)]
+    assert len(blocks) >= 2
+    for block in blocks:
+        proc = _run([sys.executable, "-c", block], tmp_path)
+        assert proc.returncode == 0, f"{block}\n{proc.stderr[-3000:]}"

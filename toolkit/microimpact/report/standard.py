@@ -1,0 +1,181 @@
+"""The standard figure of one result file (``microimpact plot RESULT.nc --out fig.png``).
+
+:func:`result_kind` recognises a result NetCDF by its content (variables, dimensions, groups), not
+by its name; :func:`standard_figure` draws the figure of that kind with the report's own figure
+functions (:mod:`.figures`), so a file plotted alone looks as it does in the PDF report.
+
+=================== =============================================== ==========================
+kind                recognised by                                   figure
+=================== =============================================== ==========================
+``phase_portraits`` a group ``portraits``                           :func:`.plot_phase_portraits`
+``fit``             ``e_n_measured`` and ``zeta_hertz``             :func:`.plot_fit`
+``flags``           ``rotation_sensitive``                          :func:`.plot_flags`
+``material_sweep``  attribute ``sweep_spec``, a ``radius`` dim      :func:`.plot_size_dependence`
+``sweep``           attribute ``sweep_spec``                        :func:`.plot_restitution_and_impulse`
+``bifurcation``     dimensions ``C1`` and ``C2``                    :func:`.plot_bifurcation_plane`
+``benchmark``       ``time_per_impact``                             :func:`.plot_work_precision`
+``kharaz``          ``tangential_restitution_curve``                :func:`.plot_kharaz`
+=================== =============================================== ==========================
+
+A sweep has further figures, as in the PDF report (``variant``, :data:`VARIANTS`): the energy-loss
+ratios (Figs. 7, 9, 11), and for a sweep of the fitted material at several sizes e_n and the
+impulse ratios at the median size.
+
+Files of the pipeline that hold numbers rather than curves (``fit_curves``, the dynamics summaries,
+the stress sweep) are recognised too, and refused with a message that says where they are drawn.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import xarray as xr
+
+from microimpact.report import figures
+from microimpact.report.inputs import at_radius, read_dataset, read_portraits
+
+__all__ = ["FIGURE_KINDS", "VARIANTS", "UnknownResultError", "result_kind", "standard_figure"]
+
+#: kinds that have a standard figure, and what it shows
+FIGURE_KINDS = {
+    "phase_portraits": "phase portraits of normal impacts (Fig. 5)",
+    "fit": "e_n(v_n) of the data with the fitted model (Fig. 3)",
+    "flags": "model e_n of each measured impact with its range under spin and angle error, flags marked",
+    "material_sweep": "e_n(v) per sphere size and the capture velocity against the size",
+    "sweep": "e_n and impulse ratios against the speed, one curve per swept value (Figs. 8-14)",
+    "bifurcation": "bifurcation plane (C1, C2) (Fig. 4)",
+    "benchmark": "work-precision diagram of the solvers",
+    "kharaz": "model against the oblique impacts of Kharaz et al. (2001)",
+}
+
+#: kind -> its figures; the first is the standard one (``microimpact plot --variant``)
+VARIANTS = {
+    "sweep": ("restitution", "energy_loss"),
+    "material_sweep": ("sizes", "restitution", "energy_loss"),
+}
+
+#: result files without a figure of their own -> where their numbers are shown
+NO_FIGURE = {
+    "fit_curves": "the model curves of a fit: draw them with the fit (microimpact plot fit.nc --curves FILE)",
+    "dynamics": "numbers of the nonlinear analysis: tables in the report (reports/report.pdf)",
+    "stress": "the stress sweep: its summary is a table in the report (reports/report.pdf)",
+}
+
+
+class UnknownResultError(ValueError):
+    """A file that is not a microimpact result file, or one without a standard figure."""
+
+
+def _open(path) -> xr.Dataset:
+    path = Path(path)
+    try:
+        return read_dataset(path)
+    except (OSError, ValueError) as exc:  # not NetCDF, or not readable as one
+        raise UnknownResultError(f"{path}: not a readable NetCDF result file ({exc})") from None
+
+
+def result_kind(path) -> str:
+    """The kind of a result NetCDF file (a key of :data:`FIGURE_KINDS` or of :data:`NO_FIGURE`).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A NetCDF file written by microimpact.
+
+    Raises
+    ------
+    UnknownResultError
+        The file cannot be read as NetCDF, or its content is none of the known kinds; the message
+        names the file.
+    """
+    import netCDF4
+
+    try:
+        with netCDF4.Dataset(os.fspath(path)) as nc:
+            if "portraits" in nc.groups:
+                return "phase_portraits"
+    except OSError as exc:
+        raise UnknownResultError(f"{path}: not a readable NetCDF result file ({exc.strerror or exc})") from None
+    ds = _open(path)
+    if "e_n_measured" in ds and "zeta_hertz" in ds:
+        return "fit"
+    if "rotation_sensitive" in ds:
+        return "flags"
+    if "sweep_spec" in ds.attrs:
+        return "material_sweep" if "radius" in ds.dims else "sweep"
+    if "C1" in ds.dims and "C2" in ds.dims:
+        return "bifurcation"
+    if "time_per_impact" in ds:
+        return "benchmark"
+    if "tangential_restitution_curve" in ds:
+        return "kharaz"
+    if "e_n" in ds and set(ds["e_n"].dims) == {"radius", "speed"}:
+        return "fit_curves"
+    if "capture_velocity" in ds and "critical_velocity" in ds:
+        return "dynamics"
+    if "case" in ds.dims and "stress" in str(ds.attrs.get("title", "")).lower():
+        return "stress"
+    raise UnknownResultError(f"{path}: not a microimpact result file of a known kind (the kinds with a figure: "
+                             f"{', '.join(FIGURE_KINDS)})")
+
+
+def standard_figure(path, *, curves=None, variant: str | None = None) -> figures.Plot:
+    """The standard figure of a result file, drawn by the report's figure functions.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A result NetCDF of a kind in :data:`FIGURE_KINDS`.
+    curves : str or os.PathLike, optional
+        For a ``fit``: its smooth model curves (``fit_curves.nc`` of the pipeline); without them
+        the model is drawn through the data points.
+    variant : str, optional
+        For a sweep, which of its figures (:data:`VARIANTS`): ``restitution`` (e_n and the
+        impulse ratios, the standard figure of a paper sweep), ``energy_loss`` (K_L, K_t), or
+        ``sizes`` (e_n per size and the capture velocity, the standard figure of a sweep at several
+        sizes); a sweep at several sizes is drawn at its median size for the first two.
+
+    Returns
+    -------
+    Plot
+        The figure and its caption.
+
+    Raises
+    ------
+    UnknownResultError
+        For an unknown file, a file of a kind without a figure, or ``curves`` given for another
+        kind; the message names the file.
+    """
+    kind = result_kind(path)
+    if kind in NO_FIGURE:
+        raise UnknownResultError(f"{path}: a '{kind}' result file has no standard figure ({NO_FIGURE[kind]})")
+    if curves is not None and kind != "fit":
+        raise UnknownResultError(f"{curves}: model curves go with a fit file, but {path} is a '{kind}' file")
+    if variant is not None and variant not in VARIANTS.get(kind, ()):
+        choices = f"its figures: {', '.join(VARIANTS[kind])}" if kind in VARIANTS else "it has one figure"
+        raise UnknownResultError(f"{path}: a '{kind}' result file has no figure {variant!r} ({choices})")
+    if kind == "phase_portraits":
+        return figures.plot_phase_portraits(read_portraits(path))
+    ds = _open(path)
+    if kind == "fit":
+        curve_ds = None
+        if curves is not None:
+            if result_kind(curves) != "fit_curves":
+                raise UnknownResultError(f"{curves}: not a file of model curves (e_n on radius x speed)")
+            curve_ds = _open(curves)
+        return figures.plot_fit(ds, curve_ds)
+    if kind in VARIANTS:
+        variant = variant or VARIANTS[kind][0]
+        if variant == "sizes":
+            return figures.plot_size_dependence(ds)
+        if kind == "material_sweep":
+            ds = at_radius(ds, ds.sizes["radius"] // 2)
+        return figures.plot_energy_loss(ds) if variant == "energy_loss" else figures.plot_restitution_and_impulse(ds)
+    draw = {
+        "flags": figures.plot_flags,
+        "bifurcation": figures.plot_bifurcation_plane,
+        "benchmark": figures.plot_work_precision,
+        "kharaz": figures.plot_kharaz,
+    }[kind]
+    return draw(ds)
