@@ -193,7 +193,7 @@ def stress_outputs(wildcards):
 #: result files (under results/, without .nc) that have a figure in reports/figures/ (figures.smk);
 #: the fit's figure (with its model curves) is made by the fit_figure rule
 FIGURE_RESULTS = (
-    ["analyst/flags"]
+    ["analyst/flags", "analyst/model_comparison", "analyst/posterior"]
     + [f"analyst/sweeps/case_{case}" for case in SWEEP_CASES]
     + ["paper/bifurcation", "paper/phase_portraits"]
     + [f"paper/sweeps/case_{case}" for case in SWEEP_CASES]

@@ -15,10 +15,13 @@ kind                recognised by                                   figure
 ``bifurcation``     dimensions ``C1`` and ``C2``                    :func:`.plot_bifurcation_plane`
 ``benchmark``       ``time_per_impact``                             :func:`.plot_work_precision`
 ``kharaz``          ``tangential_restitution_curve``                :func:`.plot_kharaz`
+``model_comparison`` ``aic`` and a ``normal_model`` dim           :func:`.plot_model_comparison`
+``posterior``       ``acceptance_fraction``                         :func:`.plot_corner`
+``oblique``         title "friction fit from oblique impacts"       :func:`.plot_oblique`
 =================== =============================================== ==========================
 
 A sweep has further figures, as in the PDF report (``variant``, :data:`VARIANTS`): the energy-loss
-ratios (Figs. 7, 9, 11), and for a sweep of the fitted material at several sizes e_n and the
+ratios (Figs. 7, 9, 11), the posterior's bands on the sweeps, and for a sweep of the fitted material at several sizes e_n and the
 impulse ratios at the median size.
 
 Files of the pipeline that hold numbers rather than curves (``fit_curves``, the dynamics summaries,
@@ -32,7 +35,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from microimpact.report import figures
+from microimpact.report import figures, models, posterior_figures
 from microimpact.report.inputs import at_radius, read_dataset, read_portraits
 
 __all__ = ["FIGURE_KINDS", "VARIANTS", "UnknownResultError", "result_kind", "standard_figure"]
@@ -47,12 +50,16 @@ FIGURE_KINDS = {
     "bifurcation": "bifurcation plane (C1, C2) (Fig. 4)",
     "benchmark": "work-precision diagram of the solvers",
     "kharaz": "model against the oblique impacts of Kharaz et al. (2001)",
+    "model_comparison": "e_n(v_n) of the data with each normal model's fitted curve (AIC/BIC in the report)",
+    "posterior": "corner plot of the posterior of the fitted parameters",
+    "oblique": "measured against fitted tangential outcome per incidence angle",
 }
 
 #: kind -> its figures; the first is the standard one (``microimpact plot --variant``)
 VARIANTS = {
     "sweep": ("restitution", "energy_loss"),
     "material_sweep": ("sizes", "restitution", "energy_loss"),
+    "posterior": ("corner", "sweep_bands"),
 }
 
 #: result files without a figure of their own -> where their numbers are shown
@@ -60,6 +67,7 @@ NO_FIGURE = {
     "fit_curves": "the model curves of a fit: draw them with the fit (microimpact plot fit.nc --curves FILE)",
     "dynamics": "numbers of the nonlinear analysis: tables in the report (reports/report.pdf)",
     "stress": "the stress sweep: its summary is a table in the report (reports/report.pdf)",
+    "oblique_without_rows": "a friction fit of data without oblique columns: nothing to draw",
 }
 
 
@@ -116,6 +124,12 @@ def result_kind(path) -> str:
         return "dynamics"
     if "case" in ds.dims and "stress" in str(ds.attrs.get("title", "")).lower():
         return "stress"
+    if "aic" in ds and "normal_model" in ds.dims:
+        return "model_comparison"
+    if "acceptance_fraction" in ds:
+        return "posterior"
+    if "friction fit from oblique" in str(ds.attrs.get("title", "")).lower():
+        return "oblique" if ds.data_vars else "oblique_without_rows"
     raise UnknownResultError(f"{path}: not a microimpact result file of a known kind (the kinds with a figure: "
                              f"{', '.join(FIGURE_KINDS)})")
 
@@ -165,6 +179,9 @@ def standard_figure(path, *, curves=None, variant: str | None = None) -> figures
                 raise UnknownResultError(f"{curves}: not a file of model curves (e_n on radius x speed)")
             curve_ds = _open(curves)
         return figures.plot_fit(ds, curve_ds)
+    if kind == "posterior":
+        variant = variant or VARIANTS[kind][0]
+        return posterior_figures.plot_corner(ds) if variant == "corner" else posterior_figures.plot_sweep_bands(ds)
     if kind in VARIANTS:
         variant = variant or VARIANTS[kind][0]
         if variant == "sizes":
@@ -177,5 +194,7 @@ def standard_figure(path, *, curves=None, variant: str | None = None) -> figures
         "bifurcation": figures.plot_bifurcation_plane,
         "benchmark": figures.plot_work_precision,
         "kharaz": figures.plot_kharaz,
+        "model_comparison": models.plot_model_comparison,
+        "oblique": posterior_figures.plot_oblique,
     }[kind]
     return draw(ds)

@@ -14,9 +14,9 @@ import math
 import numbers
 import sys
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from microimpact.io.provenance import contact_attributes
 from microimpact.io.variables import attributes
@@ -28,6 +28,9 @@ from microimpact.model.law import contact_potential_energy, nondimensional_scale
 from microimpact.model.coefficients import coefficients_kernel, impact_coefficients
 from microimpact.model.kinematics import ImpactResult, incident_velocity, slip_velocity
 from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_impulses, tangential_kernel, tangential_outcome
+
+if TYPE_CHECKING:  # xarray is imported by the batch functions only: one simulate_impact starts faster
+    import xarray as xr
 
 __all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES", "MIN_RTOL", "FAMILY_MIN_SPEEDS"]
 
@@ -46,7 +49,8 @@ RESULT_VARIABLES: tuple[str, ...] = (
 def _real_array(name: str, value) -> np.ndarray:
     """``value`` as a float array; TypeError naming ``name`` if it is not real numbers (text, a
     dict, None, bools, complex), ValueError if it is a ragged sequence."""
-    if isinstance(value, xr.DataArray):
+    xarray = sys.modules.get("xarray")  # a DataArray exists only once xarray is imported
+    if xarray is not None and isinstance(value, xarray.DataArray):
         value = value.values
     if value is None or isinstance(value, (str, bytes, bool, dict, set)):
         raise TypeError(f"{name} must be a real number or an array of them, got {type(value).__name__} {value!r}")
@@ -383,6 +387,8 @@ def _normal_dissipation(contact, normal_speed, captured, tracked):
 
 
 def _as_dataarray(name, value):
+    import xarray as xr  # on first batch use: 0.2 s of start-up that a single impact never needs
+
     if isinstance(value, xr.DataArray):
         return value.rename(name)
     a = np.asarray(value, dtype=float)
@@ -475,6 +481,8 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
 def _broadcast_inputs(inputs: dict):
     """Broadcast the inputs (plain arrays by numpy rules, then DataArrays by dimension name) and
     check them; returns the broadcast DataArrays and their flattened values."""
+    import xarray as xr  # on first batch use: 0.2 s of start-up that a single impact never needs
+
     plain = {k: _real_array(k, v) for k, v in inputs.items() if not isinstance(v, xr.DataArray)}
     for k, v in inputs.items():
         if isinstance(v, xr.DataArray):
@@ -596,6 +604,8 @@ def _direct_batch(contact, flat: dict, rtol: float):
 def _batch_dataset(arrays, results: dict) -> xr.Dataset:
     """The inputs and results of a batch as a Dataset with the inputs' dimensions and coordinates;
     every variable carries the ``units`` and ``long_name`` of :mod:`microimpact.io.variables`."""
+    import xarray as xr  # on first batch use: 0.2 s of start-up that a single impact never needs
+
     dims, shape = arrays[0].dims, arrays[0].shape
     coords = {name: c for a in arrays for name, c in a.coords.items()}
     ds = xr.Dataset(coords=coords)
