@@ -182,6 +182,8 @@ _MUST_BE_FINITE = ("max_penetration", "friction_impulse", "twist_impulse", "diss
 def _check_domain(contact, values: dict, normal_speed) -> None:
     """ModelDomainError if a result that must be finite overflowed in SI units (the nondimensional
     solve succeeded; its units did not)."""
+    if all(isinstance(values[name], float) and math.isfinite(values[name]) for name in _MUST_BE_FINITE):
+        return  # one impact, all finite: the common case, without numpy
     for name in _MUST_BE_FINITE:
         q = np.asarray(values[name], dtype=float)
         bad = ~np.isfinite(q)
