@@ -352,8 +352,9 @@ def test_changing_data_reruns_only_its_dependants(pipeline):
     # (and the normal models compared on the same data)
     assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "model_comparison", "report",
                          "fit_figure", "figure", "sweep_figure", "all"}, jobs
-    # the analyst's figures (flags, its sweeps and their further figures), not the paper's
-    assert jobs["figure"] == 1 + len(TINY_SWEEPS), jobs
+    # the analyst's figures (flags, model comparison, posterior, its sweeps and their further
+    # figures), not the paper's
+    assert jobs["figure"] == 3 + len(TINY_SWEEPS), jobs
     assert jobs["sweep_figure"] == len(TINY_SWEEPS) + 3, jobs  # restitution per case, energy loss of 2.1-2.3
 
 
