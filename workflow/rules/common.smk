@@ -25,10 +25,24 @@ config["fit"] = {
     k: (as_bool(v) if k != "weights" else v) for k, v in config["fit"].items()
 }
 # the posterior section is optional; its numbers may arrive as text from snakemake --config
-config["posterior"] = {"enabled": True, "walkers": 12, "steps": 80, "seed": 2002, "n_draws": 24, "full": False,
-                       "errors_in_variables": "auto", **config.get("posterior", {})}
-config["posterior"] = {k: (as_bool(v) if k in ("enabled", "full") else v if k == "errors_in_variables" else int(v))
-                       for k, v in config["posterior"].items()}
+config["posterior"] = {
+    "enabled": True,
+    "walkers": 12,
+    "steps": 80,
+    "seed": 2002,
+    "n_draws": 24,
+    "full": False,
+    "errors_in_variables": "auto",
+    **config.get("posterior", {}),
+}
+config["posterior"] = {
+    k: (
+        as_bool(v)
+        if k in ("enabled", "full")
+        else v if k == "errors_in_variables" else int(v)
+    )
+    for k, v in config["posterior"].items()
+}
 config["benchmark"] = {"quick": True, "throughput": False, **config["benchmark"]}
 config["benchmark"] = {k: as_bool(v) for k, v in config["benchmark"].items()}
 config["rtol"] = float(config["rtol"])

@@ -13,9 +13,9 @@ rule kharaz:
         "benchmarks/kharaz.tsv"
     conda:
         "../envs/microimpact.yaml"
+    threads: 1
     params:
         # sub-models of the "selected" model (config key contact_models; {} when absent)
         contact_models=config.get("contact_models", {}),
-    threads: 1
     script:
         "../scripts/kharaz.py"
