@@ -373,10 +373,11 @@ def test_hysteretic_captured_impacts_finish(changes):
 
 def test_elastic_mindlin_unchanged_by_the_hysteretic_settle():
     """The "mindlin" path of the coupled solver as before the hysteretic settle criterion: rebound
-    values of commit c09beb3 (rtol 1e-8), to 1e-6. The solver's own error on v_t at 10 deg is far
-    larger (4e-4: rtol 1e-8 against 1e-11), so 1e-6 still catches any change of the law; two runs
-    of the same code once differed by 6e-7 on that v_t (CI, cause not found), which a pin to
-    round-off would call a change."""
+    values of commit c09beb3 (rtol 1e-8). e_n to 1e-6; v_t to 1e-3, because at 10 deg it converges
+    slowly through the stick-slip events (rtol 1e-8, 1e-10, 1e-11 give 0.372557, 0.372655,
+    0.372704), so round-off of another build is amplified: 6e-7 between two runs here and 4.5e-5
+    with the lowest declared versions (CI). A pin tighter than the solver's accuracy is a pin to
+    one build."""
     from microimpact.solvers.coupled import solve_coupled
 
     c = WALL_1990.with_(shear_modulus=1e10, tangential_model="mindlin")
@@ -384,7 +385,7 @@ def test_elastic_mindlin_unchanged_by_the_hysteretic_settle():
     v = np.array([1.0, 3.0, 10.0, 20.0])
     got = solve_coupled(c, (-v * np.cos(a), v * np.sin(a), 0 * a), (0 * a, 0 * a, 0 * a), np.full(4, c.friction), rtol=1e-8)
     assert list(got["captured"]) == [True, False, False, False]
-    np.testing.assert_allclose(got["v_t"][1:], [0.3725573429204606, 5.183519498821398, 19.338238070975216], rtol=1e-6)
+    np.testing.assert_allclose(got["v_t"][1:], [0.3725573429204606, 5.183519498821398, 19.338238070975216], rtol=1e-3)
     np.testing.assert_allclose(got["e_n"][1:], [0.583000940126006, 0.6973413316956449, 0.3505601029520243], rtol=1e-6)
 
 
