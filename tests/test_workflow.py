@@ -487,6 +487,10 @@ def test_html_report_has_a_captioned_figure_of_every_result_file(pipeline):
 
     root, _ = pipeline
     proc = snakemake(root, "--report", "report.zip")
+    if proc.returncode != 0 and "raw.githubusercontent.com" in proc.stdout:
+        # Snakemake 8.17 (the lowest declared version, tested in CI) downloads its own LICENSE for
+        # the report; without network that fails inside Snakemake, before our files are read
+        pytest.skip("this Snakemake's --report needs network access (it fetches its LICENSE from GitHub)")
     assert proc.returncode == 0, proc.stdout[-3000:]
     import zipfile
 
