@@ -29,7 +29,7 @@ from microimpact.solvers import engine
 from microimpact.solvers.family import normal_family
 from microimpact.solvers.impact import simulate_many
 from microimpact.studies.benchmark.cases import ALL_METHODS, BenchmarkConfig, level_rtol
-from microimpact.studies.benchmark.harness import ObliqueResults, log, timed
+from microimpact.studies.benchmark.harness import ObliqueResults, random_oblique_batch, log, timed
 
 __all__ = ["run_engine_family", "family_targets", "fit_scaling", "FAMILY_TARGET_ERROR", "FAMILY_TARGET_DOP853_IMPACTS"]
 
@@ -90,20 +90,9 @@ def _dop853_time(tpi, err) -> tuple[float, float, str]:
     return float(tpi[i, j]), float(err[i, j]), "DOP853 did not reach 1e-9: its most accurate setting, a lower bound"
 
 
-def _million_batch(contact, n, seed=2026):
-    rng = np.random.default_rng(seed)
-    speed = np.exp(rng.uniform(np.log(0.3), np.log(30.0), n))
-    inc = rng.uniform(0.0, 85.0, n)
-    az = rng.uniform(0.0, 360.0, n)
-    w = speed * np.sin(np.radians(inc)) / contact.radius
-    om = (rng.uniform(-1, 1, n) * w, rng.uniform(-5, 5, n) * w, rng.uniform(-5, 5, n) * w)
-    fric = rng.uniform(0.05, 0.6, n)
-    return speed, inc, az, om, fric
-
-
 def _peak_bytes(contact, n) -> tuple[int, int]:
     """(tracemalloc peak, output bytes) of simulate_many on the family path for ``n`` impacts."""
-    speed, inc, az, om, fric = _million_batch(contact, n, seed=7)
+    speed, inc, az, om, fric = random_oblique_batch(contact, n, seed=7)
     gc.collect()
     tracemalloc.start()
     base = tracemalloc.get_traced_memory()[0]
@@ -116,7 +105,7 @@ def _peak_bytes(contact, n) -> tuple[int, int]:
 def family_targets(contact, cfg: BenchmarkConfig, tpi, err, verbose: bool = False) -> dict:
     """The million-impact target of the family path, its e_n error and memory growth."""
     n = cfg.family_impacts
-    speed, inc, az, om, fric = _million_batch(contact, n)
+    speed, inc, az, om, fric = random_oblique_batch(contact, n)
     simulate_many(contact, speed[:3000], inc[:3000], az[:3000], tuple(o[:3000] for o in om), fric[:3000],
                   rtol=FAMILY_TARGET_ERROR, family=True)  # compiled before timing
     t, ds = timed(lambda: simulate_many(contact, speed, inc, az, om, fric, rtol=FAMILY_TARGET_ERROR, family=True),

@@ -159,7 +159,9 @@ def engine_many_oblique(contact, cases, rtol) -> ObliqueResults:
 
 
 # =============================================================================== throughput / memory
-def _random_oblique_batch(contact, n, seed=12345):
+def random_oblique_batch(contact, n, seed=12345):
+    """Speeds [m/s] log-uniform in 0.5-100 m/s, incidence 10-80 deg, azimuth, spins up to 10x the rolling
+    spin [rad/s] and friction 0.15 or 0.5 of ``n`` random oblique impacts (distinct normal speeds)."""
     rng = np.random.default_rng(seed)
     speed = np.exp(rng.uniform(np.log(0.5), np.log(100.0), n))
     inc = rng.uniform(10.0, 80.0, n)
@@ -172,7 +174,7 @@ def _random_oblique_batch(contact, n, seed=12345):
 
 def measure_throughput(contact=WALL_1990, n=100_000, repeats=3, rtol=1e-10) -> dict:
     """Median wall time [s] of simulate_many on ``n`` random oblique impacts (distinct normal speeds)."""
-    speed, inc, az, om, fric = _random_oblique_batch(contact, n)
+    speed, inc, az, om, fric = random_oblique_batch(contact, n)
     simulate_many(contact, speed[:10], inc[:10], az[:10], tuple(o[:10] for o in om), fric[:10], rtol=rtol)
     t, ds = timed(lambda: simulate_many(contact, speed, inc, az, om, fric, rtol=rtol), repeats)
     n_distinct = int(np.unique(speed * np.cos(np.radians(inc))).size)
@@ -182,7 +184,7 @@ def measure_throughput(contact=WALL_1990, n=100_000, repeats=3, rtol=1e-10) -> d
 
 def measure_memory(contact=WALL_1990, n=10_000, rtol=1e-10) -> dict:
     """Peak traced Python/numpy memory [bytes] of simulate_many on ``n`` impacts, and its output size."""
-    speed, inc, az, om, fric = _random_oblique_batch(contact, n)
+    speed, inc, az, om, fric = random_oblique_batch(contact, n)
     gc.collect()
     tracemalloc.start()
     tracemalloc.reset_peak()
