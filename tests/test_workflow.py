@@ -351,11 +351,11 @@ def test_changing_data_reruns_only_its_dependants(pipeline):
     # the analyst's part follows the fit; the paper's part and the checks do not depend on the data
     # (and the normal models compared on the same data)
     assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "model_comparison", "report",
-                         "fit_figure", "figure", "sweep_figure", "all"}, jobs
-    # the analyst's figures (flags, model comparison, posterior, its sweeps and their further
-    # figures), not the paper's
-    assert jobs["figure"] == 3 + len(TINY_SWEEPS), jobs
-    assert jobs["sweep_figure"] == len(TINY_SWEEPS) + 3, jobs  # restitution per case, energy loss of 2.1-2.3
+                         "figures", "all"}, jobs
+    # the analyst's figures (one job draws them all), not the paper's or the checks'
+    assert jobs["figures"] == 1, jobs
+    outputs = re.findall(r"output: (reports/figures/\S+)", proc.stdout)
+    assert outputs == ["reports/figures/analyst"], outputs
 
 
 # --------------------------------------------------------------------------- profile, lint, config
@@ -568,7 +568,7 @@ def test_snakefile_runs_from_another_working_directory(tmp_path):
     proc = snakemake(tmp_path, "-s", str(REPO / "Snakefile"), "-d", str(elsewhere), "-n", "--cores", "1")
     assert proc.returncode == 0, proc.stdout[-3000:]
     counts = job_counts(proc.stdout)
-    assert counts.get("report") == 1 and counts.get("fit_figure") == 1, counts
+    assert counts.get("report") == 1 and counts.get("figures") == 3, counts  # the figures of each part
     assert not (elsewhere / "results").exists()  # a dry run writes no result
 
 

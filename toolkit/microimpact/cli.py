@@ -431,8 +431,7 @@ FIGURE_FORMATS = ("png", "pdf", "svg")
 
 
 def _cmd_plot(args) -> int:
-    from microimpact.io.files import atomic_path
-    from microimpact.report.standard import standard_figure
+    from microimpact.report.standard import FigureFile, save_standard_figure
 
     inputs = {"RESULT": check_input_file("RESULT", args.result)}
     if args.curves is not None:
@@ -442,10 +441,10 @@ def _cmd_plot(args) -> int:
     if fmt not in FIGURE_FORMATS:
         raise PathError("--out", args.out, f"has no figure suffix; give a file ending in "
                                            f"{', '.join('.' + f for f in FIGURE_FORMATS)}")
-    plot = standard_figure(inputs["RESULT"], curves=inputs.get("--curves"), variant=args.variant)
-    with reporting_os_errors({"--out": out}), atomic_path(out) as tmp:
-        plot.figure.savefig(tmp, format=fmt, dpi=args.dpi)
-    print(plot.caption)
+    figure = FigureFile(str(inputs["RESULT"]), str(out), inputs.get("--curves"), args.variant)
+    with reporting_os_errors({"--out": out}):
+        caption = save_standard_figure(figure, dpi=args.dpi)
+    print(caption)
     print(f"wrote {out}", file=sys.stderr)
     return 0
 

@@ -22,9 +22,12 @@ rule work_precision:
         "logs/work_precision.log",
     benchmark:
         "benchmarks/work_precision.tsv"
+    priority: 5  # the longest job off that path
     conda:
         "../envs/microimpact.yaml"
-    threads: 2  # the batch engine is timed on both cores
+    # the full study times the batch engine on both cores; the quick one (a check of the
+    # numbers, beside other jobs) leaves the second core to them
+    threads: 1 if config["benchmark"]["quick"] else 2
     params:
         quick=config["benchmark"]["quick"],
         throughput=config["benchmark"]["throughput"],

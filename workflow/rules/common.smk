@@ -204,36 +204,62 @@ def stress_outputs(wildcards):
 
 
 # ---------------------------------------------------------------- figures of the HTML report
-#: result files (under results/, without .nc) that have a figure in reports/figures/ (figures.smk);
-#: the fit's figure (with its model curves) is made by the fit_figure rule
-FIGURE_RESULTS = (
-    ["analyst/flags", "analyst/model_comparison", "analyst/posterior"]
-    + [f"analyst/sweeps/case_{case}" for case in SWEEP_CASES]
-    + ["paper/bifurcation", "paper/phase_portraits"]
-    + [f"paper/sweeps/case_{case}" for case in SWEEP_CASES]
-    + ["kharaz"]
-)
-FIGURE_RESULT_PATTERN = "|".join(re.escape(r) for r in FIGURE_RESULTS)
+#: the parts of the HTML report's figures: reports/figures/{part}/, one `figures` job each, so that
+#: new data redraws the analyst's figures only
+FIGURE_PARTS = ("analyst", "paper", "checks")
 #: Table 2 cases with an energy-loss figure in the paper (Figs. 7, 9, 11; the first entries of
 #: microimpact.report.figures.TABLE2_FIGURES, which a test compares with this list)
 ENERGY_LOSS_CASES = ("2.1", "2.2", "2.3")
+#: the figure files in reports/figures/{part}/ (for snakemake --report): NAME.png, and a sweep's
+#: further figures sweeps/case_C.VARIANT.png
+FIGURE_PATTERNS = [
+    "{result,[^.]+|sweeps/case_[0-9.]*[0-9]}.png",
+    "{result,sweeps/case_[0-9.]*[0-9]}.{variant,restitution|energy_loss}.png",
+]
+
+
+def part_figures(part):
+    """The figures of reports/figures/{part}/: dicts of the result file, the figure's name (its
+    path in the directory, without .png) and the variant (microimpact plot --variant), as in the
+    PDF: the analyst's sweeps also at the median size, and the energy-loss ratios of the cases that
+    have them in the paper."""
+    if part == "checks":
+        return [dict(result="results/kharaz.nc", name="kharaz", variant=None)]
+    names = {
+        "analyst": ["fit", "flags", "model_comparison", "posterior"],
+        "paper": ["bifurcation", "phase_portraits"],
+    }[part]
+    names += [f"sweeps/case_{c}" for c in SWEEP_CASES]
+    figures = [
+        dict(result=f"results/{part}/{n}.nc", name=n, variant=None) for n in names
+    ]
+    variants = [("energy_loss", c) for c in SWEEP_CASES if c in ENERGY_LOSS_CASES]
+    if part == "analyst":
+        variants = [("restitution", c) for c in SWEEP_CASES] + variants
+    figures += [
+        dict(
+            result=f"results/{part}/sweeps/case_{c}.nc",
+            name=f"sweeps/case_{c}.{v}",
+            variant=v,
+        )
+        for v, c in variants
+    ]
+    return figures
+
+
+def part_figure_inputs(wildcards):
+    """The result files of a part's figures (and the fit's model curves)."""
+    files = {f["result"] for f in part_figures(wildcards.part)}
+    inputs = {"results": sorted(files)}
+    if wildcards.part == "analyst":
+        inputs["curves"] = "results/analyst/fit_curves.nc"
+    return inputs
 
 
 def report_figures(wildcards=None):
-    """Every figure of the HTML report (the benchmark's is an output of the work_precision rule)."""
-    figures = ["reports/figures/analyst/fit.png"]
-    figures += [f"reports/figures/{r}.png" for r in FIGURE_RESULTS]
-    # the sweeps' further figures, as in the PDF (the sweep_figure rule): the analyst's cases at the
-    # median size, and the energy-loss ratios of the cases that have them in the paper
-    figures += [
-        f"reports/figures/analyst/sweeps/case_{c}.restitution.png" for c in SWEEP_CASES
-    ]
-    figures += [
-        f"reports/figures/{part}/sweeps/case_{c}.energy_loss.png"
-        for c in SWEEP_CASES
-        if c in ENERGY_LOSS_CASES
-        for part in ("analyst", "paper")
-    ]
+    """Every figure of the HTML report: the parts' directories, and the benchmark's figure (an
+    output of the work_precision rule)."""
+    figures = [f"reports/figures/{part}" for part in FIGURE_PARTS]
     if BENCHMARK_ENABLED:
         figures.append("results/benchmark/work_precision.png")
     return figures

@@ -12,6 +12,7 @@ rule validate_data:
         "logs/validate_data.log",
     benchmark:
         "benchmarks/validate_data.tsv"
+    priority: 10  # on the path to the report (data, fit, what uses the fit): started first
     conda:
         "../envs/microimpact.yaml"
     params:

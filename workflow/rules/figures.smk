@@ -1,67 +1,31 @@
 # The figures of the HTML report (snakemake --report report.html): the standard figure of each
-# result file, as `microimpact plot` draws it (microimpact.report.standard), with a caption from
-# workflow/report/. The PDF report (report.smk) lays out the same figure functions on A4 pages.
+# result file, as `microimpact plot` draws it (microimpact.report.standard), with its caption from
+# workflow/report/figure.rst. One job per part (FIGURE_PARTS) draws all of that part's figures: a
+# job per figure cost a process start and the imports (1.5-2 s) for 0.3 s of drawing. The PDF
+# report (report.smk) lays out the same figure functions on A4 pages.
 
 
-rule fit_figure:
+rule figures:
     input:
-        result=rules.fit.output[0],
-        curves=rules.material_simulations.output.fit_curves,
+        unpack(part_figure_inputs),
     output:
         report(
-            "reports/figures/analyst/fit.png",
-            caption="../report/fit.rst",
-            category="A. The analyst's material",
-        ),
-    log:
-        "logs/figures/analyst/fit.log",
-    conda:
-        "../envs/microimpact.yaml"
-    threads: 1
-    script:
-        "../scripts/figure.py"
-
-
-rule figure:
-    input:
-        result="results/{result}.nc",
-    output:
-        report(
-            "reports/figures/{result}.png",
+            directory("reports/figures/{part}"),
+            patterns=FIGURE_PATTERNS,
             caption="../report/figure.rst",
             category="Figures",
-            subcategory="{result}",
+            subcategory="{part}",
         ),
     log:
-        "logs/figures/{result}.log",
+        "logs/figures/{part}.log",
+    benchmark:
+        "benchmarks/figures_{part}.tsv"
     wildcard_constraints:
-        result=FIGURE_RESULT_PATTERN,
+        part="|".join(FIGURE_PARTS),
     conda:
         "../envs/microimpact.yaml"
-    threads: 1
-    script:
-        "../scripts/figure.py"
-
-
-rule sweep_figure:
-    input:
-        result="results/{part}/sweeps/case_{case}.nc",
-    output:
-        report(
-            "reports/figures/{part}/sweeps/case_{case}.{variant}.png",
-            caption="../report/sweep_figure.rst",
-            category="Figures",
-            subcategory="{part}/sweeps/case_{case}",
-        ),
-    log:
-        "logs/figures/{part}/sweeps/case_{case}.{variant}.log",
-    wildcard_constraints:
-        part="analyst|paper",
-        variant="restitution|energy_loss",
-    conda:
-        "../envs/microimpact.yaml"
-    threads: 1
+    threads: 1  # drawn in turn: the other core runs the next job meanwhile
     params:
-        variant="{variant}",
+        figures=lambda wildcards: part_figures(wildcards.part),
     script:
-        "../scripts/figure.py"
+        "../scripts/figures.py"

@@ -19,6 +19,7 @@ rule fit:
         "logs/fit.log",
     benchmark:
         "benchmarks/fit.tsv"
+    priority: 10  # on the path to the report (data, fit, what uses the fit): started first
     conda:
         "../envs/microimpact.yaml"
     threads: 1
@@ -49,6 +50,7 @@ rule flags:
         "logs/flags.log",
     benchmark:
         "benchmarks/flags.tsv"
+    priority: 10  # on the path to the report (data, fit, what uses the fit): started first
     conda:
         "../envs/microimpact.yaml"
     threads: 1
@@ -71,6 +73,7 @@ rule material_simulations:
         "logs/material_simulations.log",
     benchmark:
         "benchmarks/material_simulations.tsv"
+    priority: 10  # on the path to the report (data, fit, what uses the fit): started first
     conda:
         "../envs/microimpact.yaml"
     threads: 1

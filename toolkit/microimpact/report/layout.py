@@ -8,22 +8,26 @@ PDF is searchable. Nothing here knows what a result file contains (that is :mod:
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import multiprocessing
 import textwrap
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+import matplotlib
 import numpy as np
 import pandas as pd
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.text import Text
 
 from microimpact.io.files import atomic_path
 from microimpact.io.formatting import format_cell
 
-__all__ = ["PAGE_SIZE", "DPI", "Layout", "Page", "wrap"]
+__all__ = ["PAGE_SIZE", "DPI", "Layout", "Page", "fork_map", "render_figures", "wrap"]
 
 #: A4 portrait [in]
 PAGE_SIZE = (8.27, 11.69)
@@ -32,6 +36,7 @@ DPI = 160
 MARGIN_X = 0.65  # in
 TOP = 0.75  # in, below the top edge: running header
 BOTTOM = 0.75  # in, above the bottom edge: footer
+FOOTNOTE_Y = 0.9  # in, above the bottom edge: the title page's footnote
 TEXT_WIDTH = PAGE_SIZE[0] - 2 * MARGIN_X
 BODY_PT = 8.5
 TABLE_PT = 6.6
@@ -245,7 +250,7 @@ class Layout:
         def text(x, y, s, **kw):
             fig.text(x / W, 1 - y / H, s, va="top", **kw)
 
-        text(MARGIN_X, 1.3, "\n".join(textwrap.wrap(self.title, 48)), fontsize=20, fontweight="bold", linespacing=1.25)
+        text(MARGIN_X, 1.3, "\n".join(textwrap.wrap(self.title, 42)), fontsize=20, fontweight="bold", linespacing=1.25)
         text(MARGIN_X, 2.35, "\n".join(textwrap.wrap(subtitle, 95)), fontsize=9, linespacing=1.35)
         if warning:
             text(MARGIN_X, 3.25, warning, fontsize=11, fontweight="bold", color="#b00000")
@@ -260,12 +265,15 @@ class Layout:
         y += 0.2
         text(MARGIN_X, y, "Contents", fontsize=12, fontweight="bold")
         y += 0.3
+        # a long contents list is set closer, so that it ends above the footnote
+        step = min(0.19, (H - FOOTNOTE_Y - 0.15 - y) / max(1, len(self.contents)))
+        size = 9 * min(1.0, step / 0.17)
         for name, page in self.contents:
             part = not name[:1].isdigit()
-            text(MARGIN_X + (0 if part else 0.2), y, name, fontsize=9, fontweight="bold" if part else "normal")
-            text(W - MARGIN_X, y, f"page {page + 2}", fontsize=9, ha="right")
-            y += 0.19
-        text(MARGIN_X, H - 0.9, "\n".join(textwrap.wrap(footnote, 110)), fontsize=7.5, color="0.35")
+            text(MARGIN_X + (0 if part else 0.2), y, name, fontsize=size, fontweight="bold" if part else "normal")
+            text(W - MARGIN_X, y, f"page {page + 2}", fontsize=size, ha="right")
+            y += step
+        text(MARGIN_X, H - FOOTNOTE_Y, "\n".join(textwrap.wrap(footnote, 110)), fontsize=7.5, color="0.35")
         self.pages.insert(0, Page(fig, "title", 0.0))
 
     def save(self, path, metadata: Mapping[str, str], *, workers: int = 1) -> None:
@@ -276,7 +284,7 @@ class Layout:
         for (ax, _), image in zip(self._figures, render_figures([f for _, f in self._figures], workers)):
             ax.imshow(image, interpolation="none", aspect="auto")
         n = len(self.pages)
-        with atomic_path(path) as tmp:
+        with atomic_path(path) as tmp, _pdf_fonts(self.pages):
             with PdfPages(tmp, metadata=dict(metadata)) as pdf:
                 for k, page in enumerate(self.pages, start=1):
                     fig = page.figure
@@ -294,6 +302,35 @@ class Layout:
         fig.add_artist(Line2D([x0, x1], [y, y], transform=fig.transFigure, color="0.6", lw=0.5))
 
 
+def _core_fonts_suffice(pages) -> bool:
+    """Whether every text of ``pages`` is in the encoding of the PDF core fonts (cp1252)."""
+    for page in pages:
+        for text in page.figure.findobj(Text):
+            try:
+                text.get_text().encode("cp1252")
+            except UnicodeEncodeError:
+                return False
+    return True
+
+
+@contextlib.contextmanager
+def _pdf_fonts(pages):
+    """Write the text with the PDF core fonts (Helvetica, Courier; not embedded) where they can
+    show every character. Embedding DejaVu instead, glyph by glyph, was about 3.5 s of a 10 s
+    report (some 100,000 glyphs of tables and captions); text with a character outside cp1252
+    (a user's title, a file name) keeps the embedded fonts, so nothing is replaced by "?"."""
+    core = _core_fonts_suffice(pages)
+    quiet = logging.getLogger("matplotlib.font_manager")
+    level = quiet.level
+    if core:  # the core fonts' metrics name the weight "medium": matplotlib warns for each text
+        quiet.setLevel(logging.ERROR)
+    try:
+        with matplotlib.rc_context({"pdf.use14corefonts": core}):
+            yield
+    finally:
+        quiet.setLevel(level)
+
+
 def _render(fig: Figure) -> np.ndarray:
     """The figure as an RGBA image at :data:`DPI`."""
     canvas = FigureCanvasAgg(fig)
@@ -302,25 +339,35 @@ def _render(fig: Figure) -> np.ndarray:
     return np.asarray(canvas.buffer_rgba()).copy()
 
 
-_TO_RENDER: list = []  # the figures of render_figures, inherited by the forked workers
+_FORKED: list = []  # (function, items) of fork_map, inherited by the forked workers
 
 
-def _render_index(k: int) -> np.ndarray:
-    return _render(_TO_RENDER[k])
+def _call_forked(k: int):
+    func, items = _FORKED
+    return func(items[k])
+
+
+def fork_map(func, items: list, workers: int = 1) -> list:
+    """``[func(x) for x in items]``, by ``workers`` forked processes where that helps.
+
+    The workers inherit ``func`` and ``items`` (matplotlib figures, open datasets): nothing is
+    pickled but the index and the result. With one worker, one item, or where ``fork`` is not
+    available, the items are processed here in turn; the results are the same.
+    """
+    if workers <= 1 or len(items) < 2 or "fork" not in multiprocessing.get_all_start_methods():
+        return [func(x) for x in items]
+    _FORKED[:] = [func, items]
+    try:
+        with multiprocessing.get_context("fork").Pool(min(workers, len(items))) as pool:
+            return pool.map(_call_forked, range(len(items)), chunksize=1)
+    finally:
+        _FORKED.clear()
 
 
 def render_figures(figures: list, workers: int = 1) -> list:
-    """RGBA images of ``figures``, drawn by ``workers`` processes.
+    """RGBA images of ``figures``, drawn by ``workers`` processes (:func:`fork_map`).
 
     Drawing the figures is most of the report's time (about 0.4 s each); they are independent, so
-    forked workers draw them side by side (each inherits the figures, nothing is pickled but the
-    images). With one worker, or where ``fork`` is not available, they are drawn here in turn.
+    forked workers draw them side by side.
     """
-    if workers <= 1 or len(figures) < 2 or "fork" not in multiprocessing.get_all_start_methods():
-        return [_render(f) for f in figures]
-    _TO_RENDER[:] = figures
-    try:
-        with multiprocessing.get_context("fork").Pool(min(workers, len(figures))) as pool:
-            return pool.map(_render_index, range(len(figures)), chunksize=1)
-    finally:
-        _TO_RENDER.clear()
+    return fork_map(_render, figures, workers)

@@ -31,14 +31,18 @@ the stress sweep) are recognised too, and refused with a message that says where
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import xarray as xr
 
 from microimpact.report import figures, models, posterior_figures
+from microimpact.io.files import atomic_path
 from microimpact.report.inputs import at_radius, read_dataset, read_portraits
+from microimpact.report.layout import fork_map
 
-__all__ = ["FIGURE_KINDS", "VARIANTS", "UnknownResultError", "result_kind", "standard_figure"]
+__all__ = ["FIGURE_KINDS", "VARIANTS", "FigureFile", "UnknownResultError", "result_kind", "save_standard_figure",
+           "save_standard_figures", "standard_figure"]
 
 #: kinds that have a standard figure, and what it shows
 FIGURE_KINDS = {
@@ -198,3 +202,32 @@ def standard_figure(path, *, curves=None, variant: str | None = None) -> figures
         "oblique": posterior_figures.plot_oblique,
     }[kind]
     return draw(ds)
+
+
+@dataclass(frozen=True)
+class FigureFile:
+    """One standard figure to save: the result file, the figure file (its suffix gives the format:
+    png, pdf or svg) and the options of :func:`standard_figure`."""
+
+    result: str
+    out: str
+    curves: str | None = None
+    variant: str | None = None
+
+
+def save_standard_figure(file: FigureFile, dpi: float = 150.0) -> str:
+    """Draw the standard figure of ``file.result`` and write it to ``file.out`` atomically (its
+    directory is made if missing); returns the caption."""
+    plot = standard_figure(file.result, curves=file.curves, variant=file.variant)
+    out = Path(file.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(out) as tmp:
+        plot.figure.savefig(tmp, format=out.suffix.lower().lstrip("."), dpi=dpi)
+    return plot.caption
+
+
+def save_standard_figures(files, *, workers: int = 1, dpi: float = 150.0) -> list[str]:
+    """:func:`save_standard_figure` for each of ``files``, by ``workers`` forked processes (one
+    process start and one import for a whole set of figures: the HTML report's figures cost about
+    0.3 s each this way, against 1.5-2 s as one job each). Returns the captions in order."""
+    return fork_map(lambda f: save_standard_figure(f, dpi), list(files), workers)

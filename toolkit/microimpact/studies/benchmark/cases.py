@@ -82,7 +82,8 @@ class BenchmarkConfig:
     Setting k of the adaptive methods is rtol = 10^-(4+k) (:func:`level_rtol`); setting k of the
     Runge-Kutta-Gill method is N = 25 * 2^k steps per contact (:func:`level_steps`).
     ``time_limit`` [s] is the time per impact after which a scipy setting and the tighter ones
-    are dropped; ``reference_rtols`` are the loose and the tight rtol of the reference.
+    are dropped; an oblique case over ``oblique_time_limit`` [s] is marked timed out (and said
+    so in the notes); ``reference_rtols`` are the loose and the tight rtol of the reference.
     """
 
     quick: bool
@@ -101,6 +102,7 @@ class BenchmarkConfig:
     throughput_repeats: int
     memory_sizes: tuple
     time_limit: float
+    oblique_time_limit: float = 12.0
     reference_rtols: tuple = (1e-12, 1e-13)
     #: engine_family: distinct normal speeds per evaluation; impacts of the family target and how
     #: many of them are checked against tight direct solves
@@ -132,6 +134,7 @@ class BenchmarkConfig:
             engine_levels=(0, 2, 4, 6, 8), scipy_levels=(0, 2, 4), rkg_levels=(0, 2, 4, 6),
             oblique=_OBLIQUE_QUICK, repeats_single=5, repeats_scipy=1, repeats_batch=3, batch_size=1000,
             throughput_impacts=20_000, throughput_repeats=1, memory_sizes=(2_000, 20_000), time_limit=1.0,
+            oblique_time_limit=0.5,  # RK45 settles a captured case in 2.4 s: quick marks it timed out
             reference_rtols=(1e-11, 1e-12), family_size=20_000, family_impacts=100_000, family_check=3_000, fit_rows=10_000, family_oblique=False,
         )
 

@@ -176,9 +176,9 @@ def _run_scipy(contact, speeds, cases, cfg: BenchmarkConfig, table: _Table, note
                              "tighter settings not run")
                 log(notes[-1], verbose)
                 continue
-            _, _, obl = run_reference(contact, (), cases, rt, method=method, limit=4 * cfg.time_limit)
+            _, _, obl = run_reference(contact, (), cases, rt, method=method, limit=cfg.oblique_time_limit)
             table.record(method, k, float(np.median(times)), e_n, obl, len(speeds))
-            notes.extend(_oblique_notes(method, rt, obl, 4 * cfg.time_limit))
+            notes.extend(_oblique_notes(method, rt, obl, cfg.oblique_time_limit))
             log(f"{method} rtol {rt:g}: {np.median(times) * 1e3:.2f} ms, err {table.get('max_error_e_n', method, k):.2e}",
                 verbose)
 
