@@ -120,9 +120,11 @@ class Deadline:
         as a result."""
         if not self.limited:
             return None
+        calls = [0]  # counted here: lmfit's own count restarts inside conf_interval
 
         def iter_cb(params, nfev, resid, *args, **kwargs):
-            self.check(f"{nfev} function evaluations of {stage}")
+            calls[0] += 1
+            self.check(f"{calls[0]} function evaluations of {stage}")
 
         return iter_cb
 
