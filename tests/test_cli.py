@@ -103,3 +103,15 @@ def test_subprocess_good_and_bad():
     assert bad.returncode == 2 and bad.stdout == ""
     assert bad.stderr.startswith("microimpact: error:") and len(bad.stderr.splitlines()) == 1
     assert "--speed" in bad.stderr
+
+
+def test_time_budget_status_and_generous_budget(tmp_path, capsys):
+    """--time-budget: exit status 3 when spent (documented in --help); a generous budget runs as
+    without one (the values: tests/test_time_budget.py)."""
+    assert "3 the computation ran past --time-budget" in " ".join(cli.build_parser().format_help().split())
+    assert cli.main(["sweep", "--case", "2.2", "--out", str(tmp_path / "a.nc"), "--time-budget", "1e6"]) == 0
+    capsys.readouterr()
+    assert cli.main(["sweep", "--case", "2.2", "--out", str(tmp_path / "c.nc"), "--time-budget", "1e-9"]) == 3
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "time budget of 1e-09 s exceeded" in err and "--time-budget" in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.nc"]

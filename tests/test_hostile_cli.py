@@ -2,9 +2,11 @@
 
 Every case is a dict: ``argv`` (paths relative to a fresh work directory, see :func:`workspace`),
 ``culprit`` (words of which at least one must be in the error: the option, field, file or column at
-fault) and optionally ``readonly`` (the directory ``ro`` is not writable). Each case asserts
+fault) and optionally ``readonly`` (the directory ``ro`` is not writable) and ``status`` (3: the
+computation ran past its ``--time-budget``; default 2). Each case asserts
 
-* exit status 2 and a first stderr line ``microimpact: error: ...`` naming the culprit, no traceback;
+* exit status 2 and a first stderr line ``microimpact: error: ...`` naming the culprit, no traceback
+  (status 3: one such line, the last, after what the command announced before the work);
 * nothing written: the work directory holds the same files (hidden ones included) afterwards, so
   no output, partial output or temporary file exists;
 * every input byte-identical by sha256 (the work directory's files and the bundled materials config).
@@ -72,6 +74,10 @@ EXTREME = [("stiffness", "1e300"), ("density", "1e-300"), ("radius", "1e300"), (
            ("adhesion-line-force", "1e-300")]
 BAD_RTOL = ["0", "-1", "1", "2", "nan", "inf", "-1e-8", "abc", "1e-400", "1e-300", "1e-16"]
 BAD_SPEED = ["0", "-1", "-1e-6", "1e-300", "1e300", "nan", "inf", "-inf", "abc", "", "1e-200"]
+BAD_TIME_BUDGET = ["0", "-1", "-0", "nan", "inf", "-inf", "abc", ""]
+#: the commands that take --time-budget, each with its outputs
+BUDGETED = [[*FIT, "--out", "f.nc"], [*FLAGS, "--out", "o.csv", "--nc", "o.nc"], ["sweep", "--case", "2.1", "--out", "s.nc"],
+            ["reproduce", "--out", "r.md"]]
 
 
 def _field(option):
@@ -176,6 +182,14 @@ def _cases():
     add(["fit", "data.csv"], ["--out"])
     add(["flags", "data.csv", "--out", "o.csv"], ["--fit"])
     add(["reproduce"], ["--out"])
+    # ---- time budgets: a bad one is a usage error; a tiny one is spent by the first check (status 3)
+    for cmd in BUDGETED:
+        for value in BAD_TIME_BUDGET:
+            add([*cmd, "--time-budget", value], ["--time-budget"])
+        add([*cmd, "--time-budget", "1e-9"], ["--time-budget"], reason=["time budget of 1e-09 s exceeded after"],
+            status=3)
+    add([*FIT, "--out", "f.nc", "--posterior", "p.nc", "--oblique-out", "b.nc", "--time-budget", "1e-9"],
+        ["--time-budget"], status=3)
     add([], ["command"])
     add(["nosuch"], ["nosuch"])
     return cases
@@ -281,9 +295,14 @@ def test_hostile_case(case, workspace, monkeypatch, capsys):
     finally:
         (workspace / "ro").chmod(0o755)
     out, err = capsys.readouterr()
-    assert status == 2, (out, err)
-    first = err.splitlines()[0] if err else ""
-    assert first.startswith("microimpact: error: "), err
+    assert status == case.get("status", 2), (out, err)
+    lines = err.splitlines()
+    errors = [line for line in lines if line.startswith("microimpact: error: ")]
+    assert len(errors) == 1, err
+    first = errors[0]
+    assert first == (lines[-1] if status == 3 else lines[0]), err
+    if status == 3:
+        assert out == "", out
     assert "Traceback" not in err and "Traceback" not in out
     assert any(word in err for word in case["culprit"]), err
     for word in case.get("reason", []):

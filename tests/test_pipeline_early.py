@@ -98,3 +98,15 @@ def test_missing_and_broken_materials_config_are_refused(root):
     refused(dry_run(root, "materials=data/none.yaml"), root, "'materials'", "does not exist")
     (root / "data" / "bad_materials.yaml").write_text("pairs:\n  x_on_y: {density: -1}\n")
     refused(dry_run(root, "materials=data/bad_materials.yaml"), root, "'materials'", "x_on_y")
+
+
+def test_fit_time_budget_is_checked_at_start(tmp_path):
+    # optional (no limit by default); the schema refuses text and numbers <= 0, but lets NaN through
+    import yaml
+
+    other = make_copy(tmp_path / "wf")
+    cfg = other / "workflow" / "config" / "config.yaml"
+    data = yaml.safe_load(cfg.read_text())
+    data["fit"]["time_budget"] = float("nan")
+    cfg.write_text(yaml.safe_dump(data, sort_keys=False))
+    refused(dry_run(other), other, "'fit'", "time_budget", "nan")

@@ -1,7 +1,9 @@
 """Command line: ``microimpact simulate | sweep | fit | flags | target | reproduce | benchmark | plot | workflow``.
 
-Thin: parse, call the library, print or write. Bad arguments print one line
-``microimpact: error: ...`` to stderr and exit with status 2; nothing is written then.
+Thin: parse, call the library, print or write. Exit statuses: 0 success; 2 bad arguments, inputs
+or a solver failure (one line ``microimpact: error: ...`` on stderr); 3 the computation ran past
+``--time-budget SECONDS`` (``fit``, ``flags``, ``sweep``, ``reproduce``; one such line naming the
+budget). Nothing is written on an error: outputs are written, atomically, only after the work.
 
 Each command imports the part of the library it runs inside its own function: ``microimpact
 --help`` or ``microimpact simulate`` then never loads lmfit, pandas or the report, which keeps the
@@ -25,13 +27,17 @@ from microimpact.io.paths import (PathError, check_input_file, check_output_dir,
 from microimpact.model.contact import SUB_MODELS, Contact
 from microimpact.model.parameters import TABLE2_CASES
 from microimpact.presets import PRESETS, get_preset
-from microimpact.solvers import DEFAULT_RTOL, METHODS
+from microimpact.solvers import DEFAULT_RTOL, METHODS, TimeBudgetExceeded
 
 __all__ = ["main", "build_parser"]
 
 
 class UsageError(Exception):
     """A user error: reported in one line, exit status 2."""
+
+
+#: exit status of a computation that ran past its ``--time-budget`` (2 is a usage or solver error)
+EXIT_TIME_BUDGET = 3
 
 
 #: a negative number as an option's value: ``--radius -1e-6``, ``--omega-n -.5``, ``--speed -inf``.
@@ -125,7 +131,10 @@ def _cmd_simulate(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="microimpact", description="Microsphere contact/impact with smooth, flat surfaces.")
+    parser = _Parser(prog="microimpact", description="Microsphere contact/impact with smooth, flat surfaces.",
+                     epilog=f"Exit status: 0 success; 2 bad arguments or inputs, or a solver failure; "
+                            f"{EXIT_TIME_BUDGET} the computation ran past --time-budget (fit, flags, sweep, "
+                            "reproduce). Nothing is written on an error.")
     parser.add_argument("--version", action="version", version=f"microimpact {__version__}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
 
@@ -146,6 +155,12 @@ def build_parser() -> argparse.ArgumentParser:
                      register_benchmark, register_plot, register_workflow):
         register(sub)
     return parser
+
+
+def _add_time_budget(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--time-budget", type=_positive_float, default=None, metavar="SECONDS",
+                   help=f"stop with exit status {EXIT_TIME_BUDGET}, writing nothing, once the computation has run "
+                        "this long (wall clock; default: no limit)")
 
 
 def _add_rtol(p: argparse.ArgumentParser) -> None:
@@ -202,7 +217,8 @@ def _cmd_fit(args) -> int:
         posterior = {k: v for k, v in posterior.items() if v is not None}
     result = analyse_impacts(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
                              confidence_intervals=not args.no_confidence_intervals, posterior=posterior,
-                             errors_in_variables=args.errors_in_variables, rtol=args.rtol, progress=True)
+                             errors_in_variables=args.errors_in_variables, rtol=args.rtol, progress=True,
+                             time_budget=args.time_budget)
     with reporting_os_errors(outputs):
         written = result.save(out, outputs.get("--posterior"), outputs.get("--oblique-out"))
     print(result.report())
@@ -222,6 +238,7 @@ def register_fit(sub) -> None:
     _add_rtol(p)
     p.add_argument("--out", required=True, help="output NetCDF of the fit")
     _add_posterior_options(p)
+    _add_time_budget(p)
     p.set_defaults(func=_cmd_fit)
 
 
@@ -264,7 +281,7 @@ def _cmd_flags(args) -> int:
     table, _ = _impacts_for_pair(args)
     posterior = _load_posterior(args.posterior)
     ds = flag_measurements(table, fit, spin_bound=args.spin_bound, angle_uncertainty_deg=args.angle_uncertainty_deg,
-                           rtol=args.rtol, progress=True, posterior=posterior)
+                           rtol=args.rtol, progress=True, posterior=posterior, time_budget=args.time_budget)
     with reporting_os_errors(outputs):
         write_flags(ds, out, nc)
     n = ds.sizes["impact"]
@@ -304,6 +321,7 @@ def register_flags(sub) -> None:
     p.add_argument("--posterior", default=None, metavar="NC",
                    help="posterior NetCDF of 'microimpact fit --posterior': flags and spin ranges over its draws")
     _add_rtol(p)
+    _add_time_budget(p)
     p.set_defaults(func=_cmd_flags)
 
 
@@ -358,7 +376,7 @@ def _cmd_sweep(args) -> int:
         raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(TABLE2_CASES)}")
     contact = contact_from_args(args)
     out = check_outputs({"--out": args.out})["--out"]
-    ds = run_sweep(contact, case=args.case, rtol=args.rtol, progress=True)
+    ds = run_sweep(contact, case=args.case, rtol=args.rtol, progress=True, time_budget=args.time_budget)
     with reporting_os_errors({"--out": out}):
         write_netcdf(ds, out)
     print(f"case {args.case}: {dict(ds.sizes)} impacts, {int(ds['outcome'].sum())} captured; wrote {out}")
@@ -372,6 +390,7 @@ def register_sweep(sub) -> None:
     p.add_argument("--case", required=True, help=f"Table 2 case: {', '.join(TABLE2_CASES)} (grids: microimpact.model.parameters)")
     _add_rtol(p)
     p.add_argument("--out", required=True, help="output NetCDF")
+    _add_time_budget(p)
     p.set_defaults(func=_cmd_sweep)
 
 
@@ -379,7 +398,7 @@ def _cmd_reproduce(args) -> int:
     from microimpact.studies.reproduction import reproduction_table, write_reproduction_markdown
 
     out = check_outputs({"--out": args.out})["--out"]
-    table = reproduction_table()
+    table = reproduction_table(time_budget=args.time_budget)
     with reporting_os_errors({"--out": out}):
         write_reproduction_markdown(table, out)
     print(f"wrote {out}")
@@ -390,6 +409,7 @@ def register_reproduce(sub) -> None:
     """``microimpact reproduce --out docs/reproduction.md``: the paper-versus-toolkit table."""
     p = sub.add_parser("reproduce", help="write the table of the paper's claims against the toolkit (Markdown)")
     p.add_argument("--out", required=True, help="output Markdown file")
+    _add_time_budget(p)
     p.set_defaults(func=_cmd_reproduce)
 
 
@@ -543,6 +563,9 @@ def main(argv=None) -> int:
         if not getattr(args, "command", None):
             raise UsageError("a command is required: simulate, sweep, fit, flags, reproduce, benchmark, plot or workflow")
         return args.func(args)
+    except TimeBudgetExceeded as exc:  # a RuntimeError, but not a failure: its own status
+        print(f"microimpact: error: {exc}; give a larger --time-budget, or none for no limit", file=sys.stderr)
+        return EXIT_TIME_BUDGET
     except (UsageError, ValueError, RuntimeError) as exc:  # RuntimeError: solver failures
         print(f"microimpact: error: {exc}", file=sys.stderr)
         return 2

@@ -22,7 +22,8 @@ config.setdefault("data_synthetic", "auto")
 if config["data_synthetic"] != "auto":
     config["data_synthetic"] = as_bool(config["data_synthetic"])
 config["fit"] = {
-    k: (as_bool(v) if k != "weights" else v) for k, v in config["fit"].items()
+    k: (v if k == "weights" else float(v) if k == "time_budget" else as_bool(v))
+    for k, v in config["fit"].items()
 }
 # the posterior section is optional; its numbers may arrive as text from snakemake --config
 config["posterior"] = {
@@ -126,8 +127,8 @@ def _config_file_problem(key, what):
 
 def check_config_at_start():
     """Raise WorkflowError (one line: the config key, the value, what is accepted) for the first
-    config value that cannot work: the data files, the materials config and material_pair, and
-    paper_contact."""
+    config value that cannot work: the data files, the materials config and material_pair,
+    paper_contact and the fit's time_budget."""
     for key, what in (
         ("data", "impact CSV (data/README.md, 'Measured-impact CSV format')"),
         ("kharaz_data", "Kharaz et al. (2001) CSV"),
@@ -170,6 +171,12 @@ def check_config_at_start():
         raise WorkflowError(
             f"config key 'paper_contact': {e}; accepted: {accepted}"
         ) from None
+    from microimpact.solvers import check_time_budget
+
+    try:  # the schema lets NaN through (NaN > 0 fails no comparison)
+        check_time_budget(config["fit"].get("time_budget"), "time_budget")
+    except ValueError as e:
+        raise WorkflowError(f"config key 'fit': {e}") from None
 
 
 if getattr(workflow, "is_main_process", True):

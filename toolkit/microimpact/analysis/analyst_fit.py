@@ -19,7 +19,7 @@ import xarray as xr
 
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.provenance import stamp_parameters
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS", "POSTERIOR_FULL"]
 
@@ -86,7 +86,7 @@ class AnalystFit:
 
 def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights="auto", confidence_intervals: bool = False,
                     friction: bool = True, posterior: bool | dict = False, errors_in_variables: str = "auto",
-                    rtol: float = DEFAULT_RTOL, progress: bool = False) -> AnalystFit:
+                    rtol: float = DEFAULT_RTOL, progress: bool = False, time_budget: float | None = None) -> AnalystFit:
     """Fit the damping, the friction (if oblique columns) and optionally sample the posterior.
 
     Parameters
@@ -108,16 +108,25 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
         Relative tolerance of the normal solves. [-]
     progress : bool
         Progress bars on stderr (a terminal only).
+    time_budget : float, optional
+        Wall-clock budget of the whole analysis (all stages share it); None: no limit. [s]
 
     Returns
     -------
     AnalystFit
+
+    Raises
+    ------
+    TimeBudgetExceeded
+        A stage ran past ``time_budget``; the message names the stage and how far it got.
     """
     from microimpact.analysis.fitting import fit_damping
     from microimpact.analysis.oblique import ObliqueProblem, fit_friction
 
+    deadline = Deadline.start(time_budget, "analyst fit")
     damping = fit_damping(table, base, fit_work_of_adhesion=fit_work_of_adhesion, weights=weights,
-                          confidence_intervals=confidence_intervals, rtol=rtol, progress=progress)
+                          confidence_intervals=confidence_intervals, rtol=rtol, progress=progress,
+                          time_budget=deadline)
     ff = None
     if friction:
         try:
@@ -125,7 +134,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
         except ValueError:
             pass
         else:
-            ff = fit_friction(table, damping, rtol=rtol, progress=progress)
+            ff = fit_friction(table, damping, rtol=rtol, progress=progress, time_budget=deadline)
             damping = dataclasses.replace(damping, friction=ff.friction, info=damping.info | {
                 "friction_stderr": ff.stderr["friction"], "friction_source": "fit to the oblique columns (after the "
                 "damping fit, microimpact.analysis.oblique)", "friction_n_points": ff.n_points})
@@ -136,11 +145,12 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
                                                 sample_posterior, sweep_bands)
 
     post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], burn=opts["burn"],
-                            seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol, progress=progress)
+                            seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol, progress=progress,
+                            time_budget=deadline)
     nd = opts["n_draws"]
-    ds = posterior_dataset(post, restitution_bands(post, damping, n_draws=nd, rtol=rtol),
-                           capture_velocity_interval(post, damping, n_draws=nd),
-                           sweep_bands(post, damping, n_draws=max(nd // 2, 4), rtol=rtol))
+    ds = posterior_dataset(post, restitution_bands(post, damping, n_draws=nd, rtol=rtol, time_budget=deadline),
+                           capture_velocity_interval(post, damping, n_draws=nd, time_budget=deadline),
+                           sweep_bands(post, damping, n_draws=max(nd // 2, 4), rtol=rtol, time_budget=deadline))
     return AnalystFit(damping, ff, post, ds)
 
 

@@ -30,7 +30,7 @@ COVERAGE_SETUP = dict(n_datasets=50, first_seed=1000, radii=(1.29e-6, 3.45e-6), 
 
 def posterior_coverage(n_datasets: int = 50, *, first_seed: int = 1000, radii=(1.29e-6, 3.45e-6), n_per_radius: int = 12,
                        walkers: int = 16, steps: int = 600, burn: int = 200, level: float = 0.95,
-                       progress: bool = False) -> pd.DataFrame:
+                       progress: bool = False, time_budget: float | None = None) -> pd.DataFrame:
     """One row per data set: the fitted and posterior values and whether each interval covers.
 
     Parameters
@@ -49,12 +49,19 @@ def posterior_coverage(n_datasets: int = 50, *, first_seed: int = 1000, radii=(1
         Credible level of the intervals. [-]
     progress : bool
         Print one line per data set to stderr.
+    time_budget : float, optional
+        Wall-clock budget of the whole study (the fits and chains share it); None: no limit. [s]
 
     Returns
     -------
     pandas.DataFrame
         ``seed``, and per parameter p in (zeta_hertz, zeta_adhesion): ``p_true``, ``p_fit``,
         ``p_stderr``, ``p_low``, ``p_high``, ``p_covered``, ``p_tau``; ``acceptance``, ``seconds``.
+
+    Raises
+    ------
+    TimeBudgetExceeded
+        The study ran past ``time_budget``; the message names the stage and how far it got.
     """
     import sys
 
@@ -63,10 +70,12 @@ def posterior_coverage(n_datasets: int = 50, *, first_seed: int = 1000, radii=(1
     from microimpact.analysis.synthetic import SYNTHETIC_DEFAULTS, make_synthetic_impacts
     from microimpact.io.impacts import read_impacts
     from microimpact.io.files import write_csv
+    from microimpact.solvers import Deadline
     import tempfile
     from pathlib import Path
     from types import SimpleNamespace
 
+    deadline = Deadline.start(time_budget, "coverage study")
     truth = {k: SYNTHETIC_DEFAULTS[k] for k in ("zeta_hertz", "zeta_adhesion")}
     base = SimpleNamespace(**{k: SYNTHETIC_DEFAULTS[k] for k in ("density", "stiffness", "work_of_adhesion", "friction")},
                            damping_reference_speed=None)
@@ -79,8 +88,9 @@ def posterior_coverage(n_datasets: int = 50, *, first_seed: int = 1000, radii=(1
             write_csv(make_synthetic_impacts(seed=seed, radii=tuple(radii), n_per_radius=n_per_radius), path,
                       float_format="%.6g")
             table = read_impacts(path)
-            fit = fit_damping(table, base, confidence_intervals=False)
-            post = sample_posterior(table, fit, walkers=walkers, steps=steps, burn=burn, seed=seed)
+            fit = fit_damping(table, base, confidence_intervals=False, time_budget=deadline)
+            post = sample_posterior(table, fit, walkers=walkers, steps=steps, burn=burn, seed=seed,
+                                    time_budget=deadline)
             row = {"seed": seed}
             for p, true in truth.items():
                 lo, hi = post.interval(p, level)
@@ -88,6 +98,7 @@ def posterior_coverage(n_datasets: int = 50, *, first_seed: int = 1000, radii=(1
                         f"{p}_high": hi, f"{p}_covered": bool(lo <= true <= hi), f"{p}_tau": post.autocorr_time[p]}
             row |= {"acceptance": float(post.acceptance_fraction.mean()), "seconds": time.perf_counter() - t0}
             rows.append(row)
+            deadline.check(f"{len(rows)} of {n_datasets} data sets")
             if progress:
                 print(f"coverage: data set {k + 1}/{n_datasets} (seed {seed}): "
                       + ", ".join(f"{p} {'in' if row[f'{p}_covered'] else 'OUT'}" for p in truth)

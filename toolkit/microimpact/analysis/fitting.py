@@ -51,7 +51,7 @@ from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit, fit_par
 from microimpact.io.materials import material_contact
 from microimpact.io.progress import progress_bar
 from microimpact.model.contact import Contact
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, Deadline, TimeBudgetExceeded
 
 # The engine (numba) is imported inside the two functions that solve, so that importing the fit
 # costs no numba start-up. The result record, DampingFit, lives in fit_result (no lmfit import):
@@ -270,6 +270,7 @@ def fit_damping(
     scale_covar: bool | None = None,
     threads: int | None = 1,
     progress: bool = False,
+    time_budget: float | None = None,
 ) -> DampingFit:
     """Fit zeta_H, zeta_A (and optionally w_A) to measured e_n(v_n), jointly over particle sizes.
 
@@ -307,6 +308,9 @@ def fit_damping(
     progress : bool
         A progress bar on stderr (a terminal only; :func:`microimpact.io.progress.progress_bar`):
         the start grid, then each least-squares round.
+    time_budget : float or Deadline, optional
+        Wall-clock budget of the fit; None: no limit. Checked after every start-grid point and
+        every function evaluation of the least-squares rounds and the confidence intervals. [s]
 
     Returns
     -------
@@ -316,7 +320,10 @@ def fit_damping(
     ------
     ValueError
         For a table that cannot be fitted (names the row and column), mixed material pairs, or
-        bad arguments.
+        bad arguments (``time_budget`` <= 0 or not a number).
+    TimeBudgetExceeded
+        The fit ran past ``time_budget``; the message says how far it got. No result is returned
+        (lmfit's own abort would give a half-finished one).
 
     Notes
     -----
@@ -325,9 +332,10 @@ def fit_damping(
     Eq. (7). The model e_n is 0 below the capture velocity and continuous there, so plain
     residuals are used for every point (see the module docstring).
     """
+    deadline = Deadline.start(time_budget, "fit")
     if threads is None:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
-                            scale_covar, progress)
+                            scale_covar, progress, deadline)
     import numba  # numba and the engine start only when solving (see the imports)
 
     from microimpact.solvers import engine
@@ -336,13 +344,13 @@ def fit_damping(
     engine.set_threads(threads)
     try:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
-                            scale_covar, progress)
+                            scale_covar, progress, deadline)
     finally:
         engine.set_threads(previous)
 
 
 def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals, scale_covar,
-                 progress=False):
+                 progress=False, deadline=Deadline.start(None, "fit")):
     """The fit of :func:`fit_damping`: check, start on the grid, least squares, collect the result."""
     t0 = time.perf_counter()
     density, stiffness, w_a0, friction, vref = _material(base)
@@ -360,14 +368,19 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
 
     n_grid = np.size(start_grid[0]) * np.size(start_grid[1])
     rounds = 3 if effective else 1
-    with progress_bar(n_grid + rounds + int(bool(confidence_intervals)), f"fit of {e_n.size} impacts", progress) as advance:
+    steps = n_grid + rounds + int(bool(confidence_intervals))
+    with progress_bar(steps, f"fit of {e_n.size} impacts", progress) as advance:
+        advance = deadline.ticking(advance, steps, f"steps ({n_grid} start-grid points, {rounds} least-squares "
+                                                   f"round(s){', confidence intervals' if confidence_intervals else ''})")
         (zh0, za0), nfev = _grid_start(problem, e_n, sigma_e, w_a0, start_grid, rtol, advance)
         params = lmfit.Parameters()
         params.add("zeta_hertz", value=zh0, min=0.0)
         params.add("zeta_adhesion", value=za0, min=0.0)
         params.add("work_of_adhesion", value=w_a0, min=1e-12 if fit_work_of_adhesion else 0.0, vary=fit_work_of_adhesion)
         sigma_v = arr["normal_speed_uncertainty"] if effective else None
-        mini, result, sigma, n = _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, advance)
+        mini, result, sigma, n = _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, advance,
+                                                deadline)
+        mini.iter_cb = deadline.iter_cb("the confidence intervals")
         cis, ci_message = _confidence_intervals(mini, result, confidence_intervals)
         advance(1)
 
@@ -422,23 +435,26 @@ def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol, advance
     return (best[1], best[2]), gh.size * ga.size
 
 
-def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, advance=lambda n=1: None):
+def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, advance=lambda n=1: None,
+                   deadline=Deadline.start(None, "fit")):
     """Levenberg-Marquardt from ``params``; with speed uncertainties ``sigma_v`` [m/s] re-weighted
     twice by the effective variance. Returns (minimizer, result, sigma used, evaluations)."""
+    rounds = 1 if sigma_v is None else 3
 
-    def run(params, sigma):
+    def run(params, sigma, k):
         mini = lmfit.Minimizer(damping_residual, params, fcn_args=(problem,),
-                               fcn_kws={"e_n": e_n, "sigma": sigma, "rtol": rtol}, scale_covar=scale_covar)
+                               fcn_kws={"e_n": e_n, "sigma": sigma, "rtol": rtol}, scale_covar=scale_covar,
+                               iter_cb=deadline.iter_cb(f"least-squares round {k} of {rounds}"))
         return mini, mini.minimize(method="leastsq")
 
     sigma = sigma_e
-    mini, result = run(params, sigma)
+    mini, result = run(params, sigma, 1)
     advance(1)
     nfev = result.nfev
     if sigma_v is not None:
-        for _ in range(2):  # re-weight with the slope at the current best fit, refit
+        for k in (2, 3):  # re-weight with the slope at the current best fit, refit
             sigma = _effective_sigma(problem, result.params.valuesdict(), sigma_e, sigma_v, rtol)
-            mini, result = run(result.params, sigma)
+            mini, result = run(result.params, sigma, k)
             advance(1)
             nfev += result.nfev + 2 * len(problem.radii)
     return mini, result, sigma, nfev
@@ -473,6 +489,8 @@ def _confidence_intervals(mini, result, wanted: bool) -> tuple[dict, str]:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             raw = lmfit.conf_interval(mini, result, p_names=varied, sigmas=[1, 2])
+    except TimeBudgetExceeded:  # the caller's budget, not a failure of the intervals
+        raise
     except Exception as exc:  # noqa: BLE001 - report, do not fail the fit
         return {}, f"confidence intervals not computed: {exc}"
     # rows are (probability, value) for -2, -1, 0, +1, +2 sigma

@@ -50,7 +50,7 @@ from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.files import CONVENTIONS, write_csv, write_netcdf
 from microimpact.io.materials import material_contact
 from microimpact.io.variables import attributes
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, Deadline
 from microimpact.solvers.impact import simulate_many
 
 __all__ = ["flag_measurements", "write_flags", "fibonacci_sphere", "DEFAULT_THRESHOLDS"]
@@ -155,9 +155,10 @@ def _spin_samples(n_spin, spin_fractions) -> tuple[np.ndarray, np.ndarray]:
     return fr, np.vstack([np.zeros((1, 3)), np.repeat(dirs, fr.size, axis=0) * np.tile(fr, n_spin)[:, None]])
 
 
-def _spread(imp: _Impacts, contact_or_fit, unit, offsets, rtol, progress) -> dict:
+def _spread(imp: _Impacts, contact_or_fit, unit, offsets, rtol, progress, deadline) -> dict:
     """Coefficients over the samples, per radius: nominal, min/max over spin, angle and all, the
-    capture velocity [m/s] and whether the outcome switches over spin or over angle."""
+    capture velocity [m/s] and whether the outcome switches over spin or over angle. The deadline
+    is checked after each radius (one simulate_many each: a compiled call that cannot stop)."""
     n = imp.rows.size
     k0 = int(np.flatnonzero(offsets == 0.0)[0])
     out = {f"{c}{mm}{s}": np.full(n, np.nan) for c in _COEFS for s in _SPREADS for mm in ("", "_min", "_max")
@@ -189,6 +190,7 @@ def _spread(imp: _Impacts, contact_or_fit, unit, offsets, rtol, progress) -> dic
         out["switch_angle"][idx] = oc[:, 0, :].min(axis=1) != oc[:, 0, :].max(axis=1)
         _progress(progress, f"flags: radius {r * 1e6:.4g} um ({gi + 1}/{radii.size}), {idx.size} impacts x "
                   f"{unit.shape[0]} spins x {offsets.size} angles, {time.perf_counter() - t0:.1f} s")
+        deadline.check(f"{gi + 1} of {radii.size} radii")
     return out
 
 
@@ -196,7 +198,7 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
                       default_angle_uncertainty_deg: float = 2.0, n_spin: int = 12,
                       spin_fractions=(0.5, 1.0), angle_offsets=(-1.0, 0.0, 1.0), thresholds=None,
                       rtol: float = DEFAULT_RTOL, progress: bool = False, posterior=None, friction=None,
-                      n_draws: int = 8, explain: bool = True) -> xr.Dataset:
+                      n_draws: int = 8, explain: bool = True, time_budget: float | None = None) -> xr.Dataset:
     """Spread of the impact coefficients over unmeasured spin and angle error, and flags.
 
     Parameters
@@ -239,6 +241,10 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
         Add the explanation (needs a DampingFit or MaterialPair as ``contact_or_fit``): per-row
         ``spin_low``/``spin_high`` (the unmeasured spin consistent with the measurement),
         ``spin_moves_prediction``, ``angle_moves_prediction``, ``probably_spun``, ``spin_unexplained``.
+    time_budget : float or Deadline, optional
+        Wall-clock budget of the flags and the explanation; None: no limit. Checked after each
+        radius's batch and each posterior draw of the explanation; past it, TimeBudgetExceeded
+        says how far the flags got. [s]
 
     Returns
     -------
@@ -251,16 +257,12 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
         ``angle_sensitive``, ``near_capture`` (int8 0/1). Thresholds and sample counts are
         attributes. ``ds.to_dataframe()`` gives one row per impact.
     """
-    th = dict(DEFAULT_THRESHOLDS)
-    if thresholds:
-        unknown = set(thresholds) - set(th)
-        if unknown:
-            raise ValueError(f"unknown threshold(s) {sorted(unknown)}; known: {sorted(th)}")
-        th.update({k: float(v) for k, v in thresholds.items()})
+    deadline = Deadline.start(time_budget, "flags")
+    th = _thresholds(thresholds)
     imp = _impacts(table, spin_bound, angle_uncertainty_deg, default_angle_uncertainty_deg)
     fr, unit = _spin_samples(n_spin, spin_fractions)
     offsets = np.unique(np.append(np.asarray(angle_offsets, dtype=float), 0.0))  # 0: the nominal angle
-    out = _spread(imp, contact_or_fit, unit, offsets, rtol, progress)
+    out = _spread(imp, contact_or_fit, unit, offsets, rtol, progress, deadline)
 
     en_limit = np.where(np.isfinite(imp.e_n_uncertainty) & (imp.e_n_uncertainty > 0), imp.e_n_uncertainty, th["e_n"])
 
@@ -289,8 +291,17 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
         res = _with_explanation(res, table, contact_or_fit, posterior=posterior, friction=friction, n_draws=n_draws,
                                 spin_bound=spin_bound, angle_uncertainty_deg=angle_uncertainty_deg,
                                 default_angle_uncertainty_deg=default_angle_uncertainty_deg, rtol=rtol,
-                                progress=progress)
+                                progress=progress, time_budget=deadline)
     return res
+
+
+def _thresholds(overrides) -> dict:
+    """:data:`DEFAULT_THRESHOLDS` with ``overrides``; ValueError names an unknown one."""
+    th = dict(DEFAULT_THRESHOLDS)
+    unknown = set(overrides or {}) - set(th)
+    if unknown:
+        raise ValueError(f"unknown threshold(s) {sorted(unknown)}; known: {sorted(th)}")
+    return th | {k: float(v) for k, v in (overrides or {}).items()}
 
 
 def _with_explanation(res: xr.Dataset, table, fit, *, posterior, **options) -> xr.Dataset:

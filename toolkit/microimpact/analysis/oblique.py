@@ -52,7 +52,7 @@ import xarray as xr
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.impacts import OBLIQUE_COLUMNS
 from microimpact.io.progress import progress_bar
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
            "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"]
@@ -363,7 +363,7 @@ def engine_threads(threads: int | None = 1):
 
 
 def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rtol: float = DEFAULT_RTOL,
-                 propagate_damping: bool = True, progress: bool = False) -> FrictionFit:
+                 propagate_damping: bool = True, progress: bool = False, time_budget: float | None = None) -> FrictionFit:
     """Fit the tangential parameters (friction f) to the oblique columns, after the damping fit.
 
     Parameters
@@ -380,6 +380,8 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
         Add the damping covariance to the standard error (two refits per damping parameter).
     progress : bool
         Progress bar on stderr (a terminal only).
+    time_budget : float or Deadline, optional
+        Wall-clock budget; None: no limit. Checked after every model evaluation. [s]
 
     Returns
     -------
@@ -388,11 +390,15 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
     Raises
     ------
     ValueError
-        No oblique data (names the file), an unknown tangential model (names the hook to extend).
+        No oblique data (names the file), an unknown tangential model (names the hook to extend),
+        a ``time_budget`` that is not a number > 0.
+    TimeBudgetExceeded
+        The fit ran past ``time_budget``; the message says how far it got.
     """
     import lmfit  # only when fitting
 
     t0 = time.perf_counter()
+    deadline = Deadline.start(time_budget, "friction fit")
     problem = ObliqueProblem.from_table(table)
     contact_of = damping_fit.contact
     model_name = tangential_model or contact_of(float(problem.radius[0])).tangential_model
@@ -403,13 +409,13 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
     n_var = len(damping_fit.varied) if propagate_damping else 0
     with progress_bar(3 + 2 * n_var, "friction fit", progress) as advance, engine_threads(1):
-        best, sigma, nfev = _fit_tangential(problem, contact_of, names, weighted, rtol, lmfit)
+        best, sigma, nfev = _fit_tangential(problem, contact_of, names, weighted, rtol, lmfit, deadline=deadline)
         advance(3)
         gradient = {}
         cond = {k: best.params[k].stderr if best.params[k].stderr is not None else math.nan for k in names}
         var = {k: cond[k] ** 2 for k in names}
         if propagate_damping:
-            gradient = _damping_gradient(problem, damping_fit, names, best, sigma, rtol, lmfit, advance)
+            gradient = _damping_gradient(problem, damping_fit, names, best, sigma, rtol, lmfit, advance, deadline)
             cov = _damping_covariance(damping_fit)
             for k in names:
                 g = np.array([gradient[k][p] for p in damping_fit.varied])
@@ -433,7 +439,7 @@ def _residual(params, problem, contact_of, names, measured, sigma, rtol):
     return np.nan_to_num((model - measured) / sigma, nan=1e3)  # a captured model: far from any rebound
 
 
-def _fit_tangential(problem, contact_of, names, weighted, rtol, lmfit, start=None):
+def _fit_tangential(problem, contact_of, names, weighted, rtol, lmfit, start=None, deadline=Deadline.start(None, "")):
     """(lmfit result, effective sigma, evaluations): grid start (first parameter), leastsq, two re-weightings."""
     sig0 = problem.sigma_measured if weighted else np.ones(problem.size)
     nfev = 0
@@ -443,6 +449,7 @@ def _fit_tangential(problem, contact_of, names, weighted, rtol, lmfit, start=Non
         for g in grid:
             r = _residual({names[0]: _Value(g)}, problem, contact_of, names[:1], problem.measured, sig0, rtol)
             chi.append(float(r @ r))
+            deadline.check(f"{len(chi)} of {len(grid)} start-grid points")
         nfev += len(grid)
         start = {names[0]: float(grid[int(np.argmin(chi))])}
     params = lmfit.Parameters()
@@ -452,7 +459,7 @@ def _fit_tangential(problem, contact_of, names, weighted, rtol, lmfit, start=Non
     sigma = sig0
     for it in range(3):
         mini = lmfit.Minimizer(_residual, params, fcn_args=(problem, contact_of, names, problem.measured, sigma, rtol),
-                               scale_covar=not weighted)
+                               scale_covar=not weighted, iter_cb=deadline.iter_cb(f"least-squares round {it + 1}"))
         res = mini.minimize(method="leastsq")
         nfev += res.nfev
         if not weighted or it == 2:
@@ -467,7 +474,8 @@ class _Value:
     value: float
 
 
-def _damping_gradient(problem, damping_fit, names, best, sigma, rtol, lmfit, advance) -> dict:
+def _damping_gradient(problem, damping_fit, names, best, sigma, rtol, lmfit, advance,
+                      deadline=Deadline.start(None, "")) -> dict:
     """d(fitted tangential parameter)/d(damping parameter) by central refits at +/- one standard error."""
     grad = {k: {} for k in names}
     start = {k: best.params[k].value for k in names}
@@ -481,7 +489,8 @@ def _damping_gradient(problem, damping_fit, names, best, sigma, rtol, lmfit, adv
             def contact_of(r, values=values):
                 return damping_fit.contact(r).with_(**_contact_fields(damping_fit, r, values))
             mini = lmfit.Minimizer(_residual, _params(lmfit, names, start),
-                                   fcn_args=(problem, contact_of, names, problem.measured, sigma, rtol))
+                                   fcn_args=(problem, contact_of, names, problem.measured, sigma, rtol),
+                                   iter_cb=deadline.iter_cb(f"the refit at {p} {'+-'[s < 0]} its standard error"))
             fitted.append(mini.minimize(method="leastsq").params)
             advance(1)
         for k in names:

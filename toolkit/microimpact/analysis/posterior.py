@@ -52,7 +52,7 @@ from microimpact.analysis.fit_result import PARAMETER_NAMES
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.materials import material_contact
 from microimpact.io.progress import progress_bar
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["Posterior", "sample_posterior", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
            "sweep_bands", "posterior_dataset", "posterior_from_dataset", "load_posterior", "save_posterior",
@@ -245,7 +245,7 @@ def _contact(fit, radius, values: dict):
 # =============================================================================== sampling
 def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int = 16, steps: int = 300,
                      burn: int | None = None, seed: int = 2002, errors_in_variables: str = "auto",
-                     rtol: float = DEFAULT_RTOL, progress: bool = False) -> Posterior:
+                     rtol: float = DEFAULT_RTOL, progress: bool = False, time_budget: float | None = None) -> Posterior:
     """Sample the posterior of the fitted parameters with lmfit's ``Minimizer.emcee`` (seeded).
 
     Parameters
@@ -269,14 +269,25 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int = 16
         Relative tolerance of the normal solves. [-]
     progress : bool
         Progress bar on stderr (a terminal only).
+    time_budget : float or Deadline, optional
+        Wall-clock budget of the sampling; None: no limit. Checked between steps of the chain
+        (one step: one log-probability evaluation per walker). [s]
 
     Returns
     -------
     Posterior
+
+    Raises
+    ------
+    ValueError
+        Too few walkers or steps, a bad ``burn`` or ``time_budget``.
+    TimeBudgetExceeded
+        The chain ran past ``time_budget``; the message gives the steps done. No chain is returned.
     """
     import lmfit  # only when sampling
 
     t0 = time.perf_counter()
+    deadline = Deadline.start(time_budget, "posterior")
     like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol)
     names = list(damping_fit.varied) + (["friction"] if friction_fit is not None else [])
     best = dict(damping_fit.values) | ({"friction": friction_fit.friction} if friction_fit is not None else {})
@@ -293,16 +304,14 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int = 16
     for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion", "friction"):
         if n in best:
             params.add(n, value=best[n], min=bounds[n][0], max=bounds[n][1], vary=n in names)
-    rng = np.random.default_rng(seed)
-    scale = np.array([stderr[n] if math.isfinite(stderr[n]) and stderr[n] > 0 else 1e-3 * abs(best[n]) for n in names])
-    pos = np.array([best[n] for n in names])[None, :] + 0.3 * scale[None, :] * rng.standard_normal((walkers, len(names)))
-    lo = np.array([bounds[n][0] for n in names])
-    pos = np.where(pos <= lo, lo + 0.01 * scale, pos)
+    pos = _start_ball(names, best, stderr, [bounds[n][0] for n in names], walkers, seed)
 
     calls = [0]
     from microimpact.analysis.oblique import engine_threads
 
     with progress_bar(steps, "posterior", progress) as advance, engine_threads(1):
+        advance = deadline.ticking(advance, steps, "emcee steps")
+
         def log_probability(pars):
             calls[0] += 1
             if calls[0] % walkers == 0:
@@ -334,6 +343,16 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int = 16
                            "source": str(damping_fit.info.get("source") or "")})
 
 
+def _start_ball(names, best: dict, stderr: dict, lower, walkers: int, seed: int) -> np.ndarray:
+    """Seeded walker start positions (walkers, parameters): 0.3 standard errors around the fit,
+    kept above the lower bounds."""
+    rng = np.random.default_rng(seed)
+    scale = np.array([stderr[n] if math.isfinite(stderr[n]) and stderr[n] > 0 else 1e-3 * abs(best[n]) for n in names])
+    pos = np.array([best[n] for n in names])[None, :] + 0.3 * scale[None, :] * rng.standard_normal((walkers, len(names)))
+    lo = np.array(lower)
+    return np.where(pos <= lo, lo + 0.01 * scale, pos)
+
+
 def _autocorr(chain: np.ndarray) -> np.ndarray:
     """Integrated autocorrelation time per parameter [steps] (emcee.autocorr, without its length check)."""
     import logging
@@ -356,7 +375,7 @@ def posterior_contacts(posterior: Posterior, damping_fit, radius: float, n_draws
 
 
 def restitution_bands(posterior: Posterior, damping_fit, speeds=None, *, n_draws: int = 64,
-                      rtol: float = DEFAULT_RTOL) -> xr.Dataset:
+                      rtol: float = DEFAULT_RTOL, time_budget: float | None = None) -> xr.Dataset:
     """Posterior bands of the model e_n(v_n) at every fitted radius.
 
     Parameters
@@ -366,6 +385,8 @@ def restitution_bands(posterior: Posterior, damping_fit, speeds=None, *, n_draws
         smallest measured speed).
     n_draws : int
         Posterior draws pushed through :func:`solve_normal_many`.
+    time_budget : float or Deadline, optional
+        Wall-clock budget, checked after each draw at each radius; None: no limit. [s]
 
     Returns
     -------
@@ -382,10 +403,12 @@ def restitution_bands(posterior: Posterior, damping_fit, speeds=None, *, n_draws
     e = np.empty((radii.size, len(draws), v.size))
     from microimpact.analysis.oblique import engine_threads
 
+    deadline = Deadline.start(time_budget, "restitution bands")
     with engine_threads(1):
         for i, r in enumerate(radii):
             for j, d in enumerate(draws):
                 e[i, j] = engine.solve_normal_many(_contact(damping_fit, float(r), d), v, rtol=rtol)["e_n"]
+                deadline.check(f"{i * len(draws) + j + 1} of {radii.size * len(draws)} draws x radii")
     return xr.Dataset({"e_n_band": (("radius", "band_speed", "quantile"), np.moveaxis(np.quantile(e, QUANTILES, axis=1), 0, -1),
                                     {"units": "1", "long_name": "posterior quantiles of the model normal coefficient "
                                                                 "of restitution e_n"})},
@@ -393,8 +416,11 @@ def restitution_bands(posterior: Posterior, damping_fit, speeds=None, *, n_draws
                           "units": "m s-1", "long_name": "incident normal speed of the band"})})
 
 
-def capture_velocity_interval(posterior: Posterior, damping_fit, *, n_draws: int = 64) -> xr.Dataset:
+def capture_velocity_interval(posterior: Posterior, damping_fit, *, n_draws: int = 64,
+                              time_budget: float | None = None) -> xr.Dataset:
     """Capture velocity of each fitted radius with its posterior quantiles (credible interval).
+
+    ``time_budget`` [s] (or a Deadline; None: no limit) is checked after each radius.
 
     Returns
     -------
@@ -407,20 +433,26 @@ def capture_velocity_interval(posterior: Posterior, damping_fit, *, n_draws: int
     draws = posterior.draws(n_draws)
     from microimpact.analysis.oblique import engine_threads
 
+    deadline = Deadline.start(time_budget, "capture velocity interval")
+    v = []
     with engine_threads(1):
-        v = np.array([[capture_velocity(_contact(damping_fit, float(r), d), rtol=1e-5) for d in draws] for r in radii])
+        for r in radii:
+            v.append([capture_velocity(_contact(damping_fit, float(r), d), rtol=1e-5) for d in draws])
+            deadline.check(f"{len(v)} of {len(radii)} radii")
+    v = np.array(v)
     return xr.Dataset({"capture_velocity_quantile": (("radius", "quantile"), np.quantile(v, QUANTILES, axis=1).T, {
         "units": "m s-1", "long_name": "posterior quantiles of the normal capture velocity"})},
         coords=_coords(radii, QUANTILES))
 
 
 def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int = 16, n_speeds: int = 20,
-                rtol: float = DEFAULT_RTOL) -> xr.Dataset:
+                rtol: float = DEFAULT_RTOL, time_budget: float | None = None) -> xr.Dataset:
     """Posterior bands of the analyst's Table 2 sweeps along the measured speeds, at the median radius.
 
     Each case of :data:`microimpact.model.parameters.TABLE2_CASES` is run at its conditions with the
     largest value of each axis other than the speed (the sweep's most demanding corner), for
     ``n_draws`` posterior draws (with their friction), through :func:`microimpact.simulate_many`.
+    ``time_budget`` [s] (or a Deadline; None: no limit) is checked after each case.
 
     Returns
     -------
@@ -439,8 +471,9 @@ def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int =
     out = {q: np.empty((len(cases), len(draws), v.size)) for q in ("e_n", "mu_t", "K_L")}
     from microimpact.analysis.oblique import engine_threads
 
+    deadline = Deadline.start(time_budget, "sweep bands")
     with engine_threads(1):
-        _sweep_draws(cases, draws, damping_fit, r, v, out, rtol)
+        _sweep_draws(cases, draws, damping_fit, r, v, out, rtol, deadline)
     names = {"e_n": "normal coefficient of restitution e_n", "mu_t": "tangential impulse ratio mu_t",
              "K_L": "kinetic energy loss coefficient K_L"}
     ds = xr.Dataset(coords={
@@ -457,7 +490,7 @@ def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int =
     return ds
 
 
-def _sweep_draws(cases, draws, damping_fit, r, v, out, rtol):
+def _sweep_draws(cases, draws, damping_fit, r, v, out, rtol, deadline):
     """Fill ``out[q][case, draw, speed]`` by simulate_many (see :func:`sweep_bands`)."""
     from microimpact.model.parameters import TABLE2_CASES
     from microimpact.solvers.impact import simulate_many
@@ -470,6 +503,7 @@ def _sweep_draws(cases, draws, damping_fit, r, v, out, rtol):
                                (cond.get("omega_n", 0.0), cond.get("omega_t", 0.0), cond.get("omega_tp", 0.0)), rtol=rtol)
             for q in out:
                 out[q][i, j] = ds[q].values
+        deadline.check(f"{i + 1} of {len(cases)} cases")
 
 
 def _largest(spec):

@@ -37,7 +37,7 @@ import xarray as xr
 
 from microimpact.analysis.oblique import OBSERVABLE_UNITS, ObliqueProblem, engine_threads, rebound_state
 from microimpact.io.progress import progress_bar
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["spin_explanation", "SPIN_VARIABLES"]
 
@@ -101,7 +101,7 @@ def _predict(contact, speed, incidence_deg, spin, quantity):
 def spin_explanation(table, fit, *, posterior=None, friction: float | None = None, n_draws: int = 8,
                      spin_bound=None, angle_uncertainty_deg=None, default_angle_uncertainty_deg: float = 2.0,
                      n_scan: int = 41, default_sigma: float = 0.02, rtol: float = DEFAULT_RTOL,
-                     progress: bool = False) -> xr.Dataset:
+                     progress: bool = False, time_budget: float | None = None) -> xr.Dataset:
     """Posterior flags that explain, and the spin range consistent with each row (module docstring).
 
     Parameters
@@ -130,6 +130,8 @@ def spin_explanation(table, fit, *, posterior=None, friction: float | None = Non
         Relative tolerance of the normal solves. [-]
     progress : bool
         Progress bar on stderr (a terminal only).
+    time_budget : float or Deadline, optional
+        Wall-clock budget, checked after each draw; None: no limit. [s]
 
     Returns
     -------
@@ -138,6 +140,7 @@ def spin_explanation(table, fit, *, posterior=None, friction: float | None = Non
         ``spin_moves_prediction``, ``angle_moves_prediction``, ``probably_spun``, ``spin_unexplained``.
     """
     n = len(table)
+    deadline = Deadline.start(time_budget, "spin explanation")
     if n_scan < 3 or n_scan % 2 == 0:
         raise ValueError(f"n_scan must be odd and >= 3 (so that zero spin is scanned), got {n_scan}")
     quantity, measured, sigma_m = _row_quantities(table)
@@ -167,6 +170,7 @@ def spin_explanation(table, fit, *, posterior=None, friction: float | None = Non
     from microimpact.analysis.posterior import _contact
 
     with progress_bar(len(draws), "spin ranges", progress) as advance, engine_threads(1):
+        advance = deadline.ticking(advance, len(draws), "posterior draws")
         for j, d in enumerate(draws):
             for r in np.unique(radius):
                 idx = np.flatnonzero(radius == r)

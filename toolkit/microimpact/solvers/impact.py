@@ -435,6 +435,13 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         :class:`ImpactResult` (vectors split into ``_n``, ``_t``, ``_tp``) and carry ``units`` and
         ``long_name``; the inputs are included as variables. ``outcome`` is 0 for a rebound and 1
         for a capture (CF flag attributes).
+
+    Notes
+    -----
+    No ``time_budget``: the work is one compiled call (the normal solves on both cores, then the
+    vectorised tangential map), which cannot stop midway. A long computation made of batches
+    checks its budget between them (:func:`microimpact.studies.sweeps.run_sweep` solves its speeds
+    in blocks then; :class:`microimpact.solvers.Deadline`).
     """
     if method != "engine":
         raise ValueError(f"simulate_many runs method='engine' only, got {method!r}; for 'reference' or 'rkg' "

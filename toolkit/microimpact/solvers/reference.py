@@ -92,7 +92,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from microimpact.model import law
-from microimpact.solvers import DEFAULT_RTOL, TimeBudgetExceeded
+from microimpact.solvers import DEFAULT_RTOL, Deadline, TimeBudgetExceeded
 from microimpact.model.coefficients import impact_coefficients
 from microimpact.model.kinematics import ImpactResult, incident_velocity
 from microimpact.model.contact import Contact
@@ -366,8 +366,9 @@ def simulate_reference(
         After capture with sliding or twisting still going on: stop when the friction impulse
         still to come is bounded by ``settle_tolerance`` times the impulse so far. Default
         ``rtol``. [-]
-    time_budget : float, optional
-        Wall-clock budget of the integration; None: no budget. [s]
+    time_budget : float or Deadline, optional
+        Wall-clock budget of the integration; None: no budget; a
+        :class:`~microimpact.solvers.Deadline`: the budget of an enclosing computation. [s]
 
     Returns
     -------
@@ -402,11 +403,10 @@ def simulate_reference(
         raise ValueError(f"max_step must be > 0, got {max_step!r}")
     vel_in = incident_velocity(speed, incidence, azimuth)
     sc = _scales(contact, -vel_in[0])
-    if time_budget is not None and not (isinstance(time_budget, (int, float)) and time_budget > 0.0):
-        raise ValueError(f"time_budget must be a number of seconds > 0 (or None), got {time_budget!r}")
+    deadline = Deadline.start(time_budget, "reference solver")
     run = _Run.start(sc, contact.friction, vel_in, omega_in, settle_tol)
-    if time_budget is not None:
-        run.counter[1:] = [time.perf_counter() + float(time_budget), float(time_budget)]
+    if deadline.limited:
+        run.counter[1:] = [deadline.end, deadline.budget]
     solver = {"method": method, "rtol": rtol, "atol": atol, "max_step": max_step}
     while run.stop_reason is None:
         run.n_phases += 1

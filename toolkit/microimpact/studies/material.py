@@ -24,7 +24,7 @@ from microimpact.io.files import CONVENTIONS
 from microimpact.io.provenance import source_of_fit, stamp_parameters
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, Deadline
 from microimpact.studies.sweeps import resolve_spec, run_sweep
 
 __all__ = [
@@ -63,7 +63,7 @@ def _on_measured_speeds(spec: Mapping, speed_range: tuple[float, float]) -> dict
 
 
 def material_sweep(fit: xr.Dataset, spec: Mapping, *, case: str | None = None,
-                   rtol: float = DEFAULT_RTOL) -> xr.Dataset:
+                   rtol: float = DEFAULT_RTOL, time_budget: float | None = None) -> xr.Dataset:
     """A sweep of the analyst's material: every measured size, the measured speed range.
 
     Parameters
@@ -77,6 +77,9 @@ def material_sweep(fit: xr.Dataset, spec: Mapping, *, case: str | None = None,
         Label recorded in the attributes.
     rtol : float
         Relative tolerance of the normal solves. [-]
+    time_budget : float or Deadline, optional
+        Wall-clock budget of all sizes together (:func:`~microimpact.studies.sweeps.run_sweep`);
+        None: no limit. [s]
 
     Returns
     -------
@@ -87,7 +90,8 @@ def material_sweep(fit: xr.Dataset, spec: Mapping, *, case: str | None = None,
     """
     contacts = fitted_contacts(fit)
     grid = _on_measured_speeds(spec, measured_speed_range(fit))
-    parts = [run_sweep(c, grid, case=case, rtol=rtol) for c in contacts.values()]
+    deadline = Deadline.start(time_budget, "material sweep")
+    parts = [run_sweep(c, grid, case=case, rtol=rtol, time_budget=deadline) for c in contacts.values()]
     capture = [float(p["capture_normal_speed"]) for p in parts]
     parts = [p.drop_vars("capture_normal_speed") for p in parts]
     per_size = [name for name, var in parts[0].data_vars.items() if var.ndim > 0]  # fixed inputs stay 0-d
@@ -99,8 +103,11 @@ def material_sweep(fit: xr.Dataset, spec: Mapping, *, case: str | None = None,
     return stamp_fitted(ds, fit)
 
 
-def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL) -> xr.Dataset:
+def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL, time_budget: float | None = None) -> xr.Dataset:
     """Critical velocity (Eq. (38)) and capture velocity of the fitted material at every measured size.
+
+    ``time_budget`` [s] (or a Deadline; None: no limit) is checked after each size's capture
+    velocity (a bisection of engine solves, about a second).
 
     Returns
     -------
@@ -110,12 +117,16 @@ def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL) -> xr.Data
     """
     contacts = fitted_contacts(fit)
     radii = np.array(list(contacts))
+    deadline = Deadline.start(time_budget, "material dynamics")
+    capture = []
+    for c in contacts.values():
+        capture.append(capture_velocity(c, solver_rtol=rtol))
+        deadline.check(f"{len(capture)} of {radii.size} sizes")
     ds = xr.Dataset(
         {
             "critical_velocity": ("radius", [critical_velocity(c) for c in contacts.values()],
                                   {"units": "m s-1", "long_name": "critical velocity v_c, Eq. (38)"}),
-            "capture_velocity": ("radius", [capture_velocity(c, solver_rtol=rtol) for c in contacts.values()],
-                                 attributes("capture_normal_speed")),
+            "capture_velocity": ("radius", capture, attributes("capture_normal_speed")),
         },
         coords={"radius": ("radius", radii, attributes("radius"))},
         attrs={"Conventions": CONVENTIONS,

@@ -36,7 +36,7 @@ from microimpact.model.contact import Contact
 from microimpact.model.parameters import TABLE1
 from microimpact.presets import WALL_1990
 from microimpact.model.law import TWIST_TORQUE_FACTOR
-from microimpact.solvers import engine
+from microimpact.solvers import Deadline, engine
 from microimpact.solvers.impact import simulate_impact
 from microimpact.studies.sweeps import resolve_spec
 from microimpact.model.parameters import TABLE2_CASES
@@ -964,8 +964,20 @@ _OTHER_CLAIMS = (_claim_summary3_capture, _claim_mu_bounded_by_friction, _claim_
                  _claim_friction_range, _claim_eq18_torque)
 
 
+def _table_parts(c: Contact) -> list:
+    """The table in parts, in row order: callables returning lists of rows (a time budget is checked
+    between them)."""
+    def one(claim):
+        return lambda: [claim(c)]
+
+    return ([one(claim) for claim in _PARAMETER_CLAIMS]
+            + [lambda: _dynamics_rows(c), lambda: _fig5_rows(c), one(_claim_spin),
+               lambda: _figs_7_14_rows(c, dynamics.capture_velocity(c))]
+            + [one(claim) for claim in _OTHER_CLAIMS])
+
+
 # ----------------------------------------------------------------------------- public API
-def reproduction_table(contact: Contact = WALL_1990) -> pd.DataFrame:
+def reproduction_table(contact: Contact = WALL_1990, *, time_budget: float | None = None) -> pd.DataFrame:
     """Check the paper's numbers and statements by computation and tabulate the results.
 
     Parameters
@@ -974,6 +986,9 @@ def reproduction_table(contact: Contact = WALL_1990) -> pd.DataFrame:
         The Table 1 row 2 parameter set (default :data:`microimpact.presets.WALL_1990`). The
         Table 1 row 1 checks (Fig. 3, f0 scaling) always use
         :data:`microimpact.model.parameters.TABLE1`.
+    time_budget : float or Deadline, optional
+        Wall-clock budget; None: no limit. Checked after each claim (the Figs. 7-14 claims share
+        one engine run, checked after it). [s]
 
     Returns
     -------
@@ -983,19 +998,20 @@ def reproduction_table(contact: Contact = WALL_1990) -> pd.DataFrame:
         (formatted from numbers computed in this call), ``agree`` (True / False / "n/a") and
         ``note`` (tolerance used, misprints, explanations).
 
+    Raises
+    ------
+    TimeBudgetExceeded
+        The table ran past ``time_budget``; the message gives the rows done.
+
     Notes
     -----
     Takes a few seconds: a few hundred engine impacts and some capture-velocity bisections.
     """
-    v_capture = dynamics.capture_velocity(contact)
-    rows = (
-        [claim(contact) for claim in _PARAMETER_CLAIMS]
-        + _dynamics_rows(contact)
-        + _fig5_rows(contact)
-        + [_claim_spin(contact)]
-        + _figs_7_14_rows(contact, v_capture)
-        + [claim(contact) for claim in _OTHER_CLAIMS]
-    )
+    deadline = Deadline.start(time_budget, "reproduction table")
+    rows = []
+    for part in _table_parts(contact):
+        rows += part()
+        deadline.check(f"{len(rows)} row(s)")
     df = pd.DataFrame(rows, columns=COLUMNS)
     if df["id"].duplicated().any():  # pragma: no cover - guards the table's construction
         raise RuntimeError(f"duplicate row ids: {df['id'][df['id'].duplicated()].tolist()}")

@@ -55,7 +55,7 @@ from microimpact.io.progress import progress_bar, wants_progress
 from microimpact.io.variables import attributes
 from microimpact.model.contact import PAPER_REFERENCE
 from microimpact.model.parameters import TABLE2_CASES, table2_case
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, Deadline
 from microimpact.solvers.impact import simulate_many
 
 __all__ = [
@@ -247,7 +247,8 @@ def case_spec(case: str, overrides: Mapping | None = None) -> dict:
 
 
 def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, rtol: float = DEFAULT_RTOL,
-              institution: str | None = None, capture_speed: bool = True, progress=None) -> xr.Dataset:
+              institution: str | None = None, capture_speed: bool = True, progress=None,
+              time_budget: float | None = None) -> xr.Dataset:
     """Simulate every impact of a sweep grid with :func:`microimpact.solvers.impact.simulate_many`.
 
     Parameters
@@ -270,6 +271,11 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
         Draw a progress bar on stderr (:func:`microimpact.io.progress.progress_bar`) when stderr is
         a terminal; the speeds are then solved in blocks to advance it (same values as one batch).
         Default: silent.
+    time_budget : float or Deadline, optional
+        Wall-clock budget; None: no limit. With a budget the speeds are solved in blocks (as for
+        the progress bar) and the budget is checked after each block and after the capture
+        velocity (one :func:`~microimpact.solvers.impact.simulate_many` is a compiled call that
+        cannot stop midway); past it, TimeBudgetExceeded, giving the speeds done. [s]
 
     Returns
     -------
@@ -283,22 +289,20 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
         captured impact. CF-1.10 global attributes, the contact parameters (``contact_*``) and
         the spec as JSON (``sweep_spec``).
     """
+    deadline = Deadline.start(time_budget, f"sweep {case}" if case else "sweep")
 
     if spec is None:
         if case is None or case not in TABLE2_CASES:
             raise SweepSpecError(f"give a spec, or a case among {sorted(TABLE2_CASES)}; got case={case!r}")
         spec = TABLE2_CASES[case]
-    values = resolve_spec(spec)
-    inputs = {}
-    for key, val in values.items():
-        if np.ndim(val) == 0:
-            inputs[key] = float(val)
-        else:
-            inputs[key] = xr.DataArray(val, dims=(key,), coords={key: val}, name=key)
+    inputs = _grid_inputs(resolve_spec(spec))
     label = f"Table 2 case {case}" if case in TABLE2_CASES else (f"case {case}" if case else "parameter sweep")
     n_speeds = inputs["speed"].size if isinstance(inputs["speed"], xr.DataArray) else 1
-    with progress_bar(n_speeds + int(capture_speed), f"sweep {label}", progress) as advance:
-        ds = _simulate_grid(contact, inputs, rtol, advance, in_blocks=wants_progress(progress))
+    steps = n_speeds + int(capture_speed)
+    with progress_bar(steps, f"sweep {label}", progress) as advance:
+        advance = deadline.ticking(advance, steps, f"steps ({n_speeds} speeds, then the capture velocity)"
+                                   if capture_speed else "speeds")
+        ds = _simulate_grid(contact, inputs, rtol, advance, in_blocks=wants_progress(progress) or deadline.limited)
         if capture_speed:
             v_capture = capture_velocity(contact, solver_rtol=rtol)
             advance(1)
@@ -338,6 +342,13 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
     attrs["sweep_dims"] = " ".join(dims)
     ds.attrs = attrs
     return ds
+
+
+def _grid_inputs(values: Mapping) -> dict:
+    """simulate_many inputs of a resolved spec: a float per fixed quantity, a DataArray along its own
+    dimension per swept one."""
+    return {key: float(val) if np.ndim(val) == 0 else xr.DataArray(val, dims=(key,), coords={key: val}, name=key)
+            for key, val in values.items()}
 
 
 #: blocks of speeds a sweep is solved in when it shows a progress bar
