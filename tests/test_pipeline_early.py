@@ -110,3 +110,28 @@ def test_fit_time_budget_is_checked_at_start(tmp_path):
     data["fit"]["time_budget"] = float("nan")
     cfg.write_text(yaml.safe_dump(data, sort_keys=False))
     refused(dry_run(other), other, "'fit'", "time_budget", "nan")
+
+
+def test_a_failing_job_says_why_in_one_line_and_leaves_no_result(tmp_path):
+    """A job that fails while running (here the fit, past a tiny time budget) prints one line on the
+    terminal naming the rule, the exception and its message, keeps the traceback in its log, and
+    leaves no result file behind (microimpact.io.joblog, atomic outputs)."""
+    import yaml
+
+    other = make_copy(tmp_path / "wf")
+    cfg = other / "workflow" / "config" / "config.yaml"
+    data = yaml.safe_load(cfg.read_text())
+    data["fit"]["time_budget"] = 1e-9
+    cfg.write_text(yaml.safe_dump(data, sort_keys=False))
+    env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
+    proc = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "1", "results/analyst/fit.nc"], cwd=other,
+                          env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert proc.returncode != 0, proc.stdout[-3000:]
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("microimpact: rule fit failed: ")]
+    assert len(lines) == 1, proc.stdout[-3000:]
+    assert "TimeBudgetExceeded: fit" in lines[0] and "time budget of 1e-09 s" in lines[0], lines[0]
+    assert "logs/fit.log" in lines[0]
+    assert "Traceback" in (other / "logs" / "fit.log").read_text()
+    assert (other / "results" / "impacts_validated.csv").exists()  # the job before it ran
+    analyst = other / "results" / "analyst"
+    assert not analyst.exists() or not any(analyst.iterdir()), list(analyst.iterdir())  # no partial output

@@ -6,9 +6,10 @@ the HTML report (snakemake --report report.html).
 """
 
 import os
-import sys
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+from microimpact.io.joblog import log_job  # noqa: E402
+
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.report.standard import FigureFile, save_standard_figures  # noqa: E402
 

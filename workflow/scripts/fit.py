@@ -1,9 +1,9 @@
 """Rule fit: zeta_H, zeta_A (optionally w_A) from the measured e_n(v_n), the friction from the oblique
 columns when present, and the posterior with its bands -> results/analyst/{fit,posterior,oblique}.nc."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.solvers.engine import set_threads  # noqa: E402
 

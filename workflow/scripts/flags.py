@@ -2,9 +2,9 @@
 is near capture, and the spin consistent with it (over the posterior draws), under the fitted model
 -> results/analyst/flags.csv + results/analyst/flags.nc."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.solvers.engine import set_threads  # noqa: E402
 

@@ -1,8 +1,8 @@
 """Rule gather_sweep: combine the chunks of one case into results/sweeps/case_<case>.nc."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.studies.sweeps import combine_sweeps, load_sweep, save_sweep  # noqa: E402
 

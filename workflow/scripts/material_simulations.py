@@ -2,9 +2,9 @@
 (fit_curves.nc), the critical and capture velocity per measured size (dynamics.nc) and every
 configured Table 2 case for the fitted material (sweeps/case_<case>.nc)."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.solvers.engine import set_threads  # noqa: E402
 

@@ -1,8 +1,8 @@
 """Rule model_comparison: each normal model fitted to e_n(v_n), AIC/BIC -> results/analyst/model_comparison.nc."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.solvers.engine import set_threads  # noqa: E402
 

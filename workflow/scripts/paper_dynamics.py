@@ -2,9 +2,9 @@
 phase portraits (phase_portraits.nc), v_c, the capture velocity, C and omega_f at those speeds
 (dynamics.nc), and the (C1, C2) plane of Fig. 4 with the Table 1 cases (bifurcation.nc)."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.solvers.engine import set_threads  # noqa: E402
 

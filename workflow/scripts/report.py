@@ -1,8 +1,8 @@
 """Rule report: lay out the result files on A4 pages -> reports/report.pdf (no simulation is run)."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.report.pdf import build_report  # noqa: E402
 

@@ -1,9 +1,9 @@
 """Rule stress: seeded random stress sweep of the engine -> results/stress_summary.json (summary)
 + results/stress.nc (one row per case: inputs, measures, failures)."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.solvers.engine import set_threads  # noqa: E402
 

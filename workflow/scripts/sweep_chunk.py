@@ -1,8 +1,8 @@
 """Rule paper_sweep_chunk: chunk <chunk> of <nchunks> (split along speed) of one Table 2 case."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.solvers.engine import set_threads  # noqa: E402
 

@@ -4,9 +4,9 @@ stderr is left on the terminal: a bad file stops the pipeline here with one Impa
 lists every problem (file, row, line, column, value, what is accepted) where the analyst sees it.
 """
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake, keep_stderr=True)  # noqa: F821  (the ImpactDataError is for the terminal)
 
 from microimpact.io import read_impacts, write_csv  # noqa: E402
 

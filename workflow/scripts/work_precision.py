@@ -1,9 +1,9 @@
 """Rule work_precision: accuracy against cost of the engine, scipy's solvers and Runge-Kutta-Gill
 -> results/benchmark/ (benchmark.nc, .json, .md, work_precision.pdf/.png)."""
 
-import sys
+from microimpact.io.joblog import log_job
 
-sys.stdout = sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
 from microimpact.solvers.engine import set_threads  # noqa: E402
 

@@ -155,12 +155,12 @@ BATCH_VARIABLES = ("outcome", "e_n", "mu_t", "mu_tp", "K_L", "K_t", "velocity_ou
                    "max_penetration", "slip_ended", "friction_impulse", "dissipated_energy")
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def normal_speed_range(speed, incidence_deg):
     """(smallest, largest) incident normal speed v cos(incidence) of a batch [m/s, deg] in one
     pass, without the batch-sized temporaries of the numpy expression."""
     lo, hi = math.inf, -math.inf
-    for i in range(speed.shape[0]):
+    for i in prange(speed.shape[0]):
         v_n = speed[i] * math.cos(math.radians(incidence_deg[i]))
         lo, hi = min(lo, v_n), max(hi, v_n)
     return lo, hi

@@ -109,6 +109,8 @@ class BenchmarkConfig:
     family_size: int = 100_000
     family_impacts: int = 1_000_000
     family_check: int = 20_000
+    #: batch sizes whose peak memory growth is compared with the output's (family path)
+    family_memory_sizes: tuple = (100_000, 1_000_000)
     #: also judge the engine_family line on the oblique cases (a family over their range: seconds)
     family_oblique: bool = True
     #: rows of the large fit compared with a 100-row fit
@@ -135,7 +137,8 @@ class BenchmarkConfig:
             oblique=_OBLIQUE_QUICK, repeats_single=5, repeats_scipy=1, repeats_batch=3, batch_size=1000,
             throughput_impacts=20_000, throughput_repeats=1, memory_sizes=(2_000, 20_000), time_limit=1.0,
             oblique_time_limit=0.5,  # RK45 settles a captured case in 2.4 s: quick marks it timed out
-            reference_rtols=(1e-11, 1e-12), family_size=20_000, family_impacts=100_000, family_check=3_000, fit_rows=10_000, family_oblique=False,
+            reference_rtols=(1e-11, 1e-12), family_size=20_000, family_impacts=100_000, family_check=3_000,
+            family_memory_sizes=(20_000, 200_000), fit_rows=10_000, family_oblique=False,
         )
 
     @property
