@@ -34,7 +34,9 @@ rule report:
         "benchmarks/report.tsv"
     conda:
         "../envs/microimpact.yaml"
-    threads: 2  # the figures are drawn side by side (build_report(workers=...))
+    # one thread: the report is the last job, and the HTML figures run beside it (two workers
+    # drew its figures 1 s faster but held the second core for all of its 6 s)
+    threads: 1
     params:
         config=config,
     script:
