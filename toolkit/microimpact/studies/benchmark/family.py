@@ -163,6 +163,11 @@ def family_targets(contact, cfg: BenchmarkConfig, tpi, err, verbose: bool = Fals
         "family_target_met": bool(t_dop / (t / n) >= 1e6 / FAMILY_TARGET_DOP853_IMPACTS and e_err <= FAMILY_TARGET_ERROR),
         "family_memory_peak_growth": p1 / p0,
         "family_memory_output_growth": o1 / o0,
+        # the peak at the larger batch as a fraction of its output: below 1, memory is bounded by
+        # what the caller gets back
+        "family_memory_peak_fraction_of_output": p1 / o1,
+        # growing no faster than the output (10 % allowance for the allocator's granularity: the
+        # smaller batch's arrays stay in numpy's allocator, the larger's are memory maps)
         "family_memory_target_met": bool(p1 / p0 <= 1.1 * o1 / o0),
     }
 

@@ -261,7 +261,8 @@ def _family_section(a: dict) -> list[str]:
         f"in {a['family_seconds']:.3g} s, e_n error {a['family_max_error_e_n']:.2g}: "
         f"{a['family_ratio_per_impact']:,.0f}x | {'yes' if a['family_target_met'] else 'NO'} |",
         f"| peak memory of the family path grows no faster than the output | peak x{a['family_memory_peak_growth']:.2f}, "
-        f"output x{a['family_memory_output_growth']:.2f} | {'yes' if a['family_memory_target_met'] else 'NO'} |",
+        f"output x{a['family_memory_output_growth']:.2f} (peak {a.get('family_memory_peak_fraction_of_output', math.nan):.2f} "
+        f"of the output at the larger batch) | {'yes' if a['family_memory_target_met'] else 'NO'} |",
         f"| a fit of {json.loads(a['fit_sizes'])[-1]:,} rows takes at most {a['fit_target_ratio']:g} times a fit of "
         f"{json.loads(a['fit_sizes'])[0]} rows | {' s vs '.join(f'{x:.2f}' for x in json.loads(a['fit_seconds'])[::-1])} s: "
         f"x{a['fit_time_ratio']:.1f} | {'yes' if a['fit_target_met'] else 'NO'} |",
