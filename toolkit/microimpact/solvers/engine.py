@@ -284,6 +284,28 @@ def _event_on_interpolant(code, target, th, u0, k1, u1, k7, h, ah, aa):
     return law.nondimensional_energy(s, y, ah, aa) - target
 
 
+@njit(cache=True, inline="always")
+def illinois_point(a, fa, b, fb):
+    """The regula falsi point of a bracket [a, b] with f(a) = fa, f(b) = fb of opposite signs (its
+    midpoint where rounding puts that point outside)."""
+    x = (a * fb - b * fa) / (fb - fa)
+    return x if a < x < b else 0.5 * (a + b)
+
+
+@njit(cache=True, inline="always")
+def illinois_update(a, fa, b, fb, x, fx, side):
+    """The bracket after f(x) = fx, keeping the sign change; an end kept twice in a row has its
+    value halved (the Illinois method: superlinear where plain regula falsi stalls at one end).
+    ``side`` (0 at the start) records which end moved last; returns (a, fa, b, fb, side)."""
+    if (fx > 0.0) == (fb > 0.0):
+        if side == -1:
+            fa *= 0.5
+        return a, fa, x, fx, -1
+    if side == 1:
+        fb *= 0.5
+    return x, fx, b, fb, 1
+
+
 @njit(cache=True)
 def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
     """Step length h* in (0, h] at which event ``code`` crosses zero; on return u1, k[6] hold the
@@ -305,22 +327,11 @@ def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, er
     side = 0
     th = 1.0
     for _ in range(50):
-        th = (a * fb - b * fa) / (fb - fa)
-        if not (th > a and th < b):
-            th = 0.5 * (a + b)
+        th = illinois_point(a, fa, b, fb)
         fs = _event_on_interpolant(code, target, th, u0, k1, end, k7, h, ah, aa)
         if fs == 0.0 or (b - a) < 1e-13:
             break
-        if (fs > 0.0) == (fb > 0.0):
-            b, fb = th, fs
-            if side == -1:
-                fa *= 0.5
-            side = -1
-        else:
-            a, fa = th, fs
-            if side == 1:
-                fb *= 0.5
-            side = 1
+        a, fa, b, fb, side = illinois_update(a, fa, b, fb, th, fs, side)
     hs = th * h
     _step(u0, k1, hs, c1, c2, ah, aa, sgn, k, tmp, u1, err)
     return hs

@@ -44,7 +44,8 @@ from numba import njit, prange
 from microimpact.model import adhesion_models as am
 from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL
-from microimpact.solvers.engine import CAPTURE, OUTCOME_NAMES, REBOUND, EngineError, NormalSolution
+from microimpact.solvers.engine import (CAPTURE, OUTCOME_NAMES, REBOUND, EngineError, NormalSolution, illinois_point,
+                                       illinois_update)
 
 __all__ = ["solve_normal", "solve_normal_many", "solve_normal_reference", "settled_contact_energy",
            "MODEL_CODES"]
@@ -161,24 +162,13 @@ def _locate_boundary(model, zb, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
     side = 0
     hs = h
     for _ in range(60):
-        hs = (lo * fhi - hi * flo) / (fhi - flo)
-        if not (lo < hs < hi):
-            hs = 0.5 * (lo + hi)
+        hs = illinois_point(lo, flo, hi, fhi)
         k[0, :] = k0
         _step(model, u0, k, hs, c1, c2, a, b, e, tmp, u1, err)
         f = u1[0] - zb
         if f == 0.0 or (hi - lo) < 1e-14 * h:
             break
-        if (f > 0.0) == (fhi > 0.0):
-            hi, fhi = hs, f
-            if side == -1:
-                flo *= 0.5
-            side = -1
-        else:
-            lo, flo = hs, f
-            if side == 1:
-                fhi *= 0.5
-            side = 1
+        lo, flo, hi, fhi, side = illinois_update(lo, flo, hi, fhi, hs, f, side)
         if abs(f) < 1e-15:
             break
     k[0, :] = k0
