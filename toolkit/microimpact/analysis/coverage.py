@@ -21,6 +21,8 @@ import time
 import numpy as np
 import pandas as pd
 
+from microimpact.io.files import atomic_write
+
 __all__ = ["posterior_coverage", "COVERAGE_SETUP"]
 
 #: the study's setup (recorded with the result)
@@ -128,7 +130,7 @@ def main(argv=None) -> int:
     setup = dict(COVERAGE_SETUP) | {"n_datasets": args.n}
     df = posterior_coverage(args.n, **{k: v for k, v in setup.items() if k != "n_datasets"}, progress=True)
     summary = summarise(df, setup | {"radii": list(setup["radii"])})
-    with open(args.out, "w") as fh:
+    with atomic_write(args.out) as fh:  # a study of minutes: an interruption leaves the old file whole
         json.dump(summary, fh, indent=1, default=float)
     print(f"coverage {summary['covered_total']}/{summary['intervals']} = {100 * summary['coverage']:.1f} %")
     return 0
