@@ -272,6 +272,40 @@ def _initial_branch(z, p):
     return hist
 
 
+#: the events located within a step by :func:`_restep_to_root`: the Coulomb limit passing through
+#: zero, separation (s = 0), a turning point of the hysteretic law
+_EV_LOAD, _EV_SEPARATION, _EV_TURN = 0, 1, 2
+
+
+@njit(cache=True)
+def _event_value(code, z, p, hist):
+    if code == _EV_LOAD:
+        return _load_argument(z, p)
+    if code == _EV_SEPARATION:
+        return z[_S]
+    return _branch_slip(z, hist)
+
+
+@njit(cache=True)
+def _restep_to_root(code, fa, fb, tol, h, z, k1, p, hist, k, tmp, z1, err):
+    """Re-step from z to where event ``code`` crosses zero within the step h (regula falsi on the
+    step length; fa, fb its values at the start and end of the step, opposite signs); z1 then
+    holds the state there. Stops at |value| <= tol or a bracket below 1e-14 h."""
+    a, b = 0.0, h
+    for _ in range(60):
+        hs = b - fb * (b - a) / (fb - fa)
+        if not (a < hs < b):
+            hs = 0.5 * (a + b)
+        _step(z, k1, hs, p, hist, k, tmp, z1, err)
+        g = _event_value(code, z1, p, hist)
+        if abs(g) <= tol or (b - a) < 1e-14 * h:
+            break
+        if (g > 0.0) == (fa > 0.0):
+            a, fa = hs, g
+        else:
+            b, fb = hs, g
+
+
 @njit(cache=True)
 def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max_steps):
     """Integrate one impact of the coupled model (nondimensional; see the module docstring).
@@ -353,20 +387,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 en_n += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
             ga, gb = _load_argument(z, p), _load_argument(z1, p)
             if en_n <= _VT and ga * gb < 0.0:
-                a, fa, b, fb = 0.0, ga, h, gb
-                gref = abs(ga) + abs(gb)
-                for _ in range(60):
-                    hs = b - fb * (b - a) / (fb - fa)
-                    if not (a < hs < b):
-                        hs = 0.5 * (a + b)
-                    _step(z, k1, hs, p, hist, k, tmp, z1, err)
-                    g = _load_argument(z1, p)
-                    if abs(g) <= 1e-13 * gref or (b - a) < 1e-14 * h:
-                        break
-                    if (g > 0.0) == (ga > 0.0):
-                        a, fa = hs, g
-                    else:
-                        b, fb = hs, g
+                _restep_to_root(_EV_LOAD, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
                 restart = True
                 en = float(_N)  # accepted; the next step keeps the length h
         en = math.sqrt(en / _N)
@@ -377,18 +398,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 break
             continue
         if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: secant on the step length
-            a, fa, b, fb = 0.0, z[_S], h, z1[_S]
-            for _ in range(60):
-                hs = b - fb * (b - a) / (fb - fa)
-                if not (a < hs < b):
-                    hs = 0.5 * (a + b)
-                _step(z, k1, hs, p, hist, k, tmp, z1, err)
-                if abs(z1[_S]) <= 1e-14 * sref or (b - a) < 1e-14 * h:
-                    break
-                if z1[_S] > 0.0:
-                    a, fa = hs, z1[_S]
-                else:
-                    b, fb = hs, z1[_S]
+            _restep_to_root(_EV_SEPARATION, z[_S], z1[_S], 1e-14 * sref, h, z, k1, p, hist, k, tmp, z1, err)
             z1[_S] = 0.0
             outcome = 0
             if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
@@ -400,20 +410,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         turned = False
         if not restart and hysteretic and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
             # turning point of the hysteretic law within the step: secant on the step length
-            a, fa, b, fb = 0.0, _branch_slip(z, hist), h, _branch_slip(z1, hist)
-            gref = abs(fa) + abs(fb)
-            for _ in range(60):
-                hs = b - fb * (b - a) / (fb - fa)
-                if not (a < hs < b):
-                    hs = 0.5 * (a + b)
-                _step(z, k1, hs, p, hist, k, tmp, z1, err)
-                g = _branch_slip(z1, hist)
-                if abs(g) <= 1e-13 * gref or (b - a) < 1e-14 * h:
-                    break
-                if g > 0.0:
-                    a, fa = hs, g
-                else:
-                    b, fb = hs, g
+            ga, gb = _branch_slip(z, hist), _branch_slip(z1, hist)
+            _restep_to_root(_EV_TURN, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
             turned = True
         if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
             tau_j = z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
@@ -505,6 +503,52 @@ def _roll_stuck(states, captured, krot):
     states[stuck, _VTP], states[stuck, _WT] = vtp, vtp
 
 
+#: column 9 of the parameter rows: the tangential model
+_TANGENTIAL_MODES = {"rigid": 0.0, "mindlin": 1.0, "mindlin_deresiewicz": 2.0}
+
+
+def _parameter_rows(contact, sc, c1, c2, f, length, time) -> np.ndarray:
+    """The law's parameters of each impact, one row each (the columns of :func:`_rhs`): C1, C2, the
+    Hertz and adhesion coefficients, f, the pull-off force, the friction model, the Mindlin
+    stiffness, m r^2 / I, the tangential model (0 rigid, 1 Mindlin, 2 Mindlin-Deresiewicz) and
+    mu_r; ``length``, ``time`` the impacts' scales [m], [s]."""
+    m, r = contact.mass, contact.radius
+    mode = _TANGENTIAL_MODES[contact.tangential_model]
+    p = np.empty((f.size, 11))
+    p[:, 0] = np.broadcast_to(c1, f.shape)
+    p[:, 1] = np.broadcast_to(c2, f.shape)
+    p[:, 2], p[:, 3] = sc.a_hertz, sc.a_adhesion
+    p[:, 4] = f
+    p[:, 5] = _tc.nondimensional_pulloff_force(sc.a_hertz, sc.a_adhesion)
+    p[:, 6] = 1.0 if contact.friction_model == "pulloff" else 0.0
+    p[:, 7] = (8.0 * contact.shear_modulus * np.sqrt(r * length) * time**2 / m) if mode > 0.0 else 0.0
+    p[:, 8] = m * r * r / contact.moment_of_inertia
+    p[:, 9] = mode
+    p[:, 10] = contact.rolling_friction
+    return p
+
+
+def _tangential_si(contact, mindlin, states, info, f, v_in, w_in, slip, jl, jal, u, time):
+    """The tangential outcome in SI: (velocities and spins by name, slip ended, slip end time [s]).
+
+    A compliant contact's tangential state is integrated and its twist keeps its closed form
+    (torque (3 pi/16) f a load); the rigid contact's whole outcome is the closed-form map of the
+    impulses ``jl``, ``jal`` [N s], [N m s]."""
+    from microimpact.model.tangential import tangential_outcome  # closed-form map
+
+    m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
+    if mindlin:
+        tw = tangential_outcome(m, inertia, r, f, v_in, w_in, 0.0, jal)
+        out = {"v_t": states[:, _VT] * u, "v_tp": states[:, _VTP] * u, "omega_n": tw["omega_n"],
+               "omega_t": states[:, _WT] * u / r, "omega_tp": states[:, _WTP] * u / r}
+        slip_out = np.hypot(out["v_t"] + r * out["omega_tp"], out["v_tp"] - r * out["omega_t"])
+        return out, slip_out <= 1e-9 * np.maximum(slip, 1e-300), np.full(slip.size, np.nan)
+    tan = tangential_outcome(m, inertia, r, f, v_in, w_in, jl, jal)
+    slip_end_time = np.where(slip == 0.0, 0.0, info[:, 4] * time)
+    return ({k: tan[k] for k in ("v_t", "v_tp", "omega_n", "omega_t", "omega_tp")}, tan["slip_ended"],
+            np.where(tan["slip_ended"], slip_end_time, np.nan))
+
+
 def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _DEFAULT_MAX_STEPS) -> dict:
     """Impacts of a contact that selects tangential compliance or adhesion-aware friction.
 
@@ -534,11 +578,8 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     CoupledError
         If an impact reaches the step limit or the step size underflows.
 
-    Length: the SI <-> nondimensional conversion of every input and output in one place (about
-    half the lines build the parameter rows and the stop impulses, the rest map the end states
-    back to SI); split, the two halves would pass a dozen scales between them.
     """
-    from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form map
+    from microimpact.model.tangential import stop_impulses  # closed-form stop impulses
 
     # np.array copies: numba must not be handed the read-only views that broadcasting makes
     v_n, v_t, v_tp = (np.array(a, dtype=float).ravel() for a in np.broadcast_arrays(*velocity_in))
@@ -550,21 +591,10 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     length = np.array(np.broadcast_to(sc.length, speed.shape))
     time = np.array(np.broadcast_to(sc.time, speed.shape))
     m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
-    mode = {"rigid": 0.0, "mindlin": 1.0, "mindlin_deresiewicz": 2.0}[contact.tangential_model]
+    p = _parameter_rows(contact, sc, c1, c2, f, length, time)
+    mode = _TANGENTIAL_MODES[contact.tangential_model]
     mindlin = mode > 0.0
     aware = contact.friction_model == "pulloff"
-    fpo = _tc.nondimensional_pulloff_force(sc.a_hertz, sc.a_adhesion)
-    p = np.empty((speed.size, 11))
-    p[:, 0] = np.broadcast_to(c1, speed.shape)
-    p[:, 1] = np.broadcast_to(c2, speed.shape)
-    p[:, 2], p[:, 3] = sc.a_hertz, sc.a_adhesion
-    p[:, 4] = f
-    p[:, 5] = fpo
-    p[:, 6] = 1.0 if aware else 0.0
-    p[:, 7] = (8.0 * contact.shear_modulus * np.sqrt(r * length) * time**2 / m) if mindlin else 0.0
-    p[:, 8] = m * r * r / inertia
-    p[:, 9] = mode
-    p[:, 10] = contact.rolling_friction
     slip = np.hypot(v_t + r * w_tp, v_tp - r * w_t)
     if mindlin:
         j_stop = np.full(speed.size, np.inf)
@@ -588,22 +618,10 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     captured = info[:, 1] == 1
     jl = states[:, _J] * j_unit
     jal = states[:, _JA] * ja_unit
-    if mindlin:
-        # the twist keeps its closed form (torque (3 pi/16) f a load); the tangential state is integrated
-        tw = tangential_outcome(m, inertia, r, f, (v_n, v_t, v_tp), (w_n, w_t, w_tp), 0.0, jal)
-        if mode > 1.5 and aware:
-            _roll_stuck(states, captured, p[0, 8])
-        out = {"v_t": states[:, _VT] * u, "v_tp": states[:, _VTP] * u, "omega_n": tw["omega_n"],
-               "omega_t": states[:, _WT] * u / r, "omega_tp": states[:, _WTP] * u / r}
-        slip_out = np.hypot(out["v_t"] + r * out["omega_tp"], out["v_tp"] - r * out["omega_t"])
-        slip_ended = slip_out <= 1e-9 * np.maximum(slip, 1e-300)
-        slip_end_time = np.full(speed.size, np.nan)
-    else:
-        tan = tangential_outcome(m, inertia, r, f, (v_n, v_t, v_tp), (w_n, w_t, w_tp), jl, jal)
-        out = {k: tan[k] for k in ("v_t", "v_tp", "omega_n", "omega_t", "omega_tp")}
-        slip_ended = tan["slip_ended"]
-        slip_end_time = np.where(slip == 0.0, 0.0, info[:, 4] * time)
-        slip_end_time = np.where(slip_ended, slip_end_time, np.nan)
+    if mindlin and mode > 1.5 and aware:
+        _roll_stuck(states, captured, p[0, 8])
+    out, slip_ended, slip_end_time = _tangential_si(contact, mindlin, states, info, f, (v_n, v_t, v_tp),
+                                                    (w_n, w_t, w_tp), slip, jl, jal, u, time)
     return {
         "captured": captured,
         "e_n": np.where(captured, 0.0, -states[:, _Y] / (y0 * np.ones(speed.shape))),
