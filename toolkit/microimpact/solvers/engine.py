@@ -133,6 +133,8 @@ def engine_scales(contact, normal_speed):
         Incident normal speed, > 0. [m/s]
     """
     sc, y0, c1, c2 = nondimensional_impact(contact, normal_speed)
+    if type(y0) is float and (y0 <= MAX_ADHESIVE_SPEED or not sc.a_adhesion > 0.0):
+        return sc, y0, c1, c2  # one impact in the paper's scales: the common case, without numpy
     if not (sc.a_adhesion > 0.0 and np.any(np.asarray(y0) > MAX_ADHESIVE_SPEED)):
         return sc, y0, c1, c2
     v = np.asarray(normal_speed, dtype=float)
@@ -182,7 +184,7 @@ _MUST_BE_FINITE = ("max_penetration", "friction_impulse", "twist_impulse", "diss
 def _check_domain(contact, values: dict, normal_speed) -> None:
     """ModelDomainError if a result that must be finite overflowed in SI units (the nondimensional
     solve succeeded; its units did not)."""
-    if all(isinstance(values[name], float) and math.isfinite(values[name]) for name in _MUST_BE_FINITE):
+    if all(type(q) is float and math.isfinite(q) for q in map(values.__getitem__, _MUST_BE_FINITE)):
         return  # one impact, all finite: the common case, without numpy
     for name in _MUST_BE_FINITE:
         q = np.asarray(values[name], dtype=float)
@@ -1066,6 +1068,10 @@ class NormalSolution:
     penetration_rate: np.ndarray | None = None
 
 
+#: The record array of a solve that records nothing (never written: its capacity is 0)
+_NO_RECORD = np.zeros((1, 3))
+
+
 def solve_normal(
     contact,
     normal_speed: float,
@@ -1135,7 +1141,7 @@ def solve_normal(
     jt = 0.0 if friction_impulse_target is None else float(friction_impulse_target) / j_unit
     cap = 4096 if (trajectory or follow_capture) else 0
     while True:
-        rec = np.zeros((max(cap, 1), 3))
+        rec = np.zeros((cap, 3)) if cap else _NO_RECORD
         r = _integrate(y0, c1, c2, sc.a_hertz, sc.a_adhesion, rtol, need_tail,
                        rtol if tail_tolerance is None else tail_tolerance, jt, follow_capture,
                        settle_amplitude * (sc.a_adhesion / sc.a_hertz if sc.a_adhesion > 0 else 1.0),
@@ -1153,7 +1159,7 @@ def solve_normal(
         raise EngineError(f"engine failed for normal speed {v!r} m/s: {_failure(r[0])} after {r[11]} steps")
     solution = normal_solution(contact, sc, y0, *r[1:13], trajectory=rec[:r[13]] if cap else None)
     _check_restitution(solution.e_n, v)
-    _check_domain(contact, {k: getattr(solution, k) for k in _MUST_BE_FINITE}, v)
+    _check_domain(contact, vars(solution), v)
     return solution
 
 

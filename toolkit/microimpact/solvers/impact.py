@@ -82,6 +82,8 @@ def _real_scalar(name: str, value) -> float:
 
 def _check_call(contact, rtol) -> float:
     """The contact's type and rtol (finite, 0 < rtol < 1): TypeError / ValueError naming them."""
+    if type(rtol) is float and MIN_RTOL <= rtol < 1.0 and isinstance(contact, Contact):
+        return rtol  # the common case, without the ABC checks (a single call costs microseconds)
     if not isinstance(contact, Contact):
         hint = "; for a mapping of fields use Contact(**contact)" if isinstance(contact, Mapping) else ""
         raise TypeError(f"contact must be a microimpact Contact, got {type(contact).__name__}{hint}")
@@ -96,6 +98,8 @@ def _check_call(contact, rtol) -> float:
 
 
 def _check_omega(omega) -> tuple:
+    if type(omega) is tuple and len(omega) == 3:
+        return omega
     if isinstance(omega, (str, bytes, Mapping)) or not hasattr(omega, "__len__"):
         raise TypeError(f"omega must be a sequence of 3 components (omega_n, omega_t, omega_tp), "
                         f"got {type(omega).__name__} {omega!r}")
@@ -104,10 +108,15 @@ def _check_omega(omega) -> tuple:
     return tuple(omega)
 
 
+#: The types of the scalar fast paths (exact types: a numpy scalar takes the general path)
+_FLOATS = frozenset((float,))
+
+
 def _check_inputs(speed, incidence_deg, azimuth_deg, omega):
-    if all(isinstance(x, (int, float)) for x in (speed, incidence_deg, azimuth_deg, *omega)):
-        if math.isfinite(speed) and speed > 0.0 and math.isfinite(incidence_deg) and 0.0 <= incidence_deg < 90.0 \
-                and math.isfinite(azimuth_deg) and all(math.isfinite(w) for w in omega):
+    if _FLOATS.issuperset((type(speed), type(incidence_deg), type(azimuth_deg), *map(type, omega))):
+        w_n, w_t, w_tp = omega
+        if 0.0 < speed < math.inf and 0.0 <= incidence_deg < 90.0 and math.isfinite(azimuth_deg) \
+                and math.isfinite(w_n) and math.isfinite(w_t) and math.isfinite(w_tp):
             return  # the common scalar case, valid (the array checks below give the messages)
     speed = np.asarray(speed, dtype=float)
     inc = np.asarray(incidence_deg, dtype=float)
@@ -242,7 +251,8 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
     speed = _real_scalar("speed", speed)
     incidence_deg = _real_scalar("incidence_deg", incidence_deg)
     azimuth_deg = _real_scalar("azimuth_deg", azimuth_deg)
-    omega = tuple(_real_scalar(name, w) for name, w in zip(("omega_n", "omega_t", "omega_tp"), omega))
+    if not _FLOATS.issuperset(map(type, omega)):
+        omega = tuple(_real_scalar(name, w) for name, w in zip(("omega_n", "omega_t", "omega_tp"), omega))
     _check_inputs(speed, incidence_deg, azimuth_deg, omega)
     _check_scales(contact, speed, incidence_deg, omega)
     if not isinstance(method, str) or method not in METHODS:
@@ -300,12 +310,11 @@ def _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential) -> 
     captured = sol.outcome == "capture"
     v_out = (0.0 if captured else sol.e_n * -v_in[0], tan[0], tan[1])
     w_out = (tan[2], tan[3], tan[4])
-    coef = dict(zip(("e_n", "mu_t", "mu_tp", "K_L", "K_t"),
-                    coefficients_kernel(m, inertia, *v_in, *w_in, *v_out, *w_out, captured)))
+    e_n, mu_t, mu_tp, k_l, k_t = coefficients_kernel(m, inertia, *v_in, *w_in, *v_out, *w_out, captured)
     slip_ended = bool(tan[5])
     return ImpactResult(
         outcome=sol.outcome,
-        **coef,
+        e_n=e_n, mu_t=mu_t, mu_tp=mu_tp, K_L=k_l, K_t=k_t,
         velocity_in=v_in,
         omega_in=w_in,
         velocity_out=v_out,
