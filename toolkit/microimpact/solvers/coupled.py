@@ -38,13 +38,25 @@ is located (secant on the step length, on the normal state alone, which does not
 the branch restarts there as at first contact (:func:`_restart_branch`). Without them the steps
 shrank geometrically towards each zero of F_lim and a captured impact reached the step limit.
 
-End of a captured impact, hysteretic law: the normal oscillation has decayed below
-``SETTLE_AMPLITUDE`` of the equilibrium penetration AND the tangential state no longer changes:
-either the friction law has no limit at rest ("net": F_lim = f |F_n| = 0 at the adhesive
-equilibrium, so the sphere keeps its slip and spins for ever, up to a friction impulse of order
-``SETTLE_AMPLITUDE`` of that of one period) or the contact is stuck (p < 1, |T| < F_lim; at the
-constant load of rest the hysteretic spring only loses energy, so it never slips again). A stuck
-sphere is reported at its rolling mean (:func:`_roll_stuck`).
+End of a captured impact (every tangential model): the integration stops once the normal
+oscillation has decayed below the settle amplitude (``SETTLE_AMPLITUDE`` of the equilibrium
+penetration, or ``SETTLE_PER_RTOL`` times rtol if that is larger: the integration error keeps the
+amplitude of a long captured oscillation at 15-40 rtol, measured, so a fixed 1e-6 was never
+reached at rtol >= 1e-7). What the tangential state still does after that is taken in closed form
+(:func:`_settle_captured`), so the result does not depend on when the integration stopped:
+
+* friction with a limit at rest ("pulloff": F_lim = 2 f F_po at the adhesive equilibrium): the
+  contact force acts at the contact point, so the angular momentum about it is conserved, while
+  friction removes every slip (sliding stops in finite time at the constant limit; a stuck elastic
+  vibration of the contact averages to zero slip). The sphere ends rolling at that angular momentum
+  (:func:`_rolling_state`), without twist. Before, a stuck Mindlin contact was reported at the phase
+  of its undamped vibration where the integration stopped (K_L differed by up to 5e-2 between
+  rtol 1e-8 and 1e-10).
+* the paper's friction ("net": F_lim = f |F_n| = 0 at the equilibrium): the rest of the
+  oscillation is the linear damped tail about the equilibrium; its friction impulse (the total
+  variation of the normal rate, :func:`microimpact.solvers.engine._linear_tail_variation`) and twist
+  impulse (times a at the equilibrium) act as sliding friction, the closed-form map of the rigid
+  contact (the limit is tiny, so the compliant contact is in gross slip while it slides).
 """
 
 from __future__ import annotations
@@ -57,6 +69,7 @@ from numba import njit, prange
 from microimpact.model import law as _law
 from microimpact.model import tangential_compliance as _tc
 from microimpact.solvers.compiled_law import compiled
+from microimpact.solvers.engine import _equilibrium, _linear_tail_variation
 
 __all__ = ["coupled_kernel", "coupled_many", "CoupledError"]
 
@@ -314,8 +327,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     wt0, wtp0 rim speeds r omega_t, r omega_t'; p the law's parameters (see :func:`_rhs`); j_stop,
     ja_stop the impulses after which a captured sphere's sliding and twist are over (rigid
     contact); settle the oscillation amplitude (relative to the equilibrium) at which a captured
-    sphere is taken to be at rest (with the hysteretic law, only once its tangential state no longer
-    changes: see the module docstring).
+    sphere's integration stops (its tangential rest follows in closed form: see the module
+    docstring).
 
     Returns (status, outcome, state at the end (12,), largest xi, tau at capture, tau at which J
     reached j_stop, n_steps).
@@ -352,7 +365,6 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     n_restart = 0
     hysteretic = p[9] > 1.5
     lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
-    lim_rest = p[4] * 2.0 * p[5] if p[6] > 0.5 else 0.0  # F_lim at the adhesive equilibrium
     damped = p[0] > 0.0 or p[1] > 0.0
     xe = aa / ah if ah > 0.0 else 0.0
     omega0 = math.sqrt(ah * math.sqrt(xe)) if aa > 0.0 else 1.0
@@ -442,13 +454,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         if captured:
             dx = z[_S] * z[_S] - xe
             amp = math.sqrt(dx * dx + (z[_Y] / omega0) ** 2) / xe
-            if hysteretic:
-                # settled normal motion, and a tangential state that no longer changes: no friction
-                # at rest ("net" friction), or a stuck contact (p < 1, |T| < F_lim) at constant load
-                if amp < settle and (lim_rest == 0.0 or z[_FT] < 1.0):
-                    outcome = 1
-                    break
-            elif (z[_J] >= j_stop and z[_JA] >= ja_stop) or amp < settle:
+            # settled normal motion (the tangential rest is taken in closed form afterwards), or
+            # the rigid contact's sliding and twist over
+            if amp < settle or (z[_J] >= j_stop and z[_JA] >= ja_stop):
                 outcome = 1
                 break
         h *= 5.0 if en == 0.0 else min(5.0, max(0.2, 0.9 * en ** -0.2))
@@ -476,31 +484,81 @@ def coupled_many(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max
         out_info[i, 6] = r[7]
 
 
-#: amplitude of the captured normal oscillation, relative to the equilibrium penetration, below
-#: which a captured sphere is taken to be at rest (its tangential state no longer changes by more
-#: than this fraction of the friction impulse of one period)
+#: amplitude of the captured normal oscillation, relative to the equilibrium penetration, at which
+#: the integration of a captured sphere stops (the tangential rest is then taken in closed form)
 SETTLE_AMPLITUDE = 1e-6
+#: the settle amplitude is at least this multiple of rtol: integration error holds the amplitude of
+#: a long captured oscillation at 15-40 rtol (measured at rtol 1e-6 and 1e-7), so a smaller one
+#: may never be reached (the step limit was, at rtol 1e-7 with Mindlin contact)
+SETTLE_PER_RTOL = 1e3
 
 #: default step limit of one impact (the status code _MAX_STEPS is a different name)
 _DEFAULT_MAX_STEPS = 2_000_000
 
 
-def _roll_stuck(states, captured, krot):
-    """Replace the tangential state of captured spheres held stuck (p < 1) by its rolling mean.
+def _rolling_state(states, rows, krot):
+    """Set the tangential velocities and rim speeds of ``rows`` of ``states`` (n, 12) to rolling at
+    their angular momentum about the contact point.
 
-    A stuck contact at the constant load of rest keeps a small elastic vibration of the contact
-    point (energy below F_lim^2 / k_t, lost only slowly to micro-slip). The tangential force acts at
-    the contact point, so the angular momentum about it, m v_t - I omega_t' / r and
-    m v_t' + I omega_t / r, is conserved; the vibration averages to the rolling state of the same
-    angular momentum (u = 0), v = (k v - w) / (k + 1), w = -v with k = m r^2 / I (2.5 for a
-    homogeneous sphere: the 5/7 rule), which is also the state of least kinetic energy at that
-    angular momentum. Edits ``states`` (n, 12) in place for the rows where ``captured``.
+    The contact force acts at the contact point, so m v_t - I omega_t' / r and m v_t' + I omega_t / r
+    are conserved; rolling (u = 0) at that angular momentum is v = (k v - w) / (k + 1), w = -v, with
+    k = m r^2 / I (2.5 for a homogeneous sphere: the 5/7 rule). It is also the time average of a
+    stuck elastic vibration of the contact (its slip averages to zero).
     """
-    stuck = captured & (states[:, _FT] < 1.0)
-    vt = (krot * states[stuck, _VT] - states[stuck, _WTP]) / (krot + 1.0)
-    vtp = (krot * states[stuck, _VTP] + states[stuck, _WT]) / (krot + 1.0)
-    states[stuck, _VT], states[stuck, _WTP] = vt, -vt
-    states[stuck, _VTP], states[stuck, _WT] = vtp, vtp
+    vt = (krot * states[rows, _VT] - states[rows, _WTP]) / (krot + 1.0)
+    vtp = (krot * states[rows, _VTP] + states[rows, _WT]) / (krot + 1.0)
+    states[rows, _VT], states[rows, _WTP] = vt, -vt
+    states[rows, _VTP], states[rows, _WT] = vtp, vtp
+
+
+@njit(cache=True)
+def _tail_impulses(s, y, p):
+    """(J, J_a) still to come, nondimensional, of captured spheres whose integration stopped at
+    (s, y) near the equilibrium: the linear damped tail's total variation of y (the friction
+    impulse, F_n = -dy/dtau) and that times a = sqrt(xi_e) (the twist impulse)."""
+    j = np.empty(s.size)
+    ja = np.empty(s.size)
+    for i in range(s.size):
+        c1, c2, ah, aa = p[i, 0], p[i, 1], p[i, 2], p[i, 3]
+        xe, omega0, ceq = _equilibrium(c1, c2, ah, aa)
+        j[i] = _linear_tail_variation(s[i] * s[i] - xe, y[i], omega0, ceq)
+        ja[i] = j[i] * math.sqrt(xe)
+    return j, ja
+
+
+def _settle_captured(contact, states, captured, p, unit, j_unit, ja_unit, jl, jal):
+    """The tangential rest of captured spheres after the integration stopped (module docstring).
+
+    Edits ``states`` (n, 12); returns the friction and twist impulses [N s], [N m s] that the
+    closed-form maps (the twist, the rigid contact) are to use: the followed ones ``jl``, ``jal``
+    plus the tail's, unbounded with a friction limit at rest. ``unit``, ``j_unit``, ``ja_unit``: the
+    units of speed [m/s], friction impulse [N s] and twist impulse [N m s] of each impact.
+    """
+    rows = np.flatnonzero(captured)
+    if rows.size == 0:
+        return jl, jal
+    jl, jal = jl.copy(), jal.copy()
+    if contact.friction_model == "pulloff":
+        jl[rows] = jal[rows] = np.inf
+        if p[0, 9] > 0.0:
+            _rolling_state(states, rows, p[0, 8])
+        return jl, jal
+    m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
+    j_tail, ja_tail = _tail_impulses(states[rows, _S], states[rows, _Y], p[rows])
+    u = unit[rows]
+    j_tail *= j_unit[rows]
+    ja_tail *= ja_unit[rows]
+    if p[0, 9] > 0.0:  # compliant: the tail slides the state as the rigid contact's map does
+        from microimpact.model.tangential import tangential_outcome
+
+        zero = np.zeros(rows.size)
+        tail = tangential_outcome(m, inertia, r, p[rows, 4], (zero, states[rows, _VT] * u, states[rows, _VTP] * u),
+                                  (zero, states[rows, _WT] * u / r, states[rows, _WTP] * u / r), j_tail, zero)
+        states[rows, _VT], states[rows, _VTP] = tail["v_t"] / u, tail["v_tp"] / u
+        states[rows, _WT], states[rows, _WTP] = tail["omega_t"] * r / u, tail["omega_tp"] * r / u
+    jl[rows] += j_tail
+    jal[rows] += ja_tail
+    return jl, jal
 
 
 #: column 9 of the parameter rows: the tangential model
@@ -607,7 +665,8 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     states = np.empty((speed.size, _N))
     info = np.empty((speed.size, 7))
     coupled_many(np.ascontiguousarray(y0 * np.ones(speed.shape)), v_t / u, v_tp / u, r * w_t / u, r * w_tp / u,
-                 p, float(rtol), np.ascontiguousarray(j_stop), np.ascontiguousarray(ja_stop), SETTLE_AMPLITUDE,
+                 p, float(rtol), np.ascontiguousarray(j_stop), np.ascontiguousarray(ja_stop),
+                 max(SETTLE_AMPLITUDE, SETTLE_PER_RTOL * rtol),
                  int(max_steps), states, info)
     bad = info[:, 0] != _OK
     if np.any(bad):
@@ -618,10 +677,12 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     captured = info[:, 1] == 1
     jl = states[:, _J] * j_unit
     jal = states[:, _JA] * ja_unit
-    if mindlin and mode > 1.5 and aware:
-        _roll_stuck(states, captured, p[0, 8])
+    if aware and not mindlin:  # sliding that ends at rest, after the integration stopped
+        late = captured & np.isnan(info[:, 4]) & np.isfinite(j_stop) & (states[:, _J] < j_stop)
+        info[late, 4] = states[late, _TAU] + (j_stop[late] - states[late, _J]) / (2.0 * p[late, 5])
+    j_map, ja_map = _settle_captured(contact, states, captured, p, u, j_unit, ja_unit, jl, jal)
     out, slip_ended, slip_end_time = _tangential_si(contact, mindlin, states, info, f, (v_n, v_t, v_tp),
-                                                    (w_n, w_t, w_tp), slip, jl, jal, u, time)
+                                                    (w_n, w_t, w_tp), slip, j_map, ja_map, u, time)
     return {
         "captured": captured,
         "e_n": np.where(captured, 0.0, -states[:, _Y] / (y0 * np.ones(speed.shape))),
