@@ -12,6 +12,8 @@ import math
 import numpy as np
 from numba import njit
 
+from microimpact.model.kinematics import flat_broadcast
+
 __all__ = ["impact_coefficients", "coefficients_kernel"]
 
 
@@ -70,10 +72,8 @@ def impact_coefficients(mass, moment_of_inertia, velocity_in, omega_in, velocity
         r = coefficients_kernel(float(mass), float(moment_of_inertia), *map(float, velocity_in), *map(float, omega_in),
                                 *map(float, velocity_out), *map(float, omega_out), bool(captured))
         return dict(zip(names, r))
-    arrays = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (*velocity_in, *omega_in, *velocity_out, *omega_out)),
+    shape, flat = flat_broadcast(*(np.asarray(x, dtype=float) for x in (*velocity_in, *omega_in, *velocity_out, *omega_out)),
                                  np.asarray(captured, dtype=bool))
-    shape = arrays[0].shape
-    flat = [np.ascontiguousarray(a).ravel() for a in arrays]
     out = np.empty((5, flat[0].size))
     _coefficients_many(float(mass), float(moment_of_inertia), np.stack(flat[0:3]), np.stack(flat[3:6]),
                        np.stack(flat[6:9]), np.stack(flat[9:12]), flat[12], out)

@@ -21,6 +21,7 @@ import numpy as np
 
 __all__ = [
     "ImpactResult",
+    "flat_broadcast",
     "incident_velocity",
     "slip_velocity",
 ]
@@ -40,6 +41,19 @@ def incident_velocity(speed: float, incidence_deg: float, azimuth_deg: float) ->
     a = math.radians(incidence_deg)
     th = math.radians(azimuth_deg)
     return -speed * math.cos(a), speed * math.sin(a) * math.cos(th), speed * math.sin(a) * math.sin(th)
+
+
+def flat_broadcast(*arrays):
+    """(shape, flat arrays): ``arrays`` (numpy arrays) broadcast to one shape, each 1-D and
+    contiguous, as the compiled kernels take them.
+
+    An array that already has the shape is raveled (a view when it is contiguous); one that needs
+    broadcasting is copied. numba is never handed a view made by ``np.broadcast_arrays``, whose
+    writeable flag warns when read (a FutureWarning from numba's typing).
+    """
+    shape = np.broadcast_shapes(*(a.shape for a in arrays))
+    return shape, [np.ascontiguousarray(a).ravel() if a.shape == shape else np.array(np.broadcast_to(a, shape)).ravel()
+                   for a in arrays]
 
 
 def slip_velocity(radius, v_t, v_tp, omega_t, omega_tp):

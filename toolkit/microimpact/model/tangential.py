@@ -18,6 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
+from microimpact.model.kinematics import flat_broadcast
 from microimpact.model.law import TWIST_TORQUE_FACTOR  # torque = factor * f * a * |F_n|
 
 __all__ = ["stop_impulses", "tangential_outcome", "tangential_kernel"]
@@ -98,8 +99,7 @@ def _stops_many(mass, inertia, f, slip, w_n, j_out, ja_out):
 
 
 def _flat(*arrays):
-    b = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
-    return b[0].shape, [np.ascontiguousarray(x).ravel() for x in b]
+    return flat_broadcast(*(np.asarray(a, dtype=float) for a in arrays))
 
 
 def stop_impulses(mass, moment_of_inertia, friction, slip_speed, omega_n):
