@@ -266,6 +266,10 @@ def _family_section(a: dict) -> list[str]:
         f"| a fit of {json.loads(a['fit_sizes'])[-1]:,} rows takes at most {a['fit_target_ratio']:g} times a fit of "
         f"{json.loads(a['fit_sizes'])[0]} rows | {' s vs '.join(f'{x:.2f}' for x in json.loads(a['fit_seconds'])[::-1])} s: "
         f"x{a['fit_time_ratio']:.1f} | {'yes' if a['fit_target_met'] else 'NO'} |",
+        f"| one simulate_impact call >= {a['single_call_target_ratio']:g}x faster than DOP853 at e_n error <= "
+        f"{a['target_error_e_n']:g} | {_n(a['ratio_dop853_to_engine_single'], '.0f')}x "
+        f"({_t(a['engine_time_at_target'])} vs {_t(a['dop853_time_at_target'])}) | "
+        f"{'yes' if a['single_call_target_met'] else 'NO'} |",
         "",
         f"Path: {a['family_path']}. The e_n error is the largest over {a['family_error_checked_on']:,} random impacts "
         f"of the batch against direct engine solves at rtol 1e-13; DOP853 per impact {a['family_dop853_time_per_impact'] * 1e3:.3g} ms "

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from microimpact.studies.benchmark.cases import (
-    ALL_METHODS, TARGET_ERROR, TARGET_RATIO, TARGET_RATIO_AIM, TARGET_THROUGHPUT_SECONDS, BenchmarkConfig,
+    ALL_METHODS, SINGLE_CALL_TARGET_RATIO, TARGET_ERROR, TARGET_RATIO, TARGET_RATIO_AIM, TARGET_THROUGHPUT_SECONDS, BenchmarkConfig,
 )
 from microimpact.studies.benchmark.harness import log, measure_memory, measure_throughput
 
@@ -84,6 +84,8 @@ def accuracy_targets(tpi, err, cfg: BenchmarkConfig, reference_bound: float) -> 
         "target_ratio_met_single": bool(ratio_single >= TARGET_RATIO),
         "target_ratio_met_batch": bool(ratio_batch >= TARGET_RATIO),
         "target_ratio_aim_met_batch": bool(ratio_batch >= TARGET_RATIO_AIM),
+        "single_call_target_ratio": SINGLE_CALL_TARGET_RATIO,
+        "single_call_target_met": bool(ratio_single >= SINGLE_CALL_TARGET_RATIO),
         "target_ratio_note": note,
         "engine_converges": converges,
         "engine_error_increases": json.dumps(increases),
