@@ -36,7 +36,11 @@ sphere's oscillation about the adhesive equilibrium, where F_n = 0). There T = 0
 f max(1, a_a, y0^1.2), the order of the largest limit), and (ii) a zero of the limit within a step
 is located (secant on the step length, on the normal state alone, which does not depend on p) and
 the branch restarts there as at first contact (:func:`_restart_branch`). Without them the steps
-shrank geometrically towards each zero of F_lim and a captured impact reached the step limit.
+shrank geometrically towards each zero of F_lim and a captured impact reached the step limit. A
+zero is looked for from the side of the load on which the branch was started, so that a root found
+a rounding error short of it is not found again, and a step that contains one is either ended there
+or rejected, never accepted without the restart (both happened, and rebounds differed by 1e-5 in
+v_t between tolerances).
 
 End of a captured impact (every tangential model): the integration stops once the normal
 oscillation has decayed below the settle amplitude (``SETTLE_AMPLITUDE`` of the equilibrium
@@ -364,6 +368,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     n_turn = 0
     n_restart = 0
     hysteretic = p[9] > 1.5
+    load_side = 0.0  # sign of the Coulomb limit's load argument since the last restart (0: not yet known)
     lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
     damped = p[0] > 0.0 or p[1] > 0.0
     xe = aa / ah if ah > 0.0 else 0.0
@@ -391,16 +396,27 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
         n += 1
         restart = False
-        if hysteretic and z[_S] > 0.0 and z1[_S] > 0.0:
-            # the Coulomb limit passes through zero within the step: if the normal motion is
-            # accurate, end the step there (secant on the step length) and restart the branch
+        if hysteretic and z[_S] > 0.0 and z1[_S] > 0.0 and _load_argument(z1, p) * load_side < 0.0:
+            # the Coulomb limit passes through zero within the step (from the side the branch was
+            # started on: a root found a rounding error short of the zero is not found again): if
+            # the normal motion is accurate, end the step there (secant on the step length) and
+            # restart the branch; else take a shorter step (accepting it on the error of all
+            # states, as before, let a zero pass without a restart: results then jumped by 1e-5
+            # between tolerances)
             en_n = 0.0
             for i in range(_VT):
                 en_n += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
             ga, gb = _load_argument(z, p), _load_argument(z1, p)
-            if en_n <= _VT and ga * gb < 0.0:
-                _restep_to_root(_EV_LOAD, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
+            if en_n > _VT:
+                en = max(en, 4.0 * _N)  # rejected
+            else:
+                if ga * gb < 0.0:
+                    _restep_to_root(_EV_LOAD, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
+                else:  # the step starts at the zero (within rounding): restart there
+                    for i in range(_N):
+                        z1[i] = z[i]
                 restart = True
+                load_side = 1.0 if gb > 0.0 else -1.0
                 en = float(_N)  # accepted; the next step keeps the length h
         en = math.sqrt(en / _N)
         if en > 1.0:
@@ -439,6 +455,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             _restart_branch(z, p, hist)
             n_restart += 1
         if hysteretic:
+            if load_side == 0.0 and z[_S] > 0.0:
+                g = _load_argument(z, p)
+                load_side = 0.0 if g == 0.0 else (1.0 if g > 0.0 else -1.0)
             z[_FT] = min(max(z[_FT], 0.0), 1.0)
             _rhs(z, p, hist, k1)
         elif p[9] > 0.5:
