@@ -1244,9 +1244,11 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     sc, y0, c1, c2 = engine_scales(contact, v)
     _check_resolvable(y0, np.any(np.asarray(sc.a_adhesion) > 0.0), v)
     u = sc.speed
-    u, c1, c2, y0 = (np.ascontiguousarray(np.broadcast_to(a, v.shape), dtype=float) for a in (u, c1, c2, y0))
+    # writable copies, whatever the shapes: a read-only view (what broadcasting gives) would make
+    # numba compile the parallel kernel a second time (6 s on first use)
+    u, c1, c2, y0 = (np.array(np.broadcast_to(a, v.shape), dtype=float) for a in (u, c1, c2, y0))
     length, time = sc.length, sc.time
-    ah, aa = (np.ascontiguousarray(np.broadcast_to(a, v.shape), dtype=float) for a in (sc.a_hertz, sc.a_adhesion))
+    ah, aa = (np.array(np.broadcast_to(a, v.shape), dtype=float) for a in (sc.a_hertz, sc.a_adhesion))
     ju = contact.mass * u
     jstop = np.broadcast_to(np.asarray(friction_impulse_stop, dtype=float), v.shape) / ju
     jastop = np.broadcast_to(np.asarray(twist_impulse_stop, dtype=float), v.shape) / (ju * np.sqrt(contact.radius * length))
