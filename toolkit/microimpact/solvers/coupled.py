@@ -72,6 +72,8 @@ from numba import njit, prange
 
 from microimpact.model import law as _law
 from microimpact.model import tangential_compliance as _tc
+from microimpact.model.kinematics import flat_broadcast
+from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form maps
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.engine import _equilibrium, _linear_tail_variation
 
@@ -324,6 +326,36 @@ def _restep_to_root(code, fa, fb, tol, h, z, k1, p, hist, k, tmp, z1, err):
 
 
 @njit(cache=True)
+def _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp):
+    """A trial step from z to z1 within which the Coulomb limit passes through zero (load argument
+    ``gb`` at z1): if the normal motion is accurate, end the step at the zero (secant on the step
+    length; at z itself if z is the zero within rounding) and have the branch restarted there;
+    else reject the step. Accepting it on the error of all states, as before, let a zero pass
+    without a restart (results then jumped by 1e-5 between tolerances). Returns (the error sum
+    that decides the step, restart)."""
+    en_n = 0.0
+    for i in range(_VT):
+        en_n += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
+    if en_n > _VT:
+        return max(en, 4.0 * _N), False  # rejected
+    ga = _load_argument(z, p)
+    if ga * gb < 0.0:
+        _restep_to_root(_EV_LOAD, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
+    else:
+        for i in range(_N):
+            z1[i] = z[i]
+    return float(_N), True  # accepted; the next step keeps the length h
+
+
+@njit(cache=True, inline="always")
+def _impulse_time(z, z1, j_stop, tau_j):
+    """tau at which J reaches j_stop, interpolated within the step z -> z1 (``tau_j`` if known)."""
+    if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
+        return z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
+    return tau_j
+
+
+@njit(cache=True)
 def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max_steps):
     """Integrate one impact of the coupled model (nondimensional; see the module docstring).
 
@@ -340,7 +372,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     Length: set-up, step control, separation, capture, the hysteretic turning points and restarts
     and the settle test share the loop's state (z, k1, the branch history) and may end or continue
     the loop; they stay in one compiled loop, as in the engine, where moving the per-step work
-    into helpers was measured 1.5x slower (here not measured separately).
+    into helpers was measured 1.5x slower (here not measured separately). What runs only at an
+    event (the re-step to a root, the end of a step at a zero of the Coulomb limit, the restart of
+    the branch) is in helpers.
     """
     z = np.zeros(_N)
     z[_Y], z[_VT], z[_VTP], z[_WT], z[_WTP] = y0, vt0, vtp0, wt0, wtp0
@@ -371,8 +405,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     load_side = 0.0  # sign of the Coulomb limit's load argument since the last restart (0: not yet known)
     lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
     damped = p[0] > 0.0 or p[1] > 0.0
-    xe = aa / ah if ah > 0.0 else 0.0
-    omega0 = math.sqrt(ah * math.sqrt(xe)) if aa > 0.0 else 1.0
+    xe, omega0, _ = _equilibrium(p[0], p[1], ah, aa)
     ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
     h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
     if y0 < 1.0:
@@ -396,28 +429,14 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
         n += 1
         restart = False
-        if hysteretic and z[_S] > 0.0 and z1[_S] > 0.0 and _load_argument(z1, p) * load_side < 0.0:
-            # the Coulomb limit passes through zero within the step (from the side the branch was
-            # started on: a root found a rounding error short of the zero is not found again): if
-            # the normal motion is accurate, end the step there (secant on the step length) and
-            # restart the branch; else take a shorter step (accepting it on the error of all
-            # states, as before, let a zero pass without a restart: results then jumped by 1e-5
-            # between tolerances)
-            en_n = 0.0
-            for i in range(_VT):
-                en_n += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
-            ga, gb = _load_argument(z, p), _load_argument(z1, p)
-            if en_n > _VT:
-                en = max(en, 4.0 * _N)  # rejected
-            else:
-                if ga * gb < 0.0:
-                    _restep_to_root(_EV_LOAD, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
-                else:  # the step starts at the zero (within rounding): restart there
-                    for i in range(_N):
-                        z1[i] = z[i]
-                restart = True
-                load_side = 1.0 if gb > 0.0 else -1.0
-                en = float(_N)  # accepted; the next step keeps the length h
+        if hysteretic and z[_S] > 0.0 and z1[_S] > 0.0:
+            # the Coulomb limit passes through zero within the step, seen from the side the branch
+            # was started on (a root found a rounding error short of the zero is not found again)
+            gb = _load_argument(z1, p)
+            if gb * load_side < 0.0:
+                en, restart = _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp)
+                if restart:
+                    load_side = 1.0 if gb > 0.0 else -1.0
         en = math.sqrt(en / _N)
         if en > 1.0:
             h *= max(0.2, 0.9 * en ** -0.2)
@@ -429,8 +448,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             _restep_to_root(_EV_SEPARATION, z[_S], z1[_S], 1e-14 * sref, h, z, k1, p, hist, k, tmp, z1, err)
             z1[_S] = 0.0
             outcome = 0
-            if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
-                tau_j = z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
+            tau_j = _impulse_time(z, z1, j_stop, tau_j)
             for i in range(_N):
                 z[i] = z1[i]
             z[_FT] = z[_FTP] = 0.0  # out of contact: nothing stored
@@ -441,8 +459,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             ga, gb = _branch_slip(z, hist), _branch_slip(z1, hist)
             _restep_to_root(_EV_TURN, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
             turned = True
-        if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
-            tau_j = z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
+        tau_j = _impulse_time(z, z1, j_stop, tau_j)
         for i in range(_N):
             z[i] = z1[i]
         if turned:  # new branch: s -> -s, c from the force ratio, p = 0 (force continuous)
@@ -568,8 +585,6 @@ def _settle_captured(contact, states, captured, p, unit, j_unit, ja_unit, jl, ja
     j_tail *= j_unit[rows]
     ja_tail *= ja_unit[rows]
     if p[0, 9] > 0.0:  # compliant: the tail slides the state as the rigid contact's map does
-        from microimpact.model.tangential import tangential_outcome
-
         zero = np.zeros(rows.size)
         tail = tangential_outcome(m, inertia, r, p[rows, 4], (zero, states[rows, _VT] * u, states[rows, _VTP] * u),
                                   (zero, states[rows, _WT] * u / r, states[rows, _WTP] * u / r), j_tail, zero)
@@ -611,8 +626,6 @@ def _tangential_si(contact, mindlin, states, info, f, v_in, w_in, slip, jl, jal,
     A compliant contact's tangential state is integrated and its twist keeps its closed form
     (torque (3 pi/16) f a load); the rigid contact's whole outcome is the closed-form map of the
     impulses ``jl``, ``jal`` [N s], [N m s]."""
-    from microimpact.model.tangential import tangential_outcome  # closed-form map
-
     m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
     if mindlin:
         tw = tangential_outcome(m, inertia, r, f, v_in, w_in, 0.0, jal)
@@ -656,14 +669,11 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
         If an impact reaches the step limit or the step size underflows.
 
     """
-    from microimpact.model.tangential import stop_impulses  # closed-form stop impulses
-
-    # np.array copies: numba must not be handed the read-only views that broadcasting makes
-    v_n, v_t, v_tp = (np.array(a, dtype=float).ravel() for a in np.broadcast_arrays(*velocity_in))
-    w_n, w_t, w_tp = (np.array(np.broadcast_to(a, v_n.shape), dtype=float) for a in omega_in)
-    f = np.array(np.broadcast_to(friction, v_n.shape), dtype=float)
+    _, (v_n, v_t, v_tp, w_n, w_t, w_tp, f) = flat_broadcast(
+        *(np.asarray(a, dtype=float) for a in (*velocity_in, *omega_in, friction)))
     speed = -v_n
     sc, y0, c1, c2 = _law.nondimensional_impact(contact, speed)
+    y0 = np.array(np.broadcast_to(y0, speed.shape))
     u = np.array(np.broadcast_to(sc.speed, speed.shape))
     length = np.array(np.broadcast_to(sc.length, speed.shape))
     time = np.array(np.broadcast_to(sc.time, speed.shape))
@@ -683,7 +693,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     ja_unit = j_unit * np.sqrt(r * length)
     states = np.empty((speed.size, _N))
     info = np.empty((speed.size, 7))
-    coupled_many(np.ascontiguousarray(y0 * np.ones(speed.shape)), v_t / u, v_tp / u, r * w_t / u, r * w_tp / u,
+    coupled_many(y0, v_t / u, v_tp / u, r * w_t / u, r * w_tp / u,
                  p, float(rtol), np.ascontiguousarray(j_stop), np.ascontiguousarray(ja_stop),
                  max(SETTLE_AMPLITUDE, SETTLE_PER_RTOL * rtol),
                  int(max_steps), states, info)
@@ -704,7 +714,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
                                                     (w_n, w_t, w_tp), slip, j_map, ja_map, u, time)
     return {
         "captured": captured,
-        "e_n": np.where(captured, 0.0, -states[:, _Y] / (y0 * np.ones(speed.shape))),
+        "e_n": np.where(captured, 0.0, -states[:, _Y] / y0),
         **out,
         "contact_time": np.where(captured, np.inf, states[:, _TAU] * time),
         "capture_time": info[:, 3] * time,
