@@ -292,8 +292,9 @@ def _initial_branch(z, p):
 
 
 #: the events located within a step by :func:`_restep_to_root`: the Coulomb limit passing through
-#: zero, separation (s = 0), a turning point of the hysteretic law
-_EV_LOAD, _EV_SEPARATION, _EV_TURN = 0, 1, 2
+#: zero, separation (s = 0), a turning point of the hysteretic law. numpy integers, not int literals:
+#: numba compiles one specialization of a callee per literal argument (three instead of one).
+_EV_LOAD, _EV_SEPARATION, _EV_TURN = np.int64(0), np.int64(1), np.int64(2)
 
 
 @njit(cache=True)

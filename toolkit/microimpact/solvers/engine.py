@@ -82,6 +82,13 @@ CAPTURE = 1
 OUTCOME_NAMES = ("rebound", "capture")
 
 _NSTATE = 5  # s, y, tau, D, J_a
+
+# Events located within a step (:func:`_locate`): s = 0, y = target, dy/dsigma = 0 (an extremum of y),
+# energy = target; and of the inertia-free path (:func:`_slow_event_time`): energy or y = target.
+# numpy integers, not int literals: numba compiles one specialization of a callee per literal
+# argument (the four codes cost four compiles of _locate, 2 s).
+_EV_S, _EV_Y, _EV_DY, _EV_ENERGY = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
+_SLOW_ENERGY, _SLOW_Y = np.int64(0), np.int64(1)
 _MAX_STEPS_DEFAULT = 2_000_000
 
 # Dormand-Prince 5(4) tableau (Dormand & Prince 1980, J. Comput. Appl. Math. 6:19-26).
@@ -274,14 +281,14 @@ def _hermite(p0, p1, d0, d1, h, th):
 
 @njit(cache=True)
 def _event_on_interpolant(code, target, th, u0, k1, u1, k7, h, ah, aa):
-    if code == 2:  # d/dth of the y interpolant (proportional to dy/dsigma)
+    if code == _EV_DY:  # d/dth of the y interpolant (proportional to dy/dsigma)
         y0, y1, d0, d1 = u0[1], u1[1], k1[1], k7[1]
         return (6.0 * th * th - 6.0 * th) * (y0 - y1) + (3.0 * th * th - 4.0 * th + 1.0) * h * d0 + (3.0 * th * th - 2.0 * th) * h * d1
     s = _hermite(u0[0], u1[0], k1[0], k7[0], h, th)
-    if code == 0:
+    if code == _EV_S:
         return s
     y = _hermite(u0[1], u1[1], k1[1], k7[1], h, th)
-    if code == 1:
+    if code == _EV_Y:
         return y - target
     return law.nondimensional_energy(s, y, ah, aa) - target
 
@@ -322,7 +329,7 @@ def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, er
     k7 = k[6].copy()
     end = u1.copy()
     a, b = 0.0, 1.0
-    if code == 2:
+    if code == _EV_DY:
         fa, fb = g0 * h, g1 * h
     else:
         fa, fb = g0, g1
@@ -521,10 +528,10 @@ def _inertia_free(u, atol_y, c1, c2, ah, aa, xe):
 @njit(cache=True)
 def _slow_event_time(u, xi_end, target, kind, c1, c2, ah, aa):
     """tau at which, along the inertia-free path from the state u towards xi_end, the energy
-    (kind 0) or y (kind 1) reaches ``target``; NaN if it does not."""
+    (kind _SLOW_ENERGY) or y (kind _SLOW_Y) reaches ``target``; NaN if it does not."""
     xi0 = u[0] * u[0]
     a, b = xi0, xi_end
-    if kind == 1:
+    if kind == _SLOW_Y:
         # invert y_m: xi = a_a (1 - y C2) / (a_h (1 + y C1))
         if aa == 0.0:
             return u[2]
@@ -682,7 +689,7 @@ def _mirror_undamped(u, u1, k1, hev, J, j_target, tau_jtarget, y0, c1, c2, ah, a
         # reached on the way in, within this step (the way out is left to the caller)
         _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         yt = u[1] - (j_target - J)
-        _locate(1, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        _locate(_EV_Y, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         tau_jtarget = u1[2]
     u[0] = 0.0
     u[1] = -y0
@@ -847,7 +854,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         g0 = k1[1]
         g1 = k[6, 1]
         if u[0] > 0.0 and u1[0] <= 0.0:
-            hev = _locate(0, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            hev = _locate(_EV_S, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
             code = 0
             _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         # an extremum of y: dy/dsigma leaves its expected sign (comparing with the expected sign,
@@ -855,7 +862,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         if u[0] > 0.0 and g1 * sgn < 0.0:
             if g0 * sgn <= 0.0:
                 g0 = sgn * 1e-300
-            hh = _locate(2, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            hh = _locate(_EV_DY, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
             if code < 0 or hh < hev:
                 hev, code = hh, 2
         if code >= 0:
@@ -866,7 +873,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 code = 0
         recorded = False  # u1 was moved to a recorded event: take the step again before using it
         if not turned and u[1] > 0.0 and u1[1] <= 0.0:  # largest penetration
-            _locate(1, 0.0, u, k1, hev, u[1], u1[1], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            _locate(_EV_Y, 0.0, u, k1, hev, u[1], u1[1], c1, c2, ah, aa, sgn, k, tmp, u1, err)
             turned = True
             smax = max(smax, u1[0])
             recorded = True
@@ -885,7 +892,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             e0 = law.nondimensional_energy(u[0], u[1], ah, aa) - ecap
             e1 = law.nondimensional_energy(u1[0], u1[1], ah, aa) - ecap
             if e0 >= 0.0 and e1 < 0.0:
-                _locate(3, ecap, u, k1, hev, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                _locate(_EV_ENERGY, ecap, u, k1, hev, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 captured = True
                 tau_capture = u1[2]
                 recorded = True
@@ -896,7 +903,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             dj = abs(u1[1] - u[1])  # y is monotone within the (possibly shortened) step
             if J < j_target and J + dj >= j_target:
                 yt = u[1] + (j_target - J) * (1.0 if u1[1] > u[1] else -1.0)
-                _locate(1, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                _locate(_EV_Y, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 tau_jtarget = u1[2]
                 recorded = True
         if recorded:
@@ -944,9 +951,9 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 dj = abs(u[1] - y_t)
                 if math.isnan(tau_jtarget) and j_target > 0.0 and J < j_target <= J + dj:
                     tau_jtarget = _slow_event_time(u, xi_t, u[1] + (j_target - J) * (1.0 if y_t > u[1] else -1.0),
-                                                   1, c1, c2, ah, aa)
+                                                   _SLOW_Y, c1, c2, ah, aa)
                 if not captured and aa > 0.0:
-                    tc = _slow_event_time(u, xi_t, ecap, 0, c1, c2, ah, aa)
+                    tc = _slow_event_time(u, xi_t, ecap, _SLOW_ENERGY, c1, c2, ah, aa)
                     if not math.isnan(tc):
                         captured = True
                         tau_capture = tc
@@ -1001,8 +1008,9 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
 def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_stop, ja_stop, out):
     dummy = np.zeros((1, 3))
     for i in prange(y0.shape[0]):
-        r = _integrate(y0[i], c1[i], c2[i], ah[i], aa[i], rtol, need_tail[i], tail_tol, 0.0, False, 0.0,
-                       max_steps, dummy, 0, j_stop[i], ja_stop[i])
+        # numpy scalars, not literals: one compiled _integrate serves this kernel and solve_normal
+        r = _integrate(y0[i], c1[i], c2[i], ah[i], aa[i], rtol, need_tail[i], tail_tol, 0.0, np.bool_(False), 0.0,
+                       max_steps, dummy, np.int64(0), j_stop[i], ja_stop[i])
         out[i, 0] = r[0]
         out[i, 1] = r[1]
         out[i, 2] = r[2]

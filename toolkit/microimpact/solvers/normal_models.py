@@ -163,7 +163,8 @@ def _locate_boundary(model, zb, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
     hs = h
     for _ in range(60):
         hs = illinois_point(lo, flo, hi, fhi)
-        k[0, :] = k0
+        for i in range(_N):  # a loop, not k[0, :] = k0: the slice's shape check costs 2 s of compile
+            k[0, i] = k0[i]
         _step(model, u0, k, hs, c1, c2, a, b, e, tmp, u1, err)
         f = u1[0] - zb
         if f == 0.0 or (hi - lo) < 1e-14 * h:
@@ -171,7 +172,8 @@ def _locate_boundary(model, zb, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
         lo, flo, hi, fhi, side = illinois_update(lo, flo, hi, fhi, hs, f, side)
         if abs(f) < 1e-15:
             break
-    k[0, :] = k0
+    for i in range(_N):
+        k[0, i] = k0[i]
     return hs
 
 
