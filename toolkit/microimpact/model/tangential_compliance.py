@@ -80,8 +80,10 @@ Optional (``Contact.rolling_friction`` mu_r > 0, off by default): the constant d
 with omega_r = (omega_t, omega_t') the rolling angular velocity relative to the fixed surface. A
 sphere rolling without slip on the flat then decelerates at (5/7) mu_r |F_n| / m
 (I = (2/5) m r^2: the friction force (5/7) M_r / r keeps the contact point at rest). Model A has
-no viscous part and is not locked at omega_r = 0 (Ai et al. 2011 discuss the oscillation at rest),
-which an impact that does not stop the rolling never reaches.
+no viscous part, and as written its torque flips each time omega_r crosses zero (Ai et al. 2011
+discuss the oscillation at rest). Here rest is treated as friction at rest is: at omega_r = 0 the
+torque is set-valued, holding the sphere while the other torques stay within mu_r r |F_n| and
+letting it go with the excess (:func:`microimpact.solvers.coupled._end_at_rolling_stop`).
 
 Adhesion-aware friction ("pulloff")
 -----------------------------------

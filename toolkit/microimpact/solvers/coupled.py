@@ -17,7 +17,9 @@ solver is used only where a scene selects something else, so the paper's model p
   beside the state, and each turning point (s u.e changes sign) is located by secant iteration on
   the step length, where the branch switches with the force continuous.
 * ``rolling_friction > 0`` (with either compliant model): the torque mu_r r |F_n| against
-  (omega_t, omega_t').
+  (omega_t, omega_t'). A step within which omega_r reverses is ended where it reaches zero, and
+  omega_r is set to rest there (:func:`_end_at_rolling_stop`; also where it creeps within the
+  tolerance of zero, :func:`_hold_rolling`); at rest the torque holds the sphere up to its limit.
 
 Formulation: as the engine, nondimensional (xi = x / L, tau = t / T_c) in the Sundman variable
 sigma, d tau = s d sigma with s = sqrt(xi), which keeps the right-hand side smooth where contact
@@ -137,7 +139,7 @@ def _rhs(z, p, hist, out):
 
     p = (c1, c2, a_h, a_a, f, F_po, adhesion_aware, kappa, k_rot, tangential mode (0 rigid,
     1 mindlin, 2 mindlin_deresiewicz), mu_r); hist = (s, c, e_t, e_t') the branch of the hysteretic
-    law and the initial slip direction.
+    law and the initial slip direction (hist[4:6]: see :func:`_end_at_rolling_stop`).
     """
     c1, c2, ah, aa, f, fpo, aware, kappa, krot = p[0], p[1], p[2], p[3], p[4], p[5], p[6] > 0.5, p[7], p[8]
     mode = p[9]
@@ -174,11 +176,17 @@ def _rhs(z, p, hist, out):
         out[_FT] = s * (z[_VT] + z[_WTP])  # d delta / d tau = u, the slip of the contact point
         out[_FTP] = s * (z[_VTP] - z[_WT])
     if p[10] > 0.0 and s > 0.0:  # rolling resistance: torque mu_r r |F_n| against (omega_t, omega_t')
+        lim_r = s * krot * p[10] * abs(xi_dd)
         wm = math.sqrt(z[_WT] * z[_WT] + z[_WTP] * z[_WTP])
         if wm > 0.0:
-            g = s * krot * p[10] * abs(xi_dd) / wm
+            g = lim_r / wm
             out[_WT] -= g * z[_WT]
             out[_WTP] -= g * z[_WTP]
+        else:  # at rest (set there by _end_at_rolling_stop): held up to the limit, as friction at rest
+            tm = math.sqrt(out[_WT] * out[_WT] + out[_WTP] * out[_WTP])
+            held = 0.0 if tm <= lim_r else 1.0 - lim_r / tm
+            out[_WT] *= held
+            out[_WTP] *= held
 
 
 @njit(cache=True, fastmath=True)
@@ -262,7 +270,7 @@ def _initial_branch(z, p):
     contact). Without slip, e is the slip that a rolling-resistance torque would start, and the
     contact starts stuck (p = 0, no force).
     """
-    hist = np.zeros(4)
+    hist = np.zeros(6)  # (s, c, e_t, e_t') and the direction of omega_r at a rolling stop
     hist[0] = hist[1] = 1.0
     ut, utp = z[_VT] + z[_WTP], z[_VTP] - z[_WT]
     um = math.sqrt(ut * ut + utp * utp)
@@ -292,9 +300,10 @@ def _initial_branch(z, p):
 
 
 #: the events located within a step by :func:`_restep_to_root`: the Coulomb limit passing through
-#: zero, separation (s = 0), a turning point of the hysteretic law. numpy integers, not int literals:
-#: numba compiles one specialization of a callee per literal argument (three instead of one).
-_EV_LOAD, _EV_SEPARATION, _EV_TURN = np.int64(0), np.int64(1), np.int64(2)
+#: zero, separation (s = 0), a turning point of the hysteretic law, the rolling velocity reaching
+#: zero. numpy integers, not int literals: numba compiles one specialization of a callee per
+#: literal argument (four instead of one).
+_EV_LOAD, _EV_SEPARATION, _EV_TURN, _EV_ROLL = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
 
 
 @njit(cache=True)
@@ -303,6 +312,8 @@ def _event_value(code, z, p, hist):
         return _load_argument(z, p)
     if code == _EV_SEPARATION:
         return z[_S]
+    if code == _EV_ROLL:
+        return z[_WT] * hist[4] + z[_WTP] * hist[5]
     return _branch_slip(z, hist)
 
 
@@ -310,8 +321,9 @@ def _event_value(code, z, p, hist):
 def _restep_to_root(code, fa, fb, tol, h, z, k1, p, hist, k, tmp, z1, err):
     """Re-step from z to where event ``code`` crosses zero within the step h (regula falsi on the
     step length; fa, fb its values at the start and end of the step, opposite signs); z1 then
-    holds the state there. Stops at |value| <= tol or a bracket below 1e-14 h."""
+    holds the state there. Stops at |value| <= tol or a bracket below 1e-14 h; returns the step length."""
     a, b = 0.0, h
+    hs = h
     for _ in range(60):
         hs = b - fb * (b - a) / (fb - fa)
         if not (a < hs < b):
@@ -324,6 +336,7 @@ def _restep_to_root(code, fa, fb, tol, h, z, k1, p, hist, k, tmp, z1, err):
             a, fa = hs, g
         else:
             b, fb = hs, g
+    return hs
 
 
 @njit(cache=True)
@@ -346,6 +359,63 @@ def _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp):
         for i in range(_N):
             z1[i] = z[i]
     return float(_N), True  # accepted; the next step keeps the length h
+
+
+@njit(cache=True, inline="always")
+def _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref):
+    """Sum of the squared scaled errors of a step z -> z1 (the error of p as that of the force it
+    makes, see the module docstring)."""
+    if hysteretic:
+        err[_FT] *= min(1.0, p[4] * abs(_load_argument(z1, p)) / lim_ref)
+    en = 0.0
+    for i in range(_N):
+        en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
+    return en
+
+
+@njit(cache=True)
+def _end_at_rolling_stop(h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hysteretic, lim_ref):
+    """A trial step z -> z1 within which the rolling velocity omega_r = (w_t, w_t') reverses.
+
+    Model A's torque, -mu_r r |F_n| omega_r / |omega_r|, flips there, and an explicit integrator
+    chatters about omega_r = 0 (600,000 steps, or the step limit, and a rest state set by rounding).
+    At rest the torque is set-valued, as friction is: it holds omega_r = 0 while the other torques
+    stay within its limit (:func:`_rhs`). So the step is ended where the component of omega_r
+    along its direction at z vanishes (regula falsi on the step length), and the caller sets
+    omega_r = 0 there if what is left of it is within the step's tolerance.
+
+    Returns (the step's error sum, rest reached, step length); a step whose end is not at rest
+    within the tolerance (omega_r turned by more than a right angle) is rejected.
+    """
+    wm = math.sqrt(z[_WT] * z[_WT] + z[_WTP] * z[_WTP])
+    hist[4], hist[5] = z[_WT] / wm, z[_WTP] / wm
+    fb = z1[_WT] * hist[4] + z1[_WTP] * hist[5]
+    hs = _restep_to_root(_EV_ROLL, wm, fb, 1e-13 * (wm + abs(fb)), h, z, k1, p, hist, k, tmp, z1, err)
+    en = _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref)
+    left = math.sqrt(z1[_WT] * z1[_WT] + z1[_WTP] * z1[_WTP])
+    if left > atol[_WT] + rtol * wm:
+        return max(en, 4.0 * _N), False, hs
+    return en, True, hs
+
+
+@njit(cache=True)
+def _hold_rolling(z, k1, tol, p, hist):
+    """Set omega_r = 0 where it is within ``tol`` of zero and the torques there would hold it at rest
+    (k1, the derivative at z, is updated).
+
+    Near rest, model A's torque turns with omega_r at a rate ~ |other torques| / |omega_r|, which an
+    explicit integrator follows only with steps that shrink with |omega_r|: omega_r spiralled about
+    1e-10 for 200,000 steps without reversing. Within the tolerance, rest is as exact as the state.
+    """
+    wt, wtp = z[_WT], z[_WTP]
+    wm = math.sqrt(wt * wt + wtp * wtp)
+    if wm == 0.0 or wm > tol:
+        return
+    z[_WT] = z[_WTP] = 0.0
+    _rhs(z, p, hist, k1)
+    if k1[_WT] != 0.0 or k1[_WTP] != 0.0:  # not held: omega_r leaves rest
+        z[_WT], z[_WTP] = wt, wtp
+        _rhs(z, p, hist, k1)
 
 
 @njit(cache=True, inline="always")
@@ -403,6 +473,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     n_turn = 0
     n_restart = 0
     hysteretic = p[9] > 1.5
+    rolling = p[10] > 0.0
     load_side = 0.0  # sign of the Coulomb limit's load argument since the last restart (0: not yet known)
     lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
     damped = p[0] > 0.0 or p[1] > 0.0
@@ -423,21 +494,23 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             status = _MAX_STEPS
             break
         _step(z, k1, h, p, hist, k, tmp, z1, err)
-        if hysteretic:  # the error of p as that of the force T = F_lim ratio(p) it makes
-            err[_FT] *= min(1.0, p[4] * abs(_load_argument(z1, p)) / lim_ref)
-        en = 0.0
-        for i in range(_N):
-            en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
+        en = _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref)
         n += 1
         restart = False
+        at_rest = False
+        h_end = h  # the step's length, shorter where it ends at an event
+        if rolling and z[_S] > 0.0 and z1[_S] > 0.0 and z[_WT] * z1[_WT] + z[_WTP] * z1[_WTP] < 0.0:
+            en, at_rest, h_end = _end_at_rolling_stop(h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hysteretic,
+                                                      lim_ref)
         if hysteretic and z[_S] > 0.0 and z1[_S] > 0.0:
             # the Coulomb limit passes through zero within the step, seen from the side the branch
             # was started on (a root found a rounding error short of the zero is not found again)
             gb = _load_argument(z1, p)
             if gb * load_side < 0.0:
-                en, restart = _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp)
-                if restart:
+                en, restart = _end_at_limit_zero(en, gb, h_end, z, z1, k1, err, atol, rtol, p, hist, k, tmp)
+                if restart:  # the step now ends at that zero, before the rolling stop if any
                     load_side = 1.0 if gb > 0.0 else -1.0
+                    at_rest = False
         en = math.sqrt(en / _N)
         if en > 1.0:
             h *= max(0.2, 0.9 * en ** -0.2)
@@ -446,7 +519,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 break
             continue
         if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: secant on the step length
-            _restep_to_root(_EV_SEPARATION, z[_S], z1[_S], 1e-14 * sref, h, z, k1, p, hist, k, tmp, z1, err)
+            _restep_to_root(_EV_SEPARATION, z[_S], z1[_S], 1e-14 * sref, h_end, z, k1, p, hist, k, tmp, z1, err)
             z1[_S] = 0.0
             outcome = 0
             tau_j = _impulse_time(z, z1, j_stop, tau_j)
@@ -458,11 +531,14 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         if not restart and hysteretic and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
             # turning point of the hysteretic law within the step: secant on the step length
             ga, gb = _branch_slip(z, hist), _branch_slip(z1, hist)
-            _restep_to_root(_EV_TURN, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
+            _restep_to_root(_EV_TURN, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h_end, z, k1, p, hist, k, tmp, z1, err)
             turned = True
+            at_rest = False
         tau_j = _impulse_time(z, z1, j_stop, tau_j)
         for i in range(_N):
             z[i] = z1[i]
+        if at_rest:
+            z[_WT] = z[_WTP] = 0.0
         if turned:  # new branch: s -> -s, c from the force ratio, p = 0 (force continuous)
             ratio = _md_ratio(z[_FT], hist[0], hist[1])
             hist[0] = -hist[0]
@@ -484,6 +560,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         else:
             for i in range(_N):
                 k1[i] = k[6, i]
+        if rolling and z[_S] > 0.0:
+            _hold_rolling(z, k1, atol[_WT], p, hist)
         smax = max(smax, z[_S])
         if not captured and damped and aa > 0.0 and _energy(z[_S], z[_Y], ah, aa) < ecap:
             captured = True
