@@ -28,8 +28,11 @@ centre velocity and w = r omega the rim speeds in units of L / T_c, delta the ta
 displacement of the contact in L, J = int load dtau and J_a = int s load dtau (load =
 :func:`friction_load`). Dormand-Prince 5(4) with error control on every state; the kinks of the
 load are resolved by step rejection (the Mindlin force reaches its limit with zero slope, so gross
-slip starts smoothly). After every accepted step the displacement is held at delta* in gross slip. Separation (s = 0, y < 0) is located by secant
-iteration on the step length; capture is the exact energy test of the engine.
+slip starts smoothly). After every accepted step the displacement is held at delta* in gross slip,
+and the steps of the elastic Mindlin contact end where gross slip starts and ends
+(:func:`_end_at_slip_change`: a step across either converged only first order). Separation (s = 0,
+y < 0) is located by secant iteration on the step length; capture is the exact energy test of the
+engine.
 
 Hysteretic law where the Coulomb limit vanishes: the rate of p is ~ 1 / F_lim, and F_lim = f |F_n|
 passes through zero twice in every impact with adhesion (and twice in every period of a captured
@@ -122,12 +125,16 @@ def _branch_slip(z, hist):
 
 
 @njit(cache=True, fastmath=True, inline="always")
+def _load_rate(s, y, xi_dd, c1, c2, ah, aa):
+    """dF_n/dsigma of F_n = a_h s^3 (1 + c1 y) - a_a s (1 - c2 y), with ds = y/2, dy = s xi''."""
+    return (3.0 * ah * s * s * (1.0 + c1 * y) - aa * (1.0 - c2 * y)) * 0.5 * y + (ah * c1 * s * s * s + aa * c2 * s) * s * xi_dd
+
+
+@njit(cache=True, fastmath=True, inline="always")
 def _md_terms(z, p, hist, s, xi_dd, load):
     """(F_lim, dF_lim/dsigma, s s_b u.e) of the hysteretic law at the state z (nondimensional)."""
     c1, c2, ah, aa, f, fpo, aware = p[0], p[1], p[2], p[3], p[4], p[5], p[6] > 0.5
-    y = z[_Y]
-    # dF_n/dsigma of F_n = a_h s^3 (1 + c1 y) - a_a s (1 - c2 y), with ds = y/2, dy = s xi''
-    dfn = (3.0 * ah * s * s * (1.0 + c1 * y) - aa * (1.0 - c2 * y)) * 0.5 * y + (ah * c1 * s * s * s + aa * c2 * s) * s * xi_dd
+    dfn = _load_rate(s, z[_Y], xi_dd, c1, c2, ah, aa)
     fn_aw = -xi_dd + 2.0 * fpo if aware else -xi_dd
     dlim = f * dfn * (1.0 if fn_aw >= 0.0 else -1.0)
     return f * load, dlim, s * _branch_slip(z, hist)
@@ -225,6 +232,36 @@ def _project(z, p):
     if mag > dstar:
         z[_FT] *= dstar / mag
         z[_FTP] *= dstar / mag
+        return True
+    return False
+
+
+@njit(cache=True)
+def _gross_slip_margin(z, p):
+    """|delta| - delta* of the elastic Mindlin contact: < 0 while part of the contact sticks."""
+    s = max(z[_S], 0.0)
+    xi_dd = _acc(s, s * s * s, z[_Y], p[0], p[1], p[2], p[3])
+    lim = p[4] * (_load(-xi_dd, p[5], p[6] > 0.5) if s > 0.0 else 0.0)
+    return math.sqrt(z[_FT] * z[_FT] + z[_FTP] * z[_FTP]) - _dstar(p[7] * s, lim)
+
+
+@njit(cache=True)
+def _slip_excess(z, p):
+    """d(|delta| - delta*)/dsigma with delta moving with the slip: > 0 while gross slip goes on
+    (:func:`_project` discards the slip beyond delta*), < 0 once the contact sticks again."""
+    s = max(z[_S], 0.0)
+    mag = math.sqrt(z[_FT] * z[_FT] + z[_FTP] * z[_FTP])
+    if s == 0.0 or mag == 0.0:
+        return 0.0
+    c1, c2, ah, aa, f = p[0], p[1], p[2], p[3], p[4]
+    xi_dd = _acc(s, s * s * s, z[_Y], c1, c2, ah, aa)
+    fn = -xi_dd + 2.0 * p[5] if p[6] > 0.5 else -xi_dd
+    lim = f * abs(fn)
+    dlim = f * _load_rate(s, z[_Y], xi_dd, c1, c2, ah, aa) * (1.0 if fn >= 0.0 else -1.0)
+    kt = p[7] * s
+    dstar_rate = 1.5 * (dlim * kt - lim * p[7] * 0.5 * z[_Y]) / (kt * kt)  # delta* = 1.5 F_lim / k_t
+    along = s * ((z[_VT] + z[_WTP]) * z[_FT] + (z[_VTP] - z[_WT]) * z[_FTP]) / mag
+    return along - dstar_rate
 
 
 @njit(cache=True)
@@ -256,7 +293,7 @@ def _restart_branch(z, p, hist):
     if um > 0.0:
         hist[2], hist[3] = ut / um, utp / um
         xi_dd = _acc(s, s * s * s, y, c1, c2, ah, aa)
-        dfn = (3.0 * ah * s * s * (1.0 + c1 * y) - aa * (1.0 - c2 * y)) * 0.5 * y + (ah * c1 * s * s * s + aa * c2 * s) * s * xi_dd
+        dfn = _load_rate(s, y, xi_dd, c1, c2, ah, aa)
         a_term = s * um * p[7] * s / 1.5
         b_term = (2.0 / 3.0) * f * abs(dfn)
         z[_FT] = a_term / b_term if a_term < b_term else 1.0
@@ -304,6 +341,7 @@ def _initial_branch(z, p):
 #: zero. numpy integers, not int literals: numba compiles one specialization of a callee per
 #: literal argument (four instead of one).
 _EV_LOAD, _EV_SEPARATION, _EV_TURN, _EV_ROLL = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
+_EV_GROSS, _EV_STICK = np.int64(4), np.int64(5)  # elastic Mindlin contact: gross slip starts, ends
 
 
 @njit(cache=True)
@@ -314,6 +352,10 @@ def _event_value(code, z, p, hist):
         return z[_S]
     if code == _EV_ROLL:
         return z[_WT] * hist[4] + z[_WTP] * hist[5]
+    if code == _EV_GROSS:
+        return _gross_slip_margin(z, p)
+    if code == _EV_STICK:
+        return _slip_excess(z, p)
     return _branch_slip(z, hist)
 
 
@@ -399,6 +441,36 @@ def _end_at_rolling_stop(h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hystere
 
 
 @njit(cache=True)
+def _end_at_slip_change(slipping, h, en, z, z1, k1, err, atol, rtol, p, hist, k, tmp, lim_ref):
+    """A trial step z -> z1 of the elastic Mindlin contact within which gross slip starts
+    (|delta| reaches delta*) or, ``slipping``, ends (the slip along delta falls below the growth of
+    delta*): end the step there (regula falsi on the step length).
+
+    The force F_lim [1 - (1 - |delta|/delta*)^(3/2)] has an unbounded second derivative at
+    |delta| = delta*, and the projection after a step in gross slip keeps the slip beyond delta*
+    that came after the contact stuck again; a step across either lost order, and the solver
+    converged about first order in rtol (rebound K_L 4e-4 apart between rtol 1e-8 and 1e-10).
+    Returns (the step's error sum, a change was found, step length).
+    """
+    if slipping:
+        fa, fb, code = _slip_excess(z, p), _slip_excess(z1, p), _EV_STICK
+        if not (fa > 0.0 and fb < 0.0):
+            return en, False, h
+    else:
+        fa, fb, code = _gross_slip_margin(z, p), _gross_slip_margin(z1, p), _EV_GROSS
+        if not (fa < 0.0 and fb > 0.0):
+            return en, False, h
+    hs = _restep_to_root(code, fa, fb, 1e-13 * (abs(fa) + abs(fb)), h, z, k1, p, hist, k, tmp, z1, err)
+    if hs < 1e-6 * h:
+        # a change at the start of the step: a value a rounding error off zero where F_lim ~ 0 (a
+        # captured sphere with the paper's friction, twice per period); ending the step there
+        # repeated it with zero-length steps, so the step is kept whole and the projection decides
+        _step(z, k1, h, p, hist, k, tmp, z1, err)
+        return en, False, h
+    return _error_sum(z, z1, err, atol, rtol, p, False, lim_ref), True, hs
+
+
+@njit(cache=True)
 def _hold_rolling(z, k1, tol, p, hist):
     """Set omega_r = 0 where it is within ``tol`` of zero and the torques there would hold it at rest
     (k1, the derivative at z, is updated).
@@ -474,6 +546,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     n_restart = 0
     hysteretic = p[9] > 1.5
     rolling = p[10] > 0.0
+    elastic = 0.5 < p[9] < 1.5  # the elastic Mindlin contact
+    slipping = False  # its gross slip (found by the projection at first contact, then by events)
     load_side = 0.0  # sign of the Coulomb limit's load argument since the last restart (0: not yet known)
     lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
     damped = p[0] > 0.0 or p[1] > 0.0
@@ -499,9 +573,14 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         restart = False
         at_rest = False
         h_end = h  # the step's length, shorter where it ends at an event
+        slip_change = False
+        if elastic and z[_S] > 0.0 and z1[_S] > 0.0:
+            en, slip_change, h_end = _end_at_slip_change(slipping, h, en, z, z1, k1, err, atol, rtol, p, hist, k,
+                                                         tmp, lim_ref)
         if rolling and z[_S] > 0.0 and z1[_S] > 0.0 and z[_WT] * z1[_WT] + z[_WTP] * z1[_WTP] < 0.0:
-            en, at_rest, h_end = _end_at_rolling_stop(h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hysteretic,
+            en, at_rest, h_end = _end_at_rolling_stop(h_end, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hysteretic,
                                                       lim_ref)
+            slip_change = slip_change and not at_rest  # the rolling stop comes first
         if hysteretic and z[_S] > 0.0 and z1[_S] > 0.0:
             # the Coulomb limit passes through zero within the step, seen from the side the branch
             # was started on (a root found a rounding error short of the zero is not found again)
@@ -554,8 +633,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 load_side = 0.0 if g == 0.0 else (1.0 if g > 0.0 else -1.0)
             z[_FT] = min(max(z[_FT], 0.0), 1.0)
             _rhs(z, p, hist, k1)
-        elif p[9] > 0.5:
-            _project(z, p)
+        elif elastic:
+            projected = _project(z, p)
+            slipping = (not slipping) if slip_change else projected
             _rhs(z, p, hist, k1)
         else:
             for i in range(_N):
