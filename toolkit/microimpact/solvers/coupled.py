@@ -516,8 +516,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     and the settle test share the loop's state (z, k1, the branch history) and may end or continue
     the loop; they stay in one compiled loop, as in the engine, where moving the per-step work
     into helpers was measured 1.5x slower (here not measured separately). What runs only at an
-    event (the re-step to a root, the end of a step at a zero of the Coulomb limit, the restart of
-    the branch) is in helpers.
+    event (the re-step to a root, the end of a step at a zero of the Coulomb limit, at a rolling
+    stop or at a change of gross slip, the restart of the branch) is in helpers.
     """
     z = np.zeros(_N)
     z[_Y], z[_VT], z[_VTP], z[_WT], z[_WTP] = y0, vt0, vtp0, wt0, wtp0
