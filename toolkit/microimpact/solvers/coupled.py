@@ -222,12 +222,18 @@ def _step(z, k1, h, p, hist, k, tmp, z1, err):
 
 
 @njit(cache=True)
-def _project(z, p):
-    """Hold the tangential displacement at delta* (gross slip: the slip beyond it is not stored)."""
+def _stuck_displacement(z, p):
+    """delta* of the elastic Mindlin contact at the state z (nondimensional)."""
     s = max(z[_S], 0.0)
     xi_dd = _acc(s, s * s * s, z[_Y], p[0], p[1], p[2], p[3])
     lim = p[4] * (_load(-xi_dd, p[5], p[6] > 0.5) if s > 0.0 else 0.0)
-    dstar = _dstar(p[7] * s, lim)
+    return _dstar(p[7] * s, lim)
+
+
+@njit(cache=True)
+def _project(z, p):
+    """Hold the tangential displacement at delta* (gross slip: the slip beyond it is not stored)."""
+    dstar = _stuck_displacement(z, p)
     mag = math.sqrt(z[_FT] * z[_FT] + z[_FTP] * z[_FTP])
     if mag > dstar:
         z[_FT] *= dstar / mag
@@ -239,25 +245,19 @@ def _project(z, p):
 @njit(cache=True)
 def _gross_slip_margin(z, p):
     """|delta| - delta* of the elastic Mindlin contact: < 0 while part of the contact sticks."""
-    s = max(z[_S], 0.0)
-    xi_dd = _acc(s, s * s * s, z[_Y], p[0], p[1], p[2], p[3])
-    lim = p[4] * (_load(-xi_dd, p[5], p[6] > 0.5) if s > 0.0 else 0.0)
-    return math.sqrt(z[_FT] * z[_FT] + z[_FTP] * z[_FTP]) - _dstar(p[7] * s, lim)
+    return math.sqrt(z[_FT] * z[_FT] + z[_FTP] * z[_FTP]) - _stuck_displacement(z, p)
 
 
 @njit(cache=True)
-def _slip_excess(z, p):
+def _slip_excess(z, p, hist):
     """d(|delta| - delta*)/dsigma with delta moving with the slip: > 0 while gross slip goes on
     (:func:`_project` discards the slip beyond delta*), < 0 once the contact sticks again."""
     s = max(z[_S], 0.0)
     mag = math.sqrt(z[_FT] * z[_FT] + z[_FTP] * z[_FTP])
     if s == 0.0 or mag == 0.0:
         return 0.0
-    c1, c2, ah, aa, f = p[0], p[1], p[2], p[3], p[4]
-    xi_dd = _acc(s, s * s * s, z[_Y], c1, c2, ah, aa)
-    fn = -xi_dd + 2.0 * p[5] if p[6] > 0.5 else -xi_dd
-    lim = f * abs(fn)
-    dlim = f * _load_rate(s, z[_Y], xi_dd, c1, c2, ah, aa) * (1.0 if fn >= 0.0 else -1.0)
+    xi_dd = _acc(s, s * s * s, z[_Y], p[0], p[1], p[2], p[3])
+    lim, dlim, _ = _md_terms(z, p, hist, s, xi_dd, _load(-xi_dd, p[5], p[6] > 0.5))
     kt = p[7] * s
     dstar_rate = 1.5 * (dlim * kt - lim * p[7] * 0.5 * z[_Y]) / (kt * kt)  # delta* = 1.5 F_lim / k_t
     along = s * ((z[_VT] + z[_WTP]) * z[_FT] + (z[_VTP] - z[_WT]) * z[_FTP]) / mag
@@ -355,7 +355,7 @@ def _event_value(code, z, p, hist):
     if code == _EV_GROSS:
         return _gross_slip_margin(z, p)
     if code == _EV_STICK:
-        return _slip_excess(z, p)
+        return _slip_excess(z, p, hist)
     return _branch_slip(z, hist)
 
 
@@ -453,7 +453,7 @@ def _end_at_slip_change(slipping, h, en, z, z1, k1, err, atol, rtol, p, hist, k,
     Returns (the step's error sum, a change was found, step length).
     """
     if slipping:
-        fa, fb, code = _slip_excess(z, p), _slip_excess(z1, p), _EV_STICK
+        fa, fb, code = _slip_excess(z, p, hist), _slip_excess(z1, p, hist), _EV_STICK
         if not (fa > 0.0 and fb < 0.0):
             return en, False, h
     else:
