@@ -105,6 +105,16 @@ def test_subprocess_good_and_bad():
     assert "--speed" in bad.stderr
 
 
+def test_closed_stdout_exits_quietly():
+    """`microimpact simulate ... | head` where head has gone: no error line, the SIGPIPE status.
+    The read end is closed before the command writes (it still imports), so the write must fail."""
+    proc = subprocess.Popen([sys.executable, "-m", "microimpact.cli", *GOOD], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    proc.stdout.close()
+    _, err = proc.communicate(timeout=120)
+    assert err == "" and proc.returncode == cli.EXIT_BROKEN_PIPE == 141
+
+
 def test_time_budget_status_and_generous_budget(tmp_path, capsys):
     """--time-budget: exit status 3 when spent (documented in --help); a generous budget runs as
     without one (the values: tests/test_time_budget.py)."""

@@ -3,7 +3,7 @@
 Thin: parse, call the library, print or write. Exit statuses: 0 success; 2 bad arguments, inputs
 or a solver failure (one line ``microimpact: error: ...`` on stderr); 3 the computation ran past
 ``--time-budget SECONDS`` (``fit``, ``flags``, ``sweep``, ``reproduce``; one such line naming the
-budget). Nothing is written on an error: outputs are written, atomically, only after the work.
+budget); 141 (quietly) when the reader of stdout went away, as in ``| head``. Nothing is written on an error: outputs are written, atomically, only after the work.
 
 Each command imports the part of the library it runs inside its own function: ``microimpact
 --help`` or ``microimpact simulate`` then never loads lmfit, pandas or the report, which keeps the
@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import re
 import sys
 from dataclasses import fields
@@ -38,6 +39,9 @@ class UsageError(Exception):
 
 #: exit status of a computation that ran past its ``--time-budget`` (2 is a usage or solver error)
 EXIT_TIME_BUDGET = 3
+#: exit status when the reader of stdout closed it early (``| head``): 128 + SIGPIPE, as a POSIX
+#: tool killed by the signal reports it; nothing is printed
+EXIT_BROKEN_PIPE = 141
 
 
 #: a negative number as an option's value: ``--radius -1e-6``, ``--omega-n -.5``, ``--speed -inf``.
@@ -134,7 +138,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="microimpact", description="Microsphere contact/impact with smooth, flat surfaces.",
                      epilog=f"Exit status: 0 success; 2 bad arguments or inputs, or a solver failure; "
                             f"{EXIT_TIME_BUDGET} the computation ran past --time-budget (fit, flags, sweep, "
-                            "reproduce). Nothing is written on an error.")
+                            "reproduce); 141 (quietly) when stdout is closed early (| head). "
+                            "Nothing is written on an error.")
     parser.add_argument("--version", action="version", version=f"microimpact {__version__}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
 
@@ -562,7 +567,12 @@ def main(argv=None) -> int:
             raise UsageError(f"unrecognized arguments: {' '.join(rest)}")
         if not getattr(args, "command", None):
             raise UsageError("a command is required: simulate, sweep, fit, flags, reproduce, benchmark, plot or workflow")
-        return args.func(args)
+        status = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
+        return status
+    except BrokenPipeError:  # the reader went away (| head): stop quietly, as POSIX tools do
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
+        return EXIT_BROKEN_PIPE
     except TimeBudgetExceeded as exc:  # a RuntimeError, but not a failure: its own status
         print(f"microimpact: error: {exc}; give a larger --time-budget, or none for no limit", file=sys.stderr)
         return EXIT_TIME_BUDGET

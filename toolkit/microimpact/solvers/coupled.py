@@ -547,7 +547,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     hysteretic = p[9] > 1.5
     rolling = p[10] > 0.0
     elastic = 0.5 < p[9] < 1.5  # the elastic Mindlin contact
-    slipping = False  # its gross slip (found by the projection at first contact, then by events)
+    # its gross slip (found by the projection at first contact, then by events); a numpy bool, so
+    # that _end_at_slip_change is compiled once, not also for the literal False
+    slipping = np.bool_(False)
     load_side = 0.0  # sign of the Coulomb limit's load argument since the last restart (0: not yet known)
     lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
     damped = p[0] > 0.0 or p[1] > 0.0

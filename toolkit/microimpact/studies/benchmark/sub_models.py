@@ -57,8 +57,8 @@ def sub_model_costs(contact, speeds, incidence_deg, *, shear_modulus: float | No
     a = np.asarray(incidence_deg, dtype=float)[None, :]
     n = np.broadcast(v, a).size
     contacts = {name: contact.with_(**changes, shear_modulus=g) for name, changes in SUB_MODEL_SELECTIONS.items()}
-    for c in contacts.values():  # compile and warm up
-        simulate_many(c, v[:1], a[:, :1])
+    for c in contacts.values():  # compile and warm up on the whole grid: some impacts reach kernels
+        simulate_many(c, v, a)     # that others never call, and numba compiles each on first use
     times = {name: [] for name in contacts}
     for _ in range(max(1, int(repeats))):
         for name, c in contacts.items():
