@@ -195,7 +195,17 @@ def test_write_benchmark(small_benchmark, tmp_path):
     assert {r["method"] for r in data["results"]} == set(benchmark.ALL_METHODS)
     md = paths["markdown"].read_text()
     assert "| method |" in md and "reference" in md.lower()
+    costs = json.loads(small_benchmark.attrs["sub_model_costs"])  # each timed selection has its row
+    assert "## Cost of the sub-models" in md and all(f"| {name} |" in md for name in costs)
     assert not list((tmp_path / "out").glob(".*.tmp"))  # atomic writes leave no temporaries
+
+
+def test_markdown_says_the_cpus_were_shared_only_when_the_load_says_so(small_benchmark):
+    ds = small_benchmark.copy()
+    cpus = ds.attrs["machine_cpu_count"]
+    for load, shared in ((0.4 * cpus, False), (1.5 * cpus, True)):
+        ds.attrs.update(machine_load_average_1min_at_start=load, machine_load_average_1min_at_end=load)
+        assert ("above 1 per CPU" in benchmark.benchmark_markdown(ds)) is shared
 
 
 def test_write_benchmark_without_a_figure_writes_the_data_files(small_benchmark, tmp_path):

@@ -63,6 +63,14 @@ def _method_row(ds: xr.Dataset, name: str, method: str) -> np.ndarray:
 
 
 # =============================================================================== sections
+def _load_note(a: dict) -> str:
+    """Why the timings are noisy, where the load average says other jobs shared the CPUs."""
+    load = max(a["machine_load_average_1min_at_start"], a.get("machine_load_average_1min_at_end", math.nan))
+    if not load > a["machine_cpu_count"]:
+        return ""
+    return " (above 1 per CPU, other jobs shared the CPUs: timings are medians but noisy, the 2-thread batches most)"
+
+
 def _header(ds: xr.Dataset) -> list[str]:
     a = ds.attrs
     return [
@@ -73,8 +81,8 @@ def _header(ds: xr.Dataset) -> list[str]:
         "",
         f"Machine: {a['machine_processor']}, {a['machine_cpu_count']} CPUs, {a['machine_platform']}; "
         f"1-min load average {a['machine_load_average_1min_at_start']:.2f} at start, "
-        f"{a.get('machine_load_average_1min_at_end', math.nan):.2f} at end (above 1 per CPU, other jobs "
-        f"shared the CPUs: timings are medians but noisy, the 2-thread batches most); numba threads {a['numba_threads']}. "
+        f"{a.get('machine_load_average_1min_at_end', math.nan):.2f} at end{_load_note(a)}; "
+        f"numba threads {a['numba_threads']}. "
         f"Python {a['python_version']}, numpy {a['numpy_version']}, scipy {a['scipy_version']}, "
         f"numba {a['numba_version']}, xarray {a['xarray_version']}, microimpact {a['microimpact_version']}.",
         "",
@@ -277,6 +285,23 @@ def _family_section(a: dict) -> list[str]:
     ]
 
 
+def _sub_model_section(a: dict) -> list[str]:
+    costs = json.loads(a.get("sub_model_costs", "{}"))
+    if not costs:
+        return []
+    grid = json.loads(a.get("sub_model_grid", "{}"))
+    where = (f"{len(grid['speeds'])} speeds from {grid['speeds'][0]:.4g} to {grid['speeds'][-1]:.4g} m/s x "
+             f"{len(grid['incidence_deg'])} incidence angles from {grid['incidence_deg'][0]:g} to "
+             f"{grid['incidence_deg'][-1]:g} deg" if grid else "the same oblique impacts")
+    return ["", "## Cost of the sub-models", "",
+            f"`simulate_many` of {where}, each selection timed in turn on the same impacts (median of the "
+            "interleaved runs). The paper's model shares one normal solve among all angles at one speed; the "
+            "others run the coupled solver for each impact, and follow a captured sphere (normal speed below "
+            "the capture speed) until its oscillation settles, which is most of their cost.", "",
+            "| sub-models | time per impact | ratio to the paper's model |", "|---|---|---|"] + [
+        f"| {name} | {_t(c['time_per_impact'])} | {c['ratio_to_paper']:.1f} |" for name, c in costs.items()]
+
+
 def benchmark_markdown(ds: xr.Dataset) -> str:
     """A Markdown summary of the benchmark: reference and bound, the results table, engine and RKG
     notes, timing modes, targets, throughput and memory, notes and run time."""
@@ -287,7 +312,7 @@ def benchmark_markdown(ds: xr.Dataset) -> str:
     lines += _results_table(js["results"]) + _engine_cost(ds) + _engine_diagnostics(a) + _rkg_order(ds)
     lines += ["", "Timing modes:", ""]
     lines += [f"- `{m}`: {mode}" for m, mode in zip(ds["method"].values, ds["timing_mode"].values)]
-    lines += _targets_section(a) + _throughput_section(a) + _family_section(a)
+    lines += _targets_section(a) + _throughput_section(a) + _family_section(a) + _sub_model_section(a)
     notes = json.loads(a.get("notes", "[]"))
     if notes:
         lines += ["", "## Notes", ""] + [f"- {n}" for n in notes]

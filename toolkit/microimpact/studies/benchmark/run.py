@@ -326,8 +326,9 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
             advance()
         diag = _engine_diagnostics(contact, batch_speeds, cfg)
         log(f"engine diagnostics: {diag}", verbose)
-        sub_costs = sub_model_costs(contact, np.geomspace(speeds[0], speeds[-1], 4 if cfg.quick else 32),
-                                    np.linspace(0.0, 85.0, 5 if cfg.quick else 18), repeats=1 if cfg.quick else 3)
+        sub_grid = (np.geomspace(speeds[0], speeds[-1], 4 if cfg.quick else 32),
+                    np.linspace(0.0, 85.0, 5 if cfg.quick else 18))
+        sub_costs = sub_model_costs(contact, *sub_grid, repeats=1 if cfg.quick else 3)
         log(f"sub-model costs: {sub_costs}", verbose)
         advance()
 
@@ -351,6 +352,7 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
         "notes": json.dumps(notes),
         "engine_diagnostics": json.dumps(diag),
         "sub_model_costs": json.dumps(sub_costs),
+        "sub_model_grid": json.dumps({"speeds": sub_grid[0].tolist(), "incidence_deg": sub_grid[1].tolist()}),
         "total_seconds": time.perf_counter() - t_start,
         "machine_load_average_1min_at_end": load_average(),
         **targets,
