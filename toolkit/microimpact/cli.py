@@ -3,7 +3,8 @@
 Thin: parse, call the library, print or write. Exit statuses: 0 success; 2 bad arguments, inputs
 or a solver failure (one line ``microimpact: error: ...`` on stderr); 3 the computation ran past
 ``--time-budget SECONDS`` (``fit``, ``flags``, ``sweep``, ``reproduce``; one such line naming the
-budget); 141 (quietly) when the reader of stdout went away, as in ``| head``. Nothing is written on an error: outputs are written, atomically, only after the work.
+budget); 141, quietly, when the reader of stdout went away (``| head``). Nothing is written on an
+error: outputs are written, atomically, only after the work.
 
 Each command imports the part of the library it runs inside its own function: ``microimpact
 --help`` or ``microimpact simulate`` then never loads lmfit, pandas or the report, which keeps the
