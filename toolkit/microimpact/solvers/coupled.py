@@ -389,10 +389,7 @@ def _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp):
     else reject the step. Accepting it on the error of all states, as before, let a zero pass
     without a restart (results then jumped by 1e-5 between tolerances). Returns (the error sum
     that decides the step, restart)."""
-    en_n = 0.0
-    for i in range(_VT):
-        en_n += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
-    if en_n > _VT:
+    if _scaled_error_sum(z, z1, err, atol, rtol, _VT) > _VT:
         return max(en, 4.0 * _N), False  # rejected
     ga = _load_argument(z, p)
     if ga * gb < 0.0:
@@ -404,15 +401,21 @@ def _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp):
 
 
 @njit(cache=True, inline="always")
+def _scaled_error_sum(z, z1, err, atol, rtol, n):
+    """Sum of the squared scaled errors of the first n states of a step z -> z1."""
+    en = 0.0
+    for i in range(n):
+        en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
+    return en
+
+
+@njit(cache=True, inline="always")
 def _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref):
     """Sum of the squared scaled errors of a step z -> z1 (the error of p as that of the force it
     makes, see the module docstring)."""
     if hysteretic:
         err[_FT] *= min(1.0, p[4] * abs(_load_argument(z1, p)) / lim_ref)
-    en = 0.0
-    for i in range(_N):
-        en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
-    return en
+    return _scaled_error_sum(z, z1, err, atol, rtol, _N)
 
 
 @njit(cache=True)
