@@ -31,8 +31,8 @@ load are resolved by step rejection (the Mindlin force reaches its limit with ze
 slip starts smoothly). After every accepted step the displacement is held at delta* in gross slip,
 and the steps of the elastic Mindlin contact end where gross slip starts and ends
 (:func:`_end_at_slip_change`: a step across either converged only first order). Separation (s = 0,
-y < 0) is located by secant iteration on the step length; capture is the exact energy test of the
-engine.
+y < 0) and the largest penetration (y = 0, :func:`_peak_depth`) are located by secant iteration on
+the step length; capture is the exact energy test of the engine.
 
 Hysteretic law where the Coulomb limit vanishes: the rate of p is ~ 1 / F_lim, and F_lim = f |F_n|
 passes through zero twice in every impact with adhesion (and twice in every period of a captured
@@ -51,8 +51,12 @@ End of a captured impact (every tangential model): the integration stops once th
 oscillation has decayed below the settle amplitude (``SETTLE_AMPLITUDE`` of the equilibrium
 penetration, or ``SETTLE_PER_RTOL`` times rtol if that is larger: the integration error keeps the
 amplitude of a long captured oscillation at 15-40 rtol, measured, so a fixed 1e-6 was never
-reached at rtol >= 1e-7). What the tangential state still does after that is taken in closed form
-(:func:`_settle_captured`), so the result does not depend on when the integration stopped:
+reached at rtol >= 1e-7). A compliant contact with the pulloff limit and no rolling resistance
+stops as soon as it is captured and past its largest penetration: its result is its angular
+momentum about the contact point (below), which the contact force conserves, so following the
+oscillation (5,000-6,000 steps) changed its velocities by 2e-14 (rounding). What the tangential
+state still does after the stop is taken in closed form (:func:`_settle_captured`), so the result
+does not depend on when the integration stopped:
 
 * friction with a limit at rest ("pulloff": F_lim = 2 f F_po at the adhesive equilibrium): the
   contact force acts at the contact point, so the angular momentum about it is conserved, while
@@ -338,10 +342,11 @@ def _initial_branch(z, p):
 
 #: the events located within a step by :func:`_restep_to_root`: the Coulomb limit passing through
 #: zero, separation (s = 0), a turning point of the hysteretic law, the rolling velocity reaching
-#: zero. numpy integers, not int literals: numba compiles one specialization of a callee per
+#: zero, the largest penetration (y = 0). numpy integers, not int literals: numba compiles one specialization of a callee per
 #: literal argument (four instead of one).
 _EV_LOAD, _EV_SEPARATION, _EV_TURN, _EV_ROLL = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
 _EV_GROSS, _EV_STICK = np.int64(4), np.int64(5)  # elastic Mindlin contact: gross slip starts, ends
+_EV_DEPTH = np.int64(6)
 
 
 @njit(cache=True)
@@ -356,6 +361,8 @@ def _event_value(code, z, p, hist):
         return _gross_slip_margin(z, p)
     if code == _EV_STICK:
         return _slip_excess(z, p, hist)
+    if code == _EV_DEPTH:
+        return z[_Y]
     return _branch_slip(z, hist)
 
 
@@ -493,6 +500,23 @@ def _hold_rolling(z, k1, tol, p, hist):
         _rhs(z, p, hist, k1)
 
 
+@njit(cache=True)
+def _peak_depth(h, z, z1, k1, p, hist):
+    """s at the largest penetration, where y = dxi/dtau falls through zero within the accepted step
+    z -> z1 of length h: the state re-stepped from z to y = 0 (regula falsi on the step length, in
+    scratch arrays: the step itself is kept).
+
+    The largest s of the step's ends alone was short of it by up to 4e-4 of the penetration at
+    rtol 1e-9 (the step's length squared). The normal state does not depend on the tangential
+    one, so the root is the normal motion's own even where the step is later ended earlier (at a
+    turning point of the hysteretic law, a zero of the Coulomb limit).
+    """
+    zs, tmp, err = np.empty(_N), np.empty(_N), np.empty(_N)
+    ks = np.empty((7, _N))
+    _restep_to_root(_EV_DEPTH, z[_Y], z1[_Y], 1e-10 * (z[_Y] - z1[_Y]), h, z, k1, p, hist, ks, tmp, zs, err)
+    return zs[_S]
+
+
 @njit(cache=True, inline="always")
 def _impulse_time(z, z1, j_stop, tau_j):
     """tau at which J reaches j_stop, interpolated within the step z -> z1 (``tau_j`` if known)."""
@@ -562,6 +586,11 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     if y0 < 1.0:
         h = min(1e-3 * (12.0 / y0) ** (1.0 / 3.0), 1e-2)
     captured = False
+    peaked = False  # the largest penetration located
+    # a captured sphere with friction limited at rest and no rolling resistance ends rolling at its
+    # angular momentum about the contact point, which the contact force conserves (_rolling_state):
+    # nothing after the capture and the largest penetration changes the result
+    conserved = p[6] > 0.5 and p[9] > 0.5 and p[10] == 0.0
     tau_cap = math.nan
     tau_j = math.nan
     smax = 0.0
@@ -602,6 +631,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 status = _UNDERFLOW
                 break
             continue
+        if not peaked and z[_Y] > 0.0 and z1[_Y] <= 0.0:
+            smax = max(smax, _peak_depth(h_end, z, z1, k1, p, hist))
+            peaked = True
         if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: secant on the step length
             _restep_to_root(_EV_SEPARATION, z[_S], z1[_S], 1e-14 * sref, h_end, z, k1, p, hist, k, tmp, z1, err)
             z1[_S] = 0.0
@@ -656,10 +688,12 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             amp = math.sqrt(dx * dx + (z[_Y] / omega0) ** 2) / xe
             # settled normal motion (the tangential rest is taken in closed form afterwards), or
             # the rigid contact's sliding and twist over
-            if amp < settle or (z[_J] >= j_stop and z[_JA] >= ja_stop):
+            if amp < settle or peaked and (conserved or z[_J] >= j_stop and z[_JA] >= ja_stop):
                 outcome = 1
                 break
         h *= 5.0 if en == 0.0 else min(5.0, max(0.2, 0.9 * en ** -0.2))
+    if outcome == 1 and not peaked:  # crept into the equilibrium without turning: its supremum
+        smax = max(smax, math.sqrt(xe))
     return status, outcome, z, smax * smax, tau_cap, tau_j, n, n_turn
 
 
@@ -824,8 +858,10 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     -------
     dict of 1-D arrays (SI): ``captured``, ``e_n``, ``v_t``, ``v_tp`` [m/s], ``omega_n``,
     ``omega_t``, ``omega_tp`` [rad/s], ``contact_time``, ``capture_time``, ``slip_end_time`` [s],
-    ``max_penetration`` [m], ``turning_points`` (hysteretic law), ``friction_impulse`` (int of the friction load, |F_n| or
-    |F_n + 2 F_po|) [N s], ``slip_ended`` (bool), ``n_steps``.
+    ``max_penetration`` [m], ``turning_points`` (hysteretic law, up to where the integration
+    stopped), ``friction_impulse`` (int of the friction load, |F_n| or |F_n + 2 F_po|, over the
+    contact with the closed-form tail of a captured sphere: inf for a captured one with the pulloff
+    limit, whose load stays 2 F_po at rest) [N s], ``slip_ended`` (bool), ``n_steps``.
 
     Raises
     ------
@@ -884,8 +920,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
         "capture_time": info[:, 3] * time,
         "slip_end_time": slip_end_time,
         "max_penetration": info[:, 2] * length,
-        "friction_impulse": jl,
-        "dissipated_normal": states[:, _D] * j_unit * u,
+        "friction_impulse": j_map,
         "slip_ended": np.asarray(slip_ended, dtype=bool),
         "n_steps": info[:, 5].astype(np.int64),
         "turning_points": info[:, 6].astype(np.int64),
