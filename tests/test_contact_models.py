@@ -380,12 +380,8 @@ def test_hysteretic_captured_impacts_finish(changes):
     angles = np.array([0.0, 45.0, 85.0])
     ds = simulate_many(c, 1.0, angles)
     assert np.all(ds["outcome"].values == 1)
-    for q in ("velocity_out_t", "omega_out_tp", "omega_out_n", "dissipated_energy"):
+    for q in ("velocity_out_t", "omega_out_tp", "omega_out_n", "friction_impulse", "dissipated_energy"):
         assert np.all(np.isfinite(ds[q].values)), q
-    # the integral of the friction load: finite with the paper's friction (the load |F_n| dies
-    # out with the oscillation), unbounded with the pulloff limit (it stays 2 F_po at rest)
-    pulloff = changes.get("friction_model") == "pulloff"
-    assert np.all(np.isinf(ds["friction_impulse"].values) == pulloff)
     # final kinetic + contact energy V(X) <= initial kinetic: dissipated >= 0, to 1e-9 of the
     # incident energy (solver rtol 1e-8 on velocities, squared; measured >= 0)
     assert np.all(ds["dissipated_energy"].values >= -1e-9 * 0.5 * c.mass)

@@ -173,10 +173,11 @@ def test_coupled_solver_against_its_baseline(coupled_now):
     * ``max_penetration`` is located within the step (y = 0) instead of being the largest step end,
       so it can only grow (the old value was short by up to 4e-4 of it, and by 12 % where a
       captured rigid pulloff impact stopped before its largest penetration);
-    * ``friction_impulse`` of a captured sphere includes the closed-form tail: inf with the pulloff
-      limit (the load stays 2 F_po at rest), the linear tail's variation with the paper's friction;
     * compliant captured impacts with the pulloff limit and no rolling resistance stop at capture
-      (past the largest penetration), in a tenth of the steps or fewer.
+      (past the largest penetration), in a tenth of the steps or fewer; their velocities and spins
+      are the followed ones (conserved angular momentum), their ``friction_impulse`` (over the part
+      followed) is smaller, and a captured rigid pulloff impact now stops after its largest
+      penetration, not before, so its part followed may be longer.
     """
     cases, now, base = coupled_now
     v, w, _ = cases.impacts()
@@ -196,11 +197,7 @@ def test_coupled_solver_against_its_baseline(coupled_now):
             assert err.max(initial=0.0) <= noise, (name, key, float(err.max()))
         # the located largest penetration is never below the largest step end (within the noise)
         assert np.all(res["max_penetration"] >= old["max_penetration"] * (1.0 - noise)), name
-        if friction == "pulloff":
-            assert np.all(np.isinf(res["friction_impulse"][captured])), name
-        else:
-            tail = res["friction_impulse"][captured] / old["friction_impulse"][captured] - 1.0
-            assert np.all((tail > -noise) & (tail < 1e-3)), (name, tail.min(), tail.max())
+        assert np.all(np.isfinite(res["friction_impulse"]) & (res["friction_impulse"] > 0.0)), name
         rebound = res["friction_impulse"][~captured] / old["friction_impulse"][~captured] - 1.0
         assert np.abs(rebound).max(initial=0.0) <= noise, name
         if friction == "pulloff" and tangential != "rigid" and rolling == 0.0:

@@ -45,7 +45,7 @@ VARIABLES: dict[str, tuple[str | None, str]] = {
     "contact_time": ("s", "duration of contact (inf if captured)"),
     "max_penetration": ("m", "largest penetration x = -n"),
     "slip_ended": ("1", "1 if sliding ended and the sphere rolls"),
-    "friction_impulse": ("N s", "integral of the friction load |F_n| (|F_n + 2 F_po| with the pulloff limit) over the contact (inf if captured with the pulloff limit)"),
+    "friction_impulse": ("N s", "integral of |F_n| over the contact"),
     "dissipated_energy": ("J", "energy dissipated by damping and friction (to rest if captured)"),
     "capture_normal_speed": ("m s-1", "normal capture velocity: largest normal speed that is captured"),
     # ------------------------------------------------------------- fitted parameters

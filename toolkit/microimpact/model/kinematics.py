@@ -93,8 +93,10 @@ class ImpactResult:
     slip_end_time : float
         Time at which sliding ended; NaN if it did not. [s]
     friction_impulse : float
-        int |F_n| dt over the contact; for a captured sphere over the part followed, which lasts
-        until sliding and twist have ended or the rest of the tail is negligible. [N s]
+        int |F_n| dt over the contact (|F_n + 2 F_po| with ``friction_model="pulloff"``); for a
+        captured sphere over the part followed, which lasts until sliding and twist have ended or
+        the rest of the tail is negligible (a compliant contact with the pulloff limit and no
+        rolling resistance: until capture and the largest penetration). [N s]
     dissipated_energy : float
         Energy dissipated by normal damping plus friction (sliding and twist), so that initial
         kinetic energy = final kinetic energy + final_contact_energy + dissipated_energy. For a

@@ -858,10 +858,10 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     -------
     dict of 1-D arrays (SI): ``captured``, ``e_n``, ``v_t``, ``v_tp`` [m/s], ``omega_n``,
     ``omega_t``, ``omega_tp`` [rad/s], ``contact_time``, ``capture_time``, ``slip_end_time`` [s],
-    ``max_penetration`` [m], ``turning_points`` (hysteretic law, up to where the integration
-    stopped), ``friction_impulse`` (int of the friction load, |F_n| or |F_n + 2 F_po|, over the
-    contact with the closed-form tail of a captured sphere: inf for a captured one with the pulloff
-    limit, whose load stays 2 F_po at rest) [N s], ``slip_ended`` (bool), ``n_steps``.
+    ``max_penetration`` [m], ``turning_points`` (hysteretic law), ``friction_impulse`` (int of the
+    friction load, |F_n| or |F_n + 2 F_po|; for a captured sphere over the part followed, as
+    :class:`~microimpact.model.kinematics.ImpactResult` says) [N s], ``slip_ended`` (bool),
+    ``n_steps``.
 
     Raises
     ------
@@ -920,7 +920,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
         "capture_time": info[:, 3] * time,
         "slip_end_time": slip_end_time,
         "max_penetration": info[:, 2] * length,
-        "friction_impulse": j_map,
+        "friction_impulse": jl,
         "slip_ended": np.asarray(slip_ended, dtype=bool),
         "n_steps": info[:, 5].astype(np.int64),
         "turning_points": info[:, 6].astype(np.int64),

@@ -297,7 +297,9 @@ def _sub_model_section(a: dict) -> list[str]:
             f"`simulate_many` of {where}, each selection timed in turn on the same impacts (median of the "
             "interleaved runs). The paper's model shares one normal solve among all angles at one speed; the "
             "others run the coupled solver for each impact, and follow a captured sphere (normal speed below "
-            "the capture speed) until its oscillation settles, which is most of their cost.", "",
+            "the capture speed) until its oscillation settles, which is most of their cost; a compliant contact "
+            "with the pulloff limit and no rolling resistance stops at capture (its result is the angular "
+            "momentum about the contact point, conserved from then on).", "",
             "| sub-models | time per impact | ratio to the paper's model |", "|---|---|---|"] + [
         f"| {name} | {_t(c['time_per_impact'])} | {c['ratio_to_paper']:.1f} |" for name, c in costs.items()]
 
