@@ -25,8 +25,9 @@ The tau, J, J_a and damping-dissipation states are integrated with the motion. D
 (Dormand & Prince 1980) with error control on every state; separation is located by re-stepping
 from the start of the step (Illinois method). Capture is the exact energy test: once
 y^2/2 + U(z) falls below U at the break point, the sphere can never leave (the damping only removes
-energy). A captured sphere whose tangential outcome is needed is followed until its friction and
-twist impulses reach the values that end sliding and twist, or until it settles.
+energy). A captured sphere is followed at least to its largest penetration (y = 0); one whose
+tangential outcome is needed until its friction and twist impulses reach the values that end
+sliding and twist, or until it settles.
 
 References
 ----------
@@ -210,6 +211,7 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
     h = 1e-2 * min(1.0, 1.0 / y0)
     status, outcome = _OK, REBOUND
     zmax = u[0]
+    turned = False  # the largest penetration passed (y fell through zero)
     tau_cap = math.nan
     tau_slip = math.nan
     e_cap = threshold
@@ -236,6 +238,7 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
             _locate_boundary(model, zb, u, k, h, c1, c2, a_, b_, e_, tmp, u1, err)
         if u[1] > 0.0 and u1[1] <= 0.0:
             zmax = max(zmax, _hermite_max(u[0], u1[0], k[0, 0], k[6, 0], h))
+            turned = True
         zmax = max(zmax, u1[0])
         if j_target > 0.0 and math.isnan(tau_slip) and u1[4] >= j_target:
             frac = (j_target - u[4]) / (u1[4] - u[4]) if u1[4] > u[4] else 1.0
@@ -251,14 +254,16 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
             outcome = CAPTURE
             tau_cap = u[2]
             e_cap = e_now
-            if not need_tail:
-                break
         if outcome == CAPTURE:
-            if u[4] >= j_stop and u[5] >= ja_stop:
-                break
             # settled: oscillation amplitude below tail_tol (energy ratio floored at 1e-14, above
             # the round-off of the energy near the bottom of the well)
             if e_now - e_eq <= max(tail_tol * tail_tol, 1e-14) * (e_cap - e_eq):
+                if not turned:  # crept into the equilibrium without turning: its supremum
+                    zmax = max(zmax, z_eq)
+                break
+            # not before the largest penetration: a capture found on the way in (at the first
+            # step for a slow JKR impact) stopped short of it, up to 6x at rtol 1e-9
+            if turned and (not need_tail or u[4] >= j_stop and u[5] >= ja_stop):
                 break
         h *= min(5.0, max(0.2, 0.9 * max(norm, 1e-10) ** -0.2))
     return (float(status), float(outcome), u[1], u[2], u[3], u[4], u[5], zmax, tau_cap, tau_slip,
@@ -458,7 +463,7 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
 
     def capture(_t, w):
         return energy(w) - thr
-    capture.terminal, capture.direction = not need_tail, -1.0
+    capture.direction = -1.0
 
     def turning(_t, w):
         return w[1]
@@ -468,26 +473,37 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
 
     def stopped(_t, w):  # a captured sphere whose sliding and twist are over
         return min(w[3] - js, w[4] - jas, thr - energy(w)) if need_tail else -1.0
-    stopped.terminal, stopped.direction = True, 1.0
+    stopped.direction = 1.0
+    events = (separation, capture, turning, stopped)
     w0 = [0.0, y0, 0.0, 0.0, 0.0]
-    captured_at_start = energy(w0) < thr  # an undamped JKR impact below the sticking velocity
-    capture.terminal = capture.terminal and not captured_at_start
-    sol = solve_ivp(rhs, (0.0, 0.0 if captured_at_start and not need_tail else max_time), w0, method="DOP853",
-                    rtol=rtol, atol=rtol * max(1.0, y0) * 1e-2, events=(separation, capture, turning, stopped))
-    captured = captured_at_start or sol.t_events[1].size > 0
+    captured = energy(w0) < thr  # at the start: an undamped JKR impact below the sticking velocity
+    opts = {"method": "DOP853", "rtol": rtol, "atol": rtol * max(1.0, y0) * 1e-2}
+    # first to the largest penetration, so that a capture on the way in does not end the solve
+    # short of it; then on to separation, or to the capture (the stops with need_tail)
+    capture.terminal, turning.terminal, stopped.terminal = False, True, False
+    parts = [solve_ivp(rhs, (0.0, max_time), w0, events=events, **opts)]
+    w1 = parts[0].y[:, -1]
+    captured = captured or parts[0].t_events[1].size > 0
+    turned = parts[0].status == 1 and parts[0].t_events[0].size == 0
+    if turned and not (captured and (not need_tail or (w1[3] >= js and w1[4] >= jas))):
+        capture.terminal, turning.terminal, stopped.terminal = not need_tail, False, True
+        parts.append(solve_ivp(rhs, (parts[0].t[-1], max_time), w1, events=events, **opts))
+        captured = captured or parts[1].t_events[1].size > 0
+    sol = parts[-1]
+    capture_times = [t for part in parts for t in part.t_events[1]]
     w_end = sol.y[:, -1]
     e_unit = sc.force * sc.length
     return NormalSolution(
         outcome="capture" if captured else "rebound",
         e_n=0.0 if captured else -w_end[1] / y0,
         contact_time=math.inf if captured else sol.t[-1] * sc.time,
-        capture_time=(0.0 if captured_at_start else sol.t_events[1][0] * sc.time) if captured else math.nan,
-        max_penetration=float(max([np.max(sol.y[0])] + [w[0] for w in sol.y_events[2]])) * sc.length,
+        capture_time=(capture_times[0] * sc.time if capture_times else 0.0) if captured else math.nan,
+        max_penetration=float(max(np.max(part.y[0]) for part in parts)) * sc.length,
         friction_impulse=w_end[3] * j_unit,
         twist_impulse=w_end[4] * j_unit * sc.radius,
         dissipated_energy=(w_end[2] if captured else 0.5 * (y0**2 - w_end[1] ** 2)) * e_unit,
         final_energy=0.0 if captured else 0.5 * w_end[1] ** 2 * e_unit,
         slip_end_time=math.nan,
-        n_steps=int(sol.t.size),
+        n_steps=sum(int(part.t.size) for part in parts),
         n_rejected=0,
     )

@@ -84,7 +84,9 @@ def _rkg_impact(y0, c1, c2, ah, aa, h, max_steps, j_target):
     exit speed is y at the end of that step: past the root the force is zero (free flight), so y is
     constant there and the step already integrates the motion through the separation point
     (linearly interpolating y as well would add an O(h^2.5) error). Capture: the contact energy
-    e of :func:`microimpact.model.law.nondimensional_energy` falls below 0.
+    e of :func:`microimpact.model.law.nondimensional_energy` falls below 0; the steps go on to
+    the largest penetration (y <= 0) if the capture came on the way in, so that xi_max is the
+    largest penetration (it was the xi of the capture step: 1/70 of it for a slow impact).
 
     The nondimensional friction impulse J = int |xi''| dtau is the total variation of y, summed as
     |dy| per step, and J_a = int s |xi''| dtau (s = sqrt(xi)) by the trapezoidal rule in y; both
@@ -100,6 +102,8 @@ def _rkg_impact(y0, c1, c2, ah, aa, h, max_steps, j_target):
     ja = 0.0
     xi_max = 0.0
     tau_j = math.nan
+    n_cap = 0  # the step at which the sphere was captured (0: not yet)
+    e_cap = 0.0
     for n in range(1, max_steps + 1):
         xn, yn = _rkg_step(xi, y, h, c1, c2, ah, aa)
         dj = abs(yn - y)
@@ -112,10 +116,12 @@ def _rkg_impact(y0, c1, c2, ah, aa, h, max_steps, j_target):
             return -yn, (n - 1 + theta) * h, n, 0, jn, ja, xi_max, tau_j, 0.5 * yn * yn
         xi, y = xn, yn
         xi_max = max(xi_max, xi)
-        if aa > 0.0 and xi > 0.0:
-            e = law.nondimensional_energy(math.sqrt(xi), y, ah, aa)
-            if e < 0.0:
-                return 0.0, n * h, n, 1, jn, ja, xi_max, tau_j, e
+        if n_cap == 0 and aa > 0.0 and xi > 0.0:
+            e_cap = law.nondimensional_energy(math.sqrt(xi), y, ah, aa)
+            if e_cap < 0.0:
+                n_cap = n
+        if n_cap > 0 and y <= 0.0:
+            return 0.0, n_cap * h, n, 1, jn, ja, xi_max, tau_j, e_cap
     return math.nan, math.nan, max_steps, -1, jn, ja, xi_max, tau_j, math.nan
 
 
