@@ -31,7 +31,7 @@ load are resolved by step rejection (the Mindlin force reaches its limit with ze
 slip starts smoothly). After every accepted step the displacement is held at delta* in gross slip,
 and the steps of the elastic Mindlin contact end where gross slip starts and ends
 (:func:`_end_at_slip_change`: a step across either converged only first order). Separation (s = 0,
-y < 0) and the largest penetration (y = 0, :func:`_peak_depth`) are located by secant iteration on
+y < 0) and the largest penetration (y = 0, :func:`_root_state`) are located by secant iteration on
 the step length; capture is the exact energy test of the engine.
 
 Hysteretic law where the Coulomb limit vanishes: the rate of p is ~ 1 / F_lim, and F_lim = f |F_n|
@@ -342,11 +342,12 @@ def _initial_branch(z, p):
 
 #: the events located within a step by :func:`_restep_to_root`: the Coulomb limit passing through
 #: zero, separation (s = 0), a turning point of the hysteretic law, the rolling velocity reaching
-#: zero, the largest penetration (y = 0). numpy integers, not int literals: numba compiles one specialization of a callee per
+#: zero, the largest penetration (y = 0), the friction impulse J and the contact energy reaching a
+#: value. numpy integers, not int literals: numba compiles one specialization of a callee per
 #: literal argument (four instead of one).
 _EV_LOAD, _EV_SEPARATION, _EV_TURN, _EV_ROLL = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
 _EV_GROSS, _EV_STICK = np.int64(4), np.int64(5)  # elastic Mindlin contact: gross slip starts, ends
-_EV_DEPTH = np.int64(6)
+_EV_DEPTH, _EV_IMPULSE, _EV_ENERGY = np.int64(6), np.int64(7), np.int64(8)
 
 
 @njit(cache=True)
@@ -363,14 +364,19 @@ def _event_value(code, z, p, hist):
         return _slip_excess(z, p, hist)
     if code == _EV_DEPTH:
         return z[_Y]
+    if code == _EV_IMPULSE:
+        return z[_J]
+    if code == _EV_ENERGY:
+        return _energy(z[_S], z[_Y], p[2], p[3])
     return _branch_slip(z, hist)
 
 
 @njit(cache=True)
-def _restep_to_root(code, fa, fb, tol, h, z, k1, p, hist, k, tmp, z1, err):
-    """Re-step from z to where event ``code`` crosses zero within the step h (regula falsi on the
-    step length; fa, fb its values at the start and end of the step, opposite signs); z1 then
-    holds the state there. Stops at |value| <= tol or a bracket below 1e-14 h; returns the step length."""
+def _restep_to_root(code, target, fa, fb, tol, h, z, k1, p, hist, k, tmp, z1, err):
+    """Re-step from z to where event ``code`` reaches ``target`` within the step h (regula falsi on
+    the step length; fa, fb its values less target at the start and end of the step, opposite
+    signs); z1 then holds the state there. Stops at |value - target| <= tol or a bracket below
+    1e-14 h; returns the step length."""
     a, b = 0.0, h
     hs = h
     for _ in range(60):
@@ -378,7 +384,7 @@ def _restep_to_root(code, fa, fb, tol, h, z, k1, p, hist, k, tmp, z1, err):
         if not (a < hs < b):
             hs = 0.5 * (a + b)
         _step(z, k1, hs, p, hist, k, tmp, z1, err)
-        g = _event_value(code, z1, p, hist)
+        g = _event_value(code, z1, p, hist) - target
         if abs(g) <= tol or (b - a) < 1e-14 * h:
             break
         if (g > 0.0) == (fa > 0.0):
@@ -400,7 +406,7 @@ def _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp):
         return max(en, 4.0 * _N), False  # rejected
     ga = _load_argument(z, p)
     if ga * gb < 0.0:
-        _restep_to_root(_EV_LOAD, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
+        _restep_to_root(_EV_LOAD, 0.0, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h, z, k1, p, hist, k, tmp, z1, err)
     else:
         for i in range(_N):
             z1[i] = z[i]
@@ -442,7 +448,7 @@ def _end_at_rolling_stop(h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hystere
     wm = math.sqrt(z[_WT] * z[_WT] + z[_WTP] * z[_WTP])
     hist[4], hist[5] = z[_WT] / wm, z[_WTP] / wm
     fb = z1[_WT] * hist[4] + z1[_WTP] * hist[5]
-    hs = _restep_to_root(_EV_ROLL, wm, fb, 1e-13 * (wm + abs(fb)), h, z, k1, p, hist, k, tmp, z1, err)
+    hs = _restep_to_root(_EV_ROLL, 0.0, wm, fb, 1e-13 * (wm + abs(fb)), h, z, k1, p, hist, k, tmp, z1, err)
     en = _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref)
     left = math.sqrt(z1[_WT] * z1[_WT] + z1[_WTP] * z1[_WTP])
     if left > atol[_WT] + rtol * wm:
@@ -470,7 +476,7 @@ def _end_at_slip_change(slipping, h, en, z, z1, k1, err, atol, rtol, p, hist, k,
         fa, fb, code = _gross_slip_margin(z, p), _gross_slip_margin(z1, p), _EV_GROSS
         if not (fa < 0.0 and fb > 0.0):
             return en, False, h
-    hs = _restep_to_root(code, fa, fb, 1e-13 * (abs(fa) + abs(fb)), h, z, k1, p, hist, k, tmp, z1, err)
+    hs = _restep_to_root(code, 0.0, fa, fb, 1e-13 * (abs(fa) + abs(fb)), h, z, k1, p, hist, k, tmp, z1, err)
     if hs < 1e-6 * h:
         # a change at the start of the step: a value a rounding error off zero where F_lim ~ 0 (a
         # captured sphere with the paper's friction, twice per period); ending the step there
@@ -501,27 +507,31 @@ def _hold_rolling(z, k1, tol, p, hist):
 
 
 @njit(cache=True)
-def _peak_depth(h, z, z1, k1, p, hist):
-    """s at the largest penetration, where y = dxi/dtau falls through zero within the accepted step
-    z -> z1 of length h: the state re-stepped from z to y = 0 (regula falsi on the step length, in
-    scratch arrays: the step itself is kept).
+def _root_state(code, target, h, z, z1, k1, p, hist):
+    """The state where event ``code`` reaches ``target`` within the accepted step z -> z1 of
+    length h, re-stepped from z in scratch arrays (the step itself is kept). Used where a value
+    at an instant is reported: the largest penetration (y = 0), the end of sliding (J = J*) and
+    the capture (the energy test).
 
-    The largest s of the step's ends alone was short of it by up to 4e-4 of the penetration at
-    rtol 1e-9 (the step's length squared). The normal state does not depend on the tangential
-    one, so the root is the normal motion's own even where the step is later ended earlier (at a
-    turning point of the hysteretic law, a zero of the Coulomb limit).
+    The step's ends alone were O(h^2) off at rtol 1e-9: the largest penetration by up to 4e-4,
+    the slip-end time (J interpolated linearly in the step) by 1e-4 and the capture time (the
+    step's end) by 4e-2. The normal state does not depend on the tangential one, so a normal
+    event's root is the normal motion's own even where the step is later ended earlier (at a
+    turning point of the hysteretic law, a zero of the Coulomb limit); J grows monotonically, so
+    its root is bracketed by the whole step too.
     """
     zs, tmp, err = np.empty(_N), np.empty(_N), np.empty(_N)
     ks = np.empty((7, _N))
-    _restep_to_root(_EV_DEPTH, z[_Y], z1[_Y], 1e-10 * (z[_Y] - z1[_Y]), h, z, k1, p, hist, ks, tmp, zs, err)
-    return zs[_S]
+    fa, fb = _event_value(code, z, p, hist) - target, _event_value(code, z1, p, hist) - target
+    _restep_to_root(code, target, fa, fb, 1e-13 * (abs(fa) + abs(fb)), h, z, k1, p, hist, ks, tmp, zs, err)
+    return zs
 
 
 @njit(cache=True, inline="always")
-def _impulse_time(z, z1, j_stop, tau_j):
-    """tau at which J reaches j_stop, interpolated within the step z -> z1 (``tau_j`` if known)."""
+def _impulse_time(z, z1, j_stop, tau_j, h, k1, p, hist):
+    """tau at which J reaches j_stop within the step z -> z1 of length h (``tau_j`` if known)."""
     if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:
-        return z[_TAU] + (z1[_TAU] - z[_TAU]) * (j_stop - z[_J]) / (z1[_J] - z[_J])
+        return _root_state(_EV_IMPULSE, j_stop, h, z, z1, k1, p, hist)[_TAU]
     return tau_j
 
 
@@ -632,13 +642,13 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 break
             continue
         if not peaked and z[_Y] > 0.0 and z1[_Y] <= 0.0:
-            smax = max(smax, _peak_depth(h_end, z, z1, k1, p, hist))
+            smax = max(smax, _root_state(_EV_DEPTH, 0.0, h_end, z, z1, k1, p, hist)[_S])
             peaked = True
         if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: secant on the step length
-            _restep_to_root(_EV_SEPARATION, z[_S], z1[_S], 1e-14 * sref, h_end, z, k1, p, hist, k, tmp, z1, err)
+            _restep_to_root(_EV_SEPARATION, 0.0, z[_S], z1[_S], 1e-14 * sref, h_end, z, k1, p, hist, k, tmp, z1, err)
             z1[_S] = 0.0
             outcome = 0
-            tau_j = _impulse_time(z, z1, j_stop, tau_j)
+            tau_j = _impulse_time(z, z1, j_stop, tau_j, h_end, k1, p, hist)
             for i in range(_N):
                 z[i] = z1[i]
             z[_FT] = z[_FTP] = 0.0  # out of contact: nothing stored
@@ -647,10 +657,13 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         if not restart and hysteretic and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
             # turning point of the hysteretic law within the step: secant on the step length
             ga, gb = _branch_slip(z, hist), _branch_slip(z1, hist)
-            _restep_to_root(_EV_TURN, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h_end, z, k1, p, hist, k, tmp, z1, err)
+            _restep_to_root(_EV_TURN, 0.0, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h_end, z, k1, p, hist, k, tmp, z1, err)
             turned = True
             at_rest = False
-        tau_j = _impulse_time(z, z1, j_stop, tau_j)
+        tau_j = _impulse_time(z, z1, j_stop, tau_j, h_end, k1, p, hist)
+        if not captured and damped and aa > 0.0 and _energy(z1[_S], z1[_Y], ah, aa) < ecap:
+            captured = True
+            tau_cap = _root_state(_EV_ENERGY, ecap, h_end, z, z1, k1, p, hist)[_TAU]
         for i in range(_N):
             z[i] = z1[i]
         if at_rest:
@@ -680,9 +693,6 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         if rolling and z[_S] > 0.0:
             _hold_rolling(z, k1, atol[_WT], p, hist)
         smax = max(smax, z[_S])
-        if not captured and damped and aa > 0.0 and _energy(z[_S], z[_Y], ah, aa) < ecap:
-            captured = True
-            tau_cap = z[_TAU]
         if captured:
             dx = z[_S] * z[_S] - xe
             amp = math.sqrt(dx * dx + (z[_Y] / omega0) ** 2) / xe
