@@ -376,8 +376,9 @@ def simulate_reference(
         All fields in SI units; ``method`` is ``"reference:<method>"``. ``stop_reason`` is
         "separation" (rebound), "capture" (captured, nothing tangential left to integrate),
         "slip and twist ended" or "settled" (captured, tail integrated). For a captured sphere the
-        reported normal velocity is 0, ``contact_time`` is inf and ``final_contact_energy`` is the
-        normal contact energy (kinetic plus V) at the end of the integration.
+        reported normal velocity is 0, ``contact_time`` is inf and ``final_contact_energy`` is V(X),
+        the contact energy at rest at the equilibrium (what was left of the oscillation where the
+        integration stopped is counted as dissipated).
 
     Raises
     ------

@@ -249,8 +249,8 @@ def result_distance(contact: Contact, a, b) -> float:
     e_scale = energy_scale(contact, ke_in)
     v_scale = math.sqrt(2.0 * e_scale / contact.mass)
     m, r = contact.mass, contact.radius
-    # final_contact_energy is left out: for a capture it is the energy wherever the integration
-    # stopped (a tolerance-dependent point of the decaying oscillation), not a converged quantity
+    # final_contact_energy is left out: it is V(X) for a capture and 0 for a rebound, set by the
+    # outcome, which the normal kinetic energy term already compares
     d = [abs(0.5 * m * (a.velocity_out[0] ** 2 - b.velocity_out[0] ** 2)) / e_scale]
     d += [abs(a.velocity_out[i] - b.velocity_out[i]) / v_scale for i in (1, 2)]
     d += [r * abs(a.omega_out[i] - b.omega_out[i]) / v_scale for i in range(3)]
