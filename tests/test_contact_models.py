@@ -481,6 +481,18 @@ def test_captured_sphere_with_friction_at_rest_ends_rolling_at_its_angular_momen
         assert np.all(ds["slip_ended"].values == 1)
 
 
+@pytest.mark.parametrize("rolling, reason", [(0.0, "capture"), (0.01, "settled")])
+def test_captured_pulloff_impact_says_where_it_stopped(rolling, reason):
+    """Without rolling resistance a captured compliant impact with the pulloff limit ends at its
+    capture (past the largest penetration): nothing after it changes the result, which its
+    stop_reason says; with rolling resistance the oscillation is followed until it settles."""
+    c = WALL_1990.with_(tangential_model="mindlin", friction_model="pulloff", rolling_friction=rolling,
+                        shear_modulus=1e10)
+    res = simulate_impact(c, 0.5, 30.0, 0.0, (1e5, 0.0, 0.0))
+    assert res.outcome == "capture" and res.stop_reason == reason
+    assert res.capture_time < math.inf and res.max_penetration > 0.0
+
+
 def test_captured_mindlin_contact_at_a_loose_tolerance_finishes():
     """At rtol 1e-6 and 1e-7 this captured Mindlin impact hit the step limit (CoupledError): the
     integration error held its oscillation at 15-40 rtol, above the fixed settle amplitude 1e-6.

@@ -106,11 +106,12 @@ class ImpactResult:
         Normal contact energy left at the end: 0 for a rebound; for a captured sphere the energy
         V(X) = -(4/15) m (X/T)^2 of the sphere at rest at the equilibrium. [J]
     method : str
-        The solver: "engine", "rkg" or "reference:<scipy method>".
+        The solver: "engine", "engine:coupled (<tangential model>, <friction model>)", "rkg" or
+        "reference:<scipy method>".
     stop_reason : str
         Why the integration stopped: "separation" (rebound), "capture" (the energy test, nothing
-        tangential left), "settled" or "slip and twist ended" (a captured sphere followed for its
-        tangential outcome).
+        tangential left that the rest of the motion could change), "settled" or "slip and twist
+        ended" (a captured sphere followed for its tangential outcome).
     """
 
     outcome: str

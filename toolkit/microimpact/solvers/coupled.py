@@ -86,7 +86,7 @@ from microimpact.model.tangential import stop_impulses, tangential_outcome  # cl
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.engine import _equilibrium, _linear_tail_variation
 
-__all__ = ["coupled_kernel", "coupled_many", "CoupledError"]
+__all__ = ["coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture"]
 
 _acc = compiled(_law.nondimensional_acceleration)
 _energy = compiled(_law.nondimensional_energy)
@@ -600,7 +600,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     # a captured sphere with friction limited at rest and no rolling resistance ends rolling at its
     # angular momentum about the contact point, which the contact force conserves (_rolling_state):
     # nothing after the capture and the largest penetration changes the result
-    conserved = p[6] > 0.5 and p[9] > 0.5 and p[10] == 0.0
+    conserved = p[6] > 0.5 and p[9] > 0.5 and p[10] == 0.0  # stops_at_capture(contact)
     tau_cap = math.nan
     tau_j = math.nan
     smax = 0.0
@@ -738,6 +738,13 @@ SETTLE_PER_RTOL = 1e3
 
 #: default step limit of one impact (the status code _MAX_STEPS is a different name)
 _DEFAULT_MAX_STEPS = 2_000_000
+
+
+def stops_at_capture(contact) -> bool:
+    """Whether a captured impact of ``contact`` ends at its capture (past the largest penetration):
+    a compliant contact with the pulloff limit and no rolling resistance, whose result is then
+    fixed by its angular momentum about the contact point (module docstring)."""
+    return contact.tangential_model != "rigid" and contact.friction_model == "pulloff" and contact.rolling_friction == 0.0
 
 
 def _rolling_state(states, rows, krot):

@@ -365,6 +365,8 @@ def _coupled_results(contact, v_in, w_in, f, rtol) -> dict:
 
 def _coupled_impact_result(contact, v_in, w_in, res) -> ImpactResult:
     """The ImpactResult of one impact of the coupled solver."""
+    from microimpact.solvers.coupled import stops_at_capture
+
     one = {k: (v.item() if isinstance(v, np.ndarray) else v) for k, v in res.items()}
     captured = bool(one["outcome"])
     return ImpactResult(
@@ -379,7 +381,7 @@ def _coupled_impact_result(contact, v_in, w_in, res) -> ImpactResult:
         dissipated_energy=float(one["dissipated_energy"]),
         final_contact_energy=settled_contact_energy(contact) if captured else 0.0,
         method=f"engine:coupled ({contact.tangential_model}, {contact.friction_model})",
-        stop_reason="separation" if not captured else "settled",
+        stop_reason="separation" if not captured else "capture" if stops_at_capture(contact) else "settled",
     )
 
 
