@@ -256,6 +256,25 @@ def test_captured_impacts_reach_their_largest_penetration(speed):
                                                                                             rel=1e-4)
 
 
+@pytest.mark.parametrize("speed, incidence", [(0.001, 75.0), (0.3, 0.0), (1.0, 40.0), (1.4, 10.0), (1.449, 0.0)])
+def test_capture_time_is_where_the_energy_first_fell_below_zero(speed, incidence):
+    """The capture time, by its definition (ImpactResult), against the scipy reference, which has it
+    as an event. The engine's capture test keeps a margin below zero (10 rtol of the well depth,
+    against integration drift) and used to report where E crossed the margin, on the step's
+    interpolant: 2x late for a 0.001 m/s impact, 1e-6 near the capture speed at rtol 1e-9. Now
+    the first zero of E, located on the step itself: 1e-6 at rtol 1e-9 (measured 7e-7 at 0.001
+    m/s and 3.5e-7 at 1.449 m/s, where E falls slowest, 5e-9 elsewhere), 1e-8 at rtol 1e-12."""
+    args = (WALL_1990, speed, incidence, 20.0, (1e5, 0.0, 0.0))
+    ref = mi.simulate_impact(*args, method="reference", rtol=1e-12)
+    assert ref.outcome == "capture"
+    for rtol, tol in ((1e-9, 1e-6), (1e-12, 1e-8)):
+        got = mi.simulate_impact(*args, rtol=rtol)
+        assert got.capture_time == pytest.approx(ref.capture_time, rel=tol)
+        coupled = mi.simulate_impact(WALL_1990.with_(tangential_model="mindlin", shear_modulus=1e10), *args[1:],
+                                     rtol=rtol)
+        assert coupled.capture_time == pytest.approx(ref.capture_time, rel=tol)
+
+
 def test_method_arguments_are_checked():
     with pytest.raises(ValueError, match="method"):
         mi.simulate_impact(WALL_1990, 1.0, method="RK4")

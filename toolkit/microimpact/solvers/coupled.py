@@ -602,6 +602,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     # nothing after the capture and the largest penetration changes the result
     conserved = p[6] > 0.5 and p[9] > 0.5 and p[10] == 0.0  # stops_at_capture(contact)
     tau_cap = math.nan
+    tau_zero = math.nan  # where the energy first fell below zero (the capture time, as the engine's)
     tau_j = math.nan
     smax = 0.0
     n = 0
@@ -661,9 +662,14 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             turned = True
             at_rest = False
         tau_j = _impulse_time(z, z1, j_stop, tau_j, h_end, k1, p, hist)
-        if not captured and damped and aa > 0.0 and _energy(z1[_S], z1[_Y], ah, aa) < ecap:
-            captured = True
-            tau_cap = _root_state(_EV_ENERGY, ecap, h_end, z, z1, k1, p, hist)[_TAU]
+        if not captured and damped and aa > 0.0:
+            e1 = _energy(z1[_S], z1[_Y], ah, aa)
+            if math.isnan(tau_zero) and e1 < 0.0 <= _energy(z[_S], z[_Y], ah, aa):
+                tau_zero = _root_state(_EV_ENERGY, 0.0, h_end, z, z1, k1, p, hist)[_TAU]
+            if e1 < ecap:  # the capture test, with the engine's margin
+                captured = True
+                tau_cap = tau_zero if not math.isnan(tau_zero) else _root_state(
+                    _EV_ENERGY, ecap, h_end, z, z1, k1, p, hist)[_TAU]
         for i in range(_N):
             z[i] = z1[i]
         if at_rest:

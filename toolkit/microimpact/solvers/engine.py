@@ -346,6 +346,29 @@ def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, er
     return hs
 
 
+@njit(cache=True)
+def _energy_crossing(target, u0, k1, h, f0, f1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
+    """Step length in (0, h] at which the contact energy reaches ``target`` (f0, f1: energy less
+    target at the step's ends, opposite signs), by the Illinois method on the step itself rather
+    than on its interpolant; u1 then holds the step to there.
+
+    The time at which E first falls below zero is recorded where E falls slowly (near the capture
+    speed), so a small error of E is a large one of the time: on the cubic Hermite interpolant,
+    as :func:`_locate` finds it, the capture time was 1e-6 off at rtol 1e-9.
+    """
+    a, b = 0.0, h
+    side = 0
+    hs = h
+    for _ in range(60):
+        hs = illinois_point(a, f0, b, f1)
+        _step(u0, k1, hs, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        f = law.nondimensional_energy(u1[0], u1[1], ah, aa) - target
+        if f == 0.0 or (b - a) < 1e-14 * h:
+            break
+        a, f0, b, f1, side = illinois_update(a, f0, b, f1, hs, f, side)
+    return hs
+
+
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 
 
@@ -824,7 +847,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
     xe, omega0, ceq = _equilibrium(c1, c2, ah, aa)
     h = _initial_step(y0)
     J = smax = 0.0
-    tau_capture = tau_jtarget = math.nan
+    tau_capture = tau_jtarget = tau_zero = math.nan  # tau_zero: where E first fell below zero
     captured = turned = False
     outcome, status, n_steps, n_rej, n_rec = -1, _OK, 0, 0, 0
     if rec_cap > 0:
@@ -884,17 +907,23 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 break
         # capture: E below zero by more than the integration can drift (without damping E is
         # conserved, so a negative E could only be integration error); a true capture keeps
-        # losing energy and crosses the margin a little later
+        # losing energy and crosses the margin a little later. The capture time is where E first
+        # fell below zero (the margin's crossing, reported before, was up to 1e-6 later at rtol
+        # 1e-9, where E falls slowly: near the capture speed)
         if not captured and damped and aa > 0.0:
             if recorded:
                 _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 recorded = False
-            e0 = law.nondimensional_energy(u[0], u[1], ah, aa) - ecap
-            e1 = law.nondimensional_energy(u1[0], u1[1], ah, aa) - ecap
-            if e0 >= 0.0 and e1 < 0.0:
-                _locate(_EV_ENERGY, ecap, u, k1, hev, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            e0 = law.nondimensional_energy(u[0], u[1], ah, aa)
+            e1 = law.nondimensional_energy(u1[0], u1[1], ah, aa)
+            if math.isnan(tau_zero) and e0 >= 0.0 and e1 < 0.0:
+                _energy_crossing(0.0, u, k1, hev, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                tau_zero = u1[2]
+                _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            if e0 >= ecap and e1 < ecap:
+                _locate(_EV_ENERGY, ecap, u, k1, hev, e0 - ecap, e1 - ecap, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 captured = True
-                tau_capture = u1[2]
+                tau_capture = u1[2] if math.isnan(tau_zero) else tau_zero
                 recorded = True
         if math.isnan(tau_jtarget) and j_target > 0.0:  # end of sliding
             if recorded:
@@ -953,10 +982,12 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                     tau_jtarget = _slow_event_time(u, xi_t, u[1] + (j_target - J) * (1.0 if y_t > u[1] else -1.0),
                                                    _SLOW_Y, c1, c2, ah, aa)
                 if not captured and aa > 0.0:
+                    if math.isnan(tau_zero):
+                        tau_zero = _slow_event_time(u, xi_t, 0.0, _SLOW_ENERGY, c1, c2, ah, aa)
                     tc = _slow_event_time(u, xi_t, ecap, _SLOW_ENERGY, c1, c2, ah, aa)
                     if not math.isnan(tc):
                         captured = True
-                        tau_capture = tc
+                        tau_capture = tc if math.isnan(tau_zero) else tau_zero
                 J += dj
                 if aa == 0.0:
                     u[4] += u[0] * dj
