@@ -132,30 +132,9 @@ def _step(model, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
         err[i] = h * acc
 
 
-@njit(cache=True)
-def _hermite_max(p0, p1, d0, d1, h):
-    """Largest value of the cubic Hermite interpolant of a step (values p0, p1, slopes d0, d1). [-]"""
-    best = max(p0, p1)
-    # p(th) derivative: 3 A th^2 + 2 B th + C
-    aa = 2.0 * (p0 - p1) + h * (d0 + d1)
-    bb = 3.0 * (p1 - p0) - h * (2.0 * d0 + d1)
-    cc = h * d0
-    disc = bb * bb - 3.0 * aa * cc
-    if aa != 0.0 and disc >= 0.0:
-        for sgn in (-1.0, 1.0):
-            th = (-bb + sgn * math.sqrt(disc)) / (3.0 * aa)
-            if 0.0 < th < 1.0:
-                best = max(best, ((aa * th + bb) * th + cc) * th + p0)
-    elif aa == 0.0 and bb != 0.0:
-        th = -cc / (2.0 * bb)
-        if 0.0 < th < 1.0:
-            best = max(best, (bb * th + cc) * th + p0)
-    return best
-
-
-#: what :func:`_locate` finds: z (the boundary), the contact energy, the friction impulse J;
-#: numpy integers, so that one specialization is compiled for all three
-_EV_Z, _EV_ENERGY, _EV_J = np.int64(0), np.int64(1), np.int64(2)
+#: what :func:`_locate` finds: z (the boundary), the contact energy, the friction impulse J, y
+#: (the largest penetration at y = 0); numpy integers, so that one specialization is compiled for all
+_EV_Z, _EV_ENERGY, _EV_J, _EV_Y = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
 
 
 @njit(cache=True)
@@ -164,6 +143,8 @@ def _event_value(model, kind, u):
         return u[0]
     if kind == _EV_ENERGY:
         return _energy(model, u[0], u[1])
+    if kind == _EV_Y:
+        return u[1]
     return u[4]
 
 
@@ -193,17 +174,19 @@ def _locate(model, kind, target, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
 
 
 @njit(cache=True)
-def _event_time(model, kind, target, u0, u1, k, h, c1, c2, a, b, e):
-    """tau where the event value ``kind`` reaches ``target`` within the accepted step u0 -> u1 of
-    length h, by re-stepping in scratch arrays (the step itself is kept). Linear interpolation
-    of tau, as before, was O(h^2): the slip-end time 1e-4 off at rtol 1e-9, and the capture time
-    (then the step's end) 6 % for DMT and 3x for a slow JKR impact."""
+def _event_state(model, kind, target, u0, u1, k, h, c1, c2, a, b, e):
+    """The state where the event value ``kind`` reaches ``target`` within the accepted step
+    u0 -> u1 of length h, by re-stepping in scratch arrays (the step itself is kept). What it
+    replaced was O(h^2) or O(h^4) in the step: the slip-end time interpolated linearly in J (1e-4
+    off at rtol 1e-9), the capture time at the step's end (6 % for DMT, 3x for a slow JKR
+    impact), the largest penetration as the maximum of the step's cubic Hermite interpolant (2e-8,
+    and its end was wrong where the step also separated)."""
     ks = k.copy()
     us = u1.copy()
     tmp = np.empty(_N)
     err = np.empty(_N)
     _locate(model, kind, target, u0, ks, h, c1, c2, a, b, e, tmp, us, err)
-    return us[2]
+    return us
 
 
 @njit(cache=True)
@@ -265,17 +248,17 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
         if separated:
             _locate(model, _EV_Z, zb, u, k, h, c1, c2, a_, b_, e_, tmp, u1, err)
         if u[1] > 0.0 and u1[1] <= 0.0:
-            zmax = max(zmax, _hermite_max(u[0], u1[0], k[0, 0], k[6, 0], h))
+            zmax = max(zmax, _event_state(model, _EV_Y, 0.0, u, u1, k, h, c1, c2, a_, b_, e_)[0])
             turned = True
         zmax = max(zmax, u1[0])
         if j_target > 0.0 and math.isnan(tau_slip) and u1[4] >= j_target:
-            tau_slip = _event_time(model, _EV_J, j_target, u, u1, k, h, c1, c2, a_, b_, e_)
+            tau_slip = _event_state(model, _EV_J, j_target, u, u1, k, h, c1, c2, a_, b_, e_)[2]
         if not separated and outcome == REBOUND and _energy(model, u1[0], u1[1]) < threshold:
             outcome = CAPTURE
             e_cap = _energy(model, u1[0], u1[1])
             # where the energy fell below the threshold (at the start: captured from first contact)
-            tau_cap = u[2] if _energy(model, u[0], u[1]) < threshold else _event_time(
-                model, _EV_ENERGY, threshold, u, u1, k, h, c1, c2, a_, b_, e_)
+            tau_cap = u[2] if _energy(model, u[0], u[1]) < threshold else _event_state(
+                model, _EV_ENERGY, threshold, u, u1, k, h, c1, c2, a_, b_, e_)[2]
         for i in range(_N):
             u[i] = u1[i]
         for i in range(_N):
