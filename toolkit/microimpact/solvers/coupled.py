@@ -549,8 +549,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     Returns (status, outcome, state at the end (12,), largest xi, tau at capture, tau at which J
     reached j_stop, n_steps).
 
-    Length: set-up, step control, separation, capture, the hysteretic turning points and restarts
-    and the settle test share the loop's state (z, k1, the branch history) and may end or continue
+    Length: set-up, step control, separation, capture, the hysteretic turning points
+    and restarts, the recorded instants (largest penetration, first zero of the energy) and the
+    settle test share the loop's state (z, k1, the branch history) and may end or continue
     the loop; they stay in one compiled loop, as in the engine, where moving the per-step work
     into helpers was measured 1.5x slower (here not measured separately). What runs only at an
     event (the re-step to a root, the end of a step at a zero of the Coulomb limit, at a rolling
@@ -600,7 +601,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     # a captured sphere with friction limited at rest and no rolling resistance ends rolling at its
     # angular momentum about the contact point, which the contact force conserves (_rolling_state):
     # nothing after the capture and the largest penetration changes the result
-    conserved = p[6] > 0.5 and p[9] > 0.5 and p[10] == 0.0  # stops_at_capture(contact)
+    conserved = p[11] > 0.5  # stops_at_capture(contact), column 11 of the parameter rows
     tau_cap = math.nan
     tau_zero = math.nan  # where the energy first fell below zero (the capture time, as the engine's)
     tau_j = math.nan
@@ -824,10 +825,11 @@ def _parameter_rows(contact, sc, c1, c2, f, length, time) -> np.ndarray:
     """The law's parameters of each impact, one row each (the columns of :func:`_rhs`): C1, C2, the
     Hertz and adhesion coefficients, f, the pull-off force, the friction model, the Mindlin
     stiffness, m r^2 / I, the tangential model (0 rigid, 1 Mindlin, 2 Mindlin-Deresiewicz) and
-    mu_r; ``length``, ``time`` the impacts' scales [m], [s]."""
+    mu_r, and 1 where a captured impact ends at its capture (:func:`stops_at_capture`); ``length``,
+    ``time`` the impacts' scales [m], [s]."""
     m, r = contact.mass, contact.radius
     mode = _TANGENTIAL_MODES[contact.tangential_model]
-    p = np.empty((f.size, 11))
+    p = np.empty((f.size, 12))
     p[:, 0] = np.broadcast_to(c1, f.shape)
     p[:, 1] = np.broadcast_to(c2, f.shape)
     p[:, 2], p[:, 3] = sc.a_hertz, sc.a_adhesion
@@ -838,6 +840,7 @@ def _parameter_rows(contact, sc, c1, c2, f, length, time) -> np.ndarray:
     p[:, 8] = m * r * r / contact.moment_of_inertia
     p[:, 9] = mode
     p[:, 10] = contact.rolling_friction
+    p[:, 11] = 1.0 if stops_at_capture(contact) else 0.0
     return p
 
 

@@ -253,9 +253,10 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
         zmax = max(zmax, u1[0])
         if j_target > 0.0 and math.isnan(tau_slip) and u1[4] >= j_target:
             tau_slip = _event_state(model, _EV_J, j_target, u, u1, k, h, c1, c2, a_, b_, e_)[2]
-        if not separated and outcome == REBOUND and _energy(model, u1[0], u1[1]) < threshold:
+        e_now = _energy(model, u1[0], u1[1])
+        if not separated and outcome == REBOUND and e_now < threshold:
             outcome = CAPTURE
-            e_cap = _energy(model, u1[0], u1[1])
+            e_cap = e_now
             # where the energy fell below the threshold (at the start: captured from first contact)
             tau_cap = u[2] if _energy(model, u[0], u[1]) < threshold else _event_state(
                 model, _EV_ENERGY, threshold, u, u1, k, h, c1, c2, a_, b_, e_)[2]
@@ -265,7 +266,6 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
             k[0, i] = k[6, i]
         if separated:
             break
-        e_now = _energy(model, u[0], u[1])
         if outcome == CAPTURE:
             # settled: oscillation amplitude below tail_tol (energy ratio floored at 1e-14, above
             # the round-off of the energy near the bottom of the well)
