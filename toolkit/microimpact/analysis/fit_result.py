@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from microimpact.analysis.identifiability import status_from_variables, status_variables
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.materials import material_contact
 from microimpact.io.provenance import fit_parameter_source, stamp_parameters
@@ -66,8 +67,13 @@ class DampingFit:
     scale_covar : bool
         Whether the covariance was scaled by the reduced chi-square.
     info : dict
-        nfev, success, message, method, rtol, elapsed_s, source, sha256, material_pair,
-        ci_message.
+        nfev, success (True only where the least squares converged AND the data determine every
+        varied parameter), message, method, rtol, elapsed_s, source, sha256, material_pair,
+        ci_message, outside_physical_range (number of measured e_n kept outside [0, 1]).
+    identifiability : dict
+        ``{name: ParameterStatus}`` of each varied parameter: a value with its 95 % interval, a
+        one-sided bound, or not determined (:mod:`microimpact.analysis.identifiability`). Empty for
+        a fit file written before it existed.
     """
 
     values: dict
@@ -88,6 +94,12 @@ class DampingFit:
     weighting: str = "none"
     scale_covar: bool = True
     info: dict = field(default_factory=dict)
+    identifiability: dict = field(default_factory=dict)
+
+    @property
+    def determined(self) -> bool:
+        """True where the data determine every varied parameter (a value with a two-sided interval)."""
+        return all(st.determined for st in self.identifiability.values())
 
     # convenient accessors
     @property
@@ -174,8 +186,13 @@ class DampingFit:
             ds[f"{name}_confidence_limit"] = xr.DataArray(
                 np.array([ci.get(s, np.nan) for s in SIGMA_LEVELS], dtype=float), dims=("sigma_level",),
                 attrs={"units": units, "long_name": f"lmfit.conf_interval limit of {name}"})
+        for name, st in self.identifiability.items():
+            ds.update(status_variables(st, attributes(name)["units"]))
         ds["correlation"] = xr.DataArray(self.correlation, dims=("parameter", "parameter_b"),
                                          attrs=attributes("correlation"))
+        if "id" in d.columns:
+            ds["id"] = xr.DataArray(d["id"].to_numpy(dtype=str).astype(object), dims=("point",),
+                                    attrs={"long_name": "the id column of the impact CSV"})
         for col in ("row", "radius", "normal_speed", "e_n", "sigma", "model", "residual"):
             values = d[col].to_numpy(dtype=np.int64 if col == "row" else float)
             name = {"e_n": "e_n_measured", "model": "e_n_model"}.get(col, col)
@@ -217,6 +234,9 @@ class DampingFit:
             "normal_speed": ds["normal_speed"].values, "e_n": ds["e_n_measured"].values,
             "sigma": ds["sigma"].values, "model": ds["e_n_model"].values, "residual": ds["residual"].values,
         })
+        if "id" in ds:
+            data.insert(1, "id", ds["id"].values.astype(str))
+        statuses = {n: status_from_variables(ds, n, values[n]) for n in varied}
         ref = a.get("damping_reference_speed")
         info = {k.removeprefix("fit_"): (v.item() if hasattr(v, "item") else v) for k, v in a.items() if k.startswith("fit_")}
         return cls(values=values, stderr=stderr, varied=varied, correlation=np.array(ds["correlation"].values, dtype=float),
@@ -224,7 +244,8 @@ class DampingFit:
                    bic=float(a["bic"]), n_points=int(a["n_points"]), data=data, density=float(a["density"]),
                    stiffness=float(a["stiffness"]), friction=float(a["friction"]),
                    damping_reference_speed=None if isinstance(ref, str) else float(ref),
-                   weighting=str(a["weighting"]), scale_covar=bool(int(a["scale_covar"])), info=info)
+                   weighting=str(a["weighting"]), scale_covar=bool(int(a["scale_covar"])), info=info,
+                   identifiability={n: st for n, st in statuses.items() if st is not None})
 
     @classmethod
     def load(cls, path) -> "DampingFit":
@@ -281,6 +302,10 @@ def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
         if name not in fit.varied:
             rows.append(row | {"stderr": "fixed", "method": "fixed (given material)"})
             continue
+        st = fit.identifiability.get(name)
+        if st is not None and not st.determined:
+            rows.append(row | {"value": _bound_text(st), "stderr": "not determined", "method": st.reason})
+            continue
         ci = fit.confidence_intervals.get(name, {})
         if all(math.isfinite(ci.get(k, math.nan)) for k in (-1, 1, -2, 2)):
             ci1, ci2, method = (ci[-1], ci[1]), (ci[-2], ci[2]), "profile likelihood (lmfit.conf_interval)"
@@ -294,6 +319,15 @@ def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
             "ci1": f"[{ci1[0]:.5g}, {ci1[1]:.5g}]" if ci1 else "",
             "ci2": f"[{ci2[0]:.5g}, {ci2[1]:.5g}]" if ci2 else "", "method": method})
     return pd.DataFrame(rows, columns=list(PARAMETER_TABLE_COLUMNS))
+
+
+def _bound_text(st) -> str:
+    """The cell of a parameter the data do not determine: its bound, or 'not determined'."""
+    if st.status == "lower_bound":
+        return f">= {st.lower:.4g} (95 % bound)"
+    if st.status == "upper_bound":
+        return f"<= {st.upper:.4g} (95 % bound)"
+    return "not determined"
 
 
 def _fit_facts(fit: "DampingFit") -> dict:
@@ -317,6 +351,8 @@ def _fit_facts(fit: "DampingFit") -> dict:
         "evaluations": f"{fit.info.get('nfev', '?')} ({fit.info.get('elapsed_s', math.nan):.2f} s), "
                        f"{fit.info.get('message', '')}",
         "note": fit.info.get("ci_message") or None,
+        "measurements": (f"{fit.info['outside_physical_range']} measured e_n outside [0, 1] within their stated "
+                         "uncertainty, fitted as measured" if fit.info.get("outside_physical_range") else None),
     }
     return {k: v for k, v in facts.items() if v is not None}
 
@@ -359,13 +395,17 @@ def format_fit(fit: "DampingFit", style: str = "text") -> str:
         if r["stderr"] == "fixed":
             lines.append(f"    {r['parameter']:<17}= {r['value']} (fixed) [{r['units']}]")
             continue
+        if r["stderr"] == "not determined":
+            lines.append(f"    {r['parameter']:<17}: {r['value']} [{r['units']}]: not determined by these data "
+                         f"({r['method']})")
+            continue
         rel = f" ({r['relative']})" if r["relative"] else ""
         how = "" if r["method"].startswith("profile") else f" ({r['method']})"
         ci = f"; 1-sigma CI {r['ci1']}, 2-sigma CI {r['ci2']}{how}" if r["ci1"] else ""
         lines.append(f"    {r['parameter']:<17}= {r['value']} +/- {r['stderr']}{rel} [{r['units']}]{ci}")
     if facts["correlations"]:
         lines += ["  correlations:"] + [f"    {c}" for c in facts["correlations"]]
-    for label in ("chi-square", "AIC, BIC", "evaluations", "note"):
+    for label in ("chi-square", "AIC, BIC", "evaluations", "note", "measurements"):
         if label in facts:
             lines.append(f"  {label:<12}: {facts[label]}")
     return "\n".join(lines)

@@ -48,6 +48,7 @@ import numpy as np
 import pandas as pd
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit, fit_parameter_table, format_fit
+from microimpact.io.impacts import MEASUREMENT_TOLERANCE_SIGMAS
 from microimpact.io.materials import material_contact
 from microimpact.io.progress import progress_bar
 from microimpact.model.contact import Contact
@@ -211,16 +212,22 @@ def _table_arrays(table):
             raise ValueError(f"{src}: the table mixes material pairs ({', '.join(pairs)}); fit one pair at a time "
                              "(e.g. microimpact fit --material-pair NAME)")
     out = {}
-    for col in ("radius", "normal_speed", "e_n"):
-        x = df[col].to_numpy(dtype=float)
-        bad = ~np.isfinite(x) | ((x <= 0) if col != "e_n" else (x < 0) | (x > 1))
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            raise ValueError(f"{src}: row {rows[i]}, column {col!r}: value {x[i]!r} cannot be fitted "
-                             f"({'must be finite and > 0' if col != 'e_n' else 'e_n must lie in [0, 1]'})")
-        out[col] = x
     for col in ("e_n_uncertainty", "normal_speed_uncertainty"):
         out[col] = df[col].to_numpy(dtype=float) if col in df.columns else np.full(len(df), np.nan)
+    # a measured e_n outside [0, 1] by no more than the reader's tolerance of its stated uncertainty
+    # is a measurement and is fitted as measured (the model side stays in [0, 1])
+    allowance = MEASUREMENT_TOLERANCE_SIGMAS * np.nan_to_num(out["e_n_uncertainty"], nan=0.0).clip(min=0.0)
+    for col in ("radius", "normal_speed", "e_n"):
+        x = df[col].to_numpy(dtype=float)
+        bad = ~np.isfinite(x) | ((x <= 0) if col != "e_n" else (x < -allowance) | (x > 1 + allowance))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            rule = ("must be finite and > 0" if col != "e_n" else
+                    f"e_n must lie in [0, 1], or outside it by at most {MEASUREMENT_TOLERANCE_SIGMAS:g} stated standard "
+                    f"uncertainties (here {allowance[i] / MEASUREMENT_TOLERANCE_SIGMAS:.3g})")
+            raise ValueError(f"{src}: row {rows[i]}, column {col!r}: value {x[i]!r} cannot be fitted ({rule})")
+        out[col] = x
+    out["outside"] = int(np.count_nonzero((out["e_n"] < 0) | (out["e_n"] > 1)))
     return df, rows, out, src
 
 
@@ -384,12 +391,15 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
         cis, ci_message = _confidence_intervals(mini, result, confidence_intervals)
         advance(1)
 
+    outside = arr["outside"]
     p = result.params.valuesdict()
     model = damping_residual(p, problem, rtol=rtol)
     sig_used = np.ones_like(e_n) if sigma is None else np.asarray(sigma, dtype=float)
     data = pd.DataFrame({"row": rows, "radius": arr["radius"], "normal_speed": arr["normal_speed"],
                          "e_n": e_n, "sigma": sig_used if sigma is not None else np.full_like(e_n, np.nan),
                          "model": model, "residual": (model - e_n) / sig_used})
+    if "id" in df.columns:
+        data.insert(1, "id", df["id"].astype("string").fillna("").to_numpy(dtype=object).astype(str))
     labels = df["material_pair"].dropna().unique() if "material_pair" in df.columns else ()
     info = {"nfev": int(nfev + n), "success": bool(result.success), "message": str(result.message),
             "method": "coarse log grid + lmfit leastsq", "rtol": float(rtol),
@@ -397,13 +407,94 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
             "sha256": df.attrs.get("sha256"), "material_pair": str(labels[0]) if len(labels) == 1 else None,
             "ci_message": ci_message or None}
     varied = tuple(n for n in PARAMETER_NAMES if result.params[n].vary)
+    identifiability = damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline)
+    info["success"] = bool(result.success) and all(st.determined for st in identifiability.values())
+    if not info["success"] and result.success:
+        info["message"] = ("least squares converged, but the data do not determine "
+                           + ", ".join(n for n, st in identifiability.items() if not st.determined))
+    info["outside_physical_range"] = outside
     return DampingFit(values={n: float(result.params[n].value) for n in PARAMETER_NAMES},
                       stderr={n: _stderr(result.params[n]) for n in PARAMETER_NAMES}, varied=varied,
                       correlation=_correlation(result.params, varied), confidence_intervals=cis,
                       chisqr=float(result.chisqr), redchi=float(result.redchi), aic=float(result.aic),
                       bic=float(result.bic), n_points=int(e_n.size), data=data, density=density,
                       stiffness=stiffness, friction=friction, damping_reference_speed=vref,
-                      weighting=weighting, scale_covar=bool(scale_covar), info=info)
+                      weighting=weighting, scale_covar=bool(scale_covar), info=info,
+                      identifiability=identifiability)
+
+
+#: allowed range of each damping parameter, searched by the profile where the covariance cannot
+#: bound it (w_A relative to its start value): zeta_H of 1e3 or zeta_A of 1e4 damp every impact of
+#: the model to capture, so a profile flat up to there is flat for good
+DAMPING_RANGES = {"zeta_hertz": (0.0, 1e3), "zeta_adhesion": (0.0, 1e4), "work_of_adhesion": (1e-3, 1e2)}
+#: points of a damping parameter's profile (log-spaced over its range, plus 0 and the estimate)
+DAMPING_PROFILE_POINTS = 33
+
+
+def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline=Deadline.start(None, "fit")) -> dict:
+    """What the data determine about each varied damping parameter (:mod:`microimpact.analysis.identifiability`).
+
+    The covariance interval value +/- 1.96 stderr is used where it lies inside the parameter's range
+    (:data:`DAMPING_RANGES`); where it reaches a limit of the range, or the standard error is missing
+    or above 100 %, the chi-square profile over the whole range (the other parameters re-fitted at
+    each point) decides: an interval, a one-sided bound, or not determined.
+
+    Parameters
+    ----------
+    problem : FitProblem
+    e_n : numpy.ndarray
+        Measured e_n. [-]
+    sigma : numpy.ndarray or None
+        Uncertainties used by the fit (None: unweighted). [-]
+    result : lmfit.minimizer.MinimizerResult
+        The least-squares fit.
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+    scale_covar : bool
+        Whether chi-square is scaled by the reduced chi-square (unweighted fits).
+    deadline : Deadline
+
+    Returns
+    -------
+    dict
+        ``{name: ParameterStatus}`` for each varied parameter.
+    """
+    from microimpact.analysis.identifiability import parameter_status
+
+    out = {}
+    varied = [n for n in PARAMETER_NAMES if result.params[n].vary]
+    dof = max(e_n.size - len(varied), 1)
+    scale = max(result.chisqr / dof, 1e-300) if scale_covar else 1.0
+    for name in varied:
+        value, se = float(result.params[name].value), _stderr(result.params[name])
+        lo, hi = DAMPING_RANGES[name]
+        if name == "work_of_adhesion":
+            lo, hi = lo * value, hi * value
+        st = parameter_status(name, value, se, lo, hi)
+        if st.determined:
+            out[name] = st
+            continue
+        grid = np.unique(np.concatenate([[lo, value], np.geomspace(max(lo, 1e-4 * (hi - lo)), hi, DAMPING_PROFILE_POINTS)]))
+        chi2 = np.array([_profiled_chi2(problem, e_n, sigma, result.params, name, x, rtol, deadline) for x in grid])
+        reasons = {"not_determined": f"chi-square changes by less than the 95 % threshold over {name} in [{lo:.3g}, {hi:.3g}]",
+                   "lower_bound": f"the e_n data are as well explained by any larger {name}",
+                   "upper_bound": f"the e_n data are as well explained by any smaller {name}, down to {lo:.3g}"}
+        out[name] = parameter_status(name, value, se, lo, hi, profile=(grid, chi2 / scale), reasons=reasons)
+    return out
+
+
+def _profiled_chi2(problem, e_n, sigma, best, name, x, rtol, deadline) -> float:
+    """Chi-square with ``name`` held at ``x`` and the other varied parameters re-fitted."""
+    params = best.copy()
+    params[name].set(value=x, vary=False)
+    others = [n for n in PARAMETER_NAMES if params[n].vary]
+    if not others:
+        r = damping_residual(params, problem, e_n, sigma, rtol=rtol)
+        return float(r @ r)
+    mini = lmfit.Minimizer(damping_residual, params, fcn_args=(problem,), fcn_kws={"e_n": e_n, "sigma": sigma, "rtol": rtol},
+                           iter_cb=deadline.iter_cb(f"the profile of {name}"))
+    res = mini.minimize(method="leastsq", max_nfev=200)
+    return float(res.chisqr)
 
 
 #: points of a large data set that represent it on the start grid (:func:`_grid_start`)

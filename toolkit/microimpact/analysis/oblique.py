@@ -64,6 +64,9 @@ PARAMETER_BOUNDS: dict[str, tuple] = {"friction": (np.geomspace(0.01, 2.0, 12), 
 #: the fitted observables and their units
 OBSERVABLE_UNITS = {"tangential_restitution": "1", "rebound_tangential_speed": "m s-1", "rebound_angle_deg": "degree",
                     "rebound_spin": "rad s-1"}
+#: log-spaced points of the friction profile over PARAMETER_BOUNDS["friction"] (every entry's rolling
+#: threshold is added to them): 400 resolve chi-square's curvature at f ~ 0.01-1 to < 2 % of f
+PROFILE_POINTS = 400
 _H_SPEED = 1e-4  # relative step of the speed slope [-]
 _H_ANGLE = 0.05  # step of the angle slope [deg]
 
@@ -85,6 +88,8 @@ class ObliqueProblem:
     sigma_speed, sigma_angle : numpy.ndarray
         Incident speed [m/s] and angle [deg] uncertainties (0 where not stated).
     source : str
+    ids : numpy.ndarray or None
+        The CSV's ``id`` of each entry, where the table has that column.
     """
 
     rows: np.ndarray
@@ -98,6 +103,7 @@ class ObliqueProblem:
     sigma_speed: np.ndarray
     sigma_angle: np.ndarray
     source: str = "impact table"
+    ids: np.ndarray | None = None
 
     @classmethod
     def from_table(cls, table: pd.DataFrame) -> "ObliqueProblem":
@@ -140,7 +146,7 @@ class ObliqueProblem:
                    radius=col("radius")[idx], speed=speed[idx], incidence_deg=inc[idx], spin=zero(col("spin")[idx]),
                    measured=np.concatenate([p[2] for p in parts]), sigma_measured=np.concatenate([p[3] for p in parts]),
                    sigma_speed=zero(col("speed_uncertainty")[idx]), sigma_angle=zero(col("incidence_deg_uncertainty")[idx]),
-                   source=src)
+                   source=src, ids=table["id"].to_numpy()[idx].astype(str) if "id" in table.columns else None)
 
     @property
     def size(self) -> int:
@@ -167,12 +173,72 @@ def _observables(out: dict, speed, incidence_deg, quantity) -> np.ndarray:
     return res
 
 
+def normal_impulses(contact, speed, incidence_deg, rtol: float = DEFAULT_RTOL) -> dict:
+    """The friction-independent half of :func:`rebound_state`: the normal solve of each impact.
+
+    The normal motion does not depend on friction (model-notes section 4), so a friction fit
+    solves it once per impact and evaluates the closed-form tangential map for every trial f.
+
+    Parameters
+    ----------
+    contact : Contact
+    speed, incidence_deg : numpy.ndarray
+        Incident speed [m/s] and angle from the normal [deg].
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+
+    Returns
+    -------
+    dict of arrays: ``captured`` (bool), ``e_n`` [-], ``velocity_in_n``, ``velocity_in_t`` [m/s],
+    ``friction_impulse`` [N s], ``twist_impulse`` [N m s].
+    """
+    from microimpact.solvers import engine
+
+    a = np.radians(incidence_deg)
+    vn, vt = speed * np.cos(a), speed * np.sin(a)
+    speeds, inverse = np.unique(vn, return_inverse=True)  # one solve per distinct normal speed
+    sol = {k: v[inverse] for k, v in engine.solve_normal_many(contact, speeds, rtol=rtol).items()}
+    return {"captured": sol["captured"], "e_n": sol["e_n"], "velocity_in_n": vn, "velocity_in_t": vt,
+            "friction_impulse": sol["friction_impulse"], "twist_impulse": sol["twist_impulse"]}
+
+
+def rebound_from_impulses(contact, impulses: dict, spin, friction=None) -> dict:
+    """The closed-form half of :func:`rebound_state`, Eqs. (16)-(20), for the normal solve ``impulses``.
+
+    Parameters
+    ----------
+    contact : Contact
+    impulses : dict
+        From :func:`normal_impulses`.
+    spin : numpy.ndarray
+        Incident top-spin (omega_t' = -spin). [rad/s]
+    friction : float or numpy.ndarray, optional
+        Coulomb coefficient(s) replacing the contact's. [-]
+
+    Returns
+    -------
+    dict of arrays, as :func:`rebound_state`.
+    """
+    from microimpact.model.tangential import tangential_outcome
+
+    vn, vt = impulses["velocity_in_n"], impulses["velocity_in_t"]
+    zero = np.zeros_like(vn)
+    f = contact.friction if friction is None else friction
+    tan = tangential_outcome(contact.mass, contact.moment_of_inertia, contact.radius, f, (-vn, vt, zero),
+                             (zero, zero, -spin), impulses["friction_impulse"], impulses["twist_impulse"])
+    captured = impulses["captured"]
+    return {"captured": captured, "velocity_out_n": np.where(captured, 0.0, impulses["e_n"] * vn),
+            "velocity_out_t": tan["v_t"], "omega_out_n": tan["omega_n"], "omega_out_t": tan["omega_t"],
+            "omega_out_tp": tan["omega_tp"]}
+
+
 def rebound_state(contact, speed, incidence_deg, spin, rtol: float = DEFAULT_RTOL) -> dict:
     """Rebound velocity and spin of impacts in the incidence plane, as :func:`microimpact.simulate_many`.
 
     The fast path of the fits: one :func:`microimpact.solvers.engine.solve_normal_many` call (the
-    impulses J, J_a) and the closed-form tangential map :func:`microimpact.model.tangential.tangential_outcome`
-    -- the two halves of ``simulate_many`` without its Dataset (a test checks they agree).
+    impulses J, J_a, :func:`normal_impulses`) and the closed-form tangential map
+    :func:`microimpact.model.tangential.tangential_outcome` (:func:`rebound_from_impulses`) -- the
+    two halves of ``simulate_many`` without its Dataset (a test checks they agree).
 
     Parameters
     ----------
@@ -187,19 +253,7 @@ def rebound_state(contact, speed, incidence_deg, spin, rtol: float = DEFAULT_RTO
     dict of arrays: ``captured`` (bool), ``velocity_out_n``, ``velocity_out_t`` [m/s],
     ``omega_out_n``, ``omega_out_t``, ``omega_out_tp`` [rad/s].
     """
-    from microimpact.model.tangential import tangential_outcome
-    from microimpact.solvers import engine
-
-    a = np.radians(incidence_deg)
-    vn, vt = speed * np.cos(a), speed * np.sin(a)
-    speeds, inverse = np.unique(vn, return_inverse=True)  # one solve per distinct normal speed
-    sol = {k: v[inverse] for k, v in engine.solve_normal_many(contact, speeds, rtol=rtol).items()}
-    zero = np.zeros_like(vn)
-    tan = tangential_outcome(contact.mass, contact.moment_of_inertia, contact.radius, contact.friction,
-                             (-vn, vt, zero), (zero, zero, -spin), sol["friction_impulse"], sol["twist_impulse"])
-    return {"captured": sol["captured"], "velocity_out_n": np.where(sol["captured"], 0.0, sol["e_n"] * vn),
-            "velocity_out_t": tan["v_t"], "omega_out_n": tan["omega_n"], "omega_out_t": tan["omega_t"],
-            "omega_out_tp": tan["omega_tp"]}
+    return rebound_from_impulses(contact, normal_impulses(contact, speed, incidence_deg, rtol), spin)
 
 
 def oblique_model(problem: ObliqueProblem, contact_of, parameters: dict, *, speed=None, incidence_deg=None,
@@ -275,7 +329,14 @@ class FrictionFit:
         ``row``, ``quantity``, ``radius`` [m], ``speed`` [m/s], ``incidence_deg`` [deg], ``measured``,
         ``sigma`` (effective), ``model``, ``residual`` ((model - measured)/sigma).
     info : dict
-        ``nfev``, ``elapsed_s``, ``source``, ``method``, ``damping_gradient``.
+        ``nfev``, ``elapsed_s``, ``source``, ``method``, ``damping_gradient``, ``rolling_above``
+        (every entry rolls for f above it), ``sliding_below`` (every entry slides below it),
+        ``success`` (True only where f is determined).
+    identifiability : dict
+        ``{"friction": ParameterStatus}``: whether the data determine f (value and 95 % interval),
+        bound it from one side, or cannot tell it (:mod:`microimpact.analysis.identifiability`).
+        Where f is not determined, ``values`` holds the least-chi-square point of the profile (a
+        point of a flat region, not an estimate) and ``stderr`` NaN.
     """
 
     values: dict
@@ -288,18 +349,31 @@ class FrictionFit:
     weighted: bool
     data: pd.DataFrame
     info: dict = field(default_factory=dict)
+    identifiability: dict = field(default_factory=dict)
 
     @property
     def friction(self) -> float:
-        """Fitted Coulomb coefficient f. [-]"""
+        """Fitted Coulomb coefficient f (where not determined: a point of the flat region). [-]"""
         return self.values["friction"]
 
+    @property
+    def determined(self) -> bool:
+        """True where the data determine every fitted tangential parameter."""
+        return all(st.determined for st in self.identifiability.values())
+
     def report(self) -> str:
-        """Plain-text summary."""
+        """Plain-text summary: a value with its interval only where the data determine it."""
         lines = [f"Friction fit ({self.tangential_model} tangential model, Eqs. (16)-(20)), after the damping fit"]
         for k, v in self.values.items():
+            st = self.identifiability.get(k)
+            if st is not None and not st.determined:
+                lines.append(f"  {k:<17}: {st.describe()}")
+                continue
             lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr[k]:.3g} (with the damping uncertainty; "
                          f"{self.stderr_conditional[k]:.3g} at fixed damping)")
+            if st is not None:
+                lines.append(f"  {'':<17}  95 % interval [{st.lower:.6g}, {st.upper:.6g}] ({st.method}, damping "
+                             "uncertainty included)")
         qs = ", ".join(f"{q} ({int((self.data['quantity'] == q).sum())})" for q in dict.fromkeys(self.data["quantity"]))
         lines.append(f"  data        : {self.n_points} entries: {qs}; "
                      f"{'stated uncertainties + effective variance' if self.weighted else 'unweighted'}")
@@ -310,6 +384,10 @@ class FrictionFit:
         """CF form: scalar ``friction`` (+ ``friction_stderr``) and the entries along ``entry``."""
         d = self.data
         ds = xr.Dataset(coords={"entry": ("entry", np.arange(len(d)), {"long_name": "index of the fitted oblique entry"})})
+        from microimpact.analysis.identifiability import status_variables
+
+        for st in self.identifiability.values():
+            ds.update(status_variables(st, "1"))
         for k, v in self.values.items():
             ds[k] = xr.DataArray(v, attrs={"units": "1", "long_name": f"fitted {k} ({self.tangential_model} tangential model)"})
             ds[f"{k}_stderr"] = xr.DataArray(self.stderr[k], attrs={
@@ -317,6 +395,8 @@ class FrictionFit:
             ds[f"{k}_stderr_conditional"] = xr.DataArray(self.stderr_conditional[k], attrs={
                 "units": "1", "long_name": f"standard error of {k} at the fitted damping"})
         ds["row"] = ("entry", d["row"].to_numpy(dtype=np.int64), {"units": "1", "long_name": "data row in the impact CSV"})
+        if "id" in d.columns:
+            ds["id"] = ("entry", d["id"].to_numpy(dtype=str).astype(object), {"long_name": "the id column of the impact CSV"})
         ds["quantity"] = ("entry", d["quantity"].to_numpy(dtype=str).astype(object), {"long_name": "measured quantity"})
         for c, ln in (("radius", ("m", "sphere radius")), ("speed", ("m s-1", "incident speed")),
                       ("incidence_deg", ("degree", "incidence angle from the surface normal"))):
@@ -377,7 +457,8 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
     rtol : float
         Relative tolerance of the normal solves. [-]
     propagate_damping : bool
-        Add the damping covariance to the standard error (two refits per damping parameter).
+        Add the damping covariance to the standard error and the interval (two refits per damping
+        parameter).
     progress : bool
         Progress bar on stderr (a terminal only).
     time_budget : float or Deadline, optional
@@ -386,6 +467,8 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
     Returns
     -------
     FrictionFit
+        With :attr:`FrictionFit.identifiability`: whether the data determine f, bound it from one
+        side (``f >= f_r`` where every impact ends in rolling above f_r) or cannot tell it.
 
     Raises
     ------
@@ -394,6 +477,21 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
         a ``time_budget`` that is not a number > 0.
     TimeBudgetExceeded
         The fit ran past ``time_budget``; the message says how far it got.
+
+    Notes
+    -----
+    The objective is piecewise in f: an impact slides throughout (its rebound depends on f) below
+    its rolling threshold f*_i = 2 m |u_0| / (7 J_i) (:mod:`microimpact.model.tangential`) and rolls
+    above it (no dependence on f). A local least-squares step started where every impact rolls stops
+    at once on the flat part. The fit therefore profiles chi-square over the whole range
+    ``PARAMETER_BOUNDS["friction"]`` on a grid that contains every f*_i (the normal solves do not
+    depend on f, so each grid point is one closed-form map), refines the least chi-square by a
+    bounded scalar search between its grid neighbours, and polishes it with lmfit's ``leastsq``
+    (kept only if it does not raise chi-square). The interval is the profile-likelihood interval
+    (chi-square within :func:`~microimpact.analysis.identifiability.chi2_threshold` of its least
+    value; scaled by the reduced chi-square when no uncertainties are stated), widened in quadrature
+    by the damping uncertainty (delta method, g^T Cov(zeta) g with g = d f_hat / d zeta from refits at
+    zeta +/- one standard error).
     """
     import lmfit  # only when fitting
 
@@ -406,104 +504,230 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
         raise ValueError(f"tangential_model {model_name!r} has no fitted parameters registered; add them to "
                          f"microimpact.analysis.oblique.TANGENTIAL_PARAMETERS (known: {', '.join(TANGENTIAL_PARAMETERS)})")
     names = TANGENTIAL_PARAMETERS[model_name]
+    if names != ("friction",):  # the profile below is the rigid law's closed form in f
+        raise ValueError(f"tangential_model {model_name!r}: only the Coulomb coefficient of the rigid law is fitted "
+                         "from oblique data; add a profile for its parameters in microimpact.analysis.oblique")
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
     n_var = len(damping_fit.varied) if propagate_damping else 0
     with progress_bar(3 + 2 * n_var, "friction fit", progress) as advance, engine_threads(1):
-        best, sigma, nfev = _fit_tangential(problem, contact_of, names, weighted, rtol, lmfit, deadline=deadline)
+        objective = _FrictionObjective(problem, contact_of, weighted, rtol)
+        deadline.check("the normal solves of the friction fit")
+        best = _profile_fit(objective, lmfit, deadline)
         advance(3)
         gradient = {}
-        cond = {k: best.params[k].stderr if best.params[k].stderr is not None else math.nan for k in names}
-        var = {k: cond[k] ** 2 for k in names}
-        if propagate_damping:
-            gradient = _damping_gradient(problem, damping_fit, names, best, sigma, rtol, lmfit, advance, deadline)
+        var_damping = 0.0
+        if propagate_damping and damping_fit.varied:
+            gradient = _damping_gradient(problem, damping_fit, best.value, weighted, rtol, lmfit, advance, deadline)
             cov = _damping_covariance(damping_fit)
-            for k in names:
-                g = np.array([gradient[k][p] for p in damping_fit.varied])
-                var[k] += float(g @ cov @ g)
-    p = {k: float(best.params[k].value) for k in names}
-    model = oblique_model(problem, contact_of, p, rtol=rtol)
+            g = np.array([gradient["friction"][p] for p in damping_fit.varied])
+            var_damping = float(g @ cov @ g) if np.all(np.isfinite(g)) else math.nan
+    status = _friction_status(best, objective, var_damping)
+    p = {"friction": float(best.value)}
+    sigma = objective.sigma(best.value)
+    model = objective.model(best.value)
     data = pd.DataFrame({"row": problem.rows, "quantity": problem.quantity.astype(str), "radius": problem.radius,
                          "speed": problem.speed, "incidence_deg": problem.incidence_deg, "measured": problem.measured,
                          "sigma": sigma, "model": model, "residual": (model - problem.measured) / sigma})
-    return FrictionFit(values=p, stderr={k: math.sqrt(var[k]) for k in names}, stderr_conditional=cond,
-                       tangential_model=model_name, chisqr=float(best.chisqr), redchi=float(best.redchi),
+    if problem.ids is not None:
+        data.insert(1, "id", problem.ids)
+    cond = best.stderr if status.determined else math.nan
+    total = math.sqrt(cond ** 2 + var_damping) if status.determined else math.nan
+    dof = max(problem.size - 1, 1)
+    return FrictionFit(values=p, stderr={"friction": total}, stderr_conditional={"friction": cond},
+                       tangential_model=model_name, chisqr=float(best.chisqr), redchi=float(best.chisqr / dof),
                        n_points=problem.size, weighted=weighted, data=data,
-                       info={"nfev": nfev, "elapsed_s": time.perf_counter() - t0, "source": problem.source,
-                             "method": "grid start + lmfit leastsq, effective variance re-weighted twice",
-                             "damping_gradient": gradient})
+                       info={"nfev": best.nfev, "elapsed_s": time.perf_counter() - t0, "source": problem.source,
+                             "method": "chi-square profile over the whole range of f (every rolling threshold a grid "
+                                       "point), bounded refinement, lmfit leastsq polish",
+                             "damping_gradient": gradient, "rolling_above": best.rolling_above,
+                             "sliding_below": best.sliding_below,
+                             "success": status.determined},
+                       identifiability={"friction": status})
 
 
-def _residual(params, problem, contact_of, names, measured, sigma, rtol):
-    p = {k: params[k].value for k in names}
-    model = oblique_model(problem, contact_of, p, rtol=rtol)
-    return np.nan_to_num((model - measured) / sigma, nan=1e3)  # a captured model: far from any rebound
+# --------------------------------------------------------------------------- the friction profile
+class _FrictionObjective:
+    """Chi-square of the friction fit as a function of f, from normal solves made once.
 
+    The normal solve of every entry (and of its speed and angle perturbations, for the effective
+    variance) does not depend on f; each trial f is the closed-form tangential map only.
+    """
 
-def _fit_tangential(problem, contact_of, names, weighted, rtol, lmfit, start=None, deadline=Deadline.start(None, "")):
-    """(lmfit result, effective sigma, evaluations): grid start (first parameter), leastsq, two re-weightings."""
-    sig0 = problem.sigma_measured if weighted else np.ones(problem.size)
-    nfev = 0
-    if start is None:
-        grid, _, _ = PARAMETER_BOUNDS[names[0]]
-        chi = []
-        for g in grid:
-            r = _residual({names[0]: _Value(g)}, problem, contact_of, names[:1], problem.measured, sig0, rtol)
-            chi.append(float(r @ r))
-            deadline.check(f"{len(chi)} of {len(grid)} start-grid points")
-        nfev += len(grid)
-        start = {names[0]: float(grid[int(np.argmin(chi))])}
-    params = lmfit.Parameters()
-    for k in names:
-        _, lo, hi = PARAMETER_BOUNDS[k]
-        params.add(k, value=start[k], min=lo, max=hi)
-    sigma = sig0
-    for it in range(3):
-        mini = lmfit.Minimizer(_residual, params, fcn_args=(problem, contact_of, names, problem.measured, sigma, rtol),
-                               scale_covar=not weighted, iter_cb=deadline.iter_cb(f"least-squares round {it + 1}"))
-        res = mini.minimize(method="leastsq")
-        nfev += res.nfev
-        if not weighted or it == 2:
-            break
-        sigma = effective_sigma(problem, contact_of, {k: res.params[k].value for k in names}, rtol)
-        params = res.params
-    return res, sigma, nfev
+    def __init__(self, problem, contact_of, weighted, rtol):
+        self.problem, self.weighted = problem, weighted
+        self.radii = np.unique(problem.radius)
+        self.contacts = {float(r): contact_of(float(r)) for r in self.radii}
+        v, a = problem.speed, problem.incidence_deg
+        self.states = {"nominal": self._solve(v, a, rtol)}
+        if weighted and np.any(problem.sigma_speed > 0):
+            self.states["v+"] = self._solve(v * (1 + _H_SPEED), a, rtol)
+            self.states["v-"] = self._solve(v * (1 - _H_SPEED), a, rtol)
+        if weighted and np.any(problem.sigma_angle > 0):
+            self.states["a+"] = self._solve(v, a + _H_ANGLE, rtol)
+            self.states["a-"] = self._solve(v, np.maximum(a - _H_ANGLE, 0.0), rtol)
+        self.nfev = 0
+
+    def _solve(self, v, a, rtol):
+        out = []
+        for r in self.radii:
+            idx = np.flatnonzero(self.problem.radius == r)
+            imp = normal_impulses(self.contacts[float(r)], v[idx], np.clip(a[idx], 0.0, 89.9), rtol)
+            out.append((idx, v[idx], a[idx], imp))
+        return out
+
+    def model(self, f, state="nominal") -> np.ndarray:
+        """Model value of every entry at friction f (NaN where the model captures). [unit of the entry]"""
+        self.nfev += 1
+        out = np.empty(self.problem.size)
+        for idx, v, a, imp in self.states[state]:
+            c = self.contacts[float(self.problem.radius[idx[0]])]
+            st = rebound_from_impulses(c, imp, self.problem.spin[idx], friction=f)
+            out[idx] = np.where(st["captured"], np.nan, _observables(st, v, a, self.problem.quantity[idx]))
+        return out
+
+    def sigma(self, f) -> np.ndarray:
+        """Effective standard uncertainty of every entry at friction f (ones when unweighted)."""
+        p = self.problem
+        if not self.weighted:
+            return np.ones(p.size)
+        terms = p.sigma_measured ** 2
+        if "v+" in self.states:
+            slope = (self.model(f, "v+") - self.model(f, "v-")) / (2 * _H_SPEED * p.speed)
+            terms = terms + (np.nan_to_num(slope) * p.sigma_speed) ** 2
+        if "a+" in self.states:
+            step = p.incidence_deg + _H_ANGLE - np.maximum(p.incidence_deg - _H_ANGLE, 0.0)
+            slope = (self.model(f, "a+") - self.model(f, "a-")) / step
+            terms = terms + (np.nan_to_num(slope) * p.sigma_angle) ** 2
+        return np.sqrt(terms)
+
+    def residual(self, f, sigma=None) -> np.ndarray:
+        """(model - measured) / sigma; a captured model entry counts as far from its rebound."""
+        s = self.sigma(f) if sigma is None else sigma
+        return np.nan_to_num((self.model(f) - self.problem.measured) / s, nan=1e3)
+
+    def chi2(self, f) -> float:
+        r = self.residual(f)
+        return float(r @ r)
+
+    def rolling_thresholds(self) -> np.ndarray:
+        """f*_i above which entry i ends in rolling (inf: no friction impulse; 0: no slip). [-]"""
+        p = self.problem
+        out = np.full(p.size, np.inf)
+        for idx, v, a, imp in self.states["nominal"]:
+            c = self.contacts[float(p.radius[idx[0]])]
+            slip = np.abs(imp["velocity_in_t"] - c.radius * p.spin[idx])  # u_t = v_t + r omega_t', omega_t' = -spin
+            j = imp["friction_impulse"]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                out[idx] = np.where(j > 0, 2.0 * c.mass * slip / (7.0 * j), np.inf)
+        return out
 
 
 @dataclass(frozen=True)
-class _Value:
+class _ProfileFit:
     value: float
+    stderr: float  # local (curvature) standard error at fixed damping, NaN where not estimated
+    chisqr: float
+    grid: np.ndarray
+    chi2: np.ndarray  # the profile, scaled by the reduced chi-square when unweighted
+    nfev: int
+    rolling_above: float
+    sliding_below: float
 
 
-def _damping_gradient(problem, damping_fit, names, best, sigma, rtol, lmfit, advance,
+def _profile_fit(objective: _FrictionObjective, lmfit, deadline) -> _ProfileFit:
+    """Global minimum of chi-square(f) over the whole range, and the profile (see fit_friction)."""
+    from scipy.optimize import minimize_scalar
+
+    _, lo, hi = PARAMETER_BOUNDS["friction"]
+    thresholds = objective.rolling_thresholds()
+    finite = thresholds[np.isfinite(thresholds) & (thresholds > lo) & (thresholds < hi)]
+    grid = np.unique(np.concatenate([[lo, hi], np.geomspace(1e-4, hi, PROFILE_POINTS),
+                                     finite, finite * (1 - 1e-6), finite * (1 + 1e-6)]))
+    grid = grid[(grid >= lo) & (grid <= hi)]
+    chi2 = np.empty(grid.size)
+    for i, f in enumerate(grid):
+        chi2[i] = objective.chi2(f)
+        if i % 50 == 0:
+            deadline.check(f"{i} of {grid.size} points of the friction profile")
+    k = int(np.argmin(chi2))
+    a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+    f_best, c_best = float(grid[k]), float(chi2[k])
+    if b > a:
+        res = minimize_scalar(objective.chi2, bounds=(a, b), method="bounded", options={"xatol": 1e-10 * max(b, 1e-3)})
+        if res.fun < c_best:
+            f_best, c_best = float(res.x), float(res.fun)
+    # lmfit polish at the effective variance of the best point; kept only if it lowers chi-square
+    sigma = objective.sigma(f_best)
+    params = lmfit.Parameters()
+    params.add("friction", value=f_best, min=lo, max=hi)
+    mini = lmfit.Minimizer(lambda p: objective.residual(p["friction"].value, sigma), params,
+                           scale_covar=not objective.weighted, iter_cb=deadline.iter_cb("the friction polish"))
+    out = mini.minimize(method="leastsq")
+    f_polish = float(out.params["friction"].value)
+    c_polish = objective.chi2(f_polish)
+    if c_polish <= c_best:
+        f_best, c_best = f_polish, c_polish
+    stderr = float(out.params["friction"].stderr) if out.params["friction"].stderr is not None else math.nan
+    dof = max(objective.problem.size - 1, 1)
+    scale = 1.0 if objective.weighted else max(c_best / dof, 1e-300)  # unweighted: scatter estimates sigma
+    grid = np.append(grid, f_best)
+    chi2 = np.append(chi2, c_best)
+    order = np.argsort(grid, kind="stable")
+    rolling = float(np.max(thresholds)) if thresholds.size else math.nan
+    sliding = float(np.min(thresholds)) if thresholds.size else math.nan
+    return _ProfileFit(f_best, stderr, c_best, grid[order], chi2[order] / scale, objective.nfev + out.nfev,
+                       rolling, sliding)
+
+
+def _friction_status(best: _ProfileFit, objective: _FrictionObjective, var_damping: float):
+    """The identifiability of f: profile interval, widened by the damping uncertainty, classified."""
+    from microimpact.analysis.identifiability import (DEFAULT_LEVEL, chi2_threshold, profile_interval,
+                                                      status_from_interval)
+    from scipy import stats
+
+    _, lo_lim, hi_lim = PARAMETER_BOUNDS["friction"]
+    _, lo, hi, _ = profile_interval(best.grid, best.chi2, chi2_threshold(DEFAULT_LEVEL))
+    if math.isfinite(var_damping) and var_damping > 0:
+        zd = float(stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2)) * math.sqrt(var_damping)
+        f = best.value
+        lo = lo if lo <= lo_lim else max(lo_lim, f - math.hypot(f - lo, zd))
+        hi = hi if hi >= hi_lim else min(hi_lim, f + math.hypot(hi - f, zd))
+    roll = best.rolling_above
+    reasons = {
+        "lower_bound": (f"every impact ends in rolling for f above {roll:.3g}, where the rebound no longer depends "
+                        f"on f; the data exclude f below {lo:.3g}" if math.isfinite(roll) and roll <= hi_lim else
+                        f"chi-square stays within the {100 * DEFAULT_LEVEL:.0f} % threshold up to f = {hi_lim:g}"),
+        "upper_bound": "the data are consistent with no friction at all (f = 0)",
+        "not_determined": (f"every impact ends in rolling for f above {roll:.3g} and the data are consistent with f "
+                           "down to 0" if math.isfinite(roll) else
+                           "no impact's rebound depends on f at these data"),
+    }
+    status = status_from_interval("friction", best.value, lo, hi, lo_lim, hi_lim, method="profile", reasons=reasons)
+    if status.determined and math.isfinite(best.stderr) and best.stderr > abs(best.value):
+        return status_from_interval("friction", best.value, lo_lim, hi, lo_lim, hi_lim, reasons=reasons)
+    return status
+
+
+def _damping_gradient(problem, damping_fit, f_best, weighted, rtol, lmfit, advance,
                       deadline=Deadline.start(None, "")) -> dict:
-    """d(fitted tangential parameter)/d(damping parameter) by central refits at +/- one standard error."""
-    grad = {k: {} for k in names}
-    start = {k: best.params[k].value for k in names}
+    """d(fitted f)/d(damping parameter) by central refits (global profile) at +/- one standard error."""
+    grad = {"friction": {}}
     for p in damping_fit.varied:
         h = damping_fit.stderr[p] if math.isfinite(damping_fit.stderr[p]) and damping_fit.stderr[p] > 0 \
             else 1e-3 * abs(damping_fit.values[p])
+        x0 = damping_fit.values[p]
+        # the damping parameters are >= 0 (w_A > 0): a step that would leave that range is shortened
+        steps = (x0 + h, max(x0 - h, 0.5 * x0)) if x0 > 0 else (x0 + h, x0)
         fitted = []
-        for s in (+1, -1):
-            values = dict(damping_fit.values) | {p: damping_fit.values[p] + s * h}
+        for x in steps:
+            values = dict(damping_fit.values) | {p: x}
 
             def contact_of(r, values=values):
                 return damping_fit.contact(r).with_(**_contact_fields(damping_fit, r, values))
-            mini = lmfit.Minimizer(_residual, _params(lmfit, names, start),
-                                   fcn_args=(problem, contact_of, names, problem.measured, sigma, rtol),
-                                   iter_cb=deadline.iter_cb(f"the refit at {p} {'+-'[s < 0]} its standard error"))
-            fitted.append(mini.minimize(method="leastsq").params)
+            fitted.append(_profile_fit(_FrictionObjective(problem, contact_of, weighted, rtol), lmfit, deadline).value)
             advance(1)
-        for k in names:
-            grad[k][p] = (fitted[0][k].value - fitted[1][k].value) / (2 * h)
+        grad["friction"][p] = (fitted[0] - fitted[1]) / (steps[0] - steps[1])
     return grad
-
-
-def _params(lmfit, names, start):
-    params = lmfit.Parameters()
-    for k in names:
-        _, lo, hi = PARAMETER_BOUNDS[k]
-        params.add(k, value=start[k], min=lo, max=hi)
-    return params
 
 
 def _contact_fields(damping_fit, radius, values) -> dict:

@@ -140,6 +140,17 @@ for _name, _q in _BASE.items():
         _q.dimension, f"{_q.canonical}_uncertainty", scale=_q.scale, low_open=False
     )
 _LABELS = ("id", "size_class", "material_pair")
+
+#: A MEASURED rebound quantity outside its physical range by at most this many of its stated
+#: standard uncertainties is kept as a measurement (noise puts a nearly elastic impact's e_n above 1,
+#: a rolling sphere's rebound speed slightly below 0); beyond it, or without a stated uncertainty,
+#: the value is refused. 4 sigma: a Gaussian error goes past it with probability 6e-5 (two-sided), so a
+#: genuine measurement is essentially never refused, while a unit or sign error still is. The fits
+#: read the same constant (microimpact.analysis.fitting).
+MEASUREMENT_TOLERANCE_SIGMAS = 4.0
+#: the measured rebound quantities to which :data:`MEASUREMENT_TOLERANCE_SIGMAS` applies (the incident
+#: speed, angle and size define the experiment and keep their strict ranges)
+MEASURED_QUANTITIES = ("e_n", "rebound_normal_speed", "rebound_tangential_speed", "rebound_angle", "rebound_spin")
 _KNOWN = tuple(_QUANTITIES) + _LABELS
 
 #: the columns of the returned DataFrame, in order
@@ -616,6 +627,7 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
         raise ImpactDataError(source, _sorted(problems))
 
     _warn_implausible(Path(source).name, cells, columns, out)
+    kept = _warn_kept_outside(Path(source).name, cells, columns)
     frame = {"row": cells.rows, "line": cells.lines}
     for cname in _LABELS:
         frame[cname] = pd.array(labels.get(cname, [None] * cells.n), dtype="string")
@@ -625,7 +637,24 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     df.attrs["sha256"] = sha256
     df.attrs["units"] = dict(COLUMN_UNITS)
     df.attrs["measured"] = tuple(_QUANTITIES[n].canonical for n in columns if n in _QUANTITIES)
+    df.attrs["outside_physical_range"] = kept
     return df
+
+
+def _warn_kept_outside(name: str, cells: _Cells, columns) -> dict:
+    """One :class:`ImpactDataWarning` naming the measurements kept outside their physical range
+    (within :data:`MEASUREMENT_TOLERANCE_SIGMAS` of their stated uncertainty); returns
+    {canonical column: [data rows]}."""
+    kept = {_QUANTITIES[c].canonical: [int(r) for r in cells.rows[m]] for c, m in cells.kept_outside.items() if m.any()}
+    if kept:
+        listed = "; ".join(f"{columns[c].field if c in columns else c}: rows {', '.join(map(str, rows[:20]))}"
+                           f"{f' and {len(rows) - 20} more' if len(rows) > 20 else ''}"
+                           for c, rows in ((c, [int(r) for r in cells.rows[m]]) for c, m in cells.kept_outside.items()
+                                           if m.any()))
+        warnings.warn(f"{name}: {sum(map(len, kept.values()))} measurement(s) outside the physical range by no more "
+                      f"than {MEASUREMENT_TOLERANCE_SIGMAS:g} stated standard uncertainties, kept as measured ({listed})",
+                      ImpactDataWarning, stacklevel=3)
+    return kept
 
 
 def _warn_implausible(name: str, cells: _Cells, columns, out: dict) -> None:
@@ -848,6 +877,8 @@ class _Cells:
         # cells already reported (control characters): no second problem for them
         self.reported = {c.name: np.array([c.index in r.bad for r in records], dtype=bool)
                          for c in columns.values()}
+        # measured values kept outside their physical range (within their stated error): column -> mask
+        self.kept_outside: dict[str, np.ndarray] = {}
 
     def problems(self, mask, col: _Column, message: str) -> list[Problem]:
         """A problem of column ``col`` for every record where ``mask`` is true (cells already
@@ -896,6 +927,10 @@ def _numeric_values(cells: _Cells, columns, factors, problems: list[Problem]) ->
         x = num * factors[cname]
         with np.errstate(invalid="ignore"):
             out_of_range = np.isfinite(x) & ~q.ok(x / q.scale)
+        if cname in MEASURED_QUANTITIES and out_of_range.any():
+            kept = out_of_range & _within_stated_error(cells, columns, factors, cname, q, x)
+            out_of_range &= ~kept
+            cells.kept_outside[cname] = kept
         what = "uncertainty must be" if cname.endswith("_uncertainty") else "must be"
         if q.dimension == "angle" and unit not in ("deg", "degree", "degrees", "\u00b0"):
             for i in np.flatnonzero(out_of_range):
@@ -903,9 +938,25 @@ def _numeric_values(cells: _Cells, columns, factors, problems: list[Problem]) ->
                                         int(cells.rows[i]), int(cells.lines[i]), col.field, raw[i]))
         else:
             qualifier = " (speeds are magnitudes)" if q.dimension == "speed" and q.low == 0 else ""
+            if cname in MEASURED_QUANTITIES:
+                qualifier += (f", or outside it by at most {MEASUREMENT_TOLERANCE_SIGMAS:g} of the stated standard "
+                              f"uncertainty (column {cname}_uncertainty)")
             problems += cells.problems(out_of_range, col, f"{what} {q.range_text()}{qualifier}")
         values[q.canonical] = np.where(np.isfinite(x), x, np.nan)
     return values
+
+
+def _within_stated_error(cells: _Cells, columns, factors, cname: str, q: _Quantity, x: np.ndarray) -> np.ndarray:
+    """Whether each value of a measured column lies within MEASUREMENT_TOLERANCE_SIGMAS of its stated
+    uncertainty (column ``<name>_uncertainty``, same unit handling) of the accepted range."""
+    unc = f"{cname}_uncertainty"
+    if unc not in columns or unc not in factors:
+        return np.zeros(cells.n, dtype=bool)
+    s = _parse_numbers(cells.text[unc]) * factors[unc]
+    below = np.where(x < q.low, q.low - x, 0.0)
+    above = np.where(x > q.high, x - q.high, 0.0)
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(s) & (s > 0) & (np.maximum(below, above) <= MEASUREMENT_TOLERANCE_SIGMAS * s)
 
 
 def _labels(cells: _Cells, columns, materials, problems: list[Problem]) -> dict[str, np.ndarray]:
@@ -932,12 +983,20 @@ def _labels(cells: _Cells, columns, materials, problems: list[Problem]) -> dict[
 def _check_rebound(cells: _Cells, col: _Column, out: dict, problems: list[Problem]) -> None:
     """Append a problem for every rebound normal speed larger than the incident one (e_n > 1)."""
     vn, r = out["normal_speed"], out["rebound_normal_speed"]
+    sr, svn = out["rebound_normal_speed_uncertainty"], out["normal_speed_uncertainty"]
     with np.errstate(invalid="ignore"):
-        too_fast = r > vn
+        # a rebound faster than the incidence by no more than the stated errors allow is a measurement
+        s = np.hypot(np.nan_to_num(sr), np.nan_to_num(svn))
+        kept = (r > vn) & (s > 0) & (r - vn <= MEASUREMENT_TOLERANCE_SIGMAS * s)
+        too_fast = (r > vn) & ~kept
+    if kept.any():
+        prev = cells.kept_outside.get("rebound_normal_speed", np.zeros(cells.n, dtype=bool))
+        cells.kept_outside["rebound_normal_speed"] = prev | kept
     for i in np.flatnonzero(too_fast):
         problems.append(Problem(
             f"is larger than the incident normal speed ({vn[i]:.6g} m/s), so e_n = "
-            f"{r[i] / vn[i]:.4g} > 1; e_n must be in [0, 1]",
+            f"{r[i] / vn[i]:.4g} > 1; e_n must be in [0, 1], or above 1 by no more than "
+            f"{MEASUREMENT_TOLERANCE_SIGMAS:g} stated standard uncertainties",
             int(cells.rows[i]), int(cells.lines[i]), col.field, cells.text["rebound_normal_speed"][i]))
 
 
