@@ -13,8 +13,10 @@ t = read_impacts(str(Path(__file__).resolve().parents[2] / "data" / "synthetic_m
 for wa in (False, True):
     f = fit_damping(t, pair, fit_work_of_adhesion=wa, confidence_intervals=False)
     out[f"bundled_fit_wA_{wa}"] = {"values": f.values, "stderr": f.stderr, "chisqr": f.chisqr}
-write_csv(make_synthetic_oblique(), "obl_default.csv", float_format="%.6g")
-t = read_impacts("obl_default.csv", materials=pairs)
+import tempfile
+tmp = Path(tempfile.mkdtemp()) / "obl_default.csv"
+write_csv(make_synthetic_oblique(), tmp, float_format="%.6g")
+t = read_impacts(tmp, materials=pairs)
 f = fit_damping(t, pair, confidence_intervals=False)
 ff = fit_friction(t, f)
 out["synthetic_oblique_default"] = {"values": f.values, "stderr": f.stderr, "chisqr": f.chisqr,
