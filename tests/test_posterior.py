@@ -39,14 +39,14 @@ def small(tmp_path_factory, pair):
     write_csv(make_synthetic_impacts(seed=5, radii=(1.29e-6, 3.45e-6), n_per_radius=12), path, float_format="%.6g")
     table = read_impacts(path)
     fit = fit_damping(table, pair, confidence_intervals=False)
-    return table, fit, sample_posterior(table, fit, walkers=8, steps=120, seed=11)
+    return table, fit, sample_posterior(table, fit, walkers=8, steps=120, seed=11, require_convergence=False)
 
 
 def test_seeded_chain_is_reproducible(small):
     table, fit, post = small
-    again = sample_posterior(table, fit, walkers=8, steps=120, seed=11)
+    again = sample_posterior(table, fit, walkers=8, steps=120, seed=11, require_convergence=False)
     np.testing.assert_array_equal(post.chain, again.chain)  # same seed: bit-identical chain
-    other = sample_posterior(table, fit, walkers=8, steps=20, seed=12)
+    other = sample_posterior(table, fit, walkers=8, steps=20, seed=12, require_convergence=False)
     assert not np.array_equal(post.chain[:20], other.chain)
 
 
@@ -54,8 +54,8 @@ def test_diagnostics_are_present_and_sane(small):
     _, fit, post = small
     assert post.chain.shape == (120, 8, 2)
     assert post.names == ("zeta_hertz", "zeta_adhesion")
-    # emcee's stretch move on a near-Gaussian 2-D posterior accepts 0.2-0.9 of its proposals; all
-    # accepted or all refused would mean a broken likelihood
+    # emcee's differential-evolution moves on a near-Gaussian 2-D posterior accept 0.2-0.9 of their
+    # proposals; all accepted or all refused would mean a broken likelihood
     assert 0.2 < post.acceptance_fraction.mean() < 0.9
     for name in post.names:
         assert 1.0 <= post.autocorr_time[name] < 60.0, name
@@ -129,7 +129,7 @@ def test_auto_picks_latent_speeds_near_capture(pair, tmp_path):
     assert not like.latent[-1]  # the fastest: e_n flat, effective variance suffices
     assert not _Likelihood(fit, table, None, "effective", 1e-8).latent.any()
     assert _Likelihood(fit, table, None, "latent", 1e-8).latent.all()
-    post = sample_posterior(table, fit, walkers=8, steps=30, seed=1)
+    post = sample_posterior(table, fit, walkers=8, steps=30, seed=1, require_convergence=False)
     assert "latent true speed" in post.info["errors_in_variables"] and post.info["latent_rows"]
 
 

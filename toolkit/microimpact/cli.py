@@ -219,8 +219,10 @@ def _cmd_fit(args) -> int:
     print(f"fitting {len(table)} impacts of {pair.name} ...", file=sys.stderr, flush=True)
     posterior = False
     if outputs.get("--posterior") is not None:
-        posterior = {"walkers": args.walkers, "steps": args.steps, "seed": args.seed, "full": args.full_chain}
-        posterior = {k: v for k, v in posterior.items() if v is not None}
+        if args.full_chain:
+            raise UsageError("--full-chain was removed: the default chain now runs until it converges; "
+                             "--max-steps bounds it")
+        posterior = {"walkers": args.walkers, "steps": args.steps, "max_steps": args.max_steps, "seed": args.seed}
     result = analyse_impacts(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
                              confidence_intervals=not args.no_confidence_intervals, posterior=posterior,
                              errors_in_variables=args.errors_in_variables, rtol=args.rtol, progress=True,
@@ -250,18 +252,34 @@ def register_fit(sub) -> None:
 
 def _add_posterior_options(p: argparse.ArgumentParser) -> None:
     """The posterior and oblique options of ``microimpact fit`` (microimpact.analysis.analyst_fit)."""
+    from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_SEED, DEFAULT_WALKERS
+
     p.add_argument("--posterior", default=None, metavar="NC",
-                   help="also sample the posterior (lmfit Minimizer.emcee, seeded) and write chain, diagnostics and "
-                        "bands to this NetCDF")
-    p.add_argument("--walkers", type=_positive_int, default=None, help="emcee walkers (default 12)")
-    p.add_argument("--steps", type=_positive_int, default=None, help="emcee steps (default 80: seconds; see --full-chain)")
-    p.add_argument("--seed", type=int, default=None, help="seed of the sampler (default 2002)")
-    p.add_argument("--full-chain", action="store_true", help="a chain long enough to converge (24 x 2000; about 1.5 minutes)")
+                   help="also sample the posterior (emcee, seeded) until it converges (50 autocorrelation times, "
+                        "R-hat < 1.01, ESS >= 400) and write chain, diagnostics and bands to this NetCDF; a chain "
+                        "that collapses or does not converge is an error (exit status 2, nothing written)")
+    p.add_argument("--walkers", type=_positive_int, default=None, help=f"emcee walkers (default {DEFAULT_WALKERS})")
+    p.add_argument("--max-steps", type=_positive_int, default=None,
+                   help=f"most steps before an unconverged chain is an error (default {DEFAULT_MAX_STEPS})")
+    p.add_argument("--steps", type=_positive_int, default=None,
+                   help="run exactly this many steps (default: until converged); still an error if not converged")
+    p.add_argument("--seed", type=_non_negative_int, default=None, help=f"seed of the sampler (default {DEFAULT_SEED})")
+    p.add_argument("--full-chain", action="store_true", help=argparse.SUPPRESS)  # removed: refused with a message
     p.add_argument("--errors-in-variables", choices=("auto", "effective", "latent"), default="auto",
                    help="speed errors in the posterior: effective variance, latent true speeds, or auto (latent near "
                         "capture)")
     p.add_argument("--oblique-out", default=None, metavar="NC",
                    help="write the friction fit (oblique columns: measured vs fitted per row) to this NetCDF")
+
+
+def _non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {text!r}")
+    return value
 
 
 def _positive_int(text: str) -> int:

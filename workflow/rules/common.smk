@@ -25,14 +25,14 @@ config["fit"] = {
     k: (v if k == "weights" else float(v) if k == "time_budget" else as_bool(v))
     for k, v in config["fit"].items()
 }
-# the posterior section is optional; its numbers may arrive as text from snakemake --config
+# the posterior section is optional; its numbers may arrive as text from snakemake --config; a
+# number not given is None: the library's one default (microimpact.analysis.posterior)
 config["posterior"] = {
     "enabled": True,
-    "walkers": 12,
-    "steps": 80,
-    "seed": 2002,
-    "n_draws": 24,
-    "full": False,
+    "walkers": None,
+    "max_steps": None,
+    "seed": None,
+    "n_draws": None,
     "errors_in_variables": "auto",
     **config.get("posterior", {}),
 }
@@ -40,7 +40,7 @@ config["posterior"] = {
     k: (
         as_bool(v)
         if k in ("enabled", "full")
-        else v if k == "errors_in_variables" else int(v)
+        else v if k == "errors_in_variables" or v is None else int(v)
     )
     for k, v in config["posterior"].items()
 }

@@ -23,7 +23,7 @@ table = read_impacts(snakemake.input.data, materials=snakemake.input.materials, 
                      material_pair=snakemake.params.material_pair)  # noqa: F821
 ds = flag_measurements(table, DampingFit.from_dataset(fit_ds), rtol=snakemake.params.rtol,  # noqa: F821
                        posterior=load_posterior(snakemake.input.posterior),  # noqa: F821
-                       n_draws=snakemake.params.n_draws)  # noqa: F821
+                       **({} if snakemake.params.n_draws is None else {"n_draws": snakemake.params.n_draws}))  # noqa: F821
 ds = stamp_fitted(ds, fit_ds)
 write_flags(ds, snakemake.output.csv, snakemake.output.nc)  # noqa: F821
 print(ds)

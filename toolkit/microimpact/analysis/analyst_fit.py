@@ -21,13 +21,18 @@ from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.provenance import stamp_parameters
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
-__all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS", "POSTERIOR_FULL"]
+__all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS"]
 
-#: the posterior of the pipeline and CLI by default: short (seconds), its convergence stated
-POSTERIOR_DEFAULTS = dict(walkers=12, steps=80, burn=None, seed=2002, n_draws=24)
-#: ``full: true``: a chain long enough for the 50-autocorrelation-times rule on the bundled data
-#: (tau about 29 steps: 1700 post-burn-in steps = 59 tau; about 1.5 minutes)
-POSTERIOR_FULL = dict(walkers=24, steps=2000, burn=300, seed=2002, n_draws=64)
+def _posterior_defaults() -> dict:
+    from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS
+
+    return dict(walkers=DEFAULT_WALKERS, max_steps=DEFAULT_MAX_STEPS, steps=None, burn=None, seed=DEFAULT_SEED,
+                n_draws=DEFAULT_N_DRAWS)
+
+
+#: the posterior settings of the pipeline and the CLI: the library's one home of each
+#: (:mod:`microimpact.analysis.posterior`); the chain runs until it converges (or fails loudly)
+POSTERIOR_DEFAULTS = _posterior_defaults()
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,8 +105,9 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     friction : bool
         Fit the friction when the table has oblique columns.
     posterior : bool or dict
-        False: no posterior; True: :data:`POSTERIOR_DEFAULTS`; a dict overrides them (``walkers``,
-        ``steps``, ``burn``, ``seed``, ``n_draws``; ``full: true`` starts from :data:`POSTERIOR_FULL`).
+        False: no posterior; True: :data:`POSTERIOR_DEFAULTS` (run until converged); a dict overrides
+        them (``walkers``, ``max_steps``, ``steps`` (a fixed length), ``burn``, ``seed``, ``n_draws``;
+        None values keep the default).
     errors_in_variables : {"auto", "effective", "latent"}
         Speed-error treatment of the posterior (:mod:`microimpact.analysis.posterior`).
     rtol : float
@@ -119,6 +125,8 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     ------
     TimeBudgetExceeded
         A stage ran past ``time_budget``; the message names the stage and how far it got.
+    PosteriorError
+        The posterior collapsed or did not converge (:func:`~microimpact.analysis.posterior.sample_posterior`).
     """
     from microimpact.analysis.fitting import fit_damping
     from microimpact.analysis.oblique import ObliqueProblem, fit_friction
@@ -135,18 +143,19 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
             pass
         else:
             ff = fit_friction(table, damping, rtol=rtol, progress=progress, time_budget=deadline)
-            damping = dataclasses.replace(damping, friction=ff.friction, info=damping.info | {
-                "friction_stderr": ff.stderr["friction"], "friction_source": "fit to the oblique columns (after the "
-                "damping fit, microimpact.analysis.oblique)", "friction_n_points": ff.n_points})
+            friction, source = _friction_for_simulations(ff, damping.friction)
+            damping = dataclasses.replace(damping, friction=friction, info=damping.info | {
+                "friction_stderr": ff.stderr["friction"], "friction_source": source, "friction_n_points": ff.n_points,
+                "friction_status": ff.identifiability["friction"].status})
     if not posterior:
         return AnalystFit(damping, ff)
     opts = _posterior_options(posterior)
     from microimpact.analysis.posterior import (capture_velocity_interval, posterior_dataset, restitution_bands,
                                                 sample_posterior, sweep_bands)
 
-    post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], burn=opts["burn"],
-                            seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol, progress=progress,
-                            time_budget=deadline)
+    post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], max_steps=opts["max_steps"],
+                            burn=opts["burn"], seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol,
+                            progress=progress, time_budget=deadline)
     nd = opts["n_draws"]
     ds = posterior_dataset(post, restitution_bands(post, damping, n_draws=nd, rtol=rtol, time_budget=deadline),
                            capture_velocity_interval(post, damping, n_draws=nd, time_budget=deadline),
@@ -154,16 +163,33 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     return AnalystFit(damping, ff, post, ds)
 
 
+def _friction_for_simulations(ff, configured: float) -> tuple[float, str]:
+    """(f, why) for the fitted material's simulations: the fitted f where the data determine it;
+    else the materials config's f if the data allow it, else the end of what they allow -- and say so."""
+    st = ff.identifiability["friction"]
+    if st.determined:
+        return ff.friction, "fit to the oblique columns (after the damping fit, microimpact.analysis.oblique)"
+    if st.contains(configured):
+        value, which = configured, "the materials config's value, which the data allow"
+    else:
+        value = st.lower if configured < st.lower else st.upper
+        which = f"the end of the range the data allow nearest to the materials config's {configured:g}"
+    return float(value), (f"NOT determined by the oblique data ({st.describe()}); the fitted material's "
+                          f"simulations use f = {value:.4g}, {which}")
+
+
 def _posterior_options(posterior) -> dict:
-    """The sampler settings from ``True`` or a dict (see :func:`analyse_impacts`)."""
+    """The sampler settings from ``True`` or a dict (see :func:`analyse_impacts`); None keeps a default."""
     if posterior is True:
         return dict(POSTERIOR_DEFAULTS)
     opts = dict(posterior)
-    full = str(opts.pop("full", False)).lower() in ("true", "1")
     opts.pop("enabled", None)
+    if "full" in opts:
+        raise ValueError("posterior option 'full' was removed: the default chain now runs until it converges "
+                         "(50 autocorrelation times, R-hat < 1.01); set max_steps to bound it")
     unknown = set(opts) - set(POSTERIOR_DEFAULTS)
     if unknown:
-        raise ValueError(f"unknown posterior option(s) {sorted(unknown)}; known: {sorted(POSTERIOR_DEFAULTS)} and full")
-    base = dict(POSTERIOR_FULL if full else POSTERIOR_DEFAULTS)
-    base.update({k: (None if v is None else int(v)) for k, v in opts.items()})
+        raise ValueError(f"unknown posterior option(s) {sorted(unknown)}; known: {sorted(POSTERIOR_DEFAULTS)}")
+    base = dict(POSTERIOR_DEFAULTS)
+    base.update({k: int(v) for k, v in opts.items() if v is not None})
     return base

@@ -92,7 +92,7 @@ def posterior_coverage(n_datasets: int = 50, *, first_seed: int = 1000, radii=(1
             table = read_impacts(path)
             fit = fit_damping(table, base, confidence_intervals=False, time_budget=deadline)
             post = sample_posterior(table, fit, walkers=walkers, steps=steps, burn=burn, seed=seed,
-                                    time_budget=deadline)
+                                    time_budget=deadline, require_convergence=False)
             row = {"seed": seed}
             for p, true in truth.items():
                 lo, hi = post.interval(p, level)

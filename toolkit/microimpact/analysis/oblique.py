@@ -606,8 +606,20 @@ class _FrictionObjective:
         return np.nan_to_num((self.model(f) - self.problem.measured) / s, nan=1e3)
 
     def chi2(self, f) -> float:
+        """Chi-square at f with the effective variance at f. [-]"""
         r = self.residual(f)
         return float(r @ r)
+
+    def deviance(self, f) -> float:
+        """-2 log likelihood at f, up to a constant: chi-square plus sum(log sigma^2) when weighted. [-]
+
+        The effective variance depends on f (the slopes of the model in speed and angle differ between
+        sliding and rolling), so the likelihood's normalisation does too; without its log term a
+        region of smaller sigma would look worse than it is. Unweighted: chi-square.
+        """
+        s = self.sigma(f)
+        r = self.residual(f, s)
+        return float(r @ r) + (float(np.sum(np.log(s ** 2))) if self.weighted else 0.0)
 
     def rolling_thresholds(self) -> np.ndarray:
         """f*_i above which entry i ends in rolling (inf: no friction impulse; 0: no slip). [-]"""
@@ -628,7 +640,7 @@ class _ProfileFit:
     stderr: float  # local (curvature) standard error at fixed damping, NaN where not estimated
     chisqr: float
     grid: np.ndarray
-    chi2: np.ndarray  # the profile, scaled by the reduced chi-square when unweighted
+    chi2: np.ndarray  # the profile of the deviance, scaled by the reduced chi-square when unweighted
     nfev: int
     rolling_above: float
     sliding_below: float
@@ -644,16 +656,16 @@ def _profile_fit(objective: _FrictionObjective, lmfit, deadline) -> _ProfileFit:
     grid = np.unique(np.concatenate([[lo, hi], np.geomspace(1e-4, hi, PROFILE_POINTS),
                                      finite, finite * (1 - 1e-6), finite * (1 + 1e-6)]))
     grid = grid[(grid >= lo) & (grid <= hi)]
-    chi2 = np.empty(grid.size)
+    chi2 = np.empty(grid.size)  # the deviance (see _FrictionObjective.deviance)
     for i, f in enumerate(grid):
-        chi2[i] = objective.chi2(f)
+        chi2[i] = objective.deviance(f)
         if i % 50 == 0:
             deadline.check(f"{i} of {grid.size} points of the friction profile")
     k = int(np.argmin(chi2))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     f_best, c_best = float(grid[k]), float(chi2[k])
     if b > a:
-        res = minimize_scalar(objective.chi2, bounds=(a, b), method="bounded", options={"xatol": 1e-10 * max(b, 1e-3)})
+        res = minimize_scalar(objective.deviance, bounds=(a, b), method="bounded", options={"xatol": 1e-10 * max(b, 1e-3)})
         if res.fun < c_best:
             f_best, c_best = float(res.x), float(res.fun)
     # lmfit polish at the effective variance of the best point; kept only if it lowers chi-square
@@ -664,18 +676,19 @@ def _profile_fit(objective: _FrictionObjective, lmfit, deadline) -> _ProfileFit:
                            scale_covar=not objective.weighted, iter_cb=deadline.iter_cb("the friction polish"))
     out = mini.minimize(method="leastsq")
     f_polish = float(out.params["friction"].value)
-    c_polish = objective.chi2(f_polish)
+    c_polish = objective.deviance(f_polish)
     if c_polish <= c_best:
         f_best, c_best = f_polish, c_polish
     stderr = float(out.params["friction"].stderr) if out.params["friction"].stderr is not None else math.nan
+    chisqr = objective.chi2(f_best)
     dof = max(objective.problem.size - 1, 1)
-    scale = 1.0 if objective.weighted else max(c_best / dof, 1e-300)  # unweighted: scatter estimates sigma
+    scale = 1.0 if objective.weighted else max(chisqr / dof, 1e-300)  # unweighted: scatter estimates sigma
     grid = np.append(grid, f_best)
     chi2 = np.append(chi2, c_best)
     order = np.argsort(grid, kind="stable")
     rolling = float(np.max(thresholds)) if thresholds.size else math.nan
     sliding = float(np.min(thresholds)) if thresholds.size else math.nan
-    return _ProfileFit(f_best, stderr, c_best, grid[order], chi2[order] / scale, objective.nfev + out.nfev,
+    return _ProfileFit(f_best, stderr, chisqr, grid[order], chi2[order] / scale, objective.nfev + out.nfev,
                        rolling, sliding)
 
 

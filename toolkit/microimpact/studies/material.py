@@ -44,8 +44,16 @@ def fitted_contacts(fit: xr.Dataset, radii: Sequence[float] | None = None) -> di
 
 
 def stamp_fitted(ds: xr.Dataset, fit: xr.Dataset) -> xr.Dataset:
-    """``ds`` with the fit's ``parameter_source`` and the fitted contact of every measured size."""
-    return stamp_parameters(ds, list(fitted_contacts(fit).values()), source_of_fit(fit))
+    """``ds`` with the fit's ``parameter_source``, the fitted contact of every measured size, and what
+    the data did not determine: ``undetermined_parameters`` (each with the fit's statement) and
+    ``friction_source`` (which friction the simulations use, and why, where the fit had oblique data)."""
+    out = stamp_parameters(ds, list(fitted_contacts(fit).values()), source_of_fit(fit))
+    notes = [f"{n}: {fit[f'{n}_status'].attrs.get('reason', '')}" for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
+             if f"{n}_status" in fit and int(fit[f"{n}_status"]) != 0]
+    out.attrs["undetermined_parameters"] = "; ".join(notes) if notes else "none"
+    if "fit_friction_source" in fit.attrs:
+        out.attrs["friction_source"] = str(fit.attrs["fit_friction_source"])
+    return out
 
 
 def measured_speed_range(fit: xr.Dataset) -> tuple[float, float]:
