@@ -101,22 +101,107 @@ CONTACT_FIELDS = [f.name for f in fields(Contact)]
 
 
 def add_contact_options(p: argparse.ArgumentParser) -> None:
-    """--preset plus one option per Contact field (SI units) that overrides the preset."""
-    p.add_argument("--preset", default="wall1990", help=f"parameter preset ({', '.join(sorted(PRESETS))}); default wall1990")
+    """The material: --preset, or --fit FIT.nc, or --material-pair NAME (with --config); then one
+    option per Contact field (SI units) that overrides it, and --work-of-adhesion."""
+    p.add_argument("--preset", default=None, help=f"parameter preset ({', '.join(sorted(PRESETS))}); default wall1990")
+    p.add_argument("--fit", default=None, metavar="FIT_NC",
+                   help="use the fitted material of a fit written by 'microimpact fit' (zeta_H, zeta_A, w_A, friction; "
+                        "f0 from w_A by Eq. (7) at --radius)")
+    p.add_argument("--material-pair", default=None, metavar="NAME",
+                   help="use a material pair of the materials config (f0 from its w_A by Eq. (7) at --radius)")
+    p.add_argument("--config", default=None, help="materials config YAML for --material-pair (default: the bundled one)")
+    p.add_argument("--work-of-adhesion", type=_positive_float, default=None, metavar="SI",
+                   help="work of adhesion w_A [J/m2]: f0 from it by Eq. (7) (instead of the material's)")
     for name in CONTACT_FIELDS:
         if name in SUB_MODELS:
             p.add_argument(f"--{name.replace('_', '-')}", choices=SUB_MODELS[name], default=None,
                            help=f"sub-model (default {SUB_MODELS[name][0]}, the paper's)")
             continue
         p.add_argument(f"--{name.replace('_', '-')}", type=_finite_float, default=None, metavar="SI",
-                       help=f"override Contact.{name} (SI units)")
+                       help=f"override Contact.{name} (SI units)" + (
+                           "; the material is kept: f0 follows the radius by Eq. (7) unless "
+                           "--adhesion-line-force is given" if name == "radius" else ""))
+
+
+def _base_material(args):
+    """(material, label): the preset Contact, a DampingFit or a MaterialPair, as the options say."""
+    given = [o for o, v in (("--preset", args.preset), ("--fit", args.fit), ("--material-pair", args.material_pair))
+             if v is not None]
+    if len(given) > 1:
+        raise UsageError(f"{' and '.join(given)} both name the material; give one of them")
+    if args.config is not None and args.material_pair is None:
+        raise UsageError("--config is read only with --material-pair")
+    if args.fit is not None:
+        from microimpact.analysis.fit_result import DampingFit
+
+        path = check_input_file("--fit", args.fit)
+        try:
+            fit = DampingFit.load(path)
+        except ValueError as exc:
+            raise UsageError(f"--fit {args.fit}: {exc}") from None
+        undetermined = [st.describe() for st in fit.identifiability.values() if not st.determined]
+        if undetermined:
+            print(f"microimpact: note: --fit {args.fit}: " + "; ".join(undetermined)
+                  + "; its stored values are used", file=sys.stderr)
+        return fit, f"fit {path.name} ({fit.parameter_source})"
+    if args.material_pair is not None:
+        from microimpact.io import default_materials_path, read_materials
+
+        config = check_input_file("--config", args.config) if args.config else default_materials_path()
+        pairs = read_materials(config)
+        if args.material_pair not in pairs:
+            raise UsageError(f"--material-pair {args.material_pair!r} is not in {config}; known: {', '.join(pairs)}")
+        return pairs[args.material_pair], f"material pair {args.material_pair} of {config}"
+    name = args.preset or "wall1990"
+    return get_preset(name), f"preset {name}"
 
 
 def contact_from_args(args) -> Contact:
-    """The preset with the overrides given on the command line; ValueError names a bad field."""
-    base = get_preset(args.preset)
+    """The contact the options describe; ``args.contact_note`` says where f0 came from.
+
+    The material is kept at every size: with --radius (or --stiffness) but no --adhesion-line-force,
+    f0 follows from the material's work of adhesion by Eq. (7) (Cheng, Brach & Dunn 2002), as a fit
+    over several sizes assumes; --adhesion-line-force sets it explicitly. ValueError names a bad field.
+    """
+    from microimpact.model.contact import adhesion_line_force_from_work
+
+    material, label = _base_material(args)
     changes = {n: getattr(args, n) for n in CONTACT_FIELDS if getattr(args, n, None) is not None}
-    return base.with_(**changes) if changes else base
+    radius = changes.get("radius")
+    if isinstance(material, Contact):
+        base = material
+    else:  # a fit or a material pair: a contact exists only at a radius
+        sizes = getattr(material, "radii", None)
+        if radius is None and sizes is not None and len(sizes) == 1:
+            radius = float(sizes[0])
+        if radius is None:
+            known = f" (the fit's sizes: {', '.join(f'{r:.4g}' for r in sizes)} m)" if sizes is not None else ""
+            raise UsageError(f"give --radius with {'--fit' if args.fit else '--material-pair'}{known}")
+        from microimpact.io.materials import material_contact
+
+        base = material_contact(material, radius)
+    w_a = args.work_of_adhesion if args.work_of_adhesion is not None else base.work_of_adhesion
+    if "adhesion_line_force" in changes:
+        if args.work_of_adhesion is not None:
+            raise UsageError("--adhesion-line-force and --work-of-adhesion both set f0; give one of them")
+        contact = base.with_(**changes)
+        note = f"f0 = {contact.adhesion_line_force:.6g} N/m given on the command line"
+    elif changes.keys() & {"radius", "stiffness"} or args.work_of_adhesion is not None:
+        c = base.with_(**changes)
+        contact = c.with_(adhesion_line_force=adhesion_line_force_from_work(c.stiffness, c.radius, w_a))
+        note = (f"f0 = {contact.adhesion_line_force:.6g} N/m from w_A = {w_a:.6g} J/m2 by Eq. (7) at "
+                f"r = {contact.radius:.6g} m")
+    else:
+        contact = base
+        note = f"f0 = {contact.adhesion_line_force:.6g} N/m of the material"
+    args.contact_note = f"{label}; {note}"
+    return contact
+
+
+def contact_record(contact: Contact, note: str) -> dict:
+    """Every Contact field (SI units, sub-models by name), the work of adhesion and where f0 came from."""
+    out = {f.name: getattr(contact, f.name) for f in fields(Contact)}
+    return out | {"work_of_adhesion": contact.work_of_adhesion, "source": note}
 
 
 def _cmd_simulate(args) -> int:
@@ -125,10 +210,11 @@ def _cmd_simulate(args) -> int:
     contact = contact_from_args(args)
     result = simulate_impact(contact, args.speed, args.incidence_deg, args.azimuth_deg,
                              (args.omega_n, args.omega_t, args.omega_tp), rtol=args.rtol, method=args.method)
+    record = contact_record(contact, args.contact_note)
     if args.json:
-        print(json.dumps(result.to_dict(), indent=2))
+        print(json.dumps(result.to_dict() | {"contact": record}, indent=2))
     else:
-        d = result.to_dict()
+        d = result.to_dict() | {f"contact.{k}": v for k, v in record.items()}
         width = max(map(len, d))
         for k, v in d.items():
             print(f"{k:<{width}}  {v}")
@@ -359,6 +445,7 @@ def _cmd_target(args) -> int:
     if out is not None and not str(out).endswith((".csv", ".nc")):
         raise UsageError(f"--out {args.out!r}: the output must end in .csv or .nc")
     contact = contact_from_args(args)
+    print(f"material: {args.contact_note}", file=sys.stderr)
     res = damping_from_target(args.e_n, args.speed, contact, e_n_uncertainty=args.e_n_uncertainty,
                               n_points=args.points, rtol=args.rtol)
     c = res.curves
@@ -400,7 +487,9 @@ def _cmd_sweep(args) -> int:
         raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(TABLE2_CASES)}")
     contact = contact_from_args(args)
     out = check_outputs({"--out": args.out})["--out"]
+    print(f"material: {args.contact_note}", file=sys.stderr)
     ds = run_sweep(contact, case=args.case, rtol=args.rtol, progress=True, time_budget=args.time_budget)
+    ds.attrs["contact_source"] = args.contact_note
     with reporting_os_errors({"--out": out}):
         write_netcdf(ds, out)
     print(f"case {args.case}: {dict(ds.sizes)} impacts, {int(ds['outcome'].sum())} captured; wrote {out}")
