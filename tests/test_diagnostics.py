@@ -62,9 +62,13 @@ def test_spreads(flags):
     assert np.all(flags["mu_t_max_spin"] - flags["mu_t_min_spin"] > 0.15)
 
 
-def test_rotation_flag_follows_spin_bound(flags, table, pair):
-    assert flags["rotation_sensitive"].all()  # rolling-spin bound: every impact (the paper's point)
-    small = flag_measurements(table, pair, spin_bound=1.0)  # 1 rad/s: nothing happens
+def test_rotation_flag_needs_a_measured_quantity_that_moves(flags, table, pair):
+    # e_n-only rows: spin changes mu_t, mu_t' and K_L a lot (the paper's point, kept in the spreads),
+    # but e_n not at all (the normal motion decouples), and e_n is all these rows measured
+    assert (flags["mu_t_max_spin"] - flags["mu_t_min_spin"] > 0.05).all()
+    assert not flags["rotation_sensitive"].any()
+    np.testing.assert_allclose(flags["e_n_max_spin"], flags["e_n_min_spin"], rtol=1e-12)
+    small = flag_measurements(table, pair, spin_bound=1.0)
     assert not small["rotation_sensitive"].any()
     assert small.attrs["spin_bound_source"] == "argument"
 
@@ -83,9 +87,21 @@ def test_angle_uncertainty_sources(flags, table, pair):
     assert "table column" in flags.attrs["angle_uncertainty_source"]
     # with 1 deg around normal incidence e_n hardly moves: not angle sensitive
     assert not flags["angle_sensitive"].any()
-    # a 40 deg uncertainty cuts v_n by up to 23 %: e_n changes far more than its 3 % uncertainty
+    # a 40 deg uncertainty cuts v_n by 23 %: flagged exactly where that moves e_n by more than the row's
+    # uncertainty, by an engine solve at v cos(40 deg) written here (not the flags' own samples)
+    from microimpact.solvers import engine
+
     wide = flag_measurements(table, pair, angle_uncertainty_deg=40.0, spin_bound=0.0)
-    assert wide["angle_sensitive"].all()
+    expected = []
+    for _, row in table.iterrows():
+        c = pair.contact(row["radius"])
+        vn = row["speed"] * np.cos(np.radians(row["incidence_deg"]))
+        e = engine.solve_normal_many(c, np.array([vn, vn * np.cos(np.radians(40.0))]))["e_n"]
+        expected.append(abs(e[1] - e[0]) > row["e_n_uncertainty"])
+    np.testing.assert_array_equal(wide["angle_sensitive"].values.astype(bool), np.array(expected))
+    assert 0 < sum(expected) < len(expected)  # near capture e_n is steep, far above it flat
+    low = wide["e_n_shift_low_angle"].values
+    assert (low <= 0).all() and (low[np.array(expected)] < 0).all()  # a larger angle lowers v_n and e_n
     no_col = table.drop(columns=["incidence_deg_uncertainty"])
     d = flag_measurements(no_col.iloc[:2], pair, spin_bound=0.0)
     np.testing.assert_allclose(d["angle_uncertainty_deg"], 2.0)

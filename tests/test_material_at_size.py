@@ -97,7 +97,7 @@ def test_conflicting_or_wrong_material_sources_are_refused(capsys, fit_file, tmp
 def test_sweep_and_target_keep_the_material_and_record_it(capsys, tmp_path):
     out = tmp_path / "s.nc"
     assert main(["sweep", "--case", "2.1", "--radius", "1.29e-6", "--out", str(out)]) == 0
-    assert "by Eq. (7)" in capsys.readouterr().err
+    assert "by Eq. (7)" in capsys.readouterr().out
     with xr.open_dataset(out) as ds:
         assert "by Eq. (7) at r = 1.29e-06 m" in ds.attrs["contact_source"]
         f0 = [float(v) for k, v in ds.attrs.items() if k.endswith("adhesion_line_force")]

@@ -192,7 +192,7 @@ def contact_from_args(args) -> Contact:
         note = (f"f0 = {contact.adhesion_line_force:.6g} N/m from w_A = {w_a:.6g} J/m2 by Eq. (7) at "
                 f"r = {contact.radius:.6g} m")
     else:
-        contact = base
+        contact = base.with_(**changes) if changes else base
         note = f"f0 = {contact.adhesion_line_force:.6g} N/m of the material"
     args.contact_note = f"{label}; {note}"
     return contact
@@ -394,11 +394,9 @@ def _cmd_flags(args) -> int:
                            rtol=args.rtol, progress=True, posterior=posterior, time_budget=args.time_budget)
     with reporting_os_errors(outputs):
         write_flags(ds, out, nc)
-    n = ds.sizes["impact"]
-    print(f"{n} impacts: {int(ds['rotation_sensitive'].sum())} rotation_sensitive, "
-          f"{int(ds['angle_sensitive'].sum())} angle_sensitive, {int(ds['near_capture'].sum())} near_capture"
-          + (f", {int(ds['probably_spun'].sum())} probably_spun" if "probably_spun" in ds else "")
-          + f"; wrote {out}" + (f" and {nc}" if nc else ""))
+    from microimpact.analysis.flags import flag_summary
+
+    print(flag_summary(ds) + f"; wrote {out}" + (f" and {nc}" if nc else ""))
     return 0
 
 
@@ -445,7 +443,6 @@ def _cmd_target(args) -> int:
     if out is not None and not str(out).endswith((".csv", ".nc")):
         raise UsageError(f"--out {args.out!r}: the output must end in .csv or .nc")
     contact = contact_from_args(args)
-    print(f"material: {args.contact_note}", file=sys.stderr)
     res = damping_from_target(args.e_n, args.speed, contact, e_n_uncertainty=args.e_n_uncertainty,
                               n_points=args.points, rtol=args.rtol)
     c = res.curves
@@ -456,6 +453,7 @@ def _cmd_target(args) -> int:
     if res.best is not None:
         print("least squares over the targets: " + ", ".join(
             f"{k} = {v:.6g} +/- {res.stderr[k]:.3g}" for k, v in res.best.items()))
+    print(f"material: {args.contact_note}", file=sys.stderr)
     if out is not None:
         with reporting_os_errors({"--out": out}):
             res.save(out)
@@ -487,12 +485,12 @@ def _cmd_sweep(args) -> int:
         raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(TABLE2_CASES)}")
     contact = contact_from_args(args)
     out = check_outputs({"--out": args.out})["--out"]
-    print(f"material: {args.contact_note}", file=sys.stderr)
     ds = run_sweep(contact, case=args.case, rtol=args.rtol, progress=True, time_budget=args.time_budget)
     ds.attrs["contact_source"] = args.contact_note
     with reporting_os_errors({"--out": out}):
         write_netcdf(ds, out)
     print(f"case {args.case}: {dict(ds.sizes)} impacts, {int(ds['outcome'].sum())} captured; wrote {out}")
+    print(f"material: {args.contact_note}")
     return 0
 
 

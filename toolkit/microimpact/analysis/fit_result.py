@@ -273,7 +273,7 @@ class DampingFit:
 
 # --------------------------------------------------------------------------- the one formatter
 #: columns of :func:`fit_parameter_table`
-PARAMETER_TABLE_COLUMNS = ("parameter", "units", "value", "stderr", "relative", "ci1", "ci2", "method")
+PARAMETER_TABLE_COLUMNS = ("parameter", "units", "value", "stderr", "relative", "ci95", "ci1", "ci2", "method")
 
 
 def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
@@ -314,10 +314,12 @@ def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
         else:
             ci1 = ci2 = None
             method = "not estimated"
+        meaningful = math.isfinite(s) and v and s <= abs(v)  # a standard error above 100 % is not printed
         rows.append(row | {
-            "stderr": f"{s:.3g}", "relative": f"{100 * s / abs(v):.2g} %" if v and math.isfinite(s) else "",
-            "ci1": f"[{ci1[0]:.5g}, {ci1[1]:.5g}]" if ci1 else "",
-            "ci2": f"[{ci2[0]:.5g}, {ci2[1]:.5g}]" if ci2 else "", "method": method})
+            "stderr": f"{s:.3g}" if meaningful else "n/a", "relative": f"{100 * s / abs(v):.2g} %" if meaningful else "",
+            "ci95": f"[{st.lower:.5g}, {st.upper:.5g}]" if st is not None else "",
+            "ci1": f"[{ci1[0]:.5g}, {ci1[1]:.5g}]" if ci1 and meaningful else "",
+            "ci2": f"[{ci2[0]:.5g}, {ci2[1]:.5g}]" if ci2 and meaningful else "", "method": method})
     return pd.DataFrame(rows, columns=list(PARAMETER_TABLE_COLUMNS))
 
 
@@ -401,8 +403,10 @@ def format_fit(fit: "DampingFit", style: str = "text") -> str:
             continue
         rel = f" ({r['relative']})" if r["relative"] else ""
         how = "" if r["method"].startswith("profile") else f" ({r['method']})"
+        ci95 = f"; 95 % interval {r['ci95']} (profile likelihood)" if r["ci95"] else ""
         ci = f"; 1-sigma CI {r['ci1']}, 2-sigma CI {r['ci2']}{how}" if r["ci1"] else ""
-        lines.append(f"    {r['parameter']:<17}= {r['value']} +/- {r['stderr']}{rel} [{r['units']}]{ci}")
+        err = f" +/- {r['stderr']}{rel}" if r["stderr"] != "n/a" else ""
+        lines.append(f"    {r['parameter']:<17}= {r['value']}{err} [{r['units']}]{ci95}{ci}")
     if facts["correlations"]:
         lines += ["  correlations:"] + [f"    {c}" for c in facts["correlations"]]
     for label in ("chi-square", "AIC, BIC", "evaluations", "note", "measurements"):

@@ -22,12 +22,17 @@ taken at the nominal angle, ranges "over angle" at zero spin.
 
 Flags (thresholds recorded as Dataset attributes ``threshold_*``)
 -----------------------------------------------------------------
-* ``rotation_sensitive``: over spin, range(mu_t) or range(mu_t') > ``mu`` (default 0.05), or
-  range(K_L) > ``K_L`` (default 0.05), or range(e_n) > the e_n limit (never, by the decoupling of
-  the normal motion; kept so that the definition does not depend on it), or some spin samples are
-  captured and others not.
-* ``angle_sensitive``: over angle, range(e_n) > the e_n limit, or range(mu_t) or range(mu_t') >
-  ``mu``, or range(K_L) > ``K_L``, or the outcome changes.
+A flag is raised only where the unmeasured quantity can move a quantity the row MEASURED by more
+than its stated uncertainty (mu_t, mu_t' and K_L are derived coefficients no row measured; their
+spreads are reported, not flagged):
+
+* ``rotation_sensitive``: over spin, range(e_n) > the e_n limit (never, by the decoupling of the
+  normal motion: e_n-only rows are never R), or the row's oblique measurement moves by more than its
+  uncertainty (``spin_moves_prediction`` of :mod:`microimpact.analysis.spin`), or some spin samples
+  are captured and others not.
+* ``angle_sensitive``: over +/- one angle uncertainty, range(e_n) > the e_n limit, or the row's
+  oblique measurement moves by more than its uncertainty (``angle_moves_prediction``), or the
+  outcome changes. ``e_n_shift_low_angle``/``_high_angle`` say by how much and in which direction.
   The e_n limit is the impact's ``e_n_uncertainty`` when the table gives one (a spread smaller
   than the measurement error cannot be seen), else ``e_n`` (default 0.02).
 * ``near_capture``: normal speed / capture velocity < ``near_capture_ratio`` (default 1.5; e_n is
@@ -53,7 +58,7 @@ from microimpact.io.variables import attributes
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 from microimpact.solvers.impact import simulate_many
 
-__all__ = ["flag_measurements", "write_flags", "fibonacci_sphere", "DEFAULT_THRESHOLDS"]
+__all__ = ["flag_measurements", "write_flags", "fibonacci_sphere", "flag_summary", "DEFAULT_THRESHOLDS", "FLAG_LETTERS"]
 
 #: default flag thresholds (see the module docstring)
 DEFAULT_THRESHOLDS = {"mu": 0.05, "K_L": 0.05, "e_n": 0.02, "near_capture_ratio": 1.5}
@@ -269,10 +274,10 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
     def rng(c, s):
         return np.nan_to_num(out[f"{c}_max_{s}"] - out[f"{c}_min_{s}"], nan=0.0)
 
-    rot = ((rng("mu_t", "spin") > th["mu"]) | (rng("mu_tp", "spin") > th["mu"]) | (rng("K_L", "spin") > th["K_L"])
-           | (rng("e_n", "spin") > en_limit) | out["switch_spin"])
-    ang = ((rng("e_n", "angle") > en_limit) | (rng("mu_t", "angle") > th["mu"]) | (rng("mu_tp", "angle") > th["mu"])
-           | (rng("K_L", "angle") > th["K_L"]) | out["switch_angle"])
+    # only what the row MEASURED counts: e_n here (the oblique quantity below, from the explanation);
+    # mu_t, mu_t' and K_L are derived coefficients no row measured, so their spread flags nothing
+    rot = (rng("e_n", "spin") > en_limit) | out["switch_spin"]
+    ang = (rng("e_n", "angle") > en_limit) | out["switch_angle"]
     ratio = imp.normal_speed / out["capture_velocity"]
     res = _flags_dataset(imp, out, ratio, en_limit, {"rotation_sensitive": rot, "angle_sensitive": ang,
                                                      "near_capture": ratio < th["near_capture_ratio"]})
@@ -292,7 +297,30 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
                                 spin_bound=spin_bound, angle_uncertainty_deg=angle_uncertainty_deg,
                                 default_angle_uncertainty_deg=default_angle_uncertainty_deg, rtol=rtol,
                                 progress=progress, time_budget=deadline)
+    return _with_ids(res, table)
+
+
+def _with_ids(res: xr.Dataset, table) -> xr.Dataset:
+    """The CSV's ``id`` of each row, as a data variable along ``impact`` (where the table has one)."""
+    if "id" in table.columns:
+        res["id"] = ("impact", table["id"].astype("string").fillna("").to_numpy(dtype=object).astype(str).astype(object),
+                     {"long_name": "the id column of the impact CSV"})
     return res
+
+
+def flag_summary(ds: xr.Dataset) -> str:
+    """One line naming every flag kind found, with its count (kinds with none are left out).
+
+    Examples
+    --------
+    >>> import xarray as xr, numpy as np
+    >>> ds = xr.Dataset({"near_capture": ("impact", np.array([1, 0], dtype=np.int8))})
+    >>> flag_summary(ds)
+    '2 impacts: 1 near_capture (N)'
+    """
+    kinds = [(name, letter) for name, letter in FLAG_LETTERS.items() if name in ds]
+    found = [f"{int(ds[name].sum())} {name} ({letter})" for name, letter in kinds if int(ds[name].sum())]
+    return f"{ds.sizes['impact']} impacts: " + (", ".join(found) if found else "no flags")
 
 
 def _thresholds(overrides) -> dict:
@@ -311,15 +339,24 @@ def _with_explanation(res: xr.Dataset, table, fit, *, posterior, **options) -> x
     extra = spin_explanation(table, fit, posterior=posterior, **options)
     res = res.merge(extra.drop_vars("spin_scan_bound"), combine_attrs="no_conflicts")
     res.attrs["explanation_draws"] = "posterior draws" if posterior is not None else "point estimate"
+    # a row's oblique measurement that spin (the angle error) moves by more than its uncertainty
+    oblique = res["predicted_quantity"].values != "e_n"
+    res["rotation_sensitive"].values |= (oblique & (res["spin_moves_prediction"].values == 1)).astype(np.int8)
+    res["angle_sensitive"].values |= (oblique & (res["angle_moves_prediction"].values == 1)).astype(np.int8)
     return res
 
 
+#: flag -> the letter the report and the summary use
+FLAG_LETTERS = {"rotation_sensitive": "R", "angle_sensitive": "A", "near_capture": "N", "probably_spun": "S",
+                "spin_unexplained": "U"}
 #: flag name -> (flag_meanings, long_name)
 _FLAGS = {
-    "rotation_sensitive": ("insensitive rotation_sensitive", "range over spin of mu_t or mu_t' > threshold_mu, or "
-                           "of K_L > threshold_K_L, or of e_n > e_n_limit, or outcome changes"),
-    "angle_sensitive": ("insensitive angle_sensitive", "range over angle of e_n > e_n_limit, or of mu_t or mu_t' > "
-                        "threshold_mu, or of K_L > threshold_K_L, or outcome changes"),
+    "rotation_sensitive": ("insensitive rotation_sensitive", "unmeasured spin moves a measured quantity by more than "
+                           "its uncertainty: e_n over spin > e_n_limit (never: the normal motion decouples), or the "
+                           "row's oblique measurement (spin_moves_prediction), or the outcome changes"),
+    "angle_sensitive": ("insensitive angle_sensitive", "the angle error moves a measured quantity by more than its "
+                        "uncertainty: e_n at +/- one angle uncertainty > e_n_limit, or the row's oblique measurement "
+                        "(angle_moves_prediction), or the outcome changes"),
     "near_capture": ("far near_capture", "capture_speed_ratio < threshold_near_capture_ratio"),
 }
 
@@ -344,6 +381,10 @@ def _flags_dataset(imp: _Impacts, out: dict, ratio, en_limit, flags: dict) -> xr
     res["angle_uncertainty_deg"] = ("impact", imp.angle_uncertainty_deg, attributes(
         "angle_uncertainty_deg", long_name=f"{attributes('angle_uncertainty_deg')['long_name']} ({imp.angle_source})"))
     res["e_n_limit"] = ("impact", en_limit, attributes("e_n_limit"))
+    for side, mm in (("low", "min"), ("high", "max")):
+        res[f"e_n_shift_{side}_angle"] = ("impact", np.nan_to_num(out[f"e_n_{mm}_angle"] - out["e_n"]), {
+            "units": "1", "long_name": f"{'most negative' if side == 'low' else 'most positive'} change of the model "
+                                      "e_n at +/- one angle uncertainty (zero spin)"})
     for name, (meanings, long_name) in _FLAGS.items():
         res[name] = ("impact", flags[name].astype(np.int8), {
             "flag_values": np.array([0, 1], dtype=np.int8), "flag_meanings": meanings, "long_name": long_name})

@@ -521,6 +521,11 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
             cov = _damping_covariance(damping_fit)
             g = np.array([gradient["friction"][p] for p in damping_fit.varied])
             var_damping = float(g @ cov @ g) if np.all(np.isfinite(g)) else math.nan
+    return _friction_result(problem, objective, best, var_damping, gradient, weighted, model_name, t0)
+
+
+def _friction_result(problem, objective, best, var_damping, gradient, weighted, model_name, t0) -> "FrictionFit":
+    """The FrictionFit of a profile fit: status, value and errors only where f is determined."""
     status = _friction_status(best, objective, var_damping)
     p = {"friction": float(best.value)}
     sigma = objective.sigma(best.value)

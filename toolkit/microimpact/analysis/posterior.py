@@ -390,14 +390,15 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     documentation recommends for correlated, low-dimensional posteriors; on the bundled data they
     reach the 50-tau rule in fewer steps than the default stretch move.
 
+    Length: two thirds of the function is this docstring (the options, errors and criteria an
+    analyst needs to read in one place); the code is the checks, the likelihood and the result.
+
     References
     ----------
     Foreman-Mackey, D. et al. (2013). emcee: the MCMC hammer. PASP 125, 306. doi:10.1086/670067;
     Vehtari, A. et al. (2021). doi:10.1214/20-BA1221 (R-hat, effective sample size).
     """
-    import emcee
-
-    from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX, ess_bulk, split_rhat
+    from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX
     from microimpact.analysis.oblique import engine_threads
 
     t0 = time.perf_counter()
@@ -426,24 +427,10 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
         return value if math.isfinite(value) else -np.inf
 
     pos = np.clip(_start_ball(names, best, stderr, lo, walkers, seed), lo, hi)
-    rng = np.random.default_rng(seed)
-    moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
-    sampler = emcee.EnsembleSampler(walkers, len(names), log_probability, moves=moves)
-    sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()  # seeded
-    state = emcee.State(pos)
-    done, previous_tau, diag = 0, None, None
     with progress_bar(budget, "posterior", progress) as advance, engine_threads(1):
         advance = deadline.ticking(advance, budget, "emcee steps")
-        while done < budget:
-            chunk = min(CHECK_EVERY, budget - done)
-            for state in sampler.sample(state, iterations=chunk, store=True):
-                advance(1)
-            done += chunk
-            diag = _diagnose(sampler, names, burn, split_rhat, ess_bulk)
-            _raise_if_collapsed(diag, names, damping_fit, friction_fit, done)
-            if not fixed_length and _converged(diag, previous_tau, RHAT_MAX, ESS_MIN):
-                break
-            previous_tau = diag["tau"]
+        sampler, diag, previous_tau, done = _run_chain(log_probability, pos, seed, budget, fixed_length, burn, advance,
+                                                       names, damping_fit, friction_fit)
     converged = _converged(diag, previous_tau if not fixed_length else diag["tau"], RHAT_MAX, ESS_MIN)
     text = _convergence_text(diag, converged, RHAT_MAX, ESS_MIN)
     if require_convergence and not converged:
@@ -468,6 +455,32 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
                            "status": _statuses(damping_fit, friction_fit),
                            "bounds": _statuses(damping_fit, friction_fit, "bounds"),
                            "moves": "emcee DEMove 0.8 + DESnookerMove 0.2"})
+
+
+def _run_chain(log_probability, pos, seed, budget, fixed_length, burn, advance, names, damping_fit, friction_fit):
+    """(sampler, diagnostics, previous tau, steps done): chunks of CHECK_EVERY steps until converged,
+    collapsed (PosteriorError) or out of ``budget`` steps."""
+    import emcee
+
+    from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX, ess_bulk, split_rhat
+
+    rng = np.random.default_rng(seed)
+    moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+    sampler = emcee.EnsembleSampler(len(pos), len(names), log_probability, moves=moves)
+    sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()  # seeded
+    state = emcee.State(pos)
+    done, previous_tau, diag = 0, None, None
+    while done < budget:
+        chunk = min(CHECK_EVERY, budget - done)
+        for state in sampler.sample(state, iterations=chunk, store=True):
+            advance(1)
+        done += chunk
+        diag = _diagnose(sampler, names, burn, split_rhat, ess_bulk)
+        _raise_if_collapsed(diag, names, damping_fit, friction_fit, done)
+        if not fixed_length and _converged(diag, previous_tau, RHAT_MAX, ESS_MIN):
+            break
+        previous_tau = diag["tau"]
+    return sampler, diag, previous_tau, done
 
 
 def _diagnose(sampler, names, burn, split_rhat, ess_bulk) -> dict:

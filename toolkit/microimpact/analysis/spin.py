@@ -16,12 +16,14 @@ posterior (a set of posterior draws, or the point estimate when no posterior is 
 2. **Which unmeasured spin is consistent with the measurement?** (the inverse problem) The spin
    about t' (top-spin +, back-spin -, in the incidence plane: the one that changes the in-plane
    rebound) is scanned over [-bound, +bound]; a spin is consistent when the posterior-median
-   prediction lies within 2 sigma of the measured value, sigma^2 = (measurement uncertainty, with
+   prediction lies within :data:`CONSISTENCY_SIGMAS` (3) sigma of the measured value, sigma^2 = (measurement uncertainty, with
    the effective variance of the speed and angle errors)^2 + (posterior spread of the prediction)^2.
    The row gets ``spin_low`` / ``spin_high`` (the consistent range, [rad/s]; the whole scan for a
    row that cannot constrain spin, NaN when no spin in the scan is consistent),
-   ``probably_spun`` (zero spin is NOT consistent, some spin is) and ``spin_unexplained`` (no spin
-   in the scan explains the row: look for another cause).
+   ``probably_spun`` (zero spin is NOT consistent, some spin is) and ``spin_unexplained`` (the
+   measured quantity depends on spin, yet no spin in the scan explains the row, ``closest_sigma``
+   standard uncertainties away at best: look for another cause). A row whose prediction does not
+   depend on spin (e_n) admits every spin and is never U.
 
 Every prediction goes through :func:`microimpact.analysis.oblique.rebound_state`, i.e. one
 :func:`microimpact.solvers.engine.solve_normal_many` batch per radius and draw plus the closed-form
@@ -55,12 +57,27 @@ SPIN_VARIABLES = {
     "spin_low": ("rad s-1", "lowest incident top-spin (back-spin negative) consistent with the measurement"),
     "spin_high": ("rad s-1", "highest incident top-spin (back-spin negative) consistent with the measurement"),
     "spin_scan_bound": ("rad s-1", "largest spin magnitude scanned"),
+    "spin_shift_low": (None, "most negative change of the prediction over the spin scan (posterior median), in the "
+                             "unit of predicted_quantity"),
+    "spin_shift_high": (None, "most positive change of the prediction over the spin scan (posterior median), in the "
+                              "unit of predicted_quantity"),
+    "angle_shift_low": (None, "most negative change of the prediction at +/- one angle uncertainty (posterior "
+                              "median), in the unit of predicted_quantity"),
+    "angle_shift_high": (None, "most positive change of the prediction at +/- one angle uncertainty (posterior "
+                               "median), in the unit of predicted_quantity"),
+    "closest_sigma": ("1", "smallest distance of the prediction from the measurement over the spin scan, in "
+                           "standard uncertainties (measurement, speed and angle errors, posterior spread)"),
 }
+#: a spin is consistent with a row when the prediction lies within this many standard uncertainties
+#: of the measurement: 3 keeps a clean row unflagged with probability 0.997, so that a flag on a
+#: data set of tens of rows points at a real cause rather than at the noise
+CONSISTENCY_SIGMAS = 3.0
 _FLAGS = {
     "spin_moves_prediction": ("still moves", "spin_moves_probability >= 0.5"),
     "angle_moves_prediction": ("still moves", "angle_moves_probability >= 0.5"),
     "probably_spun": ("unspun_consistent probably_spun", "zero spin is outside the consistent spin range"),
-    "spin_unexplained": ("explained unexplained", "no spin in the scan is consistent with the measurement"),
+    "spin_unexplained": ("explained unexplained", "the measured quantity depends on spin, yet no spin in the scan is "
+                                                  "consistent with the measurement"),
 }
 
 
@@ -201,11 +218,19 @@ def _explain(pred, k0, n_scan, quantity, measured, sigma_m, bound, scan, table) 
         sigma_eff = np.sqrt(sigma_m ** 2 + np.nanmedian(speed_change, axis=0) ** 2 + np.nanmedian(angle_change, axis=0) ** 2)
         med = np.nanmedian(pred[:, :, :n_scan], axis=0)
         spread = np.nanstd(pred[:, :, :n_scan], axis=0)
+        signed = np.nanmedian(pred - p0[:, :, None], axis=0)  # (impact, sample): median change from zero spin
+        spin_lo, spin_hi = np.nanmin(signed[:, :n_scan], axis=1), np.nanmax(signed[:, :n_scan], axis=1)
+        angle_lo = np.nanmin(signed[:, n_scan:n_scan + 2], axis=1)
+        angle_hi = np.nanmax(signed[:, n_scan:n_scan + 2], axis=1)
+        distance = np.abs(med - measured[:, None]) / np.sqrt(sigma_eff[:, None] ** 2 + spread ** 2)
     spin_p = np.mean(np.nan_to_num(spin_change) > sigma_m[None, :], axis=0)
     angle_p = np.mean(np.nan_to_num(angle_change) > sigma_m[None, :], axis=0)
-    ok = np.abs(med - measured[:, None]) <= 2.0 * np.sqrt(sigma_eff[:, None] ** 2 + spread ** 2)
-    ok &= np.isfinite(med)
+    ok = np.isfinite(distance) & (distance <= CONSISTENCY_SIGMAS)
     spins = bound[:, None] * scan[None, :]
+    # a row whose prediction does not move with spin (e_n, by the decoupling of the normal motion)
+    # admits every spin: whether it fits the model is not a question about spin
+    blind = np.nanmax(np.nan_to_num(spin_change), axis=0) <= 1e-9 * np.maximum(np.abs(np.nan_to_num(p0)).max(axis=0), 1e-300)
+    ok |= blind[:, None]
     any_ok = ok.any(axis=1)
     low = np.where(any_ok, np.min(np.where(ok, spins, np.inf), axis=1), np.nan)
     high = np.where(any_ok, np.max(np.where(ok, spins, -np.inf), axis=1), np.nan)
@@ -215,7 +240,10 @@ def _explain(pred, k0, n_scan, quantity, measured, sigma_m, bound, scan, table) 
               "spin_shift": np.nan_to_num(np.median(spin_change, axis=0)) / sigma_m,
               "angle_shift": np.nan_to_num(np.median(angle_change, axis=0)) / sigma_m,
               "spin_moves_probability": spin_p, "angle_moves_probability": angle_p,
-              "spin_low": low, "spin_high": high, "spin_scan_bound": bound}
+              "spin_low": low, "spin_high": high, "spin_scan_bound": bound,
+              "spin_shift_low": np.nan_to_num(spin_lo), "spin_shift_high": np.nan_to_num(spin_hi),
+              "angle_shift_low": np.nan_to_num(angle_lo), "angle_shift_high": np.nan_to_num(angle_hi),
+              "closest_sigma": np.nanmin(np.where(np.isfinite(distance), distance, np.inf), axis=1)}
     for name, v in values.items():
         units, long_name = SPIN_VARIABLES[name]
         ds[name] = ("impact", v, {"long_name": long_name} | ({"units": units} if units else {}))
@@ -226,6 +254,7 @@ def _explain(pred, k0, n_scan, quantity, measured, sigma_m, bound, scan, table) 
                                                             "flag_meanings": meanings, "long_name": long_name})
     ds.attrs["spin_explanation"] = (
         f"spin about t' (top-spin +) scanned over +/- spin_scan_bound in {n_scan} steps; consistent: posterior-median "
-        "prediction within 2 sigma of the measurement (measurement, speed and angle errors and posterior spread)")
+        f"prediction within {CONSISTENCY_SIGMAS:g} sigma of the measurement (measurement, speed and angle errors and "
+        "posterior spread); a row whose prediction does not depend on spin (e_n) admits every spin")
     ds.attrs["spin_quantity_units"] = "; ".join(f"{k}: {v}" for k, v in (OBSERVABLE_UNITS | {"e_n": "1"}).items())
     return ds

@@ -45,9 +45,8 @@ def fit_section(lay: Layout, fit: xr.Dataset, curves: xr.Dataset | None, data: p
         lay.paragraph("(No fit_curves file was given: the model is drawn at the data points.)", color="0.4")
     lay.plot(figures.plot_fit(fit, curves), max_height=3.8)
     lay.heading("Fitted parameters")
-    lay.table(_parameter_rows(fit), {"parameter": 17, "units": 6, "value": 10, "stderr": 9, "ci1": 20, "ci2": 20,
-                                     "method": 34},
-              headers={"ci1": "1-sigma interval", "ci2": "2-sigma interval", "stderr": "std. error"}, size=7.2)
+    lay.table(_parameter_rows(fit), {"parameter": 17, "units": 6, "value": 22, "stderr": 14, "ci95": 24, "method": 40},
+              headers={"ci95": "95 % interval (profile)", "stderr": "std. error"}, size=7.2)
     lay.paragraph(_fit_statistics(fit))
     if data is not None and len(data):
         lay.heading("Data by sphere size (validated table, SI units)")
@@ -73,26 +72,31 @@ def _fit_parameters(fit: xr.Dataset) -> list[str]:
 
 
 def _parameter_rows(fit: xr.Dataset) -> pd.DataFrame:
-    """One row per fit parameter: value, standard error, 1- and 2-sigma intervals and how they were found."""
+    """One row per fit parameter: value, standard error and 95 % interval where the data determine it,
+    else the bound or 'not determined' (the fit's ``<name>_status`` variables); no standard error
+    above 100 % of the value is printed as a number."""
+    from microimpact.io.statuses import status_from_variables
+
     rows = []
     for name in _fit_parameters(fit):
         units = fit[name].attrs.get("units", "")
-        v = float(fit[name])
-        se = float(fit[f"{name}_stderr"])
+        v, se = float(fit[name]), float(fit[f"{name}_stderr"])
         if not bool(int(fit[name].attrs.get("varied", 1))):
-            rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": "fixed",
-                         "ci1": "", "ci2": "", "method": "fixed (materials config)"})
+            rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": "fixed", "ci95": "",
+                         "method": "fixed (materials config)"})
             continue
-        prof = {}
-        if f"{name}_confidence_limit" in fit:
-            lim = fit[f"{name}_confidence_limit"]
-            prof = dict(zip((int(s) for s in lim["sigma_level"].values), (float(x) for x in lim.values)))
-        if all(math.isfinite(prof.get(k, math.nan)) for k in (-1, 1, -2, 2)):
-            ci1, ci2, method = (prof[-1], prof[1]), (prof[-2], prof[2]), "profile likelihood (lmfit.conf_interval)"
-        else:
-            ci1, ci2, method = (v - se, v + se), (v - 2 * se, v + 2 * se), "covariance: value +/- k stderr"
-        rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": f"{se:.3g}",
-                     "ci1": f"[{ci1[0]:.5g}, {ci1[1]:.5g}]", "ci2": f"[{ci2[0]:.5g}, {ci2[1]:.5g}]", "method": method})
+        st = status_from_variables(fit, name, v)
+        if st is not None and not st.determined:
+            value = {"lower_bound": f">= {st.lower:.4g}", "upper_bound": f"<= {st.upper:.4g}"}.get(st.status,
+                                                                                                "not determined")
+            rows.append({"parameter": name, "units": units, "value": value, "stderr": "-", "ci95": "-",
+                         "method": f"not determined by these data: {st.reason}"})
+            continue
+        meaningful = math.isfinite(se) and v and se <= abs(v)
+        ci = (st.lower, st.upper) if st is not None else (v - 1.96 * se, v + 1.96 * se)
+        rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": f"{se:.3g}" if meaningful else "-",
+                     "ci95": f"[{ci[0]:.5g}, {ci[1]:.5g}]",
+                     "method": "profile likelihood" if st is not None else "covariance: value +/- 1.96 stderr"})
     return pd.DataFrame(rows)
 
 
@@ -131,12 +135,15 @@ def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset) -> None:
         lay.paragraph(f"(No posterior: {post.attrs.get('comment', 'not computed')}.)", color="0.4")
         return
     lay.paragraph(
-        "The fitted parameters sampled with emcee (affine-invariant ensemble sampler) through lmfit's "
-        f"Minimizer.emcee, seeded (seed {post.attrs.get('seed')}), flat priors within the bounds, walkers started "
-        "around the least-squares fit. Speed errors: " + str(post.attrs.get("errors_in_variables", "")) + ". "
-        + str(post.attrs.get("convergence", "")) + ".")
-    lay.table(_posterior_rows(post), {"parameter": 17, "median": 11, "ci95": 26, "tau": 11, "units": 7},
-              headers={"ci95": "95 % credible interval", "tau": "autocorr. [steps]"}, size=7.2)
+        "The fitted parameters sampled with emcee (ensemble sampler, differential-evolution moves), seeded "
+        f"(seed {post.attrs.get('seed')}), walkers started around the least-squares fit, run until converged "
+        "(50 autocorrelation times with a stable tau, rank-normalised split R-hat < 1.01, bulk effective sample "
+        "size >= 400; an unconverged chain stops the pipeline instead of reaching this page). Speed errors: "
+        + str(post.attrs.get("errors_in_variables", "")) + ". " + str(post.attrs.get("convergence", "")) + ".")
+    lay.table(_posterior_rows(post), {"parameter": 17, "median": 11, "ci95": 40, "prior": 18, "rhat": 8, "ess": 7,
+                                      "units": 7},
+              headers={"ci95": "95 % credible interval (or bound)", "prior": "flat prior", "rhat": "R-hat",
+                       "ess": "ESS"}, size=7.2)
     if "e_n_band" in post:
         lay.plot(pfig.plot_fit_bands(fit, post), max_height=3.6)
     lay.plot(pfig.plot_corner(post), max_height=4.6)
@@ -154,12 +161,18 @@ def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset) -> None:
 
 
 def _posterior_rows(post: xr.Dataset) -> pd.DataFrame:
+    """Median and 95 % interval where the data determine the parameter; its statement otherwise."""
     rows = []
     for n in pfig.posterior_names(post):
         q = post[f"{n}_quantile"]
+        a = post[f"chain_{n}"].attrs
         at = lambda x: float(q.sel(quantile=x, method="nearest"))  # noqa: E731
-        rows.append({"parameter": n, "median": f"{at(0.5):.5g}", "ci95": f"[{at(0.025):.5g}, {at(0.975):.5g}]",
-                     "tau": f"{float(post[f'{n}_autocorr_time']):.1f}", "units": q.attrs.get("units", "")})
+        determined = a.get("status", "determined") == "determined"
+        rows.append({"parameter": n, "median": f"{at(0.5):.5g}" if determined else "-",
+                     "ci95": f"[{at(0.025):.5g}, {at(0.975):.5g}]" if determined else str(a.get("statement", "")),
+                     "prior": f"[{a['prior_min']:.3g}, {a['prior_max']:.3g}]" if "prior_min" in a else "",
+                     "rhat": f"{a['rhat']:.3f}" if "rhat" in a else "", "ess": f"{a['ess_bulk']:.0f}" if "ess_bulk" in a else "",
+                     "units": q.attrs.get("units", "")})
     return pd.DataFrame(rows)
 
 
@@ -174,10 +187,22 @@ def oblique_section(lay: Layout, obl: xr.Dataset) -> None:
         f"Coulomb friction f fitted to the measured {', '.join(dict.fromkeys(str(q) for q in obl['quantity'].values))} "
         "with the paper's rigid tangential model (Eqs. (16)-(20)), AFTER the damping fit: the normal motion does not "
         "depend on f, and the tangential outcome depends on the damping only through the friction impulse, which the "
-        "e_n data fix; the damping covariance is propagated into the standard error "
-        f"(f = {float(obl['friction']):.5g} +- {float(obl['friction_stderr']):.3g}; "
-        f"{float(obl['friction_stderr_conditional']):.3g} at fixed damping).")
+        "e_n data fix; the damping covariance is propagated into the interval. " + _friction_statement(obl))
     lay.plot(pfig.plot_oblique(obl), max_height=4.0)
+
+
+def _friction_statement(obl: xr.Dataset) -> str:
+    """What the oblique data say of f: its value and 95 % interval, a one-sided bound, or nothing."""
+    from microimpact.io.statuses import status_from_variables
+
+    st = status_from_variables(obl, "friction", float(obl["friction"]))
+    if st is None:  # a file from before the identifiability
+        return (f"f = {float(obl['friction']):.5g} +- {float(obl['friction_stderr']):.3g} "
+                f"({float(obl['friction_stderr_conditional']):.3g} at fixed damping).")
+    if st.determined:
+        return (f"f = {st.value:.5g}, 95 % profile-likelihood interval [{st.lower:.5g}, {st.upper:.5g}] "
+                f"(standard error {float(obl['friction_stderr']):.3g}).")
+    return f"The data do not determine f: {st.describe()}."
 
 
 # =============================================================================== dynamics per size

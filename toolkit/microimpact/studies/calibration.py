@@ -217,9 +217,16 @@ def run_design(design: dict, *, posterior: bool = False, folder: Path | None = N
     base = SimpleNamespace(density=mat["density"], stiffness=mat["stiffness"],
                            work_of_adhesion=design["work_of_adhesion_start"], friction=0.5, damping_reference_speed=None)
     out = {"seed": design["seed"], "n_rows": int(len(table)), "fit_work_of_adhesion": design["fit_work_of_adhesion"]}
+    from microimpact.analysis.oblique import ObliqueProblem
+
+    try:
+        ObliqueProblem.from_table(table)
+        oblique = True
+    except ValueError:  # no oblique design, or every oblique impact captured: nothing to fit f from
+        oblique = False
     try:
         fit = fit_damping(table, base, fit_work_of_adhesion=design["fit_work_of_adhesion"], confidence_intervals=False)
-        ff = fit_friction(table, fit) if design["oblique"] is not None else None
+        ff = fit_friction(table, fit) if oblique else None
     except (ValueError, RuntimeError) as exc:
         return out | {"error": f"{type(exc).__name__}: {exc}", "seconds": time.perf_counter() - t0}
     damping_kind = "one speed" if design["one_speed"] else "speed range"

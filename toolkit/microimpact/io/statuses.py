@@ -1,0 +1,150 @@
+"""What the data determine about a fitted parameter, as a record and as CF NetCDF variables.
+
+:class:`ParameterStatus` is the answer of :mod:`microimpact.analysis.identifiability` (a value with
+its interval, a one-sided bound, or nothing); here it is stored and read back, so that everything
+that only reads result files (the report) can state it without importing the analysis.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["ParameterStatus", "STATUSES", "DEFAULT_LEVEL", "status_variables", "status_from_variables"]
+
+#: the four answers, in the order of their NetCDF flag values 0-3
+STATUSES = ("determined", "lower_bound", "upper_bound", "not_determined")
+#: confidence level of every reported interval and bound
+DEFAULT_LEVEL = 0.95
+
+
+
+@dataclass(frozen=True)
+class ParameterStatus:
+    """What the data say about one fitted parameter.
+
+    Attributes
+    ----------
+    name : str
+        Parameter name (``friction``, ``zeta_hertz``, ...).
+    status : str
+        One of :data:`STATUSES`.
+    value : float
+        The estimate where ``determined``, else NaN. [unit of the parameter]
+    lower, upper : float
+        The ``level`` interval where ``determined``; the bound and the end of the allowed range for
+        a one-sided bound (``lower_bound``: ``[bound, range max]``; ``upper_bound``:
+        ``[range min, bound]``); the whole allowed range where ``not_determined``.
+    level : float
+        Confidence level of ``[lower, upper]``. [-]
+    reason : str
+        Why, in the terms of the data (empty for an ordinary determined parameter).
+    method : str
+        How the interval was found: ``profile`` or ``covariance``.
+    """
+
+    name: str
+    status: str
+    value: float
+    lower: float
+    upper: float
+    level: float = DEFAULT_LEVEL
+    reason: str = ""
+    method: str = "covariance"
+
+    def __post_init__(self):
+        if self.status not in STATUSES:
+            raise ValueError(f"status must be one of {', '.join(STATUSES)}, got {self.status!r}")
+
+    @property
+    def determined(self) -> bool:
+        """True where the data determine a value with a finite two-sided interval."""
+        return self.status == "determined"
+
+    def contains(self, x: float) -> bool:
+        """Whether ``x`` lies in ``[lower, upper]`` (the interval, bound or range reported)."""
+        return bool(self.lower <= x <= self.upper)
+
+    def describe(self, unit: str = "", digits: int = 4) -> str:
+        """One line for a report: the value and interval, or the bound, or 'not determined'.
+
+        Examples
+        --------
+        >>> ParameterStatus("friction", "lower_bound", math.nan, 0.27, 10.0).describe()
+        'friction >= 0.27 (95 % bound; no upper limit up to 10 from these data)'
+        """
+        u = f" {unit}" if unit and unit != "1" else ""
+        pct = f"{100 * self.level:.0f} %"
+        g = f".{digits}g"
+        why = f": {self.reason}" if self.reason else ""
+        if self.status == "determined":
+            return f"{self.name} = {self.value:{g}}{u}, {pct} interval [{self.lower:{g}}, {self.upper:{g}}]{why}"
+        if self.status == "lower_bound":
+            return (f"{self.name} >= {self.lower:{g}}{u} ({pct} bound; no upper limit up to {self.upper:{g}} "
+                    f"from these data){why}")
+        if self.status == "upper_bound":
+            return (f"{self.name} <= {self.upper:{g}}{u} ({pct} bound; no lower limit down to {self.lower:{g}} "
+                    f"from these data){why}")
+        return f"{self.name}: not determined by these data (anywhere in [{self.lower:{g}}, {self.upper:{g}}]){why}"
+
+
+def status_variables(status: ParameterStatus, units: str) -> dict:
+    """CF variables of a :class:`ParameterStatus`: ``<name>_status`` (a flag), ``<name>_lower``, ``<name>_upper``.
+
+    Parameters
+    ----------
+    status : ParameterStatus
+    units : str
+        CF units of the parameter.
+
+    Returns
+    -------
+    dict of xarray.DataArray
+        Scalar variables; the status carries ``flag_values``/``flag_meanings`` (CF 1.10 section 3.5),
+        the reason, the level and the method as attributes.
+
+    Examples
+    --------
+    >>> v = status_variables(ParameterStatus("friction", "lower_bound", math.nan, 0.27, 10.0), "1")
+    >>> int(v["friction_status"]), v["friction_status"].attrs["flag_meanings"].split()[1]
+    (1, 'lower_bound')
+    """
+    import xarray as xr
+
+    n = status.name
+    what = {"determined": "interval", "lower_bound": "lower bound (upper: end of the range searched)",
+            "upper_bound": "upper bound (lower: start of the range searched)",
+            "not_determined": "range searched"}[status.status]
+    return {
+        f"{n}_status": xr.DataArray(np.int8(STATUSES.index(status.status)), attrs={
+            "long_name": f"what the data determine about {n}", "flag_values": np.arange(len(STATUSES), dtype=np.int8),
+            "flag_meanings": " ".join(STATUSES), "reason": status.reason or "determined", "level": status.level,
+            "method": status.method}),
+        f"{n}_lower": xr.DataArray(float(status.lower), attrs={
+            "units": units, "long_name": f"lower end of the {100 * status.level:.0f} % {what} of {n}"}),
+        f"{n}_upper": xr.DataArray(float(status.upper), attrs={
+            "units": units, "long_name": f"upper end of the {100 * status.level:.0f} % {what} of {n}"}),
+    }
+
+
+def status_from_variables(ds, name: str, value: float) -> ParameterStatus | None:
+    """Inverse of :func:`status_variables` (None where the file predates them).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+    name : str
+        Parameter name.
+    value : float
+        The stored estimate (used where the status is ``determined``).
+    """
+    if f"{name}_status" not in ds:
+        return None
+    v = ds[f"{name}_status"]
+    status = STATUSES[int(v.values)]
+    reason = str(v.attrs.get("reason", ""))
+    return ParameterStatus(name, status, float(value) if status == "determined" else math.nan,
+                           float(ds[f"{name}_lower"]), float(ds[f"{name}_upper"]), float(v.attrs.get("level", DEFAULT_LEVEL)),
+                           "" if reason == "determined" else reason, str(v.attrs.get("method", "")))
