@@ -9,7 +9,10 @@ added to the documentation without a test fails here:
 - ``run``: run by :func:`test_documented_command_runs`, in order, in a scratch directory holding a
   copy of data/ and docs/ (placeholders such as ``path/to/impacts.csv`` replaced by bundled files);
 - ``dry``: a Snakemake command, run as a dry run (``-n``) on a copy of the workflow;
-- ``ci``: run by ``.ci/run`` (the test checks that the CI script contains it).
+- ``ci``: run by ``.ci/run`` (the test checks that the CI script contains it);
+- ``study``: a documented study that takes tens of minutes (the committed results under docs/ came
+  from it); CI runs the same module on a smaller design (the test checks that ``.ci/run`` runs
+  ``python -m`` of that module).
 
 The Python examples (``python`` blocks) run too, and the example CSV of data/README.md is read by
 its own snippet.
@@ -46,8 +49,10 @@ HOW = {
     "microimpact fit data/synthetic_microspheres.csv --out fit.nc --posterior post.nc": "run",
     "microimpact flags data/synthetic_microspheres.csv --fit fit.nc --posterior post.nc --out flags.csv --nc flags.nc": "run",
     "microimpact target --e-n 0.6 --speed 2.0 --out curve.csv": "run",
-    # docs/posterior_coverage.md: 50 seeded data sets (minutes)
-    "python -m microimpact.analysis.coverage --out docs/posterior_coverage.json": "ci",
+    "microimpact simulate --fit fit.nc --radius 2e-6 --speed 3 --json": "run",
+    # docs/calibration.md: the calibration study (its full run takes tens of minutes: the CI runs a small one)
+    "python -m microimpact.studies.calibration --designs 300 --posterior-designs 40 --workers 2 --seed 1000 --out docs/calibration.json --figure docs/calibration.png": "study",
+    "python -m microimpact.studies.calibration --designs 12 --seed 7 --out calibration.json --figure calibration.png": "ci",
     "microimpact benchmark --quick --out results/benchmark": "ci",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "ci",
     "microimpact plot case_2.1.nc --out case_2.1.png": "run",
@@ -108,6 +113,12 @@ def test_every_documented_command_is_exercised():
     assert not unlisted, "add these commands to HOW (how they are tested):\n" + "\n".join(unlisted)
     stale = sorted(set(HOW) - {c for _, c in documented_commands()})
     assert not stale, f"HOW lists commands that no document has any more: {stale}"
+
+
+@pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "study"])
+def test_ci_runs_a_smaller_form_of_each_study(command):
+    module = re.match(r"python -m ([\w.]+)", command)[1]
+    assert f"python -m {module} " in CI, f".ci/run does not run python -m {module}"
 
 
 @pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "ci"])

@@ -206,14 +206,12 @@ def test_analyst_fit_shares_one_budget(table, pair, clock):
         analyse_impacts(table, pair, time_budget=fit_checks + 1.0, posterior={"walkers": 4, "steps": 3, "n_draws": 2})
 
 
-def test_coverage_budget():
-    from microimpact.analysis.coverage import posterior_coverage
+def test_calibration_budget():
+    from microimpact.studies.calibration import calibration_study
 
-    with pytest.raises(TimeBudgetExceeded, match=r"^fit: time budget of 1e-09 s"):
-        posterior_coverage(2, n_per_radius=4, walkers=4, steps=4, burn=1, time_budget=TINY)
+    with pytest.raises(TimeBudgetExceeded, match=r"^calibration study: time budget of 1e-09 s exceeded after 1 of 2 designs$"):
+        calibration_study(2, seed=5, time_budget=TINY)
 
-
-# --------------------------------------------------------------------------- flags
 def test_flags_budget(table, fit):
     from microimpact.analysis.flags import flag_measurements
 

@@ -358,24 +358,22 @@ def _add_posterior_options(p: argparse.ArgumentParser) -> None:
                    help="write the friction fit (oblique columns: measured vs fitted per row) to this NetCDF")
 
 
-def _non_negative_int(text: str) -> int:
+def _whole_number(text: str, smallest: int) -> int:
     try:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {text!r}")
+    if value < smallest:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= {smallest}, got {text!r}")
     return value
+
+
+def _non_negative_int(text: str) -> int:
+    return _whole_number(text, 0)
 
 
 def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
-    return value
+    return _whole_number(text, 1)
 
 
 def _cmd_flags(args) -> int:

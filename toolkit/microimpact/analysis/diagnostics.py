@@ -36,6 +36,12 @@ def _split(draws: np.ndarray) -> np.ndarray:
     return np.concatenate([x[:, :half], x[:, x.shape[1] - half:]], axis=0)
 
 
+def _usable_split(draws) -> np.ndarray | None:
+    """The split chains, or None where they hold a non-finite or no varying draw (no diagnostic then)."""
+    x = _split(draws)
+    return x if np.all(np.isfinite(x)) and np.ptp(x) > 0 else None
+
+
 def _rank_normalise(x: np.ndarray) -> np.ndarray:
     """Normal scores of the pooled ranks (average ranks for ties), fractional offset 3/8 (Blom)."""
     r = stats.rankdata(x, method="average").reshape(x.shape)
@@ -74,8 +80,8 @@ def split_rhat(draws) -> float:
     >>> split_rhat(rng.normal(size=(4, 1000)) + np.arange(4)[:, None]) > 1.5
     True
     """
-    x = _split(draws)
-    if not np.all(np.isfinite(x)) or np.ptp(x) == 0:
+    x = _usable_split(draws)
+    if x is None:
         return float("nan")
     bulk = _rhat(_rank_normalise(x))
     folded = np.abs(x - np.median(x))
@@ -146,7 +152,5 @@ def ess_bulk(draws) -> float:
     >>> 3000 < ess_bulk(rng.normal(size=(4, 1000))) < 5000
     True
     """
-    x = _split(draws)
-    if not np.all(np.isfinite(x)) or np.ptp(x) == 0:
-        return float("nan")
-    return _ess(_rank_normalise(x))
+    x = _usable_split(draws)
+    return float("nan") if x is None else _ess(_rank_normalise(x))
