@@ -125,6 +125,12 @@ def test_fit(tmp_path):
     p = check(plots.plot_fit(fit_dataset()), tmp_path, "fig3")
     assert "SYNTHETIC" in p.caption and "(fixed)" in p.caption
     assert len(p.figure.axes[0].get_legend().get_texts()) == 4  # 2 sizes + data + model
+    # the residual panel under the fit (issue 25): every point's (model - measured)/sigma, as in the file
+    ds = fit_dataset()
+    drawn = np.sort(np.concatenate([line.get_ydata() for line in p.figure.axes[1].get_lines()
+                                    if line.get_marker() == "o"]))
+    np.testing.assert_allclose(drawn, np.sort(ds["residual"].values), rtol=1e-12)
+    assert "residuals" in p.caption
 
 
 def test_work_precision(tmp_path):

@@ -642,8 +642,8 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
         Smooth model lines from :func:`microimpact.studies.sweeps.restitution_curves` (``e_n`` on
         ``radius`` x ``speed``). Without it the model is drawn at the data points, joined.
     """
-    fig = _figure(WIDTH * 0.72, 3.3)
-    ax = fig.subplots()
+    fig = _figure(WIDTH * 0.72, 4.2)
+    ax, res_ax = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": (3, 1)})
     radius = fit["radius"].values
     classes = np.unique(np.round(radius, 12))
     cols = _colors(len(classes))
@@ -660,8 +660,14 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
             order = np.argsort(v)
             ax.plot(v[order], fit["e_n_model"].values[sel][order], color=col, lw=1.3)
         handles.append(Line2D([], [], color=col, marker="o", ms=3.2, label=f"d = {2 * r * 1e6:.3g} µm"))
+        if "residual" in fit:
+            res_ax.plot(v, fit["residual"].values[sel], "o", ms=2.6, color=col, alpha=0.85)
     ax.set_xscale("log")
-    ax.set_xlabel(r"incident normal speed $v_n$ [m/s]")
+    ax.set_xlabel(r"incident normal speed $v_n$ [m/s]", fontsize=7)
+    res_ax.axhspan(-2.0, 2.0, color="0.92", zorder=0)
+    res_ax.axhline(0.0, color="0.4", lw=0.8)
+    res_ax.set_xlabel(r"incident normal speed $v_n$ [m/s]")
+    res_ax.set_ylabel("(model - data)/σ [-]", fontsize=7)
     ax.set_ylabel(r"$e_n$ [-]")
     ax.set_ylim(bottom=0.0)
     handles += [Line2D([], [], color="0.3", marker="o", ls="none", ms=3.2, label="data $\\pm 1\\sigma$"),
@@ -669,9 +675,16 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
 
     def par(name, fmt):
+        from microimpact.io.statuses import status_from_variables
+
         val = float(fit[name])
+        st = status_from_variables(fit, name, val)
+        if st is not None and not st.determined:  # no number for what the data do not determine
+            return {"lower_bound": f">= {st.lower:{fmt}}", "upper_bound": f"<= {st.upper:{fmt}}"}.get(
+                st.status, "not determined") + f" (curve drawn at {val:{fmt}})"
         err = float(fit[f"{name}_stderr"]) if f"{name}_stderr" in fit else math.nan
-        return f"{val:{fmt}}" + (f" +- {err:{fmt}}" if math.isfinite(err) else " (fixed)")
+        return f"{val:{fmt}}" + (f" +- {err:{fmt}}" if math.isfinite(err) and err <= abs(val) else
+                                 "" if math.isfinite(err) else " (fixed)")
 
     source = str(fit.attrs.get("fit_source", "")) or "the data set"
     synthetic = "synthetic" in json.dumps({k: str(v) for k, v in fit.attrs.items()}).lower()
@@ -680,7 +693,8 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
         f"measured points with 1-sigma error bars ({source}{', SYNTHETIC data' if synthetic else ''}) "
         "per sphere diameter, and the model at the best fit"
         f" (zeta_H = {par('zeta_hertz', '.3g')}, zeta_A = {par('zeta_adhesion', '.3g')}, "
-        f"w_A = {par('work_of_adhesion', '.3g')} J/m^2; reduced chi-square {float(fit.attrs.get('redchi', math.nan)):.3g})."
+        f"w_A = {par('work_of_adhesion', '.3g')} J/m^2; reduced chi-square {float(fit.attrs.get('redchi', math.nan)):.3g}). "
+        "Lower panel: residuals (model - measured) / sigma per point, the grey band +/- 2."
     )
     return Plot(fig, caption, "3")
 
