@@ -118,6 +118,7 @@ def fit_dataset():
         },
         attrs={"redchi": 1.1, "fit_source": "synthetic_impacts.csv"},
     )
+    ds["residual"] = ("point", (ds["e_n_model"].values - ds["e_n_measured"].values) / 0.02, {"units": "1"})
     return ds
 
 
