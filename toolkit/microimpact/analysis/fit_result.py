@@ -353,6 +353,7 @@ def _fit_facts(fit: "DampingFit") -> dict:
         "evaluations": f"{fit.info.get('nfev', '?')} ({fit.info.get('elapsed_s', math.nan):.2f} s), "
                        f"{fit.info.get('message', '')}",
         "note": fit.info.get("ci_message") or None,
+        "WARNING": fit.info.get("goodness_of_fit") or None,
         "measurements": (f"{fit.info['outside_physical_range']} measured e_n outside [0, 1] within their stated "
                          "uncertainty, fitted as measured" if fit.info.get("outside_physical_range") else None),
     }
@@ -409,7 +410,7 @@ def format_fit(fit: "DampingFit", style: str = "text") -> str:
         lines.append(f"    {r['parameter']:<17}= {r['value']}{err} [{r['units']}]{ci95}{ci}")
     if facts["correlations"]:
         lines += ["  correlations:"] + [f"    {c}" for c in facts["correlations"]]
-    for label in ("chi-square", "AIC, BIC", "evaluations", "note", "measurements"):
+    for label in ("chi-square", "AIC, BIC", "evaluations", "note", "measurements", "WARNING"):
         if label in facts:
             lines.append(f"  {label:<12}: {facts[label]}")
     return "\n".join(lines)

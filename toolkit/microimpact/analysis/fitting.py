@@ -379,14 +379,21 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
     with progress_bar(steps, f"fit of {e_n.size} impacts", progress) as advance:
         advance = deadline.ticking(advance, steps, f"steps ({n_grid} start-grid points, {rounds} least-squares "
                                                    f"round(s){', confidence intervals' if confidence_intervals else ''})")
-        (zh0, za0), nfev = _grid_start(problem, e_n, sigma_e, w_a0, start_grid, rtol, advance)
-        params = lmfit.Parameters()
-        params.add("zeta_hertz", value=zh0, min=0.0)
-        params.add("zeta_adhesion", value=za0, min=0.0)
-        params.add("work_of_adhesion", value=w_a0, min=1e-12 if fit_work_of_adhesion else 0.0, vary=fit_work_of_adhesion)
+        starts, nfev = _grid_start(problem, e_n, sigma_e, w_a0, start_grid, rtol, advance)
+        if fit_work_of_adhesion:  # w_A too: from the best grid point with w_A halved and doubled as well
+            starts += [(starts[0][0], starts[0][1], w_a0 * k) for k in (0.5, 2.0)]
         sigma_v = arr["normal_speed_uncertainty"] if effective else None
-        mini, result, sigma, n = _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, advance,
-                                                deadline)
+        fit_args = (problem, e_n, sigma_e, sigma_v, rtol, scale_covar, fit_work_of_adhesion, deadline)
+        best, n_runs = _multistart(starts, *fit_args)
+        nfev += n_runs
+        if _implausible(best[1], sigma_e):  # the start grid missed the valley: a denser, wider one
+            dense, n_grid2 = _grid_start(problem, e_n, sigma_e, w_a0, DENSE_START_GRID, rtol)
+            again, n_runs = _multistart(dense, *fit_args)
+            nfev += n_grid2 + n_runs
+            if again[1].chisqr < best[1].chisqr:
+                best, starts = again, dense
+        advance(rounds)
+        mini, result, sigma, n = best
         mini.iter_cb = deadline.iter_cb("the confidence intervals")
         cis, ci_message = _confidence_intervals(mini, result, confidence_intervals)
         advance(1)
@@ -407,9 +414,17 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
             "sha256": df.attrs.get("sha256"), "material_pair": str(labels[0]) if len(labels) == 1 else None,
             "ci_message": ci_message or None}
     varied = tuple(n for n in PARAMETER_NAMES if result.params[n].vary)
-    identifiability = damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline)
+    grid = starts.grid if e_n.size <= GRID_START_POINTS else None  # a subsampled grid is another chi-square
+    identifiability = damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline, w_a0, grid)
     info["elapsed_s"] = time.perf_counter() - t0
     info["success"] = bool(result.success) and all(st.determined for st in identifiability.values())
+    if _implausible(result, sigma_e):
+        from scipy import stats
+
+        info["success"] = False
+        info["goodness_of_fit"] = (f"chi-square {result.chisqr:.4g} for {result.nfree} degrees of freedom (p = "
+                                   f"{stats.chi2.sf(result.chisqr, result.nfree):.2g}): the model does not describe these "
+                                   "data within their stated uncertainties at the best fit found")
     if not info["success"] and result.success:
         info["message"] = ("least squares converged, but the data do not determine "
                            + ", ".join(n for n, st in identifiability.items() if not st.determined))
@@ -432,7 +447,8 @@ DAMPING_RANGES = {"zeta_hertz": (0.0, 1e3), "zeta_adhesion": (0.0, 1e4), "work_o
 PROFILE_XTOL = 1e-3
 
 
-def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline=Deadline.start(None, "fit")) -> dict:
+def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline=Deadline.start(None, "fit"),
+                            work_of_adhesion_start: float | None = None, grid=None) -> dict:
     """What the data determine about each varied damping parameter (:mod:`microimpact.analysis.identifiability`).
 
     The 95 % interval of every varied parameter is its profile-likelihood interval, {x : P(x) -
@@ -460,6 +476,13 @@ def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, dead
     scale_covar : bool
         Whether chi-square is scaled by the reduced chi-square (unweighted fits).
     deadline : Deadline
+    work_of_adhesion_start : float, optional
+        The material's w_A the fit started from: w_A's range is relative to it. [J/m^2]
+    grid : (array, array, array), optional
+        The start grid (zeta_H values, zeta_A values, chi-square): a grid point outside the walked
+        interval whose chi-square is within the threshold marks a second valley of the profile
+        (zeta_H and zeta_A can trade places over a narrow speed range); the interval then extends
+        over it, to where the profile walked outward from that point crosses the threshold.
 
     Returns
     -------
@@ -476,17 +499,45 @@ def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, dead
     for name in varied:
         value = float(result.params[name].value)
         lo, hi = DAMPING_RANGES[name]
-        if name == "work_of_adhesion":
-            lo, hi = lo * value, hi * value
+        if name == "work_of_adhesion":  # relative to the material's value the fit started from
+            ref = work_of_adhesion_start or value
+            lo, hi = lo * ref, hi * ref
         profile = _Profile(problem, e_n, sigma, result.params, name, rtol, scale, deadline)
         lower = profile.crossing(value, lo, level)
         upper = profile.crossing(value, hi, level)
+        for x, other in _grid_valleys(grid, name, result.chisqr, lower, upper):
+            start = result.params.copy()
+            for n, v in other.items():
+                start[n].set(value=v)
+            if profile(x, start)[0] <= level:  # confirmed by a re-fit: a second valley
+                lower = min(lower, profile.crossing(x, lo, level, start))
+                upper = max(upper, profile.crossing(x, hi, level, start))
         reasons = {"not_determined": f"chi-square changes by less than the 95 % threshold over {name} in [{lo:.3g}, {hi:.3g}]",
                    "lower_bound": f"the e_n data are as well explained by any larger {name}, up to {hi:.3g}",
                    "upper_bound": f"the e_n data are as well explained by any smaller {name}, down to {lo:.3g}"}
         out[name] = status_from_interval(name, value, lower, upper, lo, hi, method="profile", reasons=reasons,
                                          atol=1e-12 * max(abs(hi), 1.0))
     return out
+
+
+def _grid_valleys(grid, name, chisqr, lower, upper):
+    """[(x, {other parameter: value})]: candidates for a second valley of the profile of ``name``, start-grid
+    points outside [lower, upper] whose chi-square (minimised over the other grid parameter) lies within
+    twice the 95 % threshold of the grid's least, the threshold scaled by how much larger the grid's
+    chi-square is than the fit's (the grid uses the stated e_n uncertainties, the fit may add the
+    speed errors). Each candidate is confirmed by a re-fit before it counts."""
+    from microimpact.analysis.identifiability import chi2_threshold
+
+    if grid is None or name not in ("zeta_hertz", "zeta_adhesion"):
+        return []
+    gh, ga, chi2 = grid
+    least = float(np.min(chi2))
+    level = least + 2 * chi2_threshold() * max(least / max(chisqr, 1e-300), 1.0)
+    values, axis, other_name, other_values = (gh, 1, "zeta_adhesion", ga) if name == "zeta_hertz" else (ga, 0, "zeta_hertz", gh)
+    best_other = np.argmin(chi2, axis=axis)
+    prof = np.min(chi2, axis=axis)
+    return [(float(values[k]), {other_name: float(other_values[best_other[k]])}) for k in range(values.size)
+            if prof[k] <= level and not lower <= values[k] <= upper]
 
 
 class _Profile:
@@ -497,7 +548,14 @@ class _Profile:
         self.rtol, self.scale, self.deadline = rtol, scale, deadline
 
     def __call__(self, x, start=None) -> tuple[float, object]:
-        params = (start or self.best).copy()
+        """(P(x), the re-fitted parameters): the re-fit starts from the previous point's optimum and,
+        where that differs, from the best fit too (the lower wins: a continuation alone can follow a
+        valley of the other parameters that the best fit's basin leaves)."""
+        results = [self._refit(x, s) for s in ([start, self.best] if start is not None else [self.best])]
+        return min(results, key=lambda r: r[0])
+
+    def _refit(self, x, start) -> tuple[float, object]:
+        params = start.copy()
         params[self.name].set(value=x, vary=False)
         if not any(params[n].vary for n in PARAMETER_NAMES):
             r = damping_residual(params, self.problem, self.e_n, self.sigma, rtol=self.rtol)
@@ -508,14 +566,14 @@ class _Profile:
         res = mini.minimize(method="leastsq", max_nfev=400)
         return float(res.chisqr) / self.scale, res.params
 
-    def crossing(self, value, limit, level) -> float:
+    def crossing(self, value, limit, level, start=None) -> float:
         """Where P rises to ``level`` between ``value`` and ``limit`` (``limit`` if it never does)."""
         from scipy.optimize import brentq
 
         if limit == value:
             return limit
         up = limit > value
-        x_in, start = value, None
+        x_in = value
         for k in range(200):
             factor = 1.2 if k < 8 else 2.0 ** min(k - 6, 6)  # growing steps: a flat profile is walked fast
             if up:
@@ -539,10 +597,45 @@ class _Profile:
 GRID_START_POINTS = 400
 
 
-def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol, advance=lambda n=1: None):
-    """((zeta_H, zeta_A) of least chi-square on the start grid, number of evaluations).
+#: least-squares runs started from the best local minima of the start grid
+GRID_STARTS = 3
+#: the start grid used when the first fit is implausible (chi-square p-value below IMPLAUSIBLE_P with
+#: stated uncertainties): 4x denser and a decade wider in each coefficient
+DENSE_START_GRID = (np.geomspace(1e-3, 100.0, 41), np.geomspace(1e-2, 1e4, 41))
+#: p-value of chi-square below which a weighted fit counts as not describing the data
+IMPLAUSIBLE_P = 1e-3
 
-    The grid only picks the basin the least-squares fit starts in, so a large data set is
+
+def _implausible(result, sigma_e) -> bool:
+    """A weighted fit whose chi-square is improbable for its degrees of freedom (p < IMPLAUSIBLE_P)."""
+    from scipy import stats
+
+    if sigma_e is None or result.nfree < 1:
+        return False
+    return bool(stats.chi2.sf(result.chisqr, result.nfree) < IMPLAUSIBLE_P)
+
+
+def _multistart(starts, problem, e_n, sigma_e, sigma_v, rtol, scale_covar, fit_work_of_adhesion, deadline):
+    """(the least-chi-square run of _least_squares over ``starts``, evaluations): e_n trades zeta_H
+    against zeta_A along curved valleys, so one start can end in the wrong one."""
+    best, nfev = None, 0
+    for zh0, za0, wa in starts:
+        params = lmfit.Parameters()
+        params.add("zeta_hertz", value=zh0, min=0.0)
+        params.add("zeta_adhesion", value=za0, min=0.0)
+        params.add("work_of_adhesion", value=wa, min=1e-12 if fit_work_of_adhesion else 0.0, vary=fit_work_of_adhesion)
+        run = _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, lambda n=1: None, deadline)
+        nfev += run[3]
+        if best is None or run[1].chisqr < best[1].chisqr * (1 - 1e-9):
+            best = run
+    return best, nfev
+
+
+def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol, advance=lambda n=1: None):
+    """([(zeta_H, zeta_A, w_A)] at the GRID_STARTS best local minima of chi-square on the start grid,
+    best first; number of evaluations).
+
+    The grid only picks the basins the least-squares fits start in, so a large data set is
     represented by GRID_START_POINTS points spread evenly over it (a 100,000-row fit would
     otherwise spend most of its time here)."""
     gh, ga = (np.asarray(g, dtype=float).ravel() for g in start_grid)
@@ -552,16 +645,28 @@ def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol, advance
         rows = np.unique(np.linspace(0, e_n.size - 1, GRID_START_POINTS).round().astype(int))
         problem, e_n = problem.subset(rows), e_n[rows]
         sigma = sigma[rows] if np.ndim(sigma) else sigma
-    best = (math.inf, gh[0], ga[0])
-    for zh in gh:
-        for za in ga:
+    chi2 = np.full((gh.size, ga.size), math.inf)
+    for i, zh in enumerate(gh):
+        for j, za in enumerate(ga):
             r = damping_residual({"zeta_hertz": zh, "zeta_adhesion": za, "work_of_adhesion": work_of_adhesion},
                                  problem, e_n, sigma, rtol=rtol)
-            chi2 = float(r @ r)
-            if chi2 < best[0]:
-                best = (chi2, zh, za)
+            chi2[i, j] = float(r @ r)
             advance(1)
-    return (best[1], best[2]), gh.size * ga.size
+    padded = np.pad(chi2, 1, constant_values=math.inf)
+    neighbours = np.stack([padded[:-2, 1:-1], padded[2:, 1:-1], padded[1:-1, :-2], padded[1:-1, 2:]])
+    minima = np.argwhere(chi2 <= neighbours.min(axis=0))
+    order = sorted(minima.tolist(), key=lambda ij: chi2[ij[0], ij[1]])[:GRID_STARTS]
+    starts = [(float(gh[i]), float(ga[j]), float(work_of_adhesion)) for i, j in order]
+    return _GridStarts(starts, (gh, ga, chi2)), gh.size * ga.size
+
+
+class _GridStarts(list):
+    """The start points, with the grid's chi-square (zeta_H values, zeta_A values, chi2[i, j]) kept
+    for the identifiability (a second valley of the profile that a walk from the estimate cannot see)."""
+
+    def __init__(self, starts, grid):
+        super().__init__(starts)
+        self.grid = grid
 
 
 def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, advance=lambda n=1: None,

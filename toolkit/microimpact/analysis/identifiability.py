@@ -168,6 +168,12 @@ def status_from_interval(name: str, value: float, lower: float, upper: float, ra
         return ParameterStatus(name, "upper_bound", math.nan, range_min, upper, level,
                                reasons.get("upper_bound", f"the fit is equally good for every value below {upper:.4g}"),
                                method)
+    z = float(stats.norm.ppf(0.5 + level / 2))
+    if value and (upper - lower) > 2 * z * MAX_RELATIVE_UNCERTAINTY * abs(value) and lower >= 0:
+        # an interval wider than +/- 100 % of the value, on a positive parameter: say only its upper end
+        return ParameterStatus(name, "upper_bound", math.nan, range_min, upper, level,
+                               reasons.get("upper_bound", f"the data allow any value below {upper:.4g} (the interval "
+                                                          f"is wider than the value itself)"), method)
     return ParameterStatus(name, "determined", float(value), float(lower), float(upper), level, "", method)
 
 

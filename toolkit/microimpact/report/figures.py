@@ -30,6 +30,7 @@ import math
 from dataclasses import dataclass
 
 import matplotlib
+import matplotlib.ticker
 import numpy as np
 import xarray as xr
 from matplotlib import colormaps
@@ -223,6 +224,32 @@ def _capture_speeds(ds: xr.Dataset, curves) -> list[float]:
     return out
 
 
+#: speeds spanning more than this ratio are drawn on a log axis (the analyst's sweeps run over the
+#: measured speeds, often 1-100 m/s: a linear axis squeezes the capture region against its start)
+LOG_SPEED_SPAN = 10.0
+
+
+def _speed_axis(ax, ds: xr.Dataset) -> None:
+    """Linear speed axis from 0 (the paper's figures), or a log axis where the speeds span decades."""
+    v = np.asarray(ds["speed"].values, dtype=float)
+    v = v[np.isfinite(v) & (v > 0)]
+    if v.size and v.max() > LOG_SPEED_SPAN * v.min():
+        ax.set_xscale("log")
+        ax.set_xlim(v.min() / 1.05, v.max() * 1.05)
+        _plain_log_labels(ax.xaxis)
+    else:
+        ax.set_xlim(0.0, float(v.max()) * 1.02 if v.size else 1.0)
+
+
+def _plain_log_labels(axis) -> None:
+    """Plain numbers (2, 3, 5, 10) on a log axis, at most two minor labels a decade: the default
+    'm x 10^n' labels of an axis spanning less than a decade run into each other."""
+    fmt = matplotlib.ticker.FuncFormatter(lambda x, _: f"{x:g}")
+    axis.set_major_formatter(fmt)
+    axis.set_minor_locator(matplotlib.ticker.LogLocator(subs=(2.0, 5.0)))
+    axis.set_minor_formatter(fmt)
+
+
 def _mark_capture(ax, v_caps, colors) -> None:
     finite = [v for v in v_caps if math.isfinite(v)]
     if not finite:
@@ -325,7 +352,7 @@ def plot_energy_loss(ds: xr.Dataset, *, hue: str | None = None) -> Plot:
         ax.set_xlabel(r"incident speed $v$ [m/s]")
         ax.set_ylabel(ylabel)
         _panel_label(ax, title)
-        ax.set_xlim(0.0, float(ds["speed"].max()) * 1.02)
+        _speed_axis(ax, ds)
         _mark_capture(ax, v_caps, colors)
     extra = [Line2D([], [], color="0.3", ls=":", lw=1.0, label="captured\n(final state)"),
              Patch(color=CAPTURE_SHADE, label="capture range")]
@@ -401,7 +428,7 @@ def plot_restitution_and_impulse(ds: xr.Dataset, *, hue: str | None = None, pane
         ax.set_xlabel(r"incident speed $v$ [m/s]")
         ax.set_ylabel(meta[name][0])
         _panel_label(ax, f"({'abc'[k]}) " + meta[name][0].split(" ")[0] + ", " + meta[name][1])
-        ax.set_xlim(0.0, float(ds["speed"].max()) * 1.02)
+        _speed_axis(ax, ds)
         _mark_capture(ax, v_caps, colors)
         if name == "e_n":
             ax.set_ylim(bottom=0.0)
@@ -482,6 +509,8 @@ def plot_size_dependence(sweep: xr.Dataset, dynamics: xr.Dataset | None = None) 
         ax_v.plot(2e6 * np.asarray(var["radius"].values, float), var.values, marker=marker, ms=4, label=label)
     ax_v.set_xscale("log")
     ax_v.set_yscale("log")
+    for axis in (ax_v.xaxis, ax_v.yaxis, ax_e.xaxis):
+        _plain_log_labels(axis)
     ax_v.set_xlabel(r"sphere diameter $d$ [µm]")
     ax_v.set_ylabel(r"normal speed [m/s]")
     _panel_label(ax_v, "(b) capture velocity")
