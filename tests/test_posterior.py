@@ -1,4 +1,4 @@
-"""Posterior of the fitted parameters (issue 15, items 2, 3 and 8): lmfit's Minimizer.emcee, seeded,
+"""Posterior of the fitted parameters (issue 15, items 2, 3 and 8): emcee (run until converged), seeded,
 with diagnostics; bands; errors in variables (their calibration: tests/test_calibration.py).
 
 The data are the bundled SYNTHETIC microsphere file (data/README.md) and small synthetic sets.

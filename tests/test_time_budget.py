@@ -128,7 +128,9 @@ def test_fit_stopped_inside_lmfit_raises_instead_of_returning_a_half_fit(table, 
     checks = clock() - start - 1
     with pytest.raises(TimeBudgetExceeded, match=r"function evaluations of least-squares round 1 of 3$"):
         fit_damping(table, pair, start_grid=grid, time_budget=10.0)
-    with pytest.raises(TimeBudgetExceeded, match=r"function evaluations of the confidence intervals$"):
+    # the last stage of a fit is now the profile of each parameter (identifiability), a loop of lmfit
+    # fits with the same iter_cb: its abort raises as well
+    with pytest.raises(TimeBudgetExceeded, match=r"function evaluations of the profile of zeta_\w+$"):
         fit_damping(table, pair, start_grid=grid, time_budget=checks - 3.0)
 
 

@@ -544,8 +544,11 @@ def _converged(diag, previous_tau, rhat_max, ess_min) -> bool:
 
 def _convergence_text(diag, converged, rhat_max, ess_min) -> str:
     tau = float(np.max(diag["tau"])) if np.all(np.isfinite(diag["tau"])) else math.nan
-    return (f"post-burn-in chain {diag['n_post']} steps = {diag['n_post'] / tau:.0f} x the longest autocorrelation time "
-            f"({tau:.1f} steps), R-hat <= {np.nanmax(diag['rhat']):.4f}, bulk ESS >= {np.nanmin(diag['ess']):.0f}; "
+    ratio = f"{diag['n_post'] / tau:.0f}" if tau > 0 else "?"  # NaN or 0: not estimated (a very short chain)
+    rhat = f"{np.max(diag['rhat']):.4f}" if np.all(np.isfinite(diag["rhat"])) else "?"
+    ess = f"{np.min(diag['ess']):.0f}" if np.all(np.isfinite(diag["ess"])) else "?"
+    return (f"post-burn-in chain {diag['n_post']} steps = {ratio} x the longest autocorrelation time "
+            f"({tau:.1f} steps), R-hat <= {rhat}, bulk ESS >= {ess}; "
             + (f"converged ({TAU_FACTOR} tau, R-hat < {rhat_max}, ESS >= {ess_min})" if converged else
                f"NOT converged ({TAU_FACTOR} tau with a stable tau, R-hat < {rhat_max}, ESS >= {ess_min})"))
 

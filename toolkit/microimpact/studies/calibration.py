@@ -30,8 +30,9 @@ Kinds of design, from the truth (independently of what the fit says): for fricti
 (every oblique impact ends in rolling at the true f), ``all sliding`` or ``mixed``; for the damping
 parameters, ``one speed`` or ``speed range``.
 
-Run it: ``python -m microimpact.studies.calibration --designs 300 --posterior-designs 60 --workers 2
---out docs/calibration.json --figure docs/calibration.png`` (docs/calibration.md holds its results).
+Run it: ``python -m microimpact.studies.calibration --designs 300 --posterior-designs 12 --workers 2
+--seed 1000 --out docs/calibration.json --figure docs/calibration.png`` (docs/calibration.md holds
+its results).
 
 References
 ----------
