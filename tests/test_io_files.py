@@ -174,3 +174,49 @@ def test_write_netcdf_failure_keeps_old_file(tmp_path, monkeypatch):
         write_netcdf(_dataset(), path)
     assert path.read_bytes() == before
     assert leftovers(tmp_path) == []
+
+
+def test_a_signal_during_a_netcdf_write_lands_after_it_and_abandons_the_file(tmp_path, monkeypatch):
+    # SIGINT inside xarray's to_netcdf used to raise under xarray's file lock, and the writer's
+    # cleanup then waited for that lock for ever (issue 27); now the write ends, the interrupt is
+    # raised after it, and neither the target nor a temporary file is left
+    import os
+    import signal
+
+    import xarray as xr
+
+    from microimpact.io.files import write_netcdf_groups
+
+    real = xr.Dataset.to_netcdf
+    calls = []
+
+    def interrupted(self, *args, **kwargs):
+        os.kill(os.getpid(), signal.SIGINT)  # a real signal, delivered while the write is under way
+        calls.append("written")
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", interrupted)
+    target = tmp_path / "out.nc"
+    with pytest.raises(KeyboardInterrupt):
+        write_netcdf_groups({None: xr.Dataset({"x": ("t", [1.0, 2.0])}), "g": xr.Dataset({"y": 1.0})}, target)
+    assert calls == ["written", "written"]  # both groups were written before the interrupt acted
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_deferred_signals_restores_the_handlers_and_raises_each_signal_once():
+    import os
+    import signal
+
+    from microimpact.io.files import deferred_signals
+
+    seen = []
+    before = signal.signal(signal.SIGTERM, lambda s, f: seen.append(s))
+    try:
+        with deferred_signals():
+            os.kill(os.getpid(), signal.SIGTERM)
+            os.kill(os.getpid(), signal.SIGTERM)
+            assert seen == []  # held back inside the block
+        assert seen == [signal.SIGTERM]
+    finally:
+        signal.signal(signal.SIGTERM, before)

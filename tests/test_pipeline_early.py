@@ -15,6 +15,9 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
+#: the analyst's results of the bundled data (one material pair)
+PAIR = "ammonium_fluorescein_on_silicon"
+ANALYST = f"results/analyst/{PAIR}"
 
 pytestmark = pytest.mark.skipif(not (REPO / "Snakefile").exists(), reason="the Snakefile is missing")
 
@@ -124,14 +127,15 @@ def test_a_failing_job_says_why_in_one_line_and_leaves_no_result(tmp_path):
     data["fit"]["time_budget"] = 1e-9
     cfg.write_text(yaml.safe_dump(data, sort_keys=False))
     env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
-    proc = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "1", "results/analyst/fit.nc"], cwd=other,
+    proc = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "1", f"{ANALYST}/fit.nc"], cwd=other,
                           env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
     assert proc.returncode != 0, proc.stdout[-3000:]
     lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("microimpact: rule fit failed: ")]
     assert len(lines) == 1, proc.stdout[-3000:]
     assert "TimeBudgetExceeded: fit" in lines[0] and "time budget of 1e-09 s" in lines[0], lines[0]
-    assert "logs/fit.log" in lines[0]
-    assert "Traceback" in (other / "logs" / "fit.log").read_text()
+    log = f"logs/fit/{PAIR}.log"
+    assert log in lines[0]
+    assert "Traceback" in (other / log).read_text()
     assert (other / "results" / "impacts_validated.csv").exists()  # the job before it ran
     analyst = other / "results" / "analyst"
     assert not analyst.exists() or not any(analyst.iterdir()), list(analyst.iterdir())  # no partial output

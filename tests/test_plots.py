@@ -173,3 +173,67 @@ def test_size_dependence(tmp_path):
     assert len(p.figure.axes[0].get_legend().get_texts()) == 2  # one curve per diameter
     assert "critical velocity" in p.caption and "alpha" not in p.caption.split("(b)")[1]
     assert "incidence_deg = 0" in p.caption  # taken at normal incidence
+
+
+def _assert_tick_labels_apart(fig, ax, what):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    renderer = FigureCanvasAgg(fig).get_renderer()
+    fig.draw(renderer)
+    for axis, horizontal in ((ax.xaxis, True), (ax.yaxis, False)):
+        lo, hi = sorted(axis.get_view_interval())
+        ticks = [t for t in axis.get_major_ticks() + axis.get_minor_ticks()
+                 if t.label1.get_visible() and t.label1.get_text() and lo <= t.get_loc() <= hi]
+        boxes = sorted((t.label1.get_window_extent(renderer) for t in ticks), key=lambda b: b.x0 if horizontal else b.y0)
+        assert len(boxes) >= 2, (what, [t.label1.get_text() for t in ticks])
+        for a, b in zip(boxes, boxes[1:]):
+            assert (a.x1 <= b.x0 + 0.5) if horizontal else (a.y1 <= b.y0 + 0.5), (what, horizontal)
+
+
+@pytest.mark.parametrize("span", [(0.8, 3.0), (1.0, 60.0), (5e-7, 5.0), (1e-9, 1e4)])
+def test_log_axis_labels_do_not_overlap(span):
+    """A log axis over part of a decade to 13 decades, in the report's style and panel size: the
+    drawn tick labels never overlap."""
+    with matplotlib.rc_context(plots.STYLE):
+        fig = Figure(figsize=(7.0, 2.6), layout="constrained")
+        ax = fig.subplots(1, 2)[1]
+        ax.plot(span, span)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        plots._plain_log_labels(ax.yaxis)
+        plots._plain_log_labels(ax.xaxis)
+        _assert_tick_labels_apart(fig, ax, span)
+
+
+def test_size_dependence_over_seven_decades_keeps_its_labels_apart():
+    """Panel (b) of the analyst's sweep figure with a capture velocity of a few m/s and a critical
+    velocity of 1e-6 m/s (the fitted material of the pipeline's test data): its labels once ran
+    together at 1, 2 and 5 of every decade."""
+    radii = np.array([1.29e-6, 3.45e-6])
+    speed = np.geomspace(1.0, 60.0, 6)
+    sweep = xr.Dataset({"e_n": (("radius", "speed"), np.tile(np.linspace(0.3, 0.8, 6), (2, 1))),
+                        "outcome": (("radius", "speed"), np.zeros((2, 6), int))},
+                       coords={"radius": radii, "speed": speed})
+    dyn = xr.Dataset({"capture_velocity": ("radius", [5.0, 1.4]), "critical_velocity": ("radius", [3e-5, 5e-7])},
+                     coords={"radius": radii})
+    p = plots.plot_size_dependence(sweep, dyn)
+    with matplotlib.rc_context(plots.STYLE):
+        _assert_tick_labels_apart(p.figure, p.figure.axes[1], "capture velocity panel")
+
+
+def test_size_dependence_of_a_pair_without_adhesion_says_nothing_is_captured(tmp_path):
+    """A non-adhesive pair (f0 = 0, e.g. alumina on glass) has capture velocity 0 and no critical
+    velocity: panel (b) says so instead of failing on a log axis with nothing to draw (the
+    pipeline's figures job once stopped there)."""
+    radii = np.array([10e-6, 40e-6])
+    speed = np.geomspace(0.2, 20.0, 5)
+    sweep = xr.Dataset({"e_n": (("radius", "speed"), np.tile(np.linspace(0.99, 0.95, 5), (2, 1))),
+                        "outcome": (("radius", "speed"), np.zeros((2, 5), int))},
+                       coords={"radius": radii, "speed": speed})
+    dyn = xr.Dataset({"capture_velocity": ("radius", [0.0, 0.0]), "critical_velocity": ("radius", [np.nan, np.nan])},
+                     coords={"radius": radii})
+    p = check(plots.plot_size_dependence(sweep, dyn), tmp_path, "no_capture")
+    ax_v = p.figure.axes[1]
+    assert ax_v.get_yscale() == "linear" and not ax_v.get_lines()
+    assert any("no capture" in t.get_text() for t in ax_v.texts)
+    assert "every impact rebounds" in p.caption

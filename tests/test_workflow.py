@@ -44,7 +44,8 @@ TINY_STRESS = {"enabled": True, "cases": 20, "seed": 3, "reference_every": 10, "
 
 #: the section titles build_report writes as text (searchable in the PDF)
 EXPECTED_TITLES = [
-    "Part A. The analyst's material",
+    "Part A1. The analyst's material: alumina_on_soda_lime_glass",
+    "Part A2. The analyst's material: ammonium_fluorescein_on_silicon",
     "Damping fit",
     "Capture and critical velocity of the measured sizes",
     "Sensitivity sweeps of the measured material",
@@ -75,6 +76,13 @@ def snakemake(workdir: Path, *args: str, timeout: float = 300) -> subprocess.Com
 CHAIN = {"pair": "ammonium_fluorescein_on_silicon", "zeta_hertz": 1.5, "zeta_adhesion": 12.0,
          "radii_um": (1.29, 3.45), "points_per_size": 20, "e_n_sigma": 0.005, "seed": 11}
 CHAIN_CSV = "chain_impacts.csv"
+#: the chain's second material pair, in the same CSV (the pipeline fits each pair on its own rows):
+#: 20 um alumina spheres on glass, no adhesion; their cells of material_pair are left EMPTY and the
+#: run's config material_pair names this pair, so the unlabelled rows are this pair's
+SECOND = {"pair": "alumina_on_soda_lime_glass", "zeta_hertz": 3.0, "radius_um": 20.0, "points": 8,
+          "e_n_sigma": 0.01, "seed": 12}
+ANALYST = Path("results") / "analyst" / CHAIN["pair"]
+SECOND_DIR = Path("results") / "analyst" / SECOND["pair"]
 
 
 def write_chain_csv(path: Path) -> None:
@@ -93,6 +101,12 @@ def write_chain_csv(path: Path) -> None:
         e_n = mi.simulate_many(contact, speeds)["e_n"].values + rng.normal(0.0, CHAIN["e_n_sigma"], speeds.size)
         lines += [f"chain-{r_um}-{i},d{2 * r_um}um,{CHAIN['pair']},{r_um},{v:.6g},0,{e:.6g},{CHAIN['e_n_sigma']}"
                   for i, (v, e) in enumerate(zip(speeds, e_n))]
+    glass = read_materials(default_materials_path())[SECOND["pair"]].contact(SECOND["radius_um"] * 1e-6)
+    speeds = np.geomspace(0.2, 20.0, SECOND["points"])
+    e_n = (mi.simulate_many(glass.with_(zeta_hertz=SECOND["zeta_hertz"]), speeds)["e_n"].values
+           + np.random.default_rng(SECOND["seed"]).normal(0.0, SECOND["e_n_sigma"], speeds.size))
+    lines += [f"glass-{i},alumina,,{SECOND['radius_um']},{v:.6g},0,{e:.6g},{SECOND['e_n_sigma']}"
+              for i, (v, e) in enumerate(zip(speeds, e_n))]
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -107,6 +121,7 @@ def make_copy(root: Path) -> Path:
     cfg_path = root / "workflow" / "config" / "config.yaml"
     cfg = yaml.safe_load(cfg_path.read_text())
     cfg["data"] = f"data/{CHAIN_CSV}"
+    cfg["material_pair"] = SECOND["pair"]  # the pair of the rows without a material_pair cell
     cfg["data_synthetic"] = True  # made by the test: the report must say so
     cfg["sweeps"] = TINY_SWEEPS
     cfg["phase_portrait_speeds"] = [1.0e-5, 2.0]
@@ -142,16 +157,18 @@ def pipeline(tmp_path_factory):
 @pytest.mark.slow
 def test_outputs_logs_and_benchmarks_exist(pipeline):
     root, _ = pipeline
-    for rel in ["results/impacts_validated.csv", "results/analyst/fit.nc", "results/analyst/fit_curves.nc",
-                "results/analyst/flags.csv", "results/analyst/flags.nc", "results/analyst/dynamics.nc",
+    for rel in ["results/impacts_validated.csv", f"{ANALYST}/fit.nc", f"{ANALYST}/fit_curves.nc",
+                f"{ANALYST}/flags.csv", f"{ANALYST}/flags.nc", f"{ANALYST}/dynamics.nc",
                 "results/paper/phase_portraits.nc", "results/paper/dynamics.nc", "results/paper/bifurcation.nc",
                 "results/paper/reproduction.csv", "results/paper/reproduction.md", "results/kharaz.nc",
                 "results/stress_summary.json", "results/stress.nc", "reports/report.pdf",
-                *[f"results/{part}/sweeps/case_{c}.nc" for c in TINY_SWEEPS for part in ("paper", "analyst")]]:
+                *[f"{part}/sweeps/case_{c}.nc" for c in TINY_SWEEPS for part in ("results/paper", ANALYST, SECOND_DIR)]]:
         assert (root / rel).stat().st_size > 0, rel
     assert not (root / "results" / "benchmark").exists()  # benchmark switched off
-    for rule in ["validate_data", "fit", "material_simulations", "flags", "paper_dynamics", "paper_sweeps",
-                 "reproduction", "kharaz", "stress", "report"]:
+    per_pair = [f"{rule}/{pair}" for rule in ("fit", "material_simulations", "flags", "model_comparison")
+                for pair in (CHAIN["pair"], SECOND["pair"])]
+    for rule in ["validate_data", *per_pair, "paper_dynamics", "paper_sweeps", "reproduction", "kharaz", "stress",
+                 "report"]:
         assert (root / "logs" / f"{rule}.log").exists(), rule
         bench = (root / "benchmarks" / f"{rule}.tsv").read_text().splitlines()
         assert bench[0].split("\t")[0] == "s" and len(bench) == 2, rule
@@ -162,7 +179,7 @@ def test_outputs_logs_and_benchmarks_exist(pipeline):
 @pytest.mark.slow
 def test_fit_netcdf(pipeline):
     root, _ = pipeline
-    with xr.open_dataset(root / "results" / "analyst" / "fit.nc") as ds:
+    with xr.open_dataset(root / ANALYST / "fit.nc") as ds:
         for name in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion"):
             assert ds[name].attrs["units"] in ("1", "J m-2"), name
             assert np.isfinite(float(ds[name]))
@@ -174,7 +191,7 @@ def test_fit_netcdf(pipeline):
 @pytest.mark.slow
 def test_chain_fit_recovers_the_parameters_that_made_the_data(pipeline):
     root, _ = pipeline
-    with xr.open_dataset(root / "results" / "analyst" / "fit.nc") as ds:
+    with xr.open_dataset(root / ANALYST / "fit.nc") as ds:
         for name in ("zeta_hertz", "zeta_adhesion"):
             value, stderr = float(ds[name]), float(ds[f"{name}_stderr"])
             # the noise is drawn from the stated uncertainty, so the estimate is within a few
@@ -189,7 +206,7 @@ def test_chain_fit_recovers_the_parameters_that_made_the_data(pipeline):
 @pytest.mark.slow
 def test_chain_fitted_parameters_drive_the_analyst_results(pipeline):
     root, _ = pipeline
-    analyst = root / "results" / "analyst"
+    analyst = root / ANALYST
     with xr.open_dataset(analyst / "fit.nc") as fit:
         zeta_h, zeta_a = float(fit["zeta_hertz"]), float(fit["zeta_adhesion"])
         source = fit.attrs["parameter_source"]
@@ -216,6 +233,29 @@ def test_chain_fitted_parameters_drive_the_analyst_results(pipeline):
     with xr.open_dataset(root / "results" / "paper" / "sweeps" / "case_2.1.nc") as ds:
         assert ds.attrs["parameter_source"] == "preset: wall1990"
         assert ds.attrs["contact_zeta_adhesion"] == 29.0 and ds.attrs["contact_zeta_hertz"] == 0.5
+
+
+@pytest.mark.slow
+def test_each_material_pair_is_fitted_on_its_own_rows(pipeline):
+    """Two pairs in one CSV: one fit, one set of flags and sweeps per pair (issue 25), each on its
+    rows only; the unlabelled rows belong to the config's material_pair."""
+    import pandas as pd
+
+    root, _ = pipeline
+    n_chain = CHAIN["points_per_size"] * len(CHAIN["radii_um"])
+    for folder, pair, n in ((ANALYST, CHAIN["pair"], n_chain), (SECOND_DIR, SECOND["pair"], SECOND["points"])):
+        with xr.open_dataset(root / folder / "fit.nc") as ds:
+            assert ds.sizes["point"] == n, pair
+            assert ds.attrs["fit_material_pair"] == pair
+        flags = pd.read_csv(root / folder / "flags.csv")
+        assert len(flags) == n, pair
+        assert flags["id"].str.startswith("glass-" if pair == SECOND["pair"] else "chain-").all(), pair
+    # no adhesion on glass: zeta_A cannot be determined from its rows, and the fit says so
+    from microimpact.io.statuses import STATUSES
+
+    with xr.open_dataset(root / SECOND_DIR / "fit.nc") as ds:
+        assert float(ds.attrs["contact_adhesion_line_force"]) == 0.0
+        assert STATUSES[int(ds["zeta_adhesion_status"])] == "not_determined"
 
 
 @pytest.mark.slow
@@ -266,9 +306,9 @@ def test_flags_kharaz_reproduction(pipeline):
 
     root, _ = pipeline
     n = CHAIN["points_per_size"] * len(CHAIN["radii_um"])
-    flags = pd.read_csv(root / "results" / "analyst" / "flags.csv")
+    flags = pd.read_csv(root / ANALYST / "flags.csv")
     assert len(flags) == n and {"row", "rotation_sensitive", "angle_sensitive", "near_capture"} <= set(flags)
-    with xr.open_dataset(root / "results" / "analyst" / "flags.nc") as ds:
+    with xr.open_dataset(root / ANALYST / "flags.nc") as ds:
         assert ds.sizes["impact"] == n
     with xr.open_dataset(root / "results" / "kharaz.nc") as ds:
         assert any(name.startswith("tangential_restitution") for name in ds.data_vars)
@@ -352,10 +392,10 @@ def test_changing_data_reruns_only_its_dependants(pipeline):
     # (and the normal models compared on the same data)
     assert set(jobs) == {"validate_data", "fit", "material_simulations", "flags", "model_comparison", "report",
                          "figures", "all"}, jobs
-    # the analyst's figures (one job draws them all), not the paper's or the checks'
-    assert jobs["figures"] == 1, jobs
-    outputs = re.findall(r"output: (reports/figures/\S+)", proc.stdout)
-    assert outputs == ["reports/figures/analyst"], outputs
+    # the analyst's figures (one job per material pair), not the paper's or the checks'
+    assert jobs["figures"] == 2, jobs
+    outputs = sorted(re.findall(r"output: (reports/figures/\S+)", proc.stdout))
+    assert outputs == sorted(f"reports/figures/analyst/{p['pair']}" for p in (CHAIN, SECOND)), outputs
 
 
 # --------------------------------------------------------------------------- profile, lint, config
@@ -427,13 +467,14 @@ def test_bad_data_file_stops_at_validation_with_every_problem(tmp_path):
                    "3.45,2.0,90,0.5\n"
                    "3.45,-1,0,1.5\n")
     # target the fit (only validate_data runs before it) so that no unrelated job starts
-    proc = snakemake(root, "results/analyst/fit.nc", "--cores", "1", "--config", "data=data/bad.csv")
+    # (a file that does not read has the config's material_pair as its only pair)
+    proc = snakemake(root, f"{SECOND_DIR}/fit.nc", "--cores", "1", "--config", "data=data/bad.csv")
     assert proc.returncode != 0
     assert "Error in rule validate_data" in proc.stdout
     assert "ImpactDataError" in proc.stdout
     for text in ("row 2 (line 3)", "incidence_angle", "row 3 (line 4)", "speed"):
         assert text in proc.stdout, text
-    assert not (root / "results" / "analyst" / "fit.nc").exists()
+    assert not (root / SECOND_DIR / "fit.nc").exists()
 
 
 # --------------------------------------------------------------------------- interrupt and resume
@@ -456,7 +497,7 @@ def test_an_interrupted_run_resumes_as_the_readme_says(tmp_path):
                             stderr=subprocess.STDOUT, text=True, start_new_session=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 120
-    while not (root / "results" / "analyst" / "fit.nc").exists() and time.monotonic() < deadline:
+    while not (root / ANALYST / "fit.nc").exists() and time.monotonic() < deadline:
         time.sleep(0.2)
     assert proc.poll() is None, "the run ended before it could be interrupted"
     os.killpg(proc.pid, signal.SIGINT)
@@ -508,13 +549,25 @@ def test_html_report_has_a_captioned_figure_of_every_result_file(pipeline):
     results = sorted((root / "results").rglob("*.nc"))
     drawn = [p for p in results if result_kind(p) in FIGURE_KINDS]
     assert len(drawn) >= 2 * len(TINY_SWEEPS) + 5  # flags, fit, bifurcation, portraits, kharaz, the sweeps
-    expected = Counter(f"{p.stem}.png" for p in drawn)
-    # the sweeps' further figures of the PDF: the analyst's cases at the median size, and the
-    # energy-loss ratios of the cases that have an energy-loss figure in the paper (both parts)
-    expected.update(f"case_{c}.restitution.png" for c in TINY_SWEEPS)
-    expected.update(f"case_{c}.energy_loss.png" for c in TINY_SWEEPS if TABLE2_FIGURES[c][0] for _ in range(2))
+    first = next(iter(TINY_SWEEPS))
+    pairs = (CHAIN["pair"], SECOND["pair"])
+    # the analyst's standard sweep figure is drawn once per pair (the same for every case: e_n at
+    # normal incidence), from the first case
+    expected = Counter(f"{p.stem}.png" for p in drawn if not ("analyst" in p.parts and p.parent.name == "sweeps"
+                                                                and p.stem != f"case_{first}"))
+    # the sweeps' further figures of the PDF: the analyst's cases at the median size (per pair), and
+    # the energy-loss ratios of the cases that have them in the paper (the paper's part and each pair)
+    expected.update(f"case_{c}.restitution.png" for c in TINY_SWEEPS for _ in pairs)
+    expected.update(f"case_{c}.energy_loss.png" for c in TINY_SWEEPS if TABLE2_FIGURES[c][0]
+                    for _ in range(1 + len(pairs)))
     found = Counter(Path(n).name for n in names if n.endswith(".png"))
     assert found == expected, (found, expected)
+    # figures of different data differ (five byte-identical sweep figures were once drawn per run)
+    import hashlib
+
+    digests = Counter(hashlib.sha256(p.read_bytes()).hexdigest()
+                      for p in (root / "reports" / "figures").rglob("*.png"))
+    assert max(digests.values()) == 1, [d for d, k in digests.items() if k > 1]
     for p in drawn:  # each figure's caption names its result file (the fit's is its own caption)
         rel = p.relative_to(root).as_posix()
         assert rel in html or p.stem == "fit", rel
@@ -555,14 +608,14 @@ def test_plot_draws_every_result_file_or_says_why_not(pipeline, tmp_path, capsys
         else:
             assert kind in NO_FIGURE
             assert status == 2 and str(path) in err and not out.exists(), err
-    sweep = root / "results" / "analyst" / "sweeps" / "case_2.1.nc"
+    sweep = root / ANALYST / "sweeps" / "case_2.1.nc"
     for variant in ("sizes", "restitution", "energy_loss"):
         assert main(["plot", str(sweep), "--variant", variant, "--out", str(tmp_path / f"{variant}.svg")]) == 0
         assert b"<svg" in (tmp_path / f"{variant}.svg").read_bytes()[:500]
     assert main(["plot", str(root / "results" / "kharaz.nc"), "--variant", "energy_loss",
                  "--out", str(tmp_path / "k.png")]) == 2
     assert "kharaz.nc" in capsys.readouterr().err and not (tmp_path / "k.png").exists()
-    fit = root / "results" / "analyst" / "fit.nc"
+    fit = root / ANALYST / "fit.nc"
     pdf = tmp_path / "fit.pdf"
     assert main(["plot", str(fit), "--curves", str(fit.with_name("fit_curves.nc")), "--out", str(pdf)]) == 0
     assert pdf.read_bytes()[:5] == b"%PDF-"

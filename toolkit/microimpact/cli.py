@@ -275,24 +275,22 @@ def _inputs(args) -> dict:
 
 def _impacts_for_pair(args):
     """Read the impact CSV (validated against the materials config) and pick the material pair."""
-    from microimpact.io import default_materials_path, read_impacts, read_materials
+    from microimpact.io import default_materials_path, material_pairs, read_impacts, read_materials, select_material_pair
 
     data = check_input_file("data file", args.data)
     config = check_input_file("--config", args.config) if args.config else default_materials_path()
     pairs = read_materials(config)
     table = read_impacts(data, materials=pairs)
-    labels = sorted({str(x) for x in table["material_pair"].dropna().unique()})
+    labels = material_pairs(table)
     name = args.material_pair or (labels[0] if len(labels) == 1 else None)
     if name is None:
         raise UsageError(f"{data}: give --material-pair (the file has {'pairs ' + ', '.join(labels) if labels else 'no material_pair column'})")
     if name not in pairs:
         raise UsageError(f"unknown material pair {name!r}; known pairs in {config}: {', '.join(pairs)}")
-    keep = table["material_pair"].isna() | (table["material_pair"] == name)
-    if not keep.any():
-        raise UsageError(f"{data}: no impacts of material pair {name!r}")
-    sub = table[keep.to_numpy()].reset_index(drop=True)
-    sub.attrs = dict(table.attrs)
-    return sub, pairs[name]
+    try:  # unlabelled rows belong to the named pair
+        return select_material_pair(table, name, default=name), pairs[name]
+    except ValueError as e:
+        raise UsageError(str(e)) from None
 
 
 def _cmd_fit(args) -> int:
@@ -325,7 +323,7 @@ def register_fit(sub) -> None:
     p = sub.add_parser("fit", help="fit the damping coefficients to measured e_n(v_n)")
     p.add_argument("data", help="measured-impact CSV (data/README.md, 'Measured-impact CSV format')")
     p.add_argument("--config", help="materials config YAML (default: the bundled one)")
-    p.add_argument("--material-pair", help="material pair to fit (default: the file's only pair)")
+    p.add_argument("--material-pair", help="material pair to fit: its rows, and the rows without a material_pair cell (default: the file's only pair)")
     p.add_argument("--fit-work-of-adhesion", action="store_true", help="also fit w_A (shared by all radii)")
     p.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto", help="weighting (default auto)")
     p.add_argument("--no-confidence-intervals", action="store_true", help="skip lmfit.conf_interval (faster)")
@@ -584,7 +582,7 @@ def register_plot(sub) -> None:
                                     "flags, bifurcation, benchmark, Kharaz)")
     p.add_argument("result", metavar="RESULT", help="result NetCDF written by microimpact or the pipeline")
     p.add_argument("--out", required=True, help=f"figure file ({', '.join('.' + f for f in FIGURE_FORMATS)})")
-    p.add_argument("--curves", default=None, help="with a fit file: its model curves (results/analyst/fit_curves.nc)")
+    p.add_argument("--curves", default=None, help="with a fit file: its model curves (results/analyst/<pair>/fit_curves.nc)")
     p.add_argument("--variant", default=None, metavar="NAME",
                    help="for a sweep file, which of its figures: restitution (e_n, impulse ratios), energy_loss "
                         "(K_L, K_t), sizes (per size; a sweep at several sizes)")

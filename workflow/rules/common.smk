@@ -183,6 +183,33 @@ if getattr(workflow, "is_main_process", True):
     check_config_at_start()
 
 
+# ---------------------------------------------------------------- material pairs of the data
+def data_pairs():
+    """The material pairs of the impact CSV: the pipeline fits each one (its rows only) and the report
+    has a part per pair. Read when the workflow is parsed (the data file is the workflow's sample
+    sheet); a file that does not read gives the configured pair alone, and the job validate_data
+    then stops the run with every problem of the file."""
+    from microimpact.io import ImpactDataError, material_pairs, read_impacts
+    from microimpact.io.materials import MaterialsError
+    import warnings
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # validate_data shows the warnings, once
+            table = read_impacts(config["data"], materials=materials_path(), material_pair=config["material_pair"])
+    except (ImpactDataError, MaterialsError, OSError, ValueError):
+        return [config["material_pair"]]
+    return material_pairs(table, config["material_pair"])
+
+
+#: the material pairs of the data, sorted (results/analyst/{pair}/, one part of the report each)
+PAIRS = data_pairs()
+
+
+wildcard_constraints:
+    pair="|".join(re.escape(p) for p in PAIRS),
+
+
 def sweep_overrides(wildcards):
     """Keys of the config that replace those of a Table 2 case's grid ({} for none)."""
     return dict(config["sweeps"][wildcards.case] or {})
@@ -212,8 +239,8 @@ def stress_outputs(wildcards):
 
 # ---------------------------------------------------------------- figures of the HTML report
 #: the parts of the HTML report's figures: reports/figures/{part}/, one `figures` job each, so that
-#: new data redraws the analyst's figures only
-FIGURE_PARTS = ("analyst", "paper", "checks")
+#: new data redraws the analyst's figures only; one analyst part per material pair
+FIGURE_PARTS = tuple(f"analyst/{p}" for p in PAIRS) + ("paper", "checks")
 #: Table 2 cases with an energy-loss figure in the paper (Figs. 7, 9, 11; the first entries of
 #: microimpact.report.figures.TABLE2_FIGURES, which a test compares with this list)
 ENERGY_LOSS_CASES = ("2.1", "2.2", "2.3")
@@ -232,16 +259,22 @@ def part_figures(part):
     have them in the paper."""
     if part == "checks":
         return [dict(result="results/kharaz.nc", name="kharaz", variant=None)]
-    names = {
-        "analyst": ["fit", "flags", "model_comparison", "posterior"],
-        "paper": ["bifurcation", "phase_portraits"],
-    }[part]
-    names += [f"sweeps/case_{c}" for c in SWEEP_CASES]
+    analyst = part.startswith("analyst/")
+    names = (
+        ["fit", "flags", "model_comparison", "posterior"]
+        if analyst
+        else ["bifurcation", "phase_portraits"]
+    )
+    # the analyst's standard sweep figure (e_n at normal incidence and the capture velocity per
+    # size) is the same for every case (they vary spin, angle and friction, which do not change
+    # e_n at normal incidence): drawn once, from the first case; the cases differ in their
+    # restitution and energy-loss figures below
+    names += [f"sweeps/case_{c}" for c in (SWEEP_CASES[:1] if analyst else SWEEP_CASES)]
     figures = [
         dict(result=f"results/{part}/{n}.nc", name=n, variant=None) for n in names
     ]
     variants = [("energy_loss", c) for c in SWEEP_CASES if c in ENERGY_LOSS_CASES]
-    if part == "analyst":
+    if analyst:
         variants = [("restitution", c) for c in SWEEP_CASES] + variants
     figures += [
         dict(
@@ -258,8 +291,27 @@ def part_figure_inputs(wildcards):
     """The result files of a part's figures (and the fit's model curves)."""
     files = {f["result"] for f in part_figures(wildcards.part)}
     inputs = {"results": sorted(files)}
-    if wildcards.part == "analyst":
-        inputs["curves"] = "results/analyst/fit_curves.nc"
+    if wildcards.part.startswith("analyst/"):
+        inputs["curves"] = f"results/{wildcards.part}/fit_curves.nc"
+    return inputs
+
+
+def analyst_report_inputs(wildcards):
+    """The analyst's result files of every material pair for the report rule, as named inputs
+    KEY__I (I: the pair's index in params.pairs; the report script groups them back)."""
+    inputs = {}
+    for i, p in enumerate(PAIRS):
+        base = f"results/analyst/{p}"
+        inputs.update({
+            f"fit__{i}": f"{base}/fit.nc",
+            f"posterior__{i}": f"{base}/posterior.nc",
+            f"oblique__{i}": f"{base}/oblique.nc",
+            f"fit_curves__{i}": f"{base}/fit_curves.nc",
+            f"model_comparison__{i}": f"{base}/model_comparison.nc",
+            f"flags__{i}": f"{base}/flags.csv",
+            f"analyst_dynamics__{i}": f"{base}/dynamics.nc",
+            f"analyst_sweeps__{i}": [f"{base}/sweeps/case_{c}.nc" for c in SWEEP_CASES],
+        })
     return inputs
 
 

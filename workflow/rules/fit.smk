@@ -1,4 +1,4 @@
-# The analyst's material: the fit of the damping coefficients to the measured e_n(v_n) (the
+# The analyst's material, once per material pair of the data ({pair}: PAIRS in common.smk): the fit of the damping coefficients to the measured e_n(v_n) (the
 # paper's Fig. 3 procedure), the friction from the oblique columns (when the data have them), the
 # posterior of the fitted parameters with its bands (config key posterior), and everything the fitted parameters drive: the measurement flags,
 # and in one job (each is seconds; one job saves the start-up of six) the model curves, the
@@ -12,13 +12,13 @@ rule fit:
         validated=rules.validate_data.output.table,
         materials=materials_path(),
     output:
-        "results/analyst/fit.nc",
-        posterior="results/analyst/posterior.nc",
-        oblique="results/analyst/oblique.nc",
+        "results/analyst/{pair}/fit.nc",
+        posterior="results/analyst/{pair}/posterior.nc",
+        oblique="results/analyst/{pair}/oblique.nc",
     log:
-        "logs/fit.log",
+        "logs/fit/{pair}.log",
     benchmark:
-        "benchmarks/fit.tsv"
+        "benchmarks/fit/{pair}.tsv"
     priority: 10  # on the path to the report (data, fit, what uses the fit): started first
     conda:
         "../envs/microimpact.yaml"
@@ -41,15 +41,15 @@ rule flags:
         posterior=rules.fit.output.posterior,
     output:
         csv=report(
-            "results/analyst/flags.csv",
+            "results/analyst/{pair}/flags.csv",
             caption="../report/flags_table.rst",
             category="Tables",
         ),
-        nc="results/analyst/flags.nc",
+        nc="results/analyst/{pair}/flags.nc",
     log:
-        "logs/flags.log",
+        "logs/flags/{pair}.log",
     benchmark:
-        "benchmarks/flags.tsv"
+        "benchmarks/flags/{pair}.tsv"
     priority: 10  # on the path to the report (data, fit, what uses the fit): started first
     conda:
         "../envs/microimpact.yaml"
@@ -66,13 +66,13 @@ rule material_simulations:
     input:
         fit=rules.fit.output[0],
     output:
-        fit_curves="results/analyst/fit_curves.nc",
-        dynamics="results/analyst/dynamics.nc",
-        sweeps=expand("results/analyst/sweeps/case_{case}.nc", case=SWEEP_CASES),
+        fit_curves="results/analyst/{pair}/fit_curves.nc",
+        dynamics="results/analyst/{pair}/dynamics.nc",
+        sweeps=expand("results/analyst/{{pair}}/sweeps/case_{case}.nc", case=SWEEP_CASES),
     log:
-        "logs/material_simulations.log",
+        "logs/material_simulations/{pair}.log",
     benchmark:
-        "benchmarks/material_simulations.tsv"
+        "benchmarks/material_simulations/{pair}.tsv"
     priority: 10  # on the path to the report (data, fit, what uses the fit): started first
     conda:
         "../envs/microimpact.yaml"

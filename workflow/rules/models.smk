@@ -9,11 +9,11 @@ rule model_comparison:
         validated=rules.validate_data.output.table,
         materials=materials_path(),
     output:
-        "results/analyst/model_comparison.nc",
+        "results/analyst/{pair}/model_comparison.nc",
     log:
-        "logs/model_comparison.log",
+        "logs/model_comparison/{pair}.log",
     benchmark:
-        "benchmarks/model_comparison.tsv"
+        "benchmarks/model_comparison/{pair}.tsv"
     conda:
         "../envs/microimpact.yaml"
     threads: 1

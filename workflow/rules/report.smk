@@ -1,5 +1,6 @@
 # The PDF report (microimpact.report.pdf.build_report): it reads the result files below and runs
-# no model. Keys name the parts: the analyst's material (fit and what it drives), the paper's
+# no model. Keys name the parts: the analyst's material per pair (fit and what it drives; KEY__I for
+# the pair params.pairs[I]), the paper's
 # reproduction, and the checks.
 
 
@@ -7,15 +8,8 @@ rule report:
     input:
         unpack(benchmark_outputs),
         unpack(stress_outputs),
+        unpack(analyst_report_inputs),
         data_table=rules.validate_data.output.table,
-        fit=rules.fit.output[0],
-        posterior=rules.fit.output.posterior,
-        oblique=rules.fit.output.oblique,
-        fit_curves=rules.material_simulations.output.fit_curves,
-        model_comparison=rules.model_comparison.output[0],
-        flags=rules.flags.output.csv,
-        analyst_dynamics=rules.material_simulations.output.dynamics,
-        analyst_sweeps=rules.material_simulations.output.sweeps,
         phase_portraits=rules.paper_dynamics.output.phase_portraits,
         dynamics=rules.paper_dynamics.output.dynamics,
         bifurcation=rules.paper_dynamics.output.bifurcation,
@@ -39,5 +33,6 @@ rule report:
     threads: 1
     params:
         config=config,
+        pairs=PAIRS,
     script:
         "../scripts/report.py"

@@ -1,6 +1,6 @@
 """Rule flags: each measured impact's sensitivity to unmeasured spin and angle error, whether it
 is near capture, and the spin consistent with it (over the posterior draws), under the fitted model
--> results/analyst/flags.csv + results/analyst/flags.nc."""
+-> results/analyst/<pair>/flags.csv + results/analyst/<pair>/flags.nc."""
 
 from microimpact.io.joblog import log_job
 
@@ -15,12 +15,14 @@ import xarray as xr  # noqa: E402
 from microimpact.analysis.fit_result import DampingFit  # noqa: E402
 from microimpact.analysis.flags import flag_measurements, write_flags  # noqa: E402
 from microimpact.analysis.posterior import load_posterior  # noqa: E402
-from microimpact.io import read_impacts  # noqa: E402
+from microimpact.io import read_impacts, select_material_pair  # noqa: E402
 from microimpact.studies.material import stamp_fitted  # noqa: E402
 
 fit_ds = xr.load_dataset(snakemake.input.fit)  # noqa: F821
-table = read_impacts(snakemake.input.data, materials=snakemake.input.materials,  # noqa: F821
-                     material_pair=snakemake.params.material_pair)  # noqa: F821
+pair = snakemake.wildcards.pair  # noqa: F821  (this job's material pair: its rows of the data)
+table = select_material_pair(read_impacts(snakemake.input.data, materials=snakemake.input.materials,  # noqa: F821
+                                          material_pair=snakemake.params.material_pair),  # noqa: F821
+                             pair, default=snakemake.params.material_pair)  # noqa: F821
 ds = flag_measurements(table, DampingFit.from_dataset(fit_ds), rtol=snakemake.params.rtol,  # noqa: F821
                        posterior=load_posterior(snakemake.input.posterior),  # noqa: F821
                        **({} if snakemake.params.n_draws is None else {"n_draws": snakemake.params.n_draws}))  # noqa: F821

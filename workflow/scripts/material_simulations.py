@@ -1,4 +1,4 @@
-"""Rule material_simulations: what the fit drives -> results/analyst/: the model e_n(v_n) curves
+"""Rule material_simulations: what the fit drives -> results/analyst/<pair>/: the model e_n(v_n) curves
 (fit_curves.nc), the critical and capture velocity per measured size (dynamics.nc) and every
 configured Table 2 case for the fitted material (sweeps/case_<case>.nc)."""
 

@@ -6,5 +6,9 @@ log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line
 
 from microimpact.report.pdf import build_report  # noqa: E402
 
-inputs = dict(snakemake.input.items())  # noqa: F821  (named inputs; lists such as the sweeps stay lists)
-build_report(snakemake.output[0], inputs, config=snakemake.params.config, workers=snakemake.threads)  # noqa: F821
+named = dict(snakemake.input.items())  # noqa: F821  (named inputs; lists such as the sweeps stay lists)
+pairs = {p: {k.rsplit("__", 1)[0]: v for k, v in named.items() if k.endswith(f"__{i}")}
+         for i, p in enumerate(snakemake.params.pairs)}  # noqa: F821
+inputs = {k: v for k, v in named.items() if "__" not in k}
+build_report(snakemake.output[0], inputs, pairs=pairs, config=snakemake.params.config,  # noqa: F821
+             workers=snakemake.threads)  # noqa: F821

@@ -345,8 +345,10 @@ def _fit_facts(fit: "DampingFit") -> dict:
         "material": f"density {fit.density:g} kg/m3, K {fit.stiffness:.4g} Pa, friction {fit.friction:g}, "
                     "damping reference speed "
                     f"{'per-impact normal speed' if vref is None else f'{vref:g} m/s'}",
+        # only where a covariance exists (lmfit gives NaN without one: not a number to print)
         "correlations": [f"{fit.varied[a]} / {fit.varied[b]}: {fit.correlation[idx[a], idx[b]]:+.3f}"
-                         for a in range(len(idx)) for b in range(a + 1, len(idx))],
+                         for a in range(len(idx)) for b in range(a + 1, len(idx))
+                         if np.isfinite(fit.correlation[idx[a], idx[b]])],
         "chi-square": f"{fit.chisqr:.4g}, reduced {fit.redchi:.4g} "
                       f"({fit.n_points - len(fit.varied)} degrees of freedom)",
         "AIC, BIC": f"{fit.aic:.4g}, {fit.bic:.4g}",

@@ -14,8 +14,10 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import stat
 import tempfile
+import threading
 from collections.abc import Iterator, Mapping
 from datetime import datetime, timezone
 from importlib.metadata import PackageNotFoundError, version
@@ -25,11 +27,47 @@ import numpy as np
 
 from microimpact.io.variables import VARIABLES, udunits
 
-__all__ = ["atomic_path", "atomic_write", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
+__all__ = ["atomic_path", "atomic_write", "deferred_signals", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
            "CONVENTIONS", "read_netcdf_groups"]
 
 #: encoding added to every numeric, non-scalar NetCDF variable
 NETCDF_COMPRESSION = {"zlib": True, "complevel": 4}
+
+
+@contextlib.contextmanager
+def deferred_signals(signums=(signal.SIGINT, signal.SIGTERM)) -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back for the duration of the block, then act on them.
+
+    A KeyboardInterrupt raised inside netCDF4/xarray's writer is raised while xarray holds its
+    file lock, and the writer's own cleanup then waits for that lock for ever (a pipeline job
+    hung 24 minutes after Ctrl-C). The block therefore runs to its end, and a signal that came
+    during it is re-raised afterwards, with the handlers that were in place before. Outside the
+    main thread, where Python cannot install handlers, the block runs unchanged.
+
+    Examples
+    --------
+    >>> with deferred_signals():
+    ...     x = 1 + 1
+    >>> x
+    2
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    received: list[int] = []
+    previous = {}
+    for s in signums:
+        try:
+            previous[s] = signal.signal(s, lambda signum, frame: received.append(signum))
+        except (ValueError, OSError):  # pragma: no cover - a signal this platform cannot catch
+            pass
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        for s in dict.fromkeys(received):
+            signal.raise_signal(s)
 
 
 def _target_mode(path: Path) -> int:
@@ -274,7 +312,7 @@ def write_netcdf_groups(groups: Mapping, path) -> Path:
         items.insert(0, (None, xr.Dataset()))
     path = Path(path)
     prepared = [(name, *_cf_dataset(ds, root=i == 0, path=path)) for i, (name, ds) in enumerate(items)]
-    with atomic_path(path) as tmp:
+    with atomic_path(path) as tmp, deferred_signals():  # a signal lands after the write: tmp is then removed
         for i, (name, ds, encoding) in enumerate(prepared):
             ds.to_netcdf(tmp, mode="w" if i == 0 else "a", group=None if name in (None, "/") else str(name),
                          engine="netcdf4", format="NETCDF4", encoding=encoding)

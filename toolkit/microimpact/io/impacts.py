@@ -76,6 +76,8 @@ from microimpact.io.units import INTERNAL_UNIT, UnitError, accepted_units, conve
 
 __all__ = [
     "read_impacts",
+    "material_pairs",
+    "select_material_pair",
     "ImpactDataError",
     "ImpactDataWarning",
     "Problem",
@@ -1003,3 +1005,82 @@ def _check_rebound(cells: _Cells, col: _Column, out: dict, problems: list[Proble
 def _sorted(problems: list[Problem]) -> list[Problem]:
     """File/header problems first, then by row, keeping the order within a row."""
     return sorted(problems, key=lambda p: (p.row is not None, p.row or 0, p.line or 0))
+
+
+# --------------------------------------------------------------------------- material pairs
+def material_pairs(table: pd.DataFrame, default: str | None = None) -> list[str]:
+    """The material pairs of an impact table, sorted: its ``material_pair`` labels, and ``default``
+    when some row has no label (those rows belong to it).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        As returned by :func:`read_impacts`.
+    default : str, optional
+        Pair of the rows without a ``material_pair`` cell (the pipeline's config key
+        ``material_pair``, the CLI's ``--material-pair``).
+
+    Returns
+    -------
+    list of str
+
+    Examples
+    --------
+    >>> t = pd.DataFrame({"material_pair": ["b", None, "a", "b"]})
+    >>> material_pairs(t, default="c")
+    ['a', 'b', 'c']
+    >>> material_pairs(t.iloc[[0, 2]])
+    ['a', 'b']
+    """
+    labels = table["material_pair"] if "material_pair" in table.columns else pd.Series([None] * len(table), dtype=object)
+    pairs = {str(p) for p in labels.dropna().unique()}
+    if default is not None and bool(labels.isna().any()):
+        pairs.add(default)
+    return sorted(pairs)
+
+
+def select_material_pair(table: pd.DataFrame, pair: str, *, default: str | None = None) -> pd.DataFrame:
+    """The rows of one material pair: those labelled ``pair``, and the unlabelled ones when ``pair``
+    is the ``default`` pair. Row numbers (``row``), ids and ``attrs`` are kept; the label column is
+    filled with ``pair`` and ``attrs["material_pair"]`` set, so every per-row output names the pair.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        As returned by :func:`read_impacts`.
+    pair : str
+        The material pair.
+    default : str, optional
+        Pair of the rows without a ``material_pair`` cell.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The pair's rows in file order (index from 0).
+
+    Raises
+    ------
+    ValueError
+        If no row belongs to ``pair`` (the message names the pairs that do occur).
+
+    Examples
+    --------
+    >>> t = pd.DataFrame({"row": [1, 2, 3], "material_pair": pd.array(["a", None, "b"], dtype="string")})
+    >>> select_material_pair(t, "a", default="a")["row"].tolist()
+    [1, 2]
+    >>> select_material_pair(t, "b", default="a")["material_pair"].tolist()
+    ['b']
+    """
+    labels = table["material_pair"] if "material_pair" in table.columns else pd.Series([None] * len(table), dtype=object)
+    missing = labels.isna().to_numpy(dtype=bool)
+    keep = np.array([not m and str(x) == pair for x, m in zip(labels, missing)], dtype=bool)
+    if pair == default:
+        keep |= missing
+    if not keep.any():
+        src = table.attrs.get("source", "impact table")
+        raise ValueError(f"{src}: no impacts of material pair {pair!r} (pairs in the file: "
+                         f"{', '.join(material_pairs(table, default)) or 'none'})")
+    sub = table[keep].reset_index(drop=True)
+    sub["material_pair"] = pair
+    sub.attrs = {**table.attrs, "material_pair": pair}
+    return sub

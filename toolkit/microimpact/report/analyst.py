@@ -179,10 +179,11 @@ def _posterior_rows(post: xr.Dataset) -> pd.DataFrame:
 # =============================================================================== oblique
 def oblique_section(lay: Layout, obl: xr.Dataset) -> None:
     """The friction fit from the oblique columns: measured against fitted per angle."""
-    lay.section("Friction from the oblique columns", new_page=False)
     if "friction" not in obl:
-        lay.paragraph(f"({obl.attrs.get('comment', 'no friction fit')}.)", color="0.4")
+        # one line under the fit, not a section of its own (a heading and this line once filled a page)
+        lay.paragraph(f"Friction: {obl.attrs.get('comment', 'no friction fit')}.", color="0.4")
         return
+    lay.section("Friction from the oblique columns", new_page=False)
     lay.paragraph(
         f"Coulomb friction f fitted to the measured {', '.join(dict.fromkeys(str(q) for q in obl['quantity'].values))} "
         "with the paper's rigid tangential model (Eqs. (16)-(20)), AFTER the damping fit: the normal motion does not "

@@ -241,13 +241,36 @@ def _speed_axis(ax, ds: xr.Dataset) -> None:
         ax.set_xlim(0.0, float(v.max()) * 1.02 if v.size else 1.0)
 
 
+class _LogLabels(matplotlib.ticker.Formatter):
+    """Labels of a log axis that do not run into each other: plain numbers (0.5, 2, 10) between
+    0.01 and 1000, powers of ten outside; the minor ticks (2 and 5 of each decade) labelled only
+    while the axis spans at most a decade and a half (a 7-decade axis labelled at 1, 2 and 5 of
+    each decade had its labels overlap)."""
+
+    def __init__(self, minor: bool):
+        self.minor = minor
+
+    def __call__(self, x, pos=None):
+        if not (x > 0 and math.isfinite(x)):
+            return ""
+        if self.minor:
+            lo, hi = sorted(self.axis.get_view_interval())
+            if not (lo > 0 and math.log10(hi / lo) <= 1.5):
+                return ""
+        if 1e-2 <= x < 1e3:
+            return f"{x:g}"
+        exponent = math.floor(math.log10(x) + 1e-9)
+        mantissa = x / 10.0**exponent
+        return (f"$10^{{{exponent}}}$" if abs(mantissa - 1.0) < 1e-6
+                else f"${mantissa:g}\\times10^{{{exponent}}}$")
+
+
 def _plain_log_labels(axis) -> None:
-    """Plain numbers (2, 3, 5, 10) on a log axis, at most two minor labels a decade: the default
-    'm x 10^n' labels of an axis spanning less than a decade run into each other."""
-    fmt = matplotlib.ticker.FuncFormatter(lambda x, _: f"{x:g}")
-    axis.set_major_formatter(fmt)
+    """Readable labels on a log axis (:class:`_LogLabels`): the default 'm x 10^n' labels of an
+    axis spanning less than a decade run into each other, and so do minor labels over many decades."""
+    axis.set_major_formatter(_LogLabels(minor=False))
     axis.set_minor_locator(matplotlib.ticker.LogLocator(subs=(2.0, 5.0)))
-    axis.set_minor_formatter(fmt)
+    axis.set_minor_formatter(_LogLabels(minor=True))
 
 
 def _mark_capture(ax, v_caps, colors) -> None:
@@ -270,7 +293,7 @@ def _mark_capture(ax, v_caps, colors) -> None:
 def _caption_capture(ds: xr.Dataset, v_caps) -> str:
     finite = sorted({round(v, 6) for v in v_caps if math.isfinite(v)})
     if not finite:
-        return "No impact in the sweep is captured."
+        return "No impact in the sweep is captured. "
     if "capture_normal_speed" in ds:
         txt = f"Grey: captured (normal capture speed v_c = {float(ds['capture_normal_speed']):.4g} m/s, dashed line"
         if len(finite) > 1:
@@ -505,11 +528,22 @@ def plot_size_dependence(sweep: xr.Dataset, dynamics: xr.Dataset | None = None) 
                  if k in dynamics]
     elif "capture_normal_speed" in sweep and "radius" in sweep["capture_normal_speed"].dims:
         lines = [(sweep["capture_normal_speed"], "capture velocity", "o")]
+    # a non-adhesive pair (f0 = 0) captures nothing: its capture velocity is 0 and v_c undefined,
+    # which a log axis cannot show; the panel says so instead of staying empty
+    lines = [(var, label, m) for var, label, m in lines if np.any(np.asarray(var.values, float) > 0)]
     for var, label, marker in lines:
-        ax_v.plot(2e6 * np.asarray(var["radius"].values, float), var.values, marker=marker, ms=4, label=label)
+        v = np.asarray(var.values, float)
+        ax_v.plot(2e6 * np.asarray(var["radius"].values, float), np.where(v > 0, v, np.nan), marker=marker, ms=4,
+                  label=label)
     ax_v.set_xscale("log")
-    ax_v.set_yscale("log")
-    for axis in (ax_v.xaxis, ax_v.yaxis, ax_e.xaxis):
+    if lines:
+        ax_v.set_yscale("log")
+    else:
+        ax_v.set_xlim(2e6 * radii.min() / 1.5, 2e6 * radii.max() * 1.5)
+        ax_v.set_yticks([])
+        ax_v.text(0.5, 0.5, "no capture at any speed\n(no adhesion: f0 = 0)" if dynamics is not None
+                  else "no capture velocity\nin the input", transform=ax_v.transAxes, ha="center", va="center")
+    for axis in (ax_v.xaxis, ax_v.yaxis, ax_e.xaxis) if lines else (ax_v.xaxis, ax_e.xaxis):
         _plain_log_labels(axis)
     ax_v.set_xlabel(r"sphere diameter $d$ [µm]")
     ax_v.set_ylabel(r"normal speed [m/s]")
@@ -523,7 +557,9 @@ def plot_size_dependence(sweep: xr.Dataset, dynamics: xr.Dataset | None = None) 
         f"{', ' + fixed if fixed else ''}), one curve per diameter; dotted: captured (e_n = 0). "
         "(b) Normal capture velocity [m/s] (below it the sphere adheres)"
         + (" and critical velocity v_c of Eq. (38) (C = 2)" if dynamics is not None and "critical_velocity" in dynamics
-           else "") + " against the diameter [um]." + ("" if lines else " (No capture velocities in the input.)")
+           else "") + " against the diameter [um]."
+        + ("" if lines else " No capture velocity to draw: every impact rebounds." if dynamics is not None
+           else " (No capture velocities in the input.)")
     )
     return Plot(fig, caption, None)
 

@@ -23,6 +23,7 @@ from microimpact.io.files import read_netcdf_groups
 
 __all__ = [
     "INPUT_KEYS",
+    "ANALYST_KEYS",
     "check_inputs",
     "read_dataset",
     "read_table",
@@ -62,13 +63,24 @@ INPUT_KEYS = {
 }
 
 
-def check_inputs(inputs: Mapping) -> dict:
-    """``inputs`` as a dict without None values; raise on an unknown or a missing required key."""
-    unknown = sorted(set(inputs) - set(INPUT_KEYS))
+#: the keys of the analyst's part (one set per material pair in ``build_report(pairs=...)``)
+ANALYST_KEYS = ("fit", "fit_curves", "flags", "posterior", "oblique", "analyst_dynamics", "analyst_sweeps",
+                "model_comparison")
+
+
+def check_inputs(inputs: Mapping, *, keys=None, required=None) -> dict:
+    """``inputs`` as a dict without None values; raise on an unknown or a missing required key.
+
+    ``keys`` limits the accepted keys (default: all of :data:`INPUT_KEYS`); ``required`` replaces
+    the required ones (default: those of :data:`INPUT_KEYS`)."""
+    accepted = INPUT_KEYS if keys is None else {k: INPUT_KEYS[k] for k in keys}
+    unknown = sorted(set(inputs) - set(accepted))
     if unknown:
-        raise KeyError(f"build_report: unknown input key(s) {unknown}; accepted: {', '.join(INPUT_KEYS)}")
+        raise KeyError(f"build_report: unknown input key(s) {unknown}; accepted: {', '.join(accepted)}")
     out = {k: v for k, v in inputs.items() if v is not None and not (isinstance(v, (list, tuple)) and not v)}
-    missing = [k for k, (required, _) in INPUT_KEYS.items() if required and k not in out]
+    if required is None:
+        required = [k for k, (req, _) in accepted.items() if req]
+    missing = [k for k in required if k not in out]
     if missing:
         raise KeyError(f"build_report: missing required input(s) {missing} "
                        f"({'; '.join(f'{k}: {INPUT_KEYS[k][1]}' for k in missing)})")
@@ -175,12 +187,15 @@ def git_commit(directory=".") -> str | None:
 def _data_facts(t: pd.DataFrame) -> dict[str, str]:
     radii = np.unique(np.round(t["radius"].to_numpy(float) * 1e6, 4))
     v = t["normal_speed"].to_numpy(float)
+    labels = sorted({str(p) for p in t["material_pair"].dropna().unique()}) if "material_pair" in t.columns else []
     return {"data content": f"{len(t)} impacts, {len(radii)} radii ({', '.join(f'{r:g}' for r in radii)} um), "
-                            f"normal speed {np.nanmin(v):.3g}-{np.nanmax(v):.3g} m/s"}
+                            f"normal speed {np.nanmin(v):.3g}-{np.nanmax(v):.3g} m/s"
+                            + (f"; material pairs {', '.join(labels)}" if len(labels) > 1 else "")}
 
 
 def _config_facts(config: Mapping) -> dict[str, str]:
-    out = {"materials": f"{config.get('materials')} (pair {config.get('material_pair')})"}
+    out = {"materials": f"{config.get('materials')} (material_pair {config.get('material_pair')}: the pair of "
+                        "rows without a material_pair cell)"}
     sim = config.get("simulation", {})
     if sim:
         out["paper-part contact"] = ", ".join(f"{k} = {v}" for k, v in sim.items() if not isinstance(v, Mapping))

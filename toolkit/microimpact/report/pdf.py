@@ -3,7 +3,7 @@
 :func:`build_report` lays out ``reports/report.pdf`` from the NetCDF/CSV/JSON results of the
 Snakemake workflow (keys in :data:`microimpact.report.inputs.INPUT_KEYS`) in three parts:
 
-A. the analyst's material, with the parameters of the fit: the damping fit (Fig. 3 analogue),
+A. the analyst's material, with the parameters of the fit (one part per material pair of the data): the damping fit (Fig. 3 analogue),
    the normal contact models compared on the data (:mod:`.models`), capture and critical velocity
    per measured size, the Table 2 sweeps at the measured sizes and the measurement flags
    (:mod:`.analyst`);
@@ -40,7 +40,8 @@ import pandas as pd
 from microimpact import __version__
 from microimpact.model.contact import PAPER_REFERENCE
 from microimpact.report import analyst, checks, models, paper
-from microimpact.report.inputs import (INPUT_KEYS, as_list, check_inputs, git_commit, is_synthetic, provenance,
+from microimpact.io.impacts import select_material_pair
+from microimpact.report.inputs import (ANALYST_KEYS, INPUT_KEYS, as_list, check_inputs, git_commit, is_synthetic, provenance,
                                        read_dataset, read_json, read_portraits, read_table)
 from microimpact.report.layout import PAGE_SIZE, Layout
 
@@ -53,21 +54,27 @@ def _optional(inputs: Mapping, key: str, reader):
     return reader(inputs[key]) if key in inputs else None
 
 
-def _analyst_part(lay: Layout, inputs: Mapping, data: pd.DataFrame | None, synthetic: bool) -> None:
-    """Part A: every result made with the parameters of the fit to the analyst's data."""
+def _analyst_part(lay: Layout, inputs: Mapping, data: pd.DataFrame | None, synthetic: bool,
+                  label: str = "A", pair: str | None = None) -> None:
+    """Part A (A1, A2, ... with several material pairs): every result made with the parameters of the
+    fit to the analyst's data of one material pair."""
     fit = read_dataset(inputs["fit"])
+    pair = pair or fit.attrs.get("fit_material_pair")
     lay.part(
-        "Part A. The analyst's material (parameters from the fit)",
+        f"Part {label}. The analyst's material" + (f": {pair}" if pair else "") + " (parameters from the fit)",
         f"Results for the data of {fit.attrs.get('fit_source', 'the analyst')}"
+        + (f", the rows of material pair {pair}" if pair else "")
         + (" (SYNTHETIC)" if synthetic else "") + ". The damping coefficients zeta_H, zeta_A (and w_A when it is "
         "fitted) come from the fit in section 1; every simulation in this part uses them, at the measured sphere "
         "sizes and over the measured speed range.")
     analyst.fit_section(lay, fit, _optional(inputs, "fit_curves", read_dataset), data, synthetic)
+    obl = _optional(inputs, "oblique", read_dataset)
+    if obl is not None and "friction" not in obl:  # no oblique columns: one line under the fit
+        analyst.oblique_section(lay, obl)
     post = _optional(inputs, "posterior", read_dataset)
     if post is not None:
         analyst.posterior_section(lay, fit, post)
-    obl = _optional(inputs, "oblique", read_dataset)
-    if obl is not None:
+    if obl is not None and "friction" in obl:
         analyst.oblique_section(lay, obl)
     if "model_comparison" in inputs:
         models.model_comparison_section(lay, read_dataset(inputs["model_comparison"]), synthetic)
@@ -79,6 +86,16 @@ def _analyst_part(lay: Layout, inputs: Mapping, data: pd.DataFrame | None, synth
         analyst.analyst_sweeps_section(lay, sweeps, dyn)
     if "flags" in inputs:
         analyst.flags_section(lay, read_table(inputs["flags"]), data)
+
+
+def _rows_of_pair(data: pd.DataFrame | None, pair: str, default: str | None) -> pd.DataFrame | None:
+    """The validated table's rows of one material pair (None when there are none)."""
+    if data is None:
+        return None
+    try:
+        return select_material_pair(data, pair, default=default)
+    except ValueError:
+        return None
 
 
 def _paper_part(lay: Layout, inputs: Mapping) -> None:
@@ -117,7 +134,7 @@ def _checks_part(lay: Layout, inputs: Mapping, config: Mapping) -> None:
 
 
 def build_report(path, inputs: Mapping, config: Mapping | None = None, title: str | None = None, *,
-                 workers: int = 1) -> Path:
+                 pairs: Mapping[str, Mapping] | None = None, workers: int = 1) -> Path:
     """Build the PDF report from the pipeline's result files.
 
     Parameters
@@ -132,6 +149,12 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
         ``dynamics``, ``bifurcation``, ``reproduction`` (CSV), ``paper_sweeps`` (list); checks
         ``kharaz``, ``work_precision``, ``stress`` (JSON). NetCDF unless stated. In-memory
         objects (Dataset, DataFrame, dict, list of Datasets) are accepted in place of files.
+    pairs : mapping of str to mapping, optional
+        The analyst's part per material pair: pair name -> its analyst inputs (the keys
+        :data:`~microimpact.report.inputs.ANALYST_KEYS`, ``fit`` required). The report then has one
+        Part A per pair (A1, A2, ... when there are several), each with the data table's rows of its
+        pair (unlabelled rows belong to ``config["material_pair"]``), and ``inputs`` holds no
+        analyst key.
     config : mapping, optional
         The pipeline configuration (title page and appendix).
     title : str, optional
@@ -150,7 +173,13 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
     KeyError
         For an unknown key or a missing ``fit``.
     """
-    inputs = check_inputs(inputs)
+    if pairs is None:
+        inputs = check_inputs(inputs)
+    else:
+        inputs = check_inputs(inputs, keys=[k for k in INPUT_KEYS if k not in ANALYST_KEYS], required=[])
+        pairs = {p: check_inputs(v, keys=ANALYST_KEYS, required=["fit"]) for p, v in pairs.items()}
+        if not pairs:
+            raise KeyError("build_report: pairs= holds no material pair")
     config = dict(config or {})
     title = title or config.get("report_title") or _DEFAULT_TITLE
     data = _optional(inputs, "data_table", read_table)
@@ -158,7 +187,12 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
     synthetic = "SYNTHETIC" in prov.get("data", "")
 
     lay = Layout(title)
-    _analyst_part(lay, inputs, data, synthetic)
+    if pairs is None:
+        _analyst_part(lay, inputs, data, synthetic)
+    else:
+        for i, (pair, pair_inputs) in enumerate(pairs.items()):
+            _analyst_part(lay, pair_inputs, _rows_of_pair(data, pair, config.get("material_pair")), synthetic,
+                          label="A" if len(pairs) == 1 else f"A{i + 1}", pair=pair)
     _paper_part(lay, inputs)
     _checks_part(lay, inputs, config)
     lay.title_page(

@@ -121,7 +121,8 @@ def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL, time_budge
     -------
     xarray.Dataset
         ``critical_velocity`` and ``capture_velocity`` [m/s] along ``radius`` [m], with
-        ``parameter_source`` and ``contact_*`` attributes (arrays along ``radius``).
+        ``parameter_source`` and ``contact_*`` attributes (arrays along ``radius``). A size
+        without adhesion (f0 = 0) has capture velocity 0 and critical velocity NaN.
     """
     contacts = fitted_contacts(fit)
     radii = np.array(list(contacts))
@@ -132,8 +133,13 @@ def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL, time_budge
         deadline.check(f"{len(capture)} of {radii.size} sizes")
     ds = xr.Dataset(
         {
-            "critical_velocity": ("radius", [critical_velocity(c) for c in contacts.values()],
-                                  {"units": "m s-1", "long_name": "critical velocity v_c, Eq. (38)"}),
+            # Eq. (38) needs the adhesive equilibrium: without adhesion (f0 = 0) there is none and
+            # no capture (capture_velocity is 0 there), so v_c is missing, with the reason
+            "critical_velocity": ("radius", [critical_velocity(c) if c.adhesion_line_force > 0 else np.nan
+                                             for c in contacts.values()],
+                                  {"units": "m s-1", "long_name": "critical velocity v_c, Eq. (38)",
+                                   "comment": "NaN where the contact has no adhesion (f0 = 0): no adhesive "
+                                              "equilibrium, every impact rebounds"}),
             "capture_velocity": ("radius", capture, attributes("capture_normal_speed")),
         },
         coords={"radius": ("radius", radii, attributes("radius"))},
