@@ -12,6 +12,7 @@ import re
 import warnings
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from microimpact.analysis.fit_result import DampingFit
@@ -32,9 +33,12 @@ def pairs():
     return read_materials(default_materials_path())
 
 
-def _oblique(tmp_path, pairs, **design):
+def _oblique(tmp_path, pairs, extra_columns=None, **design):
     path = tmp_path / "oblique.csv"
-    write_csv(make_synthetic_oblique(**design), path, float_format="%.6g")
+    df = make_synthetic_oblique(**design)
+    for name, value in (extra_columns or {}).items():  # columns of the analyst's own
+        df[name] = [f"{value}{i}" for i in range(len(df))]
+    write_csv(df, path, float_format="%.6g")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         table = read_impacts(path, materials=pairs)
@@ -126,18 +130,27 @@ def test_every_impact_sliding_determines_f(tmp_path, pairs):
     assert st.upper - st.lower < 0.1  # 9 rows at 2 % e_t noise pin f to a few hundredths
 
 
-def test_friction_status_round_trips_through_netcdf_with_the_ids(tmp_path, pairs):
-    _, damping, ff = _oblique(tmp_path, pairs, radii=(3.45e-6,), speeds=(5.0, 10.0, 20.0),
-                              incidence_deg=(5.0, 10.0, 15.0), friction=0.6, seed=3)
+def test_friction_status_round_trips_through_netcdf_with_the_analysts_labels(tmp_path, pairs):
+    table, damping, ff = _oblique(tmp_path, pairs, extra_columns={"operator": "op", "batch no.": "b"},
+                                  radii=(3.45e-6,), speeds=(5.0, 10.0, 20.0), incidence_deg=(5.0, 10.0, 15.0),
+                                  friction=0.6, seed=3)
     ds = ff.to_dataset()
     assert int(ds["friction_status"]) == 1 and ds["friction_status"].attrs["flag_meanings"].split()[1] == "lower_bound"
     assert float(ds["friction_lower"]) == pytest.approx(ff.identifiability["friction"].lower, abs=1e-12)
+    # every fitted entry keeps the id and the analyst's own columns of its CSV row
+    by_row = table.set_index("row")
+    for frame in (ff.data, damping.data):
+        assert list(frame.columns[1:4]) == ["id", "operator", "batch no."]
+        for col in ("id", "operator", "batch no."):
+            assert list(frame[col]) == [str(by_row.loc[r, col]) for r in frame["row"]]
     assert list(ds["id"].values) == list(ff.data["id"])
+    assert list(ds["csv_batch_no"].values) == list(ff.data["batch no."])
     assert all(str(i).startswith("obl-") for i in ds["id"].values)
     damping.save(tmp_path / "fit.nc")
     back = DampingFit.load(tmp_path / "fit.nc")
     assert back.identifiability == damping.identifiability
-    assert list(back.data["id"]) == list(damping.data["id"])
+    pd.testing.assert_frame_equal(back.data[["row", "id", "operator", "batch no."]],
+                                  damping.data[["row", "id", "operator", "batch no."]], check_dtype=False)
 
 
 # ---------------------------------------------------------------------------- the damping fit

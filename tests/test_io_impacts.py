@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+import xarray as xr
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -28,7 +29,7 @@ from microimpact.io import (
     read_impacts,
     read_materials,
 )
-from microimpact.io.impacts import MAX_LISTED_PROBLEMS
+from microimpact.io.impacts import MAX_LISTED_PROBLEMS, label_variables, labels_from_dataset, row_labels
 from microimpact.io.units import UNITS
 
 DATA = Path(__file__).parent / "data"
@@ -203,8 +204,10 @@ def test_normal_speed_only_and_alternative_forms(tmp_path):
         'x1,3.45e-6,1000,0.5,0.01,10,45,1,"free, text"\n'
         "x2,3.45e-6,2000,0.25,,,0,,\n"
     )
-    with pytest.warns(ImpactDataWarning, match="notes"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ImpactDataWarning)  # 'notes' is the analyst's own column: no warning
         df = read_impacts(write(tmp_path, text))
+    assert df["notes"].tolist() == ["free, text", pd.NA]
     assert df["speed"].isna().all() and df["incidence_deg"].isna().all()
     np.testing.assert_allclose(df["normal_speed"], [1.0, 2.0], rtol=1e-15)
     np.testing.assert_allclose(df["rebound_normal_speed"], [0.5, 0.5], rtol=1e-15)
@@ -258,9 +261,35 @@ def test_empty_optional_cells_are_nan(tmp_path):
 
 def test_unknown_columns_warn_with_suggestion(tmp_path):
     text = "radius [um],normal_speed [m/s],e_n [1],raduis_uncertainty [um],operator\n3.45,1,0.5,0.1,kim\n"
-    with pytest.warns(ImpactDataWarning, match=r"'raduis_uncertainty \[um\]' \(did you mean 'radius_uncertainty'\?\)"):
+    with pytest.warns(ImpactDataWarning, match=r"'raduis_uncertainty \[um\]' \(did you mean 'radius_uncertainty'\?\)") as rec:
         df = read_impacts(write(tmp_path, text))
-    assert "operator" not in df.columns
+    assert "operator" not in str(rec[0].message)  # a column of the analyst's own is no typo: no word about it
+    # both are kept as text, as written (a typo'd quantity is not read as that quantity)
+    assert df.attrs["kept_columns"] == ("raduis_uncertainty [um]", "operator")
+    assert df["operator"].tolist() == ["kim"] and df["raduis_uncertainty [um]"].tolist() == ["0.1"]
+    assert df["radius_uncertainty"].isna().all()
+
+
+def test_the_analysts_own_columns_are_kept_as_text_and_named_as_written(tmp_path):
+    text = ('id,operator,row,radius [um],normal_speed [m/s],e_n [1],operator,"note, free",\n'
+            'a,kim,7,3.45,1,0.5,x,"n, 1",\n'
+            'b,,8,3.45,2,0.4,y,,\n')
+    df = read_impacts(write(tmp_path, text))
+    # 'row' is a column of the table: the analyst's 'row' is csv_row; a repeated name gets _2; the
+    # unnamed column of the trailing comma is dropped
+    assert df.attrs["kept_columns"] == ("operator", "csv_row", "operator_2", "note, free")
+    assert list(df.columns[-4:]) == ["operator", "csv_row", "operator_2", "note, free"]
+    assert df["row"].tolist() == [1, 2] and df["csv_row"].tolist() == ["7", "8"]
+    assert df["operator"].isna().tolist() == [False, True]
+    labels = row_labels(df)
+    assert labels.to_dict("list") == {"id": ["a", "b"], "operator": ["kim", ""], "csv_row": ["7", "8"],
+                                      "operator_2": ["x", "y"], "note, free": ["n, 1", ""]}
+    # rows of a selection keep their own labels, in their order
+    assert row_labels(df.iloc[[1]]).to_dict("list")["id"] == ["b"]
+    # NetCDF-safe variable names, the header name in an attribute, read back as it was
+    ds = xr.Dataset(label_variables(labels, "impact"))
+    assert sorted(ds.data_vars) == ["csv_note_free", "csv_operator", "csv_operator_2", "csv_row", "id"]
+    assert labels_from_dataset(ds, "impact").to_dict("list") == labels.to_dict("list")
 
 
 def test_materials_as_mapping_or_path():

@@ -94,18 +94,18 @@ def write_chain_csv(path: Path) -> None:
 
     pair = read_materials(default_materials_path())[CHAIN["pair"]]
     rng = np.random.default_rng(CHAIN["seed"])
-    lines = ["id,size_class,material_pair,radius [um],speed [m/s],incidence_angle [deg],e_n [1],e_n_uncertainty [1]"]
+    lines = ["id,size_class,material_pair,radius [um],speed [m/s],incidence_angle [deg],e_n [1],e_n_uncertainty [1],operator"]
     for r_um in CHAIN["radii_um"]:
         contact = pair.contact(r_um * 1e-6).with_(zeta_hertz=CHAIN["zeta_hertz"], zeta_adhesion=CHAIN["zeta_adhesion"])
         speeds = np.geomspace(1.3 * capture_velocity(contact), 60.0, CHAIN["points_per_size"])
         e_n = mi.simulate_many(contact, speeds)["e_n"].values + rng.normal(0.0, CHAIN["e_n_sigma"], speeds.size)
-        lines += [f"chain-{r_um}-{i},d{2 * r_um}um,{CHAIN['pair']},{r_um},{v:.6g},0,{e:.6g},{CHAIN['e_n_sigma']}"
+        lines += [f"chain-{r_um}-{i},d{2 * r_um}um,{CHAIN['pair']},{r_um},{v:.6g},0,{e:.6g},{CHAIN['e_n_sigma']},kim"
                   for i, (v, e) in enumerate(zip(speeds, e_n))]
     glass = read_materials(default_materials_path())[SECOND["pair"]].contact(SECOND["radius_um"] * 1e-6)
     speeds = np.geomspace(0.2, 20.0, SECOND["points"])
     e_n = (mi.simulate_many(glass.with_(zeta_hertz=SECOND["zeta_hertz"]), speeds)["e_n"].values
            + np.random.default_rng(SECOND["seed"]).normal(0.0, SECOND["e_n_sigma"], speeds.size))
-    lines += [f"glass-{i},alumina,,{SECOND['radius_um']},{v:.6g},0,{e:.6g},{SECOND['e_n_sigma']}"
+    lines += [f"glass-{i},alumina,,{SECOND['radius_um']},{v:.6g},0,{e:.6g},{SECOND['e_n_sigma']},lee"
               for i, (v, e) in enumerate(zip(speeds, e_n))]
     path.write_text("\n".join(lines) + "\n")
 
@@ -250,6 +250,12 @@ def test_each_material_pair_is_fitted_on_its_own_rows(pipeline):
         flags = pd.read_csv(root / folder / "flags.csv")
         assert len(flags) == n, pair
         assert flags["id"].str.startswith("glass-" if pair == SECOND["pair"] else "chain-").all(), pair
+        # the analyst's own column rides along with each row, next to its id
+        assert list(flags.columns[:3]) == ["row", "id", "operator"], pair
+        assert (flags["operator"] == ("lee" if pair == SECOND["pair"] else "kim")).all(), pair
+        with xr.open_dataset(root / folder / "fit.nc") as ds:
+            assert ds["csv_operator"].attrs["csv_column"] == "operator"
+            assert set(ds["csv_operator"].values) == {"lee" if pair == SECOND["pair"] else "kim"}, pair
     # no adhesion on glass: zeta_A cannot be determined from its rows, and the fit says so
     from microimpact.io.statuses import STATUSES
 

@@ -447,8 +447,12 @@ def _cmd_target(args) -> int:
         print(f"target {i + 1}: e_n = {row['e_n']:g} at v_n = {row['speed']:g} m/s (r = {row['radius']:.4g} m): "
               f"zeta_H from {zh[0]:.5g} (zeta_A = 0) to 0 (zeta_A = {za[-1]:.5g}); {len(zh)} curve points")
     if res.best is not None:
+        from microimpact.io.statuses import stderr_is_meaningful
+
         print("least squares over the targets: " + ", ".join(
-            f"{k} = {v:.6g} +/- {res.stderr[k]:.3g}" for k, v in res.best.items()))
+            f"{k} = {v:.6g}" + (f" +/- {res.stderr[k]:.3g}" if stderr_is_meaningful(v, res.stderr[k])
+                                else " (standard error above 100 %: not determined by these targets)")
+            for k, v in res.best.items()))
     print(f"material: {args.contact_note}", file=sys.stderr)
     if out is not None:
         with reporting_os_errors({"--out": out}):

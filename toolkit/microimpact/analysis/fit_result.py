@@ -16,7 +16,9 @@ import pandas as pd
 import xarray as xr
 
 from microimpact.analysis.identifiability import status_from_variables, status_variables
+from microimpact.io.statuses import stderr_is_meaningful
 from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.impacts import insert_row_labels, label_variables, labels_from_dataset
 from microimpact.io.materials import material_contact
 from microimpact.io.provenance import fit_parameter_source, stamp_parameters
 from microimpact.io.variables import attributes
@@ -29,6 +31,8 @@ __all__ = ["DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES",
 PARAMETER_NAMES = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
 #: sigma levels of the lmfit confidence intervals
 SIGMA_LEVELS = (-2, -1, 1, 2)
+#: the columns of DampingFit.data that the fit computes (the others are the analyst's row labels)
+_POINT_COLUMNS = ("row", "radius", "normal_speed", "e_n", "sigma", "model", "residual")
 
 
 # --------------------------------------------------------------------------- result
@@ -190,10 +194,8 @@ class DampingFit:
             ds.update(status_variables(st, attributes(name)["units"]))
         ds["correlation"] = xr.DataArray(self.correlation, dims=("parameter", "parameter_b"),
                                          attrs=attributes("correlation"))
-        if "id" in d.columns:
-            ds["id"] = xr.DataArray(d["id"].to_numpy(dtype=str).astype(object), dims=("point",),
-                                    attrs={"long_name": "the id column of the impact CSV"})
-        for col in ("row", "radius", "normal_speed", "e_n", "sigma", "model", "residual"):
+        ds.update(label_variables(d[[c for c in d.columns if c not in _POINT_COLUMNS]], "point"))
+        for col in _POINT_COLUMNS:
             values = d[col].to_numpy(dtype=np.int64 if col == "row" else float)
             name = {"e_n": "e_n_measured", "model": "e_n_model"}.get(col, col)
             ds[name] = xr.DataArray(values, dims=("point",), attrs=attributes(name))
@@ -234,8 +236,7 @@ class DampingFit:
             "normal_speed": ds["normal_speed"].values, "e_n": ds["e_n_measured"].values,
             "sigma": ds["sigma"].values, "model": ds["e_n_model"].values, "residual": ds["residual"].values,
         })
-        if "id" in ds:
-            data.insert(1, "id", ds["id"].values.astype(str))
+        data = insert_row_labels(data, labels_from_dataset(ds, "point"))
         statuses = {n: status_from_variables(ds, n, values[n]) for n in varied}
         ref = a.get("damping_reference_speed")
         info = {k.removeprefix("fit_"): (v.item() if hasattr(v, "item") else v) for k, v in a.items() if k.startswith("fit_")}
@@ -314,7 +315,7 @@ def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
         else:
             ci1 = ci2 = None
             method = "not estimated"
-        meaningful = math.isfinite(s) and v and s <= abs(v)  # a standard error above 100 % is not printed
+        meaningful = stderr_is_meaningful(v, s)
         rows.append(row | {
             "stderr": f"{s:.3g}" if meaningful else "n/a", "relative": f"{100 * s / abs(v):.2g} %" if meaningful else "",
             "ci95": f"[{st.lower:.5g}, {st.upper:.5g}]" if st is not None else "",

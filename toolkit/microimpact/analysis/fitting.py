@@ -48,7 +48,7 @@ import numpy as np
 import pandas as pd
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit, fit_parameter_table, format_fit
-from microimpact.io.impacts import MEASUREMENT_TOLERANCE_SIGMAS
+from microimpact.io.impacts import MEASUREMENT_TOLERANCE_SIGMAS, insert_row_labels, row_labels
 from microimpact.io.materials import material_contact
 from microimpact.io.progress import progress_bar
 from microimpact.model.contact import Contact
@@ -405,8 +405,7 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
     data = pd.DataFrame({"row": rows, "radius": arr["radius"], "normal_speed": arr["normal_speed"],
                          "e_n": e_n, "sigma": sig_used if sigma is not None else np.full_like(e_n, np.nan),
                          "model": model, "residual": (model - e_n) / sig_used})
-    if "id" in df.columns:
-        data.insert(1, "id", df["id"].astype("string").fillna("").to_numpy(dtype=object).astype(str))
+    data = insert_row_labels(data, row_labels(df))
     labels = df["material_pair"].dropna().unique() if "material_pair" in df.columns else ()
     info = {"nfev": int(nfev + n), "success": bool(result.success), "message": str(result.message),
             "method": "coarse log grid + lmfit leastsq", "rtol": float(rtol),

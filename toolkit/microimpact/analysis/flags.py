@@ -301,11 +301,11 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
 
 
 def _with_ids(res: xr.Dataset, table) -> xr.Dataset:
-    """The CSV's ``id`` of each row, as a data variable along ``impact`` (where the table has one)."""
-    if "id" in table.columns:
-        res["id"] = ("impact", table["id"].astype("string").fillna("").to_numpy(dtype=object).astype(str).astype(object),
-                     {"long_name": "the id column of the impact CSV"})
-    return res
+    """The analyst's labels of each row (``id`` and the CSV's own columns) as text variables along
+    ``impact`` (:func:`microimpact.io.label_variables`)."""
+    from microimpact.io.impacts import label_variables, row_labels
+
+    return res.assign(label_variables(row_labels(table), "impact"))
 
 
 def flag_summary(ds: xr.Dataset) -> str:
@@ -399,9 +399,14 @@ def write_flags(ds: xr.Dataset, csv_path, nc_path=None):
     tuple of pathlib.Path
         The files written.
     """
+    from microimpact.io.impacts import CSV_COLUMN_ATTR
+
     table = ds.to_dataframe().reset_index(drop=True)
-    cols = ["row"] + [c for c in table.columns if c not in ("row", "impact")]
-    table = table[cols]
+    # the row, then the analyst's labels (their own columns under the names of the CSV), then the flags
+    labels = [n for n, v in ds.data_vars.items() if n == "id" or CSV_COLUMN_ATTR in v.attrs]
+    cols = ["row", *labels] + [c for c in table.columns if c not in ("row", "impact", *labels)]
+    table = table[cols].rename(columns={n: str(v.attrs[CSV_COLUMN_ATTR]) for n, v in ds.data_vars.items()
+                                        if CSV_COLUMN_ATTR in v.attrs and str(v.attrs[CSV_COLUMN_ATTR]) not in cols})
     written = [write_csv(table, csv_path, float_format="%.8g")]
     if nc_path is not None:
         written.append(write_netcdf(ds, nc_path))

@@ -50,7 +50,7 @@ import pandas as pd
 import xarray as xr
 
 from microimpact.io.files import CONVENTIONS, write_netcdf
-from microimpact.io.impacts import OBLIQUE_COLUMNS
+from microimpact.io.impacts import OBLIQUE_COLUMNS, insert_row_labels, label_variables, row_labels
 from microimpact.io.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
@@ -70,6 +70,9 @@ PROFILE_POINTS = 400
 _H_SPEED = 1e-4  # relative step of the speed slope [-]
 _H_ANGLE = 0.05  # step of the angle slope [deg]
 
+#: the columns of a friction fit's data that the fit computes (the others are the analyst's row labels)
+_ENTRY_COLUMNS = ("row", "quantity", "radius", "speed", "incidence_deg", "measured", "sigma", "model", "residual")
+
 
 @dataclass(frozen=True)
 class ObliqueProblem:
@@ -88,8 +91,9 @@ class ObliqueProblem:
     sigma_speed, sigma_angle : numpy.ndarray
         Incident speed [m/s] and angle [deg] uncertainties (0 where not stated).
     source : str
-    ids : numpy.ndarray or None
-        The CSV's ``id`` of each entry, where the table has that column.
+    labels : pandas.DataFrame or None
+        The analyst's labels of each entry (``id`` and the CSV's own columns,
+        :func:`microimpact.io.row_labels`).
     """
 
     rows: np.ndarray
@@ -103,7 +107,7 @@ class ObliqueProblem:
     sigma_speed: np.ndarray
     sigma_angle: np.ndarray
     source: str = "impact table"
-    ids: np.ndarray | None = None
+    labels: pd.DataFrame | None = None
 
     @classmethod
     def from_table(cls, table: pd.DataFrame) -> "ObliqueProblem":
@@ -146,7 +150,7 @@ class ObliqueProblem:
                    radius=col("radius")[idx], speed=speed[idx], incidence_deg=inc[idx], spin=zero(col("spin")[idx]),
                    measured=np.concatenate([p[2] for p in parts]), sigma_measured=np.concatenate([p[3] for p in parts]),
                    sigma_speed=zero(col("speed_uncertainty")[idx]), sigma_angle=zero(col("incidence_deg_uncertainty")[idx]),
-                   source=src, ids=table["id"].to_numpy()[idx].astype(str) if "id" in table.columns else None)
+                   source=src, labels=row_labels(table).iloc[idx].reset_index(drop=True))
 
     @property
     def size(self) -> int:
@@ -369,8 +373,13 @@ class FrictionFit:
             if st is not None and not st.determined:
                 lines.append(f"  {k:<17}: {st.describe()}")
                 continue
-            lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr[k]:.3g} (with the damping uncertainty; "
-                         f"{self.stderr_conditional[k]:.3g} at fixed damping)")
+            from microimpact.io.statuses import stderr_is_meaningful
+
+            if stderr_is_meaningful(v, self.stderr[k]) and stderr_is_meaningful(v, self.stderr_conditional[k]):
+                lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr[k]:.3g} (with the damping uncertainty; "
+                             f"{self.stderr_conditional[k]:.3g} at fixed damping)")
+            else:  # a standard error above 100 % says nothing the interval does not say better
+                lines.append(f"  {k:<17}= {v:.6g} (standard error above 100 %: see the interval)")
             if st is not None:
                 lines.append(f"  {'':<17}  95 % interval [{st.lower:.6g}, {st.upper:.6g}] ({st.method}, damping "
                              "uncertainty included)")
@@ -395,8 +404,7 @@ class FrictionFit:
             ds[f"{k}_stderr_conditional"] = xr.DataArray(self.stderr_conditional[k], attrs={
                 "units": "1", "long_name": f"standard error of {k} at the fitted damping"})
         ds["row"] = ("entry", d["row"].to_numpy(dtype=np.int64), {"units": "1", "long_name": "data row in the impact CSV"})
-        if "id" in d.columns:
-            ds["id"] = ("entry", d["id"].to_numpy(dtype=str).astype(object), {"long_name": "the id column of the impact CSV"})
+        ds.update(label_variables(d[[c for c in d.columns if c not in _ENTRY_COLUMNS]], "entry"))
         ds["quantity"] = ("entry", d["quantity"].to_numpy(dtype=str).astype(object), {"long_name": "measured quantity"})
         for c, ln in (("radius", ("m", "sphere radius")), ("speed", ("m s-1", "incident speed")),
                       ("incidence_deg", ("degree", "incidence angle from the surface normal"))):
@@ -533,8 +541,8 @@ def _friction_result(problem, objective, best, var_damping, gradient, weighted, 
     data = pd.DataFrame({"row": problem.rows, "quantity": problem.quantity.astype(str), "radius": problem.radius,
                          "speed": problem.speed, "incidence_deg": problem.incidence_deg, "measured": problem.measured,
                          "sigma": sigma, "model": model, "residual": (model - problem.measured) / sigma})
-    if problem.ids is not None:
-        data.insert(1, "id", problem.ids)
+    if problem.labels is not None:
+        data = insert_row_labels(data, problem.labels)
     cond = best.stderr if status.determined else math.nan
     total = math.sqrt(cond ** 2 + var_damping) if status.determined else math.nan
     dof = max(problem.size - 1, 1)

@@ -20,7 +20,7 @@ import importlib
 
 #: public name -> the module of microimpact.io that defines it
 _HOMES = {
-    **dict.fromkeys(("read_impacts", "material_pairs", "select_material_pair", "ImpactDataError", "ImpactDataWarning", "Problem", "CANONICAL_COLUMNS",
+    **dict.fromkeys(("read_impacts", "material_pairs", "select_material_pair", "row_labels", "insert_row_labels", "label_variables", "labels_from_dataset", "ImpactDataError", "ImpactDataWarning", "Problem", "CANONICAL_COLUMNS",
                      "COLUMN_UNITS"), "impacts"),
     **dict.fromkeys(("MaterialPair", "MaterialsError", "read_materials", "default_materials_path",
                      "material_contact"), "materials"),

@@ -50,6 +50,12 @@ Possible but implausible values warn (:class:`ImpactDataWarning`, naming the row
 restitution above 1 without a stated ``spin``. ``df.attrs["measured"]`` lists the canonical
 columns the file gave (not derived), so a fit uses what was measured.
 
+Columns that are not part of the format (an operator, a batch, a note) are the analyst's own:
+they are kept as text after the columns above, under their header name (``csv_<name>`` where that
+name is one of the columns above), listed in ``df.attrs["kept_columns"]``, and carried with ``id``
+through every per-row output (:func:`row_labels`). A header name close to a known column (a likely
+typo) warns, naming the known column.
+
 ``df.attrs`` holds ``source`` (the path as given, str), ``sha256`` (of the file's bytes) and
 ``units`` (column -> unit string), so later flags and writers can point back to the file.
 """
@@ -76,6 +82,10 @@ from microimpact.io.units import INTERNAL_UNIT, UnitError, accepted_units, conve
 
 __all__ = [
     "read_impacts",
+    "row_labels",
+    "insert_row_labels",
+    "label_variables",
+    "labels_from_dataset",
     "material_pairs",
     "select_material_pair",
     "ImpactDataError",
@@ -584,7 +594,8 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     Warns
     -----
     ImpactDataWarning
-        For columns that are not part of the format; they are ignored.
+        For a column that is not part of the format but whose name is close to one that is (a
+        likely typo); it is kept as text like every other column of the analyst's own.
     """
     source = os.fspath(path)
     if materials is not None and not isinstance(materials, Mapping):
@@ -599,8 +610,8 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     if header_line != 1:
         header_problems = [Problem(p.message, p.row, header_line, p.column, p.value) for p in header_problems]
     problems += header_problems
-    if ignored:
-        _warn_ignored(Path(source).name, ignored)
+    kept_columns = _kept_columns(header, ignored)
+    _warn_ignored(Path(source).name, ignored)
     if not records:
         if not any(p.row is not None for p in problems):
             problems.append(Problem(
@@ -634,7 +645,10 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     for cname in _LABELS:
         frame[cname] = pd.array(labels.get(cname, [None] * cells.n), dtype="string")
     frame |= {k: out[k] for k in CANONICAL_COLUMNS if k in out}
-    df = pd.DataFrame(frame, columns=list(CANONICAL_COLUMNS))
+    for cname, index in kept_columns.items():
+        frame[cname] = pd.array([r.fields[index].strip() or None for r in records], dtype="string")
+    df = pd.DataFrame(frame, columns=[*CANONICAL_COLUMNS, *kept_columns])
+    df.attrs["kept_columns"] = tuple(kept_columns)
     df.attrs["source"] = source
     df.attrs["sha256"] = sha256
     df.attrs["units"] = dict(COLUMN_UNITS)
@@ -845,15 +859,36 @@ def _drop_unclosed_quotes(header, header_line: int, records: list[_Record]):
     return kept, problems
 
 
+def _kept_columns(header: list[str], ignored: list[str]) -> dict[str, int]:
+    """The analyst's own columns: DataFrame name -> field index. Unnamed columns (a trailing
+    comma) are dropped; a name that is also a column of the returned table gets ``csv_`` in front,
+    and a repeated name ``_2``, ``_3``, ... behind."""
+    out: dict[str, int] = {}
+    wanted = set(ignored)
+    for i, raw in enumerate(header):
+        field = raw.strip()
+        if not field or field not in wanted:
+            continue
+        name = f"csv_{field}" if field in CANONICAL_COLUMNS else field
+        base, k = name, 2
+        while name in out:
+            name, k = f"{base}_{k}", k + 1
+        out[name] = i
+    return out
+
+
 def _warn_ignored(name: str, ignored: list[str]) -> None:
-    """One :class:`ImpactDataWarning` naming the ignored columns, with the closest known name."""
+    """One :class:`ImpactDataWarning` naming the columns that are not part of the format but close
+    to a known name (likely typos; they are kept as text like the analyst's other columns)."""
     hints = []
     for f in ignored:
         close = difflib.get_close_matches(parse_header_field(f)[0], _KNOWN, n=1)
-        hints.append(f"{f!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
-    warnings.warn(
-        f"{name}: ignoring columns that are not part of the impact format: {', '.join(hints)}",
-        ImpactDataWarning, stacklevel=3)
+        if close:
+            hints.append(f"{f!r} (did you mean {close[0]!r}?)")
+    if hints:
+        warnings.warn(
+            f"{name}: columns that are not part of the impact format, kept as text labels: {', '.join(hints)}",
+            ImpactDataWarning, stacklevel=3)
 
 
 def _drop_ragged(records: list[_Record], width: int) -> tuple[list[_Record], list[Problem]]:
@@ -1084,3 +1119,91 @@ def select_material_pair(table: pd.DataFrame, pair: str, *, default: str | None 
     sub["material_pair"] = pair
     sub.attrs = {**table.attrs, "material_pair": pair}
     return sub
+
+
+# --------------------------------------------------------------------------- the analyst's row labels
+#: attribute of a NetCDF variable that holds one of the analyst's own CSV columns (its name)
+CSV_COLUMN_ATTR = "csv_column"
+
+
+def row_labels(table: pd.DataFrame) -> pd.DataFrame:
+    """The analyst's own labels of each row of an impact table: ``id`` and every kept column.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A table of :func:`read_impacts` (or rows of one).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One text column per label ('' where the cell was empty), in the table's row order, index
+        0..n-1; no columns when the file had neither an ``id`` nor columns of its own.
+
+    Examples
+    --------
+    >>> t = pd.DataFrame({"id": pd.array(["a", None], dtype="string"), "radius": [1e-6, 2e-6],
+    ...                   "operator": pd.array(["kim", "lee"], dtype="string")})
+    >>> t.attrs["kept_columns"] = ("operator",)
+    >>> row_labels(t).to_dict("list")
+    {'id': ['a', ''], 'operator': ['kim', 'lee']}
+    """
+    names = (["id"] if "id" in table.columns else []) + [c for c in table.attrs.get("kept_columns", ())
+                                                          if c in table.columns]
+    return pd.DataFrame({c: table[c].astype("string").fillna("").to_numpy(dtype=object).astype(str).astype(object)
+                         for c in names}, index=pd.RangeIndex(len(table)))
+
+
+def insert_row_labels(data: pd.DataFrame, labels: pd.DataFrame, at: int = 1) -> pd.DataFrame:
+    """``data`` (one row per labelled row, same order) with the label columns inserted at ``at``;
+    a label whose name ``data`` already uses gets ``csv_`` in front. Returns a new DataFrame.
+
+    Examples
+    --------
+    >>> d = pd.DataFrame({"row": [1, 2], "model": [0.5, 0.6]})
+    >>> list(insert_row_labels(d, pd.DataFrame({"id": ["a", "b"], "model": ["x", "y"]})).columns)
+    ['row', 'id', 'csv_model', 'model']
+    """
+    out = data.copy()
+    for k, c in enumerate(labels.columns):
+        name = c if c not in out.columns else f"csv_{c}"
+        out.insert(min(at + k, out.shape[1]), name, labels[c].to_numpy(dtype=object))
+    return out
+
+
+def label_variables(labels: pd.DataFrame, dim: str) -> dict:
+    """The labels as NetCDF-ready text variables along ``dim``: ``id`` as ``id``, each kept column
+    as ``csv_<name>`` (ASCII letters, digits and ``_``) with its name in the attribute
+    :data:`CSV_COLUMN_ATTR`; :func:`labels_from_dataset` reads them back.
+
+    Examples
+    --------
+    >>> v = label_variables(pd.DataFrame({"id": ["a"], "batch no.": ["7"]}), "point")
+    >>> sorted(v), v["csv_batch_no"].attrs["csv_column"]
+    (['csv_batch_no', 'id'], 'batch no.')
+    """
+    import xarray as xr
+
+    out = {}
+    for c in labels.columns:
+        values = labels[c].to_numpy(dtype=object).astype(str).astype(object)
+        if c == "id":
+            out["id"] = xr.DataArray(values, dims=(dim,), attrs={"long_name": "the id column of the impact CSV"})
+            continue
+        stem = re.sub(r"[^A-Za-z0-9_]+", "_", c).strip("_") or "column"
+        base = stem if stem.startswith("csv_") else f"csv_{stem}"
+        name, k = base, 2
+        while name in out:
+            name, k = f"{base}_{k}", k + 1
+        out[name] = xr.DataArray(values, dims=(dim,), attrs={
+            "long_name": f"column {c!r} of the impact CSV (the analyst's own, kept as text)", CSV_COLUMN_ATTR: c})
+    return out
+
+
+def labels_from_dataset(ds, dim: str) -> pd.DataFrame:
+    """The labels :func:`label_variables` wrote along ``dim``, as :func:`row_labels` gives them."""
+    cols = {}
+    for name, var in ds.data_vars.items():
+        if var.dims == (dim,) and (name == "id" or CSV_COLUMN_ATTR in var.attrs):
+            cols["id" if name == "id" else str(var.attrs[CSV_COLUMN_ATTR])] = var.values.astype(str).astype(object)
+    return pd.DataFrame(cols, index=pd.RangeIndex(ds.sizes[dim]) if dim in ds.sizes else None)

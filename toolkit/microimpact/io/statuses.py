@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ParameterStatus", "STATUSES", "DEFAULT_LEVEL", "status_variables", "status_from_variables"]
+__all__ = ["ParameterStatus", "STATUSES", "DEFAULT_LEVEL", "status_variables", "status_from_variables",
+           "stderr_is_meaningful"]
 
 #: the four answers, in the order of their NetCDF flag values 0-3
 STATUSES = ("determined", "lower_bound", "upper_bound", "not_determined")
@@ -88,6 +89,19 @@ class ParameterStatus:
             return (f"{self.name} <= {self.upper:{g}}{u} ({pct} bound; no lower limit down to {self.lower:{g}} "
                     f"from these data){why}")
         return f"{self.name}: not determined by these data (anywhere in [{self.lower:{g}}, {self.upper:{g}}]){why}"
+
+
+def stderr_is_meaningful(value: float, stderr: float) -> bool:
+    """Whether a standard error may be printed as a number next to its value: finite, and at most
+    100 % of a nonzero value. Above that, "value +/- stderr" spans zero and says nothing the
+    interval or bound does not say better; every printed fit result applies this one rule.
+
+    Examples
+    --------
+    >>> stderr_is_meaningful(0.5, 0.1), stderr_is_meaningful(0.5, 0.6), stderr_is_meaningful(0.0, 0.1)
+    (True, False, False)
+    """
+    return bool(math.isfinite(stderr) and math.isfinite(value) and value != 0 and stderr <= abs(value))
 
 
 def status_variables(status: ParameterStatus, units: str) -> dict:

@@ -45,6 +45,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 import tempfile
 import time
@@ -54,7 +55,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-__all__ = ["draw_design", "run_design", "calibration_study", "summarise", "plot_calibration", "main",
+__all__ = ["draw_design", "run_design", "calibration_study", "summarise", "plot_calibration", "markdown_tables", "main",
            "FITTED", "LEVEL"]
 
 #: the parameters whose statements are checked
@@ -183,6 +184,19 @@ def _statement(status) -> dict:
     return {"status": status.status, "value": status.value, "lower": status.lower, "upper": status.upper}
 
 
+def _printed_relative_error(text: str, name: str) -> float:
+    """The largest stderr / |value| of the lines ``name = value +/- stderr`` in ``text`` (NaN: none).
+
+    Examples
+    --------
+    >>> _printed_relative_error("  friction = 0.25 +/- 0.05 (with ...)", "friction")
+    0.2
+    """
+    found = [abs(float(s) / float(v)) for v, s in
+             re.findall(rf"\b{re.escape(name)}\s*= ([-+0-9.eE]+) \+/- ([0-9.eE+-]+)", text) if float(v) != 0]
+    return max(found) if found else math.nan
+
+
 def run_design(design: dict, *, posterior: bool = False, folder: Path | None = None) -> dict:
     """Simulate, fit and check one design (see the module docstring).
 
@@ -238,9 +252,11 @@ def run_design(design: dict, *, posterior: bool = False, folder: Path | None = N
         statuses |= ff.identifiability
         kinds["friction"] = _friction_kind(table, design["truth"], fit)
         stderr["friction"] = ff.stderr["friction"]
+    # what an analyst reads: the relative error of every "value +/- stderr" the fit reports print
+    printed_text = fit.report() + ("\n" + ff.report() if ff is not None else "")
     for name, st in statuses.items():
         truth = design["truth"][name]
-        printed = stderr[name] / abs(st.value) if st.determined and st.value else math.nan
+        printed = _printed_relative_error(printed_text, name)
         out[name] = {"truth": truth, "kind": kinds[name], **_statement(st), "covered": bool(st.contains(truth)),
                      "printed_relative_error": printed}
     if posterior:
@@ -386,6 +402,48 @@ def summarise(records: list[dict]) -> dict:
         out[name] = entry
     return out
 
+#: how the tables of docs/calibration.md name the parameters
+LABELS = {"zeta_hertz": "zeta_H", "zeta_adhesion": "zeta_A", "work_of_adhesion": "w_A", "friction": "f"}
+
+
+def _percent(c: dict | None) -> str:
+    if not c or not c["n"]:
+        return "-"
+    return f"{100 * c['coverage']:.1f} +/- {100 * c['mc_error']:.1f} % ({c['covered']}/{c['n']})"
+
+
+def markdown_tables(summary: dict) -> str:
+    """The result tables of docs/calibration.md, made from a study's summary (so the page cannot
+    drift from the committed JSON: ``tests/test_calibration.py`` compares them).
+
+    Coverage is written ``percent +/- one binomial standard error (covered/n)``.
+
+    Examples
+    --------
+    >>> r = [{"seed": 0, "n_rows": 5, "friction": {"kind": "mixed", "status": "determined", "covered": True,
+    ...       "printed_relative_error": 0.1}}]
+    >>> print(markdown_tables(summarise(r)).splitlines()[2])
+    | f | 1 | 100.0 +/- 0.0 % (1/1) | - | 1 / 0 / 0 / 0 | - | - | - |
+    """
+    lines = ["| parameter | designs | 95 % intervals (determined) | bounds and 'not determined' ranges "
+             "| determined / lower bound / upper bound / not determined | posterior 95 % intervals "
+             "| posterior, parameter not determined | posterior refused |",
+             "|---|---|---|---|---|---|---|---|"]
+    for name in FITTED:
+        if name not in summary:
+            continue
+        ls, po = summary[name]["least_squares"], summary[name].get("posterior", {})
+        sc = ls["status_counts"]
+        lines.append(f"| {LABELS[name]} | {sum(sc.values())} | {_percent(ls['determined'])} | {_percent(ls['bounds'])} "
+                     f"| {sc['determined']} / {sc['lower_bound']} / {sc['upper_bound']} / {sc['not_determined']} "
+                     f"| {_percent(po.get('determined'))} | {_percent(po.get('bounds'))} | {po.get('refused', '-')} |")
+    lines += ["", "| parameter | kind of design (from the truth) | 95 % intervals | bounds and ranges |",
+              "|---|---|---|---|"]
+    for name in FITTED:
+        for kind, c in summary.get(name, {}).get("least_squares", {}).get("by_kind", {}).items():
+            lines.append(f"| {LABELS[name]} | {kind} | {_percent(c['determined'])} | {_percent(c['bounds'])} |")
+    return "\n".join(lines) + "\n"
+
 
 def plot_calibration(summary: dict, path) -> Path:
     """Coverage per parameter (least squares and posterior) with 2-sigma MC error bars and the
@@ -400,7 +458,7 @@ def plot_calibration(summary: dict, path) -> Path:
     fig = Figure(figsize=(7.0, 3.4), layout="constrained")
     ax = fig.add_subplot()
     names = [n for n in FITTED if n in summary]
-    labels = {"zeta_hertz": "ζ_H", "zeta_adhesion": "ζ_A", "work_of_adhesion": "w_A", "friction": "f"}
+    labels = {"zeta_hertz": "ζ_H", "zeta_adhesion": "ζ_A", "work_of_adhesion": "w_A", "friction": "f"}  # figure glyphs
     ax.axhspan(0.93, 0.97, color="0.85", label="target 93-97 %")
     ax.axhline(0.95, color="0.5", lw=0.8)
     series = [("least_squares", "determined", "o", "least squares: 95 % interval"),
