@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 from scipy import stats
 
-from microimpact.studies.calibration import FITTED, draw_design, run_design, summarise
+from microimpact.studies.calibration import FITTED, draw_design, markdown_tables, run_design, summarise
 
 ROOT = Path(__file__).resolve().parents[1]
 COMMITTED = ROOT / "docs" / "calibration.json"
@@ -96,3 +96,9 @@ def test_committed_study_reproduces_its_first_designs():
                     # seeded data, deterministic fits: equal up to the engine's tolerance (rtol 1e-8)
                     # carried through a least-squares fit and a profile crossing (PROFILE_XTOL 1e-3)
                     assert got[name][end] == pytest.approx(want[name][end], rel=2e-3, abs=1e-9), (name, end)
+
+
+def test_calibration_page_shows_the_committed_study():
+    # docs/calibration.md quotes the committed study's tables verbatim (made by markdown_tables)
+    summary = json.loads(COMMITTED.read_text())["summary"]
+    assert markdown_tables(summary) in (ROOT / "docs" / "calibration.md").read_text()

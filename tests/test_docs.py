@@ -52,6 +52,7 @@ HOW = {
     "microimpact simulate --fit fit.nc --radius 2e-6 --speed 3 --json": "run",
     # docs/calibration.md: the calibration study (its full run takes tens of minutes: the CI runs a small one)
     "python -m microimpact.studies.calibration --designs 300 --posterior-designs 12 --workers 2 --seed 1000 --out docs/calibration.json --figure docs/calibration.png": "study",
+    "python -m microimpact.studies.calibration": "study",
     "python -m microimpact.studies.calibration --designs 12 --seed 7 --out calibration.json --figure calibration.png": "ci",
     "microimpact benchmark --quick --out results/benchmark": "ci",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "ci",

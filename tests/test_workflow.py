@@ -354,6 +354,10 @@ def test_report_pdf_pages_and_titles(pipeline):
         assert title in everything, title
     assert "SYNTHETIC" in texts[0] and "Provenance" in texts[0] and "Contents" in texts[0]
     assert "switched off" in everything  # the benchmark page says why it is empty
+    # the non-adhesive second pair: no capture velocity to tabulate or draw, and the report says why
+    flat = " ".join(everything.split())
+    assert "the pair has no adhesion (f0 = 0), so there is no capture velocity" in flat
+    assert "No capture velocity to draw: every impact rebounds" in flat
     stress_page = next(t for t in texts if "Numerical stability (stress sweep)" in t and "Seeded random" in t)
     assert "all 20 cases passed every check" in stress_page and "energy balance" in stress_page
     assert "stress sweep" in texts[0]  # provenance and contents

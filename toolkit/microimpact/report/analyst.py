@@ -150,6 +150,11 @@ def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset) -> None:
     if "capture_velocity_quantile" in post:
         lay.heading("Capture velocity with its credible interval")
         cv = post["capture_velocity_quantile"]
+        if not np.any(np.asarray(cv.values, float) > 0):  # no adhesion (f0 = 0): nothing is captured
+            lay.paragraph("No impact is captured at any speed in any posterior draw: the pair has no adhesion "
+                          "(f0 = 0), so there is no capture velocity.")
+            cv = None
+    if "capture_velocity_quantile" in post and cv is not None:
         t = pd.DataFrame({"d": [f"{2e6 * r:.4g}" for r in cv["radius"].values],
                           "median": [f"{float(cv.sel(radius=r, quantile=0.5, method='nearest')):.4g}" for r in cv["radius"].values],
                           "ci": [f"[{float(cv.sel(radius=r, quantile=0.025, method='nearest')):.4g}, "
