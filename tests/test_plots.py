@@ -237,3 +237,15 @@ def test_size_dependence_of_a_pair_without_adhesion_says_nothing_is_captured(tmp
     assert ax_v.get_yscale() == "linear" and not ax_v.get_lines()
     assert any("no capture" in t.get_text() for t in ax_v.texts)
     assert "every impact rebounds" in p.caption
+
+
+def test_every_log_axis_of_a_plot_gets_readable_labels():
+    """Plot applies the report's log-axis labels to every log axis (the fit and posterior figures
+    once showed '10^0 10^1' under a speed axis from 1 to 60 m/s)."""
+    fig = Figure(figsize=(4, 3))
+    ax = fig.add_subplot()
+    ax.plot([1.0, 60.0], [0.1, 0.9])
+    ax.set_xscale("log")
+    plots.Plot(fig, "a caption that is long enough to pass the checks of this module")
+    assert isinstance(ax.xaxis.get_major_formatter(), plots._LogLabels)
+    assert not isinstance(ax.yaxis.get_major_formatter(), plots._LogLabels)  # linear axis untouched

@@ -224,3 +224,18 @@ def test_pdf_text_uses_core_fonts_unless_a_character_needs_embedding(tmp_path):
         fonts = {font[name]["/BaseFont"] for name in font}  # indexing resolves indirect objects (pypdf 4)
         assert any(name in ("/Helvetica", "/Helvetica-Bold") for name in fonts) == core, fonts
         assert title.split()[-1] in page.extract_text()
+
+
+def test_a_table_never_splits_a_word_or_a_number_across_lines():
+    """The 'Data by sphere size' table once set its header 'impacts' as 'impact' / 's'; columns now
+    widen to their longest word or number (and the table is set smaller if it must be)."""
+    from microimpact.report.layout import Layout
+
+    lay = Layout("Report")
+    lay.new_page("Tables")
+    df = pd.DataFrame({"d": ["2.58", "6.9"], "n": [20, 20], "v": [-1.2345678e-05, 60.0]})
+    lay.table(df, {"d": 4, "n": 6, "v": 5}, headers={"d": "diameter [um]", "n": "impacts", "v": "max v_n [m/s]"})
+    text = "\n".join(t.get_text() for t in lay.pages[-1].figure.texts)
+    lines = text.splitlines()
+    for word in ("diameter", "impacts", "max", "[m/s]", "2.58", "-1.235e-05"):
+        assert any(word in line.split() for line in lines), (word, lines)

@@ -112,6 +112,14 @@ class Plot:
     caption: str
     paper_figure: str | None = None
 
+    def __post_init__(self):
+        # every log axis of every figure gets the same readable tick labels (_LogLabels): plain
+        # numbers where they are short, never the '2x10^0 3x10^0' labels that run into each other
+        for ax in self.figure.axes:
+            for axis, scale in ((ax.xaxis, ax.get_xscale()), (ax.yaxis, ax.get_yscale())):
+                if scale == "log":
+                    _plain_log_labels(axis)
+
 
 def _figure(width: float, height: float) -> Figure:
     fig = Figure(figsize=(width, height), layout="constrained")

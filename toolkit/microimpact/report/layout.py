@@ -206,6 +206,10 @@ class Layout:
         """
         headers = dict(headers or {})
         cols = [c for c in widths if c in df.columns]
+        # a column is at least as wide as its longest word or number, so that wrapping never splits one
+        # across lines (a header 'impacts' once read 'impact' / 's'); a wider table is set smaller
+        widths = {c: max([widths[c], *(len(w) for w in str(headers.get(c, c)).split()),
+                          *(len(w) for v in df[c] for w in format_cell(v).split())]) for c in cols}
         total = sum(widths[c] for c in cols) + 2 * (len(cols) - 1)
         char_w = size * 0.602 / 72  # DejaVu Sans Mono advance width [in]
         size = size if total * char_w <= TEXT_WIDTH else size * TEXT_WIDTH / (total * char_w)
