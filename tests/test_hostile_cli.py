@@ -343,6 +343,13 @@ END_TO_END = [
     (["simulate", "--speed", "1", "--stiffness", "1e300"], "stiffness=1e+300"),
     (["simulate", "--speed", "1", "--rtol", "0"], "rtol"),
     (["sweep", "--case", "2.1", "--out", "newdir/"], "slash"),
+    # issue 27: the posterior a flags run reads is an input like the others
+    (["flags", "data.csv", "--fit", "fit.nc", "--out", "x.csv", "--nc", "notfit.nc", "--posterior", "notfit.nc"],
+     "--nc 'notfit.nc': is the input --posterior"),
+    # a file of the wrong kind is refused, not read as 'no posterior'
+    (["flags", "data.csv", "--fit", "fit.nc", "--out", "x.csv", "--posterior", "fit.nc"], "not a posterior file"),
+    # an output the file system refuses (root passes os.access everywhere) is refused before the fit runs
+    (["fit", "data.csv", "--out", "f.nc", "--posterior", "/sys/p.nc"], "--posterior '/sys/p.nc'"),
 ]
 
 

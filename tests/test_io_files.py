@@ -220,3 +220,16 @@ def test_deferred_signals_restores_the_handlers_and_raises_each_signal_once():
         assert seen == [signal.SIGTERM]
     finally:
         signal.signal(signal.SIGTERM, before)
+
+
+def test_several_outputs_land_together_or_not_at_all(tmp_path):
+    """flags writes CSV and NetCDF: when the second cannot be written the first is not left behind
+    (issue 27: fit --posterior once left fit.nc after failing on the posterior)."""
+    from microimpact.analysis.flags import write_flags
+
+    ds = xr.Dataset({"row": ("impact", np.array([1, 2])), "e_n": ("impact", [0.5, 0.6])})
+    with pytest.raises(FileNotFoundError):
+        write_flags(ds, tmp_path / "flags.csv", tmp_path / "missing" / "flags.nc")
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    write_flags(ds, tmp_path / "flags.csv", tmp_path / "flags.nc")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["flags.csv", "flags.nc"]

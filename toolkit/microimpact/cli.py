@@ -378,14 +378,15 @@ def _cmd_flags(args) -> int:
     from microimpact.analysis.flags import flag_measurements, write_flags
     from microimpact.analysis.fit_result import DampingFit
 
-    outputs = check_outputs({"--out": args.out, "--nc": args.nc}, _inputs(args))
+    inputs = _inputs(args) | ({"--posterior": check_input_file("--posterior", args.posterior)} if args.posterior else {})
+    outputs = check_outputs({"--out": args.out, "--nc": args.nc}, inputs)
     out, nc = outputs["--out"], outputs.get("--nc")
     try:
         fit = DampingFit.load(args.fit)
     except ValueError as exc:
         raise UsageError(f"--fit {args.fit!r}: {exc}") from None
-    table, _ = _impacts_for_pair(args)
     posterior = _load_posterior(args.posterior)
+    table, _ = _impacts_for_pair(args)
     ds = flag_measurements(table, fit, spin_bound=args.spin_bound, angle_uncertainty_deg=args.angle_uncertainty_deg,
                            rtol=args.rtol, progress=True, posterior=posterior, time_budget=args.time_budget)
     with reporting_os_errors(outputs):

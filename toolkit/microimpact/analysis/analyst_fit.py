@@ -71,15 +71,19 @@ class AnalystFit:
                                  "comment": "the impact table has no oblique columns: no friction fit"})
 
     def save(self, fit_path, posterior_path=None, oblique_path=None) -> tuple:
-        """Write the fit, and where given the posterior and the oblique fit, as NetCDF (atomically)."""
-        written = [self.damping.save(fit_path)]
-        if posterior_path is not None:
-            ds = self.posterior_dataset if self.posterior_dataset is not None else xr.Dataset(attrs={
-                "title": "posterior of the fitted parameters", "Conventions": CONVENTIONS,
-                "comment": "posterior not computed"})
-            written.append(write_netcdf(self._stamped(ds), posterior_path))
-        if oblique_path is not None:
-            written.append(write_netcdf(self._stamped(self.oblique_dataset()), oblique_path))
+        """Write the fit, and where given the posterior and the oblique fit, as NetCDF: all of them
+        or, if one cannot be written, none (:func:`microimpact.io.files.all_or_nothing`)."""
+        from microimpact.analysis.posterior import POSTERIOR_TITLE
+        from microimpact.io.files import all_or_nothing
+
+        with all_or_nothing():
+            written = [self.damping.save(fit_path)]
+            if posterior_path is not None:
+                ds = self.posterior_dataset if self.posterior_dataset is not None else xr.Dataset(attrs={
+                    "title": POSTERIOR_TITLE, "Conventions": CONVENTIONS, "comment": "posterior not computed"})
+                written.append(write_netcdf(self._stamped(ds), posterior_path))
+            if oblique_path is not None:
+                written.append(write_netcdf(self._stamped(self.oblique_dataset()), oblique_path))
         return tuple(written)
 
     def _stamped(self, ds: xr.Dataset) -> xr.Dataset:

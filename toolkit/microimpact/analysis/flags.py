@@ -407,7 +407,10 @@ def write_flags(ds: xr.Dataset, csv_path, nc_path=None):
     cols = ["row", *labels] + [c for c in table.columns if c not in ("row", "impact", *labels)]
     table = table[cols].rename(columns={n: str(v.attrs[CSV_COLUMN_ATTR]) for n, v in ds.data_vars.items()
                                         if CSV_COLUMN_ATTR in v.attrs and str(v.attrs[CSV_COLUMN_ATTR]) not in cols})
-    written = [write_csv(table, csv_path, float_format="%.8g")]
-    if nc_path is not None:
-        written.append(write_netcdf(ds, nc_path))
+    from microimpact.io.files import all_or_nothing
+
+    with all_or_nothing():  # both files or neither
+        written = [write_csv(table, csv_path, float_format="%.8g")]
+        if nc_path is not None:
+            written.append(write_netcdf(ds, nc_path))
     return tuple(written)

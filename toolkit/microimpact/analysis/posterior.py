@@ -64,6 +64,9 @@ __all__ = ["Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "D
            "sweep_bands", "posterior_dataset", "posterior_from_dataset", "load_posterior", "save_posterior",
            "summary_table", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"]
 
+#: the title of every posterior file (a sampled one adds how it was sampled)
+POSTERIOR_TITLE = "posterior of the fitted parameters"
+
 #: units of the sampled parameters
 PARAMETER_UNITS = {"zeta_hertz": "1", "zeta_adhesion": "1", "work_of_adhesion": "J m-2", "friction": "1"}
 #: errors-in-variables treatments of the measured speed
@@ -768,7 +771,7 @@ def posterior_dataset(posterior: Posterior, *extra: xr.Dataset) -> xr.Dataset:
     for e in extra:
         ds = ds.merge(e, combine_attrs="drop_conflicts")
     ds.attrs.update({
-        "title": "posterior of the fitted parameters (emcee, run until converged)", "Conventions": CONVENTIONS,
+        "title": f"{POSTERIOR_TITLE} (emcee, run until converged)", "Conventions": CONVENTIONS,
         "sampled": " ".join(posterior.names), "burn_in": int(posterior.burn), "seed": int(posterior.seed),
         "converged": int(posterior.converged), "convergence": str(posterior.info.get("convergence", "")),
         "errors_in_variables": str(posterior.info.get("errors_in_variables", "")),
@@ -799,10 +802,20 @@ def posterior_from_dataset(ds: xr.Dataset) -> Posterior:
 
 
 def load_posterior(path) -> Posterior | None:
-    """The :class:`Posterior` of a posterior NetCDF, or None when the file holds none (posterior disabled)."""
+    """The :class:`Posterior` of a posterior NetCDF, or None when the file holds none (posterior disabled).
+
+    Raises
+    ------
+    ValueError
+        If the file is not a posterior file at all (a fit, a sweep, ...): it is not taken for "no
+        posterior" in silence.
+    """
     with xr.open_dataset(path, engine="netcdf4") as ds:
         if "sampled" not in ds.attrs:
-            return None
+            title = str(ds.attrs.get("title", ""))
+            if title.startswith(POSTERIOR_TITLE):
+                return None
+            raise ValueError(f"not a posterior file: it holds {title or 'no title'!r}")
         return posterior_from_dataset(ds.load())
 
 

@@ -13,6 +13,7 @@ or keeps those of the file it replaces.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 import signal
 import stat
@@ -27,7 +28,7 @@ import numpy as np
 
 from microimpact.io.variables import VARIABLES, udunits
 
-__all__ = ["atomic_path", "atomic_write", "deferred_signals", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
+__all__ = ["atomic_path", "atomic_write", "all_or_nothing", "deferred_signals", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
            "CONVENTIONS", "read_netcdf_groups"]
 
 #: encoding added to every numeric, non-scalar NetCDF variable
@@ -124,6 +125,10 @@ def atomic_path(path) -> Iterator[Path]:
             os.fsync(fd)
         finally:
             os.close(fd)
+        pending = _TRANSACTION.get()
+        if pending is not None:  # inside all_or_nothing(): moved into place when the whole block succeeds
+            pending.append((tmp, path, mode, directory))
+            return
         os.chmod(tmp, mode)
         os.replace(tmp, path)
         _fsync_dir(directory)
@@ -131,6 +136,54 @@ def atomic_path(path) -> Iterator[Path]:
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()
         raise
+
+
+#: the files written inside all_or_nothing(), waiting to be moved into place: (tmp, path, mode, directory)
+_TRANSACTION: contextvars.ContextVar = contextvars.ContextVar("microimpact_files_transaction", default=None)
+
+
+@contextlib.contextmanager
+def all_or_nothing() -> Iterator[None]:
+    """Every file written inside the block (through :func:`atomic_path` and the writers built on it)
+    appears when the block ends without an exception, and none does if it raises.
+
+    A command with several outputs (a fit and its posterior; flags as CSV and NetCDF) thus never
+    leaves the first written and the second missing: a failure on the second (an unwritable
+    directory found only when writing) removes the first's temporary file too. Blocks nested in
+    an outer one join it.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> try:
+    ...     with all_or_nothing():
+    ...         with atomic_write(d / "a.txt") as f:
+    ...             _ = f.write("a")
+    ...         raise OSError("the second output cannot be written")
+    ... except OSError:
+    ...     pass
+    >>> sorted(p.name for p in d.iterdir())
+    []
+    """
+    if _TRANSACTION.get() is not None:
+        yield
+        return
+    pending: list = []
+    token = _TRANSACTION.set(pending)
+    try:
+        yield
+    except BaseException:
+        for tmp, *_ in pending:
+            with contextlib.suppress(FileNotFoundError):
+                tmp.unlink()
+        raise
+    finally:
+        _TRANSACTION.reset(token)
+    for tmp, path, mode, directory in pending:
+        os.chmod(tmp, mode)
+        os.replace(tmp, path)
+        _fsync_dir(directory)
 
 
 @contextlib.contextmanager

@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import tempfile
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 
@@ -128,6 +129,17 @@ def check_output_file(option: str, path) -> Path:
         raise PathError(option, text, f"{str(directory)!r} is not a directory")
     if not os.access(directory, os.W_OK | os.X_OK):
         raise PathError(option, text, f"directory {str(directory)!r} is not writable")
+    # os.access says yes to root everywhere, and a read-only or virtual file system (/sys, /proc, a
+    # read-only mount) refuses only when a file is created: create (and remove) the temporary file
+    # the writer will need, so the refusal comes before any work
+    try:
+        fd, probe = tempfile.mkstemp(dir=directory, prefix=f".{p.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise PathError(option, text, f"cannot create a file in {str(directory)!r}: "
+                                      f"{exc.strerror or exc}") from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(probe)
     return p
 
 
