@@ -350,6 +350,10 @@ END_TO_END = [
     (["flags", "data.csv", "--fit", "fit.nc", "--out", "x.csv", "--posterior", "fit.nc"], "not a posterior file"),
     # an output the file system refuses (root passes os.access everywhere) is refused before the fit runs
     (["fit", "data.csv", "--out", "f.nc", "--posterior", "/sys/p.nc"], "--posterior '/sys/p.nc'"),
+    # a misspelt option is named, with the closest one (argparse reported '--speed' as missing)
+    (["simulate", "--sped", "1"], "unrecognized option --sped (did you mean --speed?)"),
+    # no scipy message: which target, why, and what is reachable
+    (["target", "--e-n", "0.5", "--speed", "1e-8"], "target 1: e_n = 0.5 cannot be reached at v_n = 1e-08 m/s"),
 ]
 
 

@@ -266,3 +266,17 @@ def test_reproduction_budget():
         reproduction_table(time_budget=TINY)
     with pytest.raises(ValueError, match="time_budget"):
         reproduction_table(time_budget=0)
+
+
+def test_target_budget():
+    """target takes a budget (issue 27: --points 200000 ran for hours), checked after every curve
+    point; a generous one changes nothing."""
+    from microimpact.analysis.target import damping_from_target
+    from microimpact.presets import WALL_1990
+
+    with pytest.raises(TimeBudgetExceeded, match=r"^target: time budget of 1e-09 s exceeded after 2 of 9 points "
+                                                 r"of the curve of target 1$"):
+        damping_from_target(0.5, 2.0, WALL_1990, n_points=9, time_budget=TINY)
+    a = damping_from_target(0.5, 2.0, WALL_1990, n_points=5)
+    b = damping_from_target(0.5, 2.0, WALL_1990, n_points=5, time_budget=GENEROUS)
+    np.testing.assert_array_equal(a.curves["zeta_hertz"].values, b.curves["zeta_hertz"].values)

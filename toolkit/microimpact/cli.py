@@ -441,7 +441,7 @@ def _cmd_target(args) -> int:
         raise UsageError(f"--out {args.out!r}: the output must end in .csv or .nc")
     contact = contact_from_args(args)
     res = damping_from_target(args.e_n, args.speed, contact, e_n_uncertainty=args.e_n_uncertainty,
-                              n_points=args.points, rtol=args.rtol)
+                              n_points=args.points, rtol=args.rtol, time_budget=args.time_budget)
     c = res.curves
     for i, row in res.targets.iterrows():
         zh, za = c["zeta_hertz"].values[i], c["zeta_adhesion"].values[i]
@@ -450,10 +450,12 @@ def _cmd_target(args) -> int:
     if res.best is not None:
         from microimpact.io.statuses import stderr_is_meaningful
 
+        exact = len(res.targets) <= len(res.best)  # no degrees of freedom left: nothing to estimate an error from
         print("least squares over the targets: " + ", ".join(
-            f"{k} = {v:.6g}" + (f" +/- {res.stderr[k]:.3g}" if stderr_is_meaningful(v, res.stderr[k])
+            f"{k} = {v:.6g}" + ("" if exact else f" +/- {res.stderr[k]:.3g}" if stderr_is_meaningful(v, res.stderr[k])
                                 else " (standard error above 100 %: not determined by these targets)")
-            for k, v in res.best.items()))
+            for k, v in res.best.items())
+            + (f" (exact: {len(res.targets)} targets for {len(res.best)} parameters, no uncertainty)" if exact else ""))
     print(f"material: {args.contact_note}", file=sys.stderr)
     if out is not None:
         with reporting_os_errors({"--out": out}):
@@ -475,6 +477,7 @@ def register_target(sub) -> None:
     p.add_argument("--points", type=_positive_int, default=41, help="points per curve (default 41, >= 3)")
     _add_rtol(p)
     p.add_argument("--out", default=None, help="write the curve(s): .csv (one row per point) or .nc; default: print CSV")
+    _add_time_budget(p)
     p.set_defaults(func=_cmd_target)
 
 
@@ -664,9 +667,34 @@ def register_workflow(sub) -> None:
     p.set_defaults(func=_cmd_workflow, snakemake_args=[])
 
 
+def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | None:
+    """'unrecognized option --sped (did you mean --speed?)' for the first option of ``argv`` that its
+    command does not have, or None. argparse reports a misspelt required option as missing
+    ('required: --speed') without naming what was typed."""
+    import difflib
+
+    commands = next((a.choices for a in parser._actions if isinstance(a, argparse._SubParsersAction)), {})
+    command = next((w for w in argv if not w.startswith("-")), None)
+    if command not in commands or command == "workflow":  # workflow passes unknown options to snakemake
+        return None
+    known = [o for a in commands[command]._actions for o in a.option_strings]
+    for word in argv[argv.index(command) + 1:]:
+        if word == "--":
+            break
+        name = word.split("=", 1)[0]
+        if name.startswith("-") and not NEGATIVE_NUMBER.match(name) and name not in known:
+            close = difflib.get_close_matches(name, known, n=1)
+            return f"unrecognized option {name}" + (f" (did you mean {close[0]}?)" if close else "")
+    return None
+
+
 def main(argv=None) -> int:
     parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
     try:
+        unknown = _unknown_option(parser, argv)
+        if unknown:
+            raise UsageError(unknown)
         args, rest = parser.parse_known_args(argv)
         if rest and getattr(args, "command", None) == "workflow":
             args.snakemake_args = rest  # everything microimpact does not know goes to snakemake

@@ -115,10 +115,22 @@ def _root(fun, lo: float, target: float) -> float:
     return brentq(lambda z: fun(z) - target, lo, hi, xtol=1e-10, rtol=1e-10)
 
 
-def _curve(e_n, speed, target, n_points):
+def _curve(e_n, speed, target, n_points, deadline=None, which=1):
     """(zeta_H, zeta_A) arrays of the curve e_n(speed; zeta_H, zeta_A) = target."""
+    undamped = e_n(speed, 0.0, 0.0)
+    if undamped <= target:  # damping only lowers e_n: a target at or above the undamped e_n has no curve
+        why = ("the sphere is captured there even without damping" if undamped == 0.0
+               else "damping only lowers e_n")
+        raise ValueError(f"target {which}: e_n = {target:g} cannot be reached at v_n = {speed:g} m/s: without "
+                         f"damping e_n = {undamped:.4g} there and {why}; reachable: 0 < e_n < {undamped:.4g}"
+                         + (" (a higher speed, above the capture velocity)" if undamped == 0.0 else ""))
     za_max = _root(lambda za: e_n(speed, 0.0, za), 0.0, target)
     zh_max = _root(lambda zh: e_n(speed, zh, 0.0), 0.0, target)
+    for got in (e_n(speed, 0.0, za_max), e_n(speed, zh_max, 0.0)):
+        if abs(got - target) > 1e-6:  # the root is a jump of e_n (capture), not a crossing
+            raise ValueError(f"target {which}: e_n = {target:g} cannot be reached at v_n = {speed:g} m/s: e_n jumps "
+                             f"from {undamped:.4g} to 0 there as damping grows (the sphere is captured as soon as it "
+                             "loses energy: the speed is below the capture velocity); give a higher speed")
     za = za_max * (1.0 - np.cos(np.linspace(0.0, math.pi / 2, n_points)))  # denser near zeta_A = 0, where zeta_H turns
     za[-1] = za_max
     zh = np.empty(n_points)
@@ -127,11 +139,13 @@ def _curve(e_n, speed, target, n_points):
 
     for j in range(1, n_points - 1):
         zh[j] = brentq(lambda z: e_n(speed, z, za[j]) - target, 0.0, zh_max, xtol=1e-10, rtol=1e-10)
+        if deadline is not None:
+            deadline.check(f"{j + 1} of {n_points} points of the curve of target {which}")
     return zh, za
 
 
 def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_n_uncertainty=None,
-                        n_points: int = 41, rtol: float = DEFAULT_RTOL) -> DampingTarget:
+                        n_points: int = 41, rtol: float = DEFAULT_RTOL, time_budget=None) -> DampingTarget:
     """The zeta_H, zeta_A that reproduce measured e_n at given normal speeds (module docstring).
 
     Parameters
@@ -150,6 +164,9 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
         Points per curve (>= 3).
     rtol : float
         Relative tolerance of the normal solves. [-]
+    time_budget : float, optional
+        Wall-clock limit [s], checked after every curve point
+        (:class:`~microimpact.solvers.TimeBudgetExceeded` when spent).
 
     Returns
     -------
@@ -158,8 +175,13 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
     Raises
     ------
     ValueError
-        For an e_n outside (0, 1), a speed <= 0, mismatched lengths, or no radius.
+        For an e_n outside (0, 1), a speed <= 0, mismatched lengths, or no radius; and for an e_n
+        that no damping reaches at its speed (at or above the undamped e_n, e.g. below the capture
+        velocity), naming the target and the reachable range.
     """
+    from microimpact.solvers import Deadline
+
+    deadline = Deadline.start(time_budget, "target")
     e = np.atleast_1d(np.asarray(e_n, dtype=float))
     v = np.atleast_1d(np.asarray(speed, dtype=float))
     if e.shape != v.shape:
@@ -184,7 +206,7 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
     za = np.empty((e.size, n_points))
     with engine_threads(1):  # hundreds of one-speed solves
         for i in range(e.size):
-            zh[i], za[i] = _curve(model, v[i], e[i], n_points)
+            zh[i], za[i] = _curve(model, v[i], e[i], n_points, deadline, i + 1)
     curves = xr.Dataset(
         {"zeta_hertz": (("target", "curve_point"), zh, {"units": "1", "long_name": "zeta_H on the curve that "
                                                         "reproduces the target e_n, Eq. (15)"}),
