@@ -350,6 +350,7 @@ END_TO_END = [
     (["flags", "data.csv", "--fit", "fit.nc", "--out", "x.csv", "--posterior", "fit.nc"], "not a posterior file"),
     # an output the file system refuses (root passes os.access everywhere) is refused before the fit runs
     (["fit", "data.csv", "--out", "f.nc", "--posterior", "/sys/p.nc"], "--posterior '/sys/p.nc'"),
+    (["benchmark", "--quick", "--out", "/sys/bench"], "--out '/sys/bench': cannot create"),
     # a misspelt option is named, with the closest one (argparse reported '--speed' as missing)
     (["simulate", "--sped", "1"], "unrecognized option --sped (did you mean --speed?)"),
     # no scipy message: which target, why, and what is reachable

@@ -129,18 +129,26 @@ def check_output_file(option: str, path) -> Path:
         raise PathError(option, text, f"{str(directory)!r} is not a directory")
     if not os.access(directory, os.W_OK | os.X_OK):
         raise PathError(option, text, f"directory {str(directory)!r} is not writable")
-    # os.access says yes to root everywhere, and a read-only or virtual file system (/sys, /proc, a
-    # read-only mount) refuses only when a file is created: create (and remove) the temporary file
-    # the writer will need, so the refusal comes before any work
+    _probe(option, text, directory, p.name)
+    return p
+
+
+def _probe(option: str, text: str, directory: Path, name: str, *, make_dir: bool = False) -> None:
+    """Create (and remove) a temporary file, or directory, in ``directory``. os.access says yes to
+    root everywhere, and a read-only or virtual file system (/sys, /proc, a read-only mount) refuses
+    only when something is created: the refusal then comes before any work, not after it."""
     try:
-        fd, probe = tempfile.mkstemp(dir=directory, prefix=f".{p.name}.", suffix=".tmp")
+        if make_dir:
+            probe = tempfile.mkdtemp(dir=directory, prefix=f".{name}.", suffix=".tmp")
+            os.rmdir(probe)
+            return
+        fd, probe = tempfile.mkstemp(dir=directory, prefix=f".{name}.", suffix=".tmp")
     except OSError as exc:
-        raise PathError(option, text, f"cannot create a file in {str(directory)!r}: "
-                                      f"{exc.strerror or exc}") from None
+        raise PathError(option, text, f"cannot create {'a directory' if make_dir else 'a file'} in "
+                                      f"{str(directory)!r}: {exc.strerror or exc}") from None
     os.close(fd)
     with contextlib.suppress(OSError):
         os.unlink(probe)
-    return p
 
 
 def check_output_dir(option: str, path) -> Path:
@@ -153,6 +161,7 @@ def check_output_dir(option: str, path) -> Path:
             raise PathError(option, text, "exists and is not a directory")
         if not os.access(p, os.W_OK | os.X_OK):
             raise PathError(option, text, "directory is not writable")
+        _probe(option, text, p, "output")
         return p
     ancestor = p.absolute().parent
     while not ancestor.exists():
@@ -161,6 +170,7 @@ def check_output_dir(option: str, path) -> Path:
         raise PathError(option, text, f"{str(ancestor)!r} is not a directory")
     if not os.access(ancestor, os.W_OK | os.X_OK):
         raise PathError(option, text, f"cannot create it: directory {str(ancestor)!r} is not writable")
+    _probe(option, text, ancestor, p.name, make_dir=True)
     return p
 
 
