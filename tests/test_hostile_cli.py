@@ -351,6 +351,11 @@ END_TO_END = [
     # an output the file system refuses (root passes os.access everywhere) is refused before the fit runs
     (["fit", "data.csv", "--out", "f.nc", "--posterior", "/sys/p.nc"], "--posterior '/sys/p.nc'"),
     (["benchmark", "--quick", "--out", "/sys/bench"], "--out '/sys/bench': cannot create"),
+    # memory bounded before any work, naming the options and the estimate
+    (["fit", "data.csv", "--out", "f.nc", "--posterior", "p.nc", "--walkers", "1000000000"],
+     "--walkers/--steps/--max-steps: a chain of 1000000000 walkers"),
+    (["fit", "data.csv", "--out", "f.nc", "--posterior", "p.nc", "--steps", "1000000000"], "x 1000000000 steps"),
+    (["plot", "fit.nc", "--out", "f.png", "--dpi", "1000000"], "--dpi 1e+06 needs about"),
     # a misspelt option is named, with the closest one (argparse reported '--speed' as missing)
     (["simulate", "--sped", "1"], "unrecognized option --sped (did you mean --speed?)"),
     # no scipy message: which target, why, and what is reachable

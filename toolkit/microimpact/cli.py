@@ -299,14 +299,20 @@ def _cmd_fit(args) -> int:
     outputs = check_outputs({"--out": args.out, "--posterior": args.posterior, "--oblique-out": args.oblique_out},
                             _inputs(args))
     out = outputs["--out"]
-    table, pair = _impacts_for_pair(args)
-    print(f"fitting {len(table)} impacts of {pair.name} ...", file=sys.stderr, flush=True)
     posterior = False
     if outputs.get("--posterior") is not None:
         if args.full_chain:
             raise UsageError("--full-chain was removed: the default chain now runs until it converges; "
                              "--max-steps bounds it")
         posterior = {"walkers": args.walkers, "steps": args.steps, "max_steps": args.max_steps, "seed": args.seed}
+        from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_WALKERS, check_posterior_memory
+
+        try:  # before the fit: the most parameters a chain can have (zeta_H, zeta_A, w_A, f)
+            check_posterior_memory(args.walkers or DEFAULT_WALKERS, args.steps or args.max_steps or DEFAULT_MAX_STEPS, 4)
+        except ValueError as exc:
+            raise UsageError(f"--walkers/--steps/--max-steps: {exc}") from None
+    table, pair = _impacts_for_pair(args)
+    print(f"fitting {len(table)} impacts of {pair.name} ...", file=sys.stderr, flush=True)
     result = analyse_impacts(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
                              confidence_intervals=not args.no_confidence_intervals, posterior=posterior,
                              errors_in_variables=args.errors_in_variables, rtol=args.rtol, progress=True,
@@ -576,6 +582,13 @@ def _cmd_plot(args) -> int:
     if fmt not in FIGURE_FORMATS:
         raise PathError("--out", args.out, f"has no figure suffix; give a file ending in "
                                            f"{', '.join('.' + f for f in FIGURE_FORMATS)}")
+    if fmt == "png":  # the raster: RGBA bytes of the largest standard figure (8 x 10.5 in), and its encoding
+        from microimpact.io.resources import check_memory
+
+        try:
+            check_memory(f"--dpi {args.dpi:g}", 2 * 4 * (8.0 * args.dpi) * (10.5 * args.dpi))
+        except ValueError as exc:
+            raise UsageError(str(exc)) from None
     figure = FigureFile(str(inputs["RESULT"]), str(out), inputs.get("--curves"), args.variant)
     with reporting_os_errors({"--out": out}):
         caption = save_standard_figure(figure, dpi=args.dpi)

@@ -418,6 +418,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
                          f"got walkers={walkers}, steps={budget}")
     if burn is not None and not 0 <= int(burn) < budget:
         raise ValueError(f"burn must lie in [0, steps), got {burn}")
+    check_posterior_memory(walkers, budget, len(names))
     bounds = prior_bounds(names, best)
     lo = np.array([bounds[n][0] for n in names])
     hi = np.array([bounds[n][1] for n in names])
@@ -799,6 +800,27 @@ def posterior_from_dataset(ds: xr.Dataset) -> Posterior:
                      acceptance_fraction=ds["acceptance_fraction"].values, seed=int(ds.attrs["seed"]),
                      info={"converged": bool(int(ds.attrs["converged"])), "convergence": ds.attrs.get("convergence", ""),
                            "errors_in_variables": ds.attrs.get("errors_in_variables", "")} | extra)
+
+
+def posterior_memory(walkers: int, steps: int, n_parameters: int) -> float:
+    """Bytes a chain of ``walkers`` x ``steps`` over ``n_parameters`` holds at its largest: emcee's
+    chain and log-probabilities (float64) and the posterior's own copy of the kept part.
+
+    Examples
+    --------
+    >>> posterior_memory(16, 20000, 3)
+    20480000.0
+    """
+    return 2.0 * 8.0 * float(walkers) * float(steps) * (n_parameters + 1)
+
+
+def check_posterior_memory(walkers: int, steps: int, n_parameters: int) -> None:
+    """ValueError naming walkers and steps when :func:`posterior_memory` cannot fit in the machine
+    (:func:`microimpact.io.resources.check_memory`), before anything is sampled."""
+    from microimpact.io.resources import check_memory
+
+    check_memory(f"a chain of {walkers} walkers x {steps} steps (walkers, steps / max_steps) over {n_parameters} "
+                 "parameters", posterior_memory(walkers, steps, n_parameters))
 
 
 def load_posterior(path) -> Posterior | None:
