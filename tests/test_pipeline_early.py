@@ -97,6 +97,12 @@ def test_invalid_paper_contact_fields_are_refused(tmp_path):
     refused(dry_run(other), other, "'paper_contact'", "density")
 
 
+def test_rtol_has_the_bounds_of_the_cli(root):
+    # issue 27: rtol=1.0e-300 passed the dry run (the schema has only the upper bound) and failed
+    # later as an engine step limit
+    refused(dry_run(root, "rtol=1.0e-300"), root, "'rtol'", ">= 2.22e-14")
+
+
 def test_missing_and_broken_materials_config_are_refused(root):
     refused(dry_run(root, "materials=data/none.yaml"), root, "'materials'", "does not exist")
     (root / "data" / "bad_materials.yaml").write_text("pairs:\n  x_on_y: {density: -1}\n")

@@ -87,14 +87,12 @@ def _non_negative_float(text: str) -> float:
 
 
 def _rtol(text: str) -> float:
-    value = _finite_float(text)
-    if not 0.0 < value < 1.0:
-        raise argparse.ArgumentTypeError(f"rtol must lie in (0, 1), got {text!r}")
-    from microimpact.solvers.impact import MIN_RTOL
+    from microimpact.solvers.impact import check_rtol
 
-    if value < MIN_RTOL:
-        raise argparse.ArgumentTypeError(f"rtol must be >= {MIN_RTOL:.3g} (100 machine epsilons), got {text!r}")
-    return value
+    try:
+        return check_rtol(_finite_float(text))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 CONTACT_FIELDS = [f.name for f in fields(Contact)]

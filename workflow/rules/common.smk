@@ -136,6 +136,12 @@ def check_config_at_start():
         problem = _config_file_problem(key, what)
         if problem:
             raise WorkflowError(problem)
+    from microimpact.solvers.impact import check_rtol
+
+    try:  # the bounds of the CLI's --rtol, from the one check both use
+        check_rtol(config["rtol"])
+    except (TypeError, ValueError) as e:
+        raise WorkflowError(f"config key 'rtol': {e}") from None
     path = materials_path()
     if config["materials"] != "default":
         problem = _config_file_problem(

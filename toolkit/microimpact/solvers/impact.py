@@ -33,7 +33,7 @@ from microimpact.model.tangential import _sliding_impulse, _twist_stop, stop_imp
 if TYPE_CHECKING:  # xarray is imported by the batch functions only: one simulate_impact starts faster
     import xarray as xr
 
-__all__ = ["simulate_impact", "simulate_many", "RESULT_VARIABLES", "MIN_RTOL", "FAMILY_MIN_SPEEDS"]
+__all__ = ["simulate_impact", "simulate_many", "check_rtol", "RESULT_VARIABLES", "MIN_RTOL", "FAMILY_MIN_SPEEDS"]
 
 #: smallest relative tolerance accepted: 100 machine epsilons, as scipy's solve_ivp (below it no
 #: double-precision integration can meet the tolerance, and the engine ends at its step limit)
@@ -87,6 +87,23 @@ def _check_call(contact, rtol) -> float:
     if not isinstance(contact, Contact):
         hint = "; for a mapping of fields use Contact(**contact)" if isinstance(contact, Mapping) else ""
         raise TypeError(f"contact must be a microimpact Contact, got {type(contact).__name__}{hint}")
+    return check_rtol(rtol)
+
+
+def check_rtol(rtol) -> float:
+    """``rtol`` as a float if the solvers can meet it: finite, in [:data:`MIN_RTOL`, 1); else a
+    TypeError / ValueError saying what is accepted. The CLI's ``--rtol`` and the pipeline's config
+    key ``rtol`` are checked here too, so all three accept the same values.
+
+    Examples
+    --------
+    >>> check_rtol(1e-8)
+    1e-08
+    >>> check_rtol(1e-300)
+    Traceback (most recent call last):
+    ...
+    ValueError: rtol must be >= 2.22e-14 (100 machine epsilons; a smaller tolerance cannot be met in double precision), got 1e-300
+    """
     if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real):
         raise TypeError(f"rtol must be a real number, got {type(rtol).__name__} {rtol!r}")
     if not (math.isfinite(rtol) and 0.0 < rtol < 1.0):
