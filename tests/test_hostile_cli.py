@@ -373,3 +373,30 @@ def test_entry_point(argv, words, workspace):
     assert r.stdout == ""
     assert r.stderr.count("\n") == 1 and r.stderr.startswith("microimpact: error: ") and words in r.stderr, r.stderr
     assert _snapshot(workspace) == before
+
+
+@pytest.mark.parametrize("after", [1.5, 4.0, 7.0])
+def test_ctrl_c_ends_in_one_line_with_status_130_and_writes_nothing(after, workspace):
+    """Ctrl-C (SIGINT to the process group, as a terminal sends it) at several moments of
+    ``fit --posterior`` (reading, fitting, sampling): exit 130 within seconds, one line, no
+    traceback (emcee once printed the likelihood's traceback: 87 lines), no file written."""
+    import signal
+    import time
+
+    before = _snapshot(workspace)
+    exe = shutil.which("microimpact")
+    cmd = [exe] if exe else [sys.executable, "-m", "microimpact.cli"]
+    proc = subprocess.Popen([*cmd, "fit", "data.csv", "--out", "f.nc", "--posterior", "p.nc"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    time.sleep(after)
+    if proc.poll() is not None:
+        pytest.skip(f"the fit ended within {after} s, before the signal")
+    sent = time.monotonic()
+    os.killpg(proc.pid, signal.SIGINT)
+    out, err = proc.communicate(timeout=60)
+    assert time.monotonic() - sent < 10
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert err.strip().splitlines()[-1].startswith("microimpact: interrupted; nothing was written"), err
+    assert _snapshot(workspace) == before

@@ -43,6 +43,8 @@ EXIT_TIME_BUDGET = 3
 #: exit status when the reader of stdout closed it early (``| head``): 128 + SIGPIPE, as a POSIX
 #: tool killed by the signal reports it; nothing is printed
 EXIT_BROKEN_PIPE = 141
+#: exit status after Ctrl-C (SIGINT): 128 + 2, as a shell reports a command the signal ended
+EXIT_INTERRUPTED = 130
 
 
 #: a negative number as an option's value: ``--radius -1e-6``, ``--omega-n -.5``, ``--speed -inf``.
@@ -716,6 +718,10 @@ def main(argv=None) -> int:
         status = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
+    except KeyboardInterrupt:  # Ctrl-C: one line, the shell's status for SIGINT, no traceback
+        print(f"microimpact: interrupted; nothing was written (outputs are written whole or not at all); "
+              f"run the same command again to redo it", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except BrokenPipeError:  # the reader went away (| head): stop quietly, as POSIX tools do
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
         return EXIT_BROKEN_PIPE

@@ -474,16 +474,20 @@ def _run_chain(log_probability, pos, seed, budget, fixed_length, burn, advance, 
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()  # seeded
     state = emcee.State(pos)
     done, previous_tau, diag = 0, None, None
-    while done < budget:
-        chunk = min(CHECK_EVERY, budget - done)
-        for state in sampler.sample(state, iterations=chunk, store=True):
-            advance(1)
-        done += chunk
-        diag = _diagnose(sampler, names, burn, split_rhat, ess_bulk)
-        _raise_if_collapsed(diag, names, damping_fit, friction_fit, done)
-        if not fixed_length and _converged(diag, previous_tau, RHAT_MAX, ESS_MIN):
-            break
-        previous_tau = diag["tau"]
+    from microimpact.io.files import interrupt_at_checkpoints
+
+    with interrupt_at_checkpoints() as checkpoint:  # Ctrl-C acts between steps, not inside emcee
+        while done < budget:
+            chunk = min(CHECK_EVERY, budget - done)
+            for state in sampler.sample(state, iterations=chunk, store=True):
+                advance(1)
+                checkpoint()
+            done += chunk
+            diag = _diagnose(sampler, names, burn, split_rhat, ess_bulk)
+            _raise_if_collapsed(diag, names, damping_fit, friction_fit, done)
+            if not fixed_length and _converged(diag, previous_tau, RHAT_MAX, ESS_MIN):
+                break
+            previous_tau = diag["tau"]
     return sampler, diag, previous_tau, done
 
 
