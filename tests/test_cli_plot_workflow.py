@@ -118,3 +118,38 @@ def test_workflow_without_snakemake_asks_for_the_extra(tmp_path, capsys, monkeyp
 def test_other_commands_still_refuse_unknown_arguments(capsys):
     assert main(["simulate", "--speed", "2", "--no-such-option"]) == 2
     assert "unrecognized arguments: --no-such-option" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_ctrl_c_of_the_workflow_ends_in_one_line_and_a_plain_rerun_resumes(tmp_path):
+    """Ctrl-C of ``microimpact workflow`` (SIGINT to the process group): status 130, the wrapper's
+    one line and no traceback; Snakemake stops its jobs and releases its lock (the wrapper used to
+    kill it, leaving 'Directory cannot be locked'), and the same command again goes on without
+    --unlock or --rerun-incomplete (shown by its dry run)."""
+    import os
+    import shutil
+    import signal
+    import subprocess
+    import time
+
+    exe = shutil.which("microimpact")
+    cmd = [exe] if exe else [sys.executable, "-m", "microimpact.cli"]
+    run = tmp_path / "run"
+    shutil.copytree(Path(__file__).resolve().parents[1] / "data", run / "data")
+    env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
+    proc = subprocess.Popen([*cmd, "workflow", "--directory", str(run), "--cores", "2"], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, start_new_session=True, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    deadline = time.monotonic() + 120
+    while not list(run.glob("results/**/*.nc")) and time.monotonic() < deadline:
+        time.sleep(0.5)
+    assert proc.poll() is None, "the run ended before it could be interrupted"
+    os.killpg(proc.pid, signal.SIGINT)
+    out, _ = proc.communicate(timeout=120)
+    assert proc.returncode == 130, out[-3000:]
+    assert out.strip().splitlines()[-1].startswith("microimpact: workflow interrupted"), out[-3000:]
+    assert "Traceback" not in out.split("Error in rule")[0], out[-3000:]  # job tracebacks stay in the logs
+    again = subprocess.run([*cmd, "workflow", "--directory", str(run), "--cores", "2", "-n"], capture_output=True,
+                           text=True, env=env, timeout=300)
+    assert again.returncode == 0, (again.stdout + again.stderr)[-3000:]
+    assert "Job stats" in again.stdout, again.stdout[-3000:]  # jobs left to do, and nothing in the way

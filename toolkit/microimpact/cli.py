@@ -650,6 +650,10 @@ def _snakemake_command(args) -> list[str]:
     if not any(w.split("=", 1)[0] in _CORES_OPTIONS or (w[:2] in ("-c", "-j") and not w.startswith("--"))
                for w in extra):
         extra = ["--cores", "all", *extra]
+    if "--rerun-incomplete" not in extra and "--ri" not in extra:
+        # a plain rerun after Ctrl-C or a kill resumes: outputs are written atomically, so the only
+        # incomplete ones are those of jobs that were stopped, and they are redone
+        extra = ["--rerun-incomplete", *extra]
     return [sys.executable, "-m", "snakemake", "--snakefile", str(workflow_snakefile()),
             "--directory", str(args.directory), *extra]
 
@@ -664,7 +668,23 @@ def _cmd_workflow(args) -> int:
     with reporting_os_errors({"--directory": directory}):
         directory.mkdir(parents=True, exist_ok=True)
     print(f"microimpact: running the pipeline ({command[4]}) in {directory}", file=sys.stderr, flush=True)
-    return subprocess.call(command)
+    import signal
+
+    # Ctrl-C reaches Snakemake from the terminal (same process group); Snakemake then stops its jobs,
+    # removes their unfinished outputs and releases its lock. The wrapper only waits for that:
+    # subprocess.call would kill Snakemake on the KeyboardInterrupt, leaving the directory locked.
+    interrupted: list[int] = []
+    proc = subprocess.Popen(command)
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: interrupted.append(signum))
+    try:
+        status = proc.wait()
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if interrupted:
+        print("microimpact: workflow interrupted; finished results are kept and unfinished ones removed; run the "
+              "same command again to resume", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    return status
 
 
 def register_workflow(sub) -> None:
