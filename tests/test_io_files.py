@@ -233,3 +233,26 @@ def test_several_outputs_land_together_or_not_at_all(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == []
     write_flags(ds, tmp_path / "flags.csv", tmp_path / "flags.nc")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["flags.csv", "flags.nc"]
+
+
+def test_a_killed_writers_temporary_file_is_removed_by_the_next_write(tmp_path):
+    """SIGKILL leaves the hidden temporary file (nothing can run then); the next write of the same
+    target removes it, since its writer's process is gone, and leaves a live writer's alone."""
+    target = tmp_path / "out.csv"
+    script = textwrap.dedent(f"""
+        import os, signal
+        from microimpact.io.files import atomic_write
+        with atomic_write({str(target)!r}) as f:
+            f.write("half")
+            f.flush()
+            os.kill(os.getpid(), signal.SIGKILL)
+    """)
+    proc = subprocess.run([sys.executable, "-c", script])
+    assert proc.returncode == -9
+    orphans = list(tmp_path.glob(".out.csv.*.tmp"))
+    assert len(orphans) == 1 and not target.exists()
+    live = tmp_path / f".out.csv.{os.getpid()}.abc.tmp"  # a writer of this (live) process
+    live.write_text("in progress")
+    write_csv(pd.DataFrame({"a": [1]}), target)
+    assert target.read_text() == "a\n1\n"
+    assert sorted(p.name for p in tmp_path.glob(".*.tmp")) == [live.name]

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import glob
 import os
 import signal
 import stat
@@ -111,6 +112,26 @@ def interrupt_at_checkpoints() -> Iterator:
     checkpoint()
 
 
+def _remove_orphans(directory: Path, name: str) -> None:
+    """Remove the temporary files of ``name`` left by writers that were killed (SIGKILL, a crash):
+    each temporary file carries its writer's process id, and one whose process is gone is an
+    orphan. A live writer's file (this process or another) is left alone."""
+    for tmp in directory.glob(f".{glob.escape(name)}.*.tmp"):
+        parts = tmp.name[len(name) + 2:].split(".")
+        if not parts or not parts[0].isdigit():
+            continue  # not one of ours (or written before the id was in the name)
+        pid = int(parts[0])
+        try:
+            os.kill(pid, 0)
+            continue  # alive (or another user's): not ours to remove
+        except ProcessLookupError:
+            pass
+        except PermissionError:
+            continue
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+
+
 def _target_mode(path: Path) -> int:
     try:
         return stat.S_IMODE(path.stat().st_mode)
@@ -153,7 +174,8 @@ def atomic_path(path) -> Iterator[Path]:
     if not directory.is_dir():
         raise FileNotFoundError(f"cannot write {path}: directory {directory} does not exist")
     mode = _target_mode(path)
-    fd, tmp_name = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".tmp")
+    _remove_orphans(directory, path.name)
+    fd, tmp_name = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp")
     os.close(fd)
     tmp = Path(tmp_name)
     try:
