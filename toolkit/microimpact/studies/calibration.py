@@ -464,6 +464,7 @@ def plot_calibration(summary: dict, path) -> Path:
     series = [("least_squares", "determined", "o", "least squares: 95 % interval"),
               ("least_squares", "bounds", "^", "least squares: bound / range"),
               ("posterior", "determined", "s", "posterior: 95 % interval")]
+    lowest: list[float] = []
     for j, (src, what, marker, label) in enumerate(series):
         xs, ys, es, ns = [], [], [], []
         for i, n in enumerate(names):
@@ -473,15 +474,19 @@ def plot_calibration(summary: dict, path) -> Path:
                 ys.append(c["coverage"])
                 es.append(2 * max(c["mc_error"], 1e-3))
                 ns.append(c["n"])
-        ax.errorbar(xs, ys, yerr=es, fmt=marker, capsize=3, label=label)
+        # bars clipped to [0, 1]: a coverage cannot leave it (a few posterior designs give +/- 70 %)
+        lo_err = [min(e, y) for e, y in zip(es, ys)]
+        hi_err = [min(e, 1.0 - y) for e, y in zip(es, ys)]
+        ax.errorbar(xs, ys, yerr=[lo_err, hi_err], fmt=marker, capsize=3, label=label)
+        lowest.extend(ys)
         for x, y, n in zip(xs, ys, ns):
             ax.annotate(f"n={n}", (x, y), textcoords="offset points", xytext=(0, -14), ha="center", fontsize=7)
     ax.set_xticks(range(len(names)), [labels[n] for n in names])
-    ax.set_ylim(0.7, 1.02)
+    ax.set_ylim(min([0.7, *(y - 0.08 for y in lowest)]), 1.02)  # every point on the axes
     ax.set_ylabel("fraction holding the truth")
     ax.set_title(f"Calibration over {summary['n_designs']} random designs (error bars: 2 MC standard errors)",
                  fontsize=9)
-    ax.legend(fontsize=7, loc="lower left")
+    ax.legend(fontsize=7, loc="lower right")  # the low posterior points of few designs sit on the left
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format=path.suffix.lstrip(".") or "png", dpi=150)
