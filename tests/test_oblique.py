@@ -156,3 +156,25 @@ def test_two_tangential_rebound_columns_are_refused(tmp_path):
     path.write_text(HEAD + "rebound_angle [deg],tangential_restitution [1]\n3,10,30,0.5,20,0.7\n")
     with pytest.raises(ImpactDataError, match="both give the tangential rebound"):
         read_impacts(path)
+
+
+def test_oblique_values_the_fit_cannot_use_are_named(tmp_path):
+    """Issue 27: a measured tangential_restitution at 0 deg incidence was ignored without a word.
+    The problem keeps the usable rows; with warn=True (as the friction fit calls it) one warning
+    names each unused row and why."""
+    path = tmp_path / "obl.csv"
+    path.write_text("radius [um],speed [m/s],incidence_angle [deg],e_n [1],tangential_restitution [1]\n"
+                    "3.45,5,0,0.8,0.7\n"
+                    "3.45,5,30,0.8,0.7\n"
+                    "3.45,10,45,0,0.75\n"
+                    "3.45,10,60,0.8,0.8\n")
+    table = read_impacts(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        quiet = ObliqueProblem.from_table(table)  # other readers of the table stay quiet
+    assert list(quiet.rows) == [2, 4]
+    with pytest.warns(ImpactDataWarning) as rec:
+        ObliqueProblem.from_table(table, warn=True)
+    text = " ".join(str(w.message) for w in rec)
+    assert "2 measured tangential_restitution value(s) not used" in text
+    assert "rows 1 at 0 deg incidence" in text and "rows 3 captured" in text

@@ -70,6 +70,26 @@ PROFILE_POINTS = 400
 _H_SPEED = 1e-4  # relative step of the speed slope [-]
 _H_ANGLE = 0.05  # step of the angle slope [deg]
 
+def _warn_unused(src: str, quantity: str, rows, unused, inc, e_n) -> None:
+    """One ImpactDataWarning naming the rows whose measured oblique value the friction fit cannot
+    use, and why: at normal incidence there is no tangential motion for friction to act on, and a
+    captured impact has no rebound."""
+    import warnings
+
+    from microimpact.io.impacts import ImpactDataWarning
+
+    if not np.any(unused):
+        return
+    with np.errstate(invalid="ignore"):
+        reasons = [(unused & (inc == 0), "at 0 deg incidence (no tangential motion for friction to act on)"),
+                   (unused & ~(inc == 0) & ~(e_n > 0), "captured or without e_n (no rebound to compare)"),
+                   (unused & (inc != 0) & (e_n > 0), "without incidence angle or speed")]
+    listed = "; ".join(f"rows {', '.join(map(str, rows[m][:20]))}{' and more' if m.sum() > 20 else ''} {why}"
+                       for m, why in reasons if m.any())
+    warnings.warn(f"{src}: {int(np.sum(unused))} measured {quantity} value(s) not used by the friction fit: {listed}",
+                  ImpactDataWarning, stacklevel=4)
+
+
 #: the columns of a friction fit's data that the fit computes (the others are the analyst's row labels)
 _ENTRY_COLUMNS = ("row", "quantity", "radius", "speed", "incidence_deg", "measured", "sigma", "model", "residual")
 
@@ -110,8 +130,10 @@ class ObliqueProblem:
     labels: pd.DataFrame | None = None
 
     @classmethod
-    def from_table(cls, table: pd.DataFrame) -> "ObliqueProblem":
-        """The oblique entries of a table from :func:`microimpact.io.read_impacts`.
+    def from_table(cls, table: pd.DataFrame, *, warn: bool = False) -> "ObliqueProblem":
+        """The oblique entries of a table from :func:`microimpact.io.read_impacts`; with ``warn``, an
+        ImpactDataWarning names the measured oblique values that cannot be used, and why (the
+        friction fit warns; the other readers of the same table do not repeat it).
 
         Raises
         ------
@@ -140,6 +162,8 @@ class ObliqueProblem:
             use = np.isfinite(x) & np.isfinite(inc) & (inc > 0) & np.isfinite(speed) & (col("e_n") > 0)
             idx = np.flatnonzero(use)
             parts.append((q, idx, x[idx], col(f"{q}_uncertainty")[idx]))
+            if warn:
+                _warn_unused(src, q, rows, np.isfinite(x) & ~use, inc, col("e_n"))
         if not any(p[1].size for p in parts):
             raise ValueError(f"{src}: no oblique measurement to fit friction from: give one of the columns "
                              "tangential_restitution, rebound_angle, rebound_tangential_speed or rebound_spin at a "
@@ -505,7 +529,7 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
 
     t0 = time.perf_counter()
     deadline = Deadline.start(time_budget, "friction fit")
-    problem = ObliqueProblem.from_table(table)
+    problem = ObliqueProblem.from_table(table, warn=True)
     contact_of = damping_fit.contact
     model_name = tangential_model or contact_of(float(problem.radius[0])).tangential_model
     if model_name not in TANGENTIAL_PARAMETERS:
