@@ -205,3 +205,13 @@ def test_bifurcation_plane_custom_cases_and_ranges():
     assert ds.sizes == {"C1": 31, "C2": 41, "case": 1}
     assert float(ds.C1.max()) == 3.0
 
+
+
+def test_no_rebound_at_any_speed_names_the_contact():
+    """Issue 27: data with a 1 nm sphere ended with 'every normal impact up to 1e6 m/s is captured'
+    and no word of which sphere; the message names the contact."""
+    from microimpact.dynamics.nonlinear import capture_bracket
+    from microimpact.presets import WALL_1990
+
+    with pytest.raises(ValueError, match=r"captured \(sphere radius 1e-09 m, f0 = 7.422 N/m"):
+        capture_bracket(WALL_1990.with_(radius=1e-9))

@@ -529,14 +529,17 @@ def capture_bracket(
         while solve(hi).outcome == "capture":
             lo, hi = hi, hi * 2.0
             if hi > 1e6:
-                raise ValueError("every normal impact up to 1e6 m/s is captured")
+                raise ValueError(f"every normal impact up to 1e6 m/s is captured (sphere radius {contact.radius:.4g} m, "
+                                 f"f0 = {contact.adhesion_line_force:.4g} N/m, zeta_H = {contact.zeta_hertz:.4g}, "
+                                 f"zeta_A = {contact.zeta_adhesion:.4g})")
     else:
         hi = v
         lo = v / 2.0
         while solve(lo).outcome != "capture":
             hi, lo = lo, lo / 2.0
             if lo < 1e-12:
-                raise ValueError("no normal impact down to 1e-12 m/s is captured")
+                raise ValueError(f"no normal impact down to 1e-12 m/s is captured (sphere radius {contact.radius:.4g} m, "
+                                 f"f0 = {contact.adhesion_line_force:.4g} N/m)")
     while hi - lo > xtol + rtol * hi:
         mid = 0.5 * (lo + hi)
         if solve(mid).outcome == "capture":
