@@ -117,7 +117,7 @@ def test_workflow_without_snakemake_asks_for_the_extra(tmp_path, capsys, monkeyp
 
 def test_other_commands_still_refuse_unknown_arguments(capsys):
     assert main(["simulate", "--speed", "2", "--no-such-option"]) == 2
-    assert "unrecognized arguments: --no-such-option" in capsys.readouterr().err
+    assert "unrecognized option --no-such-option" in capsys.readouterr().err
 
 
 @pytest.mark.slow
