@@ -202,7 +202,11 @@ def data_pairs():
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # validate_data shows the warnings, once
-            table = read_impacts(config["data"], materials=materials_path(), material_pair=config["material_pair"])
+            table = read_impacts(
+                config["data"],
+                materials=materials_path(),
+                material_pair=config["material_pair"],
+            )
     except (ImpactDataError, MaterialsError, OSError, ValueError):
         return [config["material_pair"]]
     return material_pairs(table, config["material_pair"])
@@ -308,16 +312,20 @@ def analyst_report_inputs(wildcards):
     inputs = {}
     for i, p in enumerate(PAIRS):
         base = f"results/analyst/{p}"
-        inputs.update({
-            f"fit__{i}": f"{base}/fit.nc",
-            f"posterior__{i}": f"{base}/posterior.nc",
-            f"oblique__{i}": f"{base}/oblique.nc",
-            f"fit_curves__{i}": f"{base}/fit_curves.nc",
-            f"model_comparison__{i}": f"{base}/model_comparison.nc",
-            f"flags__{i}": f"{base}/flags.csv",
-            f"analyst_dynamics__{i}": f"{base}/dynamics.nc",
-            f"analyst_sweeps__{i}": [f"{base}/sweeps/case_{c}.nc" for c in SWEEP_CASES],
-        })
+        inputs.update(
+            {
+                f"fit__{i}": f"{base}/fit.nc",
+                f"posterior__{i}": f"{base}/posterior.nc",
+                f"oblique__{i}": f"{base}/oblique.nc",
+                f"fit_curves__{i}": f"{base}/fit_curves.nc",
+                f"model_comparison__{i}": f"{base}/model_comparison.nc",
+                f"flags__{i}": f"{base}/flags.csv",
+                f"analyst_dynamics__{i}": f"{base}/dynamics.nc",
+                f"analyst_sweeps__{i}": [
+                    f"{base}/sweeps/case_{c}.nc" for c in SWEEP_CASES
+                ],
+            }
+        )
     return inputs
 
 

@@ -1,9 +1,10 @@
-# The analyst's material, once per material pair of the data ({pair}: PAIRS in common.smk): the fit of the damping coefficients to the measured e_n(v_n) (the
-# paper's Fig. 3 procedure), the friction from the oblique columns (when the data have them), the
-# posterior of the fitted parameters with its bands (config key posterior), and everything the fitted parameters drive: the measurement flags,
-# and in one job (each is seconds; one job saves the start-up of six) the model curves, the
-# critical and capture velocity per measured size and the Table 2 sweeps of the fitted material
-# over the measured sizes and speeds.
+# The analyst's material, once per material pair of the data ({pair}: PAIRS in common.smk): the
+# fit of the damping coefficients to the measured e_n(v_n) (the paper's Fig. 3 procedure), the
+# friction from the oblique columns (when the data have them), the posterior of the fitted
+# parameters with its bands (config key posterior), and everything the fitted parameters drive: the
+# measurement flags, and in one job (each is seconds; one job saves the start-up of six) the model
+# curves, the critical and capture velocity per measured size and the Table 2 sweeps of the fitted
+# material over the measured sizes and speeds.
 
 
 rule fit:
@@ -68,7 +69,9 @@ rule material_simulations:
     output:
         fit_curves="results/analyst/{pair}/fit_curves.nc",
         dynamics="results/analyst/{pair}/dynamics.nc",
-        sweeps=expand("results/analyst/{{pair}}/sweeps/case_{case}.nc", case=SWEEP_CASES),
+        sweeps=expand(
+            "results/analyst/{{pair}}/sweeps/case_{case}.nc", case=SWEEP_CASES
+        ),
     log:
         "logs/material_simulations/{pair}.log",
     benchmark:
