@@ -342,7 +342,7 @@ def register_fit(sub) -> None:
 
 def _add_posterior_options(p: argparse.ArgumentParser) -> None:
     """The posterior and oblique options of ``microimpact fit`` (microimpact.analysis.analyst_fit)."""
-    from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_SEED, DEFAULT_WALKERS
+    from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_SEED, DEFAULT_WALKERS
 
     p.add_argument("--posterior", default=None, metavar="NC",
                    help="also sample the posterior (emcee, seeded) until it converges (50 autocorrelation times, "

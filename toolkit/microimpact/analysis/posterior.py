@@ -54,6 +54,7 @@ import pandas as pd
 import xarray as xr
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES
+from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.materials import material_contact
 from microimpact.io.progress import progress_bar
@@ -289,10 +290,6 @@ class PosteriorError(RuntimeError):
     """
 
 
-#: walkers of the ensemble (at least 2 x the sampled parameters are needed; 16 suits 2-4)
-DEFAULT_WALKERS = 16
-#: steps after which an unconverged chain is an error (with the time budget, the chain's budget)
-DEFAULT_MAX_STEPS = 20000
 #: steps between convergence checks
 CHECK_EVERY = 100
 #: the chain after burn-in must be longer than this many integrated autocorrelation times (emcee's
@@ -303,10 +300,6 @@ TAU_STABILITY = 0.05
 #: mean acceptance fraction below which the chain counts as collapsed (a healthy stretch-move chain
 #: accepts 0.2-0.5 of its proposals)
 MIN_ACCEPTANCE = 0.05
-#: seed of the start ball and the sampler
-DEFAULT_SEED = 2002
-#: posterior draws pushed through the bands and the flags
-DEFAULT_N_DRAWS = 24
 #: upper end of the flat friction prior: far above any measured dry friction coefficient, so that it
 #: never truncates a posterior the data determine; where the data only bound f from below, the upper
 #: end of its credible interval is this prior's and is reported as such

@@ -1,0 +1,24 @@
+"""The posterior sampler's defaults, in a module that imports nothing.
+
+:mod:`microimpact.analysis.posterior` uses them and re-exports them; the command line reads them
+from here to print them in its help, which must not wait for scipy and xarray to import
+(``microimpact --help`` is held to three times the start-up of ``python -c "import numpy"``,
+.ci/startup.py).
+
+Examples
+--------
+>>> from microimpact.analysis import posterior
+>>> posterior.DEFAULT_WALKERS == DEFAULT_WALKERS
+True
+"""
+
+__all__ = ["DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS"]
+
+#: walkers of the ensemble (at least 2 x the sampled parameters are needed; 16 suits 2-4)
+DEFAULT_WALKERS = 16
+#: steps after which an unconverged chain is an error (with the time budget, the chain's budget)
+DEFAULT_MAX_STEPS = 20000
+#: seed of the start ball and the sampler
+DEFAULT_SEED = 2002
+#: posterior draws pushed through the bands and the flags
+DEFAULT_N_DRAWS = 24
