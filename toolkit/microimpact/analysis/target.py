@@ -139,10 +139,12 @@ def _curve(e_n, speed, target, n_points, deadline=None, which=1):
 
     for j in range(1, n_points - 1):
         g = lambda z: e_n(speed, z, za[j]) - target  # noqa: E731 - decreasing in z
-        lo, hi = g(0.0), g(zh_max)
-        # at the ends of a very fine curve (zeta_A within the solver tolerance of 0 or of its
-        # maximum) round-off can give both ends one sign: the point is then that end
-        zh[j] = 0.0 if lo <= 0.0 else zh_max if hi >= 0.0 else brentq(g, 0.0, zh_max, xtol=1e-10, rtol=1e-10)
+        try:
+            zh[j] = brentq(g, 0.0, zh_max, xtol=1e-10, rtol=1e-10)
+        except ValueError:
+            # at the ends of a very fine curve (zeta_A within the solver tolerance of 0 or of its
+            # maximum) round-off can give both ends one sign: the point is then that end
+            zh[j] = 0.0 if g(0.0) <= 0.0 else zh_max
         if deadline is not None:
             deadline.check(f"{j + 1} of {n_points} points of the curve of target {which}")
     return zh, za
