@@ -153,3 +153,50 @@ def test_ctrl_c_of_the_workflow_ends_in_one_line_and_a_plain_rerun_resumes(tmp_p
                            text=True, env=env, timeout=300)
     assert again.returncode == 0, (again.stdout + again.stderr)[-3000:]
     assert "Job stats" in again.stdout, again.stdout[-3000:]  # jobs left to do, and nothing in the way
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/cwd").exists(), reason="needs /proc to see other processes")
+def test_a_killed_workflow_is_unlocked_by_the_rerun_only_when_nothing_holds_the_lock(tmp_path):
+    """SIGKILL of ``microimpact workflow`` and its Snakemake leaves Snakemake's lock behind (a plain
+    snakemake then stops with 'Directory cannot be locked'). The same command again removes it and
+    says so, but not while a Snakemake process works in the directory: then it refuses with status
+    2, naming the process, and the lock stays."""
+    import os
+    import shutil
+    import signal
+    import subprocess
+    import time
+
+    exe = shutil.which("microimpact")
+    cmd = [exe] if exe else [sys.executable, "-m", "microimpact.cli"]
+    run = tmp_path / "run"
+    shutil.copytree(Path(__file__).resolve().parents[1] / "data", run / "data")
+    env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
+    proc = subprocess.Popen([*cmd, "workflow", "--directory", str(run), "--cores", "2"], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True, env=env)
+    locks = run / ".snakemake" / "locks"
+    deadline = time.monotonic() + 120
+    while not list(run.glob("results/**/*.nc")) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert proc.poll() is None and list(locks.glob("*.lock")), "the run ended before it could be killed"
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=30)
+    assert list(locks.glob("*.lock"))  # the kill left the lock
+
+    dry = [*cmd, "workflow", "--directory", str(run), "--cores", "2", "-n"]
+    holder = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)", "snakemake"], cwd=run)
+    try:
+        refused = subprocess.run(dry, capture_output=True, text=True, env=env, timeout=120)
+    finally:
+        holder.kill()
+        holder.wait()
+    assert refused.returncode == 2, refused.stderr[-2000:]
+    assert f"process {holder.pid}" in refused.stderr and "Traceback" not in refused.stderr, refused.stderr
+    assert list(locks.glob("*.lock"))
+
+    again = subprocess.run(dry, capture_output=True, text=True, env=env, timeout=300)
+    assert again.returncode == 0, (again.stdout + again.stderr)[-3000:]
+    assert "removed the lock that a stopped run left" in again.stderr, again.stderr[-2000:]
+    assert "Job stats" in again.stdout and "cannot be locked" not in again.stdout + again.stderr
+    assert not list(locks.glob("*.lock"))

@@ -10,6 +10,8 @@ added to the documentation without a test fails here:
   copy of data/ and docs/ (placeholders such as ``path/to/impacts.csv`` replaced by bundled files);
 - ``dry``: a Snakemake command, run as a dry run (``-n``) on a copy of the workflow;
 - ``ci``: run by ``.ci/run`` (the test checks that the CI script contains it);
+- ``test``: run, in the order the documentation gives, by the test named in :data:`TESTED_BY`
+  (the check here is that the test's source names the command's arguments);
 - ``study``: a documented study that takes tens of minutes (the committed results under docs/ came
   from it); CI runs the same module on a smaller design (the test checks that ``.ci/run`` runs
   ``python -m`` of that module).
@@ -64,6 +66,7 @@ HOW = {
     "snakemake --cores 2 --config data=path/to/impacts.csv": "dry",
     "snakemake --cores 2": "ci",
     "snakemake --cores 2 --rerun-incomplete": "dry",
+    "snakemake --unlock": "test",
     "snakemake --report report.html": "ci",
     "python -m microimpact.studies.benchmark": "ci",
     "python -m microimpact.studies.stress": "ci",
@@ -78,6 +81,11 @@ HOW = {
     "snakemake -n --profile workflow/profiles/slurm --config sweep_chunks=4": "dry",
     "snakemake --profile workflow/profiles/slurm": "dry",
     "snakemake --profile workflow/profiles/slurm --config sweep_chunks=32 data=path/to/impacts.csv": "dry",
+}
+
+#: "test" commands -> the test that runs them (file, function)
+TESTED_BY = {
+    "snakemake --unlock": ("tests/test_workflow.py", "test_an_interrupted_run_resumes_as_the_readme_says"),
 }
 
 #: placeholders of the documentation -> files that exist in the scratch directory
@@ -114,6 +122,18 @@ def test_every_documented_command_is_exercised():
     assert not unlisted, "add these commands to HOW (how they are tested):\n" + "\n".join(unlisted)
     stale = sorted(set(HOW) - {c for _, c in documented_commands()})
     assert not stale, f"HOW lists commands that no document has any more: {stale}"
+
+
+@pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "test"])
+def test_commands_left_to_a_named_test_are_in_that_test(command):
+    import ast
+
+    path, name = TESTED_BY[command]
+    tree = ast.parse((REPO / path).read_text())
+    (func,) = [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) and n.name == name]
+    strings = {n.value for n in ast.walk(func) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
+    for word in shlex.split(command)[1:]:
+        assert word in strings, f"{path}::{name} does not run {command!r} ({word!r} missing)"
 
 
 @pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "study"])

@@ -144,3 +144,36 @@ def test_killed_writer_leaves_no_partial_target(tmp_path, how, existing):
         assert not target.exists()  # a later run does not take the output as done
     # a hidden temporary may remain after SIGKILL; it is never the target's name
     assert all(p.name.startswith(".result.json.") for p in tmp_path.iterdir() if p != target)
+
+
+# --------------------------------------------------------------------------- Snakemake's stale lock
+@pytest.mark.skipif(not Path("/proc/self/cwd").exists(), reason="needs /proc to see other processes")
+def test_a_lock_is_removed_only_when_no_snakemake_process_works_there(tmp_path):
+    """A process that names Snakemake and works in the directory holds its lock: nothing is removed
+    while it runs; once it is gone the lock is stale and is removed. A process that does not name
+    Snakemake (the analyst's shell in that directory) holds nothing."""
+    from microimpact.io.locks import remove_stale_lock, snakemake_processes_in
+
+    locks = tmp_path / ".snakemake" / "locks"
+    locks.mkdir(parents=True)
+    for name in ("0.input.lock", "0.output.lock"):
+        (locks / name).write_text("results/fit.nc\n")
+    sleeper = [sys.executable, "-c", "import time; time.sleep(60)"]
+    shell = subprocess.Popen(sleeper, cwd=tmp_path)
+    holder = subprocess.Popen([*sleeper, "snakemake"], cwd=tmp_path)  # its command line names Snakemake
+    elsewhere = subprocess.Popen([*sleeper, "snakemake", "--directory", str(tmp_path)], cwd="/")
+    try:
+        assert snakemake_processes_in(tmp_path) == sorted([holder.pid, elsewhere.pid])
+        assert remove_stale_lock(tmp_path) == ("held", sorted([holder.pid, elsewhere.pid]))
+        assert len(list(locks.glob("*.lock"))) == 2
+        for p in (holder, elsewhere):
+            p.kill()
+            p.wait()
+        outcome, removed = remove_stale_lock(tmp_path)
+        assert outcome == "unlocked" and len(removed) == 2
+        assert not list(locks.glob("*.lock"))
+        assert remove_stale_lock(tmp_path) == ("free", [])
+    finally:
+        for p in (shell, holder, elsewhere):
+            p.kill()
+            p.wait()

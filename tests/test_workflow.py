@@ -489,8 +489,12 @@ def test_bad_data_file_stops_at_validation_with_every_problem(tmp_path):
 
 # --------------------------------------------------------------------------- interrupt and resume
 @pytest.mark.slow
-def test_an_interrupted_run_resumes_as_the_readme_says(tmp_path):
-    """SIGINT in the middle of a run, then the README's resume command finishes it.
+@pytest.mark.parametrize("signame", ["SIGINT", "SIGTERM", "SIGKILL"])
+def test_an_interrupted_run_resumes_as_the_readme_says(tmp_path, signame):
+    """A signal in the middle of a run, then the README's commands finish it: the resume command
+    after Ctrl-C (SIGINT) or SIGTERM; after SIGKILL, which leaves Snakemake's lock, ``snakemake
+    --unlock`` first. A stopped job's log says in one line that it was interrupted (no traceback),
+    and a killed writer's temporary file is gone once the resumed run has written that output.
 
     The signal goes to the run's whole process group, as Ctrl-C in a terminal sends it, and the
     run starts with SIGINT at its default: a suite started in the background (``nohup ... &``,
@@ -510,14 +514,26 @@ def test_an_interrupted_run_resumes_as_the_readme_says(tmp_path):
     while not (root / ANALYST / "fit.nc").exists() and time.monotonic() < deadline:
         time.sleep(0.2)
     assert proc.poll() is None, "the run ended before it could be interrupted"
-    os.killpg(proc.pid, signal.SIGINT)
+    os.killpg(proc.pid, getattr(signal, signame))
     out, _ = proc.communicate(timeout=120)
     assert proc.returncode != 0, out[-3000:]
     assert not (root / "reports" / "report.pdf").exists()
-    assert not list(root.rglob(".*.tmp"))  # atomic writers leave no partial file behind
+    if signame == "SIGKILL":
+        locked = snakemake(root, "--cores", "2", "--rerun-incomplete")
+        assert locked.returncode != 0 and "cannot be locked" in locked.stdout, locked.stdout[-3000:]
+        unlocked = snakemake(root, "--unlock")
+        assert unlocked.returncode == 0, unlocked.stdout[-3000:]
+    else:
+        assert not list(root.rglob(".*.tmp"))  # atomic writers leave no partial file behind
+        for log in root.glob("logs/**/*.log"):
+            text = log.read_text()
+            assert "Traceback" not in text, (log, text[-3000:])
+        stopped = [log for log in root.glob("logs/**/*.log") if f"interrupted ({signame})" in log.read_text()]
+        assert stopped or "Error in rule" not in out, out[-3000:]  # (the signal may fall between two jobs)
     resumed = snakemake(root, "--cores", "2", "--rerun-incomplete")
     assert resumed.returncode == 0, resumed.stdout[-5000:]
     assert (root / "reports" / "report.pdf").stat().st_size > 0
+    assert not list(root.rglob(".*.tmp"))
     again = snakemake(root, "-n", "--cores", "2")
     assert "Nothing to be done" in again.stdout, again.stdout[-3000:]
 

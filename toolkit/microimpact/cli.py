@@ -658,6 +658,24 @@ def _snakemake_command(args) -> list[str]:
             "--directory", str(args.directory), *extra]
 
 
+def _clear_stale_lock(directory: Path) -> None:
+    """Remove the lock a killed run left in ``directory`` when no Snakemake process works there, and
+    say so; refuse to start while one does (or when this platform cannot tell), saying what to run."""
+    from microimpact.io.locks import remove_stale_lock
+
+    outcome, detail = remove_stale_lock(directory)
+    if outcome == "unlocked":
+        print(f"microimpact: removed the lock that a stopped run left in {directory} (no Snakemake process "
+              "works there)", file=sys.stderr, flush=True)
+    elif outcome == "held":
+        ids = ", ".join(map(str, detail))
+        raise UsageError(f"--directory {directory}: a Snakemake run is going on there (process {ids}); wait for it "
+                         f"to end or stop it (kill {ids}), then run this again")
+    elif outcome == "unknown":
+        raise UsageError(f"--directory {directory} is locked by Snakemake; if no run is going on there, run "
+                         f"microimpact workflow --directory {directory} --unlock, then this again")
+
+
 def _cmd_workflow(args) -> int:
     import subprocess
 
@@ -667,6 +685,8 @@ def _cmd_workflow(args) -> int:
         raise PathError("--directory", args.directory, "is not a directory")
     with reporting_os_errors({"--directory": directory}):
         directory.mkdir(parents=True, exist_ok=True)
+    if "--unlock" not in command:
+        _clear_stale_lock(directory)
     print(f"microimpact: running the pipeline ({command[4]}) in {directory}", file=sys.stderr, flush=True)
     import signal
 

@@ -75,12 +75,14 @@ def deferred_signals(signums=(signal.SIGINT, signal.SIGTERM)) -> Iterator[None]:
 @contextlib.contextmanager
 def interrupt_at_checkpoints() -> Iterator:
     """Within the block Ctrl-C (SIGINT) only sets a flag; the yielded ``checkpoint()`` raises
-    KeyboardInterrupt once it is set, and so does the end of the block.
+    KeyboardInterrupt once it is set, and so does the end of the block. SIGTERM is held the same
+    way where a Python handler turns it into an exception (a pipeline job), and that handler is
+    called at the checkpoint.
 
     For loops whose inner calls must not be cut mid-way: emcee prints the whole traceback of a
     KeyboardInterrupt raised inside the likelihood before passing it on (87 lines on a Ctrl-C of
     ``fit --posterior``). Where SIGINT is ignored (a background job) or outside the main thread
-    nothing changes.
+    nothing changes for it.
 
     Examples
     --------
@@ -94,21 +96,31 @@ def interrupt_at_checkpoints() -> Iterator:
     ...     print("interrupted after the", done)
     interrupted after the step
     """
-    previous = signal.getsignal(signal.SIGINT)
-    if threading.current_thread() is not threading.main_thread() or previous is signal.SIG_IGN:
+    if threading.current_thread() is not threading.main_thread():
         yield lambda: None
         return
+    # SIGINT unless ignored (a background job); SIGTERM only where a handler turns it into an
+    # exception (a pipeline job, microimpact.io.joblog): at its default it ends the process at once
+    previous = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    held = [s for s, h in previous.items() if (callable(h) if s == signal.SIGTERM else h is not signal.SIG_IGN)]
     flag: list[int] = []
 
     def checkpoint() -> None:
-        if flag:
-            raise KeyboardInterrupt
+        if not flag:
+            return
+        signum = flag[0]
+        handler = previous[signum]
+        if callable(handler) and handler is not signal.default_int_handler:
+            handler(signum, None)
+        raise KeyboardInterrupt
 
-    signal.signal(signal.SIGINT, lambda signum, frame: flag.append(signum))
+    for s in held:
+        signal.signal(s, lambda signum, frame: flag.append(signum))
     try:
         yield checkpoint
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for s in held:
+            signal.signal(s, previous[s])
     checkpoint()
 
 

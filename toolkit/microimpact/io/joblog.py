@@ -3,15 +3,39 @@
 Every script in ``workflow/scripts/`` starts with :func:`log_job`. Snakemake shows a failed job as
 "Error in rule ... check log file(s)"; the reason itself would be only in the log. Here the full
 traceback still goes to the log, and one line with the rule, the exception and its message goes
-to the terminal, where the analyst is looking.
+to the terminal, where the analyst is looking. A job stopped by Ctrl-C (SIGINT) or SIGTERM is not a
+failure of the job: its log and the terminal get one line saying so and how to resume, no
+traceback, and the job ends by its signal as an unhandled one would end it (status 130 or 143).
 """
 
 from __future__ import annotations
 
+import os
+import signal
 import sys
 import traceback
 
-__all__ = ["log_job", "one_line_reason"]
+__all__ = ["log_job", "one_line_reason", "interrupted_line", "JobTerminated"]
+
+#: how to finish a run that was stopped (the README's resume command)
+RESUME = "snakemake --cores 2 --rerun-incomplete"
+
+
+class JobTerminated(Exception):
+    """SIGTERM arrived: raised in the main thread so that the job unwinds (atomic writers abandon
+    their temporary files) instead of dying where it stands."""
+
+
+def interrupted_line(rule: str, signame: str) -> str:
+    """``microimpact: rule RULE interrupted (SIGINT): ...``: one line for a job stopped by a signal.
+
+    Examples
+    --------
+    >>> interrupted_line("fit", "SIGINT")[:45]
+    'microimpact: rule fit interrupted (SIGINT); i'
+    """
+    return (f"microimpact: rule {rule} interrupted ({signame}); its outputs were not written (files "
+            f"written earlier are complete); resume the run with {RESUME}")
 
 
 def one_line_reason(rule: str, exc: BaseException, log_path: str) -> str:
@@ -41,6 +65,15 @@ def log_job(snakemake, *, keep_stderr: bool = False) -> None:
         sys.stderr = log
 
     def report(exc_type, exc, tb):
+        if issubclass(exc_type, (KeyboardInterrupt, JobTerminated)):
+            sig = signal.SIGINT if issubclass(exc_type, KeyboardInterrupt) else signal.SIGTERM
+            line = interrupted_line(snakemake.rule, sig.name)
+            print(line, file=log, flush=True)
+            print(line, file=terminal, flush=True)
+            if sig is signal.SIGTERM:  # end as SIGTERM ends a process (Python does so for SIGINT itself)
+                signal.signal(signal.SIGTERM, signal.SIG_DFL)
+                os.kill(os.getpid(), signal.SIGTERM)
+            return
         traceback.print_exception(exc_type, exc, tb, file=log)
         log.flush()
         print(one_line_reason(snakemake.rule, exc, log_path), file=terminal, flush=True)
@@ -48,3 +81,9 @@ def log_job(snakemake, *, keep_stderr: bool = False) -> None:
             print("\n".join(str(exc).strip().splitlines()[1:]), file=terminal, flush=True)
 
     sys.excepthook = report
+
+    def terminate(signum, frame):
+        raise JobTerminated("SIGTERM")
+
+    if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, terminate)
