@@ -125,3 +125,20 @@ def test_time_budget_status_and_generous_budget(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "time budget of 1e-09 s exceeded" in err and "--time-budget" in err, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.nc"]
+
+
+def test_benchmark_stops_at_its_time_budget_and_writes_nothing(tmp_path, capsys):
+    """benchmark --time-budget (issue 27: the one long command without a budget): a quick benchmark
+    takes 30-60 s here; with a 3 s budget it ends in one line with status 3 and --out stays empty.
+    The bound of 3 + 10 s allows the longest uninterruptible step (a compiled call, numba's
+    first compile of a kernel on a fresh cache) on a loaded machine."""
+    import time
+
+    out = tmp_path / "bench"
+    t0 = time.perf_counter()
+    assert cli.main(["benchmark", "--quick", "--no-throughput", "--out", str(out), "--time-budget", "3"]) == 3
+    elapsed = time.perf_counter() - t0
+    err = capsys.readouterr().err
+    assert "microimpact: error: benchmark: time budget of 3 s exceeded" in err and "--time-budget" in err, err
+    assert elapsed < 13.0, elapsed
+    assert not out.exists() or not any(out.iterdir())

@@ -280,3 +280,29 @@ def test_target_budget():
     a = damping_from_target(0.5, 2.0, WALL_1990, n_points=5)
     b = damping_from_target(0.5, 2.0, WALL_1990, n_points=5, time_budget=GENEROUS)
     np.testing.assert_array_equal(a.curves["zeta_hertz"].values, b.curves["zeta_hertz"].values)
+
+
+def test_time_limits_nest_and_the_outer_one_still_ends_the_block():
+    """A per-case limit inside a whole-run budget (the benchmark's scipy cases inside
+    ``benchmark --time-budget``): each inner block gets at most what is left of the outer one, and
+    the outer budget ends the block although every inner block resets the timer and the loop
+    catches every TimeLimitExceeded. Before nesting, the inner limit's reset cancelled the outer
+    timer and this loop ran its 40 cases (8 s)."""
+    import time
+
+    from microimpact.studies._timeout import TimeLimitExceeded, time_limit
+
+    inner_timeouts = 0
+    t0 = time.perf_counter()
+    with pytest.raises(TimeLimitExceeded, match="^run: time budget of 0.5 s exceeded$"):
+        with time_limit(0.5, "run"):
+            for _ in range(40):
+                try:
+                    with time_limit(0.2, "case"):
+                        time.sleep(0.5)
+                except TimeLimitExceeded:  # a case's limit (or the run's, inside the last case)
+                    inner_timeouts += 1
+    elapsed = time.perf_counter() - t0
+    # 0.5 s and the handler's latency; a loaded machine may add a little (0.2 s per case otherwise)
+    assert 0.45 < elapsed < 1.5, elapsed
+    assert inner_timeouts >= 2  # the cases after the budget are refused at once (caught here too)

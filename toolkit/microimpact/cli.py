@@ -2,8 +2,8 @@
 
 Thin: parse, call the library, print or write. Exit statuses: 0 success; 2 bad arguments, inputs
 or a solver failure (one line ``microimpact: error: ...`` on stderr); 3 the computation ran past
-``--time-budget SECONDS`` (``fit``, ``flags``, ``sweep``, ``reproduce``; one such line naming the
-budget); 141, quietly, when the reader of stdout went away (``| head``). Nothing is written on an
+``--time-budget SECONDS`` (``fit``, ``flags``, ``sweep``, ``target``, ``reproduce``, ``benchmark``; one
+such line naming the budget); 141, quietly, when the reader of stdout went away (``| head``). Nothing is written on an
 error: outputs are written, atomically, only after the work.
 
 Each command imports the part of the library it runs inside its own function: ``microimpact
@@ -225,7 +225,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="microimpact", description="Microsphere contact/impact with smooth, flat surfaces.",
                      epilog=f"Exit status: 0 success; 2 bad arguments or inputs, or a solver failure; "
                             f"{EXIT_TIME_BUDGET} the computation ran past --time-budget (fit, flags, sweep, "
-                            "reproduce); 141 (quietly) when stdout is closed early (| head). "
+                            "target, reproduce, benchmark); 141 (quietly) when stdout is closed early (| head). "
                             "Nothing is written on an error.")
     parser.add_argument("--version", action="version", version=f"microimpact {__version__}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
@@ -548,7 +548,7 @@ def _cmd_benchmark(args) -> int:
 
     # on a terminal a bar of the stages; elsewhere (a pipe, a log) one line per stage
     ds = run_benchmark(quick=args.quick, verbose=not wants_progress(True), throughput=not args.no_throughput,
-                       progress=True)
+                       progress=True, time_budget=args.time_budget)
     with reporting_os_errors({"--out": out, "--docs": docs}):
         paths = write_benchmark(ds, out, figure=plot_work_precision(ds).figure, docs_dir=docs)
     for path in paths.values():
@@ -563,6 +563,7 @@ def register_benchmark(sub) -> None:
     p.add_argument("--quick", action="store_true", help="small, fast run for CI and the workflow")
     p.add_argument("--docs", default=None, help="also write benchmark.md and work_precision.png here")
     p.add_argument("--no-throughput", action="store_true", help="skip the 100k throughput and memory runs")
+    _add_time_budget(p)
     p.set_defaults(func=_cmd_benchmark)
 
 

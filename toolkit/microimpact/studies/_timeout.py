@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import signal
 import threading
+import time
 
 from microimpact.solvers import TimeBudgetExceeded
 
@@ -17,25 +18,77 @@ class TimeLimitExceeded(TimeBudgetExceeded):
 
 
 @contextlib.contextmanager
-def time_limit(seconds: float | None):
+def time_limit(seconds: float | None, what: str | None = None):
     """Raise :class:`TimeLimitExceeded` in the block after ``seconds`` [s].
 
     Uses SIGALRM, so the limit applies only in the main thread on POSIX; elsewhere, and with
     ``seconds`` None, the block runs without a limit. The previous SIGALRM handler is restored.
+    Limits nest: a block inside another runs for at most what is left of the outer one, and a
+    limit that has passed raises again every 0.1 s until its block has ended, so a per-case limit
+    inside a whole-run budget (``microimpact benchmark --time-budget``), whose caller catches the
+    case's TimeLimitExceeded and goes on, does not cancel the budget; a block that ends past its
+    limit raises too.
+
+    Parameters
+    ----------
+    seconds : float or None
+        The limit [s]; None: none.
+    what : str, optional
+        The computation, for the message ("``what``: time budget of ``seconds`` s exceeded").
+
+    Examples
+    --------
+    >>> import time
+    >>> try:
+    ...     with time_limit(0.05, "nap"):
+    ...         time.sleep(1.0)
+    ... except TimeLimitExceeded as exc:
+    ...     print(exc)
+    nap: time budget of 0.05 s exceeded
     """
     usable = (seconds is not None and hasattr(signal, "setitimer")
               and threading.current_thread() is threading.main_thread())
     if not usable:
         yield
         return
-
-    def handler(signum, frame):
-        raise TimeLimitExceeded()
-
-    old = signal.signal(signal.SIGALRM, handler)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
+    message = f"{what}: time budget of {seconds:g} s exceeded" if what else ""
+    if _active and time.perf_counter() >= min(end for end, _ in _active):
+        raise TimeLimitExceeded(_expired_message())  # an enclosing limit has passed (its signal was caught)
+    previous = signal.signal(signal.SIGALRM, _on_alarm) if not _active else None
+    end = time.perf_counter() + seconds
+    _active.append((end, message))
+    _arm()
     try:
         yield
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0.0)
-        signal.signal(signal.SIGALRM, old)
+        _active.pop()
+        if _active:
+            _arm()
+        else:
+            signal.signal(signal.SIGALRM, previous)
+    if time.perf_counter() >= end:  # ran past the limit, and the block's callees caught the signal
+        raise TimeLimitExceeded(message)
+
+
+#: (end as time.perf_counter(), message) of the time_limit blocks in force, outermost first
+_active: list[tuple[float, str]] = []
+#: after a limit has passed its timer fires again this often [s] until its block has ended: a
+#: TimeLimitExceeded caught by an inner block's caller (a per-case limit) does not end the outer one
+_REPEAT = 0.1
+
+
+def _expired_message() -> str:
+    """The message of the outermost limit that has passed (else of the innermost)."""
+    now = time.perf_counter()
+    return next((msg for end, msg in _active if now >= end), _active[-1][1] if _active else "")
+
+
+def _on_alarm(signum, frame):
+    raise TimeLimitExceeded(_expired_message())
+
+
+def _arm() -> None:
+    """Set the timer to the earliest end of the limits in force (at once if it has passed)."""
+    left = min(end for end, _ in _active) - time.perf_counter()
+    signal.setitimer(signal.ITIMER_REAL, max(left, 1e-6), _REPEAT)

@@ -20,7 +20,7 @@ from microimpact.io.progress import progress_bar
 from microimpact.io.provenance import contact_attributes, preset_parameter_source
 from microimpact.io.variables import attributes
 from microimpact.presets import WALL_1990
-from microimpact.solvers import engine
+from microimpact.solvers import check_time_budget, engine
 from microimpact.solvers.impact import simulate_impact, simulate_many
 from microimpact.solvers.rkg import rkg_setup, rkg_restitution
 from microimpact.studies.benchmark.cases import (
@@ -31,6 +31,7 @@ from microimpact.studies.benchmark.harness import (
 )
 from microimpact.studies.benchmark.reference import Reference, reference_set
 from microimpact.studies.benchmark.targets import accuracy_targets, throughput_targets
+from microimpact.studies._timeout import time_limit
 
 __all__ = ["run_benchmark"]
 
@@ -273,7 +274,8 @@ _STAGES = 8
 
 
 def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkConfig | None = None,
-                  verbose: bool = False, throughput: bool = True, progress=None) -> xr.Dataset:
+                  verbose: bool = False, throughput: bool = True, progress=None,
+                  time_budget: float | None = None) -> xr.Dataset:
     """Run the work-precision benchmark and return its results.
 
     Parameters
@@ -291,6 +293,10 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
     progress : bool, optional
         A progress bar of the stages on stderr (:func:`microimpact.io.progress.progress_bar`),
         drawn only when stderr is a terminal. Default: none.
+    time_budget : float, optional
+        Stop with :class:`microimpact.solvers.TimeBudgetExceeded` once the run has taken this long
+        [s] (checked by a timer, so within a compiled call's duration, well under a second here;
+        main thread only). Default: no limit.
 
     Returns
     -------
@@ -301,10 +307,11 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
         machine, versions, the reference error bound, targets and ratios.
     """
     cfg = config or (BenchmarkConfig.quick_() if quick else BenchmarkConfig.full())
+    time_budget = check_time_budget(time_budget)
     attrs = machine_attrs()
     t_start = time.perf_counter()
     notes: list[str] = []
-    with progress_bar(_STAGES + int(throughput), "benchmark", progress) as advance:
+    with time_limit(time_budget, "benchmark"), progress_bar(_STAGES + int(throughput), "benchmark", progress) as advance:
         _warm_up(contact)
         speeds, v_cap = normal_speed_set(contact, cfg.n_speeds, cfg.max_speed, cfg.capture_margin)
         cases = cfg.oblique
