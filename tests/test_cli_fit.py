@@ -104,7 +104,7 @@ def test_bad_input_fit(small_csv, tmp_path, capsys):
 
 def test_bad_input_flags(small_csv, fitted, tmp_path, capsys):
     out = str(tmp_path / "flags.csv")
-    _fails(["flags", str(small_csv), "--fit", str(small_csv), "--out", out], tmp_path, capsys, "cannot be read as NetCDF")
+    _fails(["flags", str(small_csv), "--fit", str(small_csv), "--out", out], tmp_path, capsys, "not a damping fit")
     _fails(["flags", str(small_csv), "--fit", str(tmp_path / "none.nc"), "--out", out], tmp_path, capsys, "does not exist")
     _fails(["flags", str(small_csv), "--fit", str(fitted), "--out", out, "--spin-bound", "nan"], tmp_path, capsys, "finite")
     _fails(["flags", str(small_csv), "--fit", str(fitted), "--out", out, "--nc", str(tmp_path / "x" / "f.nc")],

@@ -347,7 +347,7 @@ END_TO_END = [
     (["flags", "data.csv", "--fit", "fit.nc", "--out", "x.csv", "--nc", "notfit.nc", "--posterior", "notfit.nc"],
      "--nc 'notfit.nc': is the input --posterior"),
     # a file of the wrong kind is refused, not read as 'no posterior'
-    (["flags", "data.csv", "--fit", "fit.nc", "--out", "x.csv", "--posterior", "fit.nc"], "not a posterior file"),
+    (["flags", "data.csv", "--fit", "fit.nc", "--out", "x.csv", "--posterior", "fit.nc"], "not a posterior (the file that 'microimpact fit --posterior' writes): it is a NetCDF file titled 'damping fit"),
     # an output the file system refuses (root passes os.access everywhere) is refused before the fit runs
     (["fit", "data.csv", "--out", "f.nc", "--posterior", "/sys/p.nc"], "--posterior '/sys/p.nc'"),
     (["benchmark", "--quick", "--out", "/sys/bench"], "--out '/sys/bench': cannot create"),

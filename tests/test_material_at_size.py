@@ -91,7 +91,7 @@ def test_conflicting_or_wrong_material_sources_are_refused(capsys, fit_file, tmp
     capsys.readouterr()
     assert main(["simulate", "--fit", str(sweep), "--radius", "2e-6", "--speed", "3"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "--fit" in err[0] and "not a damping-fit file" in err[0]
+    assert len(err) == 1 and "--fit" in err[0] and "not a damping fit" in err[0]
 
 
 def test_sweep_and_target_keep_the_material_and_record_it(capsys, tmp_path):

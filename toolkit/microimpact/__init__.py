@@ -5,15 +5,6 @@ doi:10.1080/02786820290092221, with a fast compiled engine, a scipy reference so
 damping coefficients, sensitivity sweeps and a Snakemake report.
 """
 
-from importlib.metadata import PackageNotFoundError, version
-
-from microimpact.model.kinematics import ImpactResult
-from microimpact.model.contact import Contact
-
-try:
-    __version__ = version("microimpact")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree without install
-    __version__ = "0+unknown"
 
 __all__ = ["Contact", "ImpactResult", "presets", "simulate_impact", "simulate_many", "__version__"]
 
@@ -48,15 +39,33 @@ def _announce_numba_compiles() -> None:
     event.register("numba:compile", _FirstCompileNotice())
 
 
+#: public names imported on first use -> their module
+_LAZY = {"Contact": "microimpact.model.contact", "ImpactResult": "microimpact.model.kinematics",
+         "simulate_impact": "microimpact.solvers.impact", "simulate_many": "microimpact.solvers.impact"}
+#: the subpackages and modules, importable as attributes (``microimpact.io``)
+_SUBMODULES = ("analysis", "cli", "dynamics", "io", "model", "presets", "report", "solvers", "studies")
+
+
 def __getattr__(name):
-    """The solvers and the presets are imported on first use (PEP 562): ``import microimpact`` loads
-    numpy only (no numba, xarray or pandas), and ``import microimpact.report`` compiles nothing."""
-    if name in ("simulate_impact", "simulate_many"):
-        from microimpact.solvers import impact
+    """Everything is imported on first use (PEP 562): ``import microimpact`` loads no numpy, so a
+    Ctrl-C right after ``microimpact`` starts reaches the command line's handler (one line, status
+    130) and not an import of numpy; ``import microimpact.report`` compiles nothing."""
+    import importlib
 
-        return getattr(impact, name)
-    if name == "presets":
-        import importlib
+    if name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version
 
-        return importlib.import_module("microimpact.presets")
+        try:
+            return version("microimpact")
+        except PackageNotFoundError:  # pragma: no cover - a source tree without install
+            return "0+unknown"
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    if name in _SUBMODULES:
+        return importlib.import_module(f"microimpact.{name}")
     raise AttributeError(f"module 'microimpact' has no attribute {name!r}")
+
+
+def __dir__():
+    """The public names, also those imported on first use (for ``dir()`` and tab completion)."""
+    return sorted({*globals(), "__version__", *_LAZY, *_SUBMODULES})

@@ -14,22 +14,41 @@ of each: :mod:`microimpact.model.parameters`, :data:`microimpact.solvers.DEFAULT
 
 from __future__ import annotations
 
-import argparse
-import json
-import math
-import os
-import re
+import signal
 import sys
-from dataclasses import fields
-from pathlib import Path
 
-from microimpact import __version__
-from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,
+#: the one line of a Ctrl-C, and its exit status: 128 + 2, as a shell reports a command SIGINT ended
+INTERRUPTED_LINE = ("microimpact: interrupted; nothing was written (outputs are written whole or not at all); run the "
+                    "same command again to redo it")
+EXIT_INTERRUPTED = 130
+
+
+def _interrupted_while_starting(signum, frame):
+    print(INTERRUPTED_LINE, file=sys.stderr)
+    raise SystemExit(EXIT_INTERRUPTED)
+
+
+# A Ctrl-C while the imports below load numpy (0.1-0.5 s, longer on a loaded machine) ends in the
+# same one line as one in main(), not in a traceback from inside numpy; main() puts Python's own
+# handler back. Where SIGINT is ignored (a background job) it stays ignored.
+if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+    signal.signal(signal.SIGINT, _interrupted_while_starting)
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import math  # noqa: E402
+import os  # noqa: E402
+import re  # noqa: E402
+from dataclasses import fields  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from microimpact import __version__  # noqa: E402
+from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,  # noqa: E402
                                   reporting_os_errors, same_file)
-from microimpact.model.contact import SUB_MODELS, Contact
-from microimpact.model.parameters import TABLE2_CASES
-from microimpact.presets import PRESETS, get_preset
-from microimpact.solvers import DEFAULT_RTOL, METHODS, TimeBudgetExceeded
+from microimpact.model.contact import SUB_MODELS, Contact  # noqa: E402
+from microimpact.model.parameters import TABLE2_CASES  # noqa: E402
+from microimpact.presets import PRESETS, get_preset  # noqa: E402
+from microimpact.solvers import DEFAULT_RTOL, METHODS, TimeBudgetExceeded  # noqa: E402
 
 __all__ = ["main", "build_parser"]
 
@@ -43,9 +62,6 @@ EXIT_TIME_BUDGET = 3
 #: exit status when the reader of stdout closed it early (``| head``): 128 + SIGPIPE, as a POSIX
 #: tool killed by the signal reports it; nothing is printed
 EXIT_BROKEN_PIPE = 141
-#: exit status after Ctrl-C (SIGINT): 128 + 2, as a shell reports a command the signal ended
-EXIT_INTERRUPTED = 130
-
 
 #: a negative number as an option's value: ``--radius -1e-6``, ``--omega-n -.5``, ``--speed -inf``.
 #: argparse's own pattern (``^-\d+$|^-\d*\.\d+$``) misses exponents and inf/nan, so that
@@ -413,7 +429,7 @@ def _load_posterior(path):
     try:
         return load_posterior(path)
     except (KeyError, ValueError, OSError) as exc:
-        raise UsageError(f"--posterior {path!r}: not a posterior written by 'microimpact fit --posterior' ({exc})") from None
+        raise UsageError(f"--posterior {exc}") from None
 
 
 def register_flags(sub) -> None:
@@ -743,6 +759,8 @@ def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | N
 
 
 def main(argv=None) -> int:
+    if signal.getsignal(signal.SIGINT) is _interrupted_while_starting:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
@@ -760,8 +778,7 @@ def main(argv=None) -> int:
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
     except KeyboardInterrupt:  # Ctrl-C: one line, the shell's status for SIGINT, no traceback
-        print(f"microimpact: interrupted; nothing was written (outputs are written whole or not at all); "
-              f"run the same command again to redo it", file=sys.stderr)
+        print(INTERRUPTED_LINE, file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:  # the reader went away (| head): stop quietly, as POSIX tools do
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit

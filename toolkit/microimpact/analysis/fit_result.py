@@ -263,13 +263,19 @@ class DampingFit:
                 ds = ds.load()
         except FileNotFoundError:
             raise
-        except Exception as exc:  # noqa: BLE001 - netCDF4 raises OSError/ValueError variously
-            raise ValueError(f"{path}: cannot be read as NetCDF ({exc})") from None
+        except Exception:  # noqa: BLE001 - netCDF4 raises OSError/ValueError variously
+            raise ValueError(cls._not_a_fit(path)) from None
         try:
             return cls.from_dataset(ds)
-        except KeyError as exc:
-            raise ValueError(f"{path}: not a damping-fit file written by DampingFit.save "
-                             f"(missing {exc.args[0]!r})") from None
+        except KeyError:
+            raise ValueError(cls._not_a_fit(path)) from None
+
+    @staticmethod
+    def _not_a_fit(path) -> str:
+        from microimpact.io.kinds import file_kind
+
+        return (f"{path}: not a damping fit (the file that 'microimpact fit --out' writes): it is "
+                f"{file_kind(path)}")
 
 
 # --------------------------------------------------------------------------- the one formatter

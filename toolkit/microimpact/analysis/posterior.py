@@ -829,12 +829,23 @@ def load_posterior(path) -> Posterior | None:
         If the file is not a posterior file at all (a fit, a sweep, ...): it is not taken for "no
         posterior" in silence.
     """
-    with xr.open_dataset(path, engine="netcdf4") as ds:
+    from microimpact.io.kinds import file_kind
+
+    def not_a_posterior() -> ValueError:
+        return ValueError(f"{path}: not a posterior (the file that 'microimpact fit --posterior' writes): it is "
+                          f"{file_kind(path)}")
+
+    try:
+        ds = xr.open_dataset(path, engine="netcdf4")
+    except FileNotFoundError:
+        raise
+    except Exception:  # noqa: BLE001 - netCDF4 raises OSError/ValueError variously
+        raise not_a_posterior() from None
+    with ds:
         if "sampled" not in ds.attrs:
-            title = str(ds.attrs.get("title", ""))
-            if title.startswith(POSTERIOR_TITLE):
+            if str(ds.attrs.get("title", "")).startswith(POSTERIOR_TITLE):
                 return None
-            raise ValueError(f"not a posterior file: it holds {title or 'no title'!r}")
+            raise not_a_posterior()
         return posterior_from_dataset(ds.load())
 
 

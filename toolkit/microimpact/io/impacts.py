@@ -556,6 +556,17 @@ def _check_contacts(cells: _Cells, columns, out: dict, materials, pairs, problem
 
 
 # --------------------------------------------------------------------------- main entry
+def _refuse_binary(source: str) -> None:
+    """ImpactDataError with one problem saying what the file is, for a NetCDF file, a workbook, a
+    PDF, ... (not thousands of "invalid UTF-8" problems, one per line of binary bytes)."""
+    from microimpact.io.kinds import file_kind, is_binary
+
+    if is_binary(source):
+        raise ImpactDataError(source, [Problem(
+            f"the file is {file_kind(source)}, not a CSV of measured impacts (text, UTF-8); export or save "
+            "the measurements as CSV", line=1)])
+
+
 def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     """Read and validate a CSV of measured impacts; return it in canonical columns and units.
 
@@ -605,6 +616,7 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
         raise ValueError(f"material_pair {material_pair!r} is not a pair of the materials config; {known}")
     data = Path(source).read_bytes()
     sha256 = hashlib.sha256(data).hexdigest()
+    _refuse_binary(source)
     header, header_line, records, problems = _read_records(source, data)
     columns, factors, header_problems, ignored = _check_header(header)
     if header_line != 1:

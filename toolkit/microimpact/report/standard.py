@@ -79,12 +79,18 @@ class UnknownResultError(ValueError):
     """A file that is not a microimpact result file, or one without a standard figure."""
 
 
+def _unreadable(path) -> str:
+    from microimpact.io.kinds import file_kind
+
+    return f"{path}: not a readable NetCDF result file: it is {file_kind(path)}"
+
+
 def _open(path) -> xr.Dataset:
     path = Path(path)
     try:
         return read_dataset(path)
-    except (OSError, ValueError) as exc:  # not NetCDF, or not readable as one
-        raise UnknownResultError(f"{path}: not a readable NetCDF result file ({exc})") from None
+    except (OSError, ValueError):  # not NetCDF, or not readable as one
+        raise UnknownResultError(_unreadable(path)) from None
 
 
 def result_kind(path) -> str:
@@ -107,8 +113,8 @@ def result_kind(path) -> str:
         with netCDF4.Dataset(os.fspath(path)) as nc:
             if "portraits" in nc.groups:
                 return "phase_portraits"
-    except OSError as exc:
-        raise UnknownResultError(f"{path}: not a readable NetCDF result file ({exc.strerror or exc})") from None
+    except OSError:
+        raise UnknownResultError(_unreadable(path)) from None
     ds = _open(path)
     if "e_n_measured" in ds and "zeta_hertz" in ds:
         return "fit"
