@@ -282,7 +282,7 @@ def _inputs(args) -> dict:
     bundled materials config counts as an input when no --config is given."""
     from microimpact.io.materials import default_materials_path
 
-    given = {"data file": args.data, "--config": args.config, "--fit": getattr(args, "fit", None)}
+    given = {"data file": getattr(args, "data", None), "--config": args.config, "--fit": getattr(args, "fit", None)}
     inputs = {name: check_input_file(name, path) for name, path in given.items() if path is not None}
     if args.config is None:
         inputs["the bundled materials config"] = default_materials_path()
@@ -316,6 +316,10 @@ def _cmd_fit(args) -> int:
                             _inputs(args))
     out = outputs["--out"]
     posterior = False
+    unused = [f"--{name.replace('_', '-')}" for name in ("walkers", "steps", "max_steps", "seed")
+              if getattr(args, name) is not None]
+    if outputs.get("--posterior") is None and unused:
+        raise UsageError(f"{', '.join(unused)} set the posterior's sampler, which runs only with --posterior FILE")
     if outputs.get("--posterior") is not None:
         if args.full_chain:
             raise UsageError("--full-chain was removed: the default chain now runs until it converges; "
@@ -358,7 +362,7 @@ def register_fit(sub) -> None:
 
 def _add_posterior_options(p: argparse.ArgumentParser) -> None:
     """The posterior and oblique options of ``microimpact fit`` (microimpact.analysis.analyst_fit)."""
-    from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_SEED, DEFAULT_WALKERS
+    from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_SEED, DEFAULT_WALKERS, MAX_SEED
 
     p.add_argument("--posterior", default=None, metavar="NC",
                    help="also sample the posterior (emcee, seeded) until it converges (50 autocorrelation times, "
@@ -369,7 +373,7 @@ def _add_posterior_options(p: argparse.ArgumentParser) -> None:
                    help=f"most steps before an unconverged chain is an error (default {DEFAULT_MAX_STEPS})")
     p.add_argument("--steps", type=_positive_int, default=None,
                    help="run exactly this many steps (default: until converged); still an error if not converged")
-    p.add_argument("--seed", type=_non_negative_int, default=None, help=f"seed of the sampler (default {DEFAULT_SEED})")
+    p.add_argument("--seed", type=_seed, default=None, help=f"seed of the sampler, 0 to {MAX_SEED} (default {DEFAULT_SEED})")
     p.add_argument("--full-chain", action="store_true", help=argparse.SUPPRESS)  # removed: refused with a message
     p.add_argument("--errors-in-variables", choices=("auto", "effective", "latent"), default="auto",
                    help="speed errors in the posterior: effective variance, latent true speeds, or auto (latent near "
@@ -390,6 +394,16 @@ def _whole_number(text: str, smallest: int) -> int:
 
 def _non_negative_int(text: str) -> int:
     return _whole_number(text, 0)
+
+
+def _seed(text: str) -> int:
+    from microimpact.analysis.sampling_defaults import MAX_SEED
+
+    value = _whole_number(text, 0)
+    if value > MAX_SEED:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_SEED} (the posterior file stores it as a 32-bit "
+                                         f"integer), got {text!r}")
+    return value
 
 
 def _positive_int(text: str) -> int:
@@ -458,9 +472,12 @@ def _cmd_target(args) -> int:
 
     if len(args.e_n) != len(args.speed):
         raise UsageError(f"give as many --speed as --e-n values (got {len(args.speed)} and {len(args.e_n)})")
-    out = check_outputs({"--out": args.out})["--out"] if args.out else None
+    out = check_outputs({"--out": args.out}, _inputs(args))["--out"] if args.out else None
     if out is not None and not str(out).endswith((".csv", ".nc")):
         raise UsageError(f"--out {args.out!r}: the output must end in .csv or .nc")
+    from microimpact.analysis.target import check_target_memory
+
+    check_target_memory(args.points, len(args.e_n), what=f"--points {args.points} for {len(args.e_n)} target(s)")
     contact = contact_from_args(args)
     res = damping_from_target(args.e_n, args.speed, contact, e_n_uncertainty=args.e_n_uncertainty,
                               n_points=args.points, rtol=args.rtol, time_budget=args.time_budget)
@@ -509,8 +526,8 @@ def _cmd_sweep(args) -> int:
 
     if args.case not in TABLE2_CASES:
         raise UsageError(f"argument --case: unknown case {args.case!r}; known: {', '.join(TABLE2_CASES)}")
+    out = check_outputs({"--out": args.out}, _inputs(args))["--out"]
     contact = contact_from_args(args)
-    out = check_outputs({"--out": args.out})["--out"]
     ds = run_sweep(contact, case=args.case, rtol=args.rtol, progress=True, time_budget=args.time_budget)
     ds.attrs["contact_source"] = args.contact_note
     with reporting_os_errors({"--out": out}):

@@ -45,6 +45,7 @@ from __future__ import annotations
 import contextlib
 import io as _stdio
 import math
+import numbers
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -54,7 +55,8 @@ import pandas as pd
 import xarray as xr
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES
-from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS
+from microimpact.analysis.sampling_defaults import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS,
+                                                    MAX_SEED)
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.materials import material_contact
 from microimpact.io.progress import progress_bar
@@ -411,6 +413,9 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
                          f"got walkers={walkers}, steps={budget}")
     if burn is not None and not 0 <= int(burn) < budget:
         raise ValueError(f"burn must lie in [0, steps), got {burn}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed <= MAX_SEED:
+        raise ValueError(f"seed must be a whole number in [0, {MAX_SEED}] (the posterior file stores it as a "
+                         f"32-bit integer), got {seed!r}")
     check_posterior_memory(walkers, budget, len(names))
     bounds = prior_bounds(names, best)
     lo = np.array([bounds[n][0] for n in names])

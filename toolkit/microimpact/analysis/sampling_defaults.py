@@ -12,7 +12,7 @@ Examples
 True
 """
 
-__all__ = ["DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS"]
+__all__ = ["DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS", "MAX_SEED"]
 
 #: walkers of the ensemble (at least 2 x the sampled parameters are needed; 16 suits 2-4)
 DEFAULT_WALKERS = 16
@@ -20,5 +20,7 @@ DEFAULT_WALKERS = 16
 DEFAULT_MAX_STEPS = 20000
 #: seed of the start ball and the sampler
 DEFAULT_SEED = 2002
+#: the largest seed: the posterior file stores it as a CF integer attribute (int32)
+MAX_SEED = 2**31 - 1
 #: posterior draws pushed through the bands and the flags
 DEFAULT_N_DRAWS = 24

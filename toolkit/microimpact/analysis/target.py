@@ -115,6 +115,20 @@ def _root(fun, lo: float, target: float) -> float:
     return brentq(lambda z: fun(z) - target, lo, hi, xtol=1e-10, rtol=1e-10)
 
 
+def check_target_memory(n_points: int, n_targets: int = 1, what: str | None = None) -> None:
+    """ValueError naming the request when the curves of ``n_targets`` targets at ``n_points``
+    points each cannot fit in this machine's memory (:func:`microimpact.io.resources.check_memory`):
+    six float64 values per point (the two curves, their Dataset, their table), before any solve.
+
+    Examples
+    --------
+    >>> check_target_memory(41)
+    """
+    from microimpact.io.resources import check_memory
+
+    check_memory(what or f"n_points = {n_points} for {n_targets} target(s)", 6 * 8.0 * n_points * n_targets)
+
+
 def _curve(e_n, speed, target, n_points, deadline=None, which=1):
     """(zeta_H, zeta_A) arrays of the curve e_n(speed; zeta_H, zeta_A) = target."""
     undamped = e_n(speed, 0.0, 0.0)
@@ -200,6 +214,7 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
             raise ValueError(f"target {i + 1}: speed = {float(v[i])!r} m/s must be finite and > 0")
     if n_points < 3:
         raise ValueError(f"n_points must be >= 3, got {n_points}")
+    check_target_memory(n_points, e.size)
     r = float(radius if radius is not None else getattr(material, "radius", math.nan))
     if not (math.isfinite(r) and r > 0):
         raise ValueError("give the sphere radius (radius=..., or a Contact that has one)")
