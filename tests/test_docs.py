@@ -55,6 +55,8 @@ HOW = {
     # docs/calibration.md: the calibration study (its full run takes tens of minutes: the CI runs a small one)
     "python -m microimpact.studies.calibration --designs 300 --posterior-designs 12 --workers 2 --seed 1000 --out docs/calibration.json --figure docs/calibration.png": "study",
     "python -m microimpact.studies.calibration": "study",
+    # README.md: signals at random moments of a pipeline run (the CI runs one trial)
+    "python tests/study_interruptions.py --trials 20 --load 1 --seed 1 --out docs/interruptions.json": "study",
     "python -m microimpact.studies.calibration --designs 12 --seed 7 --out calibration.json --figure calibration.png": "ci",
     "microimpact benchmark --quick --out results/benchmark": "ci",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "ci",
@@ -138,8 +140,8 @@ def test_commands_left_to_a_named_test_are_in_that_test(command):
 
 @pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "study"])
 def test_ci_runs_a_smaller_form_of_each_study(command):
-    module = re.match(r"python -m ([\w.]+)", command)[1]
-    assert f"python -m {module} " in CI, f".ci/run does not run python -m {module}"
+    module = re.match(r"python (-m [\w.]+|[\w./]+\.py)", command)[1]
+    assert f"python {module} " in CI, f".ci/run does not run python {module}"
 
 
 @pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "ci"])
