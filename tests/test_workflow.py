@@ -458,6 +458,20 @@ def test_bad_config_is_refused_naming_the_key(tmp_path, override, key):
     assert key in proc.stdout.split("Error validating config file", 1)[1], proc.stdout
 
 
+@pytest.mark.parametrize(("override", "words"), [
+    ("posterior={seed: 2147483648}", ["config key 'posterior'", "seed 2147483648", "32-bit"]),
+    ("posterior={walkers: 1000000000, max_steps: 1000000000}", ["config key 'posterior'", "TB of memory"]),
+])
+def test_sampler_config_is_checked_at_start_with_the_clis_bounds(tmp_path, override, words):
+    """The posterior's seed and chain size get the bounds of fit --seed and --walkers/--max-steps
+    before any job runs (a seed beyond int32 failed only when the sampled posterior was written)."""
+    root = make_copy(tmp_path / "sampler")
+    proc = snakemake(root, "-n", "--cores", "1", "--config", override)
+    assert proc.returncode != 0
+    for w in words:
+        assert w in proc.stdout, proc.stdout[-3000:]
+
+
 def test_bad_value_in_config_file_is_refused_naming_the_key(tmp_path):
     root = make_copy(tmp_path / "bad_file")
     cfg = root / "workflow" / "config" / "config.yaml"

@@ -183,6 +183,37 @@ def check_config_at_start():
         check_time_budget(config["fit"].get("time_budget"), "time_budget")
     except ValueError as e:
         raise WorkflowError(f"config key 'fit': {e}") from None
+    _check_posterior_config(config.get("posterior") or {})
+
+
+def _check_posterior_config(post):
+    """The CLI's bounds for the sampler: a seed the posterior file can store, a chain that fits in
+    memory (walkers x max_steps, before the fit job starts rather than when it runs out).
+    """
+    from microimpact.analysis.sampling_defaults import (
+        DEFAULT_MAX_STEPS,
+        DEFAULT_WALKERS,
+        MAX_SEED,
+    )
+
+    if not post.get("enabled", True):
+        return
+    seed = post.get("seed")
+    if seed is not None and int(seed) > MAX_SEED:
+        raise WorkflowError(
+            f"config key 'posterior': seed {seed} is above {MAX_SEED} (the posterior file stores it as a "
+            "32-bit integer)"
+        )
+    from microimpact.analysis.posterior import check_posterior_memory
+
+    try:  # the most parameters a chain can have: zeta_H, zeta_A, w_A, f
+        check_posterior_memory(
+            int(post.get("walkers") or DEFAULT_WALKERS),
+            int(post.get("max_steps") or DEFAULT_MAX_STEPS),
+            4,
+        )
+    except ValueError as e:
+        raise WorkflowError(f"config key 'posterior': {e}") from None
 
 
 if getattr(workflow, "is_main_process", True):
