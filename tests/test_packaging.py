@@ -117,3 +117,50 @@ def test_numba_compile_notice_only_when_the_cache_is_cold(tmp_path):
     assert runs[0].stdout.split() == ["3"]
     notices = [r.stderr.count("microimpact: compiling") for r in runs]
     assert notices == [1, 0], [r.stderr for r in runs]
+
+
+@pytest.mark.parametrize("package", ["microimpact", "microimpact.io", "microimpact.analysis"])
+def test_dir_shows_every_public_name_of_the_lazy_packages(package):
+    """``dir()`` and tab completion list the names a lazy package loads on first use (issue 28:
+    ``dir(microimpact.io)`` was ``['importlib']``), each name resolves, and for io and analysis the
+    table of names holds every module's ``__all__`` (a new public name cannot be missed)."""
+    import importlib
+    import pkgutil
+
+    pkg = importlib.import_module(package)
+    listed = set(dir(pkg))
+    for name in pkg.__all__:
+        assert name in listed, name
+        assert getattr(pkg, name) is not None, name
+    if package != "microimpact":
+        for info in pkgutil.iter_modules(pkg.__path__):
+            if info.name.startswith("_"):
+                continue
+            assert info.name in listed, info.name
+            module = importlib.import_module(f"{package}.{info.name}")
+            if package == "microimpact.analysis":
+                missing = set(getattr(module, "__all__", ())) - set(pkg.__all__)
+                assert not missing, (info.name, missing)
+    else:
+        for name in ("simulate_impact", "simulate_many", "Contact", "io", "analysis", "__version__"):
+            assert name in listed, name
+
+
+def test_result_reprs_are_one_line_with_the_estimates(tmp_path):
+    """A result's repr is one short line of its estimates (issue 28: DampingFit's repr printed its
+    whole DataFrame); an exact target solve shows no uncertainty."""
+    from pathlib import Path
+
+    from microimpact.analysis import analyse_impacts, damping_from_target
+    from microimpact.io import default_materials_path, read_impacts, read_materials
+    from microimpact.presets import WALL_1990
+
+    pairs = read_materials(default_materials_path())
+    table = read_impacts(Path(__file__).resolve().parents[1] / "data" / "synthetic_microspheres.csv", materials=pairs)
+    fit = analyse_impacts(table.iloc[::5], pairs["ammonium_fluorescein_on_silicon"], confidence_intervals=False)
+    text = repr(fit.damping)
+    assert "\n" not in text and len(text) < 200, text
+    assert text.startswith("DampingFit(zeta_hertz=") and "+/-" in text and "(fixed)" in text, text
+    assert repr(fit).startswith("AnalystFit(DampingFit(") and "\n" not in repr(fit)
+    exact = repr(damping_from_target([0.5, 0.6], [2.0, 3.0], WALL_1990, n_points=5))
+    assert "exact(" in exact and "+/-" not in exact, exact

@@ -532,7 +532,9 @@ def _cmd_sweep(args) -> int:
     ds.attrs["contact_source"] = args.contact_note
     with reporting_os_errors({"--out": out}):
         write_netcdf(ds, out)
-    print(f"case {args.case}: {dict(ds.sizes)} impacts, {int(ds['outcome'].sum())} captured; wrote {out}")
+    grid = " x ".join(f"{n} {dim}" for dim, n in ds.sizes.items())
+    print(f"case {args.case}: {math.prod(ds.sizes.values())} impacts ({grid}), {int(ds['outcome'].sum())} captured; "
+          f"wrote {out}")
     print(f"material: {args.contact_note}")
     return 0
 

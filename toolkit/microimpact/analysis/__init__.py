@@ -8,3 +8,55 @@
 - :mod:`.kharaz`: the model against the Kharaz et al. (2001) oblique-impact measurements.
 - :mod:`.synthetic`: labelled synthetic measurements from stated parameters.
 """
+
+import importlib
+
+#: public name -> the module of microimpact.analysis that defines it (tests/test_packaging.py checks
+#: that this table holds every module's ``__all__``)
+_HOMES = {
+    **dict.fromkeys(("AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS"), "analyst_fit"),
+    **dict.fromkeys(("split_rhat", "ess_bulk", "RHAT_MAX", "ESS_MIN"), "diagnostics"),
+    **dict.fromkeys(("DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
+                     "PARAMETER_TABLE_COLUMNS"), "fit_result"),
+    **dict.fromkeys(("FitProblem", "fit_damping", "damping_residual", "model_restitution", "DEFAULT_START_GRID"),
+                    "fitting"),
+    **dict.fromkeys(("flag_measurements", "write_flags", "fibonacci_sphere", "flag_summary", "DEFAULT_THRESHOLDS",
+                     "FLAG_LETTERS"), "flags"),
+    **dict.fromkeys(("ParameterStatus", "STATUSES", "parameter_status", "profile_interval", "chi2_threshold",
+                     "status_variables", "status_from_variables", "status_from_interval", "DEFAULT_LEVEL"),
+                    "identifiability"),
+    **dict.fromkeys(("kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
+                     "KHARAZ_CONDITIONS"), "kharaz"),
+    **dict.fromkeys(("compare_normal_models", "normal_model_restitution", "DEFAULT_MODELS"), "model_comparison"),
+    **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state",
+                     "effective_sigma", "TANGENTIAL_PARAMETERS", "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"), "oblique"),
+    **dict.fromkeys(("Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "posterior_contacts",
+                     "restitution_bands", "capture_velocity_interval", "sweep_bands", "posterior_dataset",
+                     "posterior_from_dataset", "load_posterior", "save_posterior", "summary_table",
+                     "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"), "posterior"),
+    **dict.fromkeys(("DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS", "MAX_SEED"),
+                    "sampling_defaults"),
+    **dict.fromkeys(("spin_explanation", "SPIN_VARIABLES"), "spin"),
+    **dict.fromkeys(("SYNTHETIC_DEFAULTS", "SYNTHETIC_OBLIQUE_DEFAULTS", "make_synthetic_impacts",
+                     "make_synthetic_oblique", "write_synthetic_impacts"), "synthetic"),
+    **dict.fromkeys(("DampingTarget", "damping_from_target"), "target"),
+}
+#: the modules, importable as attributes
+_MODULES = tuple(sorted(set(_HOMES.values())))
+
+__all__ = list(_HOMES)
+
+
+def __getattr__(name: str):
+    """Each public name loads its module on first use (PEP 562): ``import microimpact.analysis``
+    imports neither lmfit nor emcee."""
+    if name in _HOMES:
+        return getattr(importlib.import_module(f"microimpact.analysis.{_HOMES[name]}"), name)
+    if name in _MODULES:
+        return importlib.import_module(f"microimpact.analysis.{name}")
+    raise AttributeError(f"module 'microimpact.analysis' has no attribute {name!r}")
+
+
+def __dir__():
+    """The public names and modules, also those not loaded yet (``dir()``, tab completion)."""
+    return sorted({*globals(), *_HOMES, *_MODULES})

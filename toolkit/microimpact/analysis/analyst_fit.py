@@ -54,6 +54,10 @@ class AnalystFit:
     posterior: object = None
     posterior_dataset: xr.Dataset | None = None
 
+    def __repr__(self) -> str:
+        parts = [repr(self.damping)] + [repr(x) for x in (self.friction, self.posterior) if x is not None]
+        return f"AnalystFit({', '.join(parts)})"
+
     def report(self) -> str:
         """The text reports of the parts that were computed."""
         parts = [self.damping.report()]

@@ -163,6 +163,12 @@ class DampingFit:
     def __str__(self) -> str:  # pragma: no cover - convenience
         return self.report()
 
+    def __repr__(self) -> str:
+        from microimpact.io.formatting import estimates_repr
+
+        return estimates_repr("DampingFit", self.values, self.stderr, self.varied, redchi=float(self.redchi),
+                              n_points=int(self.n_points))
+
     # ------------------------------------------------------------------ NetCDF
     def to_dataset(self) -> xr.Dataset:
         """The fit as an xarray Dataset with CF attributes (``units``, ``long_name``).

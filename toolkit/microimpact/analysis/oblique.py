@@ -389,6 +389,12 @@ class FrictionFit:
         """True where the data determine every fitted tangential parameter."""
         return all(st.determined for st in self.identifiability.values())
 
+    def __repr__(self) -> str:
+        from microimpact.io.formatting import estimates_repr
+
+        return estimates_repr("FrictionFit", self.values, self.stderr, tangential_model=self.tangential_model,
+                              n_points=int(self.n_points))
+
     def report(self) -> str:
         """Plain-text summary: a value with its interval only where the data determine it."""
         lines = [f"Friction fit ({self.tangential_model} tangential model, Eqs. (16)-(20)), after the damping fit"]

@@ -165,6 +165,11 @@ class Posterior:
         """Post-burn-in chain longer than 50 autocorrelation times."""
         return bool(self.info.get("converged", False))
 
+    def __repr__(self) -> str:
+        steps, walkers, _ = self.chain.shape
+        return (f"Posterior({', '.join(self.names)}; {walkers} walkers x {steps} steps, burn-in {self.burn}, "
+                f"seed {self.seed}, converged={self.converged})")
+
     def report(self) -> str:
         """Plain-text summary: medians, 95 % intervals, autocorrelation, acceptance."""
         steps, walkers, _ = self.chain.shape

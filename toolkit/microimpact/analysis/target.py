@@ -57,6 +57,18 @@ class DampingTarget:
     stderr: dict | None = None
     info: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        from microimpact.io.formatting import estimates_repr
+
+        if self.best is None:
+            best = "no least-squares point"
+        elif len(self.targets) <= len(self.best):  # as many targets as parameters: solved, no error estimate
+            best = estimates_repr("exact", self.best)
+        else:
+            best = estimates_repr("best", self.best, self.stderr)
+        return (f"DampingTarget({len(self.targets)} target(s), {self.curves.sizes.get('curve_point', 0)} curve points, "
+                f"{best})")
+
     def to_dataset(self) -> xr.Dataset:
         """The curves, the targets and the best point as one CF Dataset."""
         ds = self.curves.copy()

@@ -32,7 +32,19 @@ _HOMES = {
 __all__ = list(_HOMES)
 
 
+#: the modules, importable as attributes
+_MODULES = ("files", "formatting", "impacts", "joblog", "kinds", "locks", "materials", "paths", "progress",
+            "provenance", "resources", "statuses", "units", "variables")
+
+
 def __getattr__(name: str):
     if name in _HOMES:
         return getattr(importlib.import_module(f"microimpact.io.{_HOMES[name]}"), name)
+    if name in _MODULES:
+        return importlib.import_module(f"microimpact.io.{name}")
     raise AttributeError(f"module 'microimpact.io' has no attribute {name!r}")
+
+
+def __dir__():
+    """The public names and modules, also those not loaded yet (``dir()``, tab completion)."""
+    return sorted({*globals(), *_HOMES, *_MODULES})

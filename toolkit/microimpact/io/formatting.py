@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-__all__ = ["format_cell", "format_number", "format_duration"]
+__all__ = ["format_cell", "format_number", "format_duration", "estimates_repr"]
 
 
 def format_cell(value, *, markdown: bool = False, float_format: str = ".4g") -> str:
@@ -71,3 +71,27 @@ def format_duration(seconds: float) -> str:
     if seconds < 1:
         return f"{seconds * 1e3:.3g} ms"
     return f"{seconds:.3g} s"
+
+
+def estimates_repr(kind: str, values: dict, stderr: dict | None = None, varied=None, **extra) -> str:
+    """A one-line repr of a fit-like result: each parameter with its standard error, fixed ones
+    marked, then a few scalars (``extra``); no tables or arrays (a DampingFit's default repr
+    printed its whole DataFrame).
+
+    Examples
+    --------
+    >>> estimates_repr("DampingFit", {"zeta_hertz": 0.54241, "work_of_adhesion": 0.2158},
+    ...                {"zeta_hertz": 0.1596}, varied=("zeta_hertz",), n_points=20)
+    'DampingFit(zeta_hertz=0.5424 +/- 0.16, work_of_adhesion=0.2158 (fixed), n_points=20)'
+    """
+    stderr = stderr or {}
+    parts = []
+    for name, value in values.items():
+        if varied is not None and name not in varied:
+            parts.append(f"{name}={value:.4g} (fixed)")
+        elif stderr.get(name) is not None and math.isfinite(stderr[name]):
+            parts.append(f"{name}={value:.4g} +/- {stderr[name]:.2g}")
+        else:
+            parts.append(f"{name}={value:.4g}")
+    parts += [f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v!r}" for k, v in extra.items()]
+    return f"{kind}({', '.join(parts)})"
