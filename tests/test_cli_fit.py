@@ -117,3 +117,28 @@ def test_entry_point_exit_status(tmp_path):
     assert r.returncode == 2
     assert r.stderr.count("\n") == 1 and "does not exist" in r.stderr
     assert files(tmp_path) == []
+
+
+def test_fit_json_is_the_report_as_numbers(small_csv, tmp_path, capsys):
+    """fit --json (issue 28): the parameters as the report gives them (value, 95 % interval and a
+    meaningful standard error where determined; the fixed w_A as fixed), equal to the fit file's."""
+    import json
+
+    from microimpact.analysis import DampingFit
+
+    out = tmp_path / "fit.nc"
+    assert main(["fit", str(small_csv), "--out", str(out), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    fit = DampingFit.load(out)
+    params = summary["damping"]["parameters"]
+    for name in fit.varied:
+        rec, st = params[name], fit.identifiability[name]
+        assert rec["status"] == st.status
+        if st.status == "determined":
+            assert rec["value"] == pytest.approx(fit.values[name], rel=1e-12)
+            assert rec["interval"] == pytest.approx([st.lower, st.upper], rel=1e-12)
+            assert rec["interval"][0] <= rec["value"] <= rec["interval"][1]
+        else:
+            assert "value" not in rec and "stderr" not in rec
+    assert params["work_of_adhesion"] == {"status": "fixed", "value": pytest.approx(fit.values["work_of_adhesion"])}
+    assert summary["n_points"] == len(fit.data) and summary["written"] == [str(out)]

@@ -339,9 +339,50 @@ def _cmd_fit(args) -> int:
                              time_budget=args.time_budget)
     with reporting_os_errors(outputs):
         written = result.save(out, outputs.get("--posterior"), outputs.get("--oblique-out"))
-    print(result.report())
+    if args.json:
+        print(json.dumps(_json_ready(_fit_summary(result, table, pair, written)), indent=2, allow_nan=False))
+    else:
+        print(result.report())
     print("wrote " + ", ".join(map(str, written)), file=sys.stderr)
     return 0
+
+
+def _json_ready(obj):
+    """Non-finite numbers as null (JSON has no NaN or Infinity), numpy scalars as Python numbers."""
+    if isinstance(obj, dict):
+        return {k: _json_ready(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_json_ready(v) for v in obj]
+    if isinstance(obj, bool) or obj is None or isinstance(obj, str):
+        return obj
+    value = float(obj)
+    return value if math.isfinite(value) else None
+
+
+def _fit_summary(result, table, pair, written) -> dict:
+    """``fit --json``: what the report says, as numbers, by the report's rules (a value, interval and
+    standard error only where the data determine it; else the bound)."""
+    def parameters(fit) -> dict:
+        out = {}
+        for name, value in fit.values.items():
+            st = fit.identifiability.get(name)
+            if st is not None:
+                out[name] = st.to_record(fit.stderr.get(name, float("nan")))
+            else:  # fixed: the given material's value
+                out[name] = {"status": "fixed", "value": float(value)}
+        return out
+
+    d = result.damping
+    summary = {"material_pair": pair.name, "n_points": int(len(table)),
+               "damping": {"parameters": parameters(d), "chisqr": float(d.chisqr), "redchi": float(d.redchi)},
+               "written": [str(p) for p in written]}
+    if result.friction is not None:
+        summary["friction"] = {"parameters": parameters(result.friction), "tangential_model": result.friction.tangential_model}
+    if result.posterior is not None:
+        steps, walkers, _ = result.posterior.chain.shape
+        summary["posterior"] = {"converged": result.posterior.converged, "walkers": walkers, "steps": steps,
+                                "burn": int(result.posterior.burn), "seed": int(result.posterior.seed)}
+    return summary
 
 
 def register_fit(sub) -> None:
@@ -355,6 +396,7 @@ def register_fit(sub) -> None:
     p.add_argument("--no-confidence-intervals", action="store_true", help="skip lmfit.conf_interval (faster)")
     _add_rtol(p)
     p.add_argument("--out", required=True, help="output NetCDF of the fit")
+    p.add_argument("--json", action="store_true", help="print the results as JSON instead of the text report")
     _add_posterior_options(p)
     _add_time_budget(p)
     p.set_defaults(func=_cmd_fit)

@@ -68,6 +68,31 @@ class ParameterStatus:
         """Whether ``x`` lies in ``[lower, upper]`` (the interval, bound or range reported)."""
         return bool(self.lower <= x <= self.upper)
 
+    def to_record(self, stderr: float = math.nan) -> dict:
+        """The status as JSON-ready numbers, by the rules of :meth:`describe`: a value, its
+        interval and its standard error only where the data determine it (the standard error also
+        only where :func:`stderr_is_meaningful`), else the bound or the searched range.
+
+        Examples
+        --------
+        >>> ParameterStatus("friction", "lower_bound", math.nan, 0.27, 10.0).to_record()
+        {'status': 'lower_bound', 'level': 0.95, 'lower_bound': 0.27, 'searched_up_to': 10.0}
+        """
+        rec = {"status": self.status, "level": self.level}
+        if self.status == "determined":
+            rec |= {"value": self.value, "interval": [self.lower, self.upper]}
+            if stderr_is_meaningful(self.value, stderr):
+                rec["stderr"] = float(stderr)
+        elif self.status == "lower_bound":
+            rec |= {"lower_bound": self.lower, "searched_up_to": self.upper}
+        elif self.status == "upper_bound":
+            rec |= {"upper_bound": self.upper, "searched_down_to": self.lower}
+        else:
+            rec |= {"searched_range": [self.lower, self.upper]}
+        if self.reason:
+            rec["reason"] = self.reason
+        return rec
+
     def describe(self, unit: str = "", digits: int = 4) -> str:
         """One line for a report: the value and interval, or the bound, or 'not determined'.
 
