@@ -81,6 +81,34 @@ def test_workflow_passes_unknown_options_to_snakemake_in_order(tmp_path):
     assert command[-7:] == ["--cores", "all", "-n", "--config", "data=x.csv", "rtol=1.0e-9", "results/kharaz.nc"]
 
 
+def test_workflow_config_paths_are_the_users_relative_to_where_they_typed_them(tmp_path, monkeypatch):
+    """``--config data=impacts.csv`` names the file where the user is, not in the run directory
+    Snakemake changes into (issue 28); a path that does not exist here is left for the config check."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "impacts.csv").write_text("x\n")
+    args, rest = cli.build_parser().parse_known_args(
+        ["workflow", "--directory", "run", "--config", "data=impacts.csv", "rtol=1e-9", "materials=nowhere.yaml",
+         "--config=kharaz_data=impacts.csv"])
+    args.snakemake_args = rest
+    command = cli._snakemake_command(args)
+    assert f"data={tmp_path / 'impacts.csv'}" in command
+    assert "rtol=1e-9" in command and "materials=nowhere.yaml" in command
+    assert f"--config=kharaz_data={tmp_path / 'impacts.csv'}" in command
+
+
+def test_a_workflow_refused_at_start_leaves_no_run_directory_behind(tmp_path, capsys):
+    """A bad config value stops Snakemake before any job; the run directory the command made for
+    it is removed again (issue 28: an empty directory was left)."""
+    run = tmp_path / "new_run"
+    status = main(["workflow", "--directory", str(run), "-n", "--config", "rtol=2"])
+    assert status != 0
+    assert not run.exists()
+    existing = tmp_path / "old_run"
+    existing.mkdir()
+    assert main(["workflow", "--directory", str(existing), "-n", "--config", "rtol=2"]) != 0
+    assert existing.is_dir()  # not ours to remove
+
+
 @pytest.mark.parametrize("cores", [["--cores", "1"], ["-c2"], ["--jobs=4"], ["--profile", "workflow/profiles/slurm"]])
 def test_workflow_keeps_the_cores_the_user_gives(cores):
     args = cli.build_parser().parse_args(["workflow"])

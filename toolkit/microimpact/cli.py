@@ -733,7 +733,35 @@ def _snakemake_command(args) -> list[str]:
         # incomplete ones are those of jobs that were stopped, and they are redone
         extra = ["--rerun-incomplete", *extra]
     return [sys.executable, "-m", "snakemake", "--snakefile", str(workflow_snakefile()),
-            "--directory", str(args.directory), *extra]
+            "--directory", str(args.directory), *_config_paths_from_here(extra)]
+
+
+#: config keys that name files: a relative path is the user's, typed where they are
+_CONFIG_FILE_KEYS = ("data", "kharaz_data", "materials")
+
+
+def _config_paths_from_here(words: list[str]) -> list[str]:
+    """``--config data=impacts.csv`` as the user meant it: relative to where they typed it, not to
+    the run directory Snakemake changes into. Paths that exist from here become absolute; the
+    others are left for Snakemake's check to name."""
+    out, in_config = [], False
+    for word in words:
+        if word.startswith("-"):
+            in_config = word in ("--config", "-C") or word.startswith("--config=")
+            if word.startswith("--config="):
+                key_value = word[len("--config="):]
+                word = "--config=" + _absolute_config_path(key_value)
+        elif in_config:
+            word = _absolute_config_path(word)
+        out.append(word)
+    return out
+
+
+def _absolute_config_path(key_value: str) -> str:
+    key, sep, value = key_value.partition("=")
+    if sep and key in _CONFIG_FILE_KEYS and value and not Path(value).is_absolute() and Path(value).exists():
+        return f"{key}={Path(value).resolve()}"
+    return key_value
 
 
 def _clear_stale_lock(directory: Path) -> None:
@@ -755,14 +783,26 @@ def _clear_stale_lock(directory: Path) -> None:
 
 
 def _cmd_workflow(args) -> int:
-    import subprocess
-
     command = _snakemake_command(args)
     directory = Path(args.directory)
     if directory.exists() and not directory.is_dir():
         raise PathError("--directory", args.directory, "is not a directory")
+    created = not directory.exists()
     with reporting_os_errors({"--directory": directory}):
         directory.mkdir(parents=True, exist_ok=True)
+    try:
+        return _run_workflow(command, directory)
+    finally:  # a run refused at start-up leaves no empty run directory of its own making behind
+        if created and directory.is_dir() and {p.name for p in directory.iterdir()} <= {".snakemake"} \
+                and not list(directory.glob(".snakemake/**/*.lock")):
+            import shutil
+
+            shutil.rmtree(directory, ignore_errors=True)
+
+
+def _run_workflow(command: list[str], directory: Path) -> int:
+    import subprocess
+
     if "--unlock" not in command:
         _clear_stale_lock(directory)
     print(f"microimpact: running the pipeline ({command[4]}) in {directory}", file=sys.stderr, flush=True)
