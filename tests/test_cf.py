@@ -110,10 +110,12 @@ def _failures(path) -> list[str]:
         pytest.skip(f"this compliance-checker has no {SUITE} suite")
     dataset = suite.load_dataset(str(path))
     try:
-        results, _exceptions = suite.run_all(dataset, [SUITE], skip_checks=[])[SUITE]
+        results, exceptions = suite.run_all(dataset, [SUITE], skip_checks=[])[SUITE]
     finally:  # an HDF5 file left open here crashed a later reader of the same file in this process
         dataset.close()
-    failed = []
+    # a check that raised did not run: the command-line checker then exits 2 (issue 28: text
+    # coordinate variables broke check_coordinate_variables_strict_monotonicity)
+    failed = [f"checker exception: {e}" for e in exceptions]
     for r in results:
         score, out_of = r.value if isinstance(r.value, tuple) else (int(bool(r.value)), 1)
         if score < out_of:
@@ -202,3 +204,22 @@ def test_writer_refuses_integers_outside_int32(tmp_path):
     with pytest.raises(ValueError, match="int32"):
         write_netcdf(ds, tmp_path / "big.nc")
     assert not (tmp_path / "big.nc").exists()
+
+
+def test_every_netcdf_the_cli_writes_passes_the_cf_checker_to_the_end(tmp_path):
+    """fit, flags, sweep and target as the CLI writes them: no failed check and no exception of the
+    checker (the fit's text coordinate 'parameter' made compliance-checker exit 2)."""
+    from pathlib import Path
+
+    from microimpact.cli import main
+
+    lines = (Path(__file__).resolve().parents[1] / "data" / "synthetic_microspheres.csv").read_text().splitlines()
+    data = tmp_path / "data.csv"
+    data.write_text("\n".join([lines[0]] + lines[1::5]) + "\n")
+    fit, flags, sweep, target = (tmp_path / n for n in ("fit.nc", "flags.nc", "sweep.nc", "target.nc"))
+    assert main(["fit", str(data), "--out", str(fit), "--no-confidence-intervals"]) == 0
+    assert main(["flags", str(data), "--fit", str(fit), "--out", str(tmp_path / "f.csv"), "--nc", str(flags)]) == 0
+    assert main(["sweep", "--case", "2.2", "--out", str(sweep)]) == 0
+    assert main(["target", "--e-n", "0.5", "0.6", "--speed", "2", "3", "--points", "5", "--out", str(target)]) == 0
+    failed = {p.name: f for p in (fit, flags, sweep, target) if (f := _failures(p))}
+    assert not failed, failed

@@ -6,6 +6,8 @@ from microimpact.io.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 
+from microimpact.io.files import restore_label_coordinates  # noqa: E402
+
 from microimpact.solvers.engine import set_threads  # noqa: E402
 
 set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no more)
@@ -18,7 +20,7 @@ from microimpact.analysis.posterior import load_posterior  # noqa: E402
 from microimpact.io import read_impacts, select_material_pair  # noqa: E402
 from microimpact.studies.material import stamp_fitted  # noqa: E402
 
-fit_ds = xr.load_dataset(snakemake.input.fit)  # noqa: F821
+fit_ds = restore_label_coordinates(xr.load_dataset(snakemake.input.fit))  # noqa: F821
 pair = snakemake.wildcards.pair  # noqa: F821  (this job's material pair: its rows of the data)
 table = select_material_pair(read_impacts(snakemake.input.data, materials=snakemake.input.materials,  # noqa: F821
                                           material_pair=snakemake.params.material_pair),  # noqa: F821

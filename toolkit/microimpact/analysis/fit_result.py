@@ -228,7 +228,10 @@ class DampingFit:
 
     @classmethod
     def from_dataset(cls, ds: xr.Dataset) -> "DampingFit":
-        """Inverse of :meth:`to_dataset`."""
+        """Inverse of :meth:`to_dataset` (also of the Dataset read back from its file)."""
+        from microimpact.io.files import restore_label_coordinates
+
+        ds = restore_label_coordinates(ds)
         a = ds.attrs
         varied = tuple(a["varied"].split()) if a.get("varied") else ()
         values = {n: float(ds[n]) for n in PARAMETER_NAMES}

@@ -790,7 +790,10 @@ def posterior_dataset(posterior: Posterior, *extra: xr.Dataset) -> xr.Dataset:
 
 
 def posterior_from_dataset(ds: xr.Dataset) -> Posterior:
-    """Inverse of :func:`posterior_dataset` (the chain part)."""
+    """Inverse of :func:`posterior_dataset` (the chain part; also of the Dataset read back from its file)."""
+    from microimpact.io.files import restore_label_coordinates
+
+    ds = restore_label_coordinates(ds)
     names = tuple(str(ds.attrs["sampled"]).split())
     chain = np.stack([ds[f"chain_{n}"].values for n in names], axis=-1)
     fixed = {k.removeprefix("fixed_"): float(v) for k, v in ds.attrs.items() if k.startswith("fixed_")}

@@ -30,7 +30,7 @@ import numpy as np
 from microimpact.io.variables import VARIABLES, udunits
 
 __all__ = ["atomic_path", "atomic_write", "all_or_nothing", "deferred_signals", "interrupt_at_checkpoints", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
-           "CONVENTIONS", "read_netcdf_groups"]
+           "CONVENTIONS", "read_netcdf_groups", "restore_label_coordinates", "LABEL_OF"]
 
 #: encoding added to every numeric, non-scalar NetCDF variable
 NETCDF_COMPRESSION = {"zlib": True, "complevel": 4}
@@ -340,6 +340,48 @@ def _cf_attrs(attrs: Mapping, what: str) -> dict:
     return out
 
 
+#: attribute of a text label variable written in place of a text coordinate variable: its dimension
+LABEL_OF = "label_of_dimension"
+
+
+def _labels_as_auxiliary_coordinates(ds):
+    """Text coordinate variables (``parameter`` = zeta_hertz, zeta_adhesion, ...) as auxiliary
+    coordinate variables ``<dim>_label`` along the same dimension (CF 6.1, labels).
+
+    A CF coordinate variable is numeric and strictly monotonic (CF 5); compliance-checker's
+    monotonicity check raised its own exception on text ones and exited 2. The dimension keeps its
+    name (and the data variables along it); :func:`restore_label_coordinates` makes the label the
+    index coordinate again when the file is read."""
+    for name in [d for d in ds.dims if d in ds.variables and np.dtype(ds[d].dtype).kind in "OUS"]:
+        coord = ds[name]
+        attrs = dict(coord.attrs)
+        if name in VARIABLES:
+            attrs.setdefault("long_name", VARIABLES[name][1])
+        attrs.setdefault("long_name", f"label of each {name}")
+        ds = ds.drop_vars(name).assign_coords({f"{name}_label": (name, coord.values, attrs | {LABEL_OF: name})})
+    return ds
+
+
+def restore_label_coordinates(ds):
+    """The inverse of the writer's label variables: each ``<dim>_label`` (marked with
+    :data:`LABEL_OF`) becomes the index coordinate ``<dim>`` again, so ``.sel(parameter=...)``
+    works on a file read back. Datasets without labels are returned as they are.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> ds = xr.Dataset({"x": ("p", [1.0, 2.0])}, coords={"p_label": ("p", ["a", "b"], {LABEL_OF: "p"})})
+    >>> float(restore_label_coordinates(ds)["x"].sel(p="b"))
+    2.0
+    """
+    for name in [n for n, v in ds.variables.items() if LABEL_OF in v.attrs]:
+        var = ds[name]
+        dim = var.attrs[LABEL_OF]
+        attrs = {k: v for k, v in var.attrs.items() if k != LABEL_OF}
+        ds = ds.drop_vars(name).assign_coords({dim: (dim, var.values, attrs)})
+    return ds
+
+
 def _cf_dataset(ds, *, root: bool, path: Path):
     """A copy of ``ds`` in the CF-1.10 form of the toolkit's files, and its per-variable encoding.
 
@@ -356,7 +398,7 @@ def _cf_dataset(ds, *, root: bool, path: Path):
     """
     keep = {"dtype", "_FillValue", "scale_factor", "add_offset", "units", "calendar",
             "zlib", "complevel", "shuffle", "chunksizes", "fletcher32", "contiguous"}
-    out = ds.copy(deep=False)
+    out = _labels_as_auxiliary_coordinates(ds.copy(deep=False))
     encoding = {}
     for name, var in out.variables.items():
         attrs = dict(var.attrs)
@@ -500,5 +542,5 @@ def read_netcdf_groups(path) -> list:
     out = []
     for name in names:
         with xr.open_dataset(path, group=name, engine="netcdf4", decode_timedelta=False) as ds:
-            out.append(ds.load())
+            out.append(restore_label_coordinates(ds.load()))
     return out

@@ -92,8 +92,10 @@ def read_dataset(obj) -> xr.Dataset:
     """A NetCDF file read into memory (file closed), or the Dataset itself."""
     if isinstance(obj, xr.Dataset):
         return obj
+    from microimpact.io.files import restore_label_coordinates
+
     with xr.open_dataset(obj, engine="netcdf4", decode_timedelta=False) as ds:
-        return ds.load()
+        return restore_label_coordinates(ds.load())
 
 
 def read_table(obj) -> pd.DataFrame:

@@ -503,8 +503,10 @@ def save_sweep(ds: xr.Dataset, path):
 
 def load_sweep(path) -> xr.Dataset:
     """Read a sweep written by :func:`save_sweep` into memory (file closed afterwards)."""
+    from microimpact.io.files import restore_label_coordinates
+
     with xr.open_dataset(path, decode_timedelta=False) as ds:
-        return ds.load()
+        return restore_label_coordinates(ds.load())
 
 
 # ----------------------------------------------------------------------------- model curves for figures
