@@ -483,3 +483,27 @@ def test_radius_too_large_for_the_model_names_row_and_column(tmp_path):
     assert "row 3 (line 4)" in msg and len(err.problems) == 2
     with pytest.raises(ValueError, match="known pairs"):
         read_impacts(p, materials=default_materials_path(), material_pair="nope")
+
+
+def test_a_workbook_or_netcdf_file_is_refused_in_one_line_saying_what_it_is(tmp_path):
+    """An Excel workbook (a zip with an xl/ part) or a NetCDF file given as the CSV: one problem
+    naming the kind and asking for a CSV export (issue 28: 316 and 4277 'invalid UTF-8' problems)."""
+    import zipfile
+
+    import xarray as xr
+
+    from microimpact.io import ImpactDataError, read_impacts
+
+    book = tmp_path / "impacts.xlsx"
+    with zipfile.ZipFile(book, "w") as z:
+        z.writestr("[Content_Types].xml", "<Types/>")
+        z.writestr("xl/workbook.xml", "<workbook/>")
+        z.writestr("xl/worksheets/sheet1.xml", "<worksheet/>")
+    nc = tmp_path / "impacts.nc"
+    xr.Dataset({"e_n": ("i", [0.5])}, attrs={"title": "some result"}).to_netcdf(nc)
+    for path, kind in ((book, "an Excel workbook (.xlsx)"), (nc, "a NetCDF file titled 'some result'")):
+        with pytest.raises(ImpactDataError) as info:
+            read_impacts(path)
+        assert len(info.value.problems) == 1, info.value
+        assert f"the file is {kind}, not a CSV of measured impacts" in str(info.value)
+        assert "save the measurements as CSV" in str(info.value)
