@@ -433,7 +433,7 @@ def _normal_dissipation(contact, normal_speed, captured, tracked):
     return np.where(captured, to_rest, tracked)
 
 
-def _as_dataarray(name, value):
+def _as_dataarray(name, value, dims=None):
     import xarray as xr  # on first batch use: 0.2 s of start-up that a single impact never needs
 
     if isinstance(value, xr.DataArray):
@@ -441,12 +441,99 @@ def _as_dataarray(name, value):
     a = np.asarray(value, dtype=float)
     if a.ndim == 0:
         return xr.DataArray(a, name=name)
-    dims = ("impact",) if a.ndim == 1 else tuple(f"impact_{i}" for i in range(a.ndim))
-    return xr.DataArray(a, dims=dims, name=name)
+    return xr.DataArray(a, dims=dims[-a.ndim:], name=name)
+
+
+def _plain_axis_names(plain: dict) -> tuple:
+    """Names of the axes of numpy-broadcast plain inputs: an axis along which exactly one input
+    varies (and that input along no other axis) is named after that input (``speed``,
+    ``incidence_deg``); the others ``impact_<k>`` (``impact`` for a single axis)."""
+    ndim = max((np.ndim(v) for v in plain.values()), default=0)
+    names = []
+    for k in range(ndim):
+        varying = [n for n, v in plain.items()
+                   if np.ndim(v) > ndim - 1 - k and np.shape(v)[k - ndim] > 1
+                   and sum(size > 1 for size in np.shape(v)) == 1
+                   and np.unique(np.asarray(v)).size == np.shape(v)[k - ndim]]  # distinct: an index
+        others = [n for n, v in plain.items() if np.ndim(v) > ndim - 1 - k and np.shape(v)[k - ndim] > 1]
+        names.append(varying[0] if len(varying) == 1 and len(others) == 1 else
+                     ("impact" if ndim == 1 else f"impact_{k}"))
+    if len(set(names)) < len(names):  # the same input cannot name two axes
+        names = ["impact"] if ndim == 1 else [f"impact_{k}" for k in range(ndim)]
+    return tuple(names)
+
+
+def _index_coordinates(inputs: dict, arrays: list) -> dict:
+    """An index coordinate for every dimension of the batch that has none: the values of the input
+    the dimension is named after (a plain array's axis, or a DataArray on a dimension of its own
+    name), else of the one DataArray input that lies along that dimension alone, else 0, 1, 2, ...
+    So every dimension can be ``.sel``-ed (issue 28: a DataArray without a coordinate made a 2-D
+    variable named after its dimension)."""
+    import xarray as xr
+
+    dims = arrays[0].dims
+    by_name = {a.name: a for a in arrays}
+    coords = {}
+    for d, n in zip(dims, arrays[0].shape):
+        if any(d in a.coords for a in arrays):
+            continue
+        alone = [k for k, v in inputs.items() if isinstance(v, xr.DataArray) and v.dims == (d,)]
+        name = d if d in inputs else (alone[0] if len(alone) == 1 else None)
+        if name is not None:
+            values = by_name[name].values[tuple(slice(None) if dd == d else 0 for dd in dims)]
+            if np.unique(values).size == n:  # an index needs distinct values
+                coords[d] = xr.Variable(d, values, dict(attributes(name)))
+                continue
+        coords[d] = xr.Variable(d, np.arange(n), {"long_name": f"index along {d}"})
+    return coords
+
+
+def _simulate_over_contacts(contact, contact_fields: dict, **kwargs) -> xr.Dataset:
+    """simulate_many once per combination of the varied contact fields, stacked along their
+    dimensions (an index coordinate of the field's values each); the ``contact_<field>``
+    attribute of a varied field holds its values."""
+    import dataclasses
+    import itertools
+
+    import xarray as xr
+
+    from microimpact.model.contact import Contact
+
+    known = {f.name for f in dataclasses.fields(Contact)}
+    axes = []
+    for name, value in contact_fields.items():
+        if name not in known:
+            raise TypeError(f"simulate_many got an unexpected keyword argument {name!r} (not a Contact field)")
+        if isinstance(value, xr.DataArray):
+            if value.ndim != 1:
+                raise ValueError(f"{name}: a contact field varies along one dimension, got dims {value.dims}")
+            dim, values = value.dims[0], value.values
+        else:
+            dim, values = name, np.atleast_1d(np.asarray(value, dtype=float))
+            if values.ndim != 1:
+                raise ValueError(f"{name}: a contact field varies along one dimension, got shape {values.shape}")
+        axes.append((name, dim, values))
+    dims = [d for _, d, _ in axes]
+    if len(set(dims)) < len(dims):
+        raise ValueError(f"each varied contact field needs its own dimension, got {dims}")
+
+    def nested(level: int, chosen: dict):
+        if level == len(axes):
+            return simulate_many(contact.with_(**chosen), **kwargs)
+        name, _, values = axes[level]
+        return [nested(level + 1, chosen | {name: float(v)}) for v in values]
+
+    ds = xr.combine_nested(nested(0, {}), concat_dim=dims, combine_attrs="override")
+    ds = ds.assign_coords({d: (d, v, dict(attributes(n))) for n, d, v in axes})
+    for name, dim, values in axes:
+        ds.attrs[f"contact_{name}"] = np.asarray(values, dtype=float)
+        ds.attrs[f"contact_{name}_dimension"] = dim
+    return ds
 
 
 def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0, 0.0, 0.0), friction=None, *,
-                  rtol: float = DEFAULT_RTOL, method: str = "engine", family: bool | None = None) -> xr.Dataset:
+                  rtol: float = DEFAULT_RTOL, method: str = "engine", family: bool | None = None,
+                  **contact_fields) -> xr.Dataset:
     """Simulate a batch of impacts, broadcasting the inputs, on both cores.
 
     Each distinct normal speed is solved once by the compiled engine; every angle, azimuth, spin
@@ -473,12 +560,20 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         :func:`microimpact.solvers.family.normal_family` when it costs fewer solves than solving
         each speed, else each distinct speed is solved directly. True forces the family, False
         the direct solves. The ``normal_solve_path`` attribute of the result records which ran.
+    **contact_fields
+        Contact fields that vary, e.g. ``radius=xr.DataArray([1e-6, 3e-6], dims="radius")`` or
+        ``radius=[1e-6, 3e-6]`` (dimension named after the field): one batch per combination,
+        stacked along the fields' dimensions. The other fields stay as in ``contact`` (``f0``
+        too; for f0 from a work of adhesion at each size use
+        :func:`microimpact.io.material_contact`). [SI units of each field]
 
     Returns
     -------
     xarray.Dataset
-        Dimensions from broadcasting the inputs (DataArrays by dimension name; plain arrays are
-        named ``impact`` or ``impact_0, impact_1, ...``). Variables are named after the fields of
+        Dimensions from broadcasting the inputs (DataArrays by dimension name; plain arrays by
+        numpy rules, each axis named after the one input that varies along it, else ``impact`` or
+        ``impact_0, impact_1, ...``), then those of the varied contact fields; every dimension has
+        an index coordinate (the input's values, or 0, 1, ... where no input gives distinct values). Variables are named after the fields of
         :class:`ImpactResult` (vectors split into ``_n``, ``_t``, ``_tp``) and carry ``units`` and
         ``long_name``; the inputs are included as variables. ``outcome`` is 0 for a rebound and 1
         for a capture (CF flag attributes).
@@ -490,6 +585,10 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     checks its budget between them (:func:`microimpact.studies.sweeps.run_sweep` solves its speeds
     in blocks then; :class:`microimpact.solvers.Deadline`).
     """
+    if contact_fields:
+        return _simulate_over_contacts(contact, contact_fields, speed=speed, incidence_deg=incidence_deg,
+                                       azimuth_deg=azimuth_deg, omega=omega, friction=friction, rtol=rtol,
+                                       method=method, family=family)
     if method != "engine":
         raise ValueError(f"simulate_many runs method='engine' only, got {method!r}; for 'reference' or 'rkg' "
                          "call simulate_impact in a loop")
@@ -542,14 +641,16 @@ def _broadcast_inputs(inputs: dict):
         if isinstance(v, xr.DataArray):
             _real_array(k, v)
     try:
+        axes = _plain_axis_names(plain)
         if plain:
             plain = dict(zip(plain, np.broadcast_arrays(*plain.values())))
-        arrays = xr.broadcast(*(_as_dataarray(k, plain.get(k, v)) for k, v in inputs.items()))
+        arrays = xr.broadcast(*(_as_dataarray(k, plain.get(k, v), axes) for k, v in inputs.items()))
     except ValueError as exc:
         shapes = ", ".join(f"{k} {np.shape(v)}" for k, v in inputs.items() if np.ndim(v))
         raise ValueError(f"the inputs do not broadcast together ({shapes}): {exc}") from None
     dims = arrays[0].dims
     arrays = [a.transpose(*dims) for a in arrays]
+    arrays[0] = arrays[0].assign_coords(_index_coordinates(inputs, arrays))
     flat = {a.name: np.ascontiguousarray(a.values, dtype=float).ravel() for a in arrays}
     _check_inputs(flat["speed"], flat["incidence_deg"], flat["azimuth_deg"], (flat["omega_n"], flat["omega_t"], flat["omega_tp"]))
     if np.any(~np.isfinite(flat["friction"]) | (flat["friction"] < 0.0)):
