@@ -17,6 +17,7 @@ this machine, as ``microimpact workflow`` starts them.
 from __future__ import annotations
 
 import os
+import time
 from pathlib import Path
 
 __all__ = ["lock_files", "snakemake_processes_in", "remove_stale_lock"]
@@ -58,26 +59,44 @@ def snakemake_processes_in(directory) -> list[int] | None:
         return None
     directory = Path(directory).resolve()
     found = []
-    for entry in proc.iterdir():
-        if not entry.name.isdigit() or int(entry.name) == os.getpid():
-            continue
-        try:
-            words = (entry / "cmdline").read_bytes().decode(errors="replace").split("\0")
-            cwd = Path(os.readlink(entry / "cwd"))
-        except OSError:  # gone meanwhile, or another user's (then its cwd is unreadable)
-            continue
-        if not any("snakemake" in w.lower() for w in words):
-            continue
-        named = False
-        for w in words:
-            if w and not w.startswith("-"):
-                try:
-                    named = named or _is_under((cwd / w).resolve(), directory)
-                except (OSError, RuntimeError):
-                    pass
-        if _is_under(cwd, directory) or named:
-            found.append(int(entry.name))
+    entries = [e for e in proc.iterdir() if e.name.isdigit() and int(e.name) != os.getpid()]
+    for _ in range(2):
+        blank = []
+        for entry in entries:
+            pid = _snakemake_process(entry, directory)
+            if pid == 0:
+                blank.append(entry)
+            elif pid is not None:
+                found.append(pid)
+        if not blank:
+            break
+        # a process in the middle of exec shows an empty command line for a moment (kernel
+        # threads always do): look at those once more
+        entries = blank
+        time.sleep(0.05)
     return sorted(found)
+
+
+def _snakemake_process(entry: Path, directory: Path) -> int | None:
+    """The process id of ``/proc/<pid>`` if it is a Snakemake process working in ``directory``,
+    None if not, 0 if its command line is empty (being exec'd, or a kernel thread)."""
+    try:
+        words = (entry / "cmdline").read_bytes().decode(errors="replace").split("\0")
+        cwd = Path(os.readlink(entry / "cwd"))
+    except OSError:  # gone meanwhile, or another user's (then its cwd is unreadable)
+        return None
+    if words == [""]:
+        return 0
+    if not any("snakemake" in w.lower() for w in words):
+        return None
+    named = False
+    for w in words:
+        if w and not w.startswith("-"):
+            try:
+                named = named or _is_under((cwd / w).resolve(), directory)
+            except (OSError, RuntimeError):
+                pass
+    return int(entry.name) if _is_under(cwd, directory) or named else None
 
 
 def remove_stale_lock(directory) -> tuple[str, list]:
