@@ -111,9 +111,12 @@ def trial(root: Path, moment: float, signame: str, max_stop: float) -> dict:
     }
     result["passed"] = bool((ended_before or stop <= max_stop) and not problems and not tracebacks
                             and resumed.returncode == 0 and result["nothing_left_to_do"] and not problems_after)
-    if not result["passed"]:
-        result["run_output_tail"] = out[-3000:]
-        result["resume_output_tail"] = resumed.stdout[-3000:]
+    if not result["passed"]:  # without this machine's paths (the summary may be committed)
+        def relative(text: str) -> str:
+            return text.replace(str(root), "<trial>").replace(str(Path(__file__).resolve().parents[1]), "<repo>")
+
+        result["run_output_tail"] = relative(out[-3000:])
+        result["resume_output_tail"] = relative(resumed.stdout[-3000:])
     return result
 
 
