@@ -107,6 +107,9 @@ def test_a_workflow_refused_at_start_leaves_no_run_directory_behind(tmp_path, ca
     existing.mkdir()
     assert main(["workflow", "--directory", str(existing), "-n", "--config", "rtol=2"]) != 0
     assert existing.is_dir()  # not ours to remove
+    dry = tmp_path / "dry_run"
+    assert main(["workflow", "--directory", str(dry), "-n"]) == 0
+    assert dry.is_dir()  # a run that worked keeps its directory (a dry run makes only .snakemake/)
 
 
 @pytest.mark.parametrize("cores", [["--cores", "1"], ["-c2"], ["--jobs=4"], ["--profile", "workflow/profiles/slurm"]])

@@ -790,10 +790,13 @@ def _cmd_workflow(args) -> int:
     created = not directory.exists()
     with reporting_os_errors({"--directory": directory}):
         directory.mkdir(parents=True, exist_ok=True)
+    status = None
     try:
-        return _run_workflow(command, directory)
+        status = _run_workflow(command, directory)
+        return status
     finally:  # a run refused at start-up leaves no empty run directory of its own making behind
-        if created and directory.is_dir() and {p.name for p in directory.iterdir()} <= {".snakemake"} \
+        if status != 0 and created and directory.is_dir() \
+                and {p.name for p in directory.iterdir()} <= {".snakemake"} \
                 and not list(directory.glob(".snakemake/**/*.lock")):
             import shutil
 
