@@ -135,8 +135,8 @@ def test_fit_json_is_the_report_as_numbers(small_csv, tmp_path, capsys):
         rec, st = params[name], fit.identifiability[name]
         assert rec["status"] == st.status
         if st.status == "determined":
-            assert rec["value"] == pytest.approx(fit.values[name], rel=1e-12)
-            assert rec["interval"] == pytest.approx([st.lower, st.upper], rel=1e-12)
+            assert rec["value"] == pytest.approx(fit.values[name], rel=1e-12, abs=0.0)
+            assert rec["interval"] == pytest.approx([st.lower, st.upper], rel=1e-12, abs=0.0)
             assert rec["interval"][0] <= rec["value"] <= rec["interval"][1]
         else:
             assert "value" not in rec and "stderr" not in rec
