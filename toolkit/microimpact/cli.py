@@ -865,6 +865,10 @@ def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | N
 def main(argv=None) -> int:
     if signal.getsignal(signal.SIGINT) is _interrupted_while_starting:
         signal.signal(signal.SIGINT, signal.default_int_handler)
+    if argv is None:  # a process of its own (the console script), not a caller's interpreter
+        from microimpact.io.joblog import redeliver_swallowed_signals
+
+        redeliver_swallowed_signals()
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
     try:

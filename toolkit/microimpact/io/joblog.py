@@ -13,9 +13,10 @@ from __future__ import annotations
 import os
 import signal
 import sys
+import threading
 import traceback
 
-__all__ = ["log_job", "one_line_reason", "interrupted_line", "JobTerminated"]
+__all__ = ["log_job", "one_line_reason", "interrupted_line", "JobTerminated", "redeliver_swallowed_signals"]
 
 #: how to finish a run that was stopped (the README's resume command)
 RESUME = "snakemake --cores 2 --rerun-incomplete"
@@ -24,6 +25,39 @@ RESUME = "snakemake --cores 2 --rerun-incomplete"
 class JobTerminated(Exception):
     """SIGTERM arrived: raised in the main thread so that the job unwinds (atomic writers abandon
     their temporary files) instead of dying where it stands."""
+
+
+def _redeliver(unraisable) -> None:
+    exc_type = unraisable.exc_type
+    if exc_type is not None and issubclass(exc_type, (KeyboardInterrupt, JobTerminated)):
+        signum = signal.SIGINT if issubclass(exc_type, KeyboardInterrupt) else signal.SIGTERM
+        # not from inside the hook: a signal handled before the hook returns would be swallowed again
+        timer = threading.Timer(0.05, os.kill, (os.getpid(), signum))
+        timer.daemon = True
+        timer.start()
+        return
+    sys.__unraisablehook__(unraisable)
+
+
+def redeliver_swallowed_signals() -> None:
+    """Make a Ctrl-C or SIGTERM that lands in a finaliser stop the process all the same.
+
+    Python runs signal handlers between bytecodes of the main thread, and that may be inside a
+    ``__del__`` or a weakref callback. An exception raised there cannot propagate: Python prints
+    "Exception ignored in ..." with a traceback and carries on, so the interrupted job went on
+    working and its log held a traceback (a CI run of 2026-11-26 caught a SIGTERM so, in xarray's
+    WeakValueDictionary). With this hook such a KeyboardInterrupt or :class:`JobTerminated` is
+    not printed; the same signal is sent again 50 ms later, when the finaliser has returned.
+    Other unraisable exceptions go to Python's own hook.
+
+    Examples
+    --------
+    >>> redeliver_swallowed_signals()
+    >>> sys.unraisablehook is _redeliver
+    True
+    >>> sys.unraisablehook = sys.__unraisablehook__
+    """
+    sys.unraisablehook = _redeliver
 
 
 def interrupted_line(rule: str, signame: str) -> str:
@@ -81,6 +115,7 @@ def log_job(snakemake, *, keep_stderr: bool = False) -> None:
             print("\n".join(str(exc).strip().splitlines()[1:]), file=terminal, flush=True)
 
     sys.excepthook = report
+    redeliver_swallowed_signals()
 
     def terminate(signum, frame):
         raise JobTerminated("SIGTERM")
