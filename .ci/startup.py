@@ -18,8 +18,8 @@ PY = sys.executable
 COMMANDS = {
     "python -c 'import numpy'": [PY, "-c", "import numpy"],
     "import microimpact": [PY, "-c", "import microimpact"],
-    "microimpact --help": [PY, "-m", "microimpact.cli", "--help"],
-    "microimpact simulate --speed 2 (warm)": [PY, "-m", "microimpact.cli", "simulate", "--speed", "2"],
+    "microimpact --help": [PY, "-m", "microimpact._entry", "--help"],
+    "microimpact simulate --speed 2 (warm)": [PY, "-m", "microimpact._entry", "simulate", "--speed", "2"],
 }
 HELP_TARGET = 3.0
 

@@ -77,7 +77,8 @@ def check_json(text):
 
 def test_good_run_json(capsys):
     status, out, err = run_main(GOOD, capsys)
-    assert status == 0 and err == ""
+    # nothing on stderr but, on a cold numba cache, the one-line compile notice
+    assert status == 0 and [ln for ln in err.splitlines() if not ln.startswith("microimpact: compiling")] == []
     d = check_json(out)
     assert d["outcome"] == "capture"  # Wall (1990) preset at 1 m/s is captured (model notes sec. 2)
     assert d["mu_t"] is None  # NaN for a capture becomes null: the output is strict JSON

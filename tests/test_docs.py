@@ -33,7 +33,10 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
-DOCS = [REPO / "README.md", REPO / "data" / "README.md", *sorted((REPO / "docs").glob("*.md"))]
+#: the documentation site's own pages too (docs/guide/...); not what a docs build generates
+DOCS = [REPO / "README.md", REPO / "data" / "README.md",
+        *sorted(p for p in (REPO / "docs").rglob("*.md")
+                if not {"_build", "generated", "auto_examples"} & set(p.relative_to(REPO / "docs").parts))]
 PROGRAMS = ("microimpact", "snakemake", "python", "pip", "pytest")
 CI = (REPO / ".ci" / "run").read_text()
 
@@ -75,6 +78,9 @@ HOW = {
     "python .ci/startup.py": "ci",
     'python -c "import numpy"': "run",
     "microimpact --help": "run",
+    # docs/getting-started.md: the documentation site (CI builds it, warnings as errors)
+    'pip install -e ".[docs]"': "ci",
+    "python -m sphinx -W --keep-going -b html docs docs/_build/html": "ci",
     # data/README.md
     "python workflow/scripts/make_synthetic_data.py": "run",
     # docs/cluster.md

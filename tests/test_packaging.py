@@ -129,6 +129,8 @@ def test_dir_shows_every_public_name_of_the_lazy_packages(package):
 
     pkg = importlib.import_module(package)
     listed = set(dir(pkg))
+    helpers = {n for n in listed if not n.startswith("__") and (n.startswith("_") or n == "importlib")}
+    assert not helpers, f"dir({package}) shows its private helpers {sorted(helpers)}"
     for name in pkg.__all__:
         assert name in listed, name
         assert getattr(pkg, name) is not None, name

@@ -6,6 +6,8 @@ damping coefficients, sensitivity sweeps and a Snakemake report.
 """
 
 
+from microimpact._lazy import lazy_exports as _lazy_exports
+
 __all__ = ["Contact", "ImpactResult", "presets", "simulate_impact", "simulate_many", "__version__"]
 
 
@@ -39,19 +41,18 @@ def _announce_numba_compiles() -> None:
     event.register("numba:compile", _FirstCompileNotice())
 
 
-#: public names imported on first use -> their module
-_LAZY = {"Contact": "microimpact.model.contact", "ImpactResult": "microimpact.model.kinematics",
-         "simulate_impact": "microimpact.solvers.impact", "simulate_many": "microimpact.solvers.impact"}
+#: public names imported on first use -> their module, relative to the package
+_LAZY = {"Contact": "model.contact", "ImpactResult": "model.kinematics", "simulate_impact": "solvers.impact",
+         "simulate_many": "solvers.impact"}
 #: the subpackages and modules, importable as attributes (``microimpact.io``)
 _SUBMODULES = ("analysis", "cli", "dynamics", "io", "model", "presets", "report", "solvers", "studies")
+_lazy_getattr, _lazy_dir = _lazy_exports("microimpact", _LAZY, _SUBMODULES)
 
 
 def __getattr__(name):
     """Everything is imported on first use (PEP 562): ``import microimpact`` loads no numpy, so a
     Ctrl-C right after ``microimpact`` starts reaches the command line's handler (one line, status
     130) and not an import of numpy; ``import microimpact.report`` compiles nothing."""
-    import importlib
-
     if name == "__version__":
         from importlib.metadata import PackageNotFoundError, version
 
@@ -59,13 +60,9 @@ def __getattr__(name):
             return version("microimpact")
         except PackageNotFoundError:  # pragma: no cover - a source tree without install
             return "0+unknown"
-    if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
-    if name in _SUBMODULES:
-        return importlib.import_module(f"microimpact.{name}")
-    raise AttributeError(f"module 'microimpact' has no attribute {name!r}")
+    return _lazy_getattr(name)
 
 
 def __dir__():
     """The public names, also those imported on first use (for ``dir()`` and tab completion)."""
-    return sorted({*globals(), "__version__", *_LAZY, *_SUBMODULES})
+    return sorted({*_lazy_dir(), "__version__"})

@@ -14,41 +14,23 @@ of each: :mod:`microimpact.model.parameters`, :data:`microimpact.solvers.DEFAULT
 
 from __future__ import annotations
 
-import signal
+import argparse
+import json
+import math
+import os
+import re
 import sys
+from dataclasses import fields
+from pathlib import Path
 
-#: the one line of a Ctrl-C, and its exit status: 128 + 2, as a shell reports a command SIGINT ended
-INTERRUPTED_LINE = ("microimpact: interrupted; nothing was written (outputs are written whole or not at all); run the "
-                    "same command again to redo it")
-EXIT_INTERRUPTED = 130
-
-
-def _interrupted_while_starting(signum, frame):
-    print(INTERRUPTED_LINE, file=sys.stderr)
-    raise SystemExit(EXIT_INTERRUPTED)
-
-
-# A Ctrl-C while the imports below load numpy (0.1-0.5 s, longer on a loaded machine) ends in the
-# same one line as one in main(), not in a traceback from inside numpy; main() puts Python's own
-# handler back. Where SIGINT is ignored (a background job) it stays ignored.
-if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-    signal.signal(signal.SIGINT, _interrupted_while_starting)
-
-import argparse  # noqa: E402
-import json  # noqa: E402
-import math  # noqa: E402
-import os  # noqa: E402
-import re  # noqa: E402
-from dataclasses import fields  # noqa: E402
-from pathlib import Path  # noqa: E402
-
-from microimpact import __version__  # noqa: E402
-from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,  # noqa: E402
+from microimpact import __version__
+from microimpact._entry import EXIT_INTERRUPTED, INTERRUPTED_LINE
+from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,
                                   reporting_os_errors, same_file)
-from microimpact.model.contact import SUB_MODELS, Contact  # noqa: E402
-from microimpact.model.parameters import TABLE2_CASES  # noqa: E402
-from microimpact.presets import PRESETS, get_preset  # noqa: E402
-from microimpact.solvers import DEFAULT_RTOL, METHODS, TimeBudgetExceeded  # noqa: E402
+from microimpact.model.contact import SUB_MODELS, Contact
+from microimpact.model.parameters import TABLE2_CASES
+from microimpact.presets import PRESETS, get_preset
+from microimpact.solvers import DEFAULT_RTOL, METHODS, TimeBudgetExceeded
 
 __all__ = ["main", "build_parser"]
 
@@ -863,12 +845,6 @@ def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | N
 
 
 def main(argv=None) -> int:
-    if signal.getsignal(signal.SIGINT) is _interrupted_while_starting:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-    if argv is None:  # a process of its own (the console script), not a caller's interpreter
-        from microimpact.io.joblog import redeliver_swallowed_signals
-
-        redeliver_swallowed_signals()
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
     try:
@@ -904,4 +880,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    from microimpact._entry import main as console_main
+
+    sys.exit(console_main())

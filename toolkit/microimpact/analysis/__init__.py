@@ -9,7 +9,7 @@
 - :mod:`.synthetic`: labelled synthetic measurements from stated parameters.
 """
 
-import importlib
+from microimpact._lazy import lazy_exports as _lazy_exports
 
 #: public name -> the module of microimpact.analysis that defines it (tests/test_packaging.py checks
 #: that this table holds every module's ``__all__``)
@@ -47,16 +47,4 @@ _MODULES = tuple(sorted(set(_HOMES.values())))
 __all__ = list(_HOMES)
 
 
-def __getattr__(name: str):
-    """Each public name loads its module on first use (PEP 562): ``import microimpact.analysis``
-    imports neither lmfit nor emcee."""
-    if name in _HOMES:
-        return getattr(importlib.import_module(f"microimpact.analysis.{_HOMES[name]}"), name)
-    if name in _MODULES:
-        return importlib.import_module(f"microimpact.analysis.{name}")
-    raise AttributeError(f"module 'microimpact.analysis' has no attribute {name!r}")
-
-
-def __dir__():
-    """The public names and modules, also those not loaded yet (``dir()``, tab completion)."""
-    return sorted({*globals(), *_HOMES, *_MODULES})
+__getattr__, __dir__ = _lazy_exports("microimpact.analysis", _HOMES, _MODULES)

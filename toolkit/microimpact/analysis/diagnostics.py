@@ -8,11 +8,11 @@ walkers are not independent chains, but their between/within comparison detects 
 
 References
 ----------
-.. [1] Vehtari, A., Gelman, A., Simpson, D., Carpenter, B., Buerkner, P.-C. (2021). Rank-normalization,
-   folding, and localization: an improved R-hat for assessing convergence of MCMC. Bayesian Analysis
-   16(2), 667-718. doi:10.1214/20-BA1221
-.. [2] Geyer, C. J. (1992). Practical Markov chain Monte Carlo. Statistical Science 7(4), 473-483.
-   doi:10.1214/ss/1177011137
+* Vehtari, A., Gelman, A., Simpson, D., Carpenter, B., Buerkner, P.-C. (2021). Rank-normalization,
+  folding, and localization: an improved R-hat for assessing convergence of MCMC. Bayesian Analysis
+  16(2), 667-718. doi:10.1214/20-BA1221
+* Geyer, C. J. (1992). Practical Markov chain Monte Carlo. Statistical Science 7(4), 473-483.
+  doi:10.1214/ss/1177011137
 """
 
 from __future__ import annotations

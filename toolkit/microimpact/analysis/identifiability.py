@@ -23,11 +23,11 @@ The decision (:func:`parameter_status`) works on the 100 ``level`` % interval of
 
 References
 ----------
-.. [1] Wilks, S. S. (1938). The large-sample distribution of the likelihood ratio for testing
-   composite hypotheses. Ann. Math. Statist. 9, 60-62. doi:10.1214/aoms/1177732360
-.. [2] Raue, A. et al. (2009). Structural and practical identifiability analysis of partially
-   observed dynamical models by exploiting the profile likelihood. Bioinformatics 25, 1923-1929.
-   doi:10.1093/bioinformatics/btp358
+* Wilks, S. S. (1938). The large-sample distribution of the likelihood ratio for testing
+  composite hypotheses. Ann. Math. Statist. 9, 60-62. doi:10.1214/aoms/1177732360
+* Raue, A. et al. (2009). Structural and practical identifiability analysis of partially
+  observed dynamical models by exploiting the profile likelihood. Bioinformatics 25, 1923-1929.
+  doi:10.1093/bioinformatics/btp358
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ The names above load their module on first use (PEP 562): importing a light part
 the variables table or the provenance attributes, does not import pandas or the CSV reader.
 """
 
-import importlib
+from microimpact._lazy import lazy_exports as _lazy_exports
 
 #: public name -> the module of microimpact.io that defines it
 _HOMES = {
@@ -37,14 +37,4 @@ _MODULES = ("files", "formatting", "impacts", "joblog", "kinds", "locks", "mater
             "provenance", "resources", "statuses", "units", "variables")
 
 
-def __getattr__(name: str):
-    if name in _HOMES:
-        return getattr(importlib.import_module(f"microimpact.io.{_HOMES[name]}"), name)
-    if name in _MODULES:
-        return importlib.import_module(f"microimpact.io.{name}")
-    raise AttributeError(f"module 'microimpact.io' has no attribute {name!r}")
-
-
-def __dir__():
-    """The public names and modules, also those not loaded yet (``dir()``, tab completion)."""
-    return sorted({*globals(), *_HOMES, *_MODULES})
+__getattr__, __dir__ = _lazy_exports("microimpact.io", _HOMES, _MODULES)

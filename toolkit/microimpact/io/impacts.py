@@ -10,25 +10,25 @@ One row per impact, in file order, with these columns (always all of them, in th
 missing where a value is neither given nor derivable). Uncertainties are standard uncertainties
 (one standard deviation) in the unit of their quantity.
 
-======================================  ======  ==================================================
-column                                  unit    meaning
-======================================  ======  ==================================================
-``row``                                 [-]     1-based data row in the file (blank lines skipped)
-``line``                                [-]     1-based line of the file where the row starts
-``id``, ``size_class``, ``material_pair``       text labels as written (missing: NA)
-``radius``                              [m]     sphere radius (``diameter`` / 2 if diameter given)
-``speed``                               [m/s]   incident speed magnitude
-``incidence_deg``                       [deg]   incidence angle from the surface normal, [0, 90)
-``normal_speed``                        [m/s]   incident normal speed magnitude, > 0
-``rebound_normal_speed``                [m/s]   rebound normal speed magnitude, >= 0
-``e_n``                                 [1]     normal coefficient of restitution, [0, 1]
-``rebound_tangential_speed``            [m/s]   rebound tangential speed of the centre, >= 0
-``rebound_angle_deg``                   [deg]   rebound angle from the surface normal
-``tangential_restitution``              [1]     e_t = v_t,out / v_t,in (in the incidence plane)
-``rebound_spin``                        [rad/s] angular speed |omega| after the impact, >= 0
-``spin``                                [rad/s] stated incident spin about t', + = top-spin
-``<quantity>_uncertainty``              as qty  for each quantity above from ``radius`` on
-======================================  ======  ==================================================
+==========================================  =======  ==================================================
+column                                      unit     meaning
+==========================================  =======  ==================================================
+``row``                                     [-]      1-based data row in the file (blank lines skipped)
+``line``                                    [-]      1-based line of the file where the row starts
+``id``, ``size_class``, ``material_pair``            text labels as written (missing: NA)
+``radius``                                  [m]      sphere radius (``diameter`` / 2 if diameter given)
+``speed``                                   [m/s]    incident speed magnitude
+``incidence_deg``                           [deg]    incidence angle from the surface normal, [0, 90)
+``normal_speed``                            [m/s]    incident normal speed magnitude, > 0
+``rebound_normal_speed``                    [m/s]    rebound normal speed magnitude, >= 0
+``e_n``                                     [1]      normal coefficient of restitution, [0, 1]
+``rebound_tangential_speed``                [m/s]    rebound tangential speed of the centre, >= 0
+``rebound_angle_deg``                       [deg]    rebound angle from the surface normal
+``tangential_restitution``                  [1]      e_t = v_t,out / v_t,in (in the incidence plane)
+``rebound_spin``                            [rad/s]  angular speed |omega| after the impact, >= 0
+``spin``                                    [rad/s]  stated incident spin about t', + = top-spin
+``<quantity>_uncertainty``                  as qty   for each quantity above from ``radius`` on
+==========================================  =======  ==================================================
 
 Angles are kept in degrees in columns whose names end in ``_deg``, the convention of
 :func:`microimpact.model.kinematics.incident_velocity`; everything else is SI.

@@ -290,13 +290,14 @@ def _format_error(name: str, err: jsonschema.ValidationError) -> list[str]:
     return [f"{where}: {err.message}"]
 
 
-def read_materials(path) -> dict[str, MaterialPair]:
+def read_materials(path=None) -> dict[str, MaterialPair]:
     """Read and validate a materials config.
 
     Parameters
     ----------
-    path : str or os.PathLike
-        YAML file with a top-level ``pairs`` mapping (see data/README.md, "Materials config").
+    path : str or os.PathLike, optional
+        YAML file with a top-level ``pairs`` mapping (see data/README.md, "Materials config");
+        None: the bundled config, :func:`default_materials_path`.
 
     Returns
     -------
@@ -309,8 +310,14 @@ def read_materials(path) -> dict[str, MaterialPair]:
         If the file is not valid YAML or does not match :data:`MATERIALS_SCHEMA`; the message lists
         every problem as ``<file>: <key path>: <what is wrong>``, e.g.
         ``materials.yaml: pairs.alumina.density: -3 is not > 0``.
+
+    Examples
+    --------
+    >>> pairs = read_materials()
+    >>> pairs["ammonium_fluorescein_on_silicon"].density
+    1350.0
     """
-    source = os.fspath(path)
+    source = os.fspath(default_materials_path() if path is None else path)
     name = Path(source).name
     try:
         doc = yaml.load(Path(source).read_text(encoding="utf-8"), Loader=_Loader)

@@ -32,7 +32,7 @@ With micro-slip switched off (F_t = -k_t delta up to the limit) it is their "no-
 model; as k_t grows without bound it becomes the rigid contact of the paper.
 
 Hysteretic tangential contact ("mindlin_deresiewicz")
-----------------------------------------------------
+-----------------------------------------------------
 The "mindlin" force above is a function of the displacement: unloading retraces the loading curve
 and the energy of micro-slip is returned. Mindlin & Deresiewicz (1953) showed that it is not:
 after a turning point the contact first sticks again everywhere (full stiffness k_t) and the
@@ -103,29 +103,29 @@ law F_H + F_A = sqrt(r) (K x^(3/2) - 2 pi f0 x^(1/2)), reached at x = X/3:
 
 References
 ----------
-.. [1] Mindlin, R. D. (1949), Compliance of elastic bodies in contact, J. Appl. Mech. 16:259-268.
-.. [2] Mindlin, R. D. and Deresiewicz, H. (1953), Elastic spheres in contact under varying oblique
-   forces, J. Appl. Mech. 20:327-344.
-.. [3] Johnson, K. L. (1985), Contact Mechanics, Cambridge University Press, Sec. 7.2.
-.. [4] Maw, N., Barber, J. R. and Fawcett, J. N. (1976), The oblique impact of elastic spheres,
-   Wear 38:101-114, doi:10.1016/0043-1648(76)90201-7.
-.. [5] Walton, O. R. and Braun, R. L. (1986), Viscosity, granular-temperature, and stress
-   calculations for shearing assemblies of inelastic, frictional disks, J. Rheol. 30:949-980.
-.. [6] Thornton, C. (1991), Interparticle sliding in the presence of adhesion, J. Phys. D 24:1942-1946.
-.. [7] Thornton, C. and Yin, K. K. (1991), Impact of elastic spheres with and without adhesion,
-   Powder Technol. 65:153-166, doi:10.1016/0032-5910(91)80178-L.
-.. [8] Di Renzo, A. and Di Maio, F. P. (2004), Comparison of contact-force models for the
-   simulation of collisions in DEM-based granular flow codes, Chem. Eng. Sci. 59:525-541,
-   doi:10.1016/j.ces.2003.09.037.
-.. [9] Di Renzo, A. and Di Maio, F. P. (2005), An improved integral non-linear model for the contact
-   of particles in distinct element simulations, Chem. Eng. Sci. 60:1303-1312,
-   doi:10.1016/j.ces.2004.10.004.
-.. [10] Zhou, Y. C., Wright, B. D., Yang, R. Y., Xu, B. H. and Yu, A. B. (1999), Rolling friction in
-   the dynamic simulation of sandpile formation, Physica A 269:536-553,
-   doi:10.1016/S0378-4371(99)00183-1.
-.. [11] Ai, J., Chen, J.-F., Rotter, J. M. and Ooi, J. Y. (2011), Assessment of rolling resistance
-   models in discrete element simulations, Powder Technol. 206:269-282,
-   doi:10.1016/j.powtec.2010.09.030.
+* Mindlin, R. D. (1949), Compliance of elastic bodies in contact, J. Appl. Mech. 16:259-268.
+* Mindlin, R. D. and Deresiewicz, H. (1953), Elastic spheres in contact under varying oblique
+  forces, J. Appl. Mech. 20:327-344.
+* Johnson, K. L. (1985), Contact Mechanics, Cambridge University Press, Sec. 7.2.
+* Maw, N., Barber, J. R. and Fawcett, J. N. (1976), The oblique impact of elastic spheres,
+  Wear 38:101-114, doi:10.1016/0043-1648(76)90201-7.
+* Walton, O. R. and Braun, R. L. (1986), Viscosity, granular-temperature, and stress
+  calculations for shearing assemblies of inelastic, frictional disks, J. Rheol. 30:949-980.
+* Thornton, C. (1991), Interparticle sliding in the presence of adhesion, J. Phys. D 24:1942-1946.
+* Thornton, C. and Yin, K. K. (1991), Impact of elastic spheres with and without adhesion,
+  Powder Technol. 65:153-166, doi:10.1016/0032-5910(91)80178-L.
+* Di Renzo, A. and Di Maio, F. P. (2004), Comparison of contact-force models for the
+  simulation of collisions in DEM-based granular flow codes, Chem. Eng. Sci. 59:525-541,
+  doi:10.1016/j.ces.2003.09.037.
+* Di Renzo, A. and Di Maio, F. P. (2005), An improved integral non-linear model for the contact
+  of particles in distinct element simulations, Chem. Eng. Sci. 60:1303-1312,
+  doi:10.1016/j.ces.2004.10.004.
+* Zhou, Y. C., Wright, B. D., Yang, R. Y., Xu, B. H. and Yu, A. B. (1999), Rolling friction in
+  the dynamic simulation of sandpile formation, Physica A 269:536-553,
+  doi:10.1016/S0378-4371(99)00183-1.
+* Ai, J., Chen, J.-F., Rotter, J. M. and Ooi, J. Y. (2011), Assessment of rolling resistance
+  models in discrete element simulations, Powder Technol. 206:269-282,
+  doi:10.1016/j.powtec.2010.09.030.
 """
 
 from __future__ import annotations

@@ -4,21 +4,21 @@
 by its name; :func:`standard_figure` draws the figure of that kind with the report's own figure
 functions (:mod:`.figures`), so a file plotted alone looks as it does in the PDF report.
 
-=================== =============================================== ==========================
-kind                recognised by                                   figure
-=================== =============================================== ==========================
-``phase_portraits`` a group ``portraits``                           :func:`.plot_phase_portraits`
-``fit``             ``e_n_measured`` and ``zeta_hertz``             :func:`.plot_fit`
-``flags``           ``rotation_sensitive``                          :func:`.plot_flags`
-``material_sweep``  attribute ``sweep_spec``, a ``radius`` dim      :func:`.plot_size_dependence`
-``sweep``           attribute ``sweep_spec``                        :func:`.plot_restitution_and_impulse`
-``bifurcation``     dimensions ``C1`` and ``C2``                    :func:`.plot_bifurcation_plane`
-``benchmark``       ``time_per_impact``                             :func:`.plot_work_precision`
-``kharaz``          ``tangential_restitution_curve``                :func:`.plot_kharaz`
-``model_comparison`` ``aic`` and a ``normal_model`` dim           :func:`.plot_model_comparison`
-``posterior``       ``acceptance_fraction``                         :func:`.plot_corner`
-``oblique``         title "friction fit from oblique impacts"       :func:`.plot_oblique`
-=================== =============================================== ==========================
+==================== =============================================== ==========================
+kind                 recognised by                                   figure
+==================== =============================================== ==========================
+``phase_portraits``  a group ``portraits``                           :func:`.plot_phase_portraits`
+``fit``              ``e_n_measured`` and ``zeta_hertz``             :func:`.plot_fit`
+``flags``            ``rotation_sensitive``                          :func:`.plot_flags`
+``material_sweep``   attribute ``sweep_spec``, a ``radius`` dim      :func:`.plot_size_dependence`
+``sweep``            attribute ``sweep_spec``                        :func:`.plot_restitution_and_impulse`
+``bifurcation``      dimensions ``C1`` and ``C2``                    :func:`.plot_bifurcation_plane`
+``benchmark``        ``time_per_impact``                             :func:`.plot_work_precision`
+``kharaz``           ``tangential_restitution_curve``                :func:`.plot_kharaz`
+``model_comparison`` ``aic`` and a ``normal_model`` dim              :func:`.plot_model_comparison`
+``posterior``        ``acceptance_fraction``                         :func:`.plot_corner`
+``oblique``          title "friction fit from oblique impacts"       :func:`.plot_oblique`
+==================== =============================================== ==========================
 
 A sweep has further figures, as in the PDF report (``variant``, :data:`VARIANTS`): the energy-loss
 ratios (Figs. 7, 9, 11), the posterior's bands on the sweeps, and for a sweep of the fitted material at several sizes e_n and the

@@ -29,7 +29,7 @@ The nondimensional contact energy E = y^2 / 2 + (2/5) a_H xi^(5/2) - (2/3) a_A x
 E' = -(a_H c_1 s^3 + a_A c_2 s) y^2 <= 0, so E < 0 is an exact capture test.
 
 Integration variable (Sundman transformation)
---------------------------------------------
+---------------------------------------------
 In tau the force ~ sqrt(xi) ~ sqrt(tau) is not smooth where contact starts and ends, which costs
 adaptive solvers order and accuracy exactly where e_n is decided. The solver therefore integrates
 the state ``(s, y, v_t, v_t', w_n, w_t, w_t', D, J, tau)`` in a new independent variable sigma

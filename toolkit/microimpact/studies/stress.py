@@ -64,11 +64,8 @@ grows with the number of steps: typically 1e2-1e4 x rtol, so ``TOLERANCES["conve
 1e-4. Strongly damped captures (C = C1 + C2 of order 1e2) creep into the equilibrium in ~C^2
 steps while the twisting moment keeps acting on omega_n; there the global error at rtol 1e-8 can
 pass 1e-4 (seed 0, 20,000 cases of the extended domain: 7 cases, worst 2.9e-4) although the
-integration is sound. Such a case is solved once more at rtol 1e-12 and passes as ``reference_failed``
-    the reference solver raised (e.g. its own time-in-contact limit for an incident speed of
-    1e-8 of the speed scale); the engine's own checks of the case ran.
-``slow_convergence`` when
-d_10 = distance(rtol 1e-10, rtol 1e-12) is within the same tolerance *and* at most d_8 / 10: the
+integration is sound. Such a case is solved once more at rtol 1e-12 and passes as
+``slow_convergence`` when d_10 = distance(rtol 1e-10, rtol 1e-12) is within the same tolerance *and* at most d_8 / 10: the
 error falls at least tenfold for a hundredfold tighter rtol, i.e. the result converges (measured
 d_10 / d_8 = 0.01 on those cases, first order in rtol as expected of an error dominated by where the
 creep is stopped). A bug (a missed event, a wrong branch) does not shrink with rtol and still
@@ -236,7 +233,7 @@ def energy_scale(contact: Contact, ke_in: float) -> float:
 
 
 def energy_error(contact: Contact, result) -> float:
-    """|KE_in - KE_out - final_contact_energy - dissipated| / E_scale. [-]"""
+    """The energy balance's residual, abs(KE_in - KE_out - final_contact_energy - dissipated) / E_scale. [-]"""
     ke_in = kinetic_energy(contact, result.velocity_in, result.omega_in)
     ke_out = kinetic_energy(contact, result.velocity_out, result.omega_out)
     residual = ke_in - ke_out - result.final_contact_energy - result.dissipated_energy

@@ -16,17 +16,21 @@ What is measured (all in one run, on one machine, side by side)
 * **Methods**, each at several settings (dimension ``setting``; for adaptive methods setting k is
   rtol = 10^-(4+k), for the fixed-step Runge-Kutta-Gill method N = 25 * 2^k steps per contact):
 
-  ``engine``          :func:`microimpact.simulate_impact` one call per impact (Python overhead incl.)
-  ``engine_batch``    :func:`microimpact.solvers.engine.solve_normal_many` on a batch of distinct speeds
-                      (both cores); oblique errors through :func:`microimpact.simulate_many`
-  ``engine_family``   :func:`microimpact.solvers.family.normal_family` built over the test set's
-                      speeds and evaluated on many distinct speeds (build included in the time per
-                      impact); oblique errors through :func:`microimpact.simulate_many` on the family path
-  ``rkg``             fixed-step Runge-Kutta-Gill (Gill 1951) on the plain Eq. (27) in tau, the
-                      paper's method, numba-compiled, batch over both cores (``prange``)
+  ``engine``
+      :func:`microimpact.simulate_impact` one call per impact (Python overhead incl.)
+  ``engine_batch``
+      :func:`microimpact.solvers.engine.solve_normal_many` on a batch of distinct speeds (both
+      cores); oblique errors through :func:`microimpact.simulate_many`
+  ``engine_family``
+      :func:`microimpact.solvers.family.normal_family` built over the test set's speeds and
+      evaluated on many distinct speeds (build included in the time per impact); oblique errors
+      through :func:`microimpact.simulate_many` on the family path
+  ``rkg``
+      fixed-step Runge-Kutta-Gill (Gill 1951) on the plain Eq. (27) in tau, the paper's method,
+      numba-compiled, batch over both cores (``prange``)
   ``RK45``, ``DOP853``, ``LSODA``, ``Radau``
-                      :func:`microimpact.solvers.reference.simulate_reference` with that solve_ivp method
-                      (one call per impact; atol = rtol on the O(1) nondimensional state)
+      :func:`microimpact.solvers.reference.simulate_reference` with that solve_ivp method (one
+      call per impact; atol = rtol on the O(1) nondimensional state)
 
 * **Errors**: max over the normal set of |e_n - e_n_ref| (also relative), max over the rebounding
   oblique cases of |mu_t - ref| and |mu_t' - ref|, max over all oblique cases of |K_L - ref|.

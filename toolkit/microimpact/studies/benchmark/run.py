@@ -1,7 +1,7 @@
 """The benchmark run: every method at every setting on one test set, then targets and a Dataset.
 
 :func:`run_benchmark` is a sequence of short steps: warm-up, test set, reference
-(:mod:`.reference`), one runner per method family writing into a :class:`_Table`, engine
+(:mod:`microimpact.studies.benchmark.reference`), one runner per method family writing into a :class:`_Table`, engine
 diagnostics, targets, throughput and memory, and :func:`_dataset`.
 """
 

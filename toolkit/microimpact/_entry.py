@@ -1,0 +1,42 @@
+"""The ``microimpact`` console script: :func:`microimpact.cli.main` in a process of its own.
+
+What only a process of its own may do lives here, not in :mod:`microimpact.cli`, which a test or
+a program imports and calls: install signal handlers. A Ctrl-C while the command imports numpy
+(0.1-0.5 s, longer on a loaded machine) ends in the same one line as one during the work, not in a
+traceback from inside numpy; and a signal that lands in a finaliser still stops the command
+(:func:`microimpact.io.joblog.redeliver_swallowed_signals`). Where SIGINT is ignored (a
+background job) it stays ignored.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+
+#: the one line of a Ctrl-C, and its exit status: 128 + 2, as a shell reports a command SIGINT ended
+INTERRUPTED_LINE = ("microimpact: interrupted; nothing was written (outputs are written whole or not at all); run the "
+                    "same command again to redo it")
+EXIT_INTERRUPTED = 130
+
+
+def _interrupted_while_starting(signum, frame):
+    print(INTERRUPTED_LINE, file=sys.stderr)
+    raise SystemExit(EXIT_INTERRUPTED)
+
+
+def main() -> int:
+    """Run the command line of ``sys.argv``; the exit status."""
+    starting = signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    if starting:
+        signal.signal(signal.SIGINT, _interrupted_while_starting)
+    from microimpact.cli import main as cli_main
+    from microimpact.io.joblog import redeliver_swallowed_signals
+
+    if starting:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    redeliver_swallowed_signals()
+    return cli_main()
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
