@@ -88,6 +88,7 @@ HOW = {
     "snakemake -n --profile workflow/profiles/slurm": "dry",
     "snakemake -n --profile workflow/profiles/slurm --config sweep_chunks=4": "dry",
     "snakemake --profile workflow/profiles/slurm": "dry",
+    "snakemake --profile workflow/profiles/slurm --slurm-no-account --slurm-status-command squeue": "ci",
     "snakemake --profile workflow/profiles/slurm --config sweep_chunks=32 data=path/to/impacts.csv": "dry",
 }
 

@@ -393,9 +393,6 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     documentation recommends for correlated, low-dimensional posteriors; on the bundled data they
     reach the 50-tau rule in fewer steps than the default stretch move.
 
-    Length: two thirds of the function is this docstring (the options, errors and criteria an
-    analyst needs to read in one place); the code is the checks, the likelihood and the result.
-
     References
     ----------
     Foreman-Mackey, D. et al. (2013). emcee: the MCMC hammer. PASP 125, 306. doi:10.1086/670067;
@@ -410,18 +407,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     names = list(damping_fit.varied) + (["friction"] if friction_fit is not None else [])
     best = dict(damping_fit.values) | ({"friction": friction_fit.friction} if friction_fit is not None else {})
     stderr = dict(damping_fit.stderr) | ({"friction": friction_fit.stderr["friction"]} if friction_fit is not None else {})
-    walkers = DEFAULT_WALKERS if walkers is None else int(walkers)
-    fixed_length = steps is not None
-    budget = int(steps) if fixed_length else (DEFAULT_MAX_STEPS if max_steps is None else int(max_steps))
-    if walkers < 2 * len(names) or budget < 2:
-        raise ValueError(f"walkers must be >= {2 * len(names)} (twice the {len(names)} parameters) and steps >= 2, "
-                         f"got walkers={walkers}, steps={budget}")
-    if burn is not None and not 0 <= int(burn) < budget:
-        raise ValueError(f"burn must lie in [0, steps), got {burn}")
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed <= MAX_SEED:
-        raise ValueError(f"seed must be a whole number in [0, {MAX_SEED}] (the posterior file stores it as a "
-                         f"32-bit integer), got {seed!r}")
-    check_posterior_memory(walkers, budget, len(names))
+    walkers, budget, fixed_length = _sampler_options(walkers, steps, max_steps, burn, seed, len(names))
     bounds = prior_bounds(names, best)
     lo = np.array([bounds[n][0] for n in names])
     hi = np.array([bounds[n][1] for n in names])
@@ -444,6 +430,31 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
         raise PosteriorError(f"the posterior has not converged after {done} steps of {walkers} walkers ({text}); "
                              + ("give more steps" if fixed_length else "give a larger max_steps (CLI --max-steps)")
                              + _undetermined_hint(damping_fit, friction_fit))
+    return _posterior_record(sampler, diag, names, best, bounds, like, damping_fit, friction_fit, seed, converged,
+                             text, errors_in_variables, time.perf_counter() - t0)
+
+def _sampler_options(walkers, steps, max_steps, burn, seed, n_params: int) -> tuple[int, int, bool]:
+    """(walkers, steps budget, fixed length) of :func:`sample_posterior`'s options, checked before
+    any work: a bad seed must not be found only after the whole chain has run."""
+    walkers = DEFAULT_WALKERS if walkers is None else int(walkers)
+    fixed_length = steps is not None
+    budget = int(steps) if fixed_length else (DEFAULT_MAX_STEPS if max_steps is None else int(max_steps))
+    if walkers < 2 * n_params or budget < 2:
+        raise ValueError(f"walkers must be >= {2 * n_params} (twice the {n_params} parameters) and steps >= 2, "
+                         f"got walkers={walkers}, steps={budget}")
+    if burn is not None and not 0 <= int(burn) < budget:
+        raise ValueError(f"burn must lie in [0, steps), got {burn}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed <= MAX_SEED:
+        raise ValueError(f"seed must be a whole number in [0, {MAX_SEED}] (the posterior file stores it as a "
+                         f"32-bit integer), got {seed!r}")
+    check_posterior_memory(walkers, budget, n_params)
+    return walkers, budget, fixed_length
+
+
+def _posterior_record(sampler, diag, names, best, bounds, like, damping_fit, friction_fit, seed, converged, text,
+                      errors_in_variables, elapsed) -> Posterior:
+    """The :class:`Posterior` of a finished chain: the chain, its diagnostics, what was held fixed,
+    the priors and how the speed errors entered."""
     fixed = {n: best[n] for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion") if n not in names}
     if friction_fit is None:
         fixed["friction"] = float(damping_fit.friction)
@@ -454,7 +465,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
                      autocorr_time=dict(zip(names, map(float, diag["tau"]))),
                      acceptance_fraction=np.asarray(sampler.acceptance_fraction, dtype=float), seed=int(seed),
                      info={"errors_in_variables": eiv, "latent_rows": tuple(int(r) for r in like.latent_rows),
-                           "elapsed_s": time.perf_counter() - t0, "converged": converged, "convergence": text,
+                           "elapsed_s": elapsed, "converged": converged, "convergence": text,
                            "source": str(damping_fit.info.get("source") or ""),
                            "rhat": dict(zip(names, map(float, diag["rhat"]))),
                            "ess_bulk": dict(zip(names, map(float, diag["ess"]))),
