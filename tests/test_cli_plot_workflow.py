@@ -151,15 +151,11 @@ def test_other_commands_still_refuse_unknown_arguments(capsys):
     assert "unrecognized option --no-such-option" in capsys.readouterr().err
 
 
-@pytest.mark.slow
-def test_ctrl_c_of_the_workflow_ends_in_one_line_and_a_plain_rerun_resumes(tmp_path):
-    """Ctrl-C of ``microimpact workflow`` (SIGINT to the process group): status 130, the wrapper's
-    one line and no traceback; Snakemake stops its jobs and releases its lock (the wrapper used to
-    kill it, leaving 'Directory cannot be locked'), and the same command again goes on without
-    --unlock or --rerun-incomplete (shown by its dry run)."""
+def _workflow_running(tmp_path, **popen):
+    """``microimpact workflow`` started in its own process group on a copy of data/, returned once
+    its first result file exists: (command, run directory, environment, process)."""
     import os
     import shutil
-    import signal
     import subprocess
     import time
 
@@ -168,13 +164,27 @@ def test_ctrl_c_of_the_workflow_ends_in_one_line_and_a_plain_rerun_resumes(tmp_p
     run = tmp_path / "run"
     shutil.copytree(Path(__file__).resolve().parents[1] / "data", run / "data")
     env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
-    proc = subprocess.Popen([*cmd, "workflow", "--directory", str(run), "--cores", "2"], stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True, start_new_session=True, env=env,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    proc = subprocess.Popen([*cmd, "workflow", "--directory", str(run), "--cores", "2"], start_new_session=True,
+                            env=env, **popen)
     deadline = time.monotonic() + 120
     while not list(run.glob("results/**/*.nc")) and time.monotonic() < deadline:
-        time.sleep(0.5)
-    assert proc.poll() is None, "the run ended before it could be interrupted"
+        time.sleep(0.2)
+    assert proc.poll() is None, "the run ended before it could be stopped"
+    return cmd, run, env, proc
+
+
+@pytest.mark.slow
+def test_ctrl_c_of_the_workflow_ends_in_one_line_and_a_plain_rerun_resumes(tmp_path):
+    """Ctrl-C of ``microimpact workflow`` (SIGINT to the process group): status 130, the wrapper's
+    one line and no traceback; Snakemake stops its jobs and releases its lock (the wrapper used to
+    kill it, leaving 'Directory cannot be locked'), and the same command again goes on without
+    --unlock or --rerun-incomplete (shown by its dry run)."""
+    import os
+    import signal
+    import subprocess
+
+    cmd, run, env, proc = _workflow_running(tmp_path, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     os.killpg(proc.pid, signal.SIGINT)
     out, _ = proc.communicate(timeout=120)
     assert proc.returncode == 130, out[-3000:]
@@ -194,23 +204,12 @@ def test_a_killed_workflow_is_unlocked_by_the_rerun_only_when_nothing_holds_the_
     says so, but not while a Snakemake process works in the directory: then it refuses with status
     2, naming the process, and the lock stays."""
     import os
-    import shutil
     import signal
     import subprocess
-    import time
 
-    exe = shutil.which("microimpact")
-    cmd = [exe] if exe else [sys.executable, "-m", "microimpact.cli"]
-    run = tmp_path / "run"
-    shutil.copytree(Path(__file__).resolve().parents[1] / "data", run / "data")
-    env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
-    proc = subprocess.Popen([*cmd, "workflow", "--directory", str(run), "--cores", "2"], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, start_new_session=True, env=env)
+    cmd, run, env, proc = _workflow_running(tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     locks = run / ".snakemake" / "locks"
-    deadline = time.monotonic() + 120
-    while not list(run.glob("results/**/*.nc")) and time.monotonic() < deadline:
-        time.sleep(0.2)
-    assert proc.poll() is None and list(locks.glob("*.lock")), "the run ended before it could be killed"
+    assert list(locks.glob("*.lock")), "the run ended before it could be killed"
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait(timeout=30)
     assert list(locks.glob("*.lock"))  # the kill left the lock

@@ -19,7 +19,7 @@ from microimpact.analysis.fit_result import DampingFit
 from microimpact.analysis.fitting import fit_damping
 from microimpact.analysis.identifiability import (ParameterStatus, chi2_threshold, parameter_status, profile_interval,
                                                   status_from_interval)
-from microimpact.analysis.oblique import FrictionFit, fit_friction
+from microimpact.analysis.oblique import fit_friction
 from microimpact.analysis.synthetic import make_synthetic_oblique
 from microimpact.cli import main
 from microimpact.io import default_materials_path, read_impacts, read_materials

@@ -6,20 +6,17 @@ The data are the bundled SYNTHETIC microsphere file (data/README.md) and small s
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
-import xarray as xr
 
 from microimpact.analysis.fitting import FitProblem, fit_damping, model_restitution
 from microimpact.analysis.posterior import (GAUSS_HERMITE_NODES, _Likelihood, capture_velocity_interval,
                                             load_posterior, posterior_dataset, restitution_bands, sample_posterior,
                                             sweep_bands)
-from microimpact.analysis.synthetic import SYNTHETIC_DEFAULTS, make_synthetic_impacts
+from microimpact.analysis.synthetic import make_synthetic_impacts
 from microimpact.io import default_materials_path, read_impacts, read_materials
 from microimpact.io.files import write_csv, write_netcdf
 

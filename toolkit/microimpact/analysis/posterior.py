@@ -42,8 +42,6 @@ Every model evaluation goes through :func:`microimpact.solvers.engine.solve_norm
 
 from __future__ import annotations
 
-import contextlib
-import io as _stdio
 import math
 import numbers
 import time
@@ -692,7 +690,6 @@ def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int =
         ``sweep_e_n_band``, ``sweep_mu_t_band``, ``sweep_K_L_band`` (case, sweep_speed, quantile) [1].
     """
     from microimpact.model.parameters import TABLE2_CASES
-    from microimpact.solvers.impact import simulate_many
 
     cases = list(TABLE2_CASES) if cases is None else list(cases)
     radii = damping_fit.radii

@@ -766,7 +766,7 @@ def _read_records(source: str, data: bytes) -> tuple[list[str], int, list[_Recor
     if bad is not None:
         first = bad.splitlines()[0] if bad.splitlines() else ""
         problems.append(Problem(
-            f'a quote (") opens a header field here and is not closed on this line, so the following '
+            'a quote (") opens a header field here and is not closed on this line, so the following '
             "lines were read as part of the header; remove the stray quote or close it",
             line=header_line, value=first[:60] + ("..." if len(first) > 60 else "")))
         raise ImpactDataError(source, problems)

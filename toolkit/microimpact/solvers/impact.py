@@ -493,7 +493,6 @@ def _simulate_over_contacts(contact, contact_fields: dict, **kwargs) -> xr.Datas
     dimensions (an index coordinate of the field's values each); the ``contact_<field>``
     attribute of a varied field holds its values."""
     import dataclasses
-    import itertools
 
     import xarray as xr
 

@@ -25,7 +25,6 @@ from microimpact.io.files import write_csv
 from microimpact.io.impacts import read_impacts
 from microimpact.io.materials import default_materials_path, read_materials
 
-from microimpact.solvers import engine
 from microimpact.solvers.family import normal_family
 from microimpact.solvers.impact import simulate_many
 from microimpact.studies.benchmark.cases import ALL_METHODS, BenchmarkConfig, level_rtol
