@@ -27,7 +27,7 @@ SCRIPT = textwrap.dedent("""
 
     Finaliser()
     try:
-        deadline = time.monotonic() + 5
+        deadline = time.monotonic() + 2
         while time.monotonic() < deadline:
             time.sleep(0.01)
         print("ran on")
