@@ -164,5 +164,11 @@ def test_result_reprs_are_one_line_with_the_estimates(tmp_path):
     assert "\n" not in text and len(text) < 200, text
     assert text.startswith("DampingFit(zeta_hertz=") and "+/-" in text and "(fixed)" in text, text
     assert repr(fit).startswith("AnalystFit(DampingFit(") and "\n" not in repr(fit)
+    # in a notebook: the whole report, escaped
+    import html
+
+    for result in (fit, fit.damping):
+        shown = result._repr_html_()
+        assert shown == f"<pre>{html.escape(result.report())}</pre>" and "zeta_hertz" in shown
     exact = repr(damping_from_target([0.5, 0.6], [2.0, 3.0], WALL_1990, n_points=5))
     assert "exact(" in exact and "+/-" not in exact, exact

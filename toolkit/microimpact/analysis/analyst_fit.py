@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import xarray as xr
 
+from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.provenance import stamp_parameters
 from microimpact.solvers import DEFAULT_RTOL, Deadline
@@ -36,7 +37,7 @@ POSTERIOR_DEFAULTS = _posterior_defaults()
 
 
 @dataclass(frozen=True, eq=False)
-class AnalystFit:
+class AnalystFit(ReportHTML):
     """Result of :func:`analyse_impacts`.
 
     Attributes

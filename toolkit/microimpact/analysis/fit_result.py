@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from microimpact.io.formatting import ReportHTML
 from microimpact.analysis.identifiability import status_from_variables, status_variables
 from microimpact.io.statuses import stderr_is_meaningful
 from microimpact.io.files import CONVENTIONS, write_netcdf
@@ -37,7 +38,7 @@ _POINT_COLUMNS = ("row", "radius", "normal_speed", "e_n", "sigma", "model", "res
 
 # --------------------------------------------------------------------------- result
 @dataclass(frozen=True, eq=False)
-class DampingFit:
+class DampingFit(ReportHTML):
     """Result of :func:`fit_damping`.
 
     Attributes

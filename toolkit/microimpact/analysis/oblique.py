@@ -49,6 +49,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.impacts import OBLIQUE_COLUMNS, insert_row_labels, label_variables, row_labels
 from microimpact.io.progress import progress_bar
@@ -335,7 +336,7 @@ def effective_sigma(problem: ObliqueProblem, contact_of, parameters: dict, rtol:
 
 
 @dataclass(frozen=True, eq=False)
-class FrictionFit:
+class FrictionFit(ReportHTML):
     """Result of :func:`fit_friction`.
 
     Attributes

@@ -52,6 +52,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from microimpact.io.formatting import ReportHTML
 from microimpact.analysis.fit_result import PARAMETER_NAMES
 from microimpact.analysis.sampling_defaults import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS,
                                                     MAX_SEED)
@@ -79,7 +80,7 @@ QUANTILES = (0.025, 0.16, 0.5, 0.84, 0.975)
 
 
 @dataclass(frozen=True, eq=False)
-class Posterior:
+class Posterior(ReportHTML):
     """An MCMC sample of the fitted parameters.
 
     Attributes

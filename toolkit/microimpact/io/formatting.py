@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-__all__ = ["format_cell", "format_number", "format_duration", "estimates_repr"]
+__all__ = ["format_cell", "format_number", "format_duration", "estimates_repr", "ReportHTML"]
 
 
 def format_cell(value, *, markdown: bool = False, float_format: str = ".4g") -> str:
@@ -95,3 +95,22 @@ def estimates_repr(kind: str, values: dict, stderr: dict | None = None, varied=N
             parts.append(f"{name}={value:.4g}")
     parts += [f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v!r}" for k, v in extra.items()]
     return f"{kind}({', '.join(parts)})"
+
+
+class ReportHTML:
+    """Mixin: a result with a ``report()`` text shows that text in a notebook (``_repr_html_``)
+    instead of its one-line repr.
+
+    Examples
+    --------
+    >>> class Result(ReportHTML):
+    ...     def report(self):
+    ...         return "zeta_H = 0.5 < 1"
+    >>> Result()._repr_html_()
+    '<pre>zeta_H = 0.5 &lt; 1</pre>'
+    """
+
+    def _repr_html_(self) -> str:
+        import html
+
+        return f"<pre>{html.escape(self.report())}</pre>"
