@@ -172,3 +172,22 @@ def test_result_reprs_are_one_line_with_the_estimates(tmp_path):
         assert shown == f"<pre>{html.escape(result.report())}</pre>" and "zeta_hertz" in shown
     exact = repr(damping_from_target([0.5, 0.6], [2.0, 3.0], WALL_1990, n_points=5))
     assert "exact(" in exact and "+/-" not in exact, exact
+
+
+def test_approx_has_no_hidden_absolute_tolerance():
+    """tests/conftest.py: ``pytest.approx`` without ``abs=`` is relative only, so an SI quantity of
+    a microsphere (1e-13 kg, 1e-14 J) compared with ``rel=`` fails when the result is 0."""
+    assert 0.0 != pytest.approx(2.3e-13, rel=1e-6)
+    assert 0.0 != pytest.approx(1e-14)
+    assert 2.3e-13 * (1 + 1e-9) == pytest.approx(2.3e-13, rel=1e-6)
+
+
+def test_every_solver_failure_has_one_base_class():
+    """One ``except SolverError`` catches a failure of any solver (issue 26, item 7)."""
+    from microimpact.solvers import SolverError
+    from microimpact.solvers.coupled import CoupledError
+    from microimpact.solvers.engine import EngineError
+    from microimpact.solvers.reference import ReferenceSolverError
+
+    for error in (EngineError, CoupledError, ReferenceSolverError):
+        assert issubclass(error, SolverError) and issubclass(error, RuntimeError), error

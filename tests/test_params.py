@@ -16,13 +16,27 @@ def test_wall_1990_is_table_1_row_2():
     assert get_preset("WALL1990") is c
 
 
+def test_table_1_row_1_is_as_printed():
+    """Table 1 row 1 of the paper, both ends, as printed (literal values: a mistyped f0 such as 5.430
+    must fail here, not only in a regression file made from the code itself)."""
+    from microimpact.model.parameters import TABLE1
+
+    small, large = TABLE1["row1_small"], TABLE1["row1_large"]
+    assert (small.radius, small.adhesion_line_force) == (1.29e-6, 5.340)
+    assert (large.radius, large.adhesion_line_force) == (3.45e-6, 7.390)
+    for c in (small, large):
+        assert (c.density, c.stiffness, c.zeta_hertz, c.zeta_adhesion, c.friction) == (1350.0, 1.776e9, 0.50, 29.0, 0.15)
+
+
 def test_scales_of_the_model_notes():
     # model-notes section 5 quotes X = 26 nm, T = 21 ns, m = 2.32e-13 kg (2-3 significant digits)
     c = WALL_1990
     assert c.mass == pytest.approx(2.32e-13, rel=5e-3)
     assert c.length_scale == pytest.approx(26e-9, rel=2e-2)
     assert c.time_scale == pytest.approx(21e-9, rel=2e-2)
-    assert c.moment_of_inertia == pytest.approx(0.4 * c.mass * c.radius**2, rel=1e-15)
+    # (2/5) m r^2 with m = (4/3) pi r^3 rho: 1.10555e-24 kg m^2 for r = 3.45 um
+    assert c.moment_of_inertia == pytest.approx(0.4 * (4 / 3 * math.pi * 3.45e-6**3 * 1350.0) * 3.45e-6**2, rel=1e-14)
+    assert c.moment_of_inertia == pytest.approx(1.10555e-24, rel=1e-5)
 
 
 def test_time_scale_makes_eq_28_dimensionless():

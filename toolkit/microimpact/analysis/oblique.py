@@ -40,7 +40,6 @@ by :func:`microimpact.solvers.engine.solve_normal_many` plus the closed-form tan
 
 from __future__ import annotations
 
-import contextlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -53,7 +52,7 @@ from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.impacts import OBLIQUE_COLUMNS, insert_row_labels, label_variables, row_labels
 from microimpact.io.progress import progress_bar
-from microimpact.solvers import DEFAULT_RTOL, Deadline
+from microimpact.solvers import DEFAULT_RTOL, Deadline, engine_threads
 
 __all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
            "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"]
@@ -455,30 +454,6 @@ class FrictionFit(ReportHTML):
     def save(self, path):
         """Write :meth:`to_dataset` atomically."""
         return write_netcdf(self.to_dataset(), path)
-
-
-@contextlib.contextmanager
-def engine_threads(threads: int | None = 1):
-    """Run the engine on ``threads`` threads inside the block (None: unchanged), restored after.
-
-    One thread for the fits and the sampler: they make thousands of small engine calls, for which
-    thread start-up and, on a shared machine, waiting for the second thread cost more than the
-    second core gains (measured on the 2-core machine under load: 4 ms per posterior evaluation on
-    one thread against 50 ms on two; see also :func:`microimpact.analysis.fitting.fit_damping`).
-    """
-    if threads is None:
-        yield
-        return
-    import numba
-
-    from microimpact.solvers import engine
-
-    previous = numba.get_num_threads()
-    engine.set_threads(threads)
-    try:
-        yield
-    finally:
-        engine.set_threads(previous)
 
 
 def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rtol: float = DEFAULT_RTOL,

@@ -398,7 +398,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     Vehtari, A. et al. (2021). doi:10.1214/20-BA1221 (R-hat, effective sample size).
     """
     from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX
-    from microimpact.analysis.oblique import engine_threads
+    from microimpact.solvers import engine_threads
 
     t0 = time.perf_counter()
     deadline = Deadline.start(time_budget, "posterior")
@@ -632,7 +632,7 @@ def restitution_bands(posterior: Posterior, damping_fit, speeds=None, *, n_draws
     radii = damping_fit.radii
     draws = posterior.draws(n_draws)
     e = np.empty((radii.size, len(draws), v.size))
-    from microimpact.analysis.oblique import engine_threads
+    from microimpact.solvers import engine_threads
 
     deadline = Deadline.start(time_budget, "restitution bands")
     with engine_threads(1):
@@ -662,7 +662,7 @@ def capture_velocity_interval(posterior: Posterior, damping_fit, *, n_draws: int
 
     radii = damping_fit.radii
     draws = posterior.draws(n_draws)
-    from microimpact.analysis.oblique import engine_threads
+    from microimpact.solvers import engine_threads
 
     deadline = Deadline.start(time_budget, "capture velocity interval")
     v = []
@@ -699,7 +699,7 @@ def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int =
     v = np.geomspace(lo, hi, n_speeds)
     draws = posterior.draws(n_draws)
     out = {q: np.empty((len(cases), len(draws), v.size)) for q in ("e_n", "mu_t", "K_L")}
-    from microimpact.analysis.oblique import engine_threads
+    from microimpact.solvers import engine_threads
 
     deadline = Deadline.start(time_budget, "sweep bands")
     with engine_threads(1):

@@ -37,7 +37,8 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from microimpact.analysis.oblique import OBSERVABLE_UNITS, ObliqueProblem, engine_threads, rebound_state
+from microimpact.analysis.oblique import OBSERVABLE_UNITS, ObliqueProblem, rebound_state
+from microimpact.solvers import engine_threads
 from microimpact.io.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 

@@ -232,7 +232,7 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
         raise ValueError("give the sphere radius (radius=..., or a Contact that has one)")
     se = (np.full(e.size, np.nan) if e_n_uncertainty is None
           else np.broadcast_to(np.asarray(e_n_uncertainty, dtype=float), e.shape).copy())
-    from microimpact.analysis.oblique import engine_threads
+    from microimpact.solvers import engine_threads
 
     model = _model(material, r, rtol)
     zh = np.empty((e.size, n_points))

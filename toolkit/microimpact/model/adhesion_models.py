@@ -303,7 +303,8 @@ def thornton_ning_sticking_velocity(radius, density, stiffness, work_of_adhesion
     """Thornton & Ning (1998): v_s = 1.84 (w^5 / (rho^3 E*^2 R^5))^(1/6), E* = 3 K / 4. [m/s]
 
     Parameters: R [m], rho [kg/m^3], K [Pa], w [J/m^2]. The coefficient is published to three
-    digits; :func:`jkr_sticking_velocity` gives 1.8405 in its place.
+    digits; :func:`jkr_sticking_velocity` gives sqrt(3 H pi^(2/3) / 8) = 1.84018 in its place
+    (H = :data:`JKR_HYSTERESIS`).
     """
     e_star = 0.75 * stiffness
     return THORNTON_NING_COEFFICIENT * (work_of_adhesion**5 / (density**3 * e_star**2 * radius**5)) ** (1.0 / 6.0)

@@ -18,8 +18,10 @@ solver evaluates the contact law of :mod:`microimpact.model.law`; the compiled o
 :mod:`.compiled_law`, which compiles the law's own functions instead of keeping a copy.
 """
 
+import contextlib
 import math
 import numbers
+import sys
 import time
 from dataclasses import dataclass
 
@@ -27,6 +29,17 @@ from dataclasses import dataclass
 #: At 1e-8 the engine's e_n and impulse ratios are within about 5e-8 of the reference solution
 #: (docs/benchmark.md), far below any measurement's uncertainty, at half the cost of 1e-10.
 DEFAULT_RTOL = 1e-8
+#: The smallest relative tolerance accepted: 100 machine epsilons, as scipy's solve_ivp (below it no
+#: double-precision integration can meet the tolerance, and the engine ends at its step limit).
+MIN_RTOL = 100.0 * sys.float_info.epsilon
+
+
+class SolverError(RuntimeError):
+    """A solver could not finish an impact: a caller's step limit, a step-size underflow, no outcome
+    within the reference solver's limits. The base of :class:`~microimpact.solvers.engine.EngineError`,
+    :class:`~microimpact.solvers.coupled.CoupledError` and
+    :class:`~microimpact.solvers.reference.ReferenceSolverError`, so that one ``except`` catches a
+    failure of any solver."""
 
 
 class ModelDomainError(ValueError):
@@ -127,6 +140,37 @@ class Deadline:
             self.check(f"{calls[0]} function evaluations of {stage}")
 
         return iter_cb
+
+@contextlib.contextmanager
+def engine_threads(threads: int | None = 1):
+    """Run the compiled solvers on ``threads`` threads inside the block (None: unchanged), restored after.
+
+    One thread for the fits and the sampler: they make thousands of small engine calls, for which
+    thread start-up and, on a shared machine, waiting for the second thread cost more than the
+    second core gains (4 ms per posterior evaluation on one thread against 50 ms on two, measured
+    on the 2-core machine under load).
+
+    Examples
+    --------
+    >>> import numba
+    >>> with engine_threads(1):
+    ...     numba.get_num_threads()
+    1
+    """
+    if threads is None:
+        yield
+        return
+    import numba
+
+    from microimpact.solvers import engine
+
+    previous = numba.get_num_threads()
+    engine.set_threads(threads)
+    try:
+        yield
+    finally:
+        engine.set_threads(previous)
+
 
 #: The solvers behind simulate_impact(method=...).
 METHODS = ("engine", "reference", "rkg")

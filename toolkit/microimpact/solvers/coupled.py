@@ -83,6 +83,7 @@ from microimpact.model import law as _law
 from microimpact.model import tangential_compliance as _tc
 from microimpact.model.kinematics import flat_broadcast
 from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form maps
+from microimpact.solvers import SolverError
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.engine import _equilibrium, _linear_tail_variation
 
@@ -114,7 +115,7 @@ _B = np.array([35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.
 _E = np.array([71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0])
 
 
-class CoupledError(RuntimeError):
+class CoupledError(SolverError):
     """The coupled solver could not finish an impact (step limit or step-size underflow).
 
     Not expected for valid input: every impact ends by separation or by the settle criterion of

@@ -65,7 +65,7 @@ import numpy as np
 from numba import njit, prange, set_num_threads
 
 from microimpact.model.contact import check_positive
-from microimpact.solvers import DEFAULT_RTOL, ModelDomainError
+from microimpact.solvers import DEFAULT_RTOL, ModelDomainError, SolverError
 from microimpact.model.law import Scales, hertz_impact_scales, nondimensional_impact, nondimensional_scales  # nondimensional_scales: re-exported
 from microimpact.solvers import compiled_law as law
 
@@ -215,7 +215,7 @@ def _failure(status) -> str:
     return "step limit reached" if status == _MAX_STEPS else "step size underflow"
 
 
-class EngineError(RuntimeError):
+class EngineError(SolverError):
     """The compiled solver could not finish an impact (a caller's step limit, step-size underflow,
     or a result that failed its own check). Not raised for valid input at the default step limit:
     the stress sweep of the extended domain checks this."""

@@ -20,7 +20,7 @@ import numpy as np
 
 from microimpact.io.provenance import contact_attributes
 from microimpact.io.variables import attributes
-from microimpact.solvers import DEFAULT_RTOL, METHODS, check_sub_models, engine
+from microimpact.solvers import DEFAULT_RTOL, METHODS, MIN_RTOL, check_sub_models, engine
 from microimpact.solvers.family import (FAMILY_MIN_SPEEDS, NODE_RTOL_FLOOR, FamilyBudgetExceeded, normal_family,
                                        normal_speed_range)
 from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
@@ -34,10 +34,6 @@ if TYPE_CHECKING:  # xarray is imported by the batch functions only: one simulat
     import xarray as xr
 
 __all__ = ["simulate_impact", "simulate_many", "check_rtol", "RESULT_VARIABLES", "MIN_RTOL", "FAMILY_MIN_SPEEDS"]
-
-#: smallest relative tolerance accepted: 100 machine epsilons, as scipy's solve_ivp (below it no
-#: double-precision integration can meet the tolerance, and the engine ends at its step limit)
-MIN_RTOL = 100.0 * sys.float_info.epsilon
 
 #: the variables that simulate_many returns (units and long names in microimpact.io.variables)
 RESULT_VARIABLES: tuple[str, ...] = (

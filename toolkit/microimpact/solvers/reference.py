@@ -92,7 +92,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from microimpact.model import law
-from microimpact.solvers import DEFAULT_RTOL, Deadline, TimeBudgetExceeded
+from microimpact.solvers import DEFAULT_RTOL, Deadline, SolverError, TimeBudgetExceeded
 from microimpact.model.coefficients import impact_coefficients
 from microimpact.model.kinematics import ImpactResult, incident_velocity
 from microimpact.model.contact import Contact
@@ -127,7 +127,7 @@ _TAIL_SAFETY = 2.0
 _S, _Y, _VT, _VTP, _WN, _WT, _WTP, _D, _J, _TAU = range(10)
 
 
-class ReferenceSolverError(RuntimeError):
+class ReferenceSolverError(SolverError):
     """The reference integration failed or ran out of time without an outcome."""
 
 
