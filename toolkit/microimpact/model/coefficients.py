@@ -10,8 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
-
+from microimpact._numba import njit
 from microimpact.model.kinematics import flat_broadcast
 
 __all__ = ["impact_coefficients", "coefficients_kernel"]

@@ -16,8 +16,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
-
+from microimpact._numba import njit
 from microimpact.model.kinematics import flat_broadcast
 from microimpact.model.law import TWIST_TORQUE_FACTOR  # torque = factor * f * a * |F_n|
 

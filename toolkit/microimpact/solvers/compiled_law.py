@@ -2,16 +2,12 @@
 
 No formula is written here: each function is the law's own Python function compiled by numba with
 ``inline="always"``, so it is inlined into its compiled callers (the engine and the
-Runge-Kutta-Gill integrator) and runs with their flags (``fastmath`` in the engine, none in the
-RKG). The scipy reference solver and :mod:`microimpact.dynamics` call the Python originals.
-
-Note on numba's on-disk cache: it is invalidated by changes to the caller's own source file only.
-After editing a formula in :mod:`microimpact.model.law`, delete the ``*.nbi``/``*.nbc`` files under
-``toolkit/microimpact/solvers/__pycache__`` (numba documents this limitation of ``cache=True``).
+Runge-Kutta-Gill integrator). The scipy reference solver and :mod:`microimpact.dynamics` call the
+Python originals. An edit of a law reaches the compiled solvers at their next start: their cache is
+keyed by the sources of ``model/`` and ``solvers/`` (:mod:`microimpact._numba`).
 """
 
-from numba import njit
-
+from microimpact._numba import njit
 from microimpact.model import law
 
 

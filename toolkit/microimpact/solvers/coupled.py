@@ -77,8 +77,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from microimpact._numba import njit
 from microimpact.model import law as _law
 from microimpact.model import tangential_compliance as _tc
 from microimpact.model.kinematics import flat_broadcast
@@ -129,13 +130,13 @@ def _branch_slip(z, hist):
     return hist[0] * ((z[_VT] + z[_WTP]) * hist[2] + (z[_VTP] - z[_WT]) * hist[3])
 
 
-@njit(cache=True, fastmath=True, inline="always")
+@njit(cache=True, inline="always")
 def _load_rate(s, y, xi_dd, c1, c2, ah, aa):
     """dF_n/dsigma of F_n = a_h s^3 (1 + c1 y) - a_a s (1 - c2 y), with ds = y/2, dy = s xi''."""
     return (3.0 * ah * s * s * (1.0 + c1 * y) - aa * (1.0 - c2 * y)) * 0.5 * y + (ah * c1 * s * s * s + aa * c2 * s) * s * xi_dd
 
 
-@njit(cache=True, fastmath=True, inline="always")
+@njit(cache=True, inline="always")
 def _md_terms(z, p, hist, s, xi_dd, load):
     """(F_lim, dF_lim/dsigma, s s_b u.e) of the hysteretic law at the state z (nondimensional)."""
     c1, c2, ah, aa, f, fpo, aware = p[0], p[1], p[2], p[3], p[4], p[5], p[6] > 0.5
@@ -145,7 +146,7 @@ def _md_terms(z, p, hist, s, xi_dd, load):
     return f * load, dlim, s * _branch_slip(z, hist)
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def _rhs(z, p, hist, out):
     """d/dsigma of the state z.
 
@@ -201,7 +202,7 @@ def _rhs(z, p, hist, out):
             out[_WTP] *= held
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def _step(z, k1, h, p, hist, k, tmp, z1, err):
     """One Dormand-Prince 5(4) step of length h from z (derivative k1); k[6] = f(z1)."""
     for i in range(_N):

@@ -62,8 +62,9 @@ import os
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange, set_num_threads
+from numba import prange, set_num_threads
 
+from microimpact._numba import njit
 from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL, ModelDomainError, SolverError
 from microimpact.model.law import Scales, hertz_impact_scales, nondimensional_impact, nondimensional_scales  # nondimensional_scales: re-exported
@@ -222,7 +223,7 @@ class EngineError(SolverError):
 
 
 # --------------------------------------------------------------------------- compiled core
-@njit(cache=True, fastmath=True, inline="always")
+@njit(cache=True, inline="always")
 def _derivatives(s, y, c1, c2, ah, aa, sgn):
     """d/dsigma of the state (s, y, tau, D, J_a) at (s, y) (see the module docstring)."""
     s2 = s * s
@@ -230,19 +231,19 @@ def _derivatives(s, y, c1, c2, ah, aa, sgn):
     return 0.5 * y, g, s, law.nondimensional_dissipation_rate(s2, s2 * s2, y, c1, c2, ah, aa), sgn * s * g
 
 
-@njit(cache=True, fastmath=True, inline="always")
+@njit(cache=True, inline="always")
 def _rhs_row(u, c1, c2, ah, aa, sgn, k, j):
     """d/dsigma of the state u, written into row j of k."""
     k[j, 0], k[j, 1], k[j, 2], k[j, 3], k[j, 4] = _derivatives(u[0], u[1], c1, c2, ah, aa, sgn)
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def _rhs(u, c1, c2, ah, aa, sgn, out):
     """d/dsigma of the state u, written into out."""
     out[0], out[1], out[2], out[3], out[4] = _derivatives(u[0], u[1], c1, c2, ah, aa, sgn)
 
 
-@njit(cache=True, fastmath=True)
+@njit(cache=True)
 def _step(u0, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err):
     """One DP5 step from u0 (derivative k1) over h; writes u1, err and k[6] = f(u1)."""
     n = _NSTATE  # a compile-time constant lets LLVM unroll the stage loops

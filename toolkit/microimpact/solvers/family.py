@@ -53,8 +53,9 @@ from dataclasses import dataclass, field
 
 import numba
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from microimpact._numba import njit
 from microimpact.model.coefficients import coefficients_kernel
 from microimpact.model.tangential import tangential_kernel
 from microimpact.solvers import DEFAULT_RTOL, engine

@@ -40,8 +40,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from microimpact._numba import njit
 from microimpact.model import adhesion_models as am
 from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL

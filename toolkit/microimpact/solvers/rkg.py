@@ -21,8 +21,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from microimpact._numba import njit
 from microimpact.model.contact import check_positive
 from microimpact.model.law import nondimensional_impact
 from microimpact.solvers import compiled_law as law

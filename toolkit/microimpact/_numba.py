@@ -1,0 +1,96 @@
+"""numba's ``njit`` for the compiled parts of microimpact, with an on-disk cache that cannot go stale.
+
+numba's ``cache=True`` notices edits to the compiled function's own file only, so a solver kernel
+that inlines a law of :mod:`microimpact.model.law` kept the old law after the law was edited. Every
+kernel of the package is therefore cached under a directory named after a hash of the sources of
+everything that is compiled (``model/``, ``solvers/`` and this file): a change to any of them
+starts a new cache, and an old one is never read again.
+
+Where the cache lives: ``$NUMBA_CACHE_DIR/microimpact-<hash>`` when the user sets
+``NUMBA_CACHE_DIR``; otherwise ``__pycache__/numba-<hash>`` beside this file, or, where the package
+directory cannot be written (a system-wide install), ``~/.cache/microimpact/numba-<hash>``. The
+directory is set for the package's own functions only, at their decoration; other packages'
+numba caches are not touched.
+
+No kernel uses ``fastmath``: with it, the code numba runs right after compiling and the code it
+later loads from its cache come from two separate passes of LLVM's back end and round differently,
+so a first (compiling) run and a second (cached) run of the same computation gave different
+numbers. Without it they are bitwise equal (``tests/test_compile_cache.py``), and the engine is
+not slower (README, "Speed and accuracy").
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import os
+from pathlib import Path
+
+import numba
+from numba.core import config
+
+__all__ = ["njit", "cache_directory", "source_hash"]
+
+_PACKAGE = Path(__file__).resolve().parent
+#: the sources whose compiled code is cached: a change to any of them invalidates every kernel
+_COMPILED_SOURCES = ("model", "solvers")
+
+
+@functools.lru_cache(maxsize=1)
+def source_hash() -> str:
+    """First 16 hex digits of the sha256 of the compiled sources (``model/``, ``solvers/``, this file).
+
+    Examples
+    --------
+    >>> len(source_hash())
+    16
+    """
+    digest = hashlib.sha256()
+    files = sorted(p for d in _COMPILED_SOURCES for p in (_PACKAGE / d).glob("*.py")) + [Path(__file__).resolve()]
+    for path in files:
+        digest.update(path.relative_to(_PACKAGE).as_posix().encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+@functools.lru_cache(maxsize=1)
+def cache_directory() -> str:
+    """The directory of this version's compiled kernels (module docstring).
+
+    Examples
+    --------
+    >>> source_hash() in cache_directory()
+    True
+    """
+    user = os.environ.get("NUMBA_CACHE_DIR")
+    if user:
+        return os.path.join(user, f"microimpact-{source_hash()}")
+    local = _PACKAGE / "__pycache__"
+    try:
+        local.mkdir(exist_ok=True)
+        if os.access(local, os.W_OK):
+            return str(local / f"numba-{source_hash()}")
+    except OSError:
+        pass
+    return os.path.join(os.path.expanduser("~"), ".cache", "microimpact", f"numba-{source_hash()}")
+
+
+def njit(*args, **kwargs):
+    """:func:`numba.njit`, with the package's cache directory for ``cache=True`` (module docstring).
+
+    Used as ``@njit(cache=True, ...)`` or ``njit(inline="always", cache=True)(func)``.
+    """
+    if len(args) == 1 and callable(args[0]) and not kwargs:  # bare @njit
+        return _decorate(args[0], ())
+    return lambda func: _decorate(func, args, **kwargs)
+
+
+def _decorate(func, args, **kwargs):
+    if not kwargs.get("cache"):
+        return numba.njit(*args, **kwargs)(func)
+    previous = config.CACHE_DIR
+    config.CACHE_DIR = cache_directory()  # read when the dispatcher sets up its cache, i.e. now
+    try:
+        return numba.njit(*args, **kwargs)(func)
+    finally:
+        config.CACHE_DIR = previous
