@@ -69,7 +69,7 @@ MUTATIONS = [
      '"row1_small": Contact(radius=1.29e-6, adhesion_line_force=5.430', "Table 1 row 1, f0"),
     ("model/tangential_compliance.py", "return 8.0 * shear_modulus * np.asarray(contact_radius, dtype=float)",
      "return 7.0 * shear_modulus * np.asarray(contact_radius, dtype=float)", "Mindlin stiffness k_t = 8 G* a"),
-    ("solvers/normal_models.py", "zb, z_eq = 1.0, 6.0 ** (1.0 / 3.0)", "zb, z_eq = 1.0, 5.0 ** (1.0 / 3.0)",
+    ("solvers/normal_models.py", "else 1.0), 6.0 ** (1.0 / 3.0)", "else 1.0), 5.0 ** (1.0 / 3.0)",
      "JKR settled contact, q^3 = 6"),
 ]
 

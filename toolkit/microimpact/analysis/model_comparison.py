@@ -52,7 +52,7 @@ def normal_model_restitution(problem: FitProblem, normal_model: str, zeta_hertz,
     ----------
     problem : FitProblem
         Data grouped by radius and the material (density, stiffness, damping reference speed).
-    normal_model : {"ring", "jkr", "dmt"}
+    normal_model : {"ring", "jkr", "dmt", "jkr_force"}
     zeta_hertz, zeta_adhesion : float
         Eqs. (14)-(15). [-]
     work_of_adhesion : float
@@ -114,7 +114,7 @@ def compare_normal_models(table, base, models=DEFAULT_MODELS, *, rtol: float = D
         one > 0; else unweighted).
     base : MaterialPair, Contact or DampingFit
         Density [kg/m^3], stiffness [Pa], the starting w_A [J/m^2] and the damping reference speed.
-    models : sequence of {"ring", "jkr", "dmt"}
+    models : sequence of {"ring", "jkr", "dmt", "jkr_force"}
     rtol : float
         Relative tolerance of the normal solves. [-]
     curve_points : int

@@ -24,6 +24,17 @@ U / (F_J L_J) = q^10 / 15 - 2 q^7 / 3 + q^4; the energy lost in one undamped con
 adhesion hysteresis of Johnson & Pollock 1994) is U(1) - U(q0) = 2/5 + (12/5) 4^(1/3) = 4.2098 in
 these units.
 
+Where the contact breaks. The JKR relation has two stable ways to end a contact, and they are not
+the same physics: under a controlled *displacement* (a rigid sphere pulled by its own inertia, the
+case of an impact; Johnson & Pollock 1994, Thornton & Ning 1998) the contact follows the curve
+down to d delta / d a = 0, q = 1, where the force has risen back to -(5/9) F_c; under a controlled
+*load* it breaks at the largest tension, F = -F_c, where dF/da = 0: q^3 = 3, delta = -3^(1/3) L_J.
+``normal_model="jkr"`` is the first (the impact literature's); ``"jkr_force"`` the second, which
+DEM engines use (LAMMPS ``pair_style granular`` ``jkr``: contact is lost where the pull-off force
+is reached), so that a user can match such an engine. The hysteresis of the force-controlled cycle
+is U(3^(1/3)) - U(q0) = (3/5) 4^(4/3) - (2/5) 3^(4/3) = 2.0791, and its sticking velocity is
+sqrt(2.0791 / 4.2098) = 0.703 times the displacement-controlled one.
+
 DMT (Derjaguin, Muller & Toporov 1975): the Hertz force and a constant pull-off force,
 
     F = sqrt(R) K delta^(3/2) - 2 pi w R    (delta > 0),   F = 0  (delta <= 0),
@@ -74,6 +85,9 @@ __all__ = [
     "JKR_REGIME_MIN_TABOR",
     "DMT_REGIME_MAX_TABOR",
     "JKR_HYSTERESIS",
+    "JKR_HYSTERESIS_FORCE",
+    "JKR_Q_BREAK",
+    "jkr_hysteresis",
     "THORNTON_NING_COEFFICIENT",
     "AdhesionRegimeWarning",
     "AdhesionScales",
@@ -106,6 +120,11 @@ JKR_Q_FORMATION = 4.0 ** (1.0 / 3.0)
 #: Energy lost in one undamped JKR contact cycle, U(1) - U(q0) = 2/5 + (12/5) 4^(1/3), in units of
 #: F_J L_J = pi w a_c^2 (module docstring). [-]
 JKR_HYSTERESIS = 0.4 + 2.4 * JKR_Q_FORMATION
+#: JKR q at which contact breaks, per normal model: q = 1 (d delta/da = 0) under a controlled
+#: displacement ("jkr"), q^3 = 3 (dF/da = 0, F = -F_c) under a controlled load ("jkr_force"). [-]
+JKR_Q_BREAK = {"jkr": 1.0, "jkr_force": 3.0 ** (1.0 / 3.0)}
+#: Energy lost in one undamped force-controlled JKR cycle, U(3^(1/3)) - U(q0), in units F_J L_J. [-]
+JKR_HYSTERESIS_FORCE = 0.6 * 4.0 ** (4.0 / 3.0) - 0.4 * 3.0 ** (4.0 / 3.0)
 #: Numerical coefficient of the Thornton & Ning (1998) sticking velocity, as published (3 digits). [-]
 THORNTON_NING_COEFFICIENT = 1.84
 
@@ -158,21 +177,21 @@ def adhesion_scales(contact, model: str | None = None) -> AdhesionScales:
     ----------
     contact : Contact
         With adhesion (f0 > 0, so w > 0).
-    model : {"jkr", "dmt"}, optional
-        Default ``contact.normal_model``.
+    model : {"jkr", "dmt", "jkr_force"}, optional
+        Default ``contact.normal_model``; both JKR break criteria share the JKR units.
     """
     model = contact.normal_model if model is None else model
     w, r, k = contact.work_of_adhesion, contact.radius, contact.stiffness
     if not w > 0.0:
         raise ValueError("the JKR and DMT scales need adhesion (adhesion_line_force > 0)")
-    if model == "jkr":
+    if model in ("jkr", "jkr_force"):
         a_c = (math.pi * w * r * r / (8.0 * _effective_modulus(contact))) ** (1.0 / 3.0)
         length, force, a_unit = a_c * a_c / r, math.pi * w * r, a_c
     elif model == "dmt":
         length = (2.0 * math.pi * w * math.sqrt(r) / k) ** (2.0 / 3.0)
         force, a_unit = 2.0 * math.pi * w * r, math.sqrt(r * length)
     else:
-        raise ValueError(f"adhesion_scales is for normal_model 'jkr' or 'dmt', got {model!r}")
+        raise ValueError(f"adhesion_scales is for normal_model 'jkr', 'jkr_force' or 'dmt', got {model!r}")
     return AdhesionScales(length, force, math.sqrt(contact.mass * length / force), a_unit)
 
 
@@ -210,8 +229,8 @@ def check_adhesion_regime(contact, equilibrium_separation=DEFAULT_EQUILIBRIUM_SE
     """
     mu = float(tabor_parameter(contact.radius, contact.stiffness, contact.work_of_adhesion, equilibrium_separation))
     if contact.work_of_adhesion > 0.0:
-        if contact.normal_model == "jkr" and mu < JKR_REGIME_MIN_TABOR:
-            warnings.warn(f"normal_model='jkr' with Tabor parameter mu_T = {mu:.3g} < {JKR_REGIME_MIN_TABOR:g} "
+        if contact.normal_model in ("jkr", "jkr_force") and mu < JKR_REGIME_MIN_TABOR:
+            warnings.warn(f"normal_model={contact.normal_model!r} with Tabor parameter mu_T = {mu:.3g} < {JKR_REGIME_MIN_TABOR:g} "
                           f"(z0 = {equilibrium_separation:.3g} m): outside the JKR regime (Johnson & Greenwood 1997)",
                           AdhesionRegimeWarning, stacklevel=stacklevel)
         elif contact.normal_model == "dmt" and mu > DMT_REGIME_MAX_TABOR:
@@ -289,14 +308,30 @@ def dmt_force(radius, stiffness, work_of_adhesion, approach):
 
 
 # =============================================================================== sticking velocity
+def jkr_hysteresis(normal_model: str = "jkr") -> float:
+    """Energy lost in one undamped JKR contact cycle, in units F_J L_J = pi w a_c^2. [-]
+
+    U(q_break) - U(4^(1/3)) with the break of ``normal_model`` (:data:`JKR_Q_BREAK`): 4.2098 for the
+    displacement-controlled break ("jkr"), 2.0791 for the force-controlled one ("jkr_force").
+
+    Examples
+    --------
+    >>> round(jkr_hysteresis("jkr"), 4), round(jkr_hysteresis("jkr_force"), 4)
+    (4.2098, 2.0791)
+    """
+    return JKR_HYSTERESIS_FORCE if normal_model == "jkr_force" else JKR_HYSTERESIS
+
+
 def jkr_sticking_velocity(contact) -> float:
-    """Exact undamped JKR sticking velocity v_s = sqrt(2 Delta_E / m), Delta_E = JKR_HYSTERESIS pi w a_c^2. [m/s]
+    """Exact undamped JKR sticking velocity v_s = sqrt(2 Delta_E / m), Delta_E = H pi w a_c^2. [m/s]
 
     Below v_s an elastic JKR impact is captured; above, e_n = sqrt(1 - v_s^2 / v^2). Delta_E is the
-    work of the adhesive force between delta_c and 0 on unloading (Johnson & Pollock 1994).
+    work of the adhesive force between the break and delta = 0 on unloading (Johnson & Pollock
+    1994); H = :func:`jkr_hysteresis` of the contact's break criterion ("jkr_force": force-controlled;
+    otherwise the displacement-controlled "jkr").
     """
     sc = adhesion_scales(contact, "jkr")
-    return math.sqrt(2.0 * JKR_HYSTERESIS * sc.force * sc.length / contact.mass)
+    return math.sqrt(2.0 * jkr_hysteresis(contact.normal_model) * sc.force * sc.length / contact.mass)
 
 
 def thornton_ning_sticking_velocity(radius, density, stiffness, work_of_adhesion) -> float:

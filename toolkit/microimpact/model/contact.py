@@ -28,13 +28,14 @@ __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_
 
 #: the selectable sub-models of the one contact law: field -> accepted names, the first (the
 #: paper's model) being the default. "ring" is the paper's adhesion ring force (Eqs. 4-6); "jkr"
-#: and "dmt" are the alternative normal adhesion models; "rigid" is the paper's tangentially rigid
+#: and "dmt" are the alternative normal adhesion models, "jkr_force" JKR whose contact breaks where
+#: the force reaches -F_c (as LAMMPS GRANULAR's jkr) instead of at the critical approach; "rigid" is the paper's tangentially rigid
 #: contact (closed-form tangential map), "mindlin" an elastic tangential contact with micro-slip,
 #: "mindlin_deresiewicz" the same with the loading/unloading/reloading memory (hysteresis);
 #: "net" is the paper's Coulomb limit f |F_n|, "pulloff" an adhesion-aware limit that does not vanish
 #: at the adhesive equilibrium.
 SUB_MODELS: dict[str, tuple[str, ...]] = {
-    "normal_model": ("ring", "jkr", "dmt"),
+    "normal_model": ("ring", "jkr", "dmt", "jkr_force"),
     "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
     "friction_model": ("net", "pulloff"),
 }
@@ -140,8 +141,9 @@ class Contact:
     damping_reference_speed : float or None
         Reference speed v_n of Eqs. (14)-(15). None (the paper's default) uses each impact's own
         incident normal speed; a float fixes it for every impact. [m/s]
-    normal_model : {"ring", "jkr", "dmt"}
-        Normal adhesion model (:data:`SUB_MODELS`); "ring" is the paper's. [-]
+    normal_model : {"ring", "jkr", "dmt", "jkr_force"}
+        Normal adhesion model (:data:`SUB_MODELS`); "ring" is the paper's; "jkr_force" is JKR with the
+        force-controlled break of DEM engines (:mod:`microimpact.model.adhesion_models`). [-]
     tangential_model : {"rigid", "mindlin", "mindlin_deresiewicz"}
         Tangential contact model; "rigid" is the paper's; "mindlin_deresiewicz" adds the hysteresis
         of micro-slip (:mod:`microimpact.model.tangential_compliance`). [-]

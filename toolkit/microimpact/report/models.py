@@ -17,8 +17,8 @@ from microimpact.report.layout import Layout
 
 __all__ = ["model_comparison_section", "plot_model_comparison"]
 
-_STYLES = {"ring": "-", "jkr": "--", "dmt": ":"}
-_NAMES = {"ring": "ring force (paper)", "jkr": "JKR", "dmt": "DMT"}
+_STYLES = {"ring": "-", "jkr": "--", "dmt": ":", "jkr_force": "-."}
+_NAMES = {"ring": "ring force (paper)", "jkr": "JKR", "dmt": "DMT", "jkr_force": "JKR, force-controlled break"}
 
 
 @_rc

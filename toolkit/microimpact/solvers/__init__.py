@@ -182,10 +182,10 @@ SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
     # the engine runs the paper's model (rigid, net) as one normal solve plus the closed-form map and
     # every other tangential/friction choice with the compiled coupled solver (.coupled), which
     # integrates the ring normal law only (check_sub_models refuses jkr/dmt with it)
-    "engine": {"normal_model": ("ring", "jkr", "dmt"),
+    "engine": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"),
                "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
                "friction_model": ("net", "pulloff")},
-    "reference": {"normal_model": ("ring", "jkr", "dmt"), "tangential_model": ("rigid",), "friction_model": ("net",)},
+    "reference": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"), "tangential_model": ("rigid",), "friction_model": ("net",)},
     "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
 }
 #: solver paths that model rolling resistance (Contact.rolling_friction > 0): the engine's coupled

@@ -53,8 +53,8 @@ __all__ = ["solve_normal", "solve_normal_many", "solve_normal_reference", "settl
            "MODEL_CODES"]
 
 #: the models this module integrates, and their codes in the compiled core
-MODEL_CODES = {"jkr": 1, "dmt": 2}
-_JKR, _DMT = 1, 2
+MODEL_CODES = {"jkr": 1, "dmt": 2, "jkr_force": 3}
+_JKR, _DMT, _JKR_FORCE = 1, 2, 3  # both JKR codes share the law; they differ where contact breaks
 _OK, _MAX_STEPS, _STEP_UNDERFLOW = 0, 1, 2
 _N = 6  # state: z (q or s), y, tau, D, J, J_a
 _MAX_STEPS_DEFAULT = 2_000_000
@@ -84,7 +84,7 @@ _E = np.array([71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 3
 def _rhs(model, u, c1, c2, out):
     """d/dsigma of the state u = (z, y, tau, D, J, J_a), written into out."""
     z, y = u[0], u[1]
-    if model == _JKR:
+    if model != _DMT:
         g = 4.0 * (z * z * z - 1.0)  # d tau / d sigma
         f = _jkr_force(z, y, c1, c2)
         out[0] = y
@@ -105,7 +105,7 @@ def _rhs(model, u, c1, c2, out):
 @njit(cache=True, inline="always")
 def _energy(model, z, y):
     """Contact energy y^2/2 + U(z) in the model's units. [-]"""
-    if model == _JKR:
+    if model != _DMT:
         return 0.5 * y * y + _jkr_potential(z)
     return 0.5 * y * y + _dmt_potential(z)
 
@@ -206,8 +206,8 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
     u1 = np.zeros(_N)
     tmp = np.zeros(_N)
     err = np.zeros(_N)
-    if model == _JKR:
-        zb, z_eq = 1.0, 6.0 ** (1.0 / 3.0)
+    if model != _DMT:  # breaks at q = 1 (displacement-controlled) or q^3 = 3 (force-controlled)
+        zb, z_eq = (3.0 ** (1.0 / 3.0) if model == _JKR_FORCE else 1.0), 6.0 ** (1.0 / 3.0)
         u[0] = 4.0 ** (1.0 / 3.0)
     else:
         zb, z_eq = 0.0, 1.0
@@ -305,17 +305,19 @@ def _setup(contact, normal_speed):
 
 def _penetration(model, sc, zmax):
     """Largest approach delta [m] from the largest z (q for JKR, s for DMT)."""
-    return sc.length * (zmax**4 - 4.0 * zmax if model == _JKR else zmax * zmax)
+    return sc.length * (zmax * zmax if model == _DMT else zmax**4 - 4.0 * zmax)
 
 
 def _restitution(model, y0, damping_loss):
     """e_n of a rebound from the energy balance, sqrt(1 - 2 (D + H) / y0^2). [-]
 
-    D is the integrated damping dissipation and H the JKR hysteresis (0 for DMT), in units F L.
+    D is the integrated damping dissipation and H the JKR hysteresis of the model's break (0 for
+    DMT), in units F L.
     This is more accurate than the exit rate -y_end / y0 (a few 1e-9 against 1e-8 at rtol 1e-8,
     checked against the reference at rtol 1e-13), and exact without damping.
     """
-    loss = np.asarray(damping_loss, dtype=float) + (am.JKR_HYSTERESIS if model == _JKR else 0.0)
+    hysteresis = {_JKR: am.JKR_HYSTERESIS, _JKR_FORCE: am.JKR_HYSTERESIS_FORCE}.get(model, 0.0)
+    loss = np.asarray(damping_loss, dtype=float) + hysteresis
     return np.sqrt(np.maximum(1.0 - 2.0 * loss / np.square(y0), 0.0))
 
 
@@ -430,7 +432,7 @@ def settled_contact_energy(contact) -> float:
     if _hertz(contact):
         return 0.0
     sc = am.adhesion_scales(contact)
-    if contact.normal_model == "jkr":
+    if contact.normal_model in ("jkr", "jkr_force"):
         u = am.jkr_nondimensional_potential(6.0 ** (1.0 / 3.0)) - am.jkr_nondimensional_potential(am.JKR_Q_FORMATION)
     else:
         u = am.dmt_nondimensional_potential(1.0)
@@ -453,8 +455,10 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
 
     v = check_positive("normal_speed", normal_speed)
     model, sc, y0, c1, c2 = _setup(contact, v)
-    jkr = model == _JKR
-    l_c = -3.0 if jkr else 0.0  # break at delta_c / L_J = -3 (JKR) or delta = 0 (DMT)
+    jkr = model != _DMT
+    # break at delta_c / L_J = -3 (JKR, q = 1), at -3^(1/3) (force-controlled JKR, q^3 = 3) or at
+    # delta = 0 (DMT)
+    l_c = {_JKR: -3.0, _JKR_FORCE: -(3.0 ** (1.0 / 3.0))}.get(model, 0.0)
 
     def zq(d):  # the model's z (q for JKR, s for DMT) from delta / L
         return float(am.jkr_q_from_approach(max(d, -3.0))) if jkr else math.sqrt(max(d, 0.0))
