@@ -61,7 +61,7 @@ HOW = {
     # README.md: signals at random moments of a pipeline run (the CI runs one trial)
     "python tests/study_interruptions.py --trials 20 --load 1 --seed 1 --out docs/interruptions.json": "study",
     "python -m microimpact.studies.calibration --designs 12 --seed 7 --out calibration.json --figure calibration.png": "ci",
-    # README.md: one-line mutations of the physics (its full run takes tens of minutes: the CI runs two)
+    # README.md: one-line mutations of the physics (the CI runs the first 8, without the baseline run)
     "python tests/mutation_check.py --out docs/mutations.json": "study",
     "microimpact benchmark --quick --out results/benchmark": "ci",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "ci",
