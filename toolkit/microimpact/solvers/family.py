@@ -427,11 +427,17 @@ def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = 
     -------
     NormalFamily
 
-    Example
-    -------
+    Examples
+    --------
+    >>> import microimpact as mi
     >>> from microimpact.presets import get_preset
     >>> fam = normal_family(get_preset("wall1990"), 0.2, 10.0)
     >>> out = fam.evaluate([0.5, 2.0, 7.5])
+    >>> out["captured"].tolist()
+    [True, False, False]
+    >>> direct = mi.simulate_impact(get_preset("wall1990"), 2.0).e_n
+    >>> abs(out["e_n"][1] - direct) < 1e-8
+    True
     """
     if contact.normal_model != "ring":
         raise ValueError(f"normal_family interpolates the paper's ring normal law, got normal_model={contact.normal_model!r}")
