@@ -436,7 +436,7 @@ def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = 
     >>> out["captured"].tolist()
     [True, False, False]
     >>> direct = mi.simulate_impact(get_preset("wall1990"), 2.0).e_n
-    >>> abs(out["e_n"][1] - direct) < 1e-8
+    >>> bool(abs(out["e_n"][1] - direct) < 1e-8)
     True
     """
     if contact.normal_model != "ring":
