@@ -1,4 +1,4 @@
-"""Which rows were probably spun, and by how much: flags that explain (issue 15, item 4).
+"""Which rows were probably spun, and by how much: flags that explain.
 
 For every measured impact, :func:`spin_explanation` asks two questions of the model, over the
 posterior (a set of posterior draws, or the point estimate when no posterior is given):

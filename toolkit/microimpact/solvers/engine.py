@@ -31,8 +31,8 @@ dissipation D are integrated as extra states. Integration is Dormand-Prince 5(4)
 on all states; events are located by re-stepping from the start of the step (Illinois method), so
 their accuracy is that of the integrator.
 
-Regimes left to closed forms instead of a step limit (issue 12)
-----------------------------------------------------------------
+Regimes left to closed forms instead of a step limit
+----------------------------------------------------
 * **Inertia-free (overdamped) limit.** When the damping force dwarfs inertia (inertia ratio
   |y_m'| / damping below :data:`INERTIA_FREE_ENTER` = 1e-6), relaxes the motion much faster than
   the sphere crosses the contact (relaxation ratio above :data:`RELAXATION_ENTER` = 1e3) and the
@@ -826,13 +826,11 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
 
     Length: the set-up, the undamped mirror and the decision to stop a captured sphere are
     compiled helpers (above). The work done at every step -- error norm, the events that shorten
-    the step, the advance -- stays in this loop: as compiled helpers (numba ``inline="always"`` or
-    not) they made the engine 1.5 times slower (measured: 20,000 impacts through
-    ``solve_normal_many`` on one thread, 0.057 s -> 0.085 s). The inertia-free jump is here too:
-    its test (:func:`_inertia_free`, a few multiplications at every step) is a helper, but the jump
-    rewrites the loop's own state (u, J, sgn, k1, the recorded events) and may continue the loop,
-    and so does the averaged tail of a weakly damped capture; together they took the loop from 159
-    to 214 lines, and recording the first zero of the energy (the capture time) to 224.
+    the step, the advance -- stays in this loop, because as compiled helpers (numba
+    ``inline="always"`` or not) they made the engine markedly slower (``python -m
+    microimpact.studies.benchmark`` compares such variants side by side). The inertia-free jump and
+    the averaged tail of a weakly damped capture rewrite the loop's own state (u, J, sgn, k1, the
+    recorded events) and may continue the loop, so they stay in it too; their tests are helpers.
     """
     u = np.zeros(_NSTATE)
     u[1] = y0

@@ -463,8 +463,8 @@ def _index_coordinates(inputs: dict, arrays: list) -> dict:
     """An index coordinate for every dimension of the batch that has none: the values of the input
     the dimension is named after (a plain array's axis, or a DataArray on a dimension of its own
     name), else of the one DataArray input that lies along that dimension alone, else 0, 1, 2, ...
-    So every dimension can be ``.sel``-ed (issue 28: a DataArray without a coordinate made a 2-D
-    variable named after its dimension)."""
+    So every dimension can be ``.sel``-ed (a DataArray without a coordinate would otherwise give a
+    2-D variable named after its dimension)."""
     import xarray as xr
 
     dims = arrays[0].dims
