@@ -55,6 +55,7 @@ __all__ = ["solve_normal", "solve_normal_many", "solve_normal_reference", "settl
 #: the models this module integrates, and their codes in the compiled core
 MODEL_CODES = {"jkr": 1, "dmt": 2, "jkr_force": 3}
 _JKR, _DMT, _JKR_FORCE = 1, 2, 3  # both JKR codes share the law; they differ where contact breaks
+_Q_BREAK_FORCE = am.JKR_Q_BREAK["jkr_force"]  # q^3 = 3, where F = -F_c
 _OK, _MAX_STEPS, _STEP_UNDERFLOW = 0, 1, 2
 _N = 6  # state: z (q or s), y, tau, D, J, J_a
 _MAX_STEPS_DEFAULT = 2_000_000
@@ -207,7 +208,7 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
     tmp = np.zeros(_N)
     err = np.zeros(_N)
     if model != _DMT:  # breaks at q = 1 (displacement-controlled) or q^3 = 3 (force-controlled)
-        zb, z_eq = (3.0 ** (1.0 / 3.0) if model == _JKR_FORCE else 1.0), 6.0 ** (1.0 / 3.0)
+        zb, z_eq = (_Q_BREAK_FORCE if model == _JKR_FORCE else 1.0), 6.0 ** (1.0 / 3.0)
         u[0] = 4.0 ** (1.0 / 3.0)
     else:
         zb, z_eq = 0.0, 1.0
@@ -458,7 +459,7 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
     jkr = model != _DMT
     # break at delta_c / L_J = -3 (JKR, q = 1), at -3^(1/3) (force-controlled JKR, q^3 = 3) or at
     # delta = 0 (DMT)
-    l_c = {_JKR: -3.0, _JKR_FORCE: -(3.0 ** (1.0 / 3.0))}.get(model, 0.0)
+    l_c = {_JKR: -3.0, _JKR_FORCE: _Q_BREAK_FORCE**4 - 4.0 * _Q_BREAK_FORCE}.get(model, 0.0)
 
     def zq(d):  # the model's z (q for JKR, s for DMT) from delta / L
         return float(am.jkr_q_from_approach(max(d, -3.0))) if jkr else math.sqrt(max(d, 0.0))
