@@ -218,3 +218,46 @@ def test_coupled_solver_against_its_baseline(coupled_now):
         assert np.abs(rebound).max(initial=0.0) <= noise, name
         if friction == "pulloff" and tangential != "rigid" and rolling == 0.0:
             assert res["n_steps"][captured].sum() < 0.1 * old["n_steps"][captured].sum(), name
+
+
+# --------------------------------------------------------------------------- every law
+#: Relative change (to each quantity's largest value over the cases of its law) allowed against
+#: tests/regression/baseline/laws.nc. The baseline was solved at rtol 1e-9 by the code of b2dc57e;
+#: the same code reproduces it bit for bit (no fastmath: a cold and a warm compile agree), so this
+#: only admits a rearranged expression that moves an adaptive solve's step sequence (its result
+#: then moves by far less than the solver's own error, ~1e2-1e4 rtol). A changed law or a changed
+#: event moves a quantity far more.
+LAWS_NOISE = 1e-9
+
+
+@pytest.fixture(scope="module")
+def laws_now():
+    import sys
+
+    sys.path.insert(0, str(BASELINE.parent))
+    try:
+        import laws_cases
+    finally:
+        sys.path.remove(str(BASELINE.parent))
+    return laws_cases, xr.load_dataset(BASELINE / "laws.nc")
+
+
+@pytest.mark.parametrize("selection", ["ring", "jkr", "jkr_force", "dmt", "mindlin", "mindlin_deresiewicz",
+                                       "mindlin_pulloff", "md_pulloff_rolling"])
+def test_every_law_against_its_baseline(laws_now, selection):
+    """Every law and sub-model selection of the engine solves the baseline's 40 impacts as the code
+    of b2dc57e did: the same outcome (NaN pattern: mu_t, capture time) and every quantity to
+    LAWS_NOISE of its scale."""
+    import warnings
+
+    cases, base = laws_now
+    old = base[selection].values
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        new = np.array([cases.solve(c, selection) for c in cases.cases()])
+    assert np.array_equal(np.isnan(new), np.isnan(old)), f"{selection}: outcomes changed"
+    for j, name in enumerate(base["quantity"].values):
+        ok = np.isfinite(old[:, j])
+        scale = np.max(np.abs(old[ok, j]), initial=0.0)
+        diff = np.max(np.abs(new[ok, j] - old[ok, j]), initial=0.0)
+        assert diff <= LAWS_NOISE * scale, f"{selection} {name}: moved by {diff:.3g} (scale {scale:.3g})"
