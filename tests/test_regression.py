@@ -228,6 +228,12 @@ def test_coupled_solver_against_its_baseline(coupled_now):
 #: then moves by far less than the solver's own error, ~1e2-1e4 rtol). A changed law or a changed
 #: event moves a quantity far more.
 LAWS_NOISE = 1e-9
+#: Changed on purpose since the baseline: a captured JKR or DMT impact whose tangential outcome needs
+#: the rest of its oscillation ends it with the closed-form linear damped tail once that tail's
+#: error (~ amplitude / equilibrium approach) is below rtol of J, instead of integrating it out;
+#: the twist impulse takes the contact radius at the equilibrium. Measured: 2-3 of 40 rows per law
+#: moved, by at most 3.8e-8 of the scale (omega_n of a JKR row); the other rows are bit for bit.
+LAWS_CAPTURED_TAIL = {"jkr": 1e-7, "jkr_force": 1e-7, "dmt": 1e-7}
 
 
 @pytest.fixture(scope="module")
@@ -256,8 +262,10 @@ def test_every_law_against_its_baseline(laws_now, selection):
         warnings.simplefilter("ignore")
         new = np.array([cases.solve(c, selection) for c in cases.cases()])
     assert np.array_equal(np.isnan(new), np.isnan(old)), f"{selection}: outcomes changed"
+    captured = np.isnan(old[:, list(base["quantity"].values).index("mu_t")])
+    noise = np.where(captured, LAWS_CAPTURED_TAIL.get(selection, LAWS_NOISE), LAWS_NOISE)
     for j, name in enumerate(base["quantity"].values):
         ok = np.isfinite(old[:, j])
         scale = np.max(np.abs(old[ok, j]), initial=0.0)
-        diff = np.max(np.abs(new[ok, j] - old[ok, j]), initial=0.0)
-        assert diff <= LAWS_NOISE * scale, f"{selection} {name}: moved by {diff:.3g} (scale {scale:.3g})"
+        excess = np.abs(new[ok, j] - old[ok, j]) - noise[ok] * scale
+        assert np.all(excess <= 0.0), f"{selection} {name}: moved by more than allowed (scale {scale:.3g})"

@@ -29,6 +29,23 @@ energy). A captured sphere is followed at least to its largest penetration (y = 
 tangential outcome is needed until its friction and twist impulses reach the values that end
 sliding and twist, or until it settles.
 
+Regimes left to closed forms instead of a step limit (the engine's, :mod:`.engine`):
+
+* **Inertia-free (overdamped) limit.** Where the damping rate C dwarfs the stiffness (inertia
+  ratio |dy_m/dx| / C below the engine's ``INERTIA_FREE_ENTER`` here and ``INERTIA_FREE_RESUME``
+  all the way to the equilibrium, relaxation ratio above ``RELAXATION_ENTER``) and the rate lies on
+  the slow manifold y_m = -E / C, the sphere creeps into the equilibrium: a capture whose time,
+  friction impulse (the total variation of y_m), twist impulse and dissipation are quadratures
+  along the path (:func:`_slow_jump`). A captured sphere that creeps inwards or has turned takes
+  the path under the engine's looser creeping test (ratio 1e-2). An explicit solver needs ~C^2
+  steps there: 2e6 were not enough at zeta = 1e5 (15 % of random JKR/DMT impacts over the extended
+  domain had no result before).
+* **Captured tails.** A captured sphere whose tangential outcome needs the rest of its oscillation
+  ends with the linear damped tail about the equilibrium in closed form once its error (~
+  amplitude / equilibrium approach) is below ``tail_tolerance`` of J, or after a twentieth of the
+  step budget (the integration noise of 15-40 rtol can hold a weakly damped oscillation above the
+  settle test indefinitely).
+
 References
 ----------
 Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
@@ -46,8 +63,9 @@ from microimpact._numba import njit
 from microimpact.model import adhesion_models as am
 from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL
-from microimpact.solvers.engine import (CAPTURE, OUTCOME_NAMES, REBOUND, EngineError, NormalSolution, illinois_point,
-                                       illinois_update)
+from microimpact.solvers.engine import (CAPTURE, INERTIA_FREE_ENTER, _linear_tail_variation, INERTIA_FREE_RESUME, OUTCOME_NAMES, REBOUND,
+                                       RELAXATION_ENTER, RELAXATION_RESUME, EngineError, NormalSolution,
+                                       illinois_point, illinois_update)
 
 __all__ = ["solve_normal", "solve_normal_many", "solve_normal_reference", "settled_contact_energy",
            "MODEL_CODES"]
@@ -134,6 +152,159 @@ def _step(model, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
         err[i] = h * acc
 
 
+# --------------------------------------------------------------------------- inertia-free limit
+# The force is F = E(z) + C(z) y (static part and damping coefficient, linear in the rate y of
+# x = delta / L). When the damping rate C dwarfs the stiffness (C^2 >> dE/dx), the rate relaxes in
+# a time 1/C onto the slow manifold y_m(z) = -E / C and the sphere creeps along it into the
+# equilibrium, where E = 0. An explicit solver is held to steps of ~1/C by its stability and needs
+# ~C^2 of them (2e6 were not enough at zeta = 1e5). On the manifold F = -dy/dtau is small and known:
+# the friction impulse still to come is the total variation of y_m, the twist impulse int a |dy_m|,
+# the time int dx / y_m, and the energy left is dissipated. The thresholds are the engine's
+# (:data:`microimpact.solvers.engine.INERTIA_FREE_ENTER` and the others), so every normal law enters
+# the limit where the ring law does, with an error of the order of the inertia ratio.
+_GL3_X, _GL3_W = np.polynomial.legendre.leggauss(3)
+#: inertia ratio up to which a captured sphere that creeps into the equilibrium is taken along the
+#: slow manifold, and the band about it (relative) it must lie in (the engine's creeping test)
+CREEP_RATIO = 1e-2
+CREEP_BAND = 1e-2
+_SLOW_CELLS = 600  # cells of the path, geometric in the distance to the equilibrium (ratio 1.047)
+_SLOW_DECADES = 12.0  # the path ends 1e-12 of its length before the equilibrium (y_m is then ~0)
+
+
+@njit(cache=True, inline="always")
+def _static_and_damping(model, z, c1, c2):
+    """(E, C) of F = E(z) + C(z) y: the undamped force and the damping rate (the dissipation rate
+    at y = 1). [-]"""
+    if model != _DMT:
+        return _jkr_force(z, 0.0, c1, c2), _jkr_dissipation(z, 1.0, c1, c2)
+    return _dmt_force(z, 0.0, c1, c2), _dmt_dissipation(z, 1.0, c1, c2)
+
+
+@njit(cache=True, inline="always")
+def _approach(model, z):
+    """x = delta / L of the model's z (q^4 - 4 q for JKR, s^2 for DMT). [-]"""
+    return z * z if model == _DMT else z**4 - 4.0 * z
+
+
+@njit(cache=True, inline="always")
+def _radius(model, z):
+    """Contact radius in the model's unit (q^2 for JKR, s for DMT). [-]"""
+    return z if model == _DMT else z * z
+
+
+@njit(cache=True, inline="always")
+def _slow_speed(model, z, c1, c2):
+    """y_m(z) = -E / C, the rate on the slow manifold. [-]"""
+    e, c = _static_and_damping(model, z, c1, c2)
+    return -e / c
+
+
+@njit(cache=True)
+def _slow_ratios(model, z, z_eq, c1, c2):
+    """(inertia ratio |dy_m/dx| / C, relaxation ratio C |x - x_eq| / |y_m|) at z (engine.py)."""
+    e, c = _static_and_damping(model, z, c1, c2)
+    if not c > 0.0:
+        return math.inf, 0.0
+    dz = 1e-6 * max(abs(z), 1.0)
+    dx = _approach(model, z + dz) - _approach(model, z - dz)
+    if dx == 0.0:
+        return math.inf, 0.0
+    slope = (_slow_speed(model, z + dz, c1, c2) - _slow_speed(model, z - dz, c1, c2)) / dx
+    ym = -e / c
+    relax = math.inf if ym == 0.0 else c * abs(_approach(model, z) - _approach(model, z_eq)) / abs(ym)
+    return abs(slope) / c, relax
+
+
+@njit(cache=True)
+def _slow_time_between(model, z0, z1, c1, c2):
+    """tau from z0 to z1 on the slow manifold, int dx / y_m (3-point Gauss-Legendre). [-]"""
+    t = 0.0
+    for i in range(3):
+        z = 0.5 * (z0 + z1) + 0.5 * (z1 - z0) * _GL3_X[i]
+        dz = 1e-6 * max(abs(z), 1.0)
+        dxdz = (_approach(model, z + dz) - _approach(model, z - dz)) / (2.0 * dz)
+        t += 0.5 * (z1 - z0) * _GL3_W[i] * dxdz / _slow_speed(model, z, c1, c2)
+    return t
+
+
+@njit(cache=True)
+def _slow_point(model, kind, target, za, zb_, ya, c1, c2):
+    """The z in [za, zb_] (along the path) where the energy (kind _EV_ENERGY) falls to target or
+    |y_m(z) - ya| (kind _EV_J) rises to target, by bisection (both are monotone in a cell)."""
+    lo, hi = za, zb_
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        ym = _slow_speed(model, mid, c1, c2)
+        v = (_energy(model, mid, ym) - target) if kind == _EV_ENERGY else (target - abs(ym - ya))
+        if v > 0.0:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True)
+def _slow_jump(model, u, z_eq, c1, c2, atol_y, threshold, captured, j_target, need_slip, enter, resume, band):
+    """Whether the state u follows the slow manifold into the equilibrium and, if so, the rest of
+    the impact in closed form and quadratures.
+
+    Returns (yes, tau_capture, tau_slip_end, tau_end, D, J, J_a): tau_capture where the energy
+    falls below the capture threshold (NaN if ``captured`` already), tau_slip_end where J reaches
+    j_target (NaN if not needed or not reached), and the states at the equilibrium.
+
+    Thresholds: the inertia ratio at most ``enter`` here and ``resume`` on the whole path (the
+    relaxation ratio at least 1e-3 and 1e-2 of their inverses, as the engine's), and y within
+    ``band`` |y_m| (plus twice the ratio and ten absolute tolerances) of the manifold.
+    """
+    nan = math.nan
+    z = u[0]
+    eps, relax = _slow_ratios(model, z, z_eq, c1, c2)
+    if not (eps <= enter and relax >= RELAXATION_ENTER * INERTIA_FREE_ENTER / enter):
+        return False, nan, nan, nan, nan, nan, nan
+    ym = _slow_speed(model, z, c1, c2)
+    if abs(u[1] - ym) > (2.0 * eps + band) * abs(ym) + 10.0 * atol_y:
+        return False, nan, nan, nan, nan, nan, nan
+    d0 = z - z_eq
+    ratio = 10.0 ** (-_SLOW_DECADES / _SLOW_CELLS)
+    zk = z
+    for k in range(1, _SLOW_CELLS + 1):  # the whole path must stay inertia-free
+        zk = z_eq + d0 * ratio**k
+        eps, relax = _slow_ratios(model, zk, z_eq, c1, c2)
+        if not (eps <= resume and relax >= RELAXATION_RESUME * INERTIA_FREE_RESUME / resume):
+            return False, nan, nan, nan, nan, nan, nan
+    tau, jf, ja = u[2], u[4] + abs(u[1] - ym), u[5] + _radius(model, z) * abs(u[1] - ym)
+    tau_cap, tau_slip = nan, nan
+    need_cap = not captured
+    za, ya = z, ym
+    for k in range(1, _SLOW_CELLS + 1):
+        zb_ = z_eq + d0 * ratio**k
+        yb = _slow_speed(model, zb_, c1, c2)
+        dj = abs(yb - ya)
+        if need_cap and _energy(model, zb_, yb) < threshold:
+            zc = _slow_point(model, _EV_ENERGY, threshold, za, zb_, ya, c1, c2)
+            tau_cap = tau + _slow_time_between(model, za, zc, c1, c2)
+            need_cap = False
+        if need_slip and jf + dj >= j_target:
+            zs = _slow_point(model, _EV_J, j_target - jf, za, zb_, ya, c1, c2)
+            tau_slip = tau + _slow_time_between(model, za, zs, c1, c2)
+            need_slip = False
+        for i in range(3):
+            zi = 0.5 * (za + zb_) + 0.5 * (zb_ - za) * _GL3_X[i]
+            dzi = 1e-6 * max(abs(zi), 1.0)
+            slope = (_slow_speed(model, zi + dzi, c1, c2) - _slow_speed(model, zi - dzi, c1, c2)) / (2.0 * dzi)
+            ja += 0.5 * abs(zb_ - za) * _GL3_W[i] * _radius(model, zi) * abs(slope)
+        tau += _slow_time_between(model, za, zb_, c1, c2)
+        jf += dj
+        za, ya = zb_, yb
+    # the last 1e-12 of the path: y_m falls from ya to 0 at z_eq
+    jf += abs(ya)
+    ja += _radius(model, z_eq) * abs(ya)
+    if need_slip and jf >= j_target:
+        tau_slip = tau
+    dissipated = u[3] + _energy(model, u[0], u[1]) - _energy(model, z_eq, 0.0)
+    return True, tau_cap, tau_slip, tau, dissipated, jf, ja
+
+
 #: what :func:`_locate` finds: z (the boundary), the contact energy, the friction impulse J, y
 #: (the largest penetration at y = 0); numpy integers, so that one specialization is compiled for all
 _EV_Z, _EV_ENERGY, _EV_J, _EV_Y = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
@@ -216,6 +387,12 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
     u[1] = y0
     threshold = _energy(model, zb, 0.0)
     e_eq = _energy(model, z_eq, 0.0)
+    x_eq = _approach(model, z_eq)
+    c_eq = _static_and_damping(model, z_eq, c1, c2)[1]
+    dz_eq = 1e-6 * z_eq  # the stiffness dE/dx at the equilibrium, by a central difference
+    omega_eq = math.sqrt((_static_and_damping(model, z_eq + dz_eq, c1, c2)[0]
+                          - _static_and_damping(model, z_eq - dz_eq, c1, c2)[0])
+                         / (_approach(model, z_eq + dz_eq) - _approach(model, z_eq - dz_eq)))
     yref = max(1.0, y0)
     zref = max(1.0, u[0])
     # y to rtol y0: e_n = -y_end / y0 is then accurate to rtol also for slow impacts (y0 < 1)
@@ -268,6 +445,26 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
             k[0, i] = k[6, i]
         if separated:
             break
+        if _static_and_damping(model, u[0], c1, c2)[1] >= 10.0:  # cheap test first: strongly damped here
+            # a captured sphere creeping into the equilibrium: the engine's looser creeping test
+            # (what is left of J, J_a then carries an error of ~1e-2 of itself); else only where
+            # inertia is negligible all the way
+            creep = outcome == CAPTURE and (turned or u[0] < z_eq)
+            jumped, tc, ts, te, dd, jj, jja = _slow_jump(
+                model, u, z_eq, c1, c2, atol[1], threshold, outcome == CAPTURE, j_target,
+                j_target > 0.0 and math.isnan(tau_slip), CREEP_RATIO if creep else INERTIA_FREE_ENTER,
+                CREEP_RATIO if creep else INERTIA_FREE_RESUME, CREEP_BAND if creep else 0.0)
+            if jumped:  # the inertia-free limit: the rest of the impact in closed form, a capture
+                if outcome == REBOUND:
+                    outcome = CAPTURE
+                    tau_cap = u[2] if math.isnan(tc) else tc
+                    e_cap = threshold
+                if not math.isnan(ts):
+                    tau_slip = ts
+                if u[0] < z_eq:  # crept inwards: the equilibrium is the supremum of the approach
+                    zmax = max(zmax, z_eq)
+                u[0], u[1], u[2], u[3], u[4], u[5] = z_eq, 0.0, te, dd, jj, jja
+                break
         if outcome == CAPTURE:
             # settled: oscillation amplitude below tail_tol (energy ratio floored at 1e-14, above
             # the round-off of the energy near the bottom of the well)
@@ -279,6 +476,18 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
             # step for a slow JKR impact) stopped short of it, up to 6x at rtol 1e-9
             if turned and (not need_tail or u[4] >= j_stop and u[5] >= ja_stop):
                 break
+            if turned and c_eq > 0.0:  # (undamped: the oscillation never ends; j_stop ends it)
+                # the linear damped tail about the equilibrium in closed form (the engine's), once its
+                # relative error (~ amplitude / x_eq) makes an error below tail_tol of J, or after a
+                # twentieth of the step budget (integration noise of 15-40 rtol can hold a weakly
+                # damped oscillation above the settle test indefinitely)
+                dxl = _approach(model, u[0]) - x_eq
+                tail = _linear_tail_variation(dxl, u[1], omega_eq, c_eq)
+                amp = math.sqrt(dxl * dxl + (u[1] / omega_eq) ** 2)
+                if amp / x_eq * tail <= tail_tol * u[4] or 20 * (n_acc + n_rej) >= max_steps:
+                    u[4] += tail
+                    u[5] += _radius(model, z_eq) * tail
+                    break
         h *= min(5.0, max(0.2, 0.9 * max(norm, 1e-10) ** -0.2))
     return (float(status), float(outcome), u[1], u[2], u[3], u[4], u[5], zmax, tau_cap, tau_slip,
             _energy(model, u[0], u[1]) - _energy(model, zb if model == _DMT else 4.0 ** (1.0 / 3.0), 0.0),
