@@ -86,7 +86,7 @@ from microimpact.model.kinematics import flat_broadcast
 from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form maps
 from microimpact.solvers import SolverError
 from microimpact.solvers.compiled_law import compiled
-from microimpact.solvers.engine import _equilibrium, _linear_tail_variation
+from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _linear_tail_variation, _slow_twist
 
 __all__ = ["coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture"]
 
@@ -103,6 +103,11 @@ _md_span = compiled(_tc.md_turning_span)
 _N = 12
 _S, _Y, _TAU, _D, _J, _JA, _VT, _VTP, _WT, _WTP, _FT, _FTP = range(_N)
 _OK, _MAX_STEPS, _UNDERFLOW = 0, 1, 2
+#: outcome code of a captured impact whose integration stopped creeping on the slow manifold (1: captured)
+_CREEPING = 2
+#: outcome code of a captured impact stopped after a twentieth of the step budget (its tail in
+#: closed form: averaged when weakly damped, else linear; the engine's policy)
+_LONG_TAIL = 3
 
 _A = np.array([
     [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
@@ -593,7 +598,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     load_side = 0.0  # sign of the Coulomb limit's load argument since the last restart (0: not yet known)
     lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
     damped = p[0] > 0.0 or p[1] > 0.0
-    xe, omega0, _ = _equilibrium(p[0], p[1], ah, aa)
+    xe, omega0, ceq = _equilibrium(p[0], p[1], ah, aa)
     ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
     h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
     if y0 < 1.0:
@@ -710,8 +715,20 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             if amp < settle or peaked and (conserved or z[_J] >= j_stop and z[_JA] >= ja_stop):
                 outcome = 1
                 break
+            # strongly overdamped: it creeps into the equilibrium on the slow manifold, which an
+            # explicit solver follows in ~C^2 steps (the step limit at zeta ~ 1e4); the engine's
+            # creeping test, and the rest of the normal motion in closed form (_tail_impulses)
+            # (not with rolling resistance: its torque acts all through the tail, and no closed form
+            # of it agreed with the integrated tail)
+            if not rolling and ceq > 2.0 * omega0 and (peaked or z[_S] * z[_S] < xe) and _is_creeping(
+                    z, k1, atol[_Y], np.bool_(True), p[0], p[1], ah, aa, xe, omega0, ceq):
+                outcome = _CREEPING
+                break
+            if not rolling and peaked and 20 * n >= max_steps:
+                outcome = _LONG_TAIL
+                break
         h *= 5.0 if en == 0.0 else min(5.0, max(0.2, 0.9 * en ** -0.2))
-    if outcome == 1 and not peaked:  # crept into the equilibrium without turning: its supremum
+    if outcome >= 1 and not peaked:  # crept into the equilibrium without turning: its supremum
         smax = max(smax, math.sqrt(xe))
     return status, outcome, z, smax * smax, tau_cap, tau_j, n, n_turn
 
@@ -772,21 +789,32 @@ def _rolling_state(states, rows, krot):
 
 
 @njit(cache=True)
-def _tail_impulses(s, y, p):
+def _tail_impulses(s, y, p, outcome):
     """(J, J_a) still to come, nondimensional, of captured spheres whose integration stopped at
     (s, y) near the equilibrium: the linear damped tail's total variation of y (the friction
-    impulse, F_n = -dy/dtau) and that times a = sqrt(xi_e) (the twist impulse)."""
+    impulse, F_n = -dy/dtau) and that times a = sqrt(xi_e) (the twist impulse); of those that
+    stopped creeping on the slow manifold (``outcome`` _CREEPING), |y| (y falls monotonically to 0)
+    and int s |dy| along the manifold; of those stopped by the budget (_LONG_TAIL) while weakly
+    damped (C <= 1e-2 omega0) in the well, the averaged tail (the engine's policy for each)."""
     j = np.empty(s.size)
     ja = np.empty(s.size)
     for i in range(s.size):
         c1, c2, ah, aa = p[i, 0], p[i, 1], p[i, 2], p[i, 3]
         xe, omega0, ceq = _equilibrium(c1, c2, ah, aa)
+        if outcome[i] == _CREEPING:
+            j[i] = abs(y[i])
+            ja[i] = _slow_twist(s[i] * s[i], xe, c1, c2, ah, aa)
+            continue
+        e_now = _energy(s[i], y[i], ah, aa)
+        if outcome[i] == _LONG_TAIL and ceq <= 1e-2 * omega0 and e_now < 0.0:
+            j[i], ja[i] = _averaged_tail(e_now, c1, c2, ah, aa, xe)
+            continue
         j[i] = _linear_tail_variation(s[i] * s[i] - xe, y[i], omega0, ceq)
         ja[i] = j[i] * math.sqrt(xe)
     return j, ja
 
 
-def _settle_captured(contact, states, captured, p, unit, j_unit, ja_unit, jl, jal):
+def _settle_captured(contact, states, captured, outcome, p, unit, j_unit, ja_unit, jl, jal):
     """The tangential rest of captured spheres after the integration stopped (module docstring).
 
     Edits ``states`` (n, 12); returns the friction and twist impulses [N s], [N m s] that the
@@ -804,7 +832,7 @@ def _settle_captured(contact, states, captured, p, unit, j_unit, ja_unit, jl, ja
             _rolling_state(states, rows, p[0, 8])
         return jl, jal
     m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
-    j_tail, ja_tail = _tail_impulses(states[rows, _S], states[rows, _Y], p[rows])
+    j_tail, ja_tail = _tail_impulses(states[rows, _S], states[rows, _Y], p[rows], outcome[rows])
     u = unit[rows]
     j_tail *= j_unit[rows]
     ja_tail *= ja_unit[rows]
@@ -931,13 +959,13 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
         what = "step limit reached" if info[i, 0] == _MAX_STEPS else "step size underflow"
         raise CoupledError(f"coupled solver failed for normal speed {float(speed[i])!r} m/s: {what} "
                            f"after {int(info[i, 5])} steps")
-    captured = info[:, 1] == 1
+    captured = info[:, 1] >= 1
     jl = states[:, _J] * j_unit
     jal = states[:, _JA] * ja_unit
     if aware and not mindlin:  # sliding that ends at rest, after the integration stopped
         late = captured & np.isnan(info[:, 4]) & np.isfinite(j_stop) & (states[:, _J] < j_stop)
         info[late, 4] = states[late, _TAU] + (j_stop[late] - states[late, _J]) / (2.0 * p[late, 5])
-    j_map, ja_map = _settle_captured(contact, states, captured, p, u, j_unit, ja_unit, jl, jal)
+    j_map, ja_map = _settle_captured(contact, states, captured, info[:, 1], p, u, j_unit, ja_unit, jl, jal)
     out, slip_ended, slip_end_time = _tangential_si(contact, mindlin, states, info, f, (v_n, v_t, v_tp),
                                                     (w_n, w_t, w_tp), slip, j_map, ja_map, u, time)
     return {
