@@ -191,3 +191,37 @@ def test_summary_counts_notes_apart(tmp_path):
     assert report.dataset["energy_error"].attrs["units"] == "1"
     stress.write_stress_summary(s, tmp_path / "s.json")
     assert (tmp_path / "s.json").read_text().startswith("{")
+
+
+# ------------------------------------------------------------------ every law
+@pytest.mark.parametrize("law", [law for law in stress.LAWS if law != "ring"])
+def test_every_law_passes_the_sweep(law):
+    """The first 40 cases of seed 0 under every contact law: all checks of the sweep (finite
+    results, e_n, the energy balance to 1e-8 of the case's scale, convergence in rtol). They
+    include damping up to 9e5 (cases 0, 1, 7, 9, 22, 36), which ended in the step limit for every
+    law but the ring law before the JKR/DMT and coupled solvers took the inertia-free limit and the
+    closed-form tails; and f = 0 with the pulloff limit (cases 2, 35, 36: omega_out was NaN).
+
+    With rolling resistance the coupled solver still has no closed form of the tail (its torque
+    acts all through it): 10 of the 40 cases, the strongly damped ones and slow, weakly damped
+    captures, end in the step limit. The test holds that line: no other kind of failure and no more
+    cases."""
+    report = stress.stress_sweep(40, seed=0, reference_every=0, law=law)
+    s = report.summary
+    assert s["law"] == law and s["cases_run"] == 40
+    if law == "mindlin_deresiewicz_pulloff_rolling":
+        kinds = {k for k, n in s["failures_by_kind"].items() if n}
+        assert kinds <= {"exception"}, s["failed_cases"]
+        assert s["cases_failed"] <= 10, [c["inputs"]["case"] for c in s["failed_cases"]]
+    else:
+        assert s["cases_failed"] == 0, s["failed_cases"]
+
+
+def test_compliant_law_gets_the_shear_modulus_of_its_stiffness():
+    """G* of two equal bodies with Poisson's ratio 0.3 from K = (4/3) E* (Eq. (3)): E = 3 K (1 - nu^2)
+    / 2, G = E / (2 (1 + nu)), 1/G* = 2 (2 - nu) / G, so G* / K = 3 (1 - nu) / (8 (2 - nu))."""
+    case = stress.draw_cases(1, seed=0)[0]
+    c = stress.contact_of(case, "mindlin")
+    nu = 0.3
+    assert c.shear_modulus / case["stiffness"] == pytest.approx(3 * (1 - nu) / (8 * (2 - nu)), rel=1e-12, abs=0.0)
+    assert c.tangential_model == "mindlin" and stress.contact_of(case).tangential_model == "rigid"

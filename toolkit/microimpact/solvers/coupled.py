@@ -827,7 +827,10 @@ def _settle_captured(contact, states, captured, outcome, p, unit, j_unit, ja_uni
         return jl, jal
     jl, jal = jl.copy(), jal.copy()
     if contact.friction_model == "pulloff":
-        jl[rows] = jal[rows] = np.inf
+        # (without friction, f = 0, there is no limit at rest: the impulses stay as followed, and the
+        # twist map would otherwise meet 0 x inf)
+        held = rows[p[rows, 4] > 0.0]
+        jl[held] = jal[held] = np.inf
         if p[0, 9] > 0.0:
             _rolling_state(states, rows, p[0, 8])
         return jl, jal
