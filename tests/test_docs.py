@@ -65,6 +65,8 @@ HOW = {
     "python tests/mutation_check.py --out docs/mutations.json": "study",
     "microimpact benchmark --quick --out results/benchmark": "ci",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "ci",
+    # README.md: the sweep under another contact law (10-120 s per law)
+    "python -m microimpact.studies.stress --cases 300 --law jkr --out stress_jkr.json": "study",
     "microimpact plot case_2.1.nc --out case_2.1.png": "run",
     "microimpact plot fit.nc --out fit.pdf": "run",
     "microimpact workflow --directory my_run -n": "run",

@@ -399,3 +399,22 @@ def test_result_fields():
     # friction impulse = int |F_n| dt >= net normal impulse m (v_out - v_in)
     assert res.friction_impulse >= WALL_1990.mass * (res.velocity_out[0] - res.velocity_in[0]) * (1 - 1e-12)
     assert res.to_dict()["capture_time"] is None
+
+
+@pytest.mark.parametrize("fields, named", [({"normal_model": "jkr"}, "normal_model='jkr'"),
+                                           ({"normal_model": "dmt"}, "normal_model='dmt'"),
+                                           ({"tangential_model": "mindlin", "shear_modulus": 1e10}, "tangential_model"),
+                                           ({"friction_model": "pulloff"}, "friction_model='pulloff'")])
+def test_reference_refuses_a_law_it_does_not_contain(fields, named):
+    """simulate_reference answered for the paper's ring law whatever the contact selected (the
+    stress sweep under the JKR law compared it with the JKR engine: 6 of 12 'disagreements').
+    Now it names the field; simulate_impact(method='reference') covers JKR and DMT."""
+    from microimpact import simulate_impact
+    from microimpact.presets import WALL_1990
+
+    c = WALL_1990.with_(**fields)
+    with pytest.raises(ValueError, match=named):
+        simulate_reference(c, 1.0, 30.0)
+    if "normal_model" in fields:
+        assert simulate_impact(c, 1.0, 30.0, method="reference").method != ""
+    assert simulate_reference(WALL_1990.with_(adhesion_line_force=0.0, normal_model="jkr"), 1.0).outcome == "rebound"

@@ -324,6 +324,23 @@ def _event(fun, terminal: bool, direction: float):
 
 
 # --------------------------------------------------------------------------- public API
+def _check_paper_law(contact) -> None:
+    """ValueError naming the field if ``contact`` selects a law this integration does not contain."""
+    if not isinstance(contact, Contact):
+        return  # (the type is checked where the contact is first used, with its own message)
+    chosen = {"tangential_model": "rigid", "friction_model": "net"}
+    if contact.adhesion_line_force > 0.0:
+        chosen["normal_model"] = "ring"
+    for field, paper in chosen.items():
+        if getattr(contact, field) != paper:
+            raise ValueError(f"simulate_reference integrates the paper's law ({field}={paper!r}); the contact selects "
+                             f"{field}={getattr(contact, field)!r}: use simulate_impact(..., method='reference')"
+                             + ("" if field == "normal_model" else ", which covers the paper's tangential contact only"))
+    if contact.rolling_friction > 0.0:
+        raise ValueError(f"simulate_reference has no rolling resistance; the contact selects "
+                         f"rolling_friction={contact.rolling_friction!r}")
+
+
 def simulate_reference(
     contact: Contact,
     speed: float,
@@ -384,7 +401,11 @@ def simulate_reference(
     ------
     ValueError
         For a non-finite or non-positive speed, an incidence outside [0, 90), a non-finite
-        azimuth or spin, or bad tolerances; the message names the argument and the value.
+        azimuth or spin, or bad tolerances; the message names the argument and the value. For a
+        contact that selects a sub-model this integration does not contain (an adhesive JKR or DMT
+        law, tangential compliance, the pulloff limit, rolling resistance): it would otherwise
+        answer for the paper's law; :func:`microimpact.simulate_impact` with ``method="reference"``
+        covers the JKR and DMT laws.
     ReferenceSolverError
         If solve_ivp fails or no outcome is reached within a generous time.
     TimeBudgetExceeded
@@ -397,6 +418,7 @@ def simulate_reference(
     derived twist torque (3 pi / 16) f a |F_n|; with f0 = 0 the Hertz scales replace X, T. The
     paper used a fixed-step Runge-Kutta-Gill method; this uses adaptive solve_ivp with events.
     """
+    _check_paper_law(contact)
     speed, incidence, azimuth, omega_in = _validate_impact(speed, incidence_deg, azimuth_deg, omega)
     rtol, atol, settle_tol = _validate_common(rtol, atol, settle_tolerance)
     max_step = float(max_step)
