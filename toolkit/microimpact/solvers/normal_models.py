@@ -44,7 +44,8 @@ Regimes left to closed forms instead of a step limit (the engine's, :mod:`.engin
   ends with the linear damped tail about the equilibrium in closed form once its error (~
   amplitude / equilibrium approach) is below ``tail_tolerance`` of J, or after a twentieth of the
   step budget (the integration noise of 15-40 rtol can hold a weakly damped oscillation above the
-  settle test indefinitely).
+  settle test indefinitely); then, when weakly damped (C <= 1e-2 omega0), by the method of
+  averaging over the undamped orbits (:func:`_averaged_tail`, relative error ~C / omega0).
 
 References
 ----------
@@ -305,6 +306,76 @@ def _slow_jump(model, u, z_eq, c1, c2, atol_y, threshold, captured, j_target, ne
     return True, tau_cap, tau_slip, tau, dissipated, jf, ja
 
 
+# --------------------------------------------------------------------------- averaged tail
+_GL16_X, _GL16_W = np.polynomial.legendre.leggauss(16)
+
+
+@njit(cache=True)
+def _turning_z(model, e, lo, hi):
+    """The z in [lo, hi] where U(z) = e (U monotone there), by bisection."""
+    flo = _energy(model, lo, 0.0) - e
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        fm = _energy(model, mid, 0.0) - e
+        if (fm > 0.0) == (flo > 0.0):
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True)
+def _orbit_integrals(model, e, z_lo, z_eq, c1, c2):
+    """Per cycle of the undamped orbit at energy e in the well: (energy lost to the damping,
+    total variation of y, int a |dy|). On each side of z_eq, z = end + (z_eq - end) t^2 from the
+    turning point makes y ~ sqrt(z - end) smooth in t (16-point Gauss-Legendre); int a |dy| by
+    parts, 2 a_eq y_max - int y da (inwards) + int y da (outwards), per half-cycle."""
+    ymax = math.sqrt(max(2.0 * (e - _energy(model, z_eq, 0.0)), 0.0))
+    za = _turning_z(model, e, z_lo, z_eq)
+    zhi = 2.0 * z_eq
+    while _energy(model, zhi, 0.0) < e:
+        zhi *= 2.0
+    zb_ = _turning_z(model, e, z_eq, zhi)
+    loss = 0.0
+    twist = 2.0 * _radius(model, z_eq) * ymax
+    for side in range(2):
+        end = za if side == 0 else zb_
+        width = z_eq - end
+        for i in range(_GL16_X.shape[0]):
+            t = 0.5 * (_GL16_X[i] + 1.0)
+            z = end + width * t * t
+            y = math.sqrt(max(2.0 * (e - _energy(model, z, 0.0)), 0.0))
+            dzdt = 2.0 * width * t * 0.5 * _GL16_W[i]  # dz/dt times the weight on [0, 1]
+            dz = 1e-6 * max(abs(z), 1.0)
+            dxdz = (_approach(model, z + dz) - _approach(model, z - dz)) / (2.0 * dz)
+            dadz = (_radius(model, z + dz) - _radius(model, z - dz)) / (2.0 * dz)
+            c = _static_and_damping(model, z, c1, c2)[1]
+            loss += c * y * dxdz * abs(dzdt)  # int C y dx over the half-orbit's side
+            # - int_{z_a}^{z_eq} y da + int_{z_eq}^{z_b} y da: both are - sum y a' dz/dt w (dz/dt < 0 outside)
+            twist -= y * dadz * dzdt
+    return 2.0 * loss, 4.0 * ymax, 2.0 * twist
+
+
+@njit(cache=True)
+def _averaged_tail(model, e_now, z_lo, z_eq, c1, c2):
+    """(J, J_a) still to come for a weakly damped captured sphere of energy e_now: int (variation
+    per cycle) / (energy lost per cycle) de from the bottom of the well (the engine's method of
+    averaging, in q = sqrt(e - U_eq), where the integrand is smooth); relative error ~ C / omega0."""
+    e_eq = _energy(model, z_eq, 0.0)
+    q_now = math.sqrt(max(e_now - e_eq, 0.0))
+    jt = 0.0
+    jat = 0.0
+    if q_now == 0.0:
+        return jt, jat
+    for i in range(_GL16_X.shape[0]):
+        q = 0.5 * q_now * (_GL16_X[i] + 1.0)
+        loss, var, tw = _orbit_integrals(model, e_eq + q * q, z_lo, z_eq, c1, c2)
+        w = 0.5 * q_now * _GL16_W[i] * 2.0 * q / loss
+        jt += w * var
+        jat += w * tw
+    return jt, jat
+
+
 #: what :func:`_locate` finds: z (the boundary), the contact energy, the friction impulse J, y
 #: (the largest penetration at y = 0); numpy integers, so that one specialization is compiled for all
 _EV_Z, _EV_ENERGY, _EV_J, _EV_Y = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
@@ -484,7 +555,13 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
                 dxl = _approach(model, u[0]) - x_eq
                 tail = _linear_tail_variation(dxl, u[1], omega_eq, c_eq)
                 amp = math.sqrt(dxl * dxl + (u[1] / omega_eq) ** 2)
-                if amp / x_eq * tail <= tail_tol * u[4] or 20 * (n_acc + n_rej) >= max_steps:
+                long_tail = 20 * (n_acc + n_rej) >= max_steps
+                if long_tail and c_eq <= 1e-2 * omega_eq and e_now < threshold:  # weakly damped: averaged
+                    jt, jat = _averaged_tail(model, e_now, zb, z_eq, c1, c2)
+                    u[4] += jt
+                    u[5] += jat
+                    break
+                if amp / x_eq * tail <= tail_tol * u[4] or long_tail:
                     u[4] += tail
                     u[5] += _radius(model, z_eq) * tail
                     break
