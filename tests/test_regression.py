@@ -159,15 +159,21 @@ COUPLED_NOISE = {0.0: 1e-5, 0.01: 2e-4}
 N_COUPLED = 60  # impacts of the baseline (tests/regression/coupled_cases.py)
 
 
-@pytest.fixture(scope="module")
-def coupled_now():
+def _cases_module(name: str):
+    """The module of tests/regression/ that defines a baseline's cases."""
+    import importlib
     import sys
 
     sys.path.insert(0, str(BASELINE.parent))
     try:
-        import coupled_cases
+        return importlib.import_module(name)
     finally:
         sys.path.remove(str(BASELINE.parent))
+
+
+@pytest.fixture(scope="module")
+def coupled_now():
+    coupled_cases = _cases_module("coupled_cases")
     return coupled_cases, coupled_cases.solve_all(), xr.load_dataset(BASELINE / "coupled.nc")
 
 
@@ -242,14 +248,7 @@ LAWS_CAPTURED_TAIL = {"jkr": 1e-7, "jkr_force": 1e-7, "dmt": 1e-7, "mindlin": 1e
 
 @pytest.fixture(scope="module")
 def laws_now():
-    import sys
-
-    sys.path.insert(0, str(BASELINE.parent))
-    try:
-        import laws_cases
-    finally:
-        sys.path.remove(str(BASELINE.parent))
-    return laws_cases, xr.load_dataset(BASELINE / "laws.nc")
+    return _cases_module("laws_cases"), xr.load_dataset(BASELINE / "laws.nc")
 
 
 @pytest.mark.parametrize("selection", ["ring", "jkr", "jkr_force", "dmt", "mindlin", "mindlin_deresiewicz",

@@ -228,16 +228,25 @@ def _slow_time_between(model, z0, z1, c1, c2):
     return t
 
 
+@njit(cache=True, inline="always")
+def _point_value(model, kind, z, target, ya, c1, c2):
+    """What :func:`_slow_point` brings to zero: U(z) - target (kind _EV_U), the energy on the slow
+    manifold - target (_EV_ENERGY), or target - |y_m(z) - ya| (_EV_J)."""
+    if kind == _EV_U:
+        return _energy(model, z, 0.0) - target
+    ym = _slow_speed(model, z, c1, c2)
+    return (_energy(model, z, ym) - target) if kind == _EV_ENERGY else (target - abs(ym - ya))
+
+
 @njit(cache=True)
 def _slow_point(model, kind, target, za, zb_, ya, c1, c2):
-    """The z in [za, zb_] (along the path) where the energy (kind _EV_ENERGY) falls to target or
-    |y_m(z) - ya| (kind _EV_J) rises to target, by bisection (both are monotone in a cell)."""
+    """The z in [za, zb_] where the value of ``kind`` (:func:`_point_value`) reaches zero, by
+    bisection (each is monotone there: a cell of the slow path, or one side of the well)."""
     lo, hi = za, zb_
+    vlo = _point_value(model, kind, lo, target, ya, c1, c2)
     for _ in range(100):
         mid = 0.5 * (lo + hi)
-        ym = _slow_speed(model, mid, c1, c2)
-        v = (_energy(model, mid, ym) - target) if kind == _EV_ENERGY else (target - abs(ym - ya))
-        if v > 0.0:
+        if (_point_value(model, kind, mid, target, ya, c1, c2) > 0.0) == (vlo > 0.0):
             lo = mid
         else:
             hi = mid
@@ -311,31 +320,17 @@ _GL16_X, _GL16_W = np.polynomial.legendre.leggauss(16)
 
 
 @njit(cache=True)
-def _turning_z(model, e, lo, hi):
-    """The z in [lo, hi] where U(z) = e (U monotone there), by bisection."""
-    flo = _energy(model, lo, 0.0) - e
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        fm = _energy(model, mid, 0.0) - e
-        if (fm > 0.0) == (flo > 0.0):
-            lo, flo = mid, fm
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)
-
-
-@njit(cache=True)
 def _orbit_integrals(model, e, z_lo, z_eq, c1, c2):
     """Per cycle of the undamped orbit at energy e in the well: (energy lost to the damping,
     total variation of y, int a |dy|). On each side of z_eq, z = end + (z_eq - end) t^2 from the
     turning point makes y ~ sqrt(z - end) smooth in t (16-point Gauss-Legendre); int a |dy| by
     parts, 2 a_eq y_max - int y da (inwards) + int y da (outwards), per half-cycle."""
     ymax = math.sqrt(max(2.0 * (e - _energy(model, z_eq, 0.0)), 0.0))
-    za = _turning_z(model, e, z_lo, z_eq)
+    za = _slow_point(model, _EV_U, e, z_lo, z_eq, 0.0, c1, c2)
     zhi = 2.0 * z_eq
     while _energy(model, zhi, 0.0) < e:
         zhi *= 2.0
-    zb_ = _turning_z(model, e, z_eq, zhi)
+    zb_ = _slow_point(model, _EV_U, e, z_eq, zhi, 0.0, c1, c2)
     loss = 0.0
     twist = 2.0 * _radius(model, z_eq) * ymax
     for side in range(2):
@@ -379,6 +374,7 @@ def _averaged_tail(model, e_now, z_lo, z_eq, c1, c2):
 #: what :func:`_locate` finds: z (the boundary), the contact energy, the friction impulse J, y
 #: (the largest penetration at y = 0); numpy integers, so that one specialization is compiled for all
 _EV_Z, _EV_ENERGY, _EV_J, _EV_Y = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
+_EV_U = np.int64(4)  # the potential U(z), for the turning points of an orbit (_slow_point only)
 
 
 @njit(cache=True)
