@@ -598,6 +598,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     load_side = 0.0  # sign of the Coulomb limit's load argument since the last restart (0: not yet known)
     lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
     damped = p[0] > 0.0 or p[1] > 0.0
+    conservative = not damped and aa > 0.0
+    e0 = 0.5 * y0 * y0  # the normal energy (U = 0 at first contact)
     xe, omega0, ceq = _equilibrium(p[0], p[1], ah, aa)
     ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
     h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
@@ -656,6 +658,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: secant on the step length
             _restep_to_root(_EV_SEPARATION, 0.0, z[_S], z1[_S], 1e-14 * sref, h_end, z, k1, p, hist, k, tmp, z1, err)
             z1[_S] = 0.0
+            if conservative:  # leaves with its energy: U(0) = 0
+                z1[_Y] = -y0
             outcome = 0
             tau_j = _impulse_time(z, z1, j_stop, tau_j, h_end, k1, p, hist)
             for i in range(_N):
@@ -680,6 +684,15 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                     _EV_ENERGY, ecap, h_end, z, z1, k1, p, hist)[_TAU]
         for i in range(_N):
             z[i] = z1[i]
+        refresh = False
+        if conservative and z[_S] > 0.0:
+            # undamped with adhesion: the normal motion keeps its energy y0^2 / 2 exactly (it does
+            # not feel the tangential state), so y is put back on that energy; round-off of the
+            # order of rtol times the well's depth would otherwise trap a slow sphere in the well
+            # (y0 ~ 1e-5: the step limit, where the engine mirrors the way out)
+            v2 = 2.0 * (e0 - _energy(z[_S], 0.0, ah, aa))
+            z[_Y] = math.copysign(math.sqrt(v2), z[_Y]) if v2 > 0.0 else 0.0
+            refresh = True
         if at_rest:
             z[_WT] = z[_WTP] = 0.0
         if turned:  # new branch: s -> -s, c from the force ratio, p = 0 (force continuous)
@@ -700,6 +713,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         elif elastic:
             projected = _project(z, p)
             slipping = (not slipping) if slip_change else projected
+            _rhs(z, p, hist, k1)
+        elif refresh:
             _rhs(z, p, hist, k1)
         else:
             for i in range(_N):
