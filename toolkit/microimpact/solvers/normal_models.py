@@ -624,6 +624,32 @@ def solve_normal(contact, normal_speed: float, *, rtol: float = DEFAULT_RTOL, ne
     NormalSolution
         ``dissipated_energy`` is all the energy the normal contact removes: damping plus, for JKR,
         the adhesion hysteresis of the contact cycle (``JKR_HYSTERESIS`` pi w a_c^2 for a rebound). [J]
+
+    References
+    ----------
+    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of
+    elastic solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141.
+
+    Examples
+    --------
+    Undamped, a JKR rebound loses only the hysteresis H of the contact cycle,
+    e_n = sqrt(1 - 2 H / y0^2) in the JKR units:
+
+    >>> import math
+    >>> from microimpact.model import adhesion_models as am
+    >>> from microimpact.model.parameters import TABLE1_ROW2
+    >>> c = TABLE1_ROW2.with_(normal_model="jkr", zeta_hertz=0.0, zeta_adhesion=0.0)
+    >>> sc = am.adhesion_scales(c)
+    >>> y0 = 2.0 / (sc.length / sc.time)
+    >>> abs(solve_normal(c, 2.0).e_n - math.sqrt(1.0 - 2.0 * am.JKR_HYSTERESIS / y0**2)) < 1e-8
+    True
+
+    Strongly damped, the sphere creeps into the equilibrium (the inertia-free limit, a few dozen
+    steps); the normal force keeps its sign, so int |F_n| dt is the normal momentum m v:
+
+    >>> s = solve_normal(c.with_(zeta_adhesion=1e6), 0.05)
+    >>> s.outcome, round(s.friction_impulse / (c.mass * 0.05), 9), s.n_steps < 1000
+    ('capture', 1.0, True)
     """
     from microimpact.solvers import engine
 
@@ -711,6 +737,19 @@ def settled_contact_energy(contact) -> float:
 
     JKR: U(6^(1/3)) - U(4^(1/3)) (contact forms at delta = 0 without work); DMT: U(1). In units
     F L of :func:`~microimpact.model.adhesion_models.adhesion_scales`.
+
+    Examples
+    --------
+    The JKR well, -0.6 (6^(4/3) - 4^(4/3)) F_J L_J, and the DMT well, -0.6 F_D L_D:
+
+    >>> from microimpact.model import adhesion_models as am
+    >>> from microimpact.model.parameters import TABLE1_ROW2
+    >>> for model in ("jkr", "dmt"):
+    ...     c = TABLE1_ROW2.with_(normal_model=model)
+    ...     sc = am.adhesion_scales(c)
+    ...     print(model, round(settled_contact_energy(c) / (sc.force * sc.length), 6))
+    jkr -2.731872
+    dmt -0.6
     """
     if _hertz(contact):
         return 0.0
