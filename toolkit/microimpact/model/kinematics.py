@@ -37,6 +37,13 @@ def incident_velocity(speed: float, incidence_deg: float, azimuth_deg: float) ->
         Angle from the surface normal, in [0, 90). [deg]
     azimuth_deg : float
         Direction of the tangential component in the (t, t') plane, from t towards t'. [deg]
+    
+    Examples
+    --------
+    2 m/s at 60 deg from the normal, towards t' (azimuth 90 deg):
+
+    >>> [round(v, 12) + 0.0 for v in incident_velocity(2.0, 60.0, 90.0)]
+    [-1.0, 0.0, 1.732050807569]
     """
     a = math.radians(incidence_deg)
     th = math.radians(azimuth_deg)

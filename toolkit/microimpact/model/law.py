@@ -129,6 +129,19 @@ def contact_potential_energy(contact, penetration):
     contact : Contact
     penetration : array_like
         x = -n. [m]
+    
+    Examples
+    --------
+    At the equilibrium X = 2 pi f0 / K the Hertz and adhesion forces cancel and
+    V(X) = -(4/15) m (X/T)^2 (Eqs. (29)-(30)):
+
+    >>> from microimpact.presets import WALL_1990 as c
+    >>> x = c.length_scale
+    >>> f_h = hertz_force(c.radius, c.stiffness, x)
+    >>> bool(abs(f_h + adhesion_force(c.radius, c.adhesion_line_force, x)) <= 1e-12 * f_h)
+    True
+    >>> round(float(contact_potential_energy(c, x) / (c.mass * (x / c.time_scale) ** 2)), 12)
+    -0.266666666667
     """
     x = np.maximum(penetration, 0.0)
     sr = math.sqrt(contact.radius)
@@ -164,6 +177,12 @@ def twist_friction_torque(friction, contact_radius_, normal_force_):
     p = p0 sqrt(1 - rho^2/a^2), p0 = 3 |F_n| / (2 pi a^2), gives
     2 pi f p0 int_0^a sqrt(1 - rho^2/a^2) rho^2 d rho = (3 pi / 16) f a |F_n|.
     The torque opposes the twist spin omega_n and stops when omega_n reaches zero.
+    
+    Examples
+    --------
+    >>> import math
+    >>> round(float(twist_friction_torque(1.0, 1.0, 1.0)), 10) == round(3.0 * math.pi / 16.0, 10)
+    True
     """
     return TWIST_TORQUE_FACTOR * friction * contact_radius_ * np.abs(normal_force_)
 

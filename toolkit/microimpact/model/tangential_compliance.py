@@ -185,6 +185,14 @@ def effective_shear_modulus(shear_sphere, poisson_sphere, shear_surface, poisson
     -----
     With it the Mindlin (1949) tangential stiffness of a contact of radius a is k_t = 8 G* a
     (Johnson 1985, Eq. 7.42 summed over both bodies; Di Renzo & Di Maio 2004, Table 1).
+    
+    Examples
+    --------
+    Two equal glass bodies (E = 70 GPa, nu = 0.22): G* = G / (2 (2 - nu)):
+
+    >>> g = float(shear_modulus_from_elastic(70e9, 0.22))
+    >>> round(g / 1e9, 4), round(float(effective_shear_modulus(g, 0.22, g, 0.22)) / (g / (2 * (2 - 0.22))), 12)
+    (28.6885, 1.0)
     """
     return 1.0 / ((2.0 - poisson_sphere) / shear_sphere + (2.0 - poisson_surface) / shear_surface)
 
