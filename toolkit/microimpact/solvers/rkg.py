@@ -228,6 +228,16 @@ def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS
         For a bad speed or a number of steps < 1.
     EngineError
         If no outcome is reached within 20 contact durations' worth of steps.
+    
+    Examples
+    --------
+    The paper's fixed-step method against the adaptive engine at a tight tolerance:
+
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.solvers import engine
+    >>> s = solve_normal_rkg(WALL_1990, 2.0)
+    >>> bool(abs(s.e_n - engine.solve_normal(WALL_1990, 2.0, rtol=1e-12).e_n) < 1e-6)
+    True
     """
     v = check_positive("normal_speed", normal_speed)
     if int(steps) < 1:
