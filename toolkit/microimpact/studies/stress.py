@@ -97,7 +97,7 @@ from microimpact.io.progress import progress_bar
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
 from microimpact.solvers.impact import settled_contact_energy, simulate_impact
-from microimpact.solvers import TimeBudgetExceeded
+from microimpact.solvers import TimeBudgetExceeded, check_sub_models
 from microimpact.solvers.reference import simulate_reference
 from microimpact.studies._timeout import time_limit
 from microimpact.model.adhesion_models import AdhesionRegimeWarning
@@ -136,8 +136,6 @@ LAWS = {
     "mindlin_deresiewicz_pulloff_rolling": {"tangential_model": "mindlin_deresiewicz", "friction_model": "pulloff",
                                             "rolling_friction": 0.01},
 }
-#: the laws the 3-D reference solver covers (rigid tangential contact, the paper's friction)
-_REFERENCE_LAWS = ("ring", "jkr", "jkr_force", "dmt")
 #: Poisson's ratio of both bodies of a compliant law's pair: the shear modulus G* follows from the
 #: drawn stiffness K (E = 3 K (1 - nu^2) / 2 for two equal materials, G = E / (2 (1 + nu))).
 POISSON = 0.3
@@ -377,6 +375,15 @@ def _reference_check(contact: Contact, args: tuple, fine, tol: dict, budget: flo
                                               f"{fine.e_n:.6g} vs {ref.outcome}, e_n {ref.e_n:.6g})"))
 
 
+def _reference_covers(contact: Contact) -> bool:
+    """Whether the reference method covers every sub-model of ``contact`` (the solvers' registry)."""
+    try:
+        check_sub_models(contact, "reference")
+    except ValueError:
+        return False
+    return True
+
+
 def check_case(case: dict, *, reference: bool = False, case_time_limit: float = 30.0,
                tolerances: dict | None = None, reference_budget: float = REFERENCE_BUDGET,
                law: str = "ring") -> dict:
@@ -409,7 +416,7 @@ def check_case(case: dict, *, reference: bool = False, case_time_limit: float = 
     tol = dict(TOLERANCES, **(tolerances or {}))
     out = {"outcome": "", **{k: math.nan for k in _MEASURES}, "seconds": 0.0, "failures": [], "notes": []}
     contact = contact_of(case, law)
-    reference = reference and law in _REFERENCE_LAWS
+    reference = reference and _reference_covers(contact)
     args = (contact, case["speed"], case["incidence_deg"], case["azimuth_deg"], _omega(case))
     t0 = time.perf_counter()
     try:
