@@ -7,7 +7,15 @@ quantities of a microsphere are smaller than that (mass 2.3e-13 kg, energies 1e-
 value of 0 must state its ``abs=`` (and say why it is what it is).
 """
 
-from _pytest.python_api import ApproxDecimal, ApproxScalar
+import pytest
+
+try:  # pytest >= 9.2 keeps approx in its own module
+    from _pytest.approx import ApproxDecimal, ApproxScalar
+except ImportError:
+    from _pytest.python_api import ApproxDecimal, ApproxScalar
 
 ApproxScalar.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
 ApproxDecimal.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
+# the policy took effect (a pytest that keeps the default elsewhere fails here, not silently)
+if 1e-13 == pytest.approx(0.0):
+    raise RuntimeError("tests/conftest.py could not set pytest.approx's default absolute tolerance to 0")
