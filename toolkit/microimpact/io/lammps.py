@@ -1,0 +1,306 @@
+"""The contact as LAMMPS GRANULAR input: a ``fix wall/gran ... granular`` line for a sphere on a wall.
+
+Which laws map, and how (LAMMPS documentation of ``pair_style granular`` and ``fix wall/gran``,
+https://docs.lammps.org/pair_granular.html, https://docs.lammps.org/fix_wall_gran.html):
+
+=====================================  ==========================================================
+microimpact                            LAMMPS GRANULAR (wall contact)
+=====================================  ==========================================================
+``normal_model="ring"``, f0 = 0        ``hertz/material E 0.0 nu``: (4/3) E_eff sqrt(R) delta^(3/2)
+``normal_model="jkr_force"``           ``jkr E 0.0 nu gamma``: JKR, contact lost at F = -F_c
+``normal_model="dmt"``                 ``dmt E 0.0 nu gamma``: Hertz - 4 pi gamma R
+no damping (zeta_H = zeta_A = 0)       ``damping viscoelastic`` with the prefactor 0.0
+no friction (f = 0)                    ``tangential linear_nohistory 0.0 0.0``
+=====================================  ==========================================================
+
+Conversions. LAMMPS mixes the wall's modulus with the particle's as for two particles of the same
+material, E_eff = E / (2 (1 - nu^2)) (checked against LAMMPS: a Hertz contact time agrees to 2e-15
+with this mixing and is 32 % longer with E_eff = E / (1 - nu^2)); microimpact's stiffness is
+K = (4/3) E_eff (Eq. 3 of Cheng et al. 2002), so E = (3/2) (1 - nu^2) K for any nu. LAMMPS's
+``gamma`` is a surface energy, half the work of adhesion: its JKR pull-off force 3 pi gamma R is
+(3/2) pi w_A R for gamma = w_A / 2, and its DMT force 4 pi gamma R is 2 pi w_A R.
+
+What is refused (:class:`LammpsExportError`, naming the parameter), because LAMMPS has no law that
+gives the same impact:
+
+* the paper's ring adhesion force (``normal_model="ring"`` with f0 > 0) and the
+  displacement-controlled JKR break (``normal_model="jkr"``; use ``"jkr_force"``);
+* the paper's nonlinear damping (zeta_H, zeta_A > 0): LAMMPS's ``velocity``, ``mass_velocity``,
+  ``viscoelastic``, ``tsuji`` and ``coeff_restitution`` damping are other laws;
+* friction (f > 0): the paper's rigid contact is no LAMMPS law, and microimpact's "mindlin"
+  (micro-slip) and "mindlin_deresiewicz" (hysteresis) agree with LAMMPS's ``mindlin`` variants only
+  while the contact slides throughout (above about 60 deg incidence for f = 0.3; docs/guide/lammps.md);
+* rolling resistance: microimpact's constant torque mu_r r |F_n| is not LAMMPS's spring-dashpot-slider
+  (``rolling sds``).
+
+Units. The numbers are written in one of LAMMPS's unit styles ``si``, ``cgs``, ``micro`` or
+``nano`` (:data:`LAMMPS_UNITS`), named in the header; the including script sets that style.
+
+The header records, as comments, the toolkit version, where the parameters came from (a fit's data
+file and its sha256), the fitted values, and the whole contact as one JSON line that
+:func:`read_lammps_contact` reads back (the verification, :mod:`microimpact.studies.lammps_check`,
+runs LAMMPS on the file and compares it with microimpact's prediction for that contact).
+
+References
+----------
+.. [1] LAMMPS documentation, ``pair_style granular`` and ``fix wall/gran`` (version 22 Jul 2025),
+   https://docs.lammps.org/pair_granular.html.
+.. [2] Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Aerosol Sci. Technol. 36:1081-1093,
+   doi:10.1080/02786820290092221.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, fields
+
+from microimpact.model.contact import Contact
+
+__all__ = ["LAMMPS_UNITS", "DEFAULT_POISSON", "LammpsExportError", "LammpsWallModel", "lammps_wall_model",
+           "lammps_input", "read_lammps_contact", "lammps_scales", "CONTACT_LINE",
+           "UNITS_LINE"]
+
+#: LAMMPS unit styles: (metre, kilogram, second) per unit of length, mass and time
+#: (https://docs.lammps.org/units.html)
+LAMMPS_UNITS: dict[str, tuple[float, float, float]] = {
+    "si": (1.0, 1.0, 1.0),
+    "cgs": (1e-2, 1e-3, 1.0),
+    "micro": (1e-6, 1e-15, 1e-6),
+    "nano": (1e-9, 1e-21, 1e-9),
+}
+#: Poisson ratio written with E when the caller gives none. With the explicit modulus of
+#: lammps_wall_model it changes no force (E is chosen to give the contact's K whatever nu is);
+#: it matters only if a user edits E by hand.
+DEFAULT_POISSON = 0.3
+#: prefix of the header line that carries the contact as JSON
+CONTACT_LINE = "# microimpact-contact: "
+#: prefix of the header line that names the unit style of the numbers (a comment, not a ``units``
+#: command: LAMMPS refuses ``units`` once the box exists, and the fix must come after the box)
+UNITS_LINE = "# microimpact-units: "
+
+
+class LammpsExportError(ValueError):
+    """The contact uses a law or a parameter that LAMMPS GRANULAR cannot express; the message names it."""
+
+
+@dataclass(frozen=True)
+class LammpsWallModel:
+    """The LAMMPS GRANULAR wall law of a contact, in SI units.
+
+    Attributes
+    ----------
+    normal : str
+        ``"hertz/material"``, ``"jkr"`` or ``"dmt"``.
+    youngs_modulus : float
+        E written for both the particle and the wall, E_eff = E / (2 (1 - nu^2)). [Pa]
+    poisson : float
+        nu. [-]
+    surface_energy : float
+        LAMMPS's gamma = w_A / 2 (0 for hertz/material). [J/m^2]
+    damping : float
+        The ``viscoelastic`` damping prefactor eta_n0 (0: undamped). [1/(s m)]
+    tangential : str
+        ``"linear_nohistory 0.0 0.0"``: no tangential force.
+    """
+
+    normal: str
+    youngs_modulus: float
+    poisson: float
+    surface_energy: float
+    damping: float
+    tangential: str
+
+    def granular_args(self, units: str = "si") -> str:
+        """The model arguments after ``granular`` of ``fix wall/gran``, in LAMMPS units ``units``."""
+        length, mass, time = _check_units(units)
+        pressure = mass / (length * time**2)  # Pa per unit of pressure
+        energy_area = mass / time**2  # J/m^2 per unit of energy / area
+        viscoelastic = 1.0 / (time * length)
+        normal = f"{self.normal} {self.youngs_modulus / pressure:.15g} {self.damping / viscoelastic:.15g} {self.poisson:.15g}"
+        if self.normal != "hertz/material":
+            normal += f" {self.surface_energy / energy_area:.15g}"
+        return f"{normal} damping viscoelastic tangential {self.tangential}"
+
+
+def _check_units(units: str) -> tuple[float, float, float]:
+    if units not in LAMMPS_UNITS:
+        raise LammpsExportError(f"units={units!r}: LAMMPS unit styles written here are {', '.join(LAMMPS_UNITS)}")
+    return LAMMPS_UNITS[units]
+
+
+def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> LammpsWallModel:
+    """The LAMMPS GRANULAR wall law that gives the impacts of ``contact``, or a refusal.
+
+    Parameters
+    ----------
+    contact : Contact
+    poisson : float
+        nu written with E, in (-1, 0.5). [-]
+
+    Returns
+    -------
+    LammpsWallModel
+
+    Raises
+    ------
+    LammpsExportError
+        If the contact selects a law or a parameter LAMMPS cannot express (module docstring); the
+        message names the field and its value.
+
+    References
+    ----------
+    LAMMPS documentation, ``pair_style granular`` (https://docs.lammps.org/pair_granular.html).
+
+    Examples
+    --------
+    >>> from microimpact import Contact
+    >>> c = Contact(radius=3.45e-6, density=1350.0, stiffness=1e10, adhesion_line_force=7.422,
+    ...             normal_model="jkr_force")
+    >>> m = lammps_wall_model(c)
+    >>> m.normal, round(m.youngs_modulus / 1e10, 6), round(m.surface_energy / c.work_of_adhesion, 12)
+    ('jkr', 1.365, 0.5)
+    """
+    if not -1.0 < poisson < 0.5:
+        raise LammpsExportError(f"poisson={poisson!r}: must lie in (-1, 0.5)")
+    refused = []
+    if contact.normal_model == "ring" and contact.adhesion_line_force > 0.0:
+        refused.append(f"adhesion_line_force={contact.adhesion_line_force:g} with normal_model='ring': LAMMPS has no "
+                       "adhesion ring force (choose normal_model 'jkr_force' or 'dmt')")
+    if contact.normal_model == "jkr":
+        refused.append("normal_model='jkr': LAMMPS's jkr breaks contact where the force reaches -F_c, not at the "
+                       "critical approach (choose normal_model 'jkr_force')")
+    damped = [f"{name}={getattr(contact, name):g}" for name in ("zeta_hertz", "zeta_adhesion") if getattr(contact, name) > 0.0]
+    if damped:
+        refused.append(f"{', '.join(damped)}: the paper's nonlinear damping is none of LAMMPS's damping laws "
+                       "(velocity, mass_velocity, viscoelastic, tsuji, coeff_restitution)")
+    if contact.friction > 0.0:
+        refused.append(f"friction={contact.friction:g} with tangential_model={contact.tangential_model!r}: no LAMMPS "
+                       "tangential law gives the same impacts (microimpact's Mindlin laws agree with LAMMPS's "
+                       "mindlin only while the contact slides throughout)")
+    if contact.rolling_friction > 0.0:
+        refused.append(f"rolling_friction={contact.rolling_friction:g}: microimpact's constant rolling torque is "
+                       "not LAMMPS's spring-dashpot-slider (rolling sds)")
+    if refused:
+        raise LammpsExportError("cannot be written as LAMMPS GRANULAR input: " + "; ".join(refused))
+    normal = {"ring": "hertz/material", "jkr_force": "jkr", "dmt": "dmt"}[contact.normal_model]
+    youngs = 1.5 * (1.0 - poisson**2) * contact.stiffness  # K = (4/3) E / (2 (1 - nu^2))
+    gamma = 0.5 * contact.work_of_adhesion if normal != "hertz/material" else 0.0
+    return LammpsWallModel(normal, youngs, float(poisson), gamma, 0.0, "linear_nohistory 0.0 0.0")
+
+
+def _contact_json(contact: Contact) -> str:
+    return json.dumps({f.name: getattr(contact, f.name) for f in fields(Contact)}, sort_keys=True)
+
+
+def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAULT_POISSON,
+                 wall: str = "zplane 0.0 NULL", group: str = "all", fix_id: str = "microimpact_wall",
+                 source: str = "", fitted: dict | None = None) -> str:
+    """LAMMPS input of the wall contact of ``contact``: a header and one ``fix wall/gran`` line.
+
+    Parameters
+    ----------
+    contact : Contact
+    units : {"si", "cgs", "micro", "nano"}
+        LAMMPS unit style of the numbers.
+    poisson : float
+        nu written with E. [-]
+    wall : str
+        LAMMPS wall style and its arguments (``zplane 0.0 NULL``: the plane z = 0 below the spheres).
+    group, fix_id : str
+        Group the fix acts on and its ID.
+    source : str
+        Where the parameters came from (a fit's data file and sha256), written in the header.
+    fitted : dict, optional
+        Fitted values with their intervals, ``{name: text}``, written in the header.
+
+    Returns
+    -------
+    str
+        The lines, newline-terminated, to ``include`` in a LAMMPS input after its box (``atom_style
+        sphere``), whose ``units`` command must name ``units``.
+
+    Raises
+    ------
+    LammpsExportError
+        As :func:`lammps_wall_model`, or for unknown units.
+
+    References
+    ----------
+    LAMMPS documentation, ``fix wall/gran`` (https://docs.lammps.org/fix_wall_gran.html).
+
+    Examples
+    --------
+    >>> from microimpact import Contact
+    >>> c = Contact(radius=1e-6, density=2500.0, stiffness=5e10, adhesion_line_force=0.0)
+    >>> text = lammps_input(c, units="micro")
+    >>> [line for line in text.splitlines() if not line.startswith("#")]
+    ['fix microimpact_wall all wall/gran granular hertz/material 68250000 0 0.3 damping viscoelastic tangential linear_nohistory 0.0 0.0 zplane 0.0 NULL']
+    """
+    from microimpact import __version__
+
+    model = lammps_wall_model(contact, poisson)
+    length, mass, _ = _check_units(units)
+    lines = [
+        f"# LAMMPS GRANULAR wall contact written by microimpact {__version__} (microimpact lammps export)",
+        (f"# law: {model.normal}, damping viscoelastic {model.damping:g}, tangential {model.tangential}"
+         f" (microimpact normal_model={contact.normal_model!r})"),
+        (f"# the numbers are in LAMMPS units {units}: the script must say 'units {units}' before its box and "
+         "include this file after it"),
+        (f"# sphere: radius {contact.radius:.10g} m = {contact.radius / length:.10g} length units, "
+         f"density {contact.density:.10g} kg/m^3 = {contact.density * length**3 / mass:.10g} mass/length^3"),
+        (f"# E = {model.youngs_modulus:.10g} Pa with nu = {model.poisson:g} (wall and particle), "
+         f"gamma = w_A / 2 = {model.surface_energy:.10g} J/m^2"),
+    ]
+    if source:
+        lines.append(f"# parameters from: {source}")
+    for name, text in (fitted or {}).items():
+        lines.append(f"# fitted {name}: {text}")
+    lines += [
+        "# check with: microimpact lammps verify THIS_FILE",
+        CONTACT_LINE + _contact_json(contact),
+        UNITS_LINE + units,
+        f"fix {fix_id} {group} wall/gran granular {model.granular_args(units)} {wall}",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def read_lammps_contact(text: str) -> tuple[Contact, str]:
+    """The contact and the unit style recorded in a file written by :func:`lammps_input`.
+
+    Raises
+    ------
+    ValueError
+        If the text has no contact line or no ``units`` command, naming what is missing.
+
+    Examples
+    --------
+    >>> from microimpact import Contact
+    >>> c = Contact(radius=1e-6, density=2500.0, stiffness=5e10, adhesion_line_force=0.0)
+    >>> read_lammps_contact(lammps_input(c, units="nano")) == (c, "nano")
+    True
+    """
+    record = units = None
+    for number, line in enumerate(text.splitlines(), 1):
+        if line.startswith(CONTACT_LINE):
+            try:
+                record = json.loads(line[len(CONTACT_LINE):])
+                contact = Contact(**record)
+            except (ValueError, TypeError) as exc:
+                raise ValueError(f"line {number}: the contact record does not read: {exc}") from None
+        elif line.startswith(UNITS_LINE):
+            units = line[len(UNITS_LINE):].strip()
+            if units not in LAMMPS_UNITS:
+                raise ValueError(f"line {number}: units {units!r} is not one of {', '.join(LAMMPS_UNITS)}")
+    if record is None:
+        raise ValueError(f"no '{CONTACT_LINE.strip()}' line: not written by 'microimpact lammps export'")
+    if units is None:
+        raise ValueError(f"no '{UNITS_LINE.strip()}' line: not written by 'microimpact lammps export'")
+    return contact, units
+
+
+def lammps_scales(units: str) -> dict[str, float]:
+    """SI value of one LAMMPS unit of length, mass, time, speed, density and angular speed."""
+    length, mass, time = _check_units(units)
+    return {"length": length, "mass": mass, "time": time, "speed": length / time,
+            "density": mass / length**3, "angular_speed": 1.0 / time}
+
