@@ -1,4 +1,4 @@
-"""The contact as LAMMPS GRANULAR input: a ``fix wall/gran ... granular`` line for a sphere on a wall.
+"""The contact as LAMMPS GRANULAR input: one ``fix wall/gran`` line for a sphere on a wall.
 
 Which laws map, and how (LAMMPS documentation of ``pair_style granular`` and ``fix wall/gran``,
 https://docs.lammps.org/pair_granular.html, https://docs.lammps.org/fix_wall_gran.html):
@@ -43,10 +43,11 @@ runs LAMMPS on the file and compares it with microimpact's prediction for that c
 
 References
 ----------
-.. [1] LAMMPS documentation, ``pair_style granular`` and ``fix wall/gran`` (version 22 Jul 2025),
-   https://docs.lammps.org/pair_granular.html.
-.. [2] Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Aerosol Sci. Technol. 36:1081-1093,
-   doi:10.1080/02786820290092221.
+LAMMPS documentation, ``pair_style granular`` and ``fix wall/gran`` (version 22 Jul 2025),
+https://docs.lammps.org/pair_granular.html.
+
+Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Aerosol Sci. Technol. 36:1081-1093,
+doi:10.1080/02786820290092221.
 """
 
 from __future__ import annotations

@@ -17,11 +17,12 @@ Run as ``microimpact lammps verify contact.lmp`` or ``python -m microimpact.stud
 
 References
 ----------
-.. [1] LAMMPS documentation, ``fix wall/gran`` and ``pair_style granular`` (22 Jul 2025),
-   https://docs.lammps.org/fix_wall_gran.html.
-.. [2] Thompson, A. P. et al. (2022), LAMMPS - a flexible simulation tool for particle-based materials
-   modeling at the atomic, meso, and continuum scales, Comput. Phys. Commun. 271:108171,
-   doi:10.1016/j.cpc.2021.108171.
+LAMMPS documentation, ``fix wall/gran`` and ``pair_style granular`` (22 Jul 2025),
+https://docs.lammps.org/fix_wall_gran.html.
+
+Thompson, A. P. et al. (2022), LAMMPS - a flexible simulation tool for particle-based materials
+modeling at the atomic, meso, and continuum scales, Comput. Phys. Commun. 271:108171,
+doi:10.1016/j.cpc.2021.108171.
 """
 
 from __future__ import annotations
