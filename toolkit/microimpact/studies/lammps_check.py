@@ -13,7 +13,7 @@ from the contact time (microimpact's, or the Hertz time of the normal speed for 
 two is LAMMPS's own step error, reported beside the disagreement with microimpact. An impact agrees
 when both are within the tolerance (1e-3, the issue's target; 1e-5 is typical at the default steps).
 
-Run as ``microimpact lammps verify contact.lmp`` or ``python -m microimpact.studies.lammps_check``.
+From the command line: ``microimpact lammps verify contact.lmp``.
 
 References
 ----------
@@ -297,13 +297,3 @@ def _compare(lammps, text, contact, units, speed, angle, steps, simulate_impact)
             row[f"{q}_microimpact"] = row[f"{q}_lammps"] = row[f"{q}_lammps_coarse"] = math.nan
     return row
 
-
-def main(argv=None) -> int:
-    """``python -m microimpact.studies.lammps_check FILE [--out CSV]``: the same as ``microimpact lammps verify``."""
-    from microimpact.cli import main as cli_main
-
-    return cli_main(["lammps", "verify", *(sys.argv[1:] if argv is None else argv)])
-
-
-if __name__ == "__main__":
-    sys.exit(main())
