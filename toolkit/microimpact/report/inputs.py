@@ -60,6 +60,8 @@ INPUT_KEYS = {
     "kharaz": (False, "Kharaz et al. (2001) comparison NetCDF"),
     "work_precision": (False, "work-precision benchmark NetCDF"),
     "stress": (False, "stress-sweep summary JSON"),
+    "lammps_check": (False, "LAMMPS against microimpact on the paper's microsphere as LAMMPS input, CSV "
+                            "(microimpact.studies.lammps_check)"),
 }
 
 

@@ -129,6 +129,8 @@ def _checks_part(lay: Layout, inputs: Mapping, config: Mapping) -> None:
         checks.kharaz_section(lay, read_dataset(inputs["kharaz"]))
     checks.benchmark_section(lay, _optional(inputs, "work_precision", read_dataset))
     checks.stress_section(lay, _optional(inputs, "stress", read_json), config.get("stress"))
+    if "lammps_check" in inputs:
+        checks.lammps_section(lay, read_table(inputs["lammps_check"]))
     if config:
         checks.config_section(lay, config)
 
