@@ -385,7 +385,7 @@ def test_inertia_free_limit_against_an_independent_stiff_solve():
     a = np.array([q_of(v) ** 2 for v in x])
     dy = np.abs(np.diff(y))
     j_ref, ja_ref = dy.sum(), (0.5 * (a[1:] + a[:-1]) * dy).sum()
-    r = normal_models._integrate(1, y0, c1, c2, 1e-10, True, 1e-10, 0.0, math.inf, math.inf, 2_000_000)
+    r = normal_models._integrate(1, y0, c1, c2, 0.0, 0.0, 1e-10, True, 1e-10, 0.0, math.inf, math.inf, 2_000_000)
     assert r[0] == 0 and r[1] == 1  # solved, captured
     assert r[5] == pytest.approx(j_ref, rel=1e-6, abs=0.0)
     assert r[6] == pytest.approx(ja_ref, rel=1e-6, abs=0.0)
@@ -400,8 +400,8 @@ def test_averaged_tail_of_a_weakly_damped_capture(model, y0, c1, c2):
     to its settled end (1e5-9e5 steps) against the same impact whose step budget is cut to 2e4, so
     that after a twentieth of it the rest of J and J_a comes from the method of averaging (per-cycle
     integrals of the undamped orbit). The averaging errs by ~C / omega0: measured 9e-4, 4e-4, 2e-4."""
-    full = normal_models._integrate(model, y0, c1, c2, 1e-10, True, 1e-10, 0.0, math.inf, math.inf, 50_000_000)
-    short = normal_models._integrate(model, y0, c1, c2, 1e-10, True, 1e-10, 0.0, math.inf, math.inf, 20_000)
+    full = normal_models._integrate(model, y0, c1, c2, 0.0, 0.0, 1e-10, True, 1e-10, 0.0, math.inf, math.inf, 50_000_000)
+    short = normal_models._integrate(model, y0, c1, c2, 0.0, 0.0, 1e-10, True, 1e-10, 0.0, math.inf, math.inf, 20_000)
     assert full[0] == short[0] == 0 and full[1] == short[1] == 1  # both solved, captured
     assert short[11] < 1000 < full[11]
     assert short[5] == pytest.approx(full[5], rel=2e-3, abs=0.0)

@@ -384,3 +384,45 @@ def dmt_nondimensional_potential(s):
 def dmt_nondimensional_dissipation_rate(s, y, c1, c2):
     """Damping power / (F_D L_D / T) = (C1 s^3 + C2) y^2 >= 0. [-]"""
     return (c1 * s * s * s + c2) * y * y
+
+
+# =============================================================================== Hertz, in the same form
+# Without adhesion the DMT law is Hertz's. Its own units: the speed-dependent largest undamped approach
+# L = (5 m v^2 / (4 K sqrt(R)))^(2/5) of an impact at v, force K sqrt(R) L^(3/2); state s = sqrt(delta / L)
+# as for DMT. Used with the DEM damping laws (microimpact.model.dem_damping); the paper's damped Hertz
+# law is the ring law with f0 = 0 (microimpact.model.law).
+def hertz_scales(contact, normal_speed) -> AdhesionScales:
+    """Length, force, time and contact-radius units of the Hertz law for impacts at ``normal_speed``.
+
+    L = (5 m v^2 / (4 K sqrt(R)))^(2/5) (the undamped largest approach), F = K sqrt(R) L^(3/2),
+    T = sqrt(m L / F), a unit sqrt(R L); arrays for an array of speeds. [m], [N], [s], [m]
+
+    Examples
+    --------
+    The undamped impact in these units enters at y0 = sqrt(4/5) and turns at s = 1:
+
+    >>> from microimpact.model.contact import Contact
+    >>> sc = hertz_scales(Contact(1e-6, 2000.0, 1e9, 0.0), 1.0)
+    >>> round(float(1.0 / sc.speed), 6)
+    0.894427
+    """
+    v = np.asarray(normal_speed, dtype=float)
+    k_sqrt_r = contact.stiffness * math.sqrt(contact.radius)
+    length = (1.25 * contact.mass * v * v / k_sqrt_r) ** 0.4
+    force = k_sqrt_r * length**1.5
+    return AdhesionScales(length, force, np.sqrt(contact.mass * length / force), np.sqrt(contact.radius * length))
+
+
+def hertz_nondimensional_force(s, y, c1):
+    """Hertz force with the paper's Hertzian damping, F / F_H = s^3 (1 + C1 y), s = sqrt(delta / L). [-]"""
+    return s * s * s * (1.0 + c1 * y)
+
+
+def hertz_nondimensional_potential(s):
+    """U / (F_H L) = (2/5) s^5 of the Hertz law. [-]"""
+    return 0.4 * s**5
+
+
+def hertz_nondimensional_dissipation_rate(s, y, c1):
+    """Power of the Hertzian damping, C1 s^3 y^2. [-]"""
+    return c1 * s * s * s * y * y

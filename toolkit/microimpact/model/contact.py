@@ -38,6 +38,7 @@ SUB_MODELS: dict[str, tuple[str, ...]] = {
     "normal_model": ("ring", "jkr", "dmt", "jkr_force"),
     "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
     "friction_model": ("net", "pulloff"),
+    "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
 }
 
 #: full citation of the paper, for the ``references`` attribute of the toolkit's results
@@ -156,6 +157,14 @@ class Contact:
     shear_modulus : float or None
         Effective shear modulus G* of the pair, 1/G* = (2 - nu1)/G1 + (2 - nu2)/G2, needed by the
         "mindlin" tangential model (tangential stiffness 8 G* a); None when not given. [Pa]
+    damping_model : {"paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"}
+        Normal damping law; "paper" (zeta_H, zeta_A) is the paper's; the others are the damping
+        laws of LAMMPS GRANULAR (:mod:`microimpact.model.dem_damping`), with zeta_H = zeta_A = 0.
+        "tsuji" and "coeff_restitution" need the Hertz law (``normal_model="ring"``, f0 = 0). [-]
+    damping_coefficient : float
+        The DEM damping law's coefficient: eta_n0 [1/s] of "mass_velocity", eta_n0 [1/(m s)] of
+        "viscoelastic", the restitution e in (0, 1] of "tsuji" and "coeff_restitution"; 0 with
+        the paper's damping.
 
     Raises
     ------
@@ -182,6 +191,8 @@ class Contact:
     friction_model: str = "net"
     rolling_friction: float = 0.0
     shear_modulus: float | None = None
+    damping_model: str = "paper"
+    damping_coefficient: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -194,7 +205,8 @@ class Contact:
             object.__setattr__(self, f.name, _as_number(f.name, value))
         for name in ("radius", "density", "stiffness"):
             check_positive(name, getattr(self, name))
-        for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction", "rolling_friction"):
+        for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction", "rolling_friction",
+                     "damping_coefficient"):
             _check_non_negative(name, getattr(self, name))
         for name in _OPTIONAL:
             if getattr(self, name) is not None:
@@ -202,7 +214,35 @@ class Contact:
         if self.tangential_model != "rigid" and self.shear_modulus is None:
             raise ValueError(f"tangential_model={self.tangential_model!r} needs shear_modulus "
                              "(the effective shear modulus G* [Pa])")
+        self._check_damping_model()
         self._check_scales()
+
+    def _check_damping_model(self) -> None:
+        """One damping law at a time, with the normal laws it is defined for (model.dem_damping)."""
+        model, coef = self.damping_model, self.damping_coefficient
+        if model == "paper":
+            if coef != 0.0:
+                raise ValueError(f"damping_coefficient={coef!r} belongs to a DEM damping_model; the paper's damping "
+                                 "(damping_model='paper') is set by zeta_hertz and zeta_adhesion")
+            return
+        paper = [f"{n}={getattr(self, n)!r}" for n in ("zeta_hertz", "zeta_adhesion") if getattr(self, n) != 0.0]
+        if self.damping_reference_speed is not None:
+            paper.append(f"damping_reference_speed={self.damping_reference_speed!r}")
+        if paper:
+            raise ValueError(f"damping_model={model!r} replaces the paper's damping: {', '.join(paper)} must be unset (0)")
+        hertz = self.normal_model == "ring" and self.adhesion_line_force == 0.0
+        if model in ("tsuji", "coeff_restitution"):
+            if not 0.0 < coef <= 1.0:
+                raise ValueError(f"damping_coefficient={coef!r} is the restitution of damping_model={model!r} and "
+                                 "must lie in (0, 1]")
+            if not hertz:
+                raise ValueError(f"damping_model={model!r} is defined for the Hertz law only (as in LAMMPS, no "
+                                 f"cohesion): normal_model='ring' with adhesion_line_force=0, got "
+                                 f"normal_model={self.normal_model!r}, adhesion_line_force={self.adhesion_line_force!r}")
+        elif self.normal_model == "ring" and not hertz:
+            raise ValueError(f"damping_model={model!r} with the ring adhesion force (adhesion_line_force="
+                             f"{self.adhesion_line_force!r}) is not implemented: use normal_model 'jkr_force', 'jkr' "
+                             "or 'dmt', or the paper's damping")
 
     def _check_scales(self) -> None:
         """The derived scales the solvers divide by are finite normal doubles (check_representable)."""

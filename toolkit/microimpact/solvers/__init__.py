@@ -184,9 +184,12 @@ SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
     # integrates the ring normal law only (check_sub_models refuses jkr/dmt with it)
     "engine": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"),
                "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
-               "friction_model": ("net", "pulloff")},
-    "reference": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"), "tangential_model": ("rigid",), "friction_model": ("net",)},
-    "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",)},
+               "friction_model": ("net", "pulloff"),
+               "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution")},
+    "reference": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"), "tangential_model": ("rigid",), "friction_model": ("net",),
+                  "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution")},
+    "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",),
+            "damping_model": ("paper",)},
 }
 #: solver paths that model rolling resistance (Contact.rolling_friction > 0): the engine's coupled
 #: solver (.coupled), with a compliant tangential model (ROLLING_RESISTANCE_TANGENTIAL_MODELS)
@@ -213,6 +216,11 @@ def check_sub_models(contact, method: str) -> None:
         raise ValueError(f"rolling_friction={contact.rolling_friction!r} needs a compliant tangential model "
                          f"(tangential_model one of {', '.join(map(repr, ROLLING_RESISTANCE_TANGENTIAL_MODELS))}), "
                          f"got tangential_model={contact.tangential_model!r}")
+    if contact.damping_model != "paper" and (contact.tangential_model != "rigid" or contact.friction_model != "net"):
+        raise ValueError(f"damping_model={contact.damping_model!r} runs with the paper's tangential map only "
+                         "(tangential_model='rigid', friction_model='net'): the coupled solver integrates the "
+                         f"paper's damping; got tangential_model={contact.tangential_model!r}, "
+                         f"friction_model={contact.friction_model!r}")
     if contact.normal_model != "ring" and (contact.tangential_model != "rigid" or contact.friction_model != "net"):
         raise ValueError(f"normal_model={contact.normal_model!r} runs with the paper's tangential map only "
                          "(tangential_model='rigid', friction_model='net'): the coupled solver of tangential "

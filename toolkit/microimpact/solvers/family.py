@@ -439,8 +439,9 @@ def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = 
     >>> bool(abs(out["e_n"][1] - direct) < 1e-8)
     True
     """
-    if contact.normal_model != "ring":
-        raise ValueError(f"normal_family interpolates the paper's ring normal law, got normal_model={contact.normal_model!r}")
+    if contact.normal_model != "ring" or contact.damping_model != "paper":
+        raise ValueError("normal_family interpolates the paper's ring normal law with the paper's damping, got "
+                         f"normal_model={contact.normal_model!r}, damping_model={contact.damping_model!r}")
     lo, hi = float(speed_min), float(speed_max)
     if not (0.0 < lo <= hi and math.isfinite(hi)):
         raise ValueError(f"need 0 < speed_min <= speed_max (finite), got {speed_min!r}, {speed_max!r}")
@@ -552,7 +553,7 @@ def normal_restitution(contact, normal_speed, *, rtol: float = DEFAULT_RTOL, fam
     or, for many distinct speeds, a restitution-only family (``family`` None chooses, True/False
     force) when it costs fewer than half as many solves. [-]"""
     v = np.asarray(normal_speed, dtype=float).ravel()
-    if contact.normal_model != "ring":  # JKR, DMT: their own solver, one solve per speed
+    if contact.normal_model != "ring" or contact.damping_model != "paper":  # their own solver, one solve per speed
         from microimpact.solvers import normal_models  # imported on use: it compiles its own kernels
 
         return normal_models.solve_normal_many(contact, v, rtol=rtol)["e_n"]

@@ -281,7 +281,8 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
                                np.array([contact.friction]), rtol)
         return _coupled_impact_result(contact, v_in, omega, res)
     normal = _normal_solver(contact)
-    if method == "reference" and (contact.normal_model == "ring" or contact.adhesion_line_force == 0.0):
+    if method == "reference" and contact.damping_model == "paper" and (contact.normal_model == "ring"
+                                                                       or contact.adhesion_line_force == 0.0):
         # imported here: scipy.integrate costs ~0.7 s of import time that the engine never needs
         from microimpact.solvers.reference import simulate_reference
 
@@ -399,15 +400,17 @@ def _coupled_impact_result(contact, v_in, w_in, res) -> ImpactResult:
 
 
 def _normal_solver(contact):
-    """The module that solves the contact's normal law: the paper's engine for the ring force, else
-    :mod:`microimpact.solvers.normal_models` (JKR, DMT), after checking the Tabor regime
+    """The module that solves the contact's normal law: the paper's engine for the ring force with
+    the paper's damping, else :mod:`microimpact.solvers.normal_models` (JKR, DMT, and Hertz with a
+    DEM damping law), after checking the Tabor regime of an adhesive law
     (:func:`microimpact.model.adhesion_models.check_adhesion_regime`, an AdhesionRegimeWarning)."""
-    if contact.normal_model == "ring":
+    if contact.normal_model == "ring" and contact.damping_model == "paper":
         return engine
     from microimpact.model.adhesion_models import check_adhesion_regime
     from microimpact.solvers import normal_models
 
-    check_adhesion_regime(contact, stacklevel=4)
+    if contact.adhesion_line_force > 0.0:
+        check_adhesion_regime(contact, stacklevel=4)
     return normal_models
 
 
@@ -661,9 +664,10 @@ def _family_of(contact, speed, incidence_deg, rtol, family):
     n = speed.size
     if family is False or n == 0:
         return None
-    if contact.normal_model != "ring":  # the family interpolates the paper's engine
+    if contact.normal_model != "ring" or contact.damping_model != "paper":  # the family interpolates the paper's engine
         if family:
-            raise ValueError(f"family=True covers normal_model='ring' only, got {contact.normal_model!r}")
+            raise ValueError("family=True covers normal_model='ring' with damping_model='paper' only, got "
+                             f"normal_model={contact.normal_model!r}, damping_model={contact.damping_model!r}")
         return None
     if family is None:
         if n < FAMILY_MIN_SPEEDS:

@@ -62,6 +62,7 @@ from numba import prange
 
 from microimpact._numba import njit
 from microimpact.model import adhesion_models as am
+from microimpact.model import dem_damping as dd
 from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL
 from microimpact.solvers.engine import (CAPTURE, INERTIA_FREE_ENTER, _linear_tail_variation, INERTIA_FREE_RESUME, OUTCOME_NAMES, REBOUND,
@@ -72,8 +73,8 @@ __all__ = ["solve_normal", "solve_normal_many", "solve_normal_reference", "settl
            "MODEL_CODES"]
 
 #: the models this module integrates, and their codes in the compiled core
-MODEL_CODES = {"jkr": 1, "dmt": 2, "jkr_force": 3}
-_JKR, _DMT, _JKR_FORCE = 1, 2, 3  # both JKR codes share the law; they differ where contact breaks
+MODEL_CODES = {"jkr": 1, "dmt": 2, "jkr_force": 3, "hertz": 4}
+_JKR, _DMT, _JKR_FORCE, _HERTZ = 1, 2, 3, 4  # both JKR codes share the law; they differ where contact breaks
 _Q_BREAK_FORCE = am.JKR_Q_BREAK["jkr_force"]  # q^3 = 3, where F = -F_c
 _OK, _MAX_STEPS, _STEP_UNDERFLOW = 0, 1, 2
 _N = 6  # state: z (q or s), y, tau, D, J, J_a
@@ -85,6 +86,10 @@ _jkr_dissipation = njit(inline="always", cache=True)(am.jkr_nondimensional_dissi
 _dmt_force = njit(inline="always", cache=True)(am.dmt_nondimensional_force)
 _dmt_potential = njit(inline="always", cache=True)(am.dmt_nondimensional_potential)
 _dmt_dissipation = njit(inline="always", cache=True)(am.dmt_nondimensional_dissipation_rate)
+_hertz_force = njit(inline="always", cache=True)(am.hertz_nondimensional_force)
+_hertz_potential = njit(inline="always", cache=True)(am.hertz_nondimensional_potential)
+_hertz_dissipation = njit(inline="always", cache=True)(am.hertz_nondimensional_dissipation_rate)
+_dem_force = njit(inline="always", cache=True)(dd.dem_damping_nondimensional_force)
 
 # Dormand-Prince 5(4) tableau (Dormand & Prince 1980)
 _A = np.array([
@@ -101,37 +106,54 @@ _E = np.array([71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 3
 
 # --------------------------------------------------------------------------- compiled core
 @njit(cache=True, inline="always")
-def _rhs(model, u, c1, c2, out):
+def _rhs(model, u, c1, c2, c3, p3, out):
     """d/dsigma of the state u = (z, y, tau, D, J, J_a), written into out."""
     z, y = u[0], u[1]
-    if model != _DMT:
+    if _is_jkr(model):
         g = 4.0 * (z * z * z - 1.0)  # d tau / d sigma
         f = _jkr_force(z, y, c1, c2)
         out[0] = y
-        out[3] = g * _jkr_dissipation(z, y, c1, c2)
+        p = _jkr_dissipation(z, y, c1, c2)
         a = z * z  # contact radius / a_c
-    else:
+    elif model == _DMT:
         g = z
         f = _dmt_force(z, y, c1, c2)
         out[0] = 0.5 * y
-        out[3] = g * _dmt_dissipation(z, y, c1, c2)
+        p = _dmt_dissipation(z, y, c1, c2)
         a = z  # contact radius / sqrt(R L_D)
+    else:
+        g = z
+        f = _hertz_force(z, y, c1)
+        out[0] = 0.5 * y
+        p = _hertz_dissipation(z, y, c1)
+        a = z  # contact radius / sqrt(R L)
+    fd = _dem_force(a, y, c3, p3)
+    f += fd
     out[1] = -g * f
     out[2] = g
+    out[3] = g * (p + fd * y)
     out[4] = g * abs(f)
     out[5] = g * a * abs(f)
 
 
 @njit(cache=True, inline="always")
+def _is_jkr(model):
+    """Whether the model's state is JKR's q (else DMT's or Hertz's s)."""
+    return model == _JKR or model == _JKR_FORCE
+
+
+@njit(cache=True, inline="always")
 def _energy(model, z, y):
     """Contact energy y^2/2 + U(z) in the model's units. [-]"""
-    if model != _DMT:
+    if _is_jkr(model):
         return 0.5 * y * y + _jkr_potential(z)
-    return 0.5 * y * y + _dmt_potential(z)
+    if model == _DMT:
+        return 0.5 * y * y + _dmt_potential(z)
+    return 0.5 * y * y + _hertz_potential(z)
 
 
 @njit(cache=True)
-def _step(model, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
+def _step(model, u0, k, h, c1, c2, c3, p3, a, b, e, tmp, u1, err):
     """One DP5 step from u0 (k[0] = f(u0)) over h: writes u1, err and k[6] = f(u1)."""
     for st in range(1, 6):
         for i in range(_N):
@@ -139,13 +161,13 @@ def _step(model, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
             for j in range(st):
                 acc += a[st, j] * k[j, i]
             tmp[i] = u0[i] + h * acc
-        _rhs(model, tmp, c1, c2, k[st])
+        _rhs(model, tmp, c1, c2, c3, p3, k[st])
     for i in range(_N):
         acc = 0.0
         for j in range(6):
             acc += b[j] * k[j, i]
         u1[i] = u0[i] + h * acc
-    _rhs(model, u1, c1, c2, k[6])
+    _rhs(model, u1, c1, c2, c3, p3, k[6])
     for i in range(_N):
         acc = 0.0
         for j in range(7):
@@ -173,80 +195,83 @@ _SLOW_DECADES = 12.0  # the path ends 1e-12 of its length before the equilibrium
 
 
 @njit(cache=True, inline="always")
-def _static_and_damping(model, z, c1, c2):
+def _static_and_damping(model, z, c1, c2, c3, p3):
     """(E, C) of F = E(z) + C(z) y: the undamped force and the damping rate (the dissipation rate
     at y = 1). [-]"""
-    if model != _DMT:
-        return _jkr_force(z, 0.0, c1, c2), _jkr_dissipation(z, 1.0, c1, c2)
-    return _dmt_force(z, 0.0, c1, c2), _dmt_dissipation(z, 1.0, c1, c2)
+    dem = _dem_force(_radius(model, z), 1.0, c3, p3)
+    if _is_jkr(model):
+        return _jkr_force(z, 0.0, c1, c2), _jkr_dissipation(z, 1.0, c1, c2) + dem
+    if model == _DMT:
+        return _dmt_force(z, 0.0, c1, c2), _dmt_dissipation(z, 1.0, c1, c2) + dem
+    return _hertz_force(z, 0.0, c1), _hertz_dissipation(z, 1.0, c1) + dem
 
 
 @njit(cache=True, inline="always")
 def _approach(model, z):
     """x = delta / L of the model's z (q^4 - 4 q for JKR, s^2 for DMT). [-]"""
-    return z * z if model == _DMT else z**4 - 4.0 * z
+    return z**4 - 4.0 * z if _is_jkr(model) else z * z
 
 
 @njit(cache=True, inline="always")
 def _radius(model, z):
     """Contact radius in the model's unit (q^2 for JKR, s for DMT). [-]"""
-    return z if model == _DMT else z * z
+    return z * z if _is_jkr(model) else z
 
 
 @njit(cache=True, inline="always")
-def _slow_speed(model, z, c1, c2):
+def _slow_speed(model, z, c1, c2, c3, p3):
     """y_m(z) = -E / C, the rate on the slow manifold. [-]"""
-    e, c = _static_and_damping(model, z, c1, c2)
+    e, c = _static_and_damping(model, z, c1, c2, c3, p3)
     return -e / c
 
 
 @njit(cache=True)
-def _slow_ratios(model, z, z_eq, c1, c2):
+def _slow_ratios(model, z, z_eq, c1, c2, c3, p3):
     """(inertia ratio |dy_m/dx| / C, relaxation ratio C |x - x_eq| / |y_m|) at z (engine.py)."""
-    e, c = _static_and_damping(model, z, c1, c2)
+    e, c = _static_and_damping(model, z, c1, c2, c3, p3)
     if not c > 0.0:
         return math.inf, 0.0
     dz = 1e-6 * max(abs(z), 1.0)
     dx = _approach(model, z + dz) - _approach(model, z - dz)
     if dx == 0.0:
         return math.inf, 0.0
-    slope = (_slow_speed(model, z + dz, c1, c2) - _slow_speed(model, z - dz, c1, c2)) / dx
+    slope = (_slow_speed(model, z + dz, c1, c2, c3, p3) - _slow_speed(model, z - dz, c1, c2, c3, p3)) / dx
     ym = -e / c
     relax = math.inf if ym == 0.0 else c * abs(_approach(model, z) - _approach(model, z_eq)) / abs(ym)
     return abs(slope) / c, relax
 
 
 @njit(cache=True)
-def _slow_time_between(model, z0, z1, c1, c2):
+def _slow_time_between(model, z0, z1, c1, c2, c3, p3):
     """tau from z0 to z1 on the slow manifold, int dx / y_m (3-point Gauss-Legendre). [-]"""
     t = 0.0
     for i in range(3):
         z = 0.5 * (z0 + z1) + 0.5 * (z1 - z0) * _GL3_X[i]
         dz = 1e-6 * max(abs(z), 1.0)
         dxdz = (_approach(model, z + dz) - _approach(model, z - dz)) / (2.0 * dz)
-        t += 0.5 * (z1 - z0) * _GL3_W[i] * dxdz / _slow_speed(model, z, c1, c2)
+        t += 0.5 * (z1 - z0) * _GL3_W[i] * dxdz / _slow_speed(model, z, c1, c2, c3, p3)
     return t
 
 
 @njit(cache=True, inline="always")
-def _point_value(model, kind, z, target, ya, c1, c2):
+def _point_value(model, kind, z, target, ya, c1, c2, c3, p3):
     """What :func:`_slow_point` brings to zero: U(z) - target (kind _EV_U), the energy on the slow
     manifold - target (_EV_ENERGY), or target - |y_m(z) - ya| (_EV_J)."""
     if kind == _EV_U:
         return _energy(model, z, 0.0) - target
-    ym = _slow_speed(model, z, c1, c2)
+    ym = _slow_speed(model, z, c1, c2, c3, p3)
     return (_energy(model, z, ym) - target) if kind == _EV_ENERGY else (target - abs(ym - ya))
 
 
 @njit(cache=True)
-def _slow_point(model, kind, target, za, zb_, ya, c1, c2):
+def _slow_point(model, kind, target, za, zb_, ya, c1, c2, c3, p3):
     """The z in [za, zb_] where the value of ``kind`` (:func:`_point_value`) reaches zero, by
     bisection (each is monotone there: a cell of the slow path, or one side of the well)."""
     lo, hi = za, zb_
-    vlo = _point_value(model, kind, lo, target, ya, c1, c2)
+    vlo = _point_value(model, kind, lo, target, ya, c1, c2, c3, p3)
     for _ in range(100):
         mid = 0.5 * (lo + hi)
-        if (_point_value(model, kind, mid, target, ya, c1, c2) > 0.0) == (vlo > 0.0):
+        if (_point_value(model, kind, mid, target, ya, c1, c2, c3, p3) > 0.0) == (vlo > 0.0):
             lo = mid
         else:
             hi = mid
@@ -254,7 +279,7 @@ def _slow_point(model, kind, target, za, zb_, ya, c1, c2):
 
 
 @njit(cache=True)
-def _slow_jump(model, u, z_eq, c1, c2, atol_y, threshold, captured, j_target, need_slip, enter, resume, band):
+def _slow_jump(model, u, z_eq, c1, c2, c3, p3, atol_y, threshold, captured, j_target, need_slip, enter, resume, band):
     """Whether the state u follows the slow manifold into the equilibrium and, if so, the rest of
     the impact in closed form and quadratures.
 
@@ -268,10 +293,10 @@ def _slow_jump(model, u, z_eq, c1, c2, atol_y, threshold, captured, j_target, ne
     """
     nan = math.nan
     z = u[0]
-    eps, relax = _slow_ratios(model, z, z_eq, c1, c2)
+    eps, relax = _slow_ratios(model, z, z_eq, c1, c2, c3, p3)
     if not (eps <= enter and relax >= RELAXATION_ENTER * INERTIA_FREE_ENTER / enter):
         return False, nan, nan, nan, nan, nan, nan
-    ym = _slow_speed(model, z, c1, c2)
+    ym = _slow_speed(model, z, c1, c2, c3, p3)
     if abs(u[1] - ym) > (2.0 * eps + band) * abs(ym) + 10.0 * atol_y:
         return False, nan, nan, nan, nan, nan, nan
     d0 = z - z_eq
@@ -279,7 +304,7 @@ def _slow_jump(model, u, z_eq, c1, c2, atol_y, threshold, captured, j_target, ne
     zk = z
     for k in range(1, _SLOW_CELLS + 1):  # the whole path must stay inertia-free
         zk = z_eq + d0 * ratio**k
-        eps, relax = _slow_ratios(model, zk, z_eq, c1, c2)
+        eps, relax = _slow_ratios(model, zk, z_eq, c1, c2, c3, p3)
         if not (eps <= resume and relax >= RELAXATION_RESUME * INERTIA_FREE_RESUME / resume):
             return False, nan, nan, nan, nan, nan, nan
     tau, jf, ja = u[2], u[4] + abs(u[1] - ym), u[5] + _radius(model, z) * abs(u[1] - ym)
@@ -288,22 +313,22 @@ def _slow_jump(model, u, z_eq, c1, c2, atol_y, threshold, captured, j_target, ne
     za, ya = z, ym
     for k in range(1, _SLOW_CELLS + 1):
         zb_ = z_eq + d0 * ratio**k
-        yb = _slow_speed(model, zb_, c1, c2)
+        yb = _slow_speed(model, zb_, c1, c2, c3, p3)
         dj = abs(yb - ya)
         if need_cap and _energy(model, zb_, yb) < threshold:
-            zc = _slow_point(model, _EV_ENERGY, threshold, za, zb_, ya, c1, c2)
-            tau_cap = tau + _slow_time_between(model, za, zc, c1, c2)
+            zc = _slow_point(model, _EV_ENERGY, threshold, za, zb_, ya, c1, c2, c3, p3)
+            tau_cap = tau + _slow_time_between(model, za, zc, c1, c2, c3, p3)
             need_cap = False
         if need_slip and jf + dj >= j_target:
-            zs = _slow_point(model, _EV_J, j_target - jf, za, zb_, ya, c1, c2)
-            tau_slip = tau + _slow_time_between(model, za, zs, c1, c2)
+            zs = _slow_point(model, _EV_J, j_target - jf, za, zb_, ya, c1, c2, c3, p3)
+            tau_slip = tau + _slow_time_between(model, za, zs, c1, c2, c3, p3)
             need_slip = False
         for i in range(3):
             zi = 0.5 * (za + zb_) + 0.5 * (zb_ - za) * _GL3_X[i]
             dzi = 1e-6 * max(abs(zi), 1.0)
-            slope = (_slow_speed(model, zi + dzi, c1, c2) - _slow_speed(model, zi - dzi, c1, c2)) / (2.0 * dzi)
+            slope = (_slow_speed(model, zi + dzi, c1, c2, c3, p3) - _slow_speed(model, zi - dzi, c1, c2, c3, p3)) / (2.0 * dzi)
             ja += 0.5 * abs(zb_ - za) * _GL3_W[i] * _radius(model, zi) * abs(slope)
-        tau += _slow_time_between(model, za, zb_, c1, c2)
+        tau += _slow_time_between(model, za, zb_, c1, c2, c3, p3)
         jf += dj
         za, ya = zb_, yb
     # the last 1e-12 of the path: y_m falls from ya to 0 at z_eq
@@ -320,17 +345,17 @@ _GL16_X, _GL16_W = np.polynomial.legendre.leggauss(16)
 
 
 @njit(cache=True)
-def _orbit_integrals(model, e, z_lo, z_eq, c1, c2):
+def _orbit_integrals(model, e, z_lo, z_eq, c1, c2, c3, p3):
     """Per cycle of the undamped orbit at energy e in the well: (energy lost to the damping,
     total variation of y, int a |dy|). On each side of z_eq, z = end + (z_eq - end) t^2 from the
     turning point makes y ~ sqrt(z - end) smooth in t (16-point Gauss-Legendre); int a |dy| by
     parts, 2 a_eq y_max - int y da (inwards) + int y da (outwards), per half-cycle."""
     ymax = math.sqrt(max(2.0 * (e - _energy(model, z_eq, 0.0)), 0.0))
-    za = _slow_point(model, _EV_U, e, z_lo, z_eq, 0.0, c1, c2)
+    za = _slow_point(model, _EV_U, e, z_lo, z_eq, 0.0, c1, c2, c3, p3)
     zhi = 2.0 * z_eq
     while _energy(model, zhi, 0.0) < e:
         zhi *= 2.0
-    zb_ = _slow_point(model, _EV_U, e, z_eq, zhi, 0.0, c1, c2)
+    zb_ = _slow_point(model, _EV_U, e, z_eq, zhi, 0.0, c1, c2, c3, p3)
     loss = 0.0
     twist = 2.0 * _radius(model, z_eq) * ymax
     for side in range(2):
@@ -344,7 +369,7 @@ def _orbit_integrals(model, e, z_lo, z_eq, c1, c2):
             dz = 1e-6 * max(abs(z), 1.0)
             dxdz = (_approach(model, z + dz) - _approach(model, z - dz)) / (2.0 * dz)
             dadz = (_radius(model, z + dz) - _radius(model, z - dz)) / (2.0 * dz)
-            c = _static_and_damping(model, z, c1, c2)[1]
+            c = _static_and_damping(model, z, c1, c2, c3, p3)[1]
             loss += c * y * dxdz * abs(dzdt)  # int C y dx over the half-orbit's side
             # - int_{z_a}^{z_eq} y da + int_{z_eq}^{z_b} y da: both are - sum y a' dz/dt w (dz/dt < 0 outside)
             twist -= y * dadz * dzdt
@@ -352,7 +377,7 @@ def _orbit_integrals(model, e, z_lo, z_eq, c1, c2):
 
 
 @njit(cache=True)
-def _averaged_tail(model, e_now, z_lo, z_eq, c1, c2):
+def _averaged_tail(model, e_now, z_lo, z_eq, c1, c2, c3, p3):
     """(J, J_a) still to come for a weakly damped captured sphere of energy e_now: int (variation
     per cycle) / (energy lost per cycle) de from the bottom of the well (the engine's method of
     averaging, in q = sqrt(e - U_eq), where the integrand is smooth); relative error ~ C / omega0."""
@@ -364,7 +389,7 @@ def _averaged_tail(model, e_now, z_lo, z_eq, c1, c2):
         return jt, jat
     for i in range(_GL16_X.shape[0]):
         q = 0.5 * q_now * (_GL16_X[i] + 1.0)
-        loss, var, tw = _orbit_integrals(model, e_eq + q * q, z_lo, z_eq, c1, c2)
+        loss, var, tw = _orbit_integrals(model, e_eq + q * q, z_lo, z_eq, c1, c2, c3, p3)
         w = 0.5 * q_now * _GL16_W[i] * 2.0 * q / loss
         jt += w * var
         jat += w * tw
@@ -389,7 +414,7 @@ def _event_value(model, kind, u):
 
 
 @njit(cache=True)
-def _locate(model, kind, target, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
+def _locate(model, kind, target, u0, k, h, c1, c2, c3, p3, a, b, e, tmp, u1, err):
     """Re-step from u0 to the step length in (0, h] at which the event value ``kind`` equals
     ``target`` (Illinois method; u1 holds the state at h on entry); u1 then holds the state there."""
     k0 = k[0].copy()
@@ -401,7 +426,7 @@ def _locate(model, kind, target, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
         hs = illinois_point(lo, flo, hi, fhi)
         for i in range(_N):  # a loop, not k[0, :] = k0: the slice's shape check costs 2 s of compile
             k[0, i] = k0[i]
-        _step(model, u0, k, hs, c1, c2, a, b, e, tmp, u1, err)
+        _step(model, u0, k, hs, c1, c2, c3, p3, a, b, e, tmp, u1, err)
         f = _event_value(model, kind, u1) - target
         if f == 0.0 or (hi - lo) < 1e-14 * h:
             break
@@ -414,7 +439,7 @@ def _locate(model, kind, target, u0, k, h, c1, c2, a, b, e, tmp, u1, err):
 
 
 @njit(cache=True)
-def _event_state(model, kind, target, u0, u1, k, h, c1, c2, a, b, e):
+def _event_state(model, kind, target, u0, u1, k, h, c1, c2, c3, p3, a, b, e):
     """The state where the event value ``kind`` reaches ``target`` within the accepted step
     u0 -> u1 of length h, by re-stepping in scratch arrays (the step itself is kept). What it
     replaced was O(h^2) or O(h^4) in the step: the slip-end time interpolated linearly in J (1e-4
@@ -425,12 +450,12 @@ def _event_state(model, kind, target, u0, u1, k, h, c1, c2, a, b, e):
     us = u1.copy()
     tmp = np.empty(_N)
     err = np.empty(_N)
-    _locate(model, kind, target, u0, ks, h, c1, c2, a, b, e, tmp, us, err)
+    _locate(model, kind, target, u0, ks, h, c1, c2, c3, p3, a, b, e, tmp, us, err)
     return us
 
 
 @njit(cache=True)
-def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, ja_stop, max_steps):
+def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j_stop, ja_stop, max_steps):
     """One normal impact in the model's nondimensional units.
 
     Returns the floats (status, outcome, y_end, tau_end, D, J, J_a, z_max, tau_capture,
@@ -445,26 +470,26 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
     u1 = np.zeros(_N)
     tmp = np.zeros(_N)
     err = np.zeros(_N)
-    if model != _DMT:  # breaks at q = 1 (displacement-controlled) or q^3 = 3 (force-controlled)
+    if _is_jkr(model):  # breaks at q = 1 (displacement-controlled) or q^3 = 3 (force-controlled)
         zb, z_eq = (_Q_BREAK_FORCE if model == _JKR_FORCE else 1.0), 6.0 ** (1.0 / 3.0)
         u[0] = 4.0 ** (1.0 / 3.0)
-    else:
+    else:  # DMT's equilibrium; Hertz has none (no capture): s = 1 only keeps the tail's scales finite
         zb, z_eq = 0.0, 1.0
         u[0] = 0.0
     u[1] = y0
     threshold = _energy(model, zb, 0.0)
     e_eq = _energy(model, z_eq, 0.0)
     x_eq = _approach(model, z_eq)
-    c_eq = _static_and_damping(model, z_eq, c1, c2)[1]
+    c_eq = _static_and_damping(model, z_eq, c1, c2, c3, p3)[1]
     dz_eq = 1e-6 * z_eq  # the stiffness dE/dx at the equilibrium, by a central difference
-    omega_eq = math.sqrt((_static_and_damping(model, z_eq + dz_eq, c1, c2)[0]
-                          - _static_and_damping(model, z_eq - dz_eq, c1, c2)[0])
+    omega_eq = math.sqrt((_static_and_damping(model, z_eq + dz_eq, c1, c2, c3, p3)[0]
+                          - _static_and_damping(model, z_eq - dz_eq, c1, c2, c3, p3)[0])
                          / (_approach(model, z_eq + dz_eq) - _approach(model, z_eq - dz_eq)))
     yref = max(1.0, y0)
     zref = max(1.0, u[0])
     # y to rtol y0: e_n = -y_end / y0 is then accurate to rtol also for slow impacts (y0 < 1)
     atol = np.array([rtol * zref, rtol * y0, rtol * zref, rtol * 0.5 * yref * yref, rtol * yref, rtol * yref * zref])
-    _rhs(model, u, c1, c2, k[0])
+    _rhs(model, u, c1, c2, c3, p3, k[0])
     h = 1e-2 * min(1.0, 1.0 / y0)
     status, outcome = _OK, REBOUND
     zmax = u[0]
@@ -478,7 +503,7 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
         if n_acc + n_rej >= max_steps:
             status = _MAX_STEPS
             break
-        _step(model, u, k, h, c1, c2, a_, b_, e_, tmp, u1, err)
+        _step(model, u, k, h, c1, c2, c3, p3, a_, b_, e_, tmp, u1, err)
         norm = 0.0
         for i in range(_N):
             norm = max(norm, abs(err[i]) / (atol[i] + rtol * max(abs(u[i]), abs(u1[i]))))
@@ -492,33 +517,33 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
         n_acc += 1
         separated = u1[0] <= zb and u1[1] < 0.0 and u[0] > zb and outcome == REBOUND
         if separated:
-            _locate(model, _EV_Z, zb, u, k, h, c1, c2, a_, b_, e_, tmp, u1, err)
+            _locate(model, _EV_Z, zb, u, k, h, c1, c2, c3, p3, a_, b_, e_, tmp, u1, err)
         if u[1] > 0.0 and u1[1] <= 0.0:
-            zmax = max(zmax, _event_state(model, _EV_Y, 0.0, u, u1, k, h, c1, c2, a_, b_, e_)[0])
+            zmax = max(zmax, _event_state(model, _EV_Y, 0.0, u, u1, k, h, c1, c2, c3, p3, a_, b_, e_)[0])
             turned = True
         zmax = max(zmax, u1[0])
         if j_target > 0.0 and math.isnan(tau_slip) and u1[4] >= j_target:
-            tau_slip = _event_state(model, _EV_J, j_target, u, u1, k, h, c1, c2, a_, b_, e_)[2]
+            tau_slip = _event_state(model, _EV_J, j_target, u, u1, k, h, c1, c2, c3, p3, a_, b_, e_)[2]
         e_now = _energy(model, u1[0], u1[1])
-        if not separated and outcome == REBOUND and e_now < threshold:
+        if not separated and outcome == REBOUND and e_now < threshold and model != _HERTZ:
             outcome = CAPTURE
             e_cap = e_now
             # where the energy fell below the threshold (at the start: captured from first contact)
             tau_cap = u[2] if _energy(model, u[0], u[1]) < threshold else _event_state(
-                model, _EV_ENERGY, threshold, u, u1, k, h, c1, c2, a_, b_, e_)[2]
+                model, _EV_ENERGY, threshold, u, u1, k, h, c1, c2, c3, p3, a_, b_, e_)[2]
         for i in range(_N):
             u[i] = u1[i]
         for i in range(_N):
             k[0, i] = k[6, i]
         if separated:
             break
-        if _static_and_damping(model, u[0], c1, c2)[1] >= 10.0:  # cheap test first: strongly damped here
+        if model != _HERTZ and _static_and_damping(model, u[0], c1, c2, c3, p3)[1] >= 10.0:  # cheap test first
             # a captured sphere creeping into the equilibrium: the engine's looser creeping test
             # (what is left of J, J_a then carries an error of ~1e-2 of itself); else only where
             # inertia is negligible all the way
             creep = outcome == CAPTURE and (turned or u[0] < z_eq)
             jumped, tc, ts, te, dd, jj, jja = _slow_jump(
-                model, u, z_eq, c1, c2, atol[1], threshold, outcome == CAPTURE, j_target,
+                model, u, z_eq, c1, c2, c3, p3, atol[1], threshold, outcome == CAPTURE, j_target,
                 j_target > 0.0 and math.isnan(tau_slip), CREEP_RATIO if creep else INERTIA_FREE_ENTER,
                 CREEP_RATIO if creep else INERTIA_FREE_RESUME, CREEP_BAND if creep else 0.0)
             if jumped:  # the inertia-free limit: the rest of the impact in closed form, a capture
@@ -553,7 +578,7 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
                 amp = math.sqrt(dxl * dxl + (u[1] / omega_eq) ** 2)
                 long_tail = 20 * (n_acc + n_rej) >= max_steps
                 if long_tail and c_eq <= 1e-2 * omega_eq and e_now < threshold:  # weakly damped: averaged
-                    jt, jat = _averaged_tail(model, e_now, zb, z_eq, c1, c2)
+                    jt, jat = _averaged_tail(model, e_now, zb, z_eq, c1, c2, c3, p3)
                     u[4] += jt
                     u[5] += jat
                     break
@@ -563,15 +588,15 @@ def _integrate(model, y0, c1, c2, rtol, need_tail, tail_tol, j_target, j_stop, j
                     break
         h *= min(5.0, max(0.2, 0.9 * max(norm, 1e-10) ** -0.2))
     return (float(status), float(outcome), u[1], u[2], u[3], u[4], u[5], zmax, tau_cap, tau_slip,
-            _energy(model, u[0], u[1]) - _energy(model, zb if model == _DMT else 4.0 ** (1.0 / 3.0), 0.0),
+            _energy(model, u[0], u[1]) - _energy(model, 4.0 ** (1.0 / 3.0) if _is_jkr(model) else 0.0, 0.0),
             float(n_acc), float(n_rej))
 
 
 @njit(cache=True, parallel=True)
-def _integrate_many(model, y0, c1, c2, rtol, need_tail, tail_tol, j_stop, ja_stop, max_steps, out):
+def _integrate_many(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_stop, ja_stop, max_steps, out):
     """:func:`_integrate` over arrays of speeds on all cores; row i of out holds impact i."""
     for i in prange(y0.size):
-        r = _integrate(model, y0[i], c1[i], c2[i], rtol, need_tail[i], tail_tol, 0.0, j_stop[i], ja_stop[i],
+        r = _integrate(model, y0[i], c1[i], c2[i], c3[i], p3, rtol, need_tail[i], tail_tol, 0.0, j_stop[i], ja_stop[i],
                        max_steps)
         for j in range(13):
             out[i, j] = r[j]
@@ -579,16 +604,24 @@ def _integrate_many(model, y0, c1, c2, rtol, need_tail, tail_tol, j_stop, ja_sto
 
 # --------------------------------------------------------------------------- Python interface
 def _setup(contact, normal_speed):
-    """(model code, scales, y0, C1, C2) of impacts at ``normal_speed`` [m/s] (scalar or array)."""
-    sc = am.adhesion_scales(contact)
+    """(model code, scales, y0, C1, C2, C3, p3) of impacts at ``normal_speed`` [m/s] (scalar or array).
+
+    C3 a^p3 y is the DEM damping (:func:`microimpact.model.dem_damping.dem_damping_law`) in the
+    model's units; the Hertz law (ring, f0 = 0, with a DEM damping) has speed-dependent units."""
+    if _hertz(contact):
+        sc, model = am.hertz_scales(contact, normal_speed), _HERTZ
+    else:
+        sc, model = am.adhesion_scales(contact), MODEL_CODES[contact.normal_model]
     u = sc.speed
     c_h, c_a = contact.damping_coefficients(normal_speed)
-    return MODEL_CODES[contact.normal_model], sc, normal_speed / u, c_h * u, c_a * u
+    eta, p3 = dd.dem_damping_law(contact)
+    c3 = eta * sc.radius**p3 * u / sc.force
+    return model, sc, normal_speed / u, c_h * u, c_a * u, c3, p3
 
 
 def _penetration(model, sc, zmax):
     """Largest approach delta [m] from the largest z (q for JKR, s for DMT)."""
-    return sc.length * (zmax * zmax if model == _DMT else zmax**4 - 4.0 * zmax)
+    return sc.length * (zmax**4 - 4.0 * zmax if model in (_JKR, _JKR_FORCE) else zmax * zmax)
 
 
 def _restitution(model, y0, damping_loss):
@@ -605,8 +638,19 @@ def _restitution(model, y0, damping_loss):
 
 
 def _hertz(contact):
-    """Without adhesion JKR and DMT are the Hertz law: the paper's engine solves it."""
+    """Without adhesion JKR and DMT are the Hertz law."""
     return contact.adhesion_line_force == 0.0
+
+
+def _law_name(contact):
+    """The normal law and the damping, as an error message names them."""
+    law = "hertz" if _hertz(contact) else contact.normal_model
+    return law if contact.damping_model == "paper" else f"{law} ({contact.damping_model} damping)"
+
+
+def _paper_hertz(contact):
+    """The Hertz law with the paper's damping: the paper's engine solves it (a DEM damping is solved here)."""
+    return _hertz(contact) and contact.damping_model == "paper"
 
 
 def solve_normal(contact, normal_speed: float, *, rtol: float = DEFAULT_RTOL, need_tail: bool = False,
@@ -654,18 +698,19 @@ def solve_normal(contact, normal_speed: float, *, rtol: float = DEFAULT_RTOL, ne
     from microimpact.solvers import engine
 
     v = check_positive("normal_speed", normal_speed)
-    if _hertz(contact):
+    if _paper_hertz(contact):
         return engine.solve_normal(contact.with_(normal_model="ring"), v, rtol=rtol, need_tail=need_tail,
                                    tail_tolerance=tail_tolerance, friction_impulse_target=friction_impulse_target,
                                    friction_impulse_stop=friction_impulse_stop, twist_impulse_stop=twist_impulse_stop,
                                    max_steps=max_steps)
-    model, sc, y0, c1, c2 = _setup(contact, v)
+    model, sc, y0, c1, c2, c3, p3 = _setup(contact, v)
+    sc = am.AdhesionScales(*(float(x) for x in (sc.length, sc.force, sc.time, sc.radius)))
     j_unit = sc.force * sc.time
     jt = 0.0 if friction_impulse_target is None else float(friction_impulse_target) / j_unit
-    r = _integrate(model, y0, c1, c2, float(rtol), bool(need_tail), float(rtol if tail_tolerance is None else tail_tolerance),
+    r = _integrate(model, y0, c1, c2, c3, p3, float(rtol), bool(need_tail), float(rtol if tail_tolerance is None else tail_tolerance),
                    jt, friction_impulse_stop / j_unit, twist_impulse_stop / (j_unit * sc.radius), int(max_steps))
     if r[0] != _OK:
-        raise EngineError(f"{contact.normal_model} solver failed for normal speed {v!r} m/s after {r[11]} steps")
+        raise EngineError(f"{_law_name(contact)} solver failed for normal speed {v!r} m/s after {r[11]} steps")
     captured = r[1] == CAPTURE
     e_unit = sc.force * sc.length
     e_n = 0.0 if captured else float(_restitution(model, y0, r[4]))
@@ -696,7 +741,7 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     """
     from microimpact.solvers import engine
 
-    if _hertz(contact):
+    if _paper_hertz(contact):
         return engine.solve_normal_many(contact.with_(normal_model="ring"), normal_speed, need_tail, rtol=rtol,
                                         tail_tolerance=tail_tolerance, max_steps=max_steps,
                                         friction_impulse_stop=friction_impulse_stop, twist_impulse_stop=twist_impulse_stop)
@@ -704,17 +749,17 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     if v.size and (not np.all(np.isfinite(v)) or np.any(v <= 0.0)):
         raise ValueError(f"normal speeds must be finite and > 0, got {v[~(np.isfinite(v) & (v > 0.0))][0]!r}")
     nt = np.zeros(v.shape, dtype=np.bool_) if need_tail is None else np.ascontiguousarray(need_tail, dtype=np.bool_).ravel()
-    model, sc, y0, c1, c2 = _setup(contact, v)
-    y0, c1, c2 = (np.ascontiguousarray(np.broadcast_to(x, v.shape), dtype=float) for x in (y0, c1, c2))
+    model, sc, y0, c1, c2, c3, p3 = _setup(contact, v)
+    y0, c1, c2, c3 = (np.ascontiguousarray(np.broadcast_to(x, v.shape), dtype=float) for x in (y0, c1, c2, c3))
     j_unit = sc.force * sc.time
     jstop = np.ascontiguousarray(np.broadcast_to(np.asarray(friction_impulse_stop, dtype=float), v.shape) / j_unit)
     jastop = np.ascontiguousarray(np.broadcast_to(np.asarray(twist_impulse_stop, dtype=float), v.shape) / (j_unit * sc.radius))
     out = np.empty((v.size, 13))
-    _integrate_many(model, y0, c1, c2, float(rtol), nt, float(rtol if tail_tolerance is None else tail_tolerance),
+    _integrate_many(model, y0, c1, c2, c3, p3, float(rtol), nt, float(rtol if tail_tolerance is None else tail_tolerance),
                     jstop, jastop, int(max_steps), out)
     if np.any(out[:, 0] != _OK):
         i = int(np.flatnonzero(out[:, 0] != _OK)[0])
-        raise EngineError(f"{contact.normal_model} solver failed for normal speed {float(v[i])!r} m/s")
+        raise EngineError(f"{_law_name(contact)} solver failed for normal speed {float(v[i])!r} m/s")
     captured = out[:, 1] == CAPTURE
     e_unit = sc.force * sc.length
     e_n = np.where(captured, 0.0, _restitution(model, y0, out[:, 4]))
@@ -776,8 +821,9 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
     from scipy.integrate import solve_ivp
 
     v = check_positive("normal_speed", normal_speed)
-    model, sc, y0, c1, c2 = _setup(contact, v)
-    jkr = model != _DMT
+    model, sc, y0, c1, c2, c3, p3 = _setup(contact, v)
+    sc = am.AdhesionScales(*(float(x) for x in (sc.length, sc.force, sc.time, sc.radius)))
+    jkr = model in (_JKR, _JKR_FORCE)
     # break at delta_c / L_J = -3 (JKR, q = 1), at -3^(1/3) (force-controlled JKR, q^3 = 3) or at
     # delta = 0 (DMT)
     l_c = {_JKR: -3.0, _JKR_FORCE: _Q_BREAK_FORCE**4 - 4.0 * _Q_BREAK_FORCE}.get(model, 0.0)
@@ -789,11 +835,16 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
         z, y = zq(w[0]), w[1]
         if jkr:
             f, diss, a = am.jkr_nondimensional_force(z, y, c1, c2), am.jkr_nondimensional_dissipation_rate(z, y, c1, c2), z * z
-        else:
+        elif model == _DMT:
             f, diss, a = am.dmt_nondimensional_force(z, y, c1, c2), am.dmt_nondimensional_dissipation_rate(z, y, c1, c2), z
-        return [y, -f, diss, abs(f), a * abs(f)]
+        else:
+            f, diss, a = am.hertz_nondimensional_force(z, y, c1), am.hertz_nondimensional_dissipation_rate(z, y, c1), z
+        fd = dd.dem_damping_nondimensional_force(a, y, c3, p3)
+        return [y, -(f + fd), diss + fd * y, abs(f + fd), a * abs(f + fd)]
 
-    energy = (lambda w: 0.5 * w[1] ** 2 + (am.jkr_nondimensional_potential(zq(w[0])) if jkr else am.dmt_nondimensional_potential(zq(w[0]))))
+    potential = {_DMT: am.dmt_nondimensional_potential, _HERTZ: am.hertz_nondimensional_potential}.get(
+        model, am.jkr_nondimensional_potential)
+    energy = (lambda w: 0.5 * w[1] ** 2 + potential(zq(w[0])))
     thr = energy([l_c, 0.0])
 
     def separation(_t, w):
