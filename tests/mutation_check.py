@@ -31,7 +31,7 @@ REPO = Path(__file__).resolve().parents[1]
 #: the fast physics tests that must kill every mutation (no pipeline runs, no studies)
 KILLERS = ["tests/test_params.py", "tests/test_engine.py", "tests/test_adhesion_models.py",
            "tests/test_contact_models.py", "tests/test_dynamics.py", "tests/test_independent_physics.py",
-           "tests/test_agreement.py", "tests/test_reference.py"]
+           "tests/test_agreement.py", "tests/test_reference.py", "tests/test_dem_damping.py"]
 
 #: (file under toolkit/microimpact, text that occurs exactly once, its mutation, what it breaks)
 MUTATIONS = [
@@ -71,6 +71,11 @@ MUTATIONS = [
      "return 7.0 * shear_modulus * np.asarray(contact_radius, dtype=float)", "Mindlin stiffness k_t = 8 G* a"),
     ("solvers/normal_models.py", "else 1.0), 6.0 ** (1.0 / 3.0)", "else 1.0), 5.0 ** (1.0 / 3.0)",
      "JKR settled contact, q^3 = 6"),
+    ("model/dem_damping.py", "        return coef * contact.mass, 1.0", "        return coef * contact.mass, 0.9",
+     "viscoelastic damping eta = eta_n0 m a"),
+    ("model/dem_damping.py", "return math.sqrt(2.0) * sum(", "return math.sqrt(1.9) * sum(",
+     "tsuji damping factor, sqrt(2) alpha(e)"),
+    ("model/adhesion_models.py", "    return 0.4 * s**5", "    return 0.41 * s**5", "Hertz potential (2/5) s^5"),
 ]
 
 

@@ -165,6 +165,13 @@ def contact_from_args(args) -> Contact:
 
     material, label = _base_material(args)
     changes = {n: getattr(args, n) for n in CONTACT_FIELDS if getattr(args, n, None) is not None}
+    replaced = ""
+    if changes.get("damping_model", "paper") != "paper":
+        # a DEM damping law replaces the paper's damping of the material, said in the note
+        dropped = {n: None if n == "damping_reference_speed" else 0.0
+                   for n in ("zeta_hertz", "zeta_adhesion", "damping_reference_speed") if n not in changes}
+        changes = dropped | changes
+        replaced = f"; damping_model {changes['damping_model']} replaces the paper's damping (zeta_H = zeta_A = 0)"
     radius = changes.get("radius")
     if isinstance(material, Contact):
         base = material
@@ -192,7 +199,7 @@ def contact_from_args(args) -> Contact:
     else:
         contact = base.with_(**changes) if changes else base
         note = f"f0 = {contact.adhesion_line_force:.6g} N/m of the material"
-    args.contact_note = f"{label}; {note}"
+    args.contact_note = f"{label}; {note}{replaced}"
     return contact
 
 

@@ -289,6 +289,9 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
         (f"# E = {model.youngs_modulus:.10g} Pa with nu = {model.poisson:g} (wall and particle), "
          f"gamma = w_A / 2 = {model.surface_energy:.10g} J/m^2"),
     ]
+    if contact.damping_model == "tsuji":
+        lines.append(f"# damping tsuji e = {contact.damping_coefficient:g} (with the sqrt(2) of LAMMPS's development source) "
+                     f"is written as the identical law coeff_restitution e = {model.damping:.10g}")
     if source:
         lines.append(f"# parameters from: {source}")
     for name, text in (fitted or {}).items():
