@@ -428,7 +428,9 @@ def _normal_dissipation(contact, normal_speed, captured, tracked):
     """Energy dissipated by the normal damping [J]: as tracked by the solver for a rebound; for a
     captured sphere all of it down to rest at the equilibrium, m v_n^2/2 - V(X), which does not
     depend on how far the solver followed the captured oscillation."""
-    to_rest = 0.5 * contact.mass * np.square(normal_speed) - settled_contact_energy(contact) if contact.adhesion_line_force > 0 else 0.0
+    # without adhesion (a Hertz sphere that crept to rest under a DEM damping) the rest energy is 0
+    settled = settled_contact_energy(contact) if contact.adhesion_line_force > 0 else 0.0
+    to_rest = 0.5 * contact.mass * np.square(normal_speed) - settled
     return np.where(captured, to_rest, tracked)
 
 
