@@ -1,0 +1,113 @@
+"""Fits of LAMMPS laws to measured restitution (microimpact.analysis.dem_fit): calibrated intervals
+over random experiment designs, designs that cannot determine the damping, the ranking of laws,
+and the CLI path from a CSV to a LAMMPS input.
+
+Coverage tolerance: with N determined trials the number covered by a 68.27 % interval is binomial;
+the test accepts coverage within 3.5 standard deviations (sqrt(0.683 0.317 / N)) of 0.683, a false
+alarm in about 1 of 2000 runs, while an interval half as wide (coverage 0.38) or twice as wide
+(0.95) fails at N = 240.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from microimpact.analysis.dem_fit import (DEM_LAWS, INTERVAL_LEVEL, _Model, dem_fit_coverage, fit_dem_law,
+                                          rank_dem_laws)
+
+HERTZ_MATERIAL = {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0}
+ADHESIVE = {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.01}
+
+
+def _within_binomial(covered, n):
+    sd = math.sqrt(INTERVAL_LEVEL * (1.0 - INTERVAL_LEVEL) / n)
+    return abs(covered / n - INTERVAL_LEVEL) <= 3.5 * sd
+
+
+def test_interval_coverage_over_random_designs():
+    """60 random designs for each of four laws, pooled (240 trials: the pooled coverage must lie
+    within 0.58-0.79, which an interval of Delta chi^2 = 2 (0.84) or 0.5 (0.52) does not)."""
+    determined = covered = 0
+    for i, law in enumerate([("hertz", "coeff_restitution"), ("hertz", "viscoelastic"), ("hertz", "mass_velocity"),
+                             ("jkr_force", "viscoelastic")]):
+        r = dem_fit_coverage(*law, trials=60, seed=11 + i)
+        assert r["determined"] >= 52, r  # the designs were drawn to determine the damping, mostly
+        assert 0.45 <= r["coverage"] <= 0.9, (law, r)
+        determined += r["determined"]
+        covered += r["covered"]
+    assert _within_binomial(covered, determined), (covered, determined)
+
+
+def test_coverage_when_the_scatter_is_estimated():
+    """Without stated uncertainties the interval uses s^2 t^2 (n - 1 degrees of freedom)."""
+    rng = np.random.default_rng(5)
+    covered = 0
+    trials = 80
+    for _ in range(trials):
+        n = int(rng.integers(3, 12))
+        speed = 10 ** rng.uniform(-1.0, 1.0, n)
+        model = _Model(HERTZ_MATERIAL, np.full(n, 3e-6), speed, "hertz", "viscoelastic", 1e-8)
+        truth = model.scale() * 10 ** rng.uniform(-1.3, -0.5)  # e_n <= 0.92: with the noise inside [0, 1]
+        e = model.e_n(truth) + rng.normal(0.0, 0.02, n)
+        f = fit_dem_law(pd.DataFrame({"radius": 3e-6, "normal_speed": speed, "e_n": e}), HERTZ_MATERIAL,
+                        "hertz", "viscoelastic", weights="none")
+        assert not f.sigma_known and f.status == "determined"
+        covered += f.interval[0] <= truth <= f.interval[1]
+    assert _within_binomial(covered, trials)
+
+
+def test_data_consistent_with_no_damping_give_an_upper_limit_and_no_value():
+    speed = np.array([0.2, 0.5, 1.0, 2.0, 5.0])
+    t = pd.DataFrame({"radius": 3e-6, "normal_speed": speed, "e_n": [1.0, 0.995, 1.004, 0.998, 1.001],
+                      "e_n_uncertainty": 0.01})
+    f = fit_dem_law(t, HERTZ_MATERIAL, "hertz", "viscoelastic")
+    assert f.status == "upper limit" and math.isnan(f.value)
+    assert f.interval[0] == 0.0 and 0.0 < f.interval[1] < math.inf
+    assert "consistent with no damping" in f.describe() and "eta_n0 <=" in f.describe()
+    g = fit_dem_law(t, HERTZ_MATERIAL, "hertz", "coeff_restitution")
+    assert g.status == "upper limit" and g.interval[1] == 1.0 and "e >=" in g.describe()
+
+
+def test_captured_impacts_cannot_tell_how_strong_the_damping_is():
+    """JKR impacts all below the sticking velocity are captured whatever the damping: the data
+    say nothing about eta_n0 (not determined, nothing printed as a number)."""
+    t = pd.DataFrame({"radius": 3.45e-6, "normal_speed": [1e-3, 2e-3, 3e-3], "e_n": [0.0, 0.0, 0.01],
+                      "e_n_uncertainty": 0.01})
+    f = fit_dem_law(t, ADHESIVE, "jkr_force", "viscoelastic")
+    assert f.status == "not determined" and math.isnan(f.value)
+    assert "not determined" in f.describe()
+
+
+def test_measured_values_slightly_outside_the_physical_range_are_fitted():
+    t = pd.DataFrame({"radius": 3e-6, "normal_speed": [0.5, 1.0, 2.0], "e_n": [1.012, 0.99, 1.005],
+                      "e_n_uncertainty": 0.01})
+    f = fit_dem_law(t, HERTZ_MATERIAL, "hertz", "coeff_restitution")
+    assert f.status == "upper limit"
+
+
+def test_ranking_prefers_the_law_that_made_the_data():
+    """Data made with viscoelastic damping (e_n falls with speed) against coeff_restitution (flat)."""
+    rng = np.random.default_rng(2)
+    speed = np.geomspace(0.05, 20.0, 20)
+    model = _Model(HERTZ_MATERIAL, np.full(20, 3e-6), speed, "hertz", "viscoelastic", 1e-8)
+    e = model.e_n(0.2 * model.scale()) + rng.normal(0.0, 0.005, 20)
+    assert np.ptp(model.e_n(0.2 * model.scale())) > 0.05  # the speed dependence the ranking sees
+    t = pd.DataFrame({"radius": 3e-6, "normal_speed": speed, "e_n": e, "e_n_uncertainty": 0.005})
+    ranked, fits = rank_dem_laws(t, HERTZ_MATERIAL)
+    assert ranked["law"].iloc[0] == "hertz+viscoelastic"
+    assert ranked["delta_aic"].iloc[1] > 10.0
+    assert ranked["akaike_weight"].sum() == pytest.approx(1.0, abs=1e-12)
+    assert set(ranked["law"]) == {f"{a}+{b}" for a, b in DEM_LAWS if a == "hertz"}
+
+
+def test_bad_tables_are_refused_naming_row_and_column():
+    t = pd.DataFrame({"radius": 3e-6, "normal_speed": [0.5, -1.0], "e_n": [0.7, 0.7]})
+    with pytest.raises(ValueError, match="row 2, column 'normal_speed'"):
+        fit_dem_law(t, HERTZ_MATERIAL)
+    with pytest.raises(ValueError, match="unknown DEM law hertz\\+nope"):
+        fit_dem_law(pd.DataFrame({"radius": [3e-6], "normal_speed": [1.0], "e_n": [0.5]}), HERTZ_MATERIAL,
+                    "hertz", "nope")
