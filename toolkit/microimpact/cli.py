@@ -630,6 +630,59 @@ def _cmd_lammps_export(args) -> int:
     return 0
 
 
+def _dem_law(text: str) -> tuple[str, str]:
+    """``NORMAL+DAMPING`` (e.g. ``hertz+coeff_restitution``) as a (normal, damping) pair of DEM_LAWS."""
+    from microimpact.analysis.dem_fit import DEM_LAWS
+
+    law = tuple(text.strip().lower().split("+", 1))
+    if law not in DEM_LAWS:
+        raise argparse.ArgumentTypeError(f"{text!r} is not one of {', '.join(f'{a}+{b}' for a, b in DEM_LAWS)}")
+    return law
+
+
+def _cmd_lammps_fit(args) -> int:
+    from microimpact.analysis.dem_fit import rank_dem_laws
+    from microimpact.io.files import atomic_write
+    from microimpact.io.lammps import lammps_input
+    from microimpact.io.provenance import fit_parameter_source
+
+    import numpy as np
+
+    out = check_outputs({"--out": args.out}, _inputs(args))["--out"]
+    table, pair = _impacts_for_pair(args)
+    try:
+        ranked, fits = rank_dem_laws(table, pair, [args.law] if args.law else None, weights=args.weights, rtol=args.rtol)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    shown = ranked[["law", "status", "value", "interval_low", "interval_high", "chisqr", "delta_aic", "akaike_weight"]]
+    print(shown.to_string(index=False, float_format=lambda x: f"{x:.6g}"))
+    chosen = fits[ranked["law"].iloc[0]]
+    print(chosen.describe())
+    if not chosen.determined:
+        why = ("does not describe the data" if chosen.status == "inadequate" else
+               f"the data do not determine its damping coefficient ({chosen.status})")
+        print(f"microimpact: error: {chosen.law}, the best LAMMPS law by AIC, {why}; no LAMMPS input written",
+              file=sys.stderr)
+        return EXIT_DISAGREES
+    radii = np.asarray(table["radius"], dtype=float)
+    radius = float(np.median(radii))
+    contact = chosen.contact(radius)
+    source = fit_parameter_source(table.attrs.get("source", args.data), table.attrs.get("sha256"))
+    lo, hi = chosen.interval
+    others = ", ".join(f"{law} dAIC {d:.3g}" for law, d in zip(ranked["law"].iloc[1:], ranked["delta_aic"].iloc[1:]))
+    fitted = {"damping_coefficient": f"{chosen.value:.6g} (68% profile-likelihood interval {lo:.6g} to {hi:.6g}; "
+                                     f"{chosen.n} impacts, {'stated e_n uncertainties' if chosen.sigma_known else 'scatter estimated'})",
+              "law": f"{chosen.law} (best by AIC{'; ' + others if others else ''})",
+              "radius": f"{radius:.6g} m, the median of the data's radii ({radii.min():.4g} to {radii.max():.4g} m)"}
+    pair_name = getattr(pair, "name", None) or args.material_pair
+    text = lammps_input(contact, units=args.units, source=f"{source}" + (f"; material pair {pair_name}" if pair_name else ""),
+                        fitted=fitted)
+    with reporting_os_errors({"--out": out}), atomic_write(out) as f:
+        f.write(text)
+    print(f"wrote {out} (LAMMPS units {args.units}); check it with: microimpact lammps verify {out}")
+    return 0
+
+
 def _cmd_lammps_verify(args) -> int:
     from microimpact.io.files import write_csv
     from microimpact.io.lammps import read_lammps_contact
@@ -705,6 +758,20 @@ def register_lammps(sub) -> None:
     e.add_argument("--wall", default="zplane 0.0 NULL", help="LAMMPS wall style and arguments (default 'zplane 0.0 NULL')")
     e.add_argument("--out", required=True, help="output LAMMPS input file")
     e.set_defaults(func=_cmd_lammps_export)
+    f = lsub.add_parser("fit", help="fit the damping of LAMMPS laws to measured impacts (CSV), rank the laws by AIC and "
+                                    "write the best determined one as LAMMPS input (exit status "
+                                    f"{EXIT_DISAGREES} and nothing written when the data do not determine it)")
+    f.add_argument("data", help="impact CSV (see 'microimpact fit')")
+    f.add_argument("--material-pair", default=None, help="material pair of the data (density, stiffness, w_A)")
+    f.add_argument("--config", default=None, help="materials config YAML (default: the bundled one)")
+    f.add_argument("--law", type=_dem_law, default=None, metavar="NORMAL+DAMPING",
+                   help="fit only this law, e.g. hertz+coeff_restitution (default: rank every law the material allows)")
+    f.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto",
+                   help="auto: the stated e_n uncertainties when given, else the scatter (default auto)")
+    f.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")
+    _add_rtol(f)
+    f.add_argument("--out", required=True, help="output LAMMPS input file")
+    f.set_defaults(func=_cmd_lammps_fit)
     v = lsub.add_parser("verify", help="run LAMMPS on an exported file over speeds x angles and compare with microimpact "
                                        f"(exit status {EXIT_DISAGREES} if they disagree; needs microimpact[lammps])")
     v.add_argument("input", help="a file written by 'microimpact lammps export'")

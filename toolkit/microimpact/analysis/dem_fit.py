@@ -17,6 +17,10 @@ It is searched over the physical range [0, 1] of e or [0, inf) of eta_n0, so it 
 * **determined**: both ends inside the range; the value is printed with its interval;
 * **upper limit**: the data are consistent with no damping (e = 1, eta_n0 = 0): only the upper end
   (or, for e, the lower end) is given, no value;
+* **inadequate**: with stated uncertainties, the smallest chi^2 is improbable for n - 1 degrees
+  of freedom (p below :data:`ADEQUACY_P`): the law does not describe the data, and no interval of
+  its coefficient means anything (the synthetic microsphere data of this project, made with the
+  paper's adhesive model, give chi^2 = 13802 for 99 for the best LAMMPS law);
 * **not determined**: the chi^2 does not rise by the threshold anywhere up to the strongest damping
   searched (e_n below 1e-4, a sphere that barely leaves): the data give at most a lower limit, and
   nothing is printed as a number.
@@ -51,7 +55,7 @@ from microimpact.model.dem_damping import DEM_DAMPING_MODELS, RESTITUTION_DAMPIN
 from microimpact.solvers import DEFAULT_RTOL
 
 __all__ = ["DEM_LAWS", "DemLawFit", "dem_law_contact", "fit_dem_law", "rank_dem_laws", "dem_fit_coverage",
-           "INTERVAL_LEVEL"]
+           "INTERVAL_LEVEL", "ADEQUACY_P"]
 
 #: the (normal law, damping law) pairs a LAMMPS user chooses among; "hertz" is Hertz without
 #: adhesion, "jkr_force" LAMMPS's jkr, "dmt" LAMMPS's dmt
@@ -61,6 +65,9 @@ DEM_LAWS: tuple[tuple[str, str], ...] = (
 )
 #: the probability content of the reported interval (one standard deviation of a normal law)
 INTERVAL_LEVEL = math.erf(1.0 / math.sqrt(2.0))
+#: with stated uncertainties, a law whose chi^2 has a p-value below this does not describe the data
+#: (its interval would be meaningless): status "inadequate", no value
+ADEQUACY_P = 1e-3
 _GRID = 41  # start grid over the physical range
 #: eta_n0 searched from 1e-4 critical dampings up to where e_n has fallen below 1e-4 at the median
 #: impact (Hertz: 3 critical dampings for viscoelastic, 1 for mass_velocity, measured); beyond it a
@@ -82,7 +89,8 @@ class DemLawFit:
         The 68.27 % profile-likelihood interval; an end at the physical bound (0 or 1) or inf is
         not an end the data give.
     status : str
-        ``"determined"``, ``"upper limit"`` (consistent with no damping) or ``"not determined"``.
+        ``"determined"``, ``"upper limit"`` (consistent with no damping), ``"not determined"`` or
+        ``"inadequate"`` (the law does not describe the data).
     chisqr : float
         Smallest chi^2 (with sigma = 1 when the data state no uncertainty). [-]
     n : int
@@ -125,6 +133,9 @@ class DemLawFit:
         """One line: the law, the value with its interval, or what the data cannot tell."""
         unit = {"viscoelastic": " 1/(m s)", "mass_velocity": " 1/s"}.get(self.damping_model, "")
         lo, hi = self.interval
+        if self.status == "inadequate":
+            return (f"{self.law}: does not describe the data (chi^2 = {self.chisqr:.6g} for {self.n - 1} degrees of "
+                    f"freedom, p < {ADEQUACY_P:g}); no value")
         if self.status == "determined":
             return (f"{self.law}: damping_coefficient = {self.value:.6g}{unit} "
                     f"(68% interval {lo:.6g} to {hi:.6g})")
@@ -323,6 +334,8 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
         interval = (float(weak), float(strong))
         status = "not determined" if not bounded else "upper limit" if weak == 0.0 else "determined"
         best = float(to_coef(x_best)) if math.isfinite(x_best) else 0.0
+    if sigma_known and n > 1 and stats.chi2.sf(chi_min, n - 1) < ADEQUACY_P:
+        status = "inadequate"
     k = 1
     if sigma_known:
         aic, bic = chi_min + 2 * k, chi_min + k * math.log(n)
@@ -372,10 +385,13 @@ def rank_dem_laws(table, material, laws=None, *, weights="auto", rtol: float = D
     df = pd.DataFrame([{"law": name, "status": f.status, "value": f.value, "interval_low": f.interval[0],
                         "interval_high": f.interval[1], "chisqr": f.chisqr, "aic": f.aic, "bic": f.bic}
                        for name, f in fits.items()])
+    df.loc[df["status"] == "inadequate", ["interval_low", "interval_high"]] = math.nan  # no number to print
     df["delta_aic"] = df["aic"] - df["aic"].min()
     w = np.exp(-0.5 * df["delta_aic"].to_numpy())
     df["akaike_weight"] = w / w.sum()
-    return df.sort_values("aic", kind="stable").reset_index(drop=True), fits
+    # laws of one family (tsuji and coeff_restitution: the same e_n for every speed) tie to round-off:
+    # the order of DEM_LAWS decides them
+    return df.sort_values("aic", kind="stable", key=lambda a: a.round(6)).reset_index(drop=True), fits
 
 
 def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, seed: int = 0, rtol: float = 1e-8):
