@@ -35,6 +35,8 @@ COMMANDS = {
                       {"--fit": ("fit.nc", "in"), "--out": ("c.lmp", "out")}),
     "lammps-verify": (["lammps", "verify", "{INPUT}", "--out", "{--out}"],
                       {"INPUT": ("contact.lmp", "in"), "--out": ("v.csv", "out")}),
+    "lammps-fit": (["lammps", "fit", "{DATA}", "--config", "{--config}", "--out", "{--out}"],
+                   {"DATA": ("data.csv", "in"), "--config": ("m.yaml", "in"), "--out": ("c.lmp", "out")}),
     # flags reading a posterior: for the wrong kinds only (a posterior's collisions: test_hostile_cli.py)
     "flags-posterior": (["flags", "data.csv", "--fit", "fit.nc", "--posterior", "{--posterior}", "--out", "o.csv"],
                         {"--posterior": ("notfit.nc", "in")}),
@@ -83,7 +85,7 @@ FILE_INPUTS = [("fit", "DATA", {"csv"}), ("flags", "DATA", {"csv"}), ("flags", "
                ("sweep", "--fit", {"fit"}), ("target", "--fit", {"fit"}), ("fit", "--config", {"yaml"}),
                ("flags", "--config", {"yaml"}), ("plot", "RESULT", {"fit", "sweep", "flags"}),
                ("flags-posterior", "--posterior", set()), ("lammps-export", "--fit", {"fit"}),
-               ("lammps-verify", "INPUT", set())]
+               ("lammps-verify", "INPUT", set()), ("lammps-fit", "DATA", {"csv"}), ("lammps-fit", "--config", {"yaml"})]
 WRONG_KIND = [(c, o, kind) for c, o, ok in FILE_INPUTS for kind in KINDS if kind not in ok]
 
 

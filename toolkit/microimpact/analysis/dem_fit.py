@@ -8,8 +8,8 @@ of ``viscoelastic`` and ``mass_velocity``. Every impact is solved by the toolkit
 its own radius and normal speed.
 
 Estimate and interval. The estimate minimises chi^2 = sum ((e_meas - e_model) / sigma)^2, started
-from a grid over the whole physical range (so a second minimum is not missed) and refined with
-lmfit. The interval is the profile-likelihood interval of 68.27 %: where chi^2 rises by 1 above
+from a grid over the whole physical range (so a second minimum is not missed) and refined by a
+bounded Brent minimisation (scipy) about the grid's best point. The interval is the profile-likelihood interval of 68.27 %: where chi^2 rises by 1 above
 its minimum when sigma is the stated e_n uncertainty, or by s^2 t^2 (s^2 = chi^2_min / (n - 1),
 t the Student quantile with n - 1 degrees of freedom) when the data state none (weights "none").
 It is searched over the physical range [0, 1] of e or [0, inf) of eta_n0, so it may be one-sided:
@@ -220,6 +220,46 @@ def _chisqr(model, coefficient, e_meas, sigma) -> float:
     return float(np.sum(np.square((e_meas - model.e_n(coefficient)) / sigma)))
 
 
+def _restitution_interval(rise, x_best, lo_x):
+    """(interval, status, best) of a restitution e: the ends where chi^2 rises by the threshold
+    (``rise`` > 0), searched in [lo_x, 1]; the end at e = 1 is the side of no damping."""
+    from scipy import optimize
+
+    low_damping_end = 1.0 if rise(1.0) <= 0.0 or x_best >= 1.0 else optimize.brentq(rise, x_best, 1.0, xtol=1e-12)
+    if rise(lo_x) <= 0.0:
+        strong_end, bounded = lo_x, False
+    else:
+        strong_end, bounded = (optimize.brentq(rise, lo_x, x_best, xtol=1e-12) if x_best > lo_x else lo_x), True
+    status = "not determined" if not bounded else "upper limit" if low_damping_end >= 1.0 else "determined"
+    return (float(strong_end), float(low_damping_end)), status, float(min(x_best, 1.0))
+
+
+def _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x):
+    """(interval, status, best) of eta_n0, searched in log10 coordinates x over [lo_x, hi_x] and
+    below them in eta_n0 itself (``rise_coef``); x_best = -inf when no damping fits best."""
+    from scipy import optimize
+
+    if rise_coef(0.0) <= 0.0:  # no damping is inside the interval
+        weak = 0.0
+    elif rise(lo_x) > 0.0:
+        weak = to_coef(optimize.brentq(rise, lo_x, x_best, xtol=1e-12))
+    else:  # below 1e-4 critical dampings: in the coefficient itself
+        weak = optimize.brentq(rise_coef, 0.0, to_coef(lo_x), xtol=1e-14 * to_coef(lo_x))
+    start = x_best if math.isfinite(x_best) else lo_x
+    if rise(hi_x) <= 0.0:
+        strong, bounded = math.inf, False
+    else:
+        strong, bounded = to_coef(optimize.brentq(rise, start, hi_x, xtol=1e-12)), True
+    status = "not determined" if not bounded else "upper limit" if weak == 0.0 else "determined"
+    return (float(weak), float(strong)), status, (float(to_coef(x_best)) if math.isfinite(x_best) else 0.0)
+
+
+def _information_criteria(chi_min, n, sigma_known, k=1):
+    """(AIC, BIC) of a least-squares fit with k parameters (Burnham & Anderson 2002)."""
+    base = chi_min if sigma_known else n * math.log(max(chi_min, 1e-300) / n)
+    return base + 2 * k, base + k * math.log(n)
+
+
 def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str = "coeff_restitution", *,
                 weights="auto", rtol: float = DEFAULT_RTOL) -> DemLawFit:
     """Fit the damping coefficient of a DEM law to the impacts of ``table`` (module docstring).
@@ -307,41 +347,16 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     def rise(x):
         return chi(x) - chi_min - threshold
 
-    # the side towards less damping (e -> 1, eta_n0 -> 0)
     if model.restitution:
-        low_damping_end = 1.0 if rise(1.0) <= 0.0 or x_best >= 1.0 else optimize.brentq(rise, x_best, 1.0, xtol=1e-12)
-        if rise(lo_x) <= 0.0:
-            strong_end, bounded = lo_x, False
-        else:
-            strong_end, bounded = optimize.brentq(rise, lo_x, x_best, xtol=1e-12) if x_best > lo_x else lo_x, True
-        interval = (float(strong_end), float(low_damping_end))
-        status = ("not determined" if not bounded else
-                  "upper limit" if low_damping_end >= 1.0 else "determined")
-        best = float(min(x_best, 1.0))
+        interval, status, best = _restitution_interval(rise, x_best, lo_x)
     else:
-        if chi_none - chi_min - threshold <= 0.0:  # no damping is inside the interval
-            weak = 0.0
-        elif rise(lo_x) > 0.0:
-            weak = to_coef(optimize.brentq(rise, lo_x, x_best, xtol=1e-12))
-        else:  # below 1e-4 critical dampings: in the coefficient itself
-            weak = optimize.brentq(lambda c: _chisqr(model, c, e_meas, sig) - chi_min - threshold, 0.0, to_coef(lo_x),
-                                   xtol=1e-14 * to_coef(lo_x))
-        start = x_best if math.isfinite(x_best) else lo_x
-        if rise(hi_x) <= 0.0:
-            strong, bounded = math.inf, False
-        else:
-            strong, bounded = to_coef(optimize.brentq(rise, start, hi_x, xtol=1e-12)), True
-        interval = (float(weak), float(strong))
-        status = "not determined" if not bounded else "upper limit" if weak == 0.0 else "determined"
-        best = float(to_coef(x_best)) if math.isfinite(x_best) else 0.0
+        def rise_coef(c):
+            return _chisqr(model, c, e_meas, sig) - chi_min - threshold
+
+        interval, status, best = _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x)
     if sigma_known and n > 1 and stats.chi2.sf(chi_min, n - 1) < ADEQUACY_P:
         status = "inadequate"
-    k = 1
-    if sigma_known:
-        aic, bic = chi_min + 2 * k, chi_min + k * math.log(n)
-    else:
-        base = n * math.log(max(chi_min, 1e-300) / n)
-        aic, bic = base + 2 * k, base + k * math.log(n)
+    aic, bic = _information_criteria(chi_min, n, sigma_known)
     return DemLawFit(normal_model, damping_model, best if status == "determined" else math.nan, interval, status,
                      float(chi_min), int(n), sigma_known, float(aic), float(bic), best, mat, src)
 
