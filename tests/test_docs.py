@@ -50,6 +50,9 @@ HOW = {
     'pip install -e ".[lammps]"': "ci",
     "microimpact lammps export --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0 --units micro --out contact.lmp": "run",
     "microimpact lammps verify contact.lmp --out lammps_check.csv": "ci",
+    # README.md and docs/guide/lammps.md: from a CSV to a verified LAMMPS input (needs LAMMPS for verify)
+    "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --units micro --out contact.lmp": "test",
+    "microimpact lammps verify contact.lmp": "test",
     "microimpact simulate --preset wall1990 --speed 1.0 --incidence-deg 10 --json": "run",
     "microimpact simulate --speed 3 --zeta-adhesion 10 --friction 0.3 --omega-tp 2e5": "run",
     "microimpact sweep --case 2.1 --out case_2.1.nc": "run",
@@ -103,6 +106,9 @@ HOW = {
 #: "test" commands -> the test that runs them (file, function)
 TESTED_BY = {
     "snakemake --unlock": ("tests/test_workflow.py", "test_an_interrupted_run_resumes_as_the_readme_says"),
+    "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --units micro --out contact.lmp":
+        ("tests/test_dem_fit.py", "test_csv_to_running_lammps_input_in_two_commands"),
+    "microimpact lammps verify contact.lmp": ("tests/test_dem_fit.py", "test_csv_to_running_lammps_input_in_two_commands"),
 }
 
 #: placeholders of the documentation -> files that exist in the scratch directory
