@@ -54,7 +54,7 @@ from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import DEM_DAMPING_MODELS, RESTITUTION_DAMPING_MODELS
 from microimpact.solvers import DEFAULT_RTOL
 
-__all__ = ["DEM_LAWS", "DemLawFit", "dem_law_contact", "fit_dem_law", "rank_dem_laws", "dem_fit_coverage",
+__all__ = ["DEM_LAWS", "DemLawFit", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "dem_fit_coverage",
            "INTERVAL_LEVEL", "ADEQUACY_P"]
 
 #: the (normal law, damping law) pairs a LAMMPS user chooses among; "hertz" is Hertz without
@@ -184,6 +184,33 @@ def dem_law_contact(material, radius: float, normal_model: str, damping_model: s
     f0 = 0.0 if normal_model == "hertz" else adhesion_line_force_from_work(k, radius, w)
     return Contact(radius, float(get("density")), k, f0, normal_model="ring" if normal_model == "hertz" else normal_model,
                    damping_model=damping_model, damping_coefficient=coefficient)
+
+
+def dem_law_restitution(material, radius, normal_speed, normal_model: str, damping_model: str, coefficient: float,
+                        *, rtol: float = DEFAULT_RTOL) -> np.ndarray:
+    """e_n of normal impacts under a DEM law, each at its own radius and speed. [-]
+
+    Parameters
+    ----------
+    material, normal_model, damping_model, coefficient
+        As :func:`dem_law_contact`.
+    radius, normal_speed : array_like
+        Sphere radii [m] and incident normal speeds [m/s], broadcast together.
+    rtol : float
+        Solver tolerance. [-]
+
+    Examples
+    --------
+    ``coeff_restitution`` gives its e at every speed (Hertz):
+
+    >>> m = {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0}
+    >>> dem_law_restitution(m, 2e-6, [0.1, 1.0, 10.0], "hertz", "coeff_restitution", 0.6).round(8).tolist()
+    [0.6, 0.6, 0.6]
+    """
+    r, v = np.broadcast_arrays(np.asarray(radius, dtype=float), np.asarray(normal_speed, dtype=float))
+    get = material.get if isinstance(material, dict) else lambda k: getattr(material, k)
+    mat = {k: float(get(k)) for k in ("density", "stiffness", "work_of_adhesion")}
+    return _Model(mat, r.ravel(), v.ravel(), normal_model, damping_model, rtol).e_n(coefficient).reshape(r.shape)
 
 
 class _Model:

@@ -8,14 +8,14 @@ With the sphere's mass m (LAMMPS's m_eff for a sphere on a fixed wall) and the c
 the normal law (sqrt(R delta) for Hertz and DMT, the JKR radius for JKR), as LAMMPS defines them
 (``pair_style granular``, damping keyword):
 
-===================== ====================================== =================================
-``damping_model``     eta                                    ``damping_coefficient``
-===================== ====================================== =================================
-``"mass_velocity"``   eta_n0 m                               eta_n0 [1/s]
-``"viscoelastic"``    eta_n0 m a                             eta_n0 [1/(m s)]
-``"tsuji"``           alpha(e) sqrt(m F_ne / delta)          e, the restitution aimed at [-]
-``"coeff_restitution"`` beta(e) sqrt(m F_ne / delta)         e [-]
-===================== ====================================== =================================
+======================= ====================================== =================================
+``damping_model``       eta                                    ``damping_coefficient``
+======================= ====================================== =================================
+``"mass_velocity"``     eta_n0 m                               eta_n0 [1/s]
+``"viscoelastic"``      eta_n0 m a                             eta_n0 [1/(m s)]
+``"tsuji"``             alpha(e) sqrt(m F_ne / delta)          e, the restitution aimed at [-]
+``"coeff_restitution"`` beta(e) sqrt(m F_ne / delta)           e [-]
+======================= ====================================== =================================
 
 For the Hertz law F_ne / delta = K a (K = (4/3) E*), so the last two are eta = c sqrt(m K a), a
 damping that grows as delta^(1/4): the equation of motion then has no speed scale left, and e_n
