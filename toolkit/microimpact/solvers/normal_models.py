@@ -549,13 +549,15 @@ def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j
             k[0, i] = k[6, i]
         if separated:
             break
-        # cheap test first: strongly damped here (Hertz, whose DEM damping may vanish with a: once turned)
-        if (turned if model == _HERTZ else _static_and_damping(model, u[0], c1, c2, c3, p3)[1] >= 10.0):
+        # cheap test first: strongly damped here (Hertz, whose DEM damping may vanish with a: also
+        # once turned; a strongly damped approach can end with y at the noise level of atol, never
+        # seen to turn)
+        if ((model == _HERTZ and turned) or _static_and_damping(model, u[0], c1, c2, c3, p3)[1] >= 10.0):
             # a captured sphere creeping into the equilibrium: the engine's looser creeping test
             # (what is left of J, J_a then carries an error of ~1e-2 of itself); else only where
             # inertia is negligible all the way. A Hertz sphere that creeps out inertia-free all the
             # way to s = 0 never leaves (e_n = 0 whatever the error of the test): the creeping test too
-            creep = turned if model == _HERTZ else outcome == CAPTURE and (turned or u[0] < z_eq)
+            creep = model == _HERTZ or outcome == CAPTURE and (turned or u[0] < z_eq)
             jumped, tc, ts, te, dd, jj, jja = _slow_jump(
                 model, u, z_eq, c1, c2, c3, p3, atol[1], threshold, outcome == CAPTURE, j_target,
                 j_target > 0.0 and math.isnan(tau_slip), CREEP_RATIO if creep else INERTIA_FREE_ENTER,

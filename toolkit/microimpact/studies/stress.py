@@ -135,6 +135,14 @@ LAWS = {
     "mindlin_pulloff": {"tangential_model": "mindlin", "friction_model": "pulloff"},
     "mindlin_deresiewicz_pulloff_rolling": {"tangential_model": "mindlin_deresiewicz", "friction_model": "pulloff",
                                             "rolling_friction": 0.01},
+    # LAMMPS's damping laws (microimpact.model.dem_damping), their coefficient from the drawn zeta_H
+    # (:func:`contact_of`); the Hertz ones without adhesion
+    "hertz_viscoelastic": {"damping_model": "viscoelastic", "adhesion": False},
+    "hertz_mass_velocity": {"damping_model": "mass_velocity", "adhesion": False},
+    "hertz_tsuji": {"damping_model": "tsuji", "adhesion": False},
+    "hertz_coeff_restitution": {"damping_model": "coeff_restitution", "adhesion": False},
+    "jkr_force_viscoelastic": {"normal_model": "jkr_force", "damping_model": "viscoelastic"},
+    "dmt_mass_velocity": {"normal_model": "dmt", "damping_model": "mass_velocity"},
 }
 #: Poisson's ratio of both bodies of a compliant law's pair: the shear modulus G* follows from the
 #: drawn stiffness K (E = 3 K (1 - nu^2) / 2 for two equal materials, G = E / (2 (1 + nu))).
@@ -242,6 +250,9 @@ def contact_of(case: dict, law: str = "ring") -> Contact:
     from microimpact.model import tangential_compliance as tc
 
     fields = dict(LAWS[law])
+    adhesive = fields.pop("adhesion", True)
+    if fields.get("damping_model", "paper") != "paper":
+        return _dem_contact(case, fields, adhesive)
     if fields.get("tangential_model", "rigid") != "rigid":
         youngs = 1.5 * case["stiffness"] * (1.0 - POISSON**2)
         g = float(tc.shear_modulus_from_elastic(youngs, POISSON))
@@ -250,6 +261,25 @@ def contact_of(case: dict, law: str = "ring") -> Contact:
         case["radius"], case["density"], case["stiffness"], case["work_of_adhesion"],
         zeta_hertz=case["zeta_hertz"], zeta_adhesion=case["zeta_adhesion"], friction=case["friction"], **fields,
     )
+
+
+def _dem_contact(case: dict, fields: dict, adhesive: bool) -> Contact:
+    """A case under a DEM damping law: the drawn zeta_H (1e-3 to 1e6, or 0) sets the damping as a
+    multiple of the critical damping 2 sqrt(m k) of the case's Hertz impact (k = K a at its largest
+    approach), or the restitution e = 1 / (1 + zeta_H) of tsuji and coeff_restitution."""
+    from microimpact.model.contact import adhesion_line_force_from_work
+
+    r, rho, k = case["radius"], case["density"], case["stiffness"]
+    f0 = adhesion_line_force_from_work(k, r, case["work_of_adhesion"]) if adhesive else 0.0
+    zeta = case["zeta_hertz"]
+    if fields["damping_model"] in ("tsuji", "coeff_restitution"):
+        return Contact(r, rho, k, f0, friction=case["friction"], damping_coefficient=1.0 / (1.0 + zeta), **fields)
+    base = Contact(r, rho, k, f0, friction=case["friction"], **fields)
+    v_n = max(case["speed"] * math.cos(math.radians(case["incidence_deg"])), 1e-300)
+    x = (1.25 * base.mass * v_n * v_n / (k * math.sqrt(r))) ** 0.4
+    a = math.sqrt(r * x)
+    critical = 2.0 * math.sqrt(base.mass * k * a) / base.mass / (a if fields["damping_model"] == "viscoelastic" else 1.0)
+    return base.with_(damping_coefficient=zeta * critical)
 
 
 def _omega(case):
@@ -355,8 +385,9 @@ def _reference_check(contact: Contact, args: tuple, fine, tol: dict, budget: flo
     try:
         # the solver's own budget works in any thread; SIGALRM (time_limit) stays as a backstop
         # (and is the only limit of the JKR/DMT reference, reached through simulate_impact)
-        with time_limit(2.0 * budget if contact.normal_model == "ring" else budget):
-            if contact.normal_model == "ring":
+        paper = contact.normal_model == "ring" and contact.damping_model == "paper"
+        with time_limit(2.0 * budget if paper else budget):
+            if paper:
                 ref = simulate_reference(*args, rtol=_RTOL_FINE, time_budget=budget)
             else:
                 ref = simulate_impact(*args, rtol=_RTOL_FINE, method="reference")
