@@ -244,6 +244,11 @@ LAWS_NOISE = 1e-9
 #: engine's policy): one row moved, its friction impulse by 1.2e-7 (Mindlin) and 9e-6
 #: (Mindlin-Deresiewicz) of the scale, its velocities and spins by < 1e-14.
 LAWS_CAPTURED_TAIL = {"jkr": 1e-7, "jkr_force": 1e-7, "dmt": 1e-7, "mindlin": 1e-6, "mindlin_deresiewicz": 2e-5}
+#: Changed on purpose since the baseline: a JKR or DMT rebound with e_n below 0.1 takes e_n from the
+#: exit rate instead of the energy balance, whose error grows as rtol / e_n
+#: (microimpact.solvers.normal_models._restitution). Measured: one row moved (dmt, row 18, e_n 0.0334)
+#: by 3.8e-9; the scipy reference at rtol 1e-13 puts the new value 6.8e-12 from it, the old 3.8e-9.
+LAWS_SMALL_REBOUND = {"jkr": 1e-8, "jkr_force": 1e-8, "dmt": 1e-8}
 
 
 @pytest.fixture(scope="module")
@@ -267,6 +272,8 @@ def test_every_law_against_its_baseline(laws_now, selection):
     assert np.array_equal(np.isnan(new), np.isnan(old)), f"{selection}: outcomes changed"
     captured = np.isnan(old[:, list(base["quantity"].values).index("mu_t")])
     noise = np.where(captured, LAWS_CAPTURED_TAIL.get(selection, LAWS_NOISE), LAWS_NOISE)
+    e_old = old[:, list(base["quantity"].values).index("e_n")]
+    noise = np.where(~captured & (e_old < 0.1), np.maximum(noise, LAWS_SMALL_REBOUND.get(selection, 0.0)), noise)
     for j, name in enumerate(base["quantity"].values):
         ok = np.isfinite(old[:, j])
         scale = np.max(np.abs(old[ok, j]), initial=0.0)

@@ -7,6 +7,7 @@
   unreliable.
 - :mod:`.kharaz`: the model against the Kharaz et al. (2001) oblique-impact measurements.
 - :mod:`.synthetic`: labelled synthetic measurements from stated parameters.
+- :mod:`.dem_fit`: the damping of LAMMPS GRANULAR's laws fitted to measured e_n, and the laws ranked.
 """
 
 from microimpact._lazy import lazy_exports as _lazy_exports
@@ -40,6 +41,8 @@ _HOMES = {
     **dict.fromkeys(("SYNTHETIC_DEFAULTS", "SYNTHETIC_OBLIQUE_DEFAULTS", "make_synthetic_impacts",
                      "make_synthetic_oblique", "write_synthetic_impacts"), "synthetic"),
     **dict.fromkeys(("DampingTarget", "damping_from_target"), "target"),
+    **dict.fromkeys(("DEM_LAWS", "DemLawFit", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws",
+                     "dem_fit_coverage", "INTERVAL_LEVEL", "ADEQUACY_P"), "dem_fit"),
 }
 #: the modules, importable as attributes
 _MODULES = tuple(sorted(set(_HOMES.values())))
