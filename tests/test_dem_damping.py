@@ -77,7 +77,7 @@ def test_dmt_with_dem_damping_against_an_independent_si_solve(law, coef):
     c = Contact(R, RHO, K, 0.0, normal_model="dmt").with_(
         adhesion_line_force=adhesion_line_force_from_work(K, R, w_a),
         damping_model=law, damping_coefficient=coef)
-    assert c.work_of_adhesion == pytest.approx(w_a, rel=1e-12)
+    assert c.work_of_adhesion == pytest.approx(w_a, rel=1e-12, abs=0.0)
     v = 0.3
     mine = nm.solve_normal(c, v, rtol=1e-10)
     theirs = _independent_e_n(law, coef, v, adhesion=w_a)
@@ -120,7 +120,7 @@ def test_mass_velocity_is_the_linear_oscillator_for_small_damping():
     scales as v^2 t_c: 1 - e_n is proportional to eta0 at small eta0 (ratio within 1e-3)."""
     small = [1.0 - nm.solve_normal(HERTZ.with_(damping_model="mass_velocity", damping_coefficient=eta), 1.0,
                                    rtol=1e-11).e_n for eta in (1e3, 2e3)]
-    assert small[1] / small[0] == pytest.approx(2.0, rel=1e-3)
+    assert small[1] / small[0] == pytest.approx(2.0, rel=1e-3, abs=0.0)
 
 
 def test_energy_is_conserved_by_the_dissipation_record():
@@ -168,11 +168,11 @@ def test_solvers_that_do_not_cover_a_dem_damping_say_so():
 def test_factors_against_the_lammps_formulas():
     """The two restitution factors as printed in LAMMPS's source and docs, computed here by hand."""
     assert dd.restitution_damping_factor(0.5) == pytest.approx(
-        math.sqrt(1.5) * 2.0 * math.sqrt(5.0 / 6.0) * math.log(2.0) / math.sqrt(math.pi**2 + math.log(2.0) ** 2), rel=1e-14)
+        math.sqrt(1.5) * 2.0 * math.sqrt(5.0 / 6.0) * math.log(2.0) / math.sqrt(math.pi**2 + math.log(2.0) ** 2), rel=1e-14, abs=0.0)
     assert dd.tsuji_damping_factor(0.5) == pytest.approx(
-        math.sqrt(2.0) * (1.2728 - 4.2783 / 2 + 11.087 / 4 - 22.348 / 8 + 27.467 / 16 - 18.022 / 32 + 4.8218 / 64), rel=1e-14)
+        math.sqrt(2.0) * (1.2728 - 4.2783 / 2 + 11.087 / 4 - 22.348 / 8 + 27.467 / 16 - 18.022 / 32 + 4.8218 / 64), rel=1e-14, abs=0.0)
     for e in (0.01, 0.5, 0.999):
-        assert dd.restitution_of_damping_factor(dd.restitution_damping_factor(e)) == pytest.approx(e, rel=1e-12)
+        assert dd.restitution_of_damping_factor(dd.restitution_damping_factor(e)) == pytest.approx(e, rel=1e-12, abs=0.0)
     with pytest.raises(ValueError, match="sqrt"):
         dd.restitution_of_damping_factor(3.0)
 
@@ -186,10 +186,10 @@ def test_hertz_law_in_its_units():
         h = 1e-6
         du_dx = (am.hertz_nondimensional_potential(s + h) - am.hertz_nondimensional_potential(s - h)) / (
             (s + h) ** 2 - (s - h) ** 2)
-        assert du_dx == pytest.approx(am.hertz_nondimensional_force(s, 0.0, 0.0), rel=1e-9)
+        assert du_dx == pytest.approx(am.hertz_nondimensional_force(s, 0.0, 0.0), rel=1e-9, abs=0.0)
     v = 0.7
     sc = am.hertz_scales(HERTZ, v)
-    assert float(sc.length) == pytest.approx((5.0 * MASS * v * v / (4.0 * K * math.sqrt(R))) ** 0.4, rel=1e-14)
+    assert float(sc.length) == pytest.approx((5.0 * MASS * v * v / (4.0 * K * math.sqrt(R))) ** 0.4, rel=1e-14, abs=0.0)
     undamped = HERTZ.with_(damping_model="viscoelastic", damping_coefficient=0.0)
     s = nm.solve_normal(undamped, v, rtol=1e-11)
     assert s.max_penetration / float(sc.length) == pytest.approx(1.0, abs=1e-9)

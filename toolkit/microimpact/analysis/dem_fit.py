@@ -47,11 +47,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 
 from microimpact.model.contact import Contact
-from microimpact.model.dem_damping import DEM_DAMPING_MODELS, RESTITUTION_DAMPING_MODELS
+from microimpact.model.dem_damping import RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
 from microimpact.solvers import DEFAULT_RTOL
 
 __all__ = ["DEM_LAWS", "DemLawFit", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "dem_fit_coverage",
@@ -174,16 +175,22 @@ def dem_law_contact(material, radius: float, normal_model: str, damping_model: s
     >>> c.normal_model, c.adhesion_line_force, c.damping_model
     ('ring', 0.0, 'coeff_restitution')
     """
-    from microimpact.model.contact import adhesion_line_force_from_work
+    from microimpact.io.materials import material_contact
 
-    get = material.get if isinstance(material, dict) else lambda k: getattr(material, k)
-    k, w = float(get("stiffness")), float(get("work_of_adhesion"))
     if (normal_model, damping_model) not in DEM_LAWS:
         raise ValueError(f"unknown DEM law {normal_model}+{damping_model}; known: "
                          + ", ".join(f"{a}+{b}" for a, b in DEM_LAWS))
-    f0 = 0.0 if normal_model == "hertz" else adhesion_line_force_from_work(k, radius, w)
-    return Contact(radius, float(get("density")), k, f0, normal_model="ring" if normal_model == "hertz" else normal_model,
-                   damping_model=damping_model, damping_coefficient=coefficient)
+    # the material's elasticity and w_A only (its friction and zetas belong to the paper's law)
+    mat = _material_record(material)
+    return material_contact(mat, radius, work_of_adhesion=0.0 if normal_model == "hertz" else mat.work_of_adhesion,
+                            normal_model="ring" if normal_model == "hertz" else normal_model,
+                            damping_model=damping_model, damping_coefficient=coefficient)
+
+
+def _material_record(material) -> SimpleNamespace:
+    """density [kg/m^3], stiffness [Pa] and work_of_adhesion [J/m^2] of a MaterialPair, Contact or dict."""
+    get = material.get if isinstance(material, dict) else lambda k: getattr(material, k)
+    return SimpleNamespace(**{k: float(get(k)) for k in ("density", "stiffness", "work_of_adhesion")})
 
 
 def dem_law_restitution(material, radius, normal_speed, normal_model: str, damping_model: str, coefficient: float,
@@ -208,9 +215,7 @@ def dem_law_restitution(material, radius, normal_speed, normal_model: str, dampi
     [0.6, 0.6, 0.6]
     """
     r, v = np.broadcast_arrays(np.asarray(radius, dtype=float), np.asarray(normal_speed, dtype=float))
-    get = material.get if isinstance(material, dict) else lambda k: getattr(material, k)
-    mat = {k: float(get(k)) for k in ("density", "stiffness", "work_of_adhesion")}
-    return _Model(mat, r.ravel(), v.ravel(), normal_model, damping_model, rtol).e_n(coefficient).reshape(r.shape)
+    return _Model(_material_record(material), r.ravel(), v.ravel(), normal_model, damping_model, rtol).e_n(coefficient).reshape(r.shape)
 
 
 class _Model:
@@ -237,10 +242,7 @@ class _Model:
         largest approach), the unit of the eta_n0 search. [1/s] or [1/(m s)]"""
         r, v = float(np.median(self.radii[self.index])), float(np.median(self.speed))
         c = dem_law_contact(self.material, r, self.normal_model, self.damping_model, 0.0 if not self.restitution else 1.0)
-        x = (1.25 * c.mass * v * v / (c.stiffness * math.sqrt(r))) ** 0.4
-        a = math.sqrt(r * x)
-        eta = 2.0 * math.sqrt(c.mass * c.stiffness * a)
-        return eta / c.mass / (a if self.damping_model == "viscoelastic" else 1.0)
+        return critical_damping_coefficient(c, v)
 
 
 def _chisqr(model, coefficient, e_meas, sigma) -> float:
@@ -328,6 +330,7 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     from scipy import optimize, stats
 
     from microimpact.analysis.fitting import _sigma_e, _table_arrays
+    from microimpact.analysis.identifiability import chi2_threshold
 
     df, rows, arrays, src = _table_arrays(table)
     sigma, _, _ = _sigma_e(weights, arrays, rows, src)
@@ -335,8 +338,7 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     e_meas = arrays["e_n"]
     n = e_meas.size
     sig = sigma if sigma_known else np.ones(n)
-    get = material.get if isinstance(material, dict) else lambda k: getattr(material, k)
-    mat = {k: float(get(k)) for k in ("density", "stiffness", "work_of_adhesion")}
+    mat = vars(_material_record(material))
     model = _Model(mat, arrays["radius"], arrays["normal_speed"], normal_model, damping_model, rtol)
     dem_law_contact(mat, float(arrays["radius"][0]), normal_model, damping_model, 1.0)  # the law exists
 
@@ -364,7 +366,7 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     if chi_none < chi_min:
         x_best, chi_min = (1.0 if model.restitution else -math.inf), chi_none
     if sigma_known:
-        threshold = 1.0
+        threshold = chi2_threshold(INTERVAL_LEVEL)
     elif n > 1:
         s2 = chi_min / (n - 1)
         threshold = s2 * stats.t.ppf(0.5 + INTERVAL_LEVEL / 2.0, n - 1) ** 2
@@ -420,8 +422,7 @@ def rank_dem_laws(table, material, laws=None, *, weights="auto", rtol: float = D
     """
     import pandas as pd
 
-    get = material.get if isinstance(material, dict) else lambda k: getattr(material, k)
-    adhesive = float(get("work_of_adhesion")) > 0.0
+    adhesive = _material_record(material).work_of_adhesion > 0.0
     laws = [law for law in DEM_LAWS if adhesive or law[0] == "hertz"] if laws is None else list(laws)
     fits = {f"{a}+{b}": fit_dem_law(table, material, a, b, weights=weights, rtol=rtol) for a, b in laws}
     df = pd.DataFrame([{"law": name, "status": f.status, "value": f.value, "interval_low": f.interval[0],

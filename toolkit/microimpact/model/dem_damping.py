@@ -57,7 +57,8 @@ from __future__ import annotations
 import math
 
 __all__ = ["DEM_DAMPING_MODELS", "RESTITUTION_DAMPING_MODELS", "tsuji_damping_factor",
-           "restitution_damping_factor", "restitution_of_damping_factor", "dem_damping_law"]
+           "restitution_damping_factor", "restitution_of_damping_factor", "dem_damping_law",
+           "critical_damping_coefficient"]
 
 #: the DEM damping laws (Contact.damping_model other than "paper")
 DEM_DAMPING_MODELS = ("mass_velocity", "viscoelastic", "tsuji", "coeff_restitution")
@@ -174,6 +175,40 @@ def dem_damping_law(contact) -> tuple[float, float]:
         factor = tsuji_damping_factor(coef) if model == "tsuji" else restitution_damping_factor(coef)
         return factor * math.sqrt(contact.mass * contact.stiffness), 0.5
     return 0.0, 0.0
+
+
+def critical_damping_coefficient(contact, normal_speed: float) -> float:
+    """eta_n0 of the contact's ``mass_velocity`` or ``viscoelastic`` law that equals the critical
+    damping 2 sqrt(m k) of its Hertz impact at ``normal_speed``. [1/s] or [1/(m s)]
+
+    k = K a, the Hertz stiffness at the largest undamped approach L
+    (:func:`microimpact.model.adhesion_models.hertz_scales`), a = sqrt(R L): a unit of damping for
+    searches and sweeps.
+
+    Parameters
+    ----------
+    contact : Contact
+        With ``damping_model`` "mass_velocity" or "viscoelastic".
+    normal_speed : float
+        [m/s]
+
+    Examples
+    --------
+    A 2 um sphere at 1 m/s: m = 4.524e-14 kg, L = 1.386e-8 m, a = 1.665e-7 m, k = 295.7 N/m, so
+    2 sqrt(m k) / m = 1.616e8 1/s:
+
+    >>> from microimpact.model.contact import Contact
+    >>> c = Contact(2e-6, 1350.0, 1.776e9, 0.0, damping_model="mass_velocity")
+    >>> f"{critical_damping_coefficient(c, 1.0):.4g}"
+    '1.616e+08'
+    """
+    from microimpact.model.adhesion_models import hertz_scales
+
+    if contact.damping_model not in ("mass_velocity", "viscoelastic"):
+        raise ValueError(f"a critical eta_n0 is defined for mass_velocity and viscoelastic, got {contact.damping_model!r}")
+    a = float(hertz_scales(contact, normal_speed).radius)
+    eta = 2.0 * math.sqrt(contact.mass * contact.stiffness * a)
+    return eta / contact.mass / (a if contact.damping_model == "viscoelastic" else 1.0)
 
 
 def dem_damping_nondimensional_force(a, y, c3, p3):

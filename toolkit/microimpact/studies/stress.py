@@ -268,6 +268,7 @@ def _dem_contact(case: dict, fields: dict, adhesive: bool) -> Contact:
     multiple of the critical damping 2 sqrt(m k) of the case's Hertz impact (k = K a at its largest
     approach), or the restitution e = 1 / (1 + zeta_H) of tsuji and coeff_restitution."""
     from microimpact.model.contact import adhesion_line_force_from_work
+    from microimpact.model.dem_damping import critical_damping_coefficient
 
     r, rho, k = case["radius"], case["density"], case["stiffness"]
     f0 = adhesion_line_force_from_work(k, r, case["work_of_adhesion"]) if adhesive else 0.0
@@ -276,10 +277,7 @@ def _dem_contact(case: dict, fields: dict, adhesive: bool) -> Contact:
         return Contact(r, rho, k, f0, friction=case["friction"], damping_coefficient=1.0 / (1.0 + zeta), **fields)
     base = Contact(r, rho, k, f0, friction=case["friction"], **fields)
     v_n = max(case["speed"] * math.cos(math.radians(case["incidence_deg"])), 1e-300)
-    x = (1.25 * base.mass * v_n * v_n / (k * math.sqrt(r))) ** 0.4
-    a = math.sqrt(r * x)
-    critical = 2.0 * math.sqrt(base.mass * k * a) / base.mass / (a if fields["damping_model"] == "viscoelastic" else 1.0)
-    return base.with_(damping_coefficient=zeta * critical)
+    return base.with_(damping_coefficient=zeta * critical_damping_coefficient(base, v_n))
 
 
 def _omega(case):
