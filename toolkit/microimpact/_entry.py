@@ -5,11 +5,13 @@ a program imports and calls: install signal handlers. A Ctrl-C while the command
 (0.1-0.5 s, longer on a loaded machine) ends in the same one line as one during the work, not in a
 traceback from inside numpy; and a signal that lands in a finaliser still stops the command
 (:func:`microimpact.io.joblog.redeliver_swallowed_signals`). Where SIGINT is ignored (a
-background job) it stays ignored.
+background job) it stays ignored. After the one line of a Ctrl-C the process ends at once
+(``os._exit``), without the finalisers of a compile the signal cut short.
 """
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 
@@ -35,7 +37,16 @@ def main() -> int:
     if starting:
         signal.signal(signal.SIGINT, signal.default_int_handler)
     redeliver_swallowed_signals()
-    return cli_main()
+    status = cli_main()
+    if status == EXIT_INTERRUPTED:
+        # The one line is printed and nothing was written; skip the interpreter's finalisation.
+        # A Ctrl-C that stops numba in the middle of a compile leaves llvmlite objects whose
+        # finalisers print "Exception ignored in: ObjectRef.__del__" at exit (CI, 2026-11-27),
+        # a second message after the one line.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    return status
 
 
 if __name__ == "__main__":  # pragma: no cover
