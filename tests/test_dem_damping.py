@@ -131,6 +131,21 @@ def test_energy_is_conserved_by_the_dissipation_record():
     assert s.dissipated_energy / (0.5 * c.mass * 4.0) == pytest.approx(1.0 - ref.e_n**2, abs=1e-8)
 
 
+def test_a_capture_that_lands_on_the_equilibrium_exactly_finishes():
+    """A strongly damped LAMMPS-jkr sphere (8.65 um, w_A 0.1 J/m^2, viscoelastic 4.6e14) whose
+    integration lands on the equilibrium exactly: the slow path from there has length 0, and its
+    time was 0/0 (a ZeroDivisionError inside the compiled solver, met by the joint fit of w_A and
+    the damping). The energy record closes: dissipated + final = the incident kinetic energy."""
+    c = Contact(radius=8.648308134780921e-06, density=1350.0, stiffness=1.776e9, normal_model="jkr_force",
+                adhesion_line_force=adhesion_line_force_from_work(1.776e9, 8.648308134780921e-06, 0.1),
+                zeta_hertz=0.0, zeta_adhesion=0.0, damping_model="viscoelastic", damping_coefficient=462049633439200.3)
+    v = 1.249706144564451
+    r = nm.solve_normal_many(c, np.array([v]), rtol=1e-8)
+    assert r["captured"][0] and r["e_n"][0] == 0.0 and math.isfinite(r["capture_time"][0])
+    kinetic = 0.5 * c.mass * v * v
+    assert (r["dissipated_energy"][0] + r["final_energy"][0]) / kinetic == pytest.approx(1.0, rel=1e-6, abs=0.0)
+
+
 def test_simulate_impact_runs_the_dem_damping_with_friction():
     c = HERTZ.with_(damping_model="coeff_restitution", damping_coefficient=0.6, friction=0.3)
     r = mi.simulate_impact(c, 1.0, 45.0)

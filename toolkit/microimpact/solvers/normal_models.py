@@ -251,6 +251,8 @@ def _slow_ratios(model, z, z_eq, c1, c2, c3, p3):
 @njit(cache=True)
 def _slow_time_between(model, z0, z1, c1, c2, c3, p3):
     """tau from z0 to z1 on the slow manifold, int dx / y_m (3-point Gauss-Legendre). [-]"""
+    if z1 == z0:  # a state already at the equilibrium (y_m = 0 there): no path (was 0/0)
+        return 0.0
     t = 0.0
     for i in range(3):
         z = 0.5 * (z0 + z1) + 0.5 * (z1 - z0) * _GL3_X[i]
