@@ -649,18 +649,28 @@ def _cmd_lammps_fit(args) -> int:
     import numpy as np
 
     out = check_outputs({"--out": args.out}, _inputs(args))["--out"]
+    if args.fit_adhesion and args.law and args.law[0] == "hertz":
+        raise UsageError(f"--fit-adhesion: the law {'+'.join(args.law)} has no work of adhesion to fit; give a "
+                         "jkr_force or dmt law, or no --law")
     table, pair = _impacts_for_pair(args)
     try:
-        ranked, fits = rank_dem_laws(table, pair, [args.law] if args.law else None, weights=args.weights, rtol=args.rtol)
+        ranked, fits = rank_dem_laws(table, pair, [args.law] if args.law else None, fit_adhesion=args.fit_adhesion,
+                                     weights=args.weights, rtol=args.rtol)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
-    shown = ranked[["law", "status", "value", "interval_low", "interval_high", "chisqr", "delta_aic", "akaike_weight"]]
+    columns = ["law", "status", "value", "interval_low", "interval_high"]
+    if args.fit_adhesion:
+        columns += ["adhesion_status", "work_of_adhesion", "w_low", "w_high"]
+    shown = ranked[columns + ["chisqr", "delta_aic", "akaike_weight"]]
     print(shown.to_string(index=False, float_format=lambda x: f"{x:.6g}"))
     chosen = fits[ranked["law"].iloc[0]]
     print(chosen.describe())
     if not chosen.determined:
-        why = ("does not describe the data" if chosen.status == "inadequate" else
-               f"the data do not determine its damping coefficient ({chosen.status})")
+        statuses = {"damping coefficient": chosen.status}
+        if chosen.adhesion_fitted:
+            statuses["work of adhesion"] = chosen.adhesion_status
+        why = ("does not describe the data" if chosen.status == "inadequate" else "the data do not determine its "
+               + " or ".join(f"{name} ({st})" for name, st in statuses.items() if st != "determined"))
         print(f"microimpact: error: {chosen.law}, the best LAMMPS law by AIC, {why}; no LAMMPS input written",
               file=sys.stderr)
         return EXIT_DISAGREES
@@ -673,6 +683,10 @@ def _cmd_lammps_fit(args) -> int:
     fitted = {"damping_coefficient": f"{chosen.value:.6g} (68% profile-likelihood interval {lo:.6g} to {hi:.6g}; "
                                      f"{chosen.n} impacts, {'stated e_n uncertainties' if chosen.sigma_known else 'scatter estimated'})",
               "law": f"{chosen.law} (best by AIC{'; ' + others if others else ''})",
+              **({"work_of_adhesion": f"{chosen.work_of_adhesion:.6g} J/m^2 (68% profile-likelihood interval "
+                                      f"{chosen.work_of_adhesion_interval[0]:.6g} to "
+                                      f"{chosen.work_of_adhesion_interval[1]:.6g}, the damping fitted jointly)"}
+                 if chosen.adhesion_fitted else {}),
               "radius": f"{radius:.6g} m, the median of the data's radii ({radii.min():.4g} to {radii.max():.4g} m)"}
     pair_name = getattr(pair, "name", None) or args.material_pair
     text = lammps_input(contact, units=args.units, source=f"{source}" + (f"; material pair {pair_name}" if pair_name else ""),
@@ -758,7 +772,8 @@ def register_lammps(sub) -> None:
     e.add_argument("--wall", default="zplane 0.0 NULL", help="LAMMPS wall style and arguments (default 'zplane 0.0 NULL')")
     e.add_argument("--out", required=True, help="output LAMMPS input file")
     e.set_defaults(func=_cmd_lammps_export)
-    f = lsub.add_parser("fit", help="fit the damping of LAMMPS laws to measured impacts (CSV), rank the laws by AIC and "
+    f = lsub.add_parser("fit", help="fit the damping of LAMMPS laws (with --fit-adhesion also the work of adhesion) to "
+                                    "measured impacts (CSV), rank the laws by AIC and "
                                     "write the best determined one as LAMMPS input (exit status "
                                     f"{EXIT_DISAGREES} and nothing written when the data do not determine it)")
     f.add_argument("data", help="impact CSV (see 'microimpact fit')")
@@ -766,6 +781,9 @@ def register_lammps(sub) -> None:
     f.add_argument("--config", default=None, help="materials config YAML (default: the bundled one)")
     f.add_argument("--law", type=_dem_law, default=None, metavar="NORMAL+DAMPING",
                    help="fit only this law, e.g. hertz+coeff_restitution (default: rank every law the material allows)")
+    f.add_argument("--fit-adhesion", action="store_true",
+                   help="fit the work of adhesion of the adhesive laws (jkr_force, dmt) jointly with the damping, "
+                        "instead of taking the material pair's (which may then have none)")
     f.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto",
                    help="auto: the stated e_n uncertainties when given, else the scatter (default auto)")
     f.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")

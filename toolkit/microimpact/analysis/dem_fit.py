@@ -74,6 +74,11 @@ _GRID = 41  # start grid over the physical range
 #: impact (Hertz: 3 critical dampings for viscoelastic, 1 for mass_velocity, measured); beyond it a
 #: strongly damped Hertz sphere creeps out of contact in a time that grows without bound
 _DECADES = {"viscoelastic": (-4.0, math.log10(3.0)), "mass_velocity": (-4.0, 0.0)}
+#: the work of adhesion searched over 1e-5 to 1 J/m^2 in log10 (and w_A = 0 apart): at 1 J/m^2 a
+#: 3.45 um sphere of the paper's material is captured up to 1 m/s with LAMMPS's jkr; 1e-5 J/m^2
+#: changes its e_n by less than 1e-3 at 0.05 m/s and above (measured)
+_ADHESION_DECADES = (-5.0, 0.0)
+_PROFILE_GRID = 21  # start grid of each inner and outer minimisation of the joint fit
 
 
 @dataclass(frozen=True)
@@ -121,10 +126,20 @@ class DemLawFit:
     best: float
     material: dict = field(default_factory=dict)
     source: str = ""
+    adhesion_fitted: bool = False
+    work_of_adhesion: float = math.nan
+    work_of_adhesion_interval: tuple[float, float] = (math.nan, math.nan)
+    adhesion_status: str = ""
 
     @property
     def determined(self) -> bool:
-        return self.status == "determined"
+        """Every fitted parameter determined (only then is the law written for an engine)."""
+        return self.status == "determined" and (not self.adhesion_fitted or self.adhesion_status == "determined")
+
+    @property
+    def parameters(self) -> int:
+        """Fitted parameters: the damping coefficient, and the work of adhesion when fitted."""
+        return 2 if self.adhesion_fitted else 1
 
     @property
     def law(self) -> str:
@@ -132,11 +147,25 @@ class DemLawFit:
 
     def describe(self) -> str:
         """One line: the law, the value with its interval, or what the data cannot tell."""
+        if self.status == "inadequate":
+            return (f"{self.law}: does not describe the data (chi^2 = {self.chisqr:.6g} for {self.n - self.parameters} "
+                    f"degrees of freedom, p < {ADEQUACY_P:g}); no value")
+        damping = self._describe_damping()
+        if not self.adhesion_fitted:
+            return damping
+        lo, hi = self.work_of_adhesion_interval
+        if self.adhesion_status == "determined":
+            adhesion = f"work_of_adhesion = {self.work_of_adhesion:.6g} J/m^2 (68% interval {lo:.6g} to {hi:.6g})"
+        elif self.adhesion_status == "upper limit":
+            adhesion = f"work_of_adhesion consistent with no adhesion; the data give only w_A <= {hi:.6g} J/m^2 (68%)"
+        else:
+            adhesion = (f"work_of_adhesion not determined by these data (w_A >= {lo:.6g} J/m^2, 68%: the data cannot "
+                        "tell it from a stronger adhesion)")
+        return f"{damping}; {adhesion}"
+
+    def _describe_damping(self) -> str:
         unit = {"viscoelastic": " 1/(m s)", "mass_velocity": " 1/s"}.get(self.damping_model, "")
         lo, hi = self.interval
-        if self.status == "inadequate":
-            return (f"{self.law}: does not describe the data (chi^2 = {self.chisqr:.6g} for {self.n - 1} degrees of "
-                    f"freedom, p < {ADEQUACY_P:g}); no value")
         if self.status == "determined":
             return (f"{self.law}: damping_coefficient = {self.value:.6g}{unit} "
                     f"(68% interval {lo:.6g} to {hi:.6g})")
@@ -227,13 +256,18 @@ class _Model:
         self.speed = speed
         self.restitution = damping_model in RESTITUTION_DAMPING_MODELS
 
-    def e_n(self, coefficient: float) -> np.ndarray:
+    def e_n(self, coefficient: float, work_of_adhesion: float | None = None) -> np.ndarray:
+        """e_n of every impact [-] for the damping ``coefficient`` and, when given, a trial work of
+        adhesion [J/m^2] in place of the material's."""
         from microimpact.solvers import normal_models as nm
 
+        material = self.material
+        if work_of_adhesion is not None:
+            material = {**vars(_material_record(material)), "work_of_adhesion": float(work_of_adhesion)}
         out = np.empty(self.speed.size)
         for i, r in enumerate(self.radii):
             rows = self.index == i
-            c = dem_law_contact(self.material, float(r), self.normal_model, self.damping_model, coefficient)
+            c = dem_law_contact(material, float(r), self.normal_model, self.damping_model, coefficient)
             out[rows] = nm.solve_normal_many(c, self.speed[rows], rtol=self.rtol)["e_n"]
         return out
 
@@ -245,8 +279,8 @@ class _Model:
         return critical_damping_coefficient(c, v)
 
 
-def _chisqr(model, coefficient, e_meas, sigma) -> float:
-    return float(np.sum(np.square((e_meas - model.e_n(coefficient)) / sigma)))
+def _chisqr(model, coefficient, e_meas, sigma, work_of_adhesion=None) -> float:
+    return float(np.sum(np.square((e_meas - model.e_n(coefficient, work_of_adhesion)) / sigma)))
 
 
 def _restitution_interval(rise, x_best, lo_x):
@@ -277,10 +311,134 @@ def _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x):
     start = x_best if math.isfinite(x_best) else lo_x
     if rise(hi_x) <= 0.0:
         strong, bounded = math.inf, False
+    elif rise(start) > 0.0:  # no damping best, and the chi^2 has risen already at the lowest decade searched
+        strong, bounded = optimize.brentq(rise_coef, 0.0, to_coef(lo_x), xtol=1e-14 * to_coef(lo_x)), True
     else:
         strong, bounded = to_coef(optimize.brentq(rise, start, hi_x, xtol=1e-12)), True
     status = "not determined" if not bounded else "upper limit" if weak == 0.0 else "determined"
     return (float(weak), float(strong)), status, (float(to_coef(x_best)) if math.isfinite(x_best) else 0.0)
+
+
+def _interval_threshold(chi_min, n, sigma_known, k=1):
+    """The rise of chi^2 that bounds the 68.27 % profile-likelihood interval of one parameter:
+    Delta chi^2 = 1 with stated uncertainties, s^2 t^2 (n - k degrees of freedom) without."""
+    from scipy import stats
+
+    from microimpact.analysis.identifiability import chi2_threshold
+
+    if sigma_known:
+        return chi2_threshold(INTERVAL_LEVEL)
+    if n > k:
+        return chi_min / (n - k) * stats.t.ppf(0.5 + INTERVAL_LEVEL / 2.0, n - k) ** 2
+    return math.inf
+
+
+def _minimum(f, lo, hi, grid, hints=()):
+    """(t, f(t)) with the smallest f over t = -inf (no damping, no adhesion) and [lo, hi]: a grid
+    and the ``hints`` (minimisers found nearby before), then bounded Brent about the best of them."""
+    from scipy import optimize
+
+    ts = np.linspace(lo, hi, grid)
+    step = ts[1] - ts[0]
+    candidates = [(float(t), f(float(t))) for t in ts]
+    candidates += [(float(h), f(float(h))) for h in hints if math.isfinite(h) and lo <= h <= hi]
+    t0, f0 = min(candidates, key=lambda c: c[1])
+    res = optimize.minimize_scalar(f, bounds=(max(lo, t0 - step), min(hi, t0 + step)), method="bounded",
+                                   options={"xatol": 1e-9})
+    best = (float(res.x), float(res.fun)) if res.fun <= f0 else (t0, float(f0))
+    none = f(-math.inf)
+    return (-math.inf, float(none)) if none < best[1] else best
+
+
+def _log10(value: float) -> float:
+    return math.log10(value) if value > 0.0 else -math.inf
+
+
+def _fit_with_adhesion(model, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x):
+    """The work of adhesion and the damping fitted jointly: (chi^2_min, (interval, status, best) of
+    w_A, the same of the damping). Each interval is a profile-likelihood interval: the other
+    parameter minimised at every trial value (Venzon & Moolgavkar 1988).
+
+    Coordinates u = log10 w_A and x (the damping's, :func:`fit_dem_law`), -inf for none. Every
+    minimisation over one coordinate starts from a grid and from the minimisers found before (the
+    valley of chi^2 in w_A can be narrower than the grid); a chi^2 below the minimum met while the
+    intervals are searched means the minimum was missed: the fit starts again from there (at most
+    three times).
+    """
+    from functools import lru_cache
+
+    lo_u, hi_u = _ADHESION_DECADES
+    seen = {}
+
+    @lru_cache(maxsize=None)
+    def chi(u, x):
+        value = _chisqr(model, to_coef(x), e_meas, sig, 10.0**u)
+        seen[(u, x)] = value
+        return value
+
+    hints = {"u": [], "x": []}
+    best = {"u": (), "x": ()}  # the joint minimiser: a profile through it never lies above chi^2_min
+
+    def profile_w(u):  # chi^2 at log10 w_A = u, the damping at its best
+        x, value = _minimum(lambda x: chi(u, x), lo_x, hi_x, _PROFILE_GRID, [*hints["x"][-2:], *best["x"]])
+        hints["x"].append(x)
+        return value
+
+    def profile_damping(x):
+        u, value = _minimum(lambda u: chi(u, x), lo_u, hi_u, _PROFILE_GRID, [*hints["u"][-2:], *best["u"]])
+        hints["u"].append(u)
+        return value
+
+    start = _joint_minimum(chi, lo_u, hi_u, lo_x, hi_x)
+    for _ in range(3):
+        (u_best, x_best), chi_min = _polish(chi, start, lo_u, hi_u, lo_x, hi_x)
+        best.update(u=(u_best,), x=(x_best,))
+        threshold = _interval_threshold(chi_min, e_meas.size, sigma_known, k=2)
+        adhesion = _damping_interval(lambda u: profile_w(u) - chi_min - threshold,
+                                     lambda w: profile_w(_log10(w)) - chi_min - threshold,
+                                     lambda u: 10.0**u, u_best, lo_u, hi_u)
+        damping = _damping_interval(lambda x: profile_damping(x) - chi_min - threshold,
+                                    lambda c: profile_damping(from_coef(c)) - chi_min - threshold,
+                                    to_coef, x_best, lo_x, hi_x)
+        start, lowest = min(seen.items(), key=lambda item: item[1])
+        if lowest >= chi_min - 1e-3 * threshold:  # a smaller miss moves no end of an interval visibly
+            return chi_min, adhesion, damping
+    raise RuntimeError("the joint fit of the work of adhesion and the damping did not find its minimum in three "
+                       "starts (chi^2 has several valleys)")
+
+
+def _joint_minimum(chi, lo_u, hi_u, lo_x, hi_x):
+    """The best point of a grid over (u, x), -inf (none) included in each: the start of :func:`_polish`."""
+    us = [-math.inf, *np.linspace(lo_u, hi_u, _PROFILE_GRID)]
+    xs = [-math.inf, *np.linspace(lo_x, hi_x, _PROFILE_GRID)]
+    return min(((float(u), float(x)) for u in us for x in xs), key=lambda p: chi(*p))
+
+
+def _polish(chi, start, lo_u, hi_u, lo_x, hi_x):
+    """The minimum of chi(u, x) near ``start``: Nelder-Mead in the plane (the valley of chi^2 is
+    narrow and oblique: w_A and the damping both lower e_n), or along one coordinate when the other
+    is -inf (no adhesion or no damping), then the best of that and the two edges at -inf."""
+    from scipy import optimize
+
+    u0, x0 = start
+    candidates = []
+    if math.isfinite(u0) and math.isfinite(x0):
+        def clipped(p):
+            return chi(float(np.clip(p[0], lo_u, hi_u)), float(np.clip(p[1], lo_x, hi_x)))
+
+        res = optimize.minimize(clipped, [u0, x0], method="Nelder-Mead",
+                                options={"xatol": 1e-10, "fatol": 1e-12, "maxiter": 4000, "adaptive": True,
+                                         "initial_simplex": [[u0, x0], [u0 + 0.05, x0], [u0, x0 + 0.05]]})
+        candidates.append(((float(np.clip(res.x[0], lo_u, hi_u)), float(np.clip(res.x[1], lo_x, hi_x))),
+                           float(res.fun)))
+    if math.isfinite(x0) or not math.isfinite(u0):
+        u, value = _minimum(lambda u: chi(u, x0), lo_u, hi_u, _PROFILE_GRID, [u0])
+        candidates.append(((u, x0), value))
+    if math.isfinite(u0) or not math.isfinite(x0):
+        x, value = _minimum(lambda x: chi(u0, x), lo_x, hi_x, _PROFILE_GRID, [x0])
+        candidates.append(((u0, x), value))
+    candidates.append((start, chi(*start)))
+    return min(candidates, key=lambda c: c[1])
 
 
 def _information_criteria(chi_min, n, sigma_known, k=1):
@@ -289,8 +447,18 @@ def _information_criteria(chi_min, n, sigma_known, k=1):
     return base + 2 * k, base + k * math.log(n)
 
 
+def _coordinate(model):
+    """The fitted coordinate x of the damping: e itself over [1e-3, 1], or log10(eta_n0 / critical)
+    over :data:`_DECADES` (eta_n0 = 0 is x = -inf): (to_coef, from_coef, lo_x, hi_x)."""
+    if model.restitution:
+        return (lambda x: x), (lambda c: c), 1e-3, 1.0
+    unit = model.scale()
+    lo_x, hi_x = _DECADES[model.damping_model]
+    return (lambda x: unit * 10.0**x), (lambda c: _log10(c / unit)), lo_x, hi_x
+
+
 def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str = "coeff_restitution", *,
-                weights="auto", rtol: float = DEFAULT_RTOL) -> DemLawFit:
+                fit_adhesion: bool = False, weights="auto", rtol: float = DEFAULT_RTOL) -> DemLawFit:
     """Fit the damping coefficient of a DEM law to the impacts of ``table`` (module docstring).
 
     Parameters
@@ -302,6 +470,10 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
         density [kg/m^3], stiffness [Pa], work_of_adhesion [J/m^2].
     normal_model, damping_model : str
         The law, one of :data:`DEM_LAWS`.
+    fit_adhesion : bool
+        Fit the work of adhesion jointly with the damping (``jkr_force`` and ``dmt`` only); the
+        material's w_A is then not used. Each parameter gets its own profile-likelihood interval
+        and status; the degrees of freedom are n - 2.
     weights : {"auto", "e_n", "none"} or array
         As :func:`microimpact.analysis.fitting.fit_damping`: the stated e_n uncertainties (auto: when
         given) or none (sigma estimated from the scatter).
@@ -330,8 +502,10 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     from scipy import optimize, stats
 
     from microimpact.analysis.fitting import _sigma_e, _table_arrays
-    from microimpact.analysis.identifiability import chi2_threshold
 
+    if fit_adhesion and normal_model == "hertz":
+        raise ValueError(f"fit_adhesion: {normal_model}+{damping_model} has no work of adhesion to fit; "
+                         "choose jkr_force or dmt")
     df, rows, arrays, src = _table_arrays(table)
     sigma, _, _ = _sigma_e(weights, arrays, rows, src)
     sigma_known = sigma is not None
@@ -342,15 +516,9 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     model = _Model(mat, arrays["radius"], arrays["normal_speed"], normal_model, damping_model, rtol)
     dem_law_contact(mat, float(arrays["radius"][0]), normal_model, damping_model, 1.0)  # the law exists
 
-    # the fitted coordinate x: e itself, or log10(eta_n0 / critical) over _DECADES (eta_n0 = 0 apart)
-    if model.restitution:
-        to_coef, lo_x, hi_x = (lambda x: x), 1e-3, 1.0
-    else:
-        unit = model.scale()
-        lo_x, hi_x = _DECADES[damping_model]
-
-        def to_coef(x):
-            return unit * 10.0**x
+    to_coef, from_coef, lo_x, hi_x = _coordinate(model)
+    if fit_adhesion:
+        return _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x, src)
 
     def chi(x):
         return _chisqr(model, to_coef(x), e_meas, sig)
@@ -365,13 +533,7 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     chi_none = _chisqr(model, no_damping, e_meas, sig)
     if chi_none < chi_min:
         x_best, chi_min = (1.0 if model.restitution else -math.inf), chi_none
-    if sigma_known:
-        threshold = chi2_threshold(INTERVAL_LEVEL)
-    elif n > 1:
-        s2 = chi_min / (n - 1)
-        threshold = s2 * stats.t.ppf(0.5 + INTERVAL_LEVEL / 2.0, n - 1) ** 2
-    else:
-        threshold = math.inf
+    threshold = _interval_threshold(chi_min, n, sigma_known)
 
     def rise(x):
         return chi(x) - chi_min - threshold
@@ -390,7 +552,25 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
                      float(chi_min), int(n), sigma_known, float(aic), float(bic), best, mat, src)
 
 
-def rank_dem_laws(table, material, laws=None, *, weights="auto", rtol: float = DEFAULT_RTOL):
+def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x, src) -> DemLawFit:
+    """:func:`fit_dem_law` with the work of adhesion fitted too."""
+    from scipy import stats
+
+    n = e_meas.size
+    chi_min, (w_interval, w_status, w_best), (interval, status, best) = _fit_with_adhesion(
+        model, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x)
+    if sigma_known and n > 2 and stats.chi2.sf(chi_min, n - 2) < ADEQUACY_P:
+        status = w_status = "inadequate"
+    aic, bic = _information_criteria(chi_min, n, sigma_known, k=2)
+    return DemLawFit(model.normal_model, model.damping_model, best if status == "determined" else math.nan, interval,
+                     status, float(chi_min), int(n), sigma_known, float(aic), float(bic), best,
+                     {**mat, "work_of_adhesion": w_best}, src, adhesion_fitted=True,
+                     work_of_adhesion=w_best if w_status == "determined" else math.nan,
+                     work_of_adhesion_interval=w_interval, adhesion_status=w_status)
+
+
+def rank_dem_laws(table, material, laws=None, *, fit_adhesion: bool = False, weights="auto",
+                  rtol: float = DEFAULT_RTOL):
     """Fit each DEM law to the same impacts and rank them by AIC.
 
     Parameters
@@ -398,13 +578,18 @@ def rank_dem_laws(table, material, laws=None, *, weights="auto", rtol: float = D
     table, material, weights, rtol
         As :func:`fit_dem_law`.
     laws : sequence of (normal_model, damping_model), optional
-        Default :data:`DEM_LAWS` (the adhesive ones only when the material has a work of adhesion).
+        Default :data:`DEM_LAWS` (the adhesive ones only when the material has a work of adhesion
+        or ``fit_adhesion`` is set).
+    fit_adhesion : bool
+        Fit the work of adhesion of the adhesive laws too (:func:`fit_dem_law`); their AIC and BIC
+        count two parameters.
 
     Returns
     -------
     (pandas.DataFrame, dict)
         One row per law, best first: law, status, value, interval ends, chi^2, AIC, BIC, dAIC and
-        the Akaike weight; and ``{law: DemLawFit}``.
+        the Akaike weight (with ``fit_adhesion`` also adhesion_status, work_of_adhesion and its
+        interval ends, w_low and w_high); and ``{law: DemLawFit}``.
 
     References
     ----------
@@ -422,13 +607,21 @@ def rank_dem_laws(table, material, laws=None, *, weights="auto", rtol: float = D
     """
     import pandas as pd
 
-    adhesive = _material_record(material).work_of_adhesion > 0.0
+    adhesive = fit_adhesion or _material_record(material).work_of_adhesion > 0.0
     laws = [law for law in DEM_LAWS if adhesive or law[0] == "hertz"] if laws is None else list(laws)
-    fits = {f"{a}+{b}": fit_dem_law(table, material, a, b, weights=weights, rtol=rtol) for a, b in laws}
-    df = pd.DataFrame([{"law": name, "status": f.status, "value": f.value, "interval_low": f.interval[0],
-                        "interval_high": f.interval[1], "chisqr": f.chisqr, "aic": f.aic, "bic": f.bic}
-                       for name, f in fits.items()])
-    df.loc[df["status"] == "inadequate", ["interval_low", "interval_high"]] = math.nan  # no number to print
+    fits = {f"{a}+{b}": fit_dem_law(table, material, a, b, fit_adhesion=fit_adhesion and a != "hertz", weights=weights,
+                                    rtol=rtol) for a, b in laws}
+    rows = []
+    for name, f in fits.items():
+        row = {"law": name, "status": f.status, "value": f.value, "interval_low": f.interval[0],
+               "interval_high": f.interval[1]}
+        if fit_adhesion:
+            row.update({"adhesion_status": f.adhesion_status or "not fitted", "work_of_adhesion": f.work_of_adhesion,
+                        "w_low": f.work_of_adhesion_interval[0], "w_high": f.work_of_adhesion_interval[1]})
+        rows.append({**row, "chisqr": f.chisqr, "aic": f.aic, "bic": f.bic})
+    df = pd.DataFrame(rows)
+    interval_ends = [c for c in ("interval_low", "interval_high", "w_low", "w_high") if c in df]
+    df.loc[df["status"] == "inadequate", interval_ends] = math.nan  # no number to print
     df["delta_aic"] = df["aic"] - df["aic"].min()
     w = np.exp(-0.5 * df["delta_aic"].to_numpy())
     df["akaike_weight"] = w / w.sum()
@@ -437,14 +630,28 @@ def rank_dem_laws(table, material, laws=None, *, weights="auto", rtol: float = D
     return df.sort_values("aic", kind="stable", key=lambda a: a.round(6)).reset_index(drop=True), fits
 
 
-def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, seed: int = 0, rtol: float = 1e-8):
+def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, seed: int = 0, rtol: float = 1e-8,
+                     fit_adhesion: bool = False):
     """Coverage of :func:`fit_dem_law`'s 68.27 % interval over random experiment designs.
 
     Each trial draws a design (4-30 impacts, normal speeds log-uniform over a random range within
     0.05-20 m/s, one or two radii within 1-10 um, noise sigma 0.003-0.05) and a true coefficient
     (e in 0.2-0.95, or eta_n0 giving e_n from about 0.3 to 0.97), simulates e_n with Gaussian noise
-    of the stated sigma, and fits. Returns a dict: trials, determined, covered (among the
-    determined), the coverage, and the trials that were not determined.
+    of the stated sigma (a captured sphere is recorded as e_n = 0 exactly: nothing rebounds to be
+    measured), and fits. With ``fit_adhesion`` the true work of adhesion is drawn
+    log-uniform in 3e-3-0.3 J/m^2, the speeds within 0.02-20 m/s, and both parameters are fitted;
+    many such designs cannot determine w_A (all impacts far above the sticking velocity, or all
+    captured), and are meant to.
+
+    Returns
+    -------
+    dict
+        trials; determined and covered (the damping, among the trials that determine it); coverage
+        (covered / determined); undetermined (status, truth, n, sigma of the others); and
+        ``interval_covered``: over all trials that are not inadequate, how often each parameter's
+        interval (one-sided ones included: every status states an interval) holds the truth,
+        ``{"damping": k, "work_of_adhesion": k}`` of ``adequate`` trials, with
+        ``adhesion_determined``.
 
     Examples
     --------
@@ -456,28 +663,39 @@ def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, s
 
     rng = np.random.default_rng(seed)
     material = {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0 if normal_model == "hertz" else 0.01}
-    determined = covered = 0
+    determined = covered = adequate = adhesion_determined = 0
+    interval_covered = {"damping": 0, "work_of_adhesion": 0}
     undetermined = []
     for _ in range(trials):
         n = int(rng.integers(4, 31))
-        lo = 10 ** rng.uniform(math.log10(0.05), math.log10(5.0))
+        lo = 10 ** rng.uniform(math.log10(0.02 if fit_adhesion else 0.05), math.log10(5.0))
         hi = min(20.0, lo * 10 ** rng.uniform(0.1, 2.0))
         speed = 10 ** rng.uniform(math.log10(lo), math.log10(hi), n)
         radius = rng.choice(10 ** rng.uniform(-6.0, -5.0, 2), n)
         sigma = float(10 ** rng.uniform(math.log10(0.003), math.log10(0.05)))
-        probe = _Model({k: material[k] for k in material}, radius, speed, normal_model, damping_model, rtol)
+        truth_w = float(10 ** rng.uniform(math.log10(3e-3), math.log10(0.3))) if fit_adhesion else material["work_of_adhesion"]
+        probe = _Model({**material, "work_of_adhesion": truth_w}, radius, speed, normal_model, damping_model, rtol)
         if probe.restitution:
             truth = float(rng.uniform(0.2, 0.95))
         else:
             truth = probe.scale() * 10 ** rng.uniform(-2.5, -0.5)
         e_true = probe.e_n(truth)
-        e = e_true + rng.normal(0.0, sigma, n)
+        e = np.where(e_true > 0.0, e_true + rng.normal(0.0, sigma, n), 0.0)  # a capture is seen as one, no noise
         table = pd.DataFrame({"radius": radius, "normal_speed": speed, "e_n": e, "e_n_uncertainty": sigma})
-        fit = fit_dem_law(table, material, normal_model, damping_model, weights="e_n", rtol=rtol)
+        fit = fit_dem_law(table, material, normal_model, damping_model, fit_adhesion=fit_adhesion, weights="e_n",
+                          rtol=rtol)
+        if fit.status != "inadequate":
+            adequate += 1
+            interval_covered["damping"] += fit.interval[0] <= truth <= fit.interval[1]
+            if fit_adhesion:
+                lo_w, hi_w = fit.work_of_adhesion_interval
+                interval_covered["work_of_adhesion"] += lo_w <= truth_w <= hi_w
+                adhesion_determined += fit.adhesion_status == "determined"
         if fit.status != "determined":
             undetermined.append((fit.status, truth, n, sigma))
             continue
         determined += 1
         covered += fit.interval[0] <= truth <= fit.interval[1]
     return {"trials": trials, "determined": determined, "covered": covered,
-            "coverage": covered / determined if determined else math.nan, "undetermined": undetermined}
+            "coverage": covered / determined if determined else math.nan, "undetermined": undetermined,
+            "adequate": adequate, "interval_covered": interval_covered, "adhesion_determined": adhesion_determined}
