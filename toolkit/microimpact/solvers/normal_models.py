@@ -39,7 +39,11 @@ Regimes left to closed forms instead of a step limit (the engine's, :mod:`.engin
   along the path (:func:`_slow_jump`). A captured sphere that creeps inwards or has turned takes
   the path under the engine's looser creeping test (ratio 1e-2). An explicit solver needs ~C^2
   steps there: 2e6 were not enough at zeta = 1e5 (15 % of random JKR/DMT impacts over the extended
-  domain had no result before).
+  domain had no result before). A Hertz sphere under a damping that vanishes with the contact
+  radius (``viscoelastic``) creeps out, and inertia returns just before it leaves: the creep is
+  taken along the manifold only while it is inertia-free (the engine's thresholds) and integrated
+  again from there, to the exit (e_n then follows the exact overdamped law e_n ~ eta_n0^-5 v^-1,
+  tests/test_dem_damping.py; it ended in the step limit above ~4000 critical dampings before).
 * **Captured tails.** A captured sphere whose tangential outcome needs the rest of its oscillation
   ends with the linear damped tail about the equilibrium in closed form once its error (~
   amplitude / equilibrium approach) is below ``tail_tolerance`` of J, or after a twentieth of the
@@ -288,42 +292,53 @@ def _slow_point(model, kind, target, za, zb_, ya, c1, c2, c3, p3):
 
 
 @njit(cache=True)
-def _slow_jump(model, u, z_eq, c1, c2, c3, p3, atol_y, threshold, captured, j_target, need_slip, enter, resume, band):
+def _slow_jump(model, u, z_eq, c1, c2, c3, p3, atol_y, threshold, captured, j_target, need_slip, enter, resume, band,
+               partial=False):
     """Whether the state u follows the slow manifold into the equilibrium and, if so, the rest of
     the impact in closed form and quadratures.
 
-    Returns (yes, tau_capture, tau_slip_end, tau_end, D, J, J_a): tau_capture where the energy
-    falls below the capture threshold (NaN if ``captured`` already), tau_slip_end where J reaches
-    j_target (NaN if not needed or not reached), and the states at the equilibrium.
+    Returns (yes, tau_capture, tau_slip_end, tau_end, D, J, J_a, z_end, y_end, complete):
+    tau_capture where the energy falls below the capture threshold (NaN if ``captured`` already),
+    tau_slip_end where J reaches j_target (NaN if not needed or not reached), and the states at the
+    end of the path: the equilibrium (complete), or with ``partial`` the last point of the path that
+    is still inertia-free, where the explicit integration takes over again (the engine's
+    hand-back: a Hertz sphere under a damping that vanishes with a creeps out along the manifold
+    until inertia returns just before it leaves).
 
     Thresholds: the inertia ratio at most ``enter`` here and ``resume`` on the whole path (the
     relaxation ratio at least 1e-3 and 1e-2 of their inverses, as the engine's), and y within
     ``band`` |y_m| (plus twice the ratio and ten absolute tolerances) of the manifold.
     """
     nan = math.nan
+    no = (False, nan, nan, nan, nan, nan, nan, nan, nan, False)
     z = u[0]
     eps, relax = _slow_ratios(model, z, z_eq, c1, c2, c3, p3)
     if not (eps <= enter and relax >= RELAXATION_ENTER * INERTIA_FREE_ENTER / enter):
-        return False, nan, nan, nan, nan, nan, nan
+        return no
     ym = _slow_speed(model, z, c1, c2, c3, p3)
     if abs(u[1] - ym) > (2.0 * eps + band) * abs(ym) + 10.0 * atol_y:
-        return False, nan, nan, nan, nan, nan, nan
+        return no
     d0 = z - z_eq
     ratio = 10.0 ** (-_SLOW_DECADES / _SLOW_CELLS)
+    cells = _SLOW_CELLS
     zk = z_eq + d0 * ratio**_SLOW_CELLS  # its far end first: where a damping that vanishes with a fails
     eps, relax = _slow_ratios(model, zk, z_eq, c1, c2, c3, p3)
-    if not (eps <= resume and relax >= RELAXATION_RESUME * INERTIA_FREE_RESUME / resume):
-        return False, nan, nan, nan, nan, nan, nan
-    for k in range(1, _SLOW_CELLS + 1):  # the whole path must stay inertia-free
+    complete = eps <= resume and relax >= RELAXATION_RESUME * INERTIA_FREE_RESUME / resume
+    if not complete and not partial:
+        return no
+    for k in range(1, _SLOW_CELLS + 1):  # the whole path (or with partial, a first part) inertia-free
         zk = z_eq + d0 * ratio**k
         eps, relax = _slow_ratios(model, zk, z_eq, c1, c2, c3, p3)
         if not (eps <= resume and relax >= RELAXATION_RESUME * INERTIA_FREE_RESUME / resume):
-            return False, nan, nan, nan, nan, nan, nan
+            if not partial or k == 1:
+                return no
+            cells, complete = k - 1, False
+            break
     tau, jf, ja = u[2], u[4] + abs(u[1] - ym), u[5] + _radius(model, z) * abs(u[1] - ym)
     tau_cap, tau_slip = nan, nan
     need_cap = not captured
     za, ya = z, ym
-    for k in range(1, _SLOW_CELLS + 1):
+    for k in range(1, cells + 1):
         zb_ = z_eq + d0 * ratio**k
         yb = _slow_speed(model, zb_, c1, c2, c3, p3)
         dj = abs(yb - ya)
@@ -343,13 +358,16 @@ def _slow_jump(model, u, z_eq, c1, c2, c3, p3, atol_y, threshold, captured, j_ta
         tau += _slow_time_between(model, za, zb_, c1, c2, c3, p3)
         jf += dj
         za, ya = zb_, yb
+    if not complete:  # handed back at (za, ya) on the manifold
+        dissipated = u[3] + _energy(model, u[0], u[1]) - _energy(model, za, ya)
+        return True, tau_cap, tau_slip, tau, dissipated, jf, ja, za, ya, False
     # the last 1e-12 of the path: y_m falls from ya to 0 at z_eq
     jf += abs(ya)
     ja += _radius(model, z_eq) * abs(ya)
     if need_slip and jf >= j_target:
         tau_slip = tau
     dissipated = u[3] + _energy(model, u[0], u[1]) - _energy(model, z_eq, 0.0)
-    return True, tau_cap, tau_slip, tau, dissipated, jf, ja
+    return True, tau_cap, tau_slip, tau, dissipated, jf, ja, z_eq, 0.0, True
 
 
 # --------------------------------------------------------------------------- averaged tail
@@ -560,10 +578,24 @@ def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j
             # inertia is negligible all the way. A Hertz sphere that creeps out inertia-free all the
             # way to s = 0 never leaves (e_n = 0 whatever the error of the test): the creeping test too
             creep = model == _HERTZ or outcome == CAPTURE and (turned or u[0] < z_eq)
-            jumped, tc, ts, te, dd, jj, jja = _slow_jump(
+            jumped, tc, ts, te, dd, jj, jja, _, _, _ = _slow_jump(
                 model, u, z_eq, c1, c2, c3, p3, atol[1], threshold, outcome == CAPTURE, j_target,
                 j_target > 0.0 and math.isnan(tau_slip), CREEP_RATIO if creep else INERTIA_FREE_ENTER,
                 CREEP_RATIO if creep else INERTIA_FREE_RESUME, CREEP_BAND if creep else 0.0)
+            if not jumped and model == _HERTZ:
+                # a damping that vanishes with a (viscoelastic): inertia returns before s = 0, so the
+                # creep is taken along the manifold only while it is inertia-free (the engine's
+                # thresholds, error ~ their square), then integrated again to the exit
+                moved, tc, ts, te, dd, jj, jja, z_end, y_end, whole = _slow_jump(
+                    model, u, z_eq, c1, c2, c3, p3, atol[1], threshold, True, j_target,
+                    j_target > 0.0 and math.isnan(tau_slip), INERTIA_FREE_ENTER, INERTIA_FREE_RESUME, 0.0, True)
+                jumped = moved and whole
+                if moved and not whole:
+                    if not math.isnan(ts):
+                        tau_slip = ts
+                    u[0], u[1], u[2], u[3], u[4], u[5] = z_end, y_end, te, dd, jj, jja
+                    _rhs(model, u, c1, c2, c3, p3, k[0])
+                    continue
             if jumped:  # the inertia-free limit: the rest of the impact in closed form, a capture
                 if outcome == REBOUND:
                     outcome = CAPTURE
