@@ -62,6 +62,16 @@ def contact_radius(radius, penetration):
         Sphere radius r. [m]
     penetration : array_like
         x = -n. [m]
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-dimensional modeling of microsphere contact/
+    impact with smooth, flat surfaces, Aerosol Sci. Technol. 36:1045-1060, Eq. (6).
+
+    Examples
+    --------
+    >>> contact_radius(4e-6, [1e-8, 0.0, -1e-8]).tolist()
+    [2e-07, 0.0, 0.0]
     """
     return np.sqrt(radius * np.maximum(penetration, 0.0))
 
@@ -77,6 +87,21 @@ def hertz_force(radius, stiffness, penetration):
         Effective stiffness K, Eq. (3). [Pa]
     penetration : array_like
         x = -n; no force for x <= 0. [m]
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eq. (2); Johnson, K. L. (1985), Contact Mechanics, Cambridge
+    University Press, Sec. 4.2.
+
+    Examples
+    --------
+    The energy stored at the largest penetration x* of an undamped Hertz impact,
+    int F_H dx = (2/5) F_H(x*) x*, is the incident kinetic energy:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> x_max, _ = hertz_impact_scales(c.mass, c.stiffness, c.radius, 1.0)
+    >>> round(float(0.4 * hertz_force(c.radius, c.stiffness, x_max) * x_max / (0.5 * c.mass)), 12)
+    1.0
     """
     return math.sqrt(radius) * stiffness * np.maximum(penetration, 0.0) ** 1.5
 
@@ -92,6 +117,19 @@ def adhesion_force(radius, adhesion_line_force, penetration):
         f0, Eq. (5). [N/m]
     penetration : array_like
         x = -n; no force for x <= 0. [m]
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eq. (5).
+
+    Examples
+    --------
+    At the paper's length scale X = 2 pi f0 / K (Eq. (29)) the ring force balances the Hertz force:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> x = c.length_scale
+    >>> round(float(adhesion_force(c.radius, c.adhesion_line_force, x) / hertz_force(c.radius, c.stiffness, x)), 12)
+    -1.0
     """
     return -2.0 * math.pi * adhesion_line_force * contact_radius(radius, penetration)
 
@@ -111,6 +149,21 @@ def normal_force(contact, penetration, penetration_rate, c_hertz, c_adhesion):
         x' = -n'. [m/s]
     c_hertz, c_adhesion : float
         C_H and C_A of Eqs. (14)-(15). [s/m]
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eq. (27).
+
+    Examples
+    --------
+    At the adhesive equilibrium x = X the net force vanishes at rest; moving inwards (x' > 0) the
+    Hertz damping pushes out and the adhesion damping pulls in less, so the force is positive:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> float(normal_force(c, c.length_scale, 0.0, 0.1, 0.1))
+    0.0
+    >>> bool(normal_force(c, c.length_scale, 1.0, 0.1, 0.1) > 0.0)
+    True
     """
     f_h = hertz_force(contact.radius, contact.stiffness, penetration)
     f_a = adhesion_force(contact.radius, contact.adhesion_line_force, penetration)
@@ -152,6 +205,19 @@ def damping_dissipation_rate(contact, penetration, penetration_rate, c_hertz, c_
     """Power removed by the normal damping of Eq. (27), (C_H F_H + C_A |F_A|) x'^2 >= 0. [W]
 
     Parameters as :func:`normal_force`: x [m], x' [m/s], C_H and C_A [s/m].
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (14)-(15) and (27).
+
+    Examples
+    --------
+    (C_H F_H + C_A |F_A|) x'^2: at x = X, where F_H = |F_A|, with C_H = C_A = 1 s/m and x' = 2 m/s:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> f_h = hertz_force(c.radius, c.stiffness, c.length_scale)
+    >>> round(float(damping_dissipation_rate(c, c.length_scale, 2.0, 1.0, 1.0) / (8.0 * f_h)), 12)
+    1.0
     """
     f_h = hertz_force(contact.radius, contact.stiffness, penetration)
     f_a = adhesion_force(contact.radius, contact.adhesion_line_force, penetration)
@@ -210,6 +276,18 @@ def hertz_impact_scales(mass, stiffness, radius, normal_speed):
     -------
     (length, time) : tuple of float or ndarray
         x* [m] and t* [s].
+
+    References
+    ----------
+    Johnson, K. L. (1985), Contact Mechanics, Cambridge University Press, Sec. 11.4 (the impact of
+    elastic spheres).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> length, time = hertz_impact_scales(c.mass, c.stiffness, c.radius, 1.0)
+    >>> f"{length:.6e} m", f"{time:.6e} s"
+    ('2.386574e-08 m', '2.386574e-08 s')
     """
     length = (5.0 * mass * normal_speed**2 / (4.0 * stiffness * math.sqrt(radius))) ** 0.4
     return length, length / normal_speed
@@ -239,6 +317,20 @@ def nondimensional_acceleration(root, root3, y, c1, c2, a_h, a_a):
     a_h, a_a : float
         Hertz and adhesion coefficients: 1, 1 in the paper's scales X, T (Eq. (28)); 5/4, 0 in the
         Hertz impact scales (:func:`hertz_impact_scales`). [-]
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (27)-(28).
+
+    Examples
+    --------
+    The equilibrium of the paper's scales is xi = 1 at rest; moving inwards there (y = 1) the
+    damping gives -(C1 + C2):
+
+    >>> nondimensional_acceleration(1.0, 1.0, 0.0, 0.3, 0.2, 1.0, 1.0)
+    0.0
+    >>> round(nondimensional_acceleration(1.0, 1.0, 1.0, 0.3, 0.2, 1.0, 1.0), 12)
+    -0.5
     """
     return a_a * root * (1.0 - c2 * y) - a_h * root3 * (1.0 + c1 * y)
 
@@ -258,6 +350,17 @@ def nondimensional_energy(s, y, a_h, a_a):
         y = d xi / d tau. [-]
     a_h, a_a : float
         As in :func:`nondimensional_acceleration`. [-]
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (27)-(30).
+
+    Examples
+    --------
+    >>> round(nondimensional_energy(1.0, 0.0, 1.0, 1.0), 12) == round(-4.0 / 15.0, 12)
+    True
+    >>> nondimensional_energy(0.0, 1.0, 1.25, 0.0)  # first contact in the Hertz scales: y0 = 1
+    0.5
     """
     s3 = s * s * s
     return 0.5 * y * y + a_h * 0.4 * s3 * s * s - a_a * (2.0 / 3.0) * s3
@@ -268,6 +371,15 @@ def nondimensional_dissipation_rate(root, root3, y, c1, c2, a_h, a_a):
 
     The nondimensional form of :func:`damping_dissipation_rate`. Parameters as
     :func:`nondimensional_acceleration` (the Sundman form passes (s^2, s^4) for s times the rate).
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (27)-(28).
+
+    Examples
+    --------
+    >>> nondimensional_dissipation_rate(1.0, 1.0, 2.0, 0.5, 0.25, 1.0, 1.0)  # (0.5 + 0.25) 2^2
+    3.0
     """
     return (a_h * c1 * root3 + a_a * c2 * root) * y * y
 
@@ -310,6 +422,19 @@ def nondimensional_scales(contact, normal_speed) -> Scales:
     contact : Contact
     normal_speed : float or ndarray
         Incident normal speed, > 0. Without adhesion an array gives array scales. [m/s]
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (29)-(30) (Eq. (30) is printed as T^2: :attr:`microimpact.model.contact.Contact.time_scale`).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> sc = nondimensional_scales(c, 1.0)
+    >>> f"{sc.length:.6e} m", f"{sc.time:.6e} s", sc.a_hertz, sc.a_adhesion
+    ('2.625777e-08 m', '2.084247e-08 s', 1.0, 1.0)
+    >>> nondimensional_scales(c.with_(adhesion_line_force=0.0), 1.0).a_hertz
+    1.25
     """
     if contact.adhesion_line_force > 0.0:
         return Scales(contact.length_scale, contact.time_scale, 1.0, 1.0)
@@ -328,6 +453,17 @@ def nondimensional_impact(contact, normal_speed):
     contact : Contact
     normal_speed : float or ndarray
         Incident normal speed, > 0. [m/s]
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (14)-(15) and (29)-(32).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> sc, y0, c1, c2 = nondimensional_impact(c, 1.0)
+    >>> round(y0, 6), round(y0 * sc.speed, 12)
+    (0.793764, 1.0)
     """
     sc = nondimensional_scales(contact, normal_speed)
     u = sc.speed
