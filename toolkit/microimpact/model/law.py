@@ -425,7 +425,8 @@ def nondimensional_scales(contact, normal_speed) -> Scales:
 
     References
     ----------
-    Cheng, Brach & Dunn (2002), Eqs. (29)-(30) (Eq. (30) is printed as T^2: :attr:`microimpact.model.contact.Contact.time_scale`).
+    Cheng, Brach & Dunn (2002), Eqs. (29)-(30) (Eq. (30) is printed as T^2:
+    :attr:`microimpact.model.contact.Contact.time_scale`).
 
     Examples
     --------
