@@ -179,6 +179,21 @@ def adhesion_scales(contact, model: str | None = None) -> AdhesionScales:
         With adhesion (f0 > 0, so w > 0).
     model : {"jkr", "dmt", "jkr_force"}, optional
         Default ``contact.normal_model``; both JKR break criteria share the JKR units.
+
+    References
+    ----------
+    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Proc. R. Soc. Lond. A 324:301-313;
+    Derjaguin, B. V., Muller, V. M. and Toporov, Yu. P. (1975), J. Colloid Interface Sci. 53:314-326.
+
+    Examples
+    --------
+    The JKR contact breaks (displacement-controlled) at delta_c = -3 L_J, where a = a_c:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> sc = adhesion_scales(c.with_(normal_model="jkr"))
+    >>> r, k, w = c.radius, c.stiffness, c.work_of_adhesion
+    >>> round(float(jkr_critical_approach(r, k, w) / sc.length), 12), round(float(jkr_approach(r, k, w, sc.radius) / sc.length), 12)
+    (-3.0, -3.0)
     """
     model = contact.normal_model if model is None else model
     w, r, k = contact.work_of_adhesion, contact.radius, contact.stiffness
@@ -209,6 +224,19 @@ def tabor_parameter(radius, stiffness, work_of_adhesion, equilibrium_separation=
         w. [J/m^2]
     equilibrium_separation : float
         z0 (default :data:`DEFAULT_EQUILIBRIUM_SEPARATION`). [m]
+
+    References
+    ----------
+    Tabor, D. (1977), Surface forces and surface interactions, J. Colloid Interface Sci. 58:2-13,
+    doi:10.1016/0021-9797(77)90366-5.
+
+    Examples
+    --------
+    The paper's microsphere (Table 1) with z0 = 0.4 nm lies in the JKR regime (mu_T > 5):
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> round(float(tabor_parameter(c.radius, c.stiffness, c.work_of_adhesion)), 2)
+    11.23
     """
     e_star = 0.75 * np.asarray(stiffness, dtype=float)
     return np.cbrt(np.asarray(radius, dtype=float) * np.square(work_of_adhesion)
@@ -226,6 +254,21 @@ def check_adhesion_regime(contact, equilibrium_separation=DEFAULT_EQUILIBRIUM_SE
     -------
     float
         mu_T. [-]
+
+    References
+    ----------
+    Johnson, K. L. and Greenwood, J. A. (1997), An adhesion map for the contact of elastic spheres,
+    J. Colloid Interface Sci. 192:326-333, doi:10.1006/jcis.1997.4984.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     mu = check_adhesion_regime(c.with_(normal_model="dmt"))
+    >>> round(mu, 2), caught[0].category.__name__
+    (11.23, 'AdhesionRegimeWarning')
     """
     mu = float(tabor_parameter(contact.radius, contact.stiffness, contact.work_of_adhesion, equilibrium_separation))
     if contact.work_of_adhesion > 0.0:
@@ -245,6 +288,19 @@ def jkr_approach(radius, stiffness, work_of_adhesion, contact_radius_):
     """JKR approach delta(a) = a^2 / R - sqrt(2 pi w a / E*) (Johnson et al. 1971). [m]
 
     Parameters: R [m], K [Pa] (E* = 3 K / 4), w [J/m^2], contact radius a [m].
+
+    References
+    ----------
+    Johnson, Kendall & Roberts (1971), Proc. R. Soc. Lond. A 324:301-313.
+
+    Examples
+    --------
+    Contact forms (delta = 0) at a = 4^(2/3) a_c:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> a_c = adhesion_scales(c.with_(normal_model="jkr")).radius
+    >>> abs(float(jkr_approach(c.radius, c.stiffness, c.work_of_adhesion, 4.0 ** (2.0 / 3.0) * a_c))) < 1e-22
+    True
     """
     a = np.asarray(contact_radius_, dtype=float)
     return a * a / radius - np.sqrt(2.0 * math.pi * work_of_adhesion * a / (0.75 * stiffness))
@@ -254,6 +310,21 @@ def jkr_force(radius, stiffness, work_of_adhesion, contact_radius_):
     """JKR force F(a) = 4 E* a^3 / (3 R) - sqrt(8 pi w E* a^3), positive = repulsive. [N]
 
     Parameters: R [m], K [Pa] (E* = 3 K / 4), w [J/m^2], contact radius a [m].
+
+    References
+    ----------
+    Johnson, Kendall & Roberts (1971), Proc. R. Soc. Lond. A 324:301-313.
+
+    Examples
+    --------
+    At the break of the displacement-controlled contact (a = a_c) the force is -(5/9) F_c, F_c = (3/2) pi w R:
+
+    >>> import math
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> r, k, w = c.radius, c.stiffness, c.work_of_adhesion
+    >>> a_c = adhesion_scales(c.with_(normal_model="jkr")).radius
+    >>> round(float(jkr_force(r, k, w, a_c) / (1.5 * math.pi * w * r)), 12) == round(-5.0 / 9.0, 12)
+    True
     """
     a = np.asarray(contact_radius_, dtype=float)
     e_star = 0.75 * stiffness
@@ -264,6 +335,17 @@ def jkr_critical_approach(radius, stiffness, work_of_adhesion):
     """Approach at which a JKR contact breaks, delta_c = -(3/4) (pi^2 w^2 R / E*^2)^(1/3). [m]
 
     (Thornton & Ning 1998); the minimum of :func:`jkr_approach`, at a_c = (pi w R^2 / (8 E*))^(1/3).
+
+    References
+    ----------
+    Thornton, C. and Ning, Z. (1998), A theoretical model for the stick/bounce behaviour of adhesive,
+    elastic-plastic spheres, Powder Technol. 99:154-162, doi:10.1016/S0032-5910(98)00099-0.
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> f"{float(jkr_critical_approach(c.radius, c.stiffness, c.work_of_adhesion)):.4e} m"
+    '-7.2251e-09 m'
     """
     e_star = 0.75 * stiffness
     return -0.75 * np.cbrt(math.pi**2 * np.square(work_of_adhesion) * radius / e_star**2)
@@ -278,6 +360,12 @@ def jkr_q_from_approach(approach_ratio):
     ----------
     approach_ratio : array_like
         delta / L_J >= -3 (delta_c / L_J = -3). [-]
+
+    Examples
+    --------
+    >>> q = jkr_q_from_approach([-3.0, 0.0, 10.0])
+    >>> q.round(8).tolist(), (q**4 - 4 * q).round(12).tolist()
+    ([1.0, 1.58740105, 2.06744159], [-3.0, 0.0, 10.0])
     """
     d = np.asarray(approach_ratio, dtype=float)
     q = np.sqrt(np.sqrt(np.maximum(d, 0.0) + 4.0)) + 1.0  # q^4 - 4q > d here
@@ -293,6 +381,19 @@ def jkr_contact_radius(radius, stiffness, work_of_adhesion, approach):
     """Contact radius a(delta) = a_c q^2 on the stable JKR branch (a >= a_c), delta >= delta_c. [m]
 
     Parameters: R [m], K [Pa] (E* = 3 K / 4), w [J/m^2], approach delta [m].
+
+    References
+    ----------
+    Johnson, Kendall & Roberts (1971), Proc. R. Soc. Lond. A 324:301-313.
+
+    Examples
+    --------
+    At first touch (delta = 0) a = 4^(2/3) a_c:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> a_c = adhesion_scales(c.with_(normal_model="jkr")).radius
+    >>> round(float(jkr_contact_radius(c.radius, c.stiffness, c.work_of_adhesion, 0.0) / a_c), 10)
+    2.5198420998
     """
     a_c = np.cbrt(math.pi * work_of_adhesion * radius**2 / (8.0 * 0.75 * stiffness))
     return a_c * jkr_q_from_approach(np.asarray(approach, dtype=float) / (a_c * a_c / radius)) ** 2
@@ -302,6 +403,21 @@ def dmt_force(radius, stiffness, work_of_adhesion, approach):
     """DMT force F = sqrt(R) K delta^(3/2) - 2 pi w R for delta > 0, 0 otherwise. [N]
 
     (Derjaguin, Muller & Toporov 1975). Parameters: R [m], K [Pa], w [J/m^2], approach delta [m].
+
+    References
+    ----------
+    Derjaguin, Muller & Toporov (1975), J. Colloid Interface Sci. 53:314-326.
+
+    Examples
+    --------
+    The pull-off force 2 pi w R acts at any approach > 0, and is balanced at delta = L_D:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> r, k, w = c.radius, c.stiffness, c.work_of_adhesion
+    >>> dmt_force(r, k, w, [-1e-9, 0.0]).tolist()
+    [0.0, 0.0]
+    >>> abs(float(dmt_force(r, k, w, adhesion_scales(c.with_(normal_model="dmt")).length))) < 1e-18
+    True
     """
     d = np.asarray(approach, dtype=float)
     return np.where(d > 0.0, math.sqrt(radius) * stiffness * np.maximum(d, 0.0) ** 1.5 - 2.0 * math.pi * work_of_adhesion * radius, 0.0)
@@ -329,6 +445,20 @@ def jkr_sticking_velocity(contact) -> float:
     work of the adhesive force between the break and delta = 0 on unloading (Johnson & Pollock
     1994); H = :func:`jkr_hysteresis` of the contact's break criterion ("jkr_force": force-controlled;
     otherwise the displacement-controlled "jkr").
+
+    References
+    ----------
+    Johnson, K. L. and Pollock, H. M. (1994), The role of adhesion in the impact of elastic spheres,
+    J. Adhesion Sci. Technol. 8:1323-1332, doi:10.1163/156856194X00627.
+
+    Examples
+    --------
+    The paper's microsphere: 0.452 m/s with the displacement-controlled break, 0.318 m/s with the
+    force-controlled one (LAMMPS's ``jkr``):
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> [round(jkr_sticking_velocity(c.with_(normal_model=m)), 4) for m in ("jkr", "jkr_force")]
+    [0.452, 0.3176]
     """
     sc = adhesion_scales(contact, "jkr")
     return math.sqrt(2.0 * jkr_hysteresis(contact.normal_model) * sc.force * sc.length / contact.mass)
@@ -340,6 +470,16 @@ def thornton_ning_sticking_velocity(radius, density, stiffness, work_of_adhesion
     Parameters: R [m], rho [kg/m^3], K [Pa], w [J/m^2]. The coefficient is published to three
     digits; :func:`jkr_sticking_velocity` gives sqrt(3 H pi^(2/3) / 8) = 1.84018 in its place
     (H = :data:`JKR_HYSTERESIS`).
+
+    References
+    ----------
+    Thornton & Ning (1998), Powder Technol. 99:154-162.
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> round(thornton_ning_sticking_velocity(c.radius, c.density, c.stiffness, c.work_of_adhesion), 4)
+    0.4519
     """
     e_star = 0.75 * stiffness
     return THORNTON_NING_COEFFICIENT * (work_of_adhesion**5 / (density**3 * e_star**2 * radius**5)) ** (1.0 / 6.0)
@@ -352,37 +492,78 @@ def jkr_nondimensional_force(q, y, c1, c2):
 
     The repulsive part q^6 / 6 and the adhesive part -q^3 carry the damping forms of Eq. (27);
     C1 = C_H L_J / T, C2 = C_A L_J / T.
+
+    Examples
+    --------
+    Zero at the zero-load equilibrium q^3 = 6 at rest; -5/6 at the displacement-controlled break q = 1:
+
+    >>> round(jkr_nondimensional_force(6.0 ** (1.0 / 3.0), 0.0, 0.1, 0.1), 12)
+    0.0
+    >>> round(jkr_nondimensional_force(1.0, 0.0, 0.0, 0.0), 12)
+    -0.833333333333
     """
     q3 = q * q * q
     return q3 * q3 / 6.0 * (1.0 + c1 * y) - q3 * (1.0 - c2 * y)
 
 
 def jkr_nondimensional_potential(q):
-    """U / (F_J L_J) = q^10 / 15 - 2 q^7 / 3 + q^4, dU/d(delta/L_J) = F / F_J undamped. [-]"""
+    """U / (F_J L_J) = q^10 / 15 - 2 q^7 / 3 + q^4, dU/d(delta/L_J) = F / F_J undamped. [-]
+
+    Examples
+    --------
+    The adhesion hysteresis of one undamped cycle, U(1) - U(4^(1/3)):
+
+    >>> round(jkr_nondimensional_potential(1.0) - jkr_nondimensional_potential(4.0 ** (1.0 / 3.0)), 4)
+    4.2098
+    """
     q3 = q * q * q
     q4 = q3 * q
     return q4 * (q3 * q3 / 15.0 - 2.0 * q3 / 3.0 + 1.0)
 
 
 def jkr_nondimensional_dissipation_rate(q, y, c1, c2):
-    """Damping power / (F_J L_J / T) = (C1 q^6 / 6 + C2 q^3) y^2 >= 0. [-]"""
+    """Damping power / (F_J L_J / T) = (C1 q^6 / 6 + C2 q^3) y^2 >= 0. [-]
+
+    Examples
+    --------
+    >>> round(jkr_nondimensional_dissipation_rate(1.0, 2.0, 0.6, 0.5), 12)  # (0.6 / 6 + 0.5) 2^2
+    2.4
+    """
     q3 = q * q * q
     return (c1 * q3 * q3 / 6.0 + c2 * q3) * y * y
 
 
 def dmt_nondimensional_force(s, y, c1, c2):
-    """F / F_D = s^3 (1 + C1 y) - (1 - C2 y), s = sqrt(delta / L_D), in contact. [-]"""
+    """F / F_D = s^3 (1 + C1 y) - (1 - C2 y), s = sqrt(delta / L_D), in contact. [-]
+
+    Examples
+    --------
+    >>> dmt_nondimensional_force(1.0, 0.0, 0.3, 0.3), dmt_nondimensional_force(0.0, 0.0, 0.3, 0.3)
+    (0.0, -1.0)
+    """
     return s * s * s * (1.0 + c1 * y) - (1.0 - c2 * y)
 
 
 def dmt_nondimensional_potential(s):
-    """U / (F_D L_D) = (2/5) s^5 - s^2 (contact energy relative to first touch). [-]"""
+    """U / (F_D L_D) = (2/5) s^5 - s^2 (contact energy relative to first touch). [-]
+
+    Examples
+    --------
+    >>> round(dmt_nondimensional_potential(1.0), 12)  # the bottom of the well, s = 1
+    -0.6
+    """
     s2 = s * s
     return s2 * (0.4 * s2 * s - 1.0)
 
 
 def dmt_nondimensional_dissipation_rate(s, y, c1, c2):
-    """Damping power / (F_D L_D / T) = (C1 s^3 + C2) y^2 >= 0. [-]"""
+    """Damping power / (F_D L_D / T) = (C1 s^3 + C2) y^2 >= 0. [-]
+
+    Examples
+    --------
+    >>> dmt_nondimensional_dissipation_rate(1.0, 2.0, 0.5, 0.25)  # (0.5 + 0.25) 2^2
+    3.0
+    """
     return (c1 * s * s * s + c2) * y * y
 
 
@@ -414,15 +595,35 @@ def hertz_scales(contact, normal_speed) -> AdhesionScales:
 
 
 def hertz_nondimensional_force(s, y, c1):
-    """Hertz force with the paper's Hertzian damping, F / F_H = s^3 (1 + C1 y), s = sqrt(delta / L). [-]"""
+    """Hertz force with the paper's Hertzian damping, F / F_H = s^3 (1 + C1 y), s = sqrt(delta / L). [-]
+
+    Examples
+    --------
+    >>> hertz_nondimensional_force(1.0, 0.0, 0.3), round(hertz_nondimensional_force(1.0, -1.0, 0.3), 12)
+    (1.0, 0.7)
+    """
     return s * s * s * (1.0 + c1 * y)
 
 
 def hertz_nondimensional_potential(s):
-    """U / (F_H L) = (2/5) s^5 of the Hertz law. [-]"""
+    """U / (F_H L) = (2/5) s^5 of the Hertz law. [-]
+
+    Examples
+    --------
+    The undamped impact turns at s = 1 with the incident energy y0^2 / 2 = 2/5:
+
+    >>> hertz_nondimensional_potential(1.0)
+    0.4
+    """
     return 0.4 * s**5
 
 
 def hertz_nondimensional_dissipation_rate(s, y, c1):
-    """Power of the Hertzian damping, C1 s^3 y^2. [-]"""
+    """Power of the Hertzian damping, C1 s^3 y^2. [-]
+
+    Examples
+    --------
+    >>> hertz_nondimensional_dissipation_rate(1.0, 2.0, 0.5)
+    2.0
+    """
     return c1 * s * s * s * y * y
