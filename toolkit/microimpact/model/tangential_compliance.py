@@ -167,6 +167,11 @@ def shear_modulus_from_elastic(youngs_modulus, poisson):
     References
     ----------
     Timoshenko, S. P. and Goodier, J. N. (1970), Theory of Elasticity, 3rd ed., McGraw-Hill, Sec. 6.
+
+    Examples
+    --------
+    >>> round(float(shear_modulus_from_elastic(70e9, 0.22)) / 1e9, 4)
+    28.6885
     """
     return np.asarray(youngs_modulus, dtype=float) / (2.0 * (1.0 + np.asarray(poisson, dtype=float)))
 
@@ -206,6 +211,16 @@ def tangential_stiffness(shear_modulus, contact_radius):
         Effective shear modulus G*, :func:`effective_shear_modulus`. [Pa]
     contact_radius : array_like
         Contact radius a. [m]
+
+    References
+    ----------
+    Mindlin, R. D. (1949), Compliance of elastic bodies in contact, J. Appl. Mech. 16:259-268;
+    Johnson, K. L. (1985), Contact Mechanics, Cambridge University Press, Sec. 7.2.
+
+    Examples
+    --------
+    >>> float(tangential_stiffness(1e9, 1e-7))  # G* = 1 GPa, a = 0.1 um: 8 G* a
+    800.0
     """
     return 8.0 * shear_modulus * np.asarray(contact_radius, dtype=float)
 
@@ -219,6 +234,15 @@ def stiffness_ratio(poisson):
     ----------
     poisson : array_like
         Poisson ratio nu. [-]
+
+    References
+    ----------
+    Johnson, K. L. (1985), Contact Mechanics, Cambridge University Press, Sec. 7.2.
+
+    Examples
+    --------
+    >>> round(float(stiffness_ratio(0.3)), 6), float(stiffness_ratio(0.0))
+    (0.823529, 1.0)
     """
     nu = np.asarray(poisson, dtype=float)
     return 2.0 * (1.0 - nu) / (2.0 - nu)
@@ -242,6 +266,17 @@ def maw_incidence_parameter(incidence_deg, friction, poisson, normal_restitution
         Poisson ratio nu (like materials). [-]
     normal_restitution : float
         e_n of the impact. [-]
+
+    References
+    ----------
+    Maw, N., Barber, J. R. and Fawcett, J. N. (1976), The oblique impact of elastic spheres, Wear
+    38:101-114, doi:10.1016/0043-1648(76)90201-5; Thornton, C. and Yin, K. K. (1991), Impact of
+    elastic spheres with and without adhesion, Powder Technol. 65:153-166.
+
+    Examples
+    --------
+    >>> round(float(maw_incidence_parameter(45.0, 0.5, 0.0)), 12)  # tan 45 / (0.5 x 2) x 1
+    1.0
     """
     t = np.tan(np.radians(np.asarray(incidence_deg, dtype=float)))
     return t / (friction * (1.0 + normal_restitution)) * stiffness_ratio(poisson)
@@ -256,6 +291,19 @@ def pulloff_force(contact):
     Parameters
     ----------
     contact : Contact
+
+    Examples
+    --------
+    The paper's microsphere (Table 1 row 2); the largest tension of the static law is at x = X/3:
+
+    >>> from microimpact.model.law import adhesion_force, hertz_force
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> x = c.length_scale / 3.0
+    >>> round(float(-(hertz_force(c.radius, c.stiffness, x) + adhesion_force(c.radius, c.adhesion_line_force, x))
+    ...             / pulloff_force(c)), 12)
+    1.0
+    >>> f"{pulloff_force(c):.4e} N"
+    '5.4024e-06 N'
     """
     x = contact.length_scale / 3.0
     return 4.0 * math.pi / 3.0 * contact.adhesion_line_force * math.sqrt(contact.radius * x)
@@ -271,6 +319,11 @@ def nondimensional_pulloff_force(a_h, a_a):
     ----------
     a_h, a_a : float
         Hertz and adhesion coefficients of :func:`microimpact.model.law.nondimensional_acceleration`. [-]
+
+    Examples
+    --------
+    >>> round(nondimensional_pulloff_force(1.0, 1.0), 4), nondimensional_pulloff_force(1.25, 0.0)
+    (0.3849, 0.0)
     """
     if a_a <= 0.0:
         return 0.0
@@ -289,6 +342,19 @@ def nondimensional_tangential_stiffness(contact, scales) -> float:
         Must have ``shear_modulus`` (G*). [Pa]
     scales : microimpact.model.law.Scales
         L [m] and T_c [s] of the impact.
+
+    Examples
+    --------
+    kappa s at s = 1 is k_t T_c^2 / m with k_t = 8 G* a at a = sqrt(r L):
+
+    >>> import math
+    >>> from microimpact.model.law import nondimensional_scales
+    >>> from microimpact.model.parameters import TABLE1_ROW2
+    >>> c = TABLE1_ROW2.with_(tangential_model="mindlin", shear_modulus=0.5e9)
+    >>> sc = nondimensional_scales(c, 1.0)
+    >>> k_t = float(tangential_stiffness(c.shear_modulus, math.sqrt(c.radius * sc.length)))
+    >>> round(nondimensional_tangential_stiffness(c, sc) / (k_t * sc.time**2 / c.mass), 12)
+    1.0
     """
     return 8.0 * contact.shear_modulus * math.sqrt(contact.radius * scales.length) * scales.time**2 / contact.mass
 
@@ -306,6 +372,17 @@ def friction_load(normal_force, pulloff, adhesion_aware):
         Pull-off force F_po in the same unit.
     adhesion_aware : bool
         True for the "pulloff" friction model (Thornton & Yin 1991), False for the paper's "net".
+
+    References
+    ----------
+    Thornton, C. and Yin, K. K. (1991), Powder Technol. 65:153-166.
+
+    Examples
+    --------
+    Under a net tension of 1 with pull-off force 0.5 the paper's load is 1, the adhesion-aware 0:
+
+    >>> friction_load(-1.0, 0.5, False), friction_load(-1.0, 0.5, True)
+    (1.0, 0.0)
     """
     if adhesion_aware:
         return abs(normal_force + 2.0 * pulloff)
@@ -321,6 +398,15 @@ def mindlin_stuck_displacement(stiffness, limit):
         k_t = 8 G* a (:func:`tangential_stiffness`). [N/m] or nondimensional
     limit : float
         Coulomb limit F_lim. [N] or nondimensional
+
+    References
+    ----------
+    Mindlin (1949), J. Appl. Mech. 16:259-268; Johnson (1985), Eqs. (7.40)-(7.42).
+
+    Examples
+    --------
+    >>> mindlin_stuck_displacement(2.0, 1.0)
+    0.75
     """
     if stiffness <= 0.0:
         return 0.0
@@ -341,6 +427,17 @@ def mindlin_force(delta_t, delta_tp, stuck_displacement, limit):
         delta* of :func:`mindlin_stuck_displacement`. [m] or nondimensional
     limit : float
         Coulomb limit F_lim >= 0. [N] or nondimensional
+
+    References
+    ----------
+    Mindlin (1949), J. Appl. Mech. 16:259-268; Johnson (1985), Eqs. (7.40)-(7.42).
+
+    Examples
+    --------
+    -k_t delta for a small displacement (k_t = 1.5 F_lim / delta* = 2), the limit at delta*:
+
+    >>> round(mindlin_force(1e-6, 0.0, 0.75, 1.0)[0] / -2e-6, 6), mindlin_force(0.75, 0.0, 0.75, 1.0)
+    (1.0, (-1.0, -0.0))
     """
     d = math.sqrt(delta_t * delta_t + delta_tp * delta_tp)
     if d == 0.0 or limit <= 0.0:
@@ -364,6 +461,19 @@ def md_force_ratio(branch_coordinate, branch_sign, branch_span):
         s = +1 or -1, the direction of the current branch. [-]
     branch_span : float
         c = 1 + |T_r| / F_lim of the branch (1 virgin, 2 from gross slip). [-]
+
+    References
+    ----------
+    Mindlin, R. D. and Deresiewicz, H. (1953), Elastic spheres in contact under varying oblique forces,
+    J. Appl. Mech. 20:327-344; Thornton, C. (1991), Interparticle sliding in the presence of adhesion,
+    J. Phys. D 24:1942-1946.
+
+    Examples
+    --------
+    A branch from gross slip (c = 2) starts at the opposite limit and ends at the limit:
+
+    >>> md_force_ratio(0.0, 1.0, 2.0), md_force_ratio(1.0, 1.0, 2.0)
+    (-1.0, 1.0)
     """
     p = min(max(branch_coordinate, 0.0), 1.0)
     return branch_sign * (1.0 - branch_span * (1.0 - p) ** 1.5)
@@ -390,6 +500,18 @@ def md_branch_rate(branch_coordinate, branch_span, branch_slip, stiffness, limit
         F_lim = f L. [N] or nondimensional
     limit_rate : float
         dF_lim / dt. [N/s] or nondimensional
+
+    References
+    ----------
+    Thornton (1991), J. Phys. D 24:1942-1946.
+
+    Examples
+    --------
+    On the virgin curve (c = 1, p = 0) at constant limit the rate is u k_t / (1.5 F_lim); at gross
+    slip (p = 1) it is held:
+
+    >>> md_branch_rate(0.0, 1.0, 1.0, 3.0, 2.0, 0.0), md_branch_rate(1.0, 2.0, 1.0, 3.0, 2.0, 0.0)
+    (1.0, 0.0)
     """
     if limit <= 0.0:
         return 0.0
@@ -412,6 +534,11 @@ def md_turning_span(force_ratio, new_sign):
         T / F_lim at the turning point, :func:`md_force_ratio`. [-]
     new_sign : float
         s' = +1 or -1. [-]
+
+    Examples
+    --------
+    >>> md_turning_span(-1.0, 1.0), md_turning_span(0.0, 1.0)  # from gross slip; from zero force
+    (2.0, 1.0)
     """
     return max(1.0 - new_sign * force_ratio, 1e-9)
 
@@ -430,5 +557,15 @@ def rolling_deceleration(rolling_friction, normal_force, mass):
         F_n. [N]
     mass : float
         m. [kg]
+
+    References
+    ----------
+    Zhou, Y. C., Wright, B. D., Yang, R. Y., Xu, B. H. and Yu, A. B. (1999), Rolling friction in the
+    dynamic simulation of sandpile formation, Physica A 269:536-553.
+
+    Examples
+    --------
+    >>> float(rolling_deceleration(0.01, 7.0, 1e-12))  # (5/7) 0.01 x 7 N / 1e-12 kg
+    50000000000.0
     """
     return 5.0 / 7.0 * rolling_friction * np.abs(np.asarray(normal_force, dtype=float)) / mass
