@@ -108,6 +108,19 @@ def nondimensional_rhs(xi, y, c1, c2):
     (dxi, dy) : tuple of ndarray
         d xi / d tau = y and d y / d tau = -xi^(3/2) (1 + C1 y) + xi^(1/2) (1 - C2 y). [-]
         For xi <= 0 (no contact) the contact force is zero and dy = 0 (free flight).
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eq. (33).
+
+    Examples
+    --------
+    At rest at the equilibrium nothing moves; at xi = 4 the Hertz term (4^(3/2) = 8) beats the
+    adhesion (4^(1/2) = 2), and in free flight the rate is constant:
+
+    >>> dxi, dy = nondimensional_rhs([-0.5, 1.0, 4.0], [1.0, 0.0, 1.0], 0.0, 0.0)
+    >>> dxi.tolist(), dy.tolist()
+    ([1.0, 0.0, 1.0], [0.0, 0.0, -6.0])
     """
     y = np.asarray(y, dtype=float)
     xp = np.maximum(np.asarray(xi, dtype=float), 0.0)
@@ -137,6 +150,17 @@ def jacobian(xi, y, c1, c2):
     The field is not differentiable at xi = 0 (the x^(1/2) adhesion term): there the (2, 1) entry
     is returned as +inf when 1 - C2 y > 0 (its limit from inside the contact). For xi < 0 (free
     flight) the Jacobian is [[0, 1], [0, 0]].
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eq. (34).
+
+    Examples
+    --------
+    At the equilibrium (1, 0): [[0, 1], [-1, -(C1 + C2)]]:
+
+    >>> jacobian(1.0, 0.0, 0.3, 0.2).tolist()
+    [[0.0, 1.0], [-1.0, -0.5]]
     """
     xi = np.asarray(xi, dtype=float)
     y = np.asarray(y, dtype=float)
@@ -167,6 +191,11 @@ def equilibria():
         Rows (xi, y). (0, 0) is the point of first touch, where the field is not differentiable
         (see :func:`jacobian`); (1, 0) is the static adhesive equilibrium x = X, whose nature
         depends on C = C1 + C2 (:func:`equilibrium_eigenvalues`).
+
+    Examples
+    --------
+    >>> equilibria().tolist()
+    [[0.0, 0.0], [1.0, 0.0]]
     """
     return np.array([[0.0, 0.0], [1.0, 0.0]])
 
@@ -184,6 +213,17 @@ def equilibrium_eigenvalues(c):
     ndarray of complex, shape shape(c) + (2,)
         lambda = (-C + sqrt(C^2 - 4)) / 2 and (-C - sqrt(C^2 - 4)) / 2 (for C < 2 the one with
         positive imaginary part first), in units of 1/T. [-]
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (35)-(36).
+
+    Examples
+    --------
+    >>> equilibrium_eigenvalues([2.0, 2.5]).real.tolist()
+    [[-1.0, -1.0], [-0.5, -2.0]]
+    >>> round(float(equilibrium_eigenvalues(1.0)[0].imag), 12) == round(3**0.5 / 2, 12)
+    True
     """
     c = np.asarray(c, dtype=float)
     root = np.sqrt((c * c - 4.0).astype(complex))
@@ -196,6 +236,11 @@ def nondimensional_energy(xi, y):
     The dimensional energy of :func:`microimpact.model.law.contact_potential_energy` plus the normal
     kinetic energy is e m X^2 / T^2. e < 0 means captured (the sphere can no longer reach xi = 0);
     e = -4/15 at the equilibrium (1, 0).
+
+    Examples
+    --------
+    >>> round(float(nondimensional_energy(1.0, 0.0)), 12) == round(-4.0 / 15.0, 12)
+    True
     """
     s = np.sqrt(np.maximum(np.asarray(xi, dtype=float), 0.0))
     return law.nondimensional_energy(s, np.asarray(y, dtype=float), 1.0, 1.0)
@@ -231,6 +276,18 @@ def total_damping(contact: Contact, speed):
     -------
     float or ndarray
         C. [-]
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (14)-(15), (31)-(32).
+
+    Examples
+    --------
+    C ~ v^(-1/5): 32 times the speed halves it.
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> round(float(total_damping(c, 0.5) / total_damping(c, 16.0)), 12)
+    2.0
     """
     _check_adhesive(contact)
 
@@ -254,6 +311,15 @@ def equilibrium_type(c, *, critical_rtol: float = CRITICAL_RTOL):
     Returns "spiral sink" (C < 2, complex eigenvalues with negative real part), "critical"
     (|C - 2| <= critical_rtol * 2, double eigenvalue -1) or "sink" (C > 2, two negative real
     eigenvalues). Arrays give an object array of these strings.
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eq. (36).
+
+    Examples
+    --------
+    >>> equilibrium_type(1.0), equilibrium_type(2.0), equilibrium_type(3.0)
+    ('spiral sink', 'critical', 'sink')
     """
     c_arr = np.asarray(c, dtype=float)
     if c_arr.ndim == 0:
@@ -278,6 +344,18 @@ def classify(contact: Contact, speed, *, critical_rtol: float = CRITICAL_RTOL):
     str or ndarray of str
         "spiral sink" (C < 2, speed > v_c), "critical" (C = 2, speed = v_c) or "sink"
         (C > 2, speed < v_c).
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (35)-(36), (38).
+
+    Examples
+    --------
+    Table 1 row 2: below v_c = 2.25e-5 m/s a sink, above a spiral sink:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> classify(c, [1e-6, 1.0]).tolist()
+    ['sink', 'spiral sink']
     """
     return equilibrium_type(total_damping(contact, speed), critical_rtol=critical_rtol)
 
@@ -316,6 +394,16 @@ def critical_velocity_closed_form(contact: Contact) -> float:
     m^(-1/2), C = 2 gives v_c = ((zeta_H + zeta_A) X / (2 T (r^3 K / m)^(2/5)))^5, which
     simplifies to Eq. (38) as printed. For Table 1 row 2 it gives 2.246e-5 m/s; the paper prints
     2.25e-5 (three significant figures).
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eq. (38).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> f"{critical_velocity_closed_form(c):.4e} m/s"
+    '2.2463e-05 m/s'
     """
     _check_speed_dependent(contact)
     f0, r, k, m = contact.adhesion_line_force, contact.radius, contact.stiffness, contact.mass
@@ -336,6 +424,12 @@ def critical_velocity_numeric(contact: Contact, *, xtol: float = 1e-14) -> float
     ------
     ValueError
         As :func:`critical_velocity_closed_form`.
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> round(critical_velocity_numeric(c) / critical_velocity_closed_form(c), 12)
+    1.0
     """
     _check_speed_dependent(contact)
 
@@ -380,6 +474,16 @@ def critical_velocity(contact: Contact, *, method: str = "closed_form") -> float
         no critical velocity exists (a raise rather than NaN, so that a sweep cannot silently
         plot a meaningless number; the message gives the speed-independent C and its type).
         Also if f0 = 0 or zeta_H + zeta_A = 0, or for an unknown method.
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eq. (38).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> f"{critical_velocity(c):.3e} m/s"  # the paper prints 2.25e-5
+    '2.246e-05 m/s'
     """
     if method == "closed_form":
         return critical_velocity_closed_form(contact)
@@ -412,6 +516,16 @@ def asymptotic_frequency(contact: Contact, speed):
     of 1/T, which gives the form used here. The paper's "2.0e7 Hz" (Fig. 5b, 0.5 m/s) is this
     omega_f in rad/s evaluated with r = 6.89 um; for the Table 1 radius r = 3.45 um it is
     4.75e7 rad/s (7.57 MHz).
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (36)-(37).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> f"{float(asymptotic_frequency(c, 0.5)):.3e} rad/s"
+    '4.754e+07 rad/s'
     """
     _check_adhesive(contact)
     t_scale = contact.time_scale
