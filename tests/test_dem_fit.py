@@ -28,6 +28,7 @@ def _within_binomial(covered, n):
     return abs(covered / n - INTERVAL_LEVEL) <= 3.5 * sd
 
 
+@pytest.mark.slow  # a calibration study: run once in CI (the first suite), not again on the wheel
 def test_interval_coverage_over_random_designs():
     """60 random designs for each of four laws, pooled (240 trials: the pooled coverage must lie
     within 0.58-0.79, which an interval of Delta chi^2 = 2 (0.84) or 0.5 (0.52) does not)."""
@@ -209,6 +210,7 @@ def test_joint_fit_recovers_the_work_of_adhesion_and_the_damping(normal_model, d
     assert "work_of_adhesion = 0.05" in f.describe()
 
 
+@pytest.mark.slow  # a calibration study: run once in CI (the first suite), not again on the wheel
 def test_joint_fit_coverage_over_random_designs():
     """Random designs (dem_fit_coverage with fit_adhesion: true w_A 3e-3-0.3 J/m^2, speeds within
     0.02-20 m/s), two laws x 20 designs. Every status states an interval (one-sided when the data
