@@ -246,6 +246,14 @@ def test_joint_fit_says_what_the_data_cannot_tell():
     assert "consistent with no adhesion" in g.describe()
 
 
+def test_too_few_impacts_for_the_scatter_say_so():
+    """Two impacts, no stated uncertainty, two parameters: the scatter has no degree of freedom."""
+    t = pd.DataFrame({"radius": 3e-6, "normal_speed": [1.0, 2.0], "e_n": [0.5, 0.6]})
+    f = fit_dem_law(t, ADHESIVE, "dmt", "viscoelastic", fit_adhesion=True)
+    assert f.status == f.adhesion_status == "not determined" and not f.determined
+    assert "2 impacts without stated e_n uncertainties cannot give 2 parameter(s)" in f.describe()
+
+
 def test_joint_fit_counts_two_parameters_and_refuses_hertz():
     t, _ = _adhesive_table("jkr_force", "viscoelastic", 0.05, 0.03, np.geomspace(0.02, 3.0, 8), rng=np.random.default_rng(1))
     one = fit_dem_law(t, {**ADHESIVE, "work_of_adhesion": 0.05}, "jkr_force", "viscoelastic")

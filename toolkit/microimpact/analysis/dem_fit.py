@@ -150,6 +150,9 @@ class DemLawFit:
         if self.status == "inadequate":
             return (f"{self.law}: does not describe the data (chi^2 = {self.chisqr:.6g} for {self.n - self.parameters} "
                     f"degrees of freedom, p < {ADEQUACY_P:g}); no value")
+        if not self.sigma_known and self.n <= self.parameters:
+            return (f"{self.law}: {self.n} impacts without stated e_n uncertainties cannot give {self.parameters} "
+                    "parameter(s) and their scatter; no value (state e_n_uncertainty, or measure more impacts)")
         damping = self._describe_damping()
         if not self.adhesion_fitted:
             return damping
