@@ -410,3 +410,23 @@ def test_ctrl_c_ends_in_one_line_with_status_130_and_writes_nothing(argv, after,
     assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
     assert err.strip().splitlines()[-1].startswith("microimpact: interrupted; nothing was written"), err
     assert _snapshot(workspace) == before
+
+
+def test_a_warning_is_one_line_naming_the_input_not_the_installation(tmp_path):
+    """The console script prints a warning as ``microimpact: warning: ...`` on one line (Python's
+    form was two lines naming cli.py and a source line of the installation). A measured e_n of
+    1.006 with a stated uncertainty of 0.01 is kept as measured, with that warning."""
+    csv = tmp_path / "impacts.csv"
+    csv.write_text("id,material_pair,radius [um],speed [m/s],incidence_angle [deg],e_n [1],e_n_uncertainty [1]\n"
+                   "a,ammonium_fluorescein_on_silicon,1.29,1.0,0,0.80,0.01\n"
+                   "b,ammonium_fluorescein_on_silicon,1.29,2.0,0,1.006,0.01\n"
+                   "c,ammonium_fluorescein_on_silicon,1.29,4.0,0,0.70,0.01\n")
+    exe = shutil.which("microimpact")
+    cmd = [exe] if exe else [sys.executable, "-m", "microimpact.cli"]
+    r = subprocess.run([*cmd, "fit", str(csv), "--out", str(tmp_path / "fit.nc"), "--no-confidence-intervals"],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    warned = [line for line in r.stderr.splitlines() if "warning:" in line.lower()]
+    assert warned == ["microimpact: warning: impacts.csv: 1 measurement(s) outside the physical range by no more "
+                      "than 4 stated standard uncertainties, kept as measured (e_n [1]: rows 2)"], r.stderr
+    assert ".py:" not in r.stderr and "ImpactDataWarning" not in r.stderr, r.stderr

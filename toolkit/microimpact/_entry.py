@@ -6,7 +6,8 @@ a program imports and calls: install signal handlers. A Ctrl-C while the command
 traceback from inside numpy; and a signal that lands in a finaliser still stops the command
 (:func:`microimpact.io.joblog.redeliver_swallowed_signals`). Where SIGINT is ignored (a
 background job) it stays ignored. After the one line of a Ctrl-C the process ends at once
-(``os._exit``), without the finalisers of a compile the signal cut short.
+(``os._exit``), without the finalisers of a compile the signal cut short. Warnings are printed
+as one line each, ``microimpact: warning: ...``.
 """
 
 from __future__ import annotations
@@ -14,11 +15,21 @@ from __future__ import annotations
 import os
 import signal
 import sys
+import warnings
 
 #: the one line of a Ctrl-C, and its exit status: 128 + 2, as a shell reports a command SIGINT ended
 INTERRUPTED_LINE = ("microimpact: interrupted; nothing was written (outputs are written whole or not at all); run the "
                     "same command again to redo it")
 EXIT_INTERRUPTED = 130
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one line, ``microimpact: warning: MESSAGE``: Python's form names a file and a
+    source line of the installation, not the analyst's input; other libraries' warnings keep
+    their category's name."""
+    own = category.__module__.startswith("microimpact")
+    print(f"microimpact: warning: {message}" + ("" if own else f" ({category.__name__})"),
+          file=sys.stderr if file is None else file)
 
 
 def _interrupted_while_starting(signum, frame):
@@ -37,6 +48,7 @@ def main() -> int:
     if starting:
         signal.signal(signal.SIGINT, signal.default_int_handler)
     redeliver_swallowed_signals()
+    warnings.showwarning = _show_warning
     status = cli_main()
     if status == EXIT_INTERRUPTED:
         # The one line is printed and nothing was written; skip the interpreter's finalisation.

@@ -641,7 +641,8 @@ def _dem_law(text: str) -> tuple[str, str]:
 
 
 def _cmd_lammps_fit(args) -> int:
-    from microimpact.analysis.dem_fit import rank_dem_laws
+    from microimpact.analysis.dem_fit import candidate_laws, rank_dem_laws
+    from microimpact.io.progress import progress_bar
     from microimpact.io.files import atomic_write
     from microimpact.io.lammps import lammps_input
     from microimpact.io.provenance import fit_parameter_source
@@ -653,9 +654,11 @@ def _cmd_lammps_fit(args) -> int:
         raise UsageError(f"--fit-adhesion: the law {'+'.join(args.law)} has no work of adhesion to fit; give a "
                          "jkr_force or dmt law, or no --law")
     table, pair = _impacts_for_pair(args)
+    laws = [args.law] if args.law else candidate_laws(pair, args.fit_adhesion)
     try:
-        ranked, fits = rank_dem_laws(table, pair, [args.law] if args.law else None, fit_adhesion=args.fit_adhesion,
-                                     weights=args.weights, rtol=args.rtol)
+        with progress_bar(len(laws), "LAMMPS laws fitted") as advance:
+            ranked, fits = rank_dem_laws(table, pair, laws, fit_adhesion=args.fit_adhesion, weights=args.weights,
+                                         rtol=args.rtol, progress=advance)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     columns = ["law", "status", "value", "interval_low", "interval_high"]

@@ -41,7 +41,7 @@ _HOMES = {
     **dict.fromkeys(("SYNTHETIC_DEFAULTS", "SYNTHETIC_OBLIQUE_DEFAULTS", "make_synthetic_impacts",
                      "make_synthetic_oblique", "write_synthetic_impacts"), "synthetic"),
     **dict.fromkeys(("DampingTarget", "damping_from_target"), "target"),
-    **dict.fromkeys(("DEM_LAWS", "DemLawFit", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws",
+    **dict.fromkeys(("DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws",
                      "dem_fit_coverage", "INTERVAL_LEVEL", "ADEQUACY_P"), "dem_fit"),
 }
 #: the modules, importable as attributes

@@ -55,7 +55,7 @@ from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
 from microimpact.solvers import DEFAULT_RTOL
 
-__all__ = ["DEM_LAWS", "DemLawFit", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "dem_fit_coverage",
+__all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "dem_fit_coverage",
            "INTERVAL_LEVEL", "ADEQUACY_P"]
 
 #: the (normal law, damping law) pairs a LAMMPS user chooses among; "hertz" is Hertz without
@@ -572,8 +572,23 @@ def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, h
                      work_of_adhesion_interval=w_interval, adhesion_status=w_status)
 
 
+def candidate_laws(material, fit_adhesion: bool = False) -> list[tuple[str, str]]:
+    """The DEM laws a material allows: the Hertz laws, and the adhesive ones when the material has
+    a work of adhesion or it is fitted.
+
+    Examples
+    --------
+    >>> len(candidate_laws({"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0}))
+    4
+    >>> len(candidate_laws({"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0}, fit_adhesion=True))
+    8
+    """
+    adhesive = fit_adhesion or _material_record(material).work_of_adhesion > 0.0
+    return [law for law in DEM_LAWS if adhesive or law[0] == "hertz"]
+
+
 def rank_dem_laws(table, material, laws=None, *, fit_adhesion: bool = False, weights="auto",
-                  rtol: float = DEFAULT_RTOL):
+                  rtol: float = DEFAULT_RTOL, progress=None):
     """Fit each DEM law to the same impacts and rank them by AIC.
 
     Parameters
@@ -581,11 +596,12 @@ def rank_dem_laws(table, material, laws=None, *, fit_adhesion: bool = False, wei
     table, material, weights, rtol
         As :func:`fit_dem_law`.
     laws : sequence of (normal_model, damping_model), optional
-        Default :data:`DEM_LAWS` (the adhesive ones only when the material has a work of adhesion
-        or ``fit_adhesion`` is set).
+        Default :func:`candidate_laws`.
     fit_adhesion : bool
         Fit the work of adhesion of the adhesive laws too (:func:`fit_dem_law`); their AIC and BIC
         count two parameters.
+    progress : callable, optional
+        Called once after each law is fitted (a progress bar's ``advance``).
 
     Returns
     -------
@@ -610,10 +626,13 @@ def rank_dem_laws(table, material, laws=None, *, fit_adhesion: bool = False, wei
     """
     import pandas as pd
 
-    adhesive = fit_adhesion or _material_record(material).work_of_adhesion > 0.0
-    laws = [law for law in DEM_LAWS if adhesive or law[0] == "hertz"] if laws is None else list(laws)
-    fits = {f"{a}+{b}": fit_dem_law(table, material, a, b, fit_adhesion=fit_adhesion and a != "hertz", weights=weights,
-                                    rtol=rtol) for a, b in laws}
+    laws = candidate_laws(material, fit_adhesion) if laws is None else list(laws)
+    fits = {}
+    for a, b in laws:
+        fits[f"{a}+{b}"] = fit_dem_law(table, material, a, b, fit_adhesion=fit_adhesion and a != "hertz", weights=weights,
+                                       rtol=rtol)
+        if progress is not None:
+            progress()
     rows = []
     for name, f in fits.items():
         row = {"law": name, "status": f.status, "value": f.value, "interval_low": f.interval[0],

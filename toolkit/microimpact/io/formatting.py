@@ -39,6 +39,11 @@ def format_cell(value, *, markdown: bool = False, float_format: str = ".4g") -> 
     Returns
     -------
     str
+
+    Examples
+    --------
+    >>> format_cell(0.123456789)
+    '0.1235'
     """
     if value is None:
         text = ""
@@ -54,7 +59,13 @@ def format_cell(value, *, markdown: bool = False, float_format: str = ".4g") -> 
 
 
 def format_number(x, spec: str = ".2e") -> str:
-    """``x`` formatted with ``spec``; ``"-"`` for None or NaN, ``"inf"`` for infinity."""
+    """``x`` formatted with ``spec``; ``"-"`` for None or NaN, ``"inf"`` for infinity.
+
+    Examples
+    --------
+    >>> format_number(1234.5678, ".3g")
+    '1.23e+03'
+    """
     if x is None or (isinstance(x, float) and math.isnan(x)):
         return "-"
     if isinstance(x, float) and math.isinf(x):
@@ -63,7 +74,13 @@ def format_number(x, spec: str = ".2e") -> str:
 
 
 def format_duration(seconds: float) -> str:
-    """A duration [s] in us, ms or s to 3 significant digits; ``"-"`` for NaN, ``"> limit"`` for inf."""
+    """A duration [s] in us, ms or s to 3 significant digits; ``"-"`` for NaN, ``"> limit"`` for inf.
+
+    Examples
+    --------
+    >>> format_duration(3725.0), format_duration(0.5)
+    ('3.72e+03 s', '500 ms')
+    """
     if not math.isfinite(seconds):
         return "-" if math.isnan(seconds) else "> limit"
     if seconds < 1e-3:

@@ -214,6 +214,16 @@ def material_contact(material, radius: float, **changes) -> Contact:
     ------
     ValueError
         If ``material`` lacks density, stiffness or work of adhesion, or a value is invalid.
+
+    Examples
+    --------
+    The bundled pair of the synthetic data at the radius 1.29 um: f0 from its w_A by Eq. (7):
+
+    >>> from microimpact.io import read_materials
+    >>> pair = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> c = material_contact(pair, 1.29e-6)
+    >>> round(c.adhesion_line_force, 4), c.zeta_hertz
+    (5.347, 0.5)
     """
     if isinstance(material, Contact) and not changes:
         return material if radius == material.radius else material.at_radius(radius)
@@ -232,7 +242,13 @@ def material_contact(material, radius: float, **changes) -> Contact:
 
 
 def default_materials_path() -> Path:
-    """Path of the materials config bundled with the package (``microimpact/io/materials.yaml``)."""
+    """Path of the materials config bundled with the package (``microimpact/io/materials.yaml``).
+
+    Examples
+    --------
+    >>> default_materials_path().name
+    'materials.yaml'
+    """
     return Path(str(files("microimpact.io") / "materials.yaml"))
 
 

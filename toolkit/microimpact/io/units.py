@@ -66,7 +66,13 @@ def _normalise(unit: str) -> str:
 
 
 def accepted_units(dimension: str) -> tuple[str, ...]:
-    """The accepted spellings of units of ``dimension`` ('length', 'speed', 'angle', 'dimensionless', 'angular_speed')."""
+    """The accepted spellings of units of ``dimension`` ('length', 'speed', 'angle', 'dimensionless', 'angular_speed').
+
+    Examples
+    --------
+    >>> accepted_units("length")[:3]
+    ('m', 'mm', 'um')
+    """
     return tuple(UNITS[dimension])
 
 
@@ -89,6 +95,11 @@ def conversion_factor(unit: str, dimension: str) -> float:
     ------
     UnitError
         If ``unit`` is not accepted for ``dimension``; the message lists the accepted units.
+
+    Examples
+    --------
+    >>> conversion_factor("um", "length")
+    1e-06
     """
     table = UNITS[dimension]
     try:
@@ -115,6 +126,11 @@ def to_internal(values, unit: str, dimension: str) -> np.ndarray:
     -------
     numpy.ndarray
         ``values * conversion_factor(unit, dimension)`` as float64. [internal unit]
+
+    Examples
+    --------
+    >>> to_internal([1.0, 2.0], "um", "length").tolist()
+    [1e-06, 2e-06]
     """
     return np.asarray(values, dtype=float) * conversion_factor(unit, dimension)
 
@@ -128,6 +144,11 @@ def parse_header_field(field: str) -> tuple[str, str | None]:
     The name is lower-cased and stripped; the unit is stripped, or None when there are no
     brackets. A field that does not match the pattern (e.g. nested brackets) is returned whole
     as the name with no unit, which then fails as an unknown column or a column without a unit.
+
+    Examples
+    --------
+    >>> parse_header_field("radius [um]")
+    ('radius', 'um')
     """
     m = _HEADER.match(field)
     if m is None:

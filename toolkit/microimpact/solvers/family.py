@@ -551,7 +551,14 @@ class _Builder:
 def normal_restitution(contact, normal_speed, *, rtol: float = DEFAULT_RTOL, family: bool | None = None) -> np.ndarray:
     """e_n at many normal speeds [m/s] (a fit's model): one direct engine solve per distinct speed,
     or, for many distinct speeds, a restitution-only family (``family`` None chooses, True/False
-    force) when it costs fewer than half as many solves. [-]"""
+    force) when it costs fewer than half as many solves. [-]
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> normal_restitution(c, [10.0, 30.0]).round(6).tolist()
+    [0.715808, 0.735996]
+    """
     v = np.asarray(normal_speed, dtype=float).ravel()
     if contact.normal_model != "ring" or contact.damping_model != "paper":  # their own solver, one solve per speed
         from microimpact.solvers import normal_models  # imported on use: it compiles its own kernels

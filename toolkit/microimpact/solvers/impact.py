@@ -258,6 +258,19 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
         "rkg" when the sphere is captured while the tangential outcome is needed (friction with
         slip or twist): the RKG stops at the capture test and does not follow the captured
         oscillation whose friction impulse the map needs (use "engine" or "reference").
+
+    Examples
+    --------
+    An undamped, non-adhesive Hertz sphere rebounds with e_n = 1; with friction 0.2 at 60 deg it
+    slides throughout, and the tangential impulse ratio is -f (Eq. (22)):
+
+    >>> from microimpact.model.contact import Contact
+    >>> c = Contact(3.45e-6, 1350.0, 1.776e9, 0.0)
+    >>> simulate_impact(c, 1.0, 0.0).e_n
+    1.0
+    >>> r = simulate_impact(c.with_(friction=0.2), 1.0, 60.0)
+    >>> r.outcome, round(r.mu_t, 6)
+    ('rebound', -0.2)
     """
     rtol = _check_call(contact, rtol)
     omega = _check_omega(omega)
@@ -416,7 +429,15 @@ def _normal_solver(contact):
 
 def settled_contact_energy(contact) -> float:
     """Contact energy of a sphere at rest at its equilibrium: V(X) = -(4/15) m (X/T)^2 for the
-    paper's law, :func:`microimpact.solvers.normal_models.settled_contact_energy` for JKR, DMT. [J]"""
+    paper's law, :func:`microimpact.solvers.normal_models.settled_contact_energy` for JKR, DMT. [J]
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> e = settled_contact_energy(c)
+    >>> round(e / (-4.0 / 15.0 * c.mass * (c.length_scale / c.time_scale) ** 2), 12)
+    1.0
+    """
     if contact.normal_model != "ring":
         from microimpact.solvers.normal_models import settled_contact_energy as settled
 
@@ -584,6 +605,15 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     vectorised tangential map), which cannot stop midway. A long computation made of batches
     checks its budget between them (:func:`microimpact.studies.sweeps.run_sweep` solves its speeds
     in blocks then; :class:`microimpact.solvers.Deadline`).
+
+    Examples
+    --------
+    Table 1 row 2 (the paper's microsphere): captured at 0.1 and 1 m/s, a rebound at 10 m/s:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> ds = simulate_many(c, [0.1, 1.0, 10.0], 0.0)
+    >>> ds["e_n"].values.round(6).tolist()
+    [0.0, 0.0, 0.715808]
     """
     if contact_fields:
         return _simulate_over_contacts(contact, contact_fields, speed=speed, incidence_deg=incidence_deg,

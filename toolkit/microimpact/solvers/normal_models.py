@@ -796,6 +796,19 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
 
     Parameters as there: ``normal_speed`` [m/s] (1-D, > 0), ``need_tail`` per speed,
     ``friction_impulse_stop`` [N s] and ``twist_impulse_stop`` [N m s] per speed.
+
+    Examples
+    --------
+    An undamped JKR impact at twice the sticking velocity v_s rebounds with
+    e_n = sqrt(1 - (v_s / v)^2) = sqrt(3) / 2 (the adhesion hysteresis is the only loss):
+
+    >>> import numpy as np
+    >>> from microimpact.model.adhesion_models import jkr_sticking_velocity
+    >>> from microimpact.model.parameters import TABLE1_ROW2
+    >>> c = TABLE1_ROW2.with_(normal_model="jkr", zeta_hertz=0.0, zeta_adhesion=0.0)
+    >>> r = solve_normal_many(c, np.array([2.0 * jkr_sticking_velocity(c)]), rtol=1e-10)
+    >>> round(float(r["e_n"][0]), 8) == round(3**0.5 / 2, 8)
+    True
     """
     from microimpact.solvers import engine
 
@@ -875,6 +888,14 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
     (:func:`~microimpact.model.adhesion_models.jkr_contact_radius`); separation and capture are
     solve_ivp events. A captured sphere with ``need_tail`` is followed until J, J_a reach the stops
     or ``max_time`` (in units of T). Parameters as :func:`solve_normal`. [m/s], [-], [N s], [N m s]
+
+    Examples
+    --------
+    >>> from microimpact.model.adhesion_models import jkr_sticking_velocity
+    >>> from microimpact.model.parameters import TABLE1_ROW2
+    >>> c = TABLE1_ROW2.with_(normal_model="jkr", zeta_hertz=0.0, zeta_adhesion=0.0)
+    >>> bool(round(solve_normal_reference(c, 2.0 * jkr_sticking_velocity(c), rtol=1e-12).e_n, 8) == round(3**0.5 / 2, 8))
+    True
     """
     from scipy.integrate import solve_ivp
 
