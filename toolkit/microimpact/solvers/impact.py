@@ -221,6 +221,8 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
                     rtol: float = DEFAULT_RTOL, method: str = "engine", steps: int | None = None) -> ImpactResult:
     """Simulate one impact of a sphere on the flat surface.
 
+    Length: the docstring of a main entry point (parameters and examples); the body is short.
+
     Parameters
     ----------
     contact : Contact
@@ -556,6 +558,8 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
                   rtol: float = DEFAULT_RTOL, method: str = "engine", family: bool | None = None,
                   **contact_fields) -> xr.Dataset:
     """Simulate a batch of impacts, broadcasting the inputs, on both cores.
+
+    Length: the docstring of a main entry point (parameters and examples); the body is short.
 
     Each distinct normal speed is solved once by the compiled engine; every angle, azimuth, spin
     and friction coefficient that shares it costs only the closed-form tangential map. Captured

@@ -357,6 +357,8 @@ def simulate_reference(
 ) -> ImpactResult:
     """Integrate one impact with the full 3-D equations (reference solution).
 
+    Length: the docstring of a main entry point (parameters and examples); the body is short.
+
     Parameters
     ----------
     contact : Contact
