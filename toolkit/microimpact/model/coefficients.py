@@ -20,7 +20,13 @@ __all__ = ["impact_coefficients", "coefficients_kernel"]
 def coefficients_kernel(mass, moment_of_inertia, vn_i, vt_i, vtp_i, wn_i, wt_i, wtp_i,
                         vn_r, vt_r, vtp_r, wn_r, wt_r, wtp_r, captured):
     """Scalar Eqs. (21)-(25) (compiled); see :func:`impact_coefficients`. Returns
-    (e_n, mu_t, mu_tp, K_L, K_t)."""
+    (e_n, mu_t, mu_tp, K_L, K_t).
+
+    Examples
+    --------
+    >>> coefficients_kernel(1.0, 0.4, -2.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 0.0, 0.0, 0.0, False)[0]
+    0.5
+    """
     if captured:
         e_n, mu_t, mu_tp = 0.0, math.nan, math.nan
     else:
@@ -65,6 +71,19 @@ def impact_coefficients(mass, moment_of_inertia, velocity_in, omega_in, velocity
     -------
     dict with e_n, mu_t, mu_tp, K_L, K_t (floats for scalar input, arrays otherwise). For a captured sphere e_n = 0 and the impulse ratios are
     NaN (there is no rebound and so no impulse ratio); K_L and K_t use the final state.
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (21)-(25).
+
+    Examples
+    --------
+    In at (v_n, v_t) = (-2, 1) m/s, out at (1, 0.5) m/s, no spin: e_n = 1/2, mu_t = -0.5 / 3, and
+    three quarters of the kinetic energy are kept:
+
+    >>> r = impact_coefficients(1.0, 0.4, (-2.0, 1.0, 0.0), (0.0, 0.0, 0.0), (1.0, 0.5, 0.0), (0.0, 0.0, 0.0), False)
+    >>> r["e_n"], round(r["mu_t"], 12), r["K_L"]
+    (0.5, -0.166666666667, 0.75)
     """
     names = ("e_n", "mu_t", "mu_tp", "K_L", "K_t")
     if np.ndim(captured) == 0 and all(np.ndim(x) == 0 for x in (*velocity_in, *omega_in, *velocity_out, *omega_out)):

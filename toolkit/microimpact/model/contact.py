@@ -53,6 +53,15 @@ def check_positive(name: str, value) -> float:
     """``float(value)`` if it is a finite number > 0; else a ValueError that names ``name`` and the value.
 
     The one check of a positive input (radius, stiffness, a normal speed [m/s], ...).
+
+    Examples
+    --------
+    >>> check_positive("radius [m]", "3.45e-6")
+    3.45e-06
+    >>> check_positive("radius [m]", -1)
+    Traceback (most recent call last):
+    ...
+    ValueError: radius [m] must be a finite number > 0, got -1
     """
     try:
         v = float(value)
@@ -73,6 +82,13 @@ def check_representable(what: str, value, culprits: str) -> None:
 
     An input can be valid on its own (``stiffness=1e300``) yet give a scale that underflows to 0 or
     overflows to inf, which the solvers would divide by (a ZeroDivisionError) or carry as NaN.
+
+    Examples
+    --------
+    >>> check_representable("length scale [m]", 0.0, "stiffness=1e300, radius=1e-300")
+    Traceback (most recent call last):
+    ...
+    ValueError: stiffness=1e300, radius=1e-300: the derived length scale [m] is 0.0, outside the floating-point range ...
     """
     v = float(value)
     if not (math.isfinite(v) and v >= _TINY):

@@ -57,6 +57,13 @@ def flat_broadcast(*arrays):
     An array that already has the shape is raveled (a view when it is contiguous); one that needs
     broadcasting is copied. numba is never handed a view made by ``np.broadcast_arrays``, whose
     writeable flag warns when read (a FutureWarning from numba's typing).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> shape, (a, b) = flat_broadcast(np.ones(3), np.array(2.0))
+    >>> shape, b.tolist()
+    ((3,), [2.0, 2.0, 2.0])
     """
     shape = np.broadcast_shapes(*(a.shape for a in arrays))
     return shape, [np.ascontiguousarray(a).ravel() if a.shape == shape else np.array(np.broadcast_to(a, shape)).ravel()
@@ -67,6 +74,17 @@ def slip_velocity(radius, v_t, v_tp, omega_t, omega_tp):
     """Velocity of the contact point relative to the surface, (u_t, u_t'). [m/s]
 
     u_t = v_t + r omega_t', u_t' = v_t' - r omega_t (consistent with Eqs. (19)-(20) as printed).
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (19)-(20).
+
+    Examples
+    --------
+    A sphere of 1 um radius moving at 1 m/s and spinning at omega_t' = -1e6 rad/s rolls: no slip.
+
+    >>> slip_velocity(1e-6, 1.0, 0.0, 0.0, -1e6)
+    (0.0, 0.0)
     """
     return v_t + radius * omega_tp, v_tp - radius * omega_t
 

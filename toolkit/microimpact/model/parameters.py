@@ -86,6 +86,11 @@ def table2_case(name: str) -> dict:
     ------
     ValueError
         If there is no such case; the message lists the known ones.
+
+    Examples
+    --------
+    >>> table2_case("2.1")["speed"]
+    {'start': 0.2, 'stop': 10.0, 'num': 50}
     """
     try:
         spec = TABLE2_CASES[str(name)]
