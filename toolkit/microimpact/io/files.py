@@ -438,6 +438,13 @@ def write_netcdf(ds, path) -> Path:
 
     The file follows CF-1.10 (see :func:`write_netcdf_groups` for what the writer adds); the values
     are written as they are. The same as ``write_netcdf_groups({None: ds}, path)``.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> path = write_netcdf(xr.Dataset({"e_n": ("speed", [0.5])}), "t.nc")
+    >>> xr.open_dataset(path).attrs["Conventions"]
+    'CF-1.10'
     """
     return write_netcdf_groups({None: ds}, path)
 
@@ -504,6 +511,14 @@ def write_csv(df, path, **to_csv_kwargs) -> Path:
     -------
     pathlib.Path
         ``path``.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> write_csv(pd.DataFrame({"e_n": [0.5]}), "t.csv")
+    PosixPath('t.csv')
+    >>> open("t.csv").read()
+    'e_n\\n0.5\\n'
     """
     to_csv_kwargs.setdefault("index", False)
     with atomic_write(path, "w", newline="") as f:

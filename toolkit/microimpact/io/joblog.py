@@ -73,7 +73,13 @@ def interrupted_line(rule: str, signame: str) -> str:
 
 
 def one_line_reason(rule: str, exc: BaseException, log_path: str) -> str:
-    """``microimpact: rule RULE failed: Type: first line of the message (traceback: LOG)``."""
+    """``microimpact: rule RULE failed: Type: first line of the message (traceback: LOG)``.
+
+    Examples
+    --------
+    >>> one_line_reason("fit", ValueError("row 3: bad value\\nmore detail"), "logs/fit.log")
+    'microimpact: rule fit failed: ValueError: row 3: bad value (traceback: logs/fit.log)'
+    """
     message = str(exc).strip().splitlines()
     first = f": {message[0]}" if message else ""
     return f"microimpact: rule {rule} failed: {type(exc).__name__}{first} (traceback: {log_path})"

@@ -340,7 +340,16 @@ def read_lammps_contact(text: str) -> tuple[Contact, str]:
 
 
 def lammps_scales(units: str) -> dict[str, float]:
-    """SI value of one LAMMPS unit of length, mass, time, speed, density and angular speed."""
+    """SI value of one LAMMPS unit of length, mass, time, speed, density and angular speed.
+
+    Examples
+    --------
+    LAMMPS's ``micro`` style: micrometres, picograms, microseconds:
+
+    >>> s = lammps_scales("micro")
+    >>> s["length"], s["mass"], s["time"]
+    (1e-06, 1e-15, 1e-06)
+    """
     length, mass, time = _check_units(units)
     return {"length": length, "mass": mass, "time": time, "speed": length / time,
             "density": mass / length**3, "angular_speed": 1.0 / time}

@@ -91,6 +91,13 @@ def check_input_file(option: str, path) -> Path:
     option : str
         Name of the argument, for the message (``"data file"``, ``"--fit"``, ...).
     path : str or os.PathLike
+
+    Examples
+    --------
+    >>> check_input_file("data file", "missing.csv")
+    Traceback (most recent call last):
+    ...
+    microimpact.io.paths.PathError: data file 'missing.csv': does not exist or is not a file
     """
     text = _text(option, path)
     p = Path(text)
@@ -112,6 +119,11 @@ def check_output_file(option: str, path) -> Path:
     Refused: a name with a trailing slash (a directory), an existing directory, a directory that
     does not exist or that this user cannot write, a name or path too long for the file system,
     an existing output that is not a regular file.
+
+    Examples
+    --------
+    >>> check_output_file("--out", "out.nc")
+    PosixPath('out.nc')
     """
     text = _text(option, path)
     if text.endswith(("/", os.sep)) or (os.altsep and text.endswith(os.altsep)):
@@ -176,7 +188,16 @@ def check_output_dir(option: str, path) -> Path:
 
 def same_file(a, b) -> bool:
     """Whether paths ``a`` and ``b`` name the same file: equal after resolving symbolic links and
-    ``..``, or (both existing) the same inode, as for a hard link."""
+    ``..``, or (both existing) the same inode, as for a hard link.
+
+    Examples
+    --------
+    >>> import os
+    >>> _ = open("a.csv", "w").write("x\\n")
+    >>> os.symlink("a.csv", "b.csv")
+    >>> same_file("a.csv", "b.csv"), same_file("a.csv", "c.csv")
+    (True, False)
+    """
     pa, pb = Path(a), Path(b)
     with contextlib.suppress(OSError):
         if pa.exists() and pb.exists() and os.path.samefile(pa, pb):

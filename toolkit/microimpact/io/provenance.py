@@ -59,6 +59,11 @@ def fit_parameter_source(source, sha256) -> str:
 
     Only the file's name is kept (no directories of the machine that ran the fit); the sha256 of
     its bytes identifies it. ``unknown`` stands for what was not recorded (a table built in memory).
+
+    Examples
+    --------
+    >>> fit_parameter_source("impacts.csv", "ab" * 32)[:28]
+    'fit: impacts.csv abababababa'
     """
     name = Path(str(source)).name if source else "unknown"
     return f"fit: {name} {sha256 or 'unknown'}"
@@ -71,10 +76,22 @@ def source_of_fit(fit: xr.Dataset) -> str:
 
 
 def preset_parameter_source(name: str) -> str:
-    """``"preset: <name>"``: parameters from a named set of :mod:`microimpact.presets`."""
+    """``"preset: <name>"``: parameters from a named set of :mod:`microimpact.presets`.
+
+    Examples
+    --------
+    >>> preset_parameter_source("wall1990")
+    'preset: wall1990'
+    """
     return f"preset: {name}"
 
 
 def materials_parameter_source(pair: str) -> str:
-    """``"materials: <pair>"``: parameters from a pair of a materials config."""
+    """``"materials: <pair>"``: parameters from a pair of a materials config.
+
+    Examples
+    --------
+    >>> materials_parameter_source("ammonium_fluorescein_on_silicon")
+    'materials: ammonium_fluorescein_on_silicon'
+    """
     return f"materials: {pair}"

@@ -106,7 +106,13 @@ UNIT_SPELLINGS: dict[str, str] = {
 
 
 def udunits(units: str) -> str:
-    """``units`` in the toolkit's one UDUNITS style (``"m/s"`` -> ``"m s-1"``); others unchanged."""
+    """``units`` in the toolkit's one UDUNITS style (``"m/s"`` -> ``"m s-1"``); others unchanged.
+
+    Examples
+    --------
+    >>> udunits("m/s"), udunits("kg")
+    ('m s-1', 'kg')
+    """
     return UNIT_SPELLINGS.get(str(units).strip(), str(units).strip())
 
 
@@ -117,11 +123,23 @@ def attributes(name: str, **extra) -> dict:
     ------
     KeyError
         If ``name`` is not in the table (add it there, once).
+
+    Examples
+    --------
+    >>> attributes("e_n")["long_name"]
+    'normal coefficient of restitution, Eq. (21)'
     """
     units, long_name = VARIABLES[name]
     return {**({} if units is None else {"units": units}), "long_name": long_name, **extra}
 
 
 def variable(name: str, dims, values, **extra) -> tuple:
-    """``(dims, values, attributes)``: a Dataset variable of ``name`` with its table attributes."""
+    """``(dims, values, attributes)``: a Dataset variable of ``name`` with its table attributes.
+
+    Examples
+    --------
+    >>> dims, values, attrs = variable("e_n", "speed", [0.5])
+    >>> dims, attrs["units"]
+    ('speed', '1')
+    """
     return (dims, values, attributes(name, **extra))
