@@ -14,6 +14,9 @@ no damping (zeta_H = zeta_A = 0)       ``damping viscoelastic`` with the prefact
                                        normal law's damping slot (model/dem_damping.py);
                                        ``tsuji`` as the identical ``coeff_restitution`` law
 no friction (f = 0)                    ``tangential linear_nohistory 0.0 0.0``
+``tangential_model="linear_history"``  ``tangential linear_history k_t x_gamma,t f``
+``tangential_model="lammps_mindlin"``  ``tangential mindlin 8G* x_gamma,t f``
+                                       (:mod:`microimpact.model.dem_tangential`)
 =====================================  ==========================================================
 
 Conversions. LAMMPS mixes the wall's modulus with the particle's as for two particles of the same
@@ -30,9 +33,11 @@ gives the same impact:
   displacement-controlled JKR break (``normal_model="jkr"``; use ``"jkr_force"``);
 * the paper's nonlinear damping (zeta_H, zeta_A > 0): LAMMPS's ``velocity``, ``mass_velocity``,
   ``viscoelastic``, ``tsuji`` and ``coeff_restitution`` damping are other laws;
-* friction (f > 0): the paper's rigid contact is no LAMMPS law, and microimpact's "mindlin"
-  (micro-slip) and "mindlin_deresiewicz" (hysteresis) agree with LAMMPS's ``mindlin`` variants only
-  while the contact slides throughout (above about 60 deg incidence for f = 0.3; docs/guide/lammps.md);
+* friction (f > 0) with microimpact's own tangential laws: the paper's rigid contact is no LAMMPS
+  law, and microimpact's "mindlin" (micro-slip) and "mindlin_deresiewicz" (hysteresis) agree with
+  LAMMPS's ``mindlin`` variants only while the contact slides throughout (above about 60 deg
+  incidence for f = 0.3; docs/guide/lammps.md); choose LAMMPS's own laws, ``linear_history`` or
+  ``lammps_mindlin``;
 * rolling resistance: microimpact's constant torque mu_r r |F_n| is not LAMMPS's spring-dashpot-slider
   (``rolling sds``).
 
@@ -60,6 +65,7 @@ from dataclasses import dataclass, fields
 
 from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import restitution_of_damping_factor, tsuji_damping_factor
+from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 
 __all__ = ["LAMMPS_UNITS", "DEFAULT_POISSON", "LammpsExportError", "LammpsWallModel", "lammps_wall_model",
            "lammps_input", "lammps_expressible", "read_lammps_contact", "lammps_scales", "CONTACT_LINE",
@@ -107,9 +113,16 @@ class LammpsWallModel:
         (0: undamped) or of ``mass_velocity`` [1/s], the restitution e of ``tsuji`` and
         ``coeff_restitution`` [-].
     tangential : str
-        ``"linear_nohistory 0.0 0.0"``: no tangential force.
+        LAMMPS's tangential keyword: ``"linear_nohistory"`` (no friction: its coefficients are 0),
+        ``"linear_history"`` or ``"mindlin"``.
     damping_model : str
         LAMMPS's damping keyword (microimpact's ``damping_model``; ``viscoelastic`` when undamped).
+    tangential_stiffness : float
+        k_t of ``linear_history`` [N/m], 8 G* of ``mindlin`` [Pa]; 0 for ``linear_nohistory``.
+    tangential_damping : float
+        x_gamma,t. [-]
+    friction : float
+        mu. [-]
     """
 
     normal: str
@@ -119,6 +132,9 @@ class LammpsWallModel:
     damping: float
     tangential: str
     damping_model: str = "viscoelastic"
+    tangential_stiffness: float = 0.0
+    tangential_damping: float = 0.0
+    friction: float = 0.0
 
     def granular_args(self, units: str = "si") -> str:
         """The model arguments after ``granular`` of ``fix wall/gran``, in LAMMPS units ``units``."""
@@ -129,7 +145,11 @@ class LammpsWallModel:
         normal = f"{self.normal} {self.youngs_modulus / pressure:.15g} {self.damping / damping_unit:.15g} {self.poisson:.15g}"
         if self.normal != "hertz/material":
             normal += f" {self.surface_energy / energy_area:.15g}"
-        return f"{normal} damping {self.damping_model} tangential {self.tangential}"
+        tangential = f"{self.tangential_damping:.15g} {self.friction:.15g}"
+        if self.tangential != "linear_nohistory":
+            stiffness_unit = pressure if self.tangential == "mindlin" else mass / time**2  # Pa, or N/m
+            tangential = f"{self.tangential_stiffness / stiffness_unit:.15g} {tangential}"
+        return f"{normal} damping {self.damping_model} tangential {self.tangential} {tangential}"
 
 
 def _check_units(units: str) -> tuple[float, float, float]:
@@ -183,7 +203,7 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
     if damped:
         refused.append(f"{', '.join(damped)}: the paper's nonlinear damping is none of LAMMPS's damping laws "
                        "(choose damping_model mass_velocity, viscoelastic, tsuji or coeff_restitution)")
-    if contact.friction > 0.0:
+    if contact.friction > 0.0 and contact.tangential_model not in DEM_TANGENTIAL_MODELS:
         refused.append(f"friction={contact.friction:g} with tangential_model={contact.tangential_model!r}: no LAMMPS "
                        "tangential law gives the same impacts (microimpact's Mindlin laws agree with LAMMPS's "
                        "mindlin only while the contact slides throughout)")
@@ -200,7 +220,12 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
         damping_model, damping = "viscoelastic", 0.0
     elif damping_model == "tsuji":  # the same law as coeff_restitution, free of LAMMPS's sqrt(2) change
         damping_model, damping = "coeff_restitution", restitution_of_damping_factor(tsuji_damping_factor(damping))
-    return LammpsWallModel(normal, youngs, float(poisson), gamma, damping, "linear_nohistory 0.0 0.0", damping_model)
+    tangential, stiffness = "linear_nohistory", 0.0
+    if contact.friction > 0.0:
+        tangential = DEM_TANGENTIAL_MODELS[contact.tangential_model]
+        stiffness = contact.tangential_stiffness if tangential == "linear_history" else 8.0 * contact.shear_modulus
+    return LammpsWallModel(normal, youngs, float(poisson), gamma, damping, tangential, damping_model, stiffness,
+                           contact.tangential_damping if contact.friction > 0.0 else 0.0, contact.friction)
 
 
 def lammps_expressible(contact: Contact) -> Contact:
@@ -281,7 +306,7 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
     lines = [
         f"# LAMMPS GRANULAR wall contact written by microimpact {__version__} (microimpact lammps export)",
         (f"# law: {model.normal}, damping {model.damping_model} {model.damping:g}, tangential {model.tangential}"
-         f" (microimpact normal_model={contact.normal_model!r})"),
+         f" (microimpact normal_model={contact.normal_model!r}, tangential_model={contact.tangential_model!r})"),
         (f"# the numbers are in LAMMPS units {units}: the script must say 'units {units}' before its box and "
          "include this file after it"),
         (f"# sphere: radius {contact.radius:.10g} m = {contact.radius / length:.10g} length units, "
@@ -289,6 +314,10 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
         (f"# E = {model.youngs_modulus:.10g} Pa with nu = {model.poisson:g} (wall and particle), "
          f"gamma = w_A / 2 = {model.surface_energy:.10g} J/m^2"),
     ]
+    if model.tangential != "linear_nohistory":
+        unit = "N/m" if model.tangential == "linear_history" else "Pa (8 G*)"
+        lines.append(f"# tangential {model.tangential}: k_t = {model.tangential_stiffness:.10g} {unit}, "
+                     f"x_gamma,t = {model.tangential_damping:g}, mu = {model.friction:g}")
     if contact.damping_model == "tsuji":
         lines.append(f"# damping tsuji e = {contact.damping_coefficient:g} (with the sqrt(2) of LAMMPS's development source) "
                      f"is written as the identical law coeff_restitution e = {model.damping:.10g}")

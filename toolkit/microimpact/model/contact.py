@@ -36,7 +36,7 @@ __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_
 #: at the adhesive equilibrium.
 SUB_MODELS: dict[str, tuple[str, ...]] = {
     "normal_model": ("ring", "jkr", "dmt", "jkr_force"),
-    "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
+    "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", "linear_history", "lammps_mindlin"),
     "friction_model": ("net", "pulloff"),
     "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
 }
@@ -122,7 +122,7 @@ def _check_poisson(name: str, value: float) -> None:
 
 
 #: fields that may be None (not given)
-_OPTIONAL = ("damping_reference_speed", "shear_modulus")
+_OPTIONAL = ("damping_reference_speed", "shear_modulus", "tangential_stiffness")
 
 
 def _sub_model(name: str, value) -> str:
@@ -161,9 +161,11 @@ class Contact:
     normal_model : {"ring", "jkr", "dmt", "jkr_force"}
         Normal adhesion model (:data:`SUB_MODELS`); "ring" is the paper's; "jkr_force" is JKR with the
         force-controlled break of DEM engines (:mod:`microimpact.model.adhesion_models`). [-]
-    tangential_model : {"rigid", "mindlin", "mindlin_deresiewicz"}
+    tangential_model : {"rigid", "mindlin", "mindlin_deresiewicz", "linear_history", "lammps_mindlin"}
         Tangential contact model; "rigid" is the paper's; "mindlin_deresiewicz" adds the hysteresis
-        of micro-slip (:mod:`microimpact.model.tangential_compliance`). [-]
+        of micro-slip (:mod:`microimpact.model.tangential_compliance`); "linear_history" and
+        "lammps_mindlin" are LAMMPS GRANULAR's history laws (:mod:`microimpact.model.dem_tangential`),
+        with LAMMPS's normal laws only (ring without adhesion, "jkr_force", "dmt"; no paper damping). [-]
     friction_model : {"net", "pulloff"}
         Coulomb friction limit; "net" (f |F_n|) is the paper's. [-]
     rolling_friction : float
@@ -181,6 +183,12 @@ class Contact:
         The DEM damping law's coefficient: eta_n0 [1/s] of "mass_velocity", eta_n0 [1/(m s)] of
         "viscoelastic", the restitution e in (0, 1] of "tsuji" and "coeff_restitution"; 0 with
         the paper's damping.
+    tangential_stiffness : float or None
+        k_t of the "linear_history" tangential law (LAMMPS's ``linear_history k_t``); None
+        otherwise. [N/m]
+    tangential_damping : float
+        x_gamma,t of the DEM tangential laws: their tangential damping is x_gamma,t times the
+        normal damping coefficient of ``damping_model`` (LAMMPS's convention); 0 by default. [-]
 
     Raises
     ------
@@ -209,6 +217,8 @@ class Contact:
     shear_modulus: float | None = None
     damping_model: str = "paper"
     damping_coefficient: float = 0.0
+    tangential_stiffness: float | None = None
+    tangential_damping: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -222,16 +232,42 @@ class Contact:
         for name in ("radius", "density", "stiffness"):
             check_positive(name, getattr(self, name))
         for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction", "rolling_friction",
-                     "damping_coefficient"):
+                     "damping_coefficient", "tangential_damping"):
             _check_non_negative(name, getattr(self, name))
         for name in _OPTIONAL:
             if getattr(self, name) is not None:
                 check_positive(name, getattr(self, name))
-        if self.tangential_model != "rigid" and self.shear_modulus is None:
+        if self.tangential_model not in ("rigid", "linear_history") and self.shear_modulus is None:
             raise ValueError(f"tangential_model={self.tangential_model!r} needs shear_modulus "
                              "(the effective shear modulus G* [Pa])")
+        self._check_dem_tangential()
         self._check_damping_model()
         self._check_scales()
+
+    def _check_dem_tangential(self) -> None:
+        """The DEM tangential laws with their own parameters and LAMMPS's normal laws (model.dem_tangential)."""
+        model = self.tangential_model
+        dem = model in ("linear_history", "lammps_mindlin")
+        if (model == "linear_history") != (self.tangential_stiffness is not None):
+            raise ValueError("tangential_stiffness (k_t [N/m]) belongs to tangential_model='linear_history', and that "
+                             f"law needs it: got tangential_model={model!r}, tangential_stiffness={self.tangential_stiffness!r}")
+        if self.tangential_damping != 0.0 and not dem:
+            raise ValueError(f"tangential_damping={self.tangential_damping!r} belongs to the DEM tangential laws "
+                             f"('linear_history', 'lammps_mindlin'), got tangential_model={model!r}")
+        if not dem:
+            return
+        other = []
+        if self.normal_model == "jkr":
+            other.append("normal_model='jkr' (use 'jkr_force', LAMMPS's break)")
+        if self.normal_model == "ring" and self.adhesion_line_force > 0.0:
+            other.append(f"the ring adhesion force (adhesion_line_force={self.adhesion_line_force!r}; use 'jkr_force' or 'dmt')")
+        other += [f"{n}={getattr(self, n)!r}" for n in ("zeta_hertz", "zeta_adhesion", "rolling_friction")
+                  if getattr(self, n) != 0.0]
+        if self.friction_model != "net":
+            other.append(f"friction_model={self.friction_model!r} (the limit is LAMMPS's own)")
+        if other:
+            raise ValueError(f"tangential_model={model!r} is LAMMPS's law and runs with LAMMPS's normal laws and "
+                             f"damping only; not with {', '.join(other)}")
 
     def _check_damping_model(self) -> None:
         """One damping law at a time, with the normal laws it is defined for (model.dem_damping)."""

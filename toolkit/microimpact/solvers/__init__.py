@@ -183,7 +183,7 @@ SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
     # every other tangential/friction choice with the compiled coupled solver (.coupled), which
     # integrates the ring normal law only (check_sub_models refuses jkr/dmt with it)
     "engine": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"),
-               "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz"),
+               "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", "linear_history", "lammps_mindlin"),
                "friction_model": ("net", "pulloff"),
                "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution")},
     "reference": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"), "tangential_model": ("rigid",), "friction_model": ("net",),
@@ -216,6 +216,8 @@ def check_sub_models(contact, method: str) -> None:
         raise ValueError(f"rolling_friction={contact.rolling_friction!r} needs a compliant tangential model "
                          f"(tangential_model one of {', '.join(map(repr, ROLLING_RESISTANCE_TANGENTIAL_MODELS))}), "
                          f"got tangential_model={contact.tangential_model!r}")
+    if contact.tangential_model in ("linear_history", "lammps_mindlin"):  # with LAMMPS's normal laws (Contact checks)
+        return
     if contact.damping_model != "paper" and (contact.tangential_model != "rigid" or contact.friction_model != "net"):
         raise ValueError(f"damping_model={contact.damping_model!r} runs with the paper's tangential map only "
                          "(tangential_model='rigid', friction_model='net'): the coupled solver integrates the "

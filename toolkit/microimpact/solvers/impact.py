@@ -367,12 +367,41 @@ def _needs_coupled(contact) -> bool:
     return contact.tangential_model != "rigid" or contact.friction_model != "net"
 
 
+def _dem_tangential_batch(contact, v_in, w_in, f, rtol) -> dict:
+    """:func:`microimpact.solvers.dem_tangential.solve_dem_tangential` over a batch, in the coupled
+    solver's result form (one impact at a time: it integrates in Python)."""
+    from microimpact.solvers.dem_tangential import solve_dem_tangential
+
+    n = np.broadcast(*v_in, *w_in, f).size
+    v_in, w_in = ([np.broadcast_to(x, (n,)) for x in group] for group in (v_in, w_in))
+    f = np.broadcast_to(f, (n,))
+    names = ("e_n", "v_t", "v_tp", "omega_n", "omega_t", "omega_tp", "contact_time", "capture_time",
+             "slip_end_time", "max_penetration", "friction_impulse")
+    out = {k: np.empty(n) for k in names}
+    out["captured"] = np.empty(n, dtype=bool)
+    out["slip_ended"] = np.empty(n, dtype=bool)
+    for i in range(n):
+        one = contact if f[i] == contact.friction else contact.with_(friction=float(f[i]))
+        r = solve_dem_tangential(one, tuple(float(x[i]) for x in v_in), tuple(float(w[i]) for w in w_in), rtol=rtol)
+        normal = r["normal"]
+        out["captured"][i] = normal.outcome == "capture"
+        out["e_n"][i] = normal.e_n
+        out["v_t"][i], out["v_tp"][i] = r["velocity_out"][1:]
+        out["omega_n"][i], out["omega_t"][i], out["omega_tp"][i] = r["omega_out"]
+        out["contact_time"][i], out["capture_time"][i] = normal.contact_time, normal.capture_time
+        out["max_penetration"][i], out["friction_impulse"][i] = normal.max_penetration, normal.friction_impulse
+        out["slip_ended"][i], out["slip_end_time"][i] = r["slip_ended"], r["slip_end_time"]
+    return out
+
+
 def _coupled_results(contact, v_in, w_in, f, rtol) -> dict:
-    """The batch results (as :func:`_solve_batch`) of the compiled coupled solver."""
+    """The batch results (as :func:`_solve_batch`) of the compiled coupled solver, or of the DEM
+    tangential laws' solver (:mod:`microimpact.solvers.dem_tangential`)."""
     from microimpact.solvers.coupled import solve_coupled
+    from microimpact.solvers.dem_tangential import uses_dem_tangential
 
     m, inertia = contact.mass, contact.moment_of_inertia
-    c = solve_coupled(contact, v_in, w_in, f, rtol=rtol)
+    c = (_dem_tangential_batch if uses_dem_tangential(contact) else solve_coupled)(contact, v_in, w_in, f, rtol=rtol)
     captured = c["captured"]
     vn_out = np.where(captured, 0.0, -c["e_n"] * v_in[0])
     v_out = (vn_out, c["v_t"], c["v_tp"])
@@ -395,6 +424,7 @@ def _coupled_results(contact, v_in, w_in, f, rtol) -> dict:
 def _coupled_impact_result(contact, v_in, w_in, res) -> ImpactResult:
     """The ImpactResult of one impact of the coupled solver."""
     from microimpact.solvers.coupled import stops_at_capture
+    from microimpact.solvers.dem_tangential import uses_dem_tangential
 
     one = {k: (v.item() if isinstance(v, np.ndarray) else v) for k, v in res.items()}
     captured = bool(one["outcome"])
@@ -409,8 +439,9 @@ def _coupled_impact_result(contact, v_in, w_in, res) -> ImpactResult:
         slip_end_time=float(one["slip_end_time"]), friction_impulse=float(one["friction_impulse"]),
         dissipated_energy=float(one["dissipated_energy"]),
         final_contact_energy=settled_contact_energy(contact) if captured else 0.0,
-        method=f"engine:coupled ({contact.tangential_model}, {contact.friction_model})",
-        stop_reason="separation" if not captured else "capture" if stops_at_capture(contact) else "settled",
+        method=(f"engine:dem_tangential ({contact.tangential_model})" if uses_dem_tangential(contact)
+                else f"engine:coupled ({contact.tangential_model}, {contact.friction_model})"),
+        stop_reason="separation" if not captured else "capture" if (stops_at_capture(contact) or uses_dem_tangential(contact)) else "settled",
     )
 
 
