@@ -727,8 +727,10 @@ def _cmd_lammps_verify(args) -> int:
     if out is not None:
         with reporting_os_errors({"--out": out}):
             write_csv(table, out, index=False)
-    shown = table[["speed", "incidence_deg", "outcome_lammps", "e_n_microimpact", "e_n_lammps", "difference",
-                   "step_error", "agrees"]]
+    columns = ["speed", "incidence_deg", "outcome_lammps", "e_n_microimpact", "e_n_lammps"]
+    if contact.friction > 0.0:  # the tangential restitution too (the spin ratio is in the --out table)
+        columns += ["e_t_microimpact", "e_t_lammps"]
+    shown = table[columns + ["difference", "step_error", "agrees"]]
     print(shown.to_string(index=False, float_format=lambda v: f"{v:.7g}"))
     worst = table["difference"].max()
     print(f"LAMMPS {table.attrs['lammps_version']} on {path.name}: {int(table['agrees'].sum())} of {len(table)} impacts "

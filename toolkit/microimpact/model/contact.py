@@ -31,7 +31,8 @@ __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_
 #: and "dmt" are the alternative normal adhesion models, "jkr_force" JKR whose contact breaks where
 #: the force reaches -F_c (as LAMMPS GRANULAR's jkr) instead of at the critical approach; "rigid" is the paper's tangentially rigid
 #: contact (closed-form tangential map), "mindlin" an elastic tangential contact with micro-slip,
-#: "mindlin_deresiewicz" the same with the loading/unloading/reloading memory (hysteresis);
+#: "mindlin_deresiewicz" the same with the loading/unloading/reloading memory (hysteresis),
+#: "linear_history" and "lammps_mindlin" LAMMPS GRANULAR's history laws (model.dem_tangential);
 #: "net" is the paper's Coulomb limit f |F_n|, "pulloff" an adhesion-aware limit that does not vanish
 #: at the adhesive equilibrium.
 SUB_MODELS: dict[str, tuple[str, ...]] = {
