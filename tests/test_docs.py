@@ -50,6 +50,9 @@ HOW = {
     'pip install -e ".[lammps]"': "ci",
     "microimpact lammps export --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0 --units micro --out contact.lmp": "run",
     "microimpact lammps verify contact.lmp --out lammps_check.csv": "ci",
+    # docs/guide/lammps.md: LAMMPS's tangential laws (their LAMMPS runs: tests/test_lammps.py)
+    "microimpact simulate --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0.3 --tangential-model lammps_mindlin --shear-modulus 3e8 --speed 1 --incidence-deg 40": "run",
+    "microimpact lammps export --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0.3 --tangential-model lammps_mindlin --shear-modulus 3e8 --units micro --out contact.lmp": "run",
     # README.md and docs/guide/lammps.md: from a CSV to a verified LAMMPS input (needs LAMMPS for verify)
     "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --units micro --out contact.lmp": "test",
     "microimpact lammps verify contact.lmp": "test",

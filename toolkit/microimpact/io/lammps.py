@@ -146,7 +146,9 @@ class LammpsWallModel:
         if self.normal != "hertz/material":
             normal += f" {self.surface_energy / energy_area:.15g}"
         tangential = f"{self.tangential_damping:.15g} {self.friction:.15g}"
-        if self.tangential != "linear_nohistory":
+        if self.tangential == "linear_nohistory":  # no tangential force
+            tangential = "0.0 0.0"
+        else:
             stiffness_unit = pressure if self.tangential == "mindlin" else mass / time**2  # Pa, or N/m
             tangential = f"{self.tangential_stiffness / stiffness_unit:.15g} {tangential}"
         return f"{normal} damping {self.damping_model} tangential {self.tangential} {tangential}"

@@ -170,7 +170,7 @@ def lammps_tangential_force(history, slip_velocity, stiffness: float, damping: f
     halved and the history with it:
 
     >>> f, xi = lammps_tangential_force([1e-9, 0.0], [0.0, 0.0], 100.0, 0.0, 5e-8)
-    >>> [round(x * 1e9, 12) for x in f], [round(x * 1e9, 12) for x in xi]
+    >>> [round(float(x) * 1e9, 12) + 0.0 for x in f], [round(float(x) * 1e9, 12) + 0.0 for x in xi]
     ([-50.0, 0.0], [0.5, 0.0])
     """
     xi = np.array(history, dtype=float)

@@ -341,7 +341,7 @@ def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict
         z_scale = max(1.0, am.jkr_q_from_approach(peak) if law.jkr else math.sqrt(peak))
         u_end, _, slide_end, switches, slip_ended = _integrate(law, (slip[0] / unit, slip[1] / unit),
                                                                min(rtol, TANGENTIAL_RTOL), tau_scale, z_scale)
-        impulse = ((u_end[0] * unit - slip[0]) / kappa, (u_end[1] * unit - slip[1]) / kappa)
+        impulse = (float(u_end[0] * unit - slip[0]) / kappa, float(u_end[1] * unit - slip[1]) / kappa)
         slip_end_time = slide_end * float(sc.time) if math.isfinite(slide_end) else math.nan
     j_t, j_tp = impulse
     return {
