@@ -78,7 +78,7 @@ def lammps_tangential_stiffness(tangential_model: str, stiffness: float, contact
     tangential_model : {"linear_history", "lammps_mindlin"}
     stiffness : float
         LAMMPS's k_t: [N/m] for ``linear_history``; 8 G* [Pa] for ``lammps_mindlin``.
-    contact_radius : array_like
+    contact_radius : float or ndarray
         Contact radius a of the normal law. [m]
 
     Returns
@@ -93,13 +93,13 @@ def lammps_tangential_stiffness(tangential_model: str, stiffness: float, contact
     --------
     >>> lammps_tangential_stiffness("linear_history", 250.0, 1e-7)
     250.0
-    >>> float(lammps_tangential_stiffness("lammps_mindlin", 8e9, 1e-7))  # 8 G* a, G* = 1 GPa
+    >>> round(lammps_tangential_stiffness("lammps_mindlin", 8e9, 1e-7), 9)  # 8 G* a, G* = 1 GPa
     800.0
     """
     if tangential_model == "linear_history":
         return stiffness
     if tangential_model == "lammps_mindlin":
-        return stiffness * np.asarray(contact_radius, dtype=float)
+        return stiffness * contact_radius
     raise ValueError(f"tangential_model must be one of {', '.join(map(repr, DEM_TANGENTIAL_MODELS))}, "
                      f"got {tangential_model!r}")
 
@@ -112,12 +112,14 @@ def lammps_critical_normal_force(elastic_force, damping_force, pulloff_force):
 
     Parameters
     ----------
-    elastic_force : array_like
+    elastic_force : float or ndarray
         Elastic normal force F_ne with its adhesive part, repulsive positive. [N]
-    damping_force : array_like
+    damping_force : float or ndarray
         Normal damping force F_nd. [N]
     pulloff_force : float
         F_po: 2 pi w R for DMT, (3/2) pi w R for JKR, 0 without adhesion. [N]
+
+    Any consistent units serve (the solver calls it in the normal law's units).
 
     References
     ----------
@@ -127,14 +129,14 @@ def lammps_critical_normal_force(elastic_force, damping_force, pulloff_force):
     --------
     At the adhesive equilibrium (F_ne = 0) the limit is 2 F_po, not 0:
 
-    >>> float(lammps_critical_normal_force(0.0, 0.0, 1e-7))
+    >>> lammps_critical_normal_force(0.0, 0.0, 1e-7)
     2e-07
-    >>> float(lammps_critical_normal_force(-1e-8, -3e-8, 0.0))  # Hertz: the damping counts
+    >>> lammps_critical_normal_force(-1e-8, -3e-8, 0.0)  # Hertz: the damping counts
     4e-08
     """
     if pulloff_force > 0.0:
-        return np.abs(np.asarray(elastic_force, dtype=float) + 2.0 * pulloff_force)
-    return np.abs(np.asarray(elastic_force, dtype=float) + np.asarray(damping_force, dtype=float))
+        return abs(elastic_force + 2.0 * pulloff_force)
+    return abs(elastic_force + damping_force)
 
 
 def lammps_tangential_force(history, slip_velocity, stiffness: float, damping: float, limit: float):

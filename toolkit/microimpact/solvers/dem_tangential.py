@@ -49,7 +49,8 @@ import math
 import numpy as np
 
 from microimpact.model import adhesion_models as am
-from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
+from microimpact.model.dem_tangential import (DEM_TANGENTIAL_MODELS, lammps_critical_normal_force,
+                                              lammps_tangential_stiffness)
 from microimpact.solvers import SolverError
 
 __all__ = ["DemTangentialError", "solve_dem_tangential", "uses_dem_tangential", "TANGENTIAL_RTOL"]
@@ -93,10 +94,12 @@ class _Law:
         self.pulloff = 1.5 if self.jkr else (1.0 if self.dmt else 0.0)  # F_po / F unit
         force = float(sc.force)
         length = float(sc.length)
-        if contact.tangential_model == "linear_history":
-            self.k0, self.k1 = contact.tangential_stiffness * length / force, 0.0
-        else:  # k = 8 G* a
-            self.k0, self.k1 = 0.0, 8.0 * contact.shear_modulus * float(sc.radius) * length / force
+        # k in the law's units, F / L, from the model's k(a) in SI: k = k0 + k1 a (a in its unit)
+        self.model = contact.tangential_model
+        self.k_param = (contact.tangential_stiffness if self.model == "linear_history" else 8.0 * contact.shear_modulus)
+        self.k_unit, self.a_unit = force / length, float(sc.radius)
+        self.k0 = lammps_tangential_stiffness(self.model, self.k_param, 0.0) / self.k_unit
+        self.k1 = lammps_tangential_stiffness(self.model, self.k_param, self.a_unit) / self.k_unit - self.k0
         self.x_t = contact.tangential_damping
         self.mu = contact.friction
         self.kappa = 1.0 + contact.mass * contact.radius**2 / contact.moment_of_inertia
@@ -122,17 +125,17 @@ class _Law:
             eta, deta = (c3, 0.0) if p3 == 0.0 else (0.0, 0.0)
         fd = eta * y
         dy = -g * (fe + fd)
-        if self.pulloff > 0.0:
-            n0 = fe + 2.0 * self.pulloff
-            dn0 = dfe
+        n0 = lammps_critical_normal_force(fe, fd, self.pulloff)
+        if self.pulloff > 0.0:  # its rate: F_ne + 2 F_po, or F_ne + F_nd, times its sign
+            dn0 = dfe if fe + 2.0 * self.pulloff >= 0.0 else -dfe
         else:
-            n0 = fe + fd
             dn0 = dfe + deta * y + eta * dy
-        sign = 1.0 if n0 >= 0.0 else -1.0
-        return g, dz, a, da, eta, deta, dy, sign * n0, sign * dn0
+            dn0 = dn0 if fe + fd >= 0.0 else -dn0
+        return g, dz, a, da, eta, deta, dy, n0, dn0
 
     def stiffness(self, a):
-        return self.k0 + self.k1 * a
+        """k(a) of the tangential law (model.dem_tangential), in F / L. [-]"""
+        return lammps_tangential_stiffness(self.model, self.k_param, a * self.a_unit) / self.k_unit
 
 
 def _rhs_and_switch(law, x, mode):
