@@ -31,7 +31,8 @@ REPO = Path(__file__).resolve().parents[1]
 #: the fast physics tests that must kill every mutation (no pipeline runs, no studies)
 KILLERS = ["tests/test_params.py", "tests/test_engine.py", "tests/test_adhesion_models.py",
            "tests/test_contact_models.py", "tests/test_dynamics.py", "tests/test_independent_physics.py",
-           "tests/test_agreement.py", "tests/test_reference.py", "tests/test_dem_damping.py"]
+           "tests/test_agreement.py", "tests/test_reference.py", "tests/test_dem_damping.py",
+           "tests/test_dem_tangential.py"]
 
 #: (file under toolkit/microimpact, text that occurs exactly once, its mutation, what it breaks)
 MUTATIONS = [
@@ -76,6 +77,12 @@ MUTATIONS = [
     ("model/dem_damping.py", "return math.sqrt(2.0) * sum(", "return math.sqrt(1.9) * sum(",
      "tsuji damping factor, sqrt(2) alpha(e)"),
     ("model/adhesion_models.py", "    return 0.4 * s**5", "    return 0.41 * s**5", "Hertz potential (2/5) s^5"),
+    ("model/dem_tangential.py", "return abs(elastic_force + 2.0 * pulloff_force)",
+     "return abs(elastic_force + 1.9 * pulloff_force)", "LAMMPS's friction limit with adhesion, |F_ne + 2 F_po|"),
+    ("model/dem_tangential.py", "return abs(elastic_force + damping_force)", "return abs(elastic_force)",
+     "LAMMPS's Hertz friction limit counts the damping, |F_ne + F_nd|"),
+    ("model/dem_tangential.py", "return stiffness * contact_radius", "return 1.01 * stiffness * contact_radius",
+     "LAMMPS's Mindlin spring k_t a"),
 ]
 
 
