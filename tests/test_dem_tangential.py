@@ -206,3 +206,43 @@ def test_the_tangential_law_is_written_in_the_units_of_its_coefficients(law, sti
     assert fix[i + 3:i + 5] == ["0.4", "0.25"]
     assert read_lammps_contact(text)[0] == c
     assert lammps_wall_model(c).friction == 0.25
+
+
+def test_random_impacts_over_the_domain_all_get_a_converged_result():
+    # radius 0.1-100 um, K 0.1-300 GPa, any of the three normal laws and four damping laws, mu
+    # 0.01-3, spin up to the rolling spin, incidence 0-89.9 deg: every impact has a result (2400
+    # such impacts measured: no failure; before the slip-frame and chatter fixes 64 of 300 failed),
+    # and it does not move when the tolerance falls 100-fold, except where the tangential damping
+    # force exceeds the friction limit hundreds of times: there the force rides the limit (stick and
+    # slip both consistent to rounding) and which one holds decides the rest of the contact. Measured
+    # over 300: one such impact (DMT, x = 1.36, mu = 0.012) moved by 3.1e-3, the others < 1e-6.
+    from microimpact.model.dem_damping import critical_damping_coefficient
+
+    rng = np.random.default_rng(7)
+    done, moved = 0, []
+    while done < 40:
+        r, k = 10 ** rng.uniform(-7, -4), 10 ** rng.uniform(8, 11.5)
+        normal = str(rng.choice(["hertz", "jkr_force", "dmt"]))
+        damping = str(rng.choice(["paper", "mass_velocity", "viscoelastic", "coeff_restitution"]))
+        if normal != "hertz" and damping == "coeff_restitution":
+            damping = "viscoelastic"
+        kw = {"friction": 10 ** rng.uniform(-2, 0.5)}
+        if rng.random() < 0.5:
+            kw |= {"tangential_model": "linear_history", "tangential_stiffness": 10 ** rng.uniform(-1, 4)}
+        else:
+            kw |= {"tangential_model": "lammps_mindlin", "shear_modulus": k * 10 ** rng.uniform(-1.5, 0)}
+        v, angle = 10 ** rng.uniform(-3, 2), rng.uniform(0.0, 89.9)
+        if damping != "paper":
+            coef = (rng.uniform(0.05, 1.0) if damping == "coeff_restitution" else
+                    critical_damping_coefficient(Contact(r, 2500.0, k, 0.0, damping_model=damping), v)
+                    * 10 ** rng.uniform(-3, 0.5))
+            kw |= {"damping_model": damping, "damping_coefficient": coef, "tangential_damping": rng.uniform(0, 2)}
+        w_a = 0.0 if normal == "hertz" else 10 ** rng.uniform(-3, -0.5)
+        c = Contact.from_work_of_adhesion(r, 2500.0, k, w_a, **({} if normal == "hertz" else {"normal_model": normal}), **kw)
+        spin = tuple(rng.normal(0.0, 1.0, 3) * v / r * rng.choice([0.0, 1.0]))
+        a, b = (simulate_impact(c, v, angle, 30.0, omega=spin, rtol=rt) for rt in (1e-8, 1e-10))
+        assert all(map(math.isfinite, a.velocity_out + a.omega_out))
+        moved.append(np.abs(np.subtract(a.velocity_out, b.velocity_out)).max() / (v + r * np.abs(spin).max()))
+        done += 1
+    moved = np.array(moved)
+    assert (moved > 1e-6).sum() <= 1 and moved.max() < 1e-2, moved
