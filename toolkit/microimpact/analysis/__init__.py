@@ -29,7 +29,7 @@ _HOMES = {
     **dict.fromkeys(("kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
                      "KHARAZ_CONDITIONS"), "kharaz"),
     **dict.fromkeys(("compare_normal_models", "normal_model_restitution", "DEFAULT_MODELS"), "model_comparison"),
-    **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state",
+    **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "oblique_model", "rebound_state",
                      "effective_sigma", "TANGENTIAL_PARAMETERS", "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"), "oblique"),
     **dict.fromkeys(("Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "posterior_contacts",
                      "restitution_bands", "capture_velocity_interval", "sweep_bands", "posterior_dataset",

@@ -54,7 +54,7 @@ from microimpact.io.impacts import OBLIQUE_COLUMNS, insert_row_labels, label_var
 from microimpact.io.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL, Deadline, engine_threads
 
-__all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "DEM_PROFILE_POINTS", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
+__all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
            "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"]
 
 #: Contact.tangential_model -> the Contact fields fitted from oblique data (the compliance hook)
