@@ -1,5 +1,5 @@
 """Impacts with a DEM tangential law (LAMMPS's ``linear_history`` and ``mindlin``,
-:mod:`microimpact.model.dem_tangential`): the normal law of :mod:`.normal_models` and the history
+:mod:`microimpact.model.dem_tangential`): the normal law of :mod:`microimpact.solvers.normal_models` and the history
 spring with its Coulomb limit, integrated together.
 
 The normal motion does not feel the tangential force (LAMMPS's wall contact has no coupling back),
@@ -7,7 +7,7 @@ so the normal outcome is the compiled normal solver's (:func:`microimpact.solver
 e_n, capture, contact time, largest penetration). What it leaves is the tangential state, whose
 force depends on the normal state at every instant; it is integrated here with the normal motion.
 
-Formulation. The normal law in its own units and Sundman variable (:mod:`.normal_models`: state
+Formulation. The normal law in its own units and Sundman variable (:mod:`microimpact.solvers.normal_models`: state
 q = sqrt(a / a_c) for JKR, s = sqrt(delta / L) for DMT and Hertz, rate y), with the tangential
 state in the same units: the slip velocity u (2 components, units L / T) and, in stick, the
 history xi (units L), in slide the direction e of the force (a unit vector), the force being
