@@ -343,7 +343,8 @@ class FrictionFit(ReportHTML):
     values : dict
         Fitted tangential parameters (``friction`` [-]).
     stderr : dict
-        Standard errors including the propagated damping covariance, same units.
+        Standard errors including the propagated damping covariance, same units (for a DEM
+        tangential law, :func:`fit_dem_friction`, at the given normal law: nothing propagated).
     stderr_conditional : dict
         Standard errors with the damping held at its fitted values.
     tangential_model : str
@@ -431,8 +432,10 @@ class FrictionFit(ReportHTML):
             ds.update(status_variables(st, "1"))
         for k, v in self.values.items():
             ds[k] = xr.DataArray(v, attrs={"units": "1", "long_name": f"fitted {k} ({self.tangential_model} tangential model)"})
+            dem = self.tangential_model in ("linear_history", "lammps_mindlin")  # fit_dem_friction: no propagation
             ds[f"{k}_stderr"] = xr.DataArray(self.stderr[k], attrs={
-                "units": "1", "long_name": f"standard error of {k}, damping uncertainty propagated"})
+                "units": "1", "long_name": f"standard error of {k}, " + ("at the given normal law" if dem
+                                                                        else "damping uncertainty propagated")})
             ds[f"{k}_stderr_conditional"] = xr.DataArray(self.stderr_conditional[k], attrs={
                 "units": "1", "long_name": f"standard error of {k} at the fitted damping"})
         ds["row"] = ("entry", d["row"].to_numpy(dtype=np.int64), {"units": "1", "long_name": "data row in the impact CSV"})
