@@ -105,7 +105,8 @@ class _Law:
         self.scales = sc
         self.y0 = float(y0)
         self.c3, self.p3 = float(c3), float(p3)
-        self.pulloff = 1.5 if self.jkr else (1.0 if self.dmt else 0.0)  # F_po / F unit
+        # LAMMPS's pull-off force in the law's force unit: (3/2) pi w R / (pi w R) for JKR, 2 pi w R / (2 pi w R) for DMT
+        self.pulloff = 1.5 if self.jkr else (1.0 if self.dmt else 0.0)
         force = float(sc.force)
         length = float(sc.length)
         # k in the law's units, F / L, from the model's k(a) in SI: k = k0 + k1 a (a in its unit)
@@ -120,18 +121,18 @@ class _Law:
         self.cap_floor = 0.0  # set by _integrate from its tolerance
 
     def normal(self, z, y):
-        """(g, dz/dsigma, a, da/dsigma, F_elastic, F_damping, dy/dsigma, F_n0, dF_n0/dsigma)."""
+        """(g = dtau/dsigma, dz/dsigma, a, da/dsigma, eta_n, deta_n/dsigma, dy/dsigma, F_n0, dF_n0/dsigma)
+        in the law's units; the elastic force is the model's (model.adhesion_models), its rate here."""
         if self.jkr:
-            q3 = z * z * z
-            g, dz, a = 4.0 * (q3 - 1.0), y, z * z
+            g, dz, a = 4.0 * (z * z * z - 1.0), y, z * z
             da = 2.0 * z * dz
-            fe = q3 * q3 / 6.0 - q3
-            dfe = (z * z * z * z * z - 3.0 * z * z) * dz
+            fe = am.jkr_nondimensional_force(z, 0.0, 0.0, 0.0)
+            dfe = (z * z * z * z * z - 3.0 * z * z) * dz  # d(q^6/6 - q^3)/dq dq/dsigma
         else:
             g, dz, a = z, 0.5 * y, z
             da = dz
-            fe = z * z * z - (1.0 if self.dmt else 0.0)
-            dfe = 3.0 * z * z * dz
+            fe = am.dmt_nondimensional_force(z, 0.0, 0.0, 0.0) if self.dmt else am.hertz_nondimensional_force(z, 0.0, 0.0)
+            dfe = 3.0 * z * z * dz  # d(s^3 [- 1])/ds ds/dsigma
         c3, p3 = self.c3, self.p3
         if c3 != 0.0 and a > 0.0:
             eta = c3 * a**p3
