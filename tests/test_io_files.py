@@ -256,3 +256,58 @@ def test_a_killed_writers_temporary_file_is_removed_by_the_next_write(tmp_path):
     write_csv(pd.DataFrame({"a": [1]}), target)
     assert target.read_text() == "a\n1\n"
     assert sorted(p.name for p in tmp_path.glob(".*.tmp")) == [live.name]
+
+
+def test_a_signal_between_two_moves_into_place_lands_after_both(tmp_path, monkeypatch):
+    """A Ctrl-C while the outputs of one command are moved into place (CI 2026-11-27: ``flags``
+    left ``x.csv`` and ``.x.nc.*.tmp`` and said nothing was written): every output lands whole,
+    no temporary file is left, the interrupt is raised afterwards, and the process knows which
+    files it wrote, so that the CLI can say so."""
+    import signal
+
+    from microimpact.io import files
+
+    real = files._fsync_dir
+    moved = []
+
+    def signal_after_first_move(directory):
+        moved.append(directory)
+        if len(moved) == 1:
+            os.kill(os.getpid(), signal.SIGINT)  # a real signal, between the first and second move
+        return real(directory)
+
+    monkeypatch.setattr(files, "_fsync_dir", signal_after_first_move)
+    before = len(files.committed_outputs())
+    with pytest.raises(KeyboardInterrupt):
+        with files.all_or_nothing():
+            with atomic_write(tmp_path / "a.csv") as f:
+                f.write("a")
+            with atomic_write(tmp_path / "b.nc") as f:
+                f.write("b")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.csv", "b.nc"]
+    assert (tmp_path / "b.nc").read_text() == "b"
+    assert files.committed_outputs()[before:] == (tmp_path / "a.csv", tmp_path / "b.nc")
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_an_interrupt_after_the_outputs_are_in_place_is_reported_truthfully(tmp_path, monkeypatch, capsys):
+    """The CLI's Ctrl-C line names the outputs it had already moved into place instead of claiming
+    that nothing was written."""
+    import signal
+
+    from microimpact import cli
+    from microimpact.io import files
+
+    real = files._commit
+
+    def commit_then_signal(moves):
+        real(moves)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(files, "_commit", commit_then_signal)
+    monkeypatch.chdir(tmp_path)
+    status = cli.main(["target", "--e-n", "0.6", "--speed", "2", "--points", "5", "--out", "one.csv"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 130
+    assert err[-1].startswith("microimpact: interrupted after writing one.csv (complete"), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["one.csv"]

@@ -23,6 +23,13 @@ INTERRUPTED_LINE = ("microimpact: interrupted; nothing was written (outputs are 
 EXIT_INTERRUPTED = 130
 
 
+def interrupted_after_writing(paths) -> str:
+    """The one line of a Ctrl-C that came after some outputs were complete and in place (the
+    signal is held while files are moved into place, so each named file is whole)."""
+    return (f"microimpact: interrupted after writing {', '.join(str(p) for p in paths)} "
+            "(complete; nothing else was written)")
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """A warning as one line, ``microimpact: warning: MESSAGE``: Python's form names a file and a
     source line of the installation, not the analyst's input; other libraries' warnings keep

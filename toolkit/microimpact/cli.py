@@ -24,7 +24,7 @@ from dataclasses import fields
 from pathlib import Path
 
 from microimpact import __version__
-from microimpact._entry import EXIT_INTERRUPTED, INTERRUPTED_LINE
+from microimpact._entry import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_after_writing
 from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,
                                   reporting_os_errors, same_file)
 from microimpact.model.contact import SUB_MODELS, Contact
@@ -1132,8 +1132,11 @@ def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | N
 
 
 def main(argv=None) -> int:
+    from microimpact.io.files import committed_outputs
+
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
+    already = len(committed_outputs())
     try:
         unknown = _unknown_option(parser, argv)
         if unknown:
@@ -1149,7 +1152,8 @@ def main(argv=None) -> int:
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
     except KeyboardInterrupt:  # Ctrl-C: one line, the shell's status for SIGINT, no traceback
-        print(INTERRUPTED_LINE, file=sys.stderr)
+        written = committed_outputs()[already:]
+        print(interrupted_after_writing(written) if written else INTERRUPTED_LINE, file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:  # the reader went away (| head): stop quietly, as POSIX tools do
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit

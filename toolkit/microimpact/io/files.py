@@ -29,7 +29,7 @@ import numpy as np
 
 from microimpact.io.variables import VARIABLES, udunits
 
-__all__ = ["atomic_path", "atomic_write", "all_or_nothing", "deferred_signals", "interrupt_at_checkpoints", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
+__all__ = ["atomic_path", "atomic_write", "all_or_nothing", "committed_outputs", "deferred_signals", "interrupt_at_checkpoints", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
            "CONVENTIONS", "read_netcdf_groups", "restore_label_coordinates", "LABEL_OF"]
 
 #: encoding added to every numeric, non-scalar NetCDF variable
@@ -203,13 +203,46 @@ def atomic_path(path) -> Iterator[Path]:
         if pending is not None:  # inside all_or_nothing(): moved into place when the whole block succeeds
             pending.append((tmp, path, mode, directory))
             return
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
-        _fsync_dir(directory)
+        _commit([(tmp, path, mode, directory)])
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()
         raise
+
+
+#: every output this process has moved into place, in order (see :func:`committed_outputs`)
+_COMMITTED: list[Path] = []
+
+
+def committed_outputs() -> tuple[Path, ...]:
+    """The files this process has moved into place so far, in order.
+
+    A command that is interrupted reports from it what it had written (a Ctrl-C that lands after
+    its outputs were moved into place must not be answered with "nothing was written").
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> target = pathlib.Path(tempfile.mkdtemp()) / "a.txt"
+    >>> with atomic_write(target) as f:
+    ...     _ = f.write("a")
+    >>> committed_outputs()[-1] == target
+    True
+    """
+    return tuple(_COMMITTED)
+
+
+def _commit(moves) -> None:
+    """Move finished temporary files into place, with SIGINT and SIGTERM held until all are moved:
+    a signal between two moves would leave the first output written and the second's temporary
+    file behind (CI, 2026-11-27: Ctrl-C of ``flags`` during its commit left ``x.csv`` and
+    ``.x.nc.*.tmp``). The held signal is raised once every file is in place."""
+    with deferred_signals():
+        for tmp, path, mode, directory in moves:
+            os.chmod(tmp, mode)
+            os.replace(tmp, path)
+            _COMMITTED.append(path)
+            _fsync_dir(directory)
 
 
 #: the files written inside all_or_nothing(), waiting to be moved into place: (tmp, path, mode, directory)
@@ -248,16 +281,14 @@ def all_or_nothing() -> Iterator[None]:
     try:
         yield
     except BaseException:
-        for tmp, *_ in pending:
-            with contextlib.suppress(FileNotFoundError):
-                tmp.unlink()
+        with deferred_signals():  # a second Ctrl-C must not leave a temporary file behind
+            for tmp, *_ in pending:
+                with contextlib.suppress(FileNotFoundError):
+                    tmp.unlink()
         raise
     finally:
         _TRANSACTION.reset(token)
-    for tmp, path, mode, directory in pending:
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
-        _fsync_dir(directory)
+    _commit(pending)
 
 
 @contextlib.contextmanager
