@@ -116,6 +116,7 @@ def results(tmp_path_factory):
     lammps = pd.DataFrame({"speed": [0.1, 0.1, 2.0, 2.0], "incidence_deg": [0.0, 80.0, 0.0, 80.0],
                            "outcome_lammps": ["capture", "capture", "rebound", "rebound"],
                            "e_n_microimpact": [0.0, 0.0, 0.866025, 0.5], "e_n_lammps": [0.0, 0.0, 0.866024, 0.5],
+                           "e_t_microimpact": [np.nan, np.nan, np.nan, 0.811674], "e_t_lammps": [np.nan, np.nan, np.nan, 0.811664],
                            "difference": [0.0, 0.0, 9.2e-8, 1e-7], "step_error": [0.0, 0.0, 2.8e-7, 3e-7],
                            "agrees": [True, True, True, False], "lammps_version": 20250722, "tolerance": 1e-3,
                            "parameter_source": "preset: wall1990, in LAMMPS's law"})
@@ -163,6 +164,7 @@ def test_report_has_both_parts_and_their_sources(results, report_text):
     c = text.index("LAMMPS GRANULAR on the exported contact")
     assert c > text.index("Part C.") and "3 of 4 impacts agree within 0.001" in text[c:]
     assert "(2 captured by both)" in text[c:] and "run by LAMMPS 20250722" in text[c:]
+    assert "e_t LAMMPS" in text[c:] and "0.811664" in text[c:]  # the tangential law's restitution is shown
     assert f"page {len(report_text)} of {len(report_text)}" in report_text[-1]
 
 

@@ -12,12 +12,13 @@ from microimpact.studies.lammps_check import verify_lammps  # noqa: E402
 
 contact, source = named_contact(snakemake.params.contact)  # noqa: F821
 contact = lammps_expressible(contact)
-text = lammps_input(contact, source=f"{source} (config paper_contact), in LAMMPS's law: normal_model "
-                                    f"{contact.normal_model!r}, no damping, no friction")
+law = (f"normal_model {contact.normal_model!r}, no damping, tangential_model {contact.tangential_model!r}, "
+       f"friction {contact.friction:g}")
+text = lammps_input(contact, source=f"{source} (config paper_contact), in LAMMPS's laws: {law}")
 table = verify_lammps(text)
 table["lammps_version"] = table.attrs["lammps_version"]
 table["tolerance"] = table.attrs["tolerance"]
-table["parameter_source"] = f"{source}, in LAMMPS's law (normal_model {contact.normal_model!r}, no damping, no friction)"
+table["parameter_source"] = f"{source}, in LAMMPS's laws ({law})"
 print(table.to_string())
 if not table.attrs["passed"]:
     raise RuntimeError(f"LAMMPS and microimpact disagree on {int((~table['agrees']).sum())} of {len(table)} impacts "

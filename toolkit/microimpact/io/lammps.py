@@ -160,6 +160,11 @@ def _check_units(units: str) -> tuple[float, float, float]:
     return LAMMPS_UNITS[units]
 
 
+def _youngs_modulus(stiffness: float, poisson: float) -> float:
+    """E of wall and sphere alike that gives the paper's K = (4/3) E* with E* = E / (2 (1 - nu^2)). [Pa]"""
+    return 1.5 * (1.0 - poisson**2) * stiffness
+
+
 def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> LammpsWallModel:
     """The LAMMPS GRANULAR wall law that gives the impacts of ``contact``, or a refusal.
 
@@ -215,7 +220,7 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
     if refused:
         raise LammpsExportError("cannot be written as LAMMPS GRANULAR input: " + "; ".join(refused))
     normal = {"ring": "hertz/material", "jkr_force": "jkr", "dmt": "dmt"}[contact.normal_model]
-    youngs = 1.5 * (1.0 - poisson**2) * contact.stiffness  # K = (4/3) E / (2 (1 - nu^2))
+    youngs = _youngs_modulus(contact.stiffness, poisson)
     gamma = 0.5 * contact.work_of_adhesion if normal != "hertz/material" else 0.0
     damping_model, damping = contact.damping_model, contact.damping_coefficient
     if damping_model == "paper":
@@ -230,27 +235,56 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
                            contact.tangential_damping if contact.friction > 0.0 else 0.0, contact.friction)
 
 
-def lammps_expressible(contact: Contact) -> Contact:
+def lammps_expressible(contact: Contact, poisson: float = DEFAULT_POISSON) -> Contact:
     """The part of ``contact`` that LAMMPS GRANULAR can express: its elasticity and work of adhesion,
     with the force-controlled JKR break (Hertz when f0 = 0), its DEM damping law if it has one
-    (:mod:`microimpact.model.dem_damping`; the paper's damping is dropped), no friction, no rolling
-    resistance.
+    (:mod:`microimpact.model.dem_damping`; the paper's damping is dropped), its Coulomb friction
+    through LAMMPS's ``tangential mindlin`` law, no rolling resistance.
 
     A contact to check the export with, when the contact itself (the paper's damped ring law, say)
-    cannot be written: the same sphere, stiffness and w_A, in LAMMPS's own law.
+    cannot be written: the same sphere, stiffness, w_A and mu, in LAMMPS's own laws. The Mindlin
+    stiffness 8 G* a takes the contact's ``shear_modulus`` G* where it has one, else G* of wall and
+    sphere both of the E and nu the export writes (G = E / (2 (1 + nu)), G* = G / (2 (2 - nu)); what
+    LAMMPS computes for ``mindlin NULL``), without tangential damping.
+
+    Parameters
+    ----------
+    contact : Contact
+    poisson : float
+        nu of the export (:func:`lammps_wall_model`), which sets G* when the contact has none. [-]
+
+    Returns
+    -------
+    Contact
+
+    References
+    ----------
+    LAMMPS documentation, ``pair_style granular`` (https://docs.lammps.org/pair_granular.html),
+    tangential ``mindlin``.
 
     Examples
     --------
     >>> from microimpact.presets import WALL_1990
     >>> c = lammps_expressible(WALL_1990)
-    >>> c.normal_model, c.zeta_hertz, c.friction, c.work_of_adhesion == WALL_1990.work_of_adhesion
-    ('jkr_force', 0.0, 0.0, True)
-    >>> lammps_wall_model(c).normal
-    'jkr'
+    >>> c.normal_model, c.zeta_hertz, c.tangential_model, c.friction == WALL_1990.friction
+    ('jkr_force', 0.0, 'lammps_mindlin', True)
+    >>> lammps_wall_model(c).normal, lammps_wall_model(c).tangential
+    ('jkr', 'mindlin')
+    >>> round(c.shear_modulus / (0.75 * c.stiffness), 6)  # G* / E* = (1 - nu) / (2 (2 - nu)) at nu = 0.3
+    0.205882
     """
+    from microimpact.model.tangential_compliance import effective_shear_modulus, shear_modulus_from_elastic
+
+    friction = {"friction": 0.0, "tangential_model": "rigid", "shear_modulus": None}
+    if contact.friction > 0.0:
+        shear = contact.shear_modulus
+        if shear is None:
+            g = float(shear_modulus_from_elastic(_youngs_modulus(contact.stiffness, poisson), poisson))
+            shear = float(effective_shear_modulus(g, poisson, g, poisson))
+        friction = {"friction": contact.friction, "tangential_model": "lammps_mindlin", "shear_modulus": shear}
     return contact.with_(normal_model="jkr_force" if contact.adhesion_line_force > 0.0 else "ring",
-                         zeta_hertz=0.0, zeta_adhesion=0.0, friction=0.0, rolling_friction=0.0,
-                         tangential_model="rigid", friction_model="net", shear_modulus=None)
+                         zeta_hertz=0.0, zeta_adhesion=0.0, rolling_friction=0.0, friction_model="net",
+                         tangential_stiffness=None, tangential_damping=0.0, **friction)
 
 
 def _contact_json(contact: Contact) -> str:

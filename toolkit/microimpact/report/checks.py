@@ -161,27 +161,39 @@ def lammps_section(lay: Layout, table: pd.DataFrame) -> None:
     n, agree = len(table), int(table["agrees"].astype(str).str.lower().eq("true").sum())
     captured = int((table["outcome_lammps"] == "capture").sum())
     lay.paragraph(
-        f"The paper's microsphere in the law LAMMPS can express (the force-controlled JKR break, no damping, no "
-        f"friction; microimpact.io.lammps.lammps_expressible) was written as a fix wall/gran line "
+        f"The paper's microsphere in the laws LAMMPS can express (the force-controlled JKR break, no damping, its "
+        f"friction coefficient through LAMMPS's tangential mindlin law with G* of the exported E and nu; "
+        f"microimpact.io.lammps.lammps_expressible) was written as a fix wall/gran line "
         f"(results/lammps/contact.lmp) and run by LAMMPS {first.get('lammps_version', '?')} itself, one sphere "
         f"against the wall with fix nve/sphere, at 2000 and 4000 steps per contact time "
         f"(microimpact.studies.lammps_check). {agree} of {n} impacts agree within {float(first['tolerance']):g} "
         f"in e_n, the tangential restitution and the rebound spin ({captured} captured by both); the largest "
         f"difference is {float(table['difference'].max()):.2g} and LAMMPS's own largest step error (the two "
-        f"runs apart) {float(table['step_error'].max()):.2g}. The paper's damping, ring adhesion and friction have "
-        "no LAMMPS law (docs/guide/lammps.md).")
+        f"runs apart) {float(table['step_error'].max()):.2g}. The paper's damping, ring adhesion and rigid "
+        "tangential contact have no LAMMPS law (docs/guide/lammps.md).")
     lay.source(str(first.get("parameter_source", "?")))
-    rows = table[table["incidence_deg"].isin([table["incidence_deg"].min(), table["incidence_deg"].max()])]
+    # the head-on and the two largest angles: the tangential law shows only off the normal
+    angles = sorted(table["incidence_deg"].unique())
+    rows = table[table["incidence_deg"].isin([angles[0], *angles[-2:]])]
     shown = pd.DataFrame({"speed": rows["speed"].map(lambda v: f"{v:.4g}"),
                           "angle": rows["incidence_deg"].map(lambda v: f"{v:g}"),
                           "outcome": rows["outcome_lammps"],
                           "mi": rows["e_n_microimpact"].map(lambda v: f"{v:.6f}"),
                           "lmp": rows["e_n_lammps"].map(lambda v: f"{v:.6f}"),
+                          "t_mi": rows["e_t_microimpact"].map(_optional),
+                          "t_lmp": rows["e_t_lammps"].map(_optional),
                           "diff": rows["difference"].map(lambda v: f"{v:.1e}"),
                           "step": rows["step_error"].map(lambda v: f"{v:.1e}")})
-    lay.table(shown, {"speed": 12, "angle": 9, "outcome": 12, "mi": 14, "lmp": 14, "diff": 11, "step": 11},
-              headers={"speed": "v [m/s]", "angle": "angle [deg]", "mi": "e_n microimpact", "lmp": "e_n LAMMPS",
-                       "diff": "difference", "step": "step error"}, size=7.0)
+    lay.table(shown, {"speed": 10, "angle": 8, "outcome": 10, "mi": 11, "lmp": 11, "t_mi": 11, "t_lmp": 11,
+                      "diff": 10, "step": 10},
+              headers={"speed": "v [m/s]", "angle": "angle [deg]", "mi": "e_n micro.", "lmp": "e_n LAMMPS",
+                       "t_mi": "e_t micro.", "t_lmp": "e_t LAMMPS", "diff": "difference", "step": "step error"},
+              size=7.0)
+
+
+def _optional(value) -> str:
+    """A value of the table, or a dash where it has none (no tangential motion: head-on, captured)."""
+    return "-" if pd.isna(value) else f"{float(value):.6f}"
 
 
 # =============================================================================== stress sweep
