@@ -83,6 +83,11 @@ MUTATIONS = [
      "LAMMPS's Hertz friction limit counts the damping, |F_ne + F_nd|"),
     ("model/dem_tangential.py", "return stiffness * contact_radius", "return 1.01 * stiffness * contact_radius",
      "LAMMPS's Mindlin spring k_t a"),
+    ("model/dem_tangential.py", "        rate = rate + radius_rate * history", "        rate = rate + 0.5 * radius_rate * history",
+     "LAMMPS's mindlin_rescale, H scaled by a_new / a_old while a falls"),
+    ("model/dem_tangential.py", "rate = -stiffness * slip_velocity if tangential_model in FORCE_HISTORY_MODELS",
+     "rate = -0.99 * stiffness * slip_velocity if tangential_model in FORCE_HISTORY_MODELS",
+     "LAMMPS's mindlin/force, dF = -k u dt"),
 ]
 
 

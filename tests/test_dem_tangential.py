@@ -24,16 +24,21 @@ def _kappa(contact):
     return 1.0 / contact.mass + contact.radius**2 / contact.moment_of_inertia
 
 
-def test_a_contact_that_slides_throughout_takes_mu_times_the_normal_impulse():
+MINDLIN_VARIANTS = ["lammps_mindlin", "lammps_mindlin_rescale", "lammps_mindlin_force", "lammps_mindlin_rescale_force"]
+
+
+@pytest.mark.parametrize("law", MINDLIN_VARIANTS)
+def test_a_contact_that_slides_throughout_takes_mu_times_the_normal_impulse(law):
     # Hertz, undamped: F_n0 = F_n, so a contact sliding from touch to separation (70 deg, mu 0.2:
-    # k u / (mu y) stays above 1) takes the tangential impulse mu int F_n dt = mu m v_n (1 + e_n)
-    c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.2, tangential_model="lammps_mindlin", shear_modulus=3e8)
+    # k u / (mu y) stays above 1) takes the tangential impulse mu int F_n dt = mu m v_n (1 + e_n),
+    # whatever the history is (the variants differ only in stick)
+    c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.2, tangential_model=law, shear_modulus=3e8)
     r = simulate_impact(c, 1.0, 70.0)
     j_t = c.mass * (r.velocity_out[1] - r.velocity_in[1])
     j_n = c.mass * (r.velocity_out[0] - r.velocity_in[0])
     # measured 8.7e-11 relative (the tangential integration's tolerance is 1e-10, TANGENTIAL_RTOL)
     assert j_t / j_n == pytest.approx(-0.2, rel=1e-9, abs=0)
-    assert r.method == "engine:dem_tangential (lammps_mindlin)" and not r.slip_ended
+    assert r.method == f"engine:dem_tangential ({law})" and not r.slip_ended
 
 
 @pytest.mark.parametrize("normal_model", ["jkr_force", "dmt"])
@@ -80,7 +85,8 @@ def test_a_stuck_linear_spring_oscillates_harmonically_for_the_contact_time(norm
 
 def _lammps_steps(contact, speed, angle, steps):
     """LAMMPS's update for a sphere on a wall, written independently of the solver: velocity Verlet,
-    the history advanced by u dt, then the force and history of lammps_tangential_force, with
+    the history rescaled by a / a_old while a falls (the rescale variants), advanced by u dt (or by
+    -k u dt for the force variants), then the force and history of lammps_tangential_force, with
     LAMMPS's Hertz limit |F_ne + F_nd| and viscoelastic damping eta = eta_n0 m a written out here.
     Returns the slip velocity at separation. [m/s]"""
     m, r, inertia = contact.mass, contact.radius, contact.moment_of_inertia
@@ -91,14 +97,20 @@ def _lammps_steps(contact, speed, angle, steps):
     dt = t_c / steps
     delta, vd, vt, w = 0.0, v_n, v_t, 0.0  # approach, its rate, tangential velocity, r omega
     xi = np.zeros(2)
+    law = contact.tangential_model
+    a_old = [0.0]
 
     def forces(delta, vd, vt, w, xi):
         a = math.sqrt(r * max(delta, 0.0))
         eta = eta_n0 * m * a
         fn = k_h * max(delta, 0.0) ** 1.5 + eta * vd
         u = np.array([vt + w, 0.0])
-        xi = xi + u * dt
-        ft, xi = lammps_tangential_force(xi, u, 8.0 * contact.shear_modulus * a, x_t * eta, contact.friction * abs(fn))
+        k = contact.tangential_stiffness if law == "linear_history" else 8.0 * contact.shear_modulus * a
+        if "rescale" in law and a < a_old[0]:
+            xi = xi * (a / a_old[0])
+        a_old[0] = a
+        xi = xi + (-k * u * dt if law.endswith("_force") else u * dt)
+        ft, xi = lammps_tangential_force(xi, u, k, x_t * eta, contact.friction * abs(fn), law)
         return fn, ft[0], xi
 
     fn, ft, xi = forces(delta, vd, vt, w, xi)
@@ -130,6 +142,66 @@ def test_lammps_update_written_step_by_step_converges_to_the_solver(angle, dampi
     # stick-slip-stick cycle), 2.7e-7 and 3.5e-8 (25 deg), damped 5.2e-6 and 1.1e-6 (first order; at
     # 5 deg damped 2.3e-3 and 5.8e-4, also first order): the update converges to the solver
     assert fine < bound and coarse > 3.0 * fine
+
+
+VISCOELASTIC = {"damping_model": "viscoelastic", "damping_coefficient": 3e13, "tangential_damping": 0.5}
+
+
+@pytest.mark.parametrize("law, speed, angle, damping, bound", [
+    # measured |LAMMPS update - solver| at 8000 steps (2000 steps: four times as much, first order)
+    ("lammps_mindlin_rescale", 1.0, 5.0, {}, 2.6e-4),  # 1.29e-4
+    ("lammps_mindlin_rescale", 1.0, 25.0, VISCOELASTIC, 2.3e-5),  # 1.14e-5
+    ("lammps_mindlin_force", 1.0, 5.0, {}, 7.1e-4),  # 3.55e-4
+    ("lammps_mindlin_force", 1.0, 25.0, VISCOELASTIC, 3.1e-5),  # 1.54e-5
+    ("lammps_mindlin_rescale_force", 1.0, 5.0, {}, 7.6e-4),  # 3.80e-4
+    ("lammps_mindlin_rescale_force", 1.0, 25.0, {}, 1.8e-6),  # 9.1e-7
+    # a crossing of the limit inside one step of the integrator: missed before (the update then
+    # stayed 3.4e-4 away at 2000 and 8000 steps), 7.5e-6 now
+    ("linear_history", 5.0, 5.0, VISCOELASTIC, 1.5e-5),
+])
+def test_the_lammps_variants_written_step_by_step_converge_to_the_solver(law, speed, angle, damping, bound):
+    # mindlin_rescale scales the displacement by a / a_old while a falls, the /force variants keep
+    # the force, dF = -k u dt: the solver's continuous forms of each (model.dem_tangential
+    # .lammps_history_rate) are what LAMMPS's update tends to
+    stiffness = {"tangential_stiffness": 50.0} if law == "linear_history" else {"shear_modulus": 3e8}
+    c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.3 if law == "linear_history" else 0.2,
+                tangential_model=law, **stiffness, **damping)
+    u_in = speed * math.sin(math.radians(angle))
+    mine = _slip(simulate_impact(c, speed, angle), c) / u_in
+    coarse, fine = (abs(_lammps_steps(c, speed, angle, n) / u_in - mine) for n in (2000, 8000))
+    assert fine < bound and coarse > 3.0 * fine
+
+
+@pytest.mark.parametrize("law, normal, speed, angle, lammps", [
+    # LAMMPS 2025.7.22 (lammps verify): e_t 0.902543, 0.902729, 0.902776 at 2000, 8000, 32000 steps
+    # per contact time, 0.902792 extrapolated (first order); microimpact stuck to the end before
+    # (a crossing of the limit in the step that ended the contact): 0.899620
+    ("lammps_mindlin_force", {"adhesion_line_force": 0.5, "normal_model": "jkr_force"}, 0.129573, 20.0, 0.902792),
+    # LAMMPS: 0.734406 and 0.734408 at 2000 and 16000 steps; microimpact at rtol 1e-8 before (a
+    # restart on the limit rounded to its outside hid the next crossing): 0.806976
+    ("lammps_mindlin", {"work_of_adhesion": 0.014441446653871828, "normal_model": "dmt", "damping_model": "mass_velocity",
+                        "damping_coefficient": 1024528.3035097125, "tangential_damping": 0.4128522629568543,
+                        "radius": 3.299439223567253e-06, "density": 2500.0, "stiffness": 312319848.95139885,
+                        "friction": 0.4425139204364359, "shear_modulus": 75504076.03797604}, 26.661956631800162,
+     47.350482141895455, 0.734408),
+])
+def test_impacts_where_a_crossing_of_the_limit_was_lost_agree_with_lammps(law, normal, speed, angle, lammps):
+    kw = {**SPHERE, "friction": 0.3, "shear_modulus": 3e8, "tangential_model": law} | normal
+    c = Contact.from_work_of_adhesion(**kw) if "work_of_adhesion" in kw else Contact(**kw)
+    r = simulate_impact(c, speed, angle)  # the default rtol, 1e-8
+    # 1e-5: LAMMPS's remaining step error at its finest run (1.6e-5 before extrapolation)
+    assert r.velocity_out[1] / r.velocity_in[1] == pytest.approx(lammps, abs=1e-5)
+
+
+def test_the_variants_differ_where_the_contact_sticks_while_it_unloads():
+    # at 5 deg the contact sticks through the unloading: the rescaled history falls with a, the
+    # force history keeps its value, so the four give four tangential outcomes (measured u_out / u_in
+    # 0.0877, 0.1007, 0.1631, 0.1482 in the order of MINDLIN_VARIANTS; all equal when sliding throughout)
+    out = []
+    for law in MINDLIN_VARIANTS:
+        c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.2, tangential_model=law, shear_modulus=3e8)
+        out.append(_slip(simulate_impact(c, 1.0, 5.0), c) / math.sin(math.radians(5.0)))
+    assert min(abs(a - b) for i, a in enumerate(out) for b in out[i + 1:]) > 3e-3
 
 
 def test_results_do_not_depend_on_the_azimuth_and_keep_the_twist():
@@ -193,6 +265,9 @@ def test_contacts_the_dem_laws_cannot_take_are_refused_by_name(changes, named):
     # 1e-15 kg / (1e-6 m 1e-12 s^2) = 1e3 Pa
     ("linear_history", {"tangential_stiffness": 30.0}, "linear_history", 1e3),
     ("lammps_mindlin", {"shear_modulus": 3e8}, "mindlin", 1e-3),
+    ("lammps_mindlin_rescale", {"shear_modulus": 3e8}, "mindlin_rescale", 1e-3),
+    ("lammps_mindlin_force", {"shear_modulus": 3e8}, "mindlin/force", 1e-3),
+    ("lammps_mindlin_rescale_force", {"shear_modulus": 3e8}, "mindlin_rescale/force", 1e-3),
 ])
 def test_the_tangential_law_is_written_in_the_units_of_its_coefficients(law, stiffness, keyword, per_si):
     c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.25, tangential_model=law, tangential_damping=0.4,
@@ -209,13 +284,12 @@ def test_the_tangential_law_is_written_in_the_units_of_its_coefficients(law, sti
 
 
 def test_random_impacts_over_the_domain_all_get_a_converged_result():
-    # radius 0.1-100 um, K 0.1-300 GPa, any of the three normal laws and four damping laws, mu
-    # 0.01-3, spin up to the rolling spin, incidence 0-89.9 deg: every impact has a result (2400
-    # such impacts measured: no failure; before the slip-frame and chatter fixes 64 of 300 failed),
-    # and it does not move when the tolerance falls 100-fold, except where the tangential damping
-    # force exceeds the friction limit hundreds of times: there the force rides the limit (stick and
-    # slip both consistent to rounding) and which one holds decides the rest of the contact. Measured
-    # over 300: one such impact (DMT, x = 1.36, mu = 0.012) moved by 3.1e-3, the others < 1e-6.
+    # radius 0.1-100 um, K 0.1-300 GPa, any of the three normal laws and four damping laws, the
+    # five LAMMPS laws, mu 0.01-3, spin up to the rolling spin, incidence 0-89.9 deg: every impact
+    # has a result (before the slip-frame and chatter fixes 64 of 300 failed), and it does not move
+    # when the tolerance falls 100-fold. Measured over 600 (two seeds): all within 1e-7. Before the
+    # crossings inside a step were looked for (solvers.dem_tangential._crossing_inside_a_step),
+    # 4 of 300 moved, by up to 0.25 (a crossing of the limit lost, LAMMPS siding with rtol 1e-10).
     from microimpact.model.dem_damping import critical_damping_coefficient
 
     rng = np.random.default_rng(7)
@@ -230,7 +304,7 @@ def test_random_impacts_over_the_domain_all_get_a_converged_result():
         if rng.random() < 0.5:
             kw |= {"tangential_model": "linear_history", "tangential_stiffness": 10 ** rng.uniform(-1, 4)}
         else:
-            kw |= {"tangential_model": "lammps_mindlin", "shear_modulus": k * 10 ** rng.uniform(-1.5, 0)}
+            kw |= {"tangential_model": str(rng.choice(MINDLIN_VARIANTS)), "shear_modulus": k * 10 ** rng.uniform(-1.5, 0)}
         v, angle = 10 ** rng.uniform(-3, 2), rng.uniform(0.0, 89.9)
         if damping != "paper":
             coef = (rng.uniform(0.05, 1.0) if damping == "coeff_restitution" else
@@ -245,7 +319,7 @@ def test_random_impacts_over_the_domain_all_get_a_converged_result():
         moved.append(np.abs(np.subtract(a.velocity_out, b.velocity_out)).max() / (v + r * np.abs(spin).max()))
         done += 1
     moved = np.array(moved)
-    assert (moved > 1e-6).sum() <= 1 and moved.max() < 1e-2, moved
+    assert moved.max() < 1e-6, moved
 
 
 # ------------------------------------------------------------------ the friction fit of a DEM law

@@ -28,6 +28,7 @@ from microimpact._entry import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_a
 from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,
                                   reporting_os_errors, same_file)
 from microimpact.model.contact import SUB_MODELS, Contact
+from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 from microimpact.model.parameters import TABLE2_CASES
 from microimpact.presets import PRESETS, get_preset
 from microimpact.solvers import DEFAULT_RTOL, METHODS, TimeBudgetExceeded
@@ -652,7 +653,7 @@ def _lammps_tangential_fields(args) -> dict:
         fields_["tangential_stiffness"] = args.tangential_stiffness
     else:
         if args.shear_modulus is None:
-            raise UsageError("--tangential-model lammps_mindlin needs --shear-modulus (G* [Pa]; LAMMPS's k_t = 8 G*)")
+            raise UsageError(f"--tangential-model {args.tangential_model} needs --shear-modulus (G* [Pa]; LAMMPS's k_t = 8 G*)")
         fields_["shear_modulus"] = args.shear_modulus
     return fields_
 
@@ -846,13 +847,13 @@ def register_lammps(sub) -> None:
                         "instead of taking the material pair's (which may then have none)")
     f.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto",
                    help="auto: the stated e_n uncertainties when given, else the scatter (default auto)")
-    f.add_argument("--tangential-model", choices=("linear_history", "lammps_mindlin"), default=None,
+    f.add_argument("--tangential-model", choices=tuple(DEM_TANGENTIAL_MODELS), default=None,
                    help="also fit the friction mu of this LAMMPS tangential law to the oblique columns (after the "
                         "normal law), and write it; needs --tangential-stiffness or --shear-modulus")
     f.add_argument("--tangential-stiffness", type=_positive_float, default=None, metavar="SI",
                    help="k_t of linear_history [N/m]")
     f.add_argument("--shear-modulus", type=_positive_float, default=None, metavar="SI",
-                   help="G* of lammps_mindlin [Pa] (LAMMPS's k_t = 8 G*)")
+                   help="G* of the lammps_mindlin laws [Pa] (LAMMPS's k_t = 8 G*)")
     f.add_argument("--tangential-damping", type=_non_negative_float, default=0.0, metavar="X",
                    help="x_gamma,t of the tangential law (default 0)")
     f.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")

@@ -52,6 +52,7 @@ from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.impacts import OBLIQUE_COLUMNS, insert_row_labels, label_variables, row_labels
 from microimpact.io.progress import progress_bar
+from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 from microimpact.solvers import DEFAULT_RTOL, Deadline, engine_threads
 
 __all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
@@ -398,7 +399,7 @@ class FrictionFit(ReportHTML):
 
     def report(self) -> str:
         """Plain-text summary: a value with its interval only where the data determine it."""
-        dem = self.tangential_model in ("linear_history", "lammps_mindlin")
+        dem = self.tangential_model in DEM_TANGENTIAL_MODELS
         lines = [f"Friction fit (LAMMPS's {self.tangential_model} tangential law), the normal law held at its values"
                  if dem else f"Friction fit ({self.tangential_model} tangential model, Eqs. (16)-(20)), after the damping fit"]
         for k, v in self.values.items():
@@ -432,7 +433,7 @@ class FrictionFit(ReportHTML):
             ds.update(status_variables(st, "1"))
         for k, v in self.values.items():
             ds[k] = xr.DataArray(v, attrs={"units": "1", "long_name": f"fitted {k} ({self.tangential_model} tangential model)"})
-            dem = self.tangential_model in ("linear_history", "lammps_mindlin")  # fit_dem_friction: no propagation
+            dem = self.tangential_model in DEM_TANGENTIAL_MODELS  # fit_dem_friction: no propagation
             ds[f"{k}_stderr"] = xr.DataArray(self.stderr[k], attrs={
                 "units": "1", "long_name": f"standard error of {k}, " + ("at the given normal law" if dem
                                                                         else "damping uncertainty propagated")})
@@ -738,7 +739,7 @@ def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress:
     problem = ObliqueProblem.from_table(table, warn=True)
     contact = contact_of(float(problem.radius[0]))
     if not uses_dem_tangential(contact):
-        raise ValueError(f"fit_dem_friction fits a DEM tangential law ('linear_history', 'lammps_mindlin'); the "
+        raise ValueError(f"fit_dem_friction fits a DEM tangential law ({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}); the "
                          f"contact has tangential_model={contact.tangential_model!r} (use fit_friction)")
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
     with progress_bar(2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20), "friction fit", progress) as advance:

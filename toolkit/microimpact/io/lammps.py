@@ -15,7 +15,8 @@ no damping (zeta_H = zeta_A = 0)       ``damping viscoelastic`` with the prefact
                                        ``tsuji`` as the identical ``coeff_restitution`` law
 no friction (f = 0)                    ``tangential linear_nohistory 0.0 0.0``
 ``tangential_model="linear_history"``  ``tangential linear_history k_t x_gamma,t f``
-``tangential_model="lammps_mindlin"``  ``tangential mindlin 8G* x_gamma,t f``
+``tangential_model="lammps_mindlin"``  ``tangential mindlin 8G* x_gamma,t f`` (and its variants
+                                       ``mindlin_rescale``, ``mindlin/force``, ``mindlin_rescale/force``)
                                        (:mod:`microimpact.model.dem_tangential`)
 =====================================  ==========================================================
 
@@ -114,7 +115,8 @@ class LammpsWallModel:
         ``coeff_restitution`` [-].
     tangential : str
         LAMMPS's tangential keyword: ``"linear_nohistory"`` (no friction: its coefficients are 0),
-        ``"linear_history"`` or ``"mindlin"``.
+        ``"linear_history"``, ``"mindlin"`` or a Mindlin variant (``"mindlin_rescale"``, ``"mindlin/force"``,
+        ``"mindlin_rescale/force"``).
     damping_model : str
         LAMMPS's damping keyword (microimpact's ``damping_model``; ``viscoelastic`` when undamped).
     tangential_stiffness : float
@@ -149,7 +151,7 @@ class LammpsWallModel:
         if self.tangential == "linear_nohistory":  # no tangential force
             tangential = "0.0 0.0"
         else:
-            stiffness_unit = pressure if self.tangential == "mindlin" else mass / time**2  # Pa, or N/m
+            stiffness_unit = mass / time**2 if self.tangential == "linear_history" else pressure  # N/m, or Pa
             tangential = f"{self.tangential_stiffness / stiffness_unit:.15g} {tangential}"
         return f"{normal} damping {self.damping_model} tangential {self.tangential} {tangential}"
 

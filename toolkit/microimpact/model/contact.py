@@ -24,6 +24,8 @@ from functools import cached_property
 
 import numpy as np
 
+from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
+
 __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_representable"]
 
 #: the selectable sub-models of the one contact law: field -> accepted names, the first (the
@@ -32,12 +34,12 @@ __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_
 #: the force reaches -F_c (as LAMMPS GRANULAR's jkr) instead of at the critical approach; "rigid" is the paper's tangentially rigid
 #: contact (closed-form tangential map), "mindlin" an elastic tangential contact with micro-slip,
 #: "mindlin_deresiewicz" the same with the loading/unloading/reloading memory (hysteresis),
-#: "linear_history" and "lammps_mindlin" LAMMPS GRANULAR's history laws (model.dem_tangential);
+#: "linear_history" and the "lammps_mindlin*" variants LAMMPS GRANULAR's history laws (model.dem_tangential);
 #: "net" is the paper's Coulomb limit f |F_n|, "pulloff" an adhesion-aware limit that does not vanish
 #: at the adhesive equilibrium.
 SUB_MODELS: dict[str, tuple[str, ...]] = {
     "normal_model": ("ring", "jkr", "dmt", "jkr_force"),
-    "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", "linear_history", "lammps_mindlin"),
+    "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", *DEM_TANGENTIAL_MODELS),
     "friction_model": ("net", "pulloff"),
     "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
 }
@@ -162,10 +164,11 @@ class Contact:
     normal_model : {"ring", "jkr", "dmt", "jkr_force"}
         Normal adhesion model (:data:`SUB_MODELS`); "ring" is the paper's; "jkr_force" is JKR with the
         force-controlled break of DEM engines (:mod:`microimpact.model.adhesion_models`). [-]
-    tangential_model : {"rigid", "mindlin", "mindlin_deresiewicz", "linear_history", "lammps_mindlin"}
+    tangential_model : {"rigid", "mindlin", "mindlin_deresiewicz", "linear_history", "lammps_mindlin", ...}
         Tangential contact model; "rigid" is the paper's; "mindlin_deresiewicz" adds the hysteresis
         of micro-slip (:mod:`microimpact.model.tangential_compliance`); "linear_history" and
-        "lammps_mindlin" are LAMMPS GRANULAR's history laws (:mod:`microimpact.model.dem_tangential`),
+        "lammps_mindlin" (with its variants "lammps_mindlin_rescale", "lammps_mindlin_force",
+        "lammps_mindlin_rescale_force") are LAMMPS GRANULAR's history laws (:mod:`microimpact.model.dem_tangential`),
         with LAMMPS's normal laws only (ring without adhesion, "jkr_force", "dmt"; no paper damping). [-]
     friction_model : {"net", "pulloff"}
         Coulomb friction limit; "net" (f |F_n|) is the paper's. [-]
@@ -248,13 +251,13 @@ class Contact:
     def _check_dem_tangential(self) -> None:
         """The DEM tangential laws with their own parameters and LAMMPS's normal laws (model.dem_tangential)."""
         model = self.tangential_model
-        dem = model in ("linear_history", "lammps_mindlin")
+        dem = model in DEM_TANGENTIAL_MODELS
         if (model == "linear_history") != (self.tangential_stiffness is not None):
             raise ValueError("tangential_stiffness (k_t [N/m]) belongs to tangential_model='linear_history', and that "
                              f"law needs it: got tangential_model={model!r}, tangential_stiffness={self.tangential_stiffness!r}")
         if self.tangential_damping != 0.0 and not dem:
             raise ValueError(f"tangential_damping={self.tangential_damping!r} belongs to the DEM tangential laws "
-                             f"('linear_history', 'lammps_mindlin'), got tangential_model={model!r}")
+                             f"({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}), got tangential_model={model!r}")
         if not dem:
             return
         other = []

@@ -3,14 +3,19 @@ Mindlin laws of :mod:`microimpact.model.tangential_compliance`.
 
 A :class:`~microimpact.model.contact.Contact` selects one with ``tangential_model``:
 
-=========================== ============================ ======================================
-``tangential_model``        LAMMPS (``pair_style         stiffness k of the history spring
-                            granular``, ``tangential``)
-=========================== ============================ ======================================
-``"linear_history"``        ``linear_history k x mu``    k = ``tangential_stiffness`` [N/m]
-``"lammps_mindlin"``        ``mindlin 8G* x mu``         k = 8 G* a (``shear_modulus`` G*,
-                                                         a the normal law's contact radius)
-=========================== ============================ ======================================
+================================== ===================================== ===============================
+``tangential_model``               LAMMPS (``pair_style granular``,      stiffness k of the history
+                                   ``tangential``)                       spring
+================================== ===================================== ===============================
+``"linear_history"``               ``linear_history k x mu``             k = ``tangential_stiffness``
+                                                                         [N/m]
+``"lammps_mindlin"``               ``mindlin 8G* x mu``                  k = 8 G* a (``shear_modulus``
+                                                                         G*, a the normal law's
+                                                                         contact radius)
+``"lammps_mindlin_rescale"``       ``mindlin_rescale 8G* x mu``          8 G* a
+``"lammps_mindlin_force"``         ``mindlin/force 8G* x mu``            8 G* a
+``"lammps_mindlin_rescale_force"`` ``mindlin_rescale/force 8G* x mu``    8 G* a
+================================== ===================================== ===============================
 
 Both keep a history xi, the tangential displacement of the contact point since first touch
 (LAMMPS's ``history``), and give the force
@@ -35,6 +40,15 @@ the limit. Their friction limit is F_n0 above, where microimpact's is f |F_n| ("
 f |F_n + 2 F_po| ("pulloff"). The paper's contact is tangentially rigid. For a contact that slides
 throughout, all give the same impulse f int F_n0 dt.
 
+The Mindlin variants differ in what the history H is and how it follows the contact radius
+(:func:`lammps_history_rate`, :func:`lammps_elastic_force`): ``mindlin`` and ``mindlin_rescale``
+store the displacement, F_e = -k H with dH/dt = u, so that the force falls with k = 8 G* a as the
+contact shrinks; the ``/force`` variants store the elastic force itself, dH/dt = -k u (Thornton et
+al. 2013, Eq. 18), which keeps its value as a falls; the ``rescale`` variants scale H by a_new / a_old
+while a falls (LAMMPS: ``history *= a / a_old`` at each step of unloading), dH/dt gaining
+(da/dt / a) H there, so that the stored energy does not outlive the contact that held it (the
+displacement form then falls as a^2, the force form as a).
+
 In continuous time (the limit of LAMMPS's step, which the solver follows,
 :mod:`microimpact.solvers.dem_tangential`): in stick, d xi / dt = u; in slide, the force stays on
 the limit, F_t = mu F_n0 e, and its direction e turns with the part of the trial force's rate
@@ -51,6 +65,10 @@ LAMMPS documentation, ``pair_style granular``, tangential models (version 22 Jul
 https://docs.lammps.org/pair_granular.html; source src/GRANULAR/gran_sub_mod_tangential.cpp and
 gran_sub_mod_normal.cpp (``set_fncrit``).
 
+Thornton, C., Cummins, S. J. and Cleary, P. W. (2013), An investigation of the comparative behaviour
+of alternative contact force models during inelastic collisions, Powder Technol. 233:30-46,
+doi:10.1016/j.powtec.2012.08.012.
+
 Luding, S. (2008), Cohesive, frictional powders: contact models for tension, Granular Matter
 10:235-246, doi:10.1007/s10035-008-0099-x.
 
@@ -63,11 +81,18 @@ import math
 
 import numpy as np
 
-__all__ = ["DEM_TANGENTIAL_MODELS", "lammps_tangential_stiffness", "lammps_critical_normal_force",
-           "lammps_tangential_force"]
+__all__ = ["DEM_TANGENTIAL_MODELS", "FORCE_HISTORY_MODELS", "RESCALED_MODELS", "lammps_tangential_stiffness",
+           "lammps_critical_normal_force", "lammps_tangential_force", "lammps_elastic_force",
+           "lammps_history_of_force", "lammps_history_rate"]
 
 #: the DEM tangential laws (Contact.tangential_model), with their LAMMPS names
-DEM_TANGENTIAL_MODELS = {"linear_history": "linear_history", "lammps_mindlin": "mindlin"}
+DEM_TANGENTIAL_MODELS = {"linear_history": "linear_history", "lammps_mindlin": "mindlin",
+                         "lammps_mindlin_rescale": "mindlin_rescale", "lammps_mindlin_force": "mindlin/force",
+                         "lammps_mindlin_rescale_force": "mindlin_rescale/force"}
+#: the laws whose history is the elastic force (LAMMPS's ``/force`` variants), not the displacement
+FORCE_HISTORY_MODELS = frozenset({"lammps_mindlin_force", "lammps_mindlin_rescale_force"})
+#: the laws whose history is scaled by a_new / a_old while the contact radius falls
+RESCALED_MODELS = frozenset({"lammps_mindlin_rescale", "lammps_mindlin_rescale_force"})
 
 
 def lammps_tangential_stiffness(tangential_model: str, stiffness: float, contact_radius):
@@ -75,15 +100,16 @@ def lammps_tangential_stiffness(tangential_model: str, stiffness: float, contact
 
     Parameters
     ----------
-    tangential_model : {"linear_history", "lammps_mindlin"}
+    tangential_model : str
+        One of :data:`DEM_TANGENTIAL_MODELS`.
     stiffness : float
-        LAMMPS's k_t: [N/m] for ``linear_history``; 8 G* [Pa] for ``lammps_mindlin``.
+        LAMMPS's k_t: [N/m] for ``linear_history``; 8 G* [Pa] for the Mindlin variants.
     contact_radius : float or ndarray
         Contact radius a of the normal law. [m]
 
     Returns
     -------
-    k_t for ``linear_history``, k_t a for ``lammps_mindlin``. [N/m]
+    k_t for ``linear_history``, k_t a for the Mindlin variants. [N/m]
 
     References
     ----------
@@ -98,7 +124,7 @@ def lammps_tangential_stiffness(tangential_model: str, stiffness: float, contact
     """
     if tangential_model == "linear_history":
         return stiffness
-    if tangential_model == "lammps_mindlin":
+    if tangential_model in DEM_TANGENTIAL_MODELS:
         return stiffness * contact_radius
     raise ValueError(f"tangential_model must be one of {', '.join(map(repr, DEM_TANGENTIAL_MODELS))}, "
                      f"got {tangential_model!r}")
@@ -139,14 +165,16 @@ def lammps_critical_normal_force(elastic_force, damping_force, pulloff_force):
     return abs(elastic_force + damping_force)
 
 
-def lammps_tangential_force(history, slip_velocity, stiffness: float, damping: float, limit: float):
+def lammps_tangential_force(history, slip_velocity, stiffness: float, damping: float, limit: float,
+                            tangential_model: str = "lammps_mindlin"):
     """Force and history of one evaluation of LAMMPS's history laws: the trial force, scaled to
     the limit if it exceeds it, and the history reset to the scaled force's elastic part.
 
     Parameters
     ----------
     history : array_like, shape (..., 2)
-        Tangential displacement xi after the step's update (xi + u dt). [m]
+        History H after the step's update: the displacement xi (+ u dt) [m], or for the ``/force``
+        variants (:data:`FORCE_HISTORY_MODELS`) the elastic force (- k u dt) [N].
     slip_velocity : array_like, shape (..., 2)
         Velocity u of the contact point relative to the wall. [m/s]
     stiffness : float
@@ -155,11 +183,13 @@ def lammps_tangential_force(history, slip_velocity, stiffness: float, damping: f
         eta_t = x_gamma,t eta_n. [kg/s]
     limit : float
         mu F_n0. [N]
+    tangential_model : str
+        One of :data:`DEM_TANGENTIAL_MODELS` (which history H is). [-]
 
     Returns
     -------
     force, history : ndarray
-        F_t [N] and the history to keep [m].
+        F_t [N] and the history to keep [m] or [N].
 
     References
     ----------
@@ -178,11 +208,113 @@ def lammps_tangential_force(history, slip_velocity, stiffness: float, damping: f
     xi = np.array(history, dtype=float)
     u = np.asarray(slip_velocity, dtype=float)
     damp = -damping * u
-    force = -stiffness * xi + damp
+    force = lammps_elastic_force(tangential_model, xi, stiffness) + damp
     size = np.linalg.norm(force, axis=-1, keepdims=True)
     over = (size > limit) & (np.linalg.norm(xi, axis=-1, keepdims=True) > 0.0)
     scale = np.where(over, limit / np.where(size > 0.0, size, 1.0), 1.0)
     force = force * scale
-    if stiffness > 0.0:
-        xi = np.where(over, -(force - damp) / stiffness, xi)
+    if stiffness > 0.0 or tangential_model in FORCE_HISTORY_MODELS:
+        xi = np.where(over, lammps_history_of_force(tangential_model, force - damp, stiffness), xi)
     return force, xi
+
+
+def lammps_elastic_force(tangential_model: str, history, stiffness):
+    """Elastic part of the tangential force of a DEM law, F_e = -k H, or H for the ``/force``
+    variants, whose history is that force. [N]
+
+    Parameters
+    ----------
+    tangential_model : str
+        One of :data:`DEM_TANGENTIAL_MODELS`.
+    history : float or ndarray
+        H: displacement [m], or force [N] (:data:`FORCE_HISTORY_MODELS`).
+    stiffness : float
+        k of the spring now (:func:`lammps_tangential_stiffness`). [N/m]
+
+    Any consistent units serve (the solver calls it in the normal law's units).
+
+    References
+    ----------
+    LAMMPS source, src/GRANULAR/gran_sub_mod_tangential.cpp, ``GranSubModTangentialMindlin``.
+
+    Examples
+    --------
+    >>> lammps_elastic_force("lammps_mindlin", 2e-9, 100.0) * 1e7, lammps_elastic_force("lammps_mindlin_force", -2e-7, 100.0) * 1e7
+    (-2.0, -2.0)
+    """
+    if tangential_model in FORCE_HISTORY_MODELS:
+        return history
+    return -stiffness * history
+
+
+def lammps_history_of_force(tangential_model: str, elastic_force, stiffness):
+    """The history that gives the elastic force ``elastic_force``: the inverse of
+    :func:`lammps_elastic_force` (LAMMPS's reset of the history where the force is scaled to the
+    limit). [m] or [N]
+
+    Parameters
+    ----------
+    tangential_model : str
+        One of :data:`DEM_TANGENTIAL_MODELS`.
+    elastic_force : float or ndarray
+        F_e. [N]
+    stiffness : float
+        k of the spring now, > 0 for the displacement histories. [N/m]
+
+    References
+    ----------
+    LAMMPS source, src/GRANULAR/gran_sub_mod_tangential.cpp, ``GranSubModTangentialMindlin``.
+
+    Examples
+    --------
+    >>> round(lammps_history_of_force("lammps_mindlin", -2e-7, 100.0) * 1e9, 12), lammps_history_of_force("lammps_mindlin_force", -2e-7, 100.0) * 1e7
+    (2.0, -2.0)
+    """
+    if tangential_model in FORCE_HISTORY_MODELS:
+        return elastic_force
+    return -elastic_force / stiffness
+
+
+def lammps_history_rate(tangential_model: str, history, slip_velocity, stiffness, radius_rate):
+    """dH/dt of a stuck contact: the continuous-time limit of LAMMPS's history update. [m/s] or [N/s]
+
+    u for a displacement history, -k u for a ``/force`` history (:data:`FORCE_HISTORY_MODELS`);
+    the ``rescale`` variants (:data:`RESCALED_MODELS`) add (da/dt / a) H while the contact radius
+    falls (LAMMPS scales H by a_new / a_old at each such step).
+
+    Parameters
+    ----------
+    tangential_model : str
+        One of :data:`DEM_TANGENTIAL_MODELS`.
+    history : float or ndarray
+        H. [m] or [N]
+    slip_velocity : float or ndarray
+        u, the velocity of the contact point relative to the wall. [m/s]
+    stiffness : float
+        k of the spring now. [N/m]
+    radius_rate : float
+        (da/dt) / a of the contact radius. [1/s]
+
+    Any consistent units serve; the solver passes rates per its own time variable.
+
+    References
+    ----------
+    LAMMPS source, src/GRANULAR/gran_sub_mod_tangential.cpp, ``GranSubModTangentialMindlin``
+    (``mindlin_force``, ``mindlin_rescale``); Thornton et al. (2013), Eq. (18).
+
+    Examples
+    --------
+    Unloading at da/dt / a = -100 1/s with a displacement history of 1 nm and no slip: only the
+    rescaled law lets it fall, at -1e-7 m/s:
+
+    >>> lammps_history_rate("lammps_mindlin", 1e-9, 0.0, 50.0, -100.0)
+    0.0
+    >>> round(lammps_history_rate("lammps_mindlin_rescale", 1e-9, 0.0, 50.0, -100.0), 20)
+    -1e-07
+    >>> lammps_history_rate("lammps_mindlin_force", 0.0, 2e-3, 50.0, -100.0)  # -k u
+    -0.1
+    """
+    rate = -stiffness * slip_velocity if tangential_model in FORCE_HISTORY_MODELS else slip_velocity
+    if tangential_model in RESCALED_MODELS and radius_rate < 0.0:
+        rate = rate + radius_rate * history
+    return rate

@@ -25,6 +25,8 @@ import sys
 import time
 from dataclasses import dataclass
 
+from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
+
 #: The one default relative tolerance of every entry point (API, CLI, pipeline config ``rtol``).
 #: At 1e-8 the engine's e_n and impulse ratios are within about 5e-8 of the reference solution
 #: (docs/benchmark.md), far below any measurement's uncertainty, at half the cost of 1e-10.
@@ -183,7 +185,7 @@ SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
     # every other tangential/friction choice with the compiled coupled solver (.coupled), which
     # integrates the ring normal law only (check_sub_models refuses jkr/dmt with it)
     "engine": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"),
-               "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", "linear_history", "lammps_mindlin"),
+               "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", *DEM_TANGENTIAL_MODELS),
                "friction_model": ("net", "pulloff"),
                "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution")},
     "reference": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"), "tangential_model": ("rigid",), "friction_model": ("net",),
@@ -216,7 +218,7 @@ def check_sub_models(contact, method: str) -> None:
         raise ValueError(f"rolling_friction={contact.rolling_friction!r} needs a compliant tangential model "
                          f"(tangential_model one of {', '.join(map(repr, ROLLING_RESISTANCE_TANGENTIAL_MODELS))}), "
                          f"got tangential_model={contact.tangential_model!r}")
-    if contact.tangential_model in ("linear_history", "lammps_mindlin"):  # with LAMMPS's normal laws (Contact checks)
+    if contact.tangential_model in DEM_TANGENTIAL_MODELS:  # with LAMMPS's normal laws (Contact checks)
         return
     if contact.damping_model != "paper" and (contact.tangential_model != "rigid" or contact.friction_model != "net"):
         raise ValueError(f"damping_model={contact.damping_model!r} runs with the paper's tangential map only "

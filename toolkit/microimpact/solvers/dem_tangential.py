@@ -10,13 +10,14 @@ force depends on the normal state at every instant; it is integrated here with t
 Formulation. The normal law in its own units and Sundman variable (:mod:`microimpact.solvers.normal_models`: state
 q = sqrt(a / a_c) for JKR, s = sqrt(delta / L) for DMT and Hertz, rate y), with the tangential
 state in the same units: the slip velocity u (2 components, units L / T) and, in stick, the
-history xi (units L), in slide the direction e of the force (a unit vector), the force being
-mu F_n0 e there. With kappa = 1 + m r^2 / I (the slip responds to a tangential force F as
-du/dt = kappa F / m):
+history H (the displacement xi, units L, or for the ``/force`` variants the elastic force, units F),
+in slide the direction e of the force (a unit vector), the force being mu F_n0 e there. With
+kappa = 1 + m r^2 / I (the slip responds to a tangential force F as du/dt = kappa F / m):
 
-* stick: F = -k xi - eta_t u, d xi / dt = u, du / dt = kappa F;
+* stick: F = F_e(H) - eta_t u, dH/dt of the law (:func:`~microimpact.model.dem_tangential.lammps_history_rate`:
+  u, or -k u; plus (da/dt / a) H while a falls for the rescaled variants), du / dt = kappa F;
 * slide: F = mu F_n0 e, du / dt = kappa F, de / dt = (1 - e e^T) G' / (mu F_n0), G' the rate of the
-  trial force -k xi - eta_t u with xi = -(F + eta_t u) / k its history.
+  trial force F_e(H) - eta_t u with H the history of the elastic part F + eta_t u.
 
 The tangential problem is one-dimensional: the wall is isotropic, the history starts at 0 and the
 force acts on the slip alone (no twisting or rolling torque), so xi, u and F stay on the line of the
@@ -35,10 +36,14 @@ integrator of its own beside the compiled ones (the one-core issue, docs/guide/l
 (tens of ms per impact) and without the engine's overdamped limits: an impact whose normal motion
 creeps (tens of thousands of critical dampings) ends in a :class:`DemTangentialError`.
 
-Conditioning: where the tangential damping force exceeds the friction limit hundreds of times, the
-force rides the limit with stick and slip both consistent to rounding, and which one holds decides
-the rest of the contact (one random impact in 300 moved by 3e-3 between rtol 1e-8 and 1e-10;
-tests/test_dem_tangential.py). A switch undone at once is ridden through (``_CHATTER_SPAN``).
+Events are located by sign changes between the ends of a step, and after a switch the state
+starts on the limit (the switch function is 0 to rounding): a crossing inside one step, in the
+step that ends the contact, or after a restart rounded to the wrong side was lost, and the
+outcome then depended on the tolerance (4 of 300 random impacts moved by up to 0.25 between rtol
+1e-8 and 1e-10, LAMMPS siding with the finer). Each stick phase is therefore integrated with dense
+output and its maxima of |F| - mu F_n0 and its last instant are checked (``_crossing_inside_a_step``);
+600 random impacts now move by less than 1e-7 (tests/test_dem_tangential.py). A switch undone at
+once is ridden through (``_CHATTER_SPAN``).
 
 A captured sphere (JKR, DMT) ends at rest on the wall, with the limit 2 mu F_po > 0 there: the
 slip stops in finite time and the sphere rolls, so its tangential outcome is the rolling state,
@@ -61,7 +66,8 @@ import math
 import numpy as np
 
 from microimpact.model import adhesion_models as am
-from microimpact.model.dem_tangential import (DEM_TANGENTIAL_MODELS, lammps_critical_normal_force,
+from microimpact.model.dem_tangential import (DEM_TANGENTIAL_MODELS, FORCE_HISTORY_MODELS, lammps_critical_normal_force,
+                                              lammps_elastic_force, lammps_history_of_force, lammps_history_rate,
                                               lammps_tangential_stiffness)
 from microimpact.solvers import SolverError
 
@@ -78,6 +84,8 @@ _MAX_EVALUATIONS = 2_000_000
 _CHATTER_SPAN = 1e-7
 #: span of the Sundman variable given to scipy: the contact ends by its event long before
 _SIGMA_SPAN = 1e7
+#: points of the dense output scanned for the force inside the limit after a restart on it
+_SCAN_POINTS = 257
 #: JKR's state where LAMMPS's contact breaks, q^3 = 3 (F = -F_c)
 _Q_BREAK = am.JKR_Q_BREAK["jkr_force"]
 
@@ -111,6 +119,7 @@ class _Law:
         length = float(sc.length)
         # k in the law's units, F / L, from the model's k(a) in SI: k = k0 + k1 a (a in its unit)
         self.model = contact.tangential_model
+        self.force_history = self.model in FORCE_HISTORY_MODELS
         self.k_param = (contact.tangential_stiffness if self.model == "linear_history" else 8.0 * contact.shear_modulus)
         self.k_unit, self.a_unit = force / length, float(sc.radius)
         self.k0 = lammps_tangential_stiffness(self.model, self.k_param, 0.0) / self.k_unit
@@ -155,11 +164,13 @@ class _Law:
 
 
 def _rhs_and_switch(law, x, mode):
-    """(d/dsigma of the state, the switch function of ``mode``) at the state x.
+    """(d/dsigma of the state, the switch function of ``mode``, the rate of stick's switch) at x.
 
     The switch functions are relative, in [-1, 1]: (|F| - mu F_n0) / (|F| + mu F_n0) in stick, and
     (e . G' - (mu F_n0)') / (|e . G'| + |(mu F_n0)'|) in slide, so that their zeros stay well
-    conditioned where force and limit both vanish (Hertz at touch and separation, like s^3)."""
+    conditioned where force and limit both vanish (Hertz at touch and separation, like s^3). The
+    third value is that of slide with e = F / |F| in stick: the sign of the rate of |F| - mu F_n0,
+    whose maxima ``_integrate`` watches for a crossing of the limit inside one step."""
     z, y, s1, s2, u1, u2 = x[0], x[1], x[2], x[3], x[4], x[5]
     g, dz, a, da, eta, deta, dy, n0, dn0 = law.normal(z, y)
     cap, dcap = law.mu * n0, law.mu * dn0
@@ -167,24 +178,42 @@ def _rhs_and_switch(law, x, mode):
     k = law.stiffness(a)
     out = np.empty(7)
     out[0], out[1], out[6] = dz, dy, g
+    # (da/dsigma) / a, for the rescaled histories (model.dem_tangential.lammps_history_rate)
+    radius_rate = da / a if a > 0.0 else 0.0
     if mode == _STICK:
-        f1, f2 = -k * s1 - eta_t * u1, -k * s2 - eta_t * u2
-        out[2], out[3] = g * u1, g * u2
+        h1, h2 = s1, s2
+        f1 = lammps_elastic_force(law.model, h1, k) - eta_t * u1
+        f2 = lammps_elastic_force(law.model, h2, k) - eta_t * u2
         size = math.hypot(f1, f2)
+        e1, e2 = (f1 / size, f2 / size) if size > 0.0 else (0.0, 0.0)
         switch = (size - cap) / (size + cap) if size + cap > 0.0 else -1.0
     else:
         norm = math.hypot(s1, s2)
         e1, e2 = s1 / norm, s2 / norm
         f1, f2 = cap * e1, cap * e2
-        du1, du2 = g * law.kappa * f1, g * law.kappa * f2
-        dk = law.k1 * da
-        if k > 0.0:
-            xi1, xi2 = -(f1 + eta_t * u1) / k, -(f2 + eta_t * u2) / k
+        # the history the force on the limit leaves (model.dem_tangential: LAMMPS resets it to the
+        # elastic part of the scaled force)
+        fe1, fe2 = f1 + eta_t * u1, f2 + eta_t * u2
+        if law.force_history or k > 0.0:
+            h1, h2 = lammps_history_of_force(law.model, fe1, k), lammps_history_of_force(law.model, fe2, k)
         else:  # first touch of a Mindlin spring (a = 0): no history yet
-            xi1 = xi2 = 0.0
-        g1 = -dk * xi1 - k * g * u1 - deta_t * u1 - eta_t * du1
-        g2 = -dk * xi2 - k * g * u2 - deta_t * u2 - eta_t * du2
-        along = e1 * g1 + e2 * g2
+            h1 = h2 = 0.0
+    du1, du2 = g * law.kappa * f1, g * law.kappa * f2
+    dh1 = lammps_history_rate(law.model, h1, g * u1, k, radius_rate)
+    dh2 = lammps_history_rate(law.model, h2, g * u2, k, radius_rate)
+    # G', the rate of the trial force F_e(H) - eta_t u
+    if law.force_history:
+        dfe1, dfe2 = dh1, dh2
+    else:
+        dk = law.k1 * da
+        dfe1, dfe2 = -dk * h1 - k * dh1, -dk * h2 - k * dh2
+    g1 = dfe1 - deta_t * u1 - eta_t * du1
+    g2 = dfe2 - deta_t * u2 - eta_t * du2
+    along = e1 * g1 + e2 * g2
+    rate = (along - dcap) / (abs(along) + abs(dcap)) if abs(along) + abs(dcap) > 0.0 else 1.0
+    if mode == _STICK:
+        out[2], out[3] = dh1, dh2
+    else:
         # the direction turns at (1 - e e^T) G' / (mu F_n0); where the limit is below cap_floor (a
         # tolerance's part of the largest limit) the turning is taken at cap_floor: a force that small
         # moves the outcome by less than the tolerance whatever its direction, while 1 / (mu F_n0)
@@ -192,9 +221,9 @@ def _rhs_and_switch(law, x, mode):
         # doubles (23 of 120 random planar impacts before)
         turn = max(cap, law.cap_floor)
         out[2], out[3] = (g1 - along * e1) / turn, (g2 - along * e2) / turn
-        switch = (along - dcap) / (abs(along) + abs(dcap)) if abs(along) + abs(dcap) > 0.0 else 1.0
-    out[4], out[5] = g * law.kappa * f1, g * law.kappa * f2
-    return out, switch
+        switch = rate
+    out[4], out[5] = du1, du2
+    return out, switch, rate
 
 
 def _separation(law, x):
@@ -219,7 +248,10 @@ def _start_mode(law, x):
         probe[0] = 0.5 * x[1] * sigma
         tau = 0.25 * x[1] * sigma * sigma
     probe[2:4] = x[4:6] * tau
-    _, switch = _rhs_and_switch(law, probe, _STICK)
+    if law.force_history:  # H = -int k u dt, with k ~ a ~ t^(1/2) for Hertz and DMT, ~ const for JKR
+        k = law.stiffness(law.normal(probe[0], probe[1])[2])
+        probe[2:4] *= -k * (1.0 if law.jkr else 2.0 / 3.0)
+    switch = _rhs_and_switch(law, probe, _STICK)[1]
     if switch <= 0.0:
         return _STICK, 0.0
     # sliding from touch; against the slip, except where LAMMPS's Mindlin spring starts at a = 0
@@ -228,7 +260,9 @@ def _start_mode(law, x):
     # force k a xi it gives grows with a / a_touch, which carries the trial force across the limit
     # at once: the force starts at the limit along the slip (LAMMPS converges to this as its step
     # falls: e_t 0.73763, 0.73631, 0.73628 at 500, 8000, 128000 steps per contact, DMT, 60 deg)
-    forward = law.k1 > 0.0 and not law.jkr and law.c3 > 0.0 and law.p3 < 1.0 and law.x_t > 0.0
+    # (a force history is reset to the elastic force itself, without the 1 / a: no such start)
+    forward = (law.k1 > 0.0 and not law.force_history and not law.jkr and law.c3 > 0.0 and law.p3 < 1.0
+               and law.x_t > 0.0)
     return _SLIDE, (1.0 if forward else -1.0)
 
 
@@ -245,7 +279,9 @@ def _integrate(law, u0, rtol, tau_scale, z_scale):
     if mode == _SLIDE:
         x[2:4] = direction * np.asarray(u0) / math.hypot(*u0)
     speed = max(math.hypot(*u0), 1e-300)
-    history = speed * tau_scale
+    history = speed * tau_scale  # a displacement's scale; a force history's is k at the largest contact
+    if law.force_history:
+        history *= law.stiffness(z_scale**2 if law.jkr else z_scale)
     evaluations = [0]
     sigma, switches, events, slide_end = 0.0, 0, 0, math.nan
 
@@ -263,8 +299,14 @@ def _integrate(law, u0, rtol, tau_scale, z_scale):
             return -1.0 if mode == _STICK else 1.0
         return _rhs_and_switch(law, state, mode)[1]
 
+    def peak(_, state):  # a maximum of |F| - mu F_n0 in stick (its rate falls through 0)
+        if _separation(law, state) <= 0.0:
+            return 1.0
+        return _rhs_and_switch(law, state, _STICK)[2]
+
     separation.terminal, separation.direction = True, -1.0
     switch.terminal = True
+    peak.direction = -1.0
     last, repeats = -math.inf, 0
     while True:
         switch.direction = 1.0 if mode == _STICK else -1.0
@@ -274,17 +316,22 @@ def _integrate(law, u0, rtol, tau_scale, z_scale):
         # the limit's, h = 0 touched without crossing): the motion is the same in both to first
         # order, so the new mode is kept over a short stretch with its switch event off
         span = _CHATTER_SPAN * max(sigma, 1.0) if repeats >= 2 else _SIGMA_SPAN
-        sol = solve_ivp(rhs, (sigma, sigma + span), x, method="DOP853", rtol=rtol,
-                        atol=atol, events=(separation,) if repeats >= 2 else (separation, switch))
+        watch = mode == _STICK and repeats < 2
+        sol = solve_ivp(rhs, (sigma, sigma + span), x, method="DOP853", rtol=rtol, atol=atol, dense_output=watch,
+                        events=(separation,) if repeats >= 2 else (separation, switch, peak) if watch else (separation, switch))
         if sol.status == 0 and repeats >= 2:  # the stretch is done: watch for switches again
             sigma, x, repeats = float(sol.t[-1]), sol.y[:, -1].copy(), 0
             continue
         if sol.status != 1:
             raise DemTangentialError(f"DEM tangential integration stopped: {sol.message}")
-        if sol.t_events[0].size:
+        missed = _crossing_inside_a_step(sol, sigma, switch) if watch else None
+        if missed is not None:
+            sigma, x = missed
+        elif sol.t_events[0].size:
             end = sol.y_events[0][0]
             return end[4:6], end[6], (slide_end if mode == _STICK else math.nan), switches, mode == _STICK
-        sigma, x = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
+        else:
+            sigma, x = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
         repeats = repeats + 1 if sigma - last <= 1e-12 * max(sigma, 1.0) else 0
         last = sigma
         events += 1
@@ -293,16 +340,53 @@ def _integrate(law, u0, rtol, tau_scale, z_scale):
         _, _, a, _, eta, _, _, n0, _ = law.normal(x[0], x[1])
         eta_t = law.x_t * eta
         if mode == _STICK:  # the force reached the limit: slide along it, unless it only grazes it
-            f = -law.stiffness(a) * x[2:4] - eta_t * x[4:6]
+            f = lammps_elastic_force(law.model, x[2:4], law.stiffness(a)) - eta_t * x[4:6]
             sliding = x.copy()
             sliding[2:4] = f / math.hypot(*f)
             if _rhs_and_switch(law, sliding, _SLIDE)[1] > 0.0:
                 x, mode, switches = sliding, _SLIDE, switches + 1
         else:  # the trial force turns inwards: stick, with the history of the force on the limit
             e = x[2:4] / math.hypot(*x[2:4])
-            x[2:4] = -(law.mu * n0 * e + eta_t * x[4:6]) / law.stiffness(a)
+            x[2:4] = lammps_history_of_force(law.model, law.mu * n0 * e + eta_t * x[4:6], law.stiffness(a))
             mode, switches = _STICK, switches + 1
             slide_end = x[6]
+
+
+def _crossing_inside_a_step(sol, start, switch):
+    """(sigma, state) where stick's force first reached the limit unseen by the events, or None.
+
+    scipy's events see a sign change of the switch function only between the ends of a step, and
+    past the end of contact the switch function is held negative (the law is not defined there).
+    A crossing of the limit in the step that ends the contact, or an excursion of |F| above
+    mu F_n0 that begins and ends inside one step, was therefore lost (LAMMPS's JKR with
+    mindlin/force, 0.13 m/s, 20 deg: stuck to the end with |F| 9 % above the limit there, e_t
+    0.8998 against LAMMPS's 0.9029). Each maximum of |F| - mu F_n0 (``peak``) and the last
+    instant of contact are therefore checked on the dense output; where one lies above the
+    limit, the first crossing before it is the switch."""
+    from scipy.optimize import brentq
+
+    tops = list(sol.t_events[2])
+    if sol.t_events[0].size:  # the contact ended: look just inside its end
+        end = float(sol.t_events[0][0])
+        tops = [t for t in tops if t < end] + [end - 1e-9 * (end - start)]
+    lo = start
+    for top in tops:
+        if top <= lo or switch(top, sol.sol(top)) <= 0.0:
+            lo = max(lo, top)
+            continue
+        if switch(lo, sol.sol(lo)) > 0.0:
+            # on the limit at the start (just stuck again), above it by rounding: the events saw no
+            # sign change. Where the force went inside the limit, the crossing is after that; where
+            # it never did, the contact slides on at once (DMT, mass_velocity, 47 deg: the crossing
+            # 0.4 contact times in was lost this way, e_t 0.8070 at rtol 1e-8 against 0.7344, LAMMPS's
+            # 0.73441 at 2000 and 16000 steps)
+            inside = next((t for t in np.linspace(lo, top, _SCAN_POINTS)[1:-1] if switch(t, sol.sol(t)) < 0.0), None)
+            if inside is None:
+                return lo, sol.sol(lo)
+            lo = inside
+        root = brentq(lambda t: switch(t, sol.sol(t)), lo, top, xtol=1e-15 * max(abs(top), 1.0), rtol=1e-15)
+        return root, sol.sol(root)
+    return None
 
 
 def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict:
@@ -311,7 +395,7 @@ def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict
     Parameters
     ----------
     contact : Contact
-        ``tangential_model`` "linear_history" or "lammps_mindlin".
+        ``tangential_model`` one of :data:`~microimpact.model.dem_tangential.DEM_TANGENTIAL_MODELS`.
     velocity_in : tuple of 3 float
         (v_n, v_t, v_t') before contact, v_n < 0. [m/s]
     omega_in : tuple of 3 float
