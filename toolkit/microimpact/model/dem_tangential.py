@@ -82,7 +82,7 @@ import math
 import numpy as np
 
 __all__ = ["DEM_TANGENTIAL_MODELS", "FORCE_HISTORY_MODELS", "RESCALED_MODELS", "lammps_tangential_stiffness",
-           "lammps_critical_normal_force", "lammps_tangential_force", "lammps_elastic_force",
+           "lammps_pulloff_force", "lammps_critical_normal_force", "lammps_critical_normal_force_rate", "lammps_tangential_force", "lammps_elastic_force",
            "lammps_history_of_force", "lammps_history_rate"]
 
 #: the DEM tangential laws (Contact.tangential_model), with their LAMMPS names
@@ -163,6 +163,69 @@ def lammps_critical_normal_force(elastic_force, damping_force, pulloff_force):
     if pulloff_force > 0.0:
         return abs(elastic_force + 2.0 * pulloff_force)
     return abs(elastic_force + damping_force)
+
+
+def lammps_pulloff_force(normal_model: str, radius: float, work_of_adhesion: float) -> float:
+    """LAMMPS's pull-off force F_po of a normal law, the one in its friction limit. [N]
+
+    (3/2) pi w R for JKR (``normal_model`` "jkr_force", LAMMPS's ``jkr``), 2 pi w R for DMT, 0 for
+    Hertz (``"ring"`` without adhesion).
+
+    Parameters
+    ----------
+    normal_model : {"ring", "jkr_force", "dmt"}
+    radius : float
+        Sphere radius R (the wall's is infinite). [m]
+    work_of_adhesion : float
+        w = 2 gamma, LAMMPS's ``cohesion`` gamma being w / 2. [J/m^2]
+
+    References
+    ----------
+    LAMMPS source, src/GRANULAR/gran_sub_mod_normal.cpp (``F_pulloff`` of the JKR and DMT models).
+
+    Examples
+    --------
+    >>> round(lammps_pulloff_force("jkr_force", 1e-6, 0.02) / (math.pi * 0.02 * 1e-6), 12)
+    1.5
+    >>> lammps_pulloff_force("ring", 1e-6, 0.0)
+    0.0
+    """
+    if normal_model == "jkr_force":
+        return 1.5 * math.pi * work_of_adhesion * radius
+    if normal_model == "dmt":
+        return 2.0 * math.pi * work_of_adhesion * radius
+    return 0.0
+
+
+def lammps_critical_normal_force_rate(elastic_force, damping_force, pulloff_force, elastic_rate, damping_rate):
+    """d F_n0 / dt of :func:`lammps_critical_normal_force`, where F_n0 is not zero. [N/s]
+
+    Parameters
+    ----------
+    elastic_force, damping_force, pulloff_force : float
+        As :func:`lammps_critical_normal_force`. [N]
+    elastic_rate, damping_rate : float
+        dF_ne/dt and dF_nd/dt. [N/s]
+
+    Any consistent units serve (the solver calls it per its own time variable).
+
+    References
+    ----------
+    LAMMPS source, src/GRANULAR/gran_sub_mod_normal.cpp, ``set_fncrit``.
+
+    Examples
+    --------
+    With adhesion the damping does not count; without it, it does, with the sign of the total:
+
+    >>> lammps_critical_normal_force_rate(-1.0, 5.0, 1.0, 2.0, 3.0)
+    2.0
+    >>> lammps_critical_normal_force_rate(-1.0, -3.0, 0.0, 2.0, 3.0)
+    -5.0
+    """
+    if pulloff_force > 0.0:
+        return elastic_rate if elastic_force + 2.0 * pulloff_force >= 0.0 else -elastic_rate
+    rate = elastic_rate + damping_rate
+    return rate if elastic_force + damping_force >= 0.0 else -rate
 
 
 def lammps_tangential_force(history, slip_velocity, stiffness: float, damping: float, limit: float,

@@ -67,7 +67,8 @@ import numpy as np
 
 from microimpact.model import adhesion_models as am
 from microimpact.model.dem_tangential import (DEM_TANGENTIAL_MODELS, FORCE_HISTORY_MODELS, lammps_critical_normal_force,
-                                              lammps_elastic_force, lammps_history_of_force, lammps_history_rate,
+                                              lammps_critical_normal_force_rate, lammps_elastic_force,
+                                              lammps_pulloff_force, lammps_history_of_force, lammps_history_rate,
                                               lammps_tangential_stiffness)
 from microimpact.solvers import SolverError
 
@@ -113,9 +114,9 @@ class _Law:
         self.scales = sc
         self.y0 = float(y0)
         self.c3, self.p3 = float(c3), float(p3)
-        # LAMMPS's pull-off force in the law's force unit: (3/2) pi w R / (pi w R) for JKR, 2 pi w R / (2 pi w R) for DMT
-        self.pulloff = 1.5 if self.jkr else (1.0 if self.dmt else 0.0)
         force = float(sc.force)
+        # LAMMPS's pull-off force in the law's force unit (1.5 for JKR, 1 for DMT)
+        self.pulloff = lammps_pulloff_force(contact.normal_model, contact.radius, contact.work_of_adhesion) / force
         length = float(sc.length)
         # k in the law's units, F / L, from the model's k(a) in SI: k = k0 + k1 a (a in its unit)
         self.model = contact.tangential_model
@@ -151,11 +152,7 @@ class _Law:
         fd = eta * y
         dy = -g * (fe + fd)
         n0 = lammps_critical_normal_force(fe, fd, self.pulloff)
-        if self.pulloff > 0.0:  # its rate: F_ne + 2 F_po, or F_ne + F_nd, times its sign
-            dn0 = dfe if fe + 2.0 * self.pulloff >= 0.0 else -dfe
-        else:
-            dn0 = dfe + deta * y + eta * dy
-            dn0 = dn0 if fe + fd >= 0.0 else -dn0
+        dn0 = lammps_critical_normal_force_rate(fe, fd, self.pulloff, dfe, deta * y + eta * dy)
         return g, dz, a, da, eta, deta, dy, n0, dn0
 
     def stiffness(self, a):
