@@ -412,3 +412,38 @@ def test_lammps_fit_writes_the_fitted_friction_of_a_tangential_law(tmp_path, cap
     assert main(argv[:-2] + ["--out", "c2.lmp", "--tangential-stiffness", "10"]) == 2  # k_t belongs to linear_history
     assert main(argv[:8] + ["--shear-modulus", "1e9", "--out", "c3.lmp"]) == 2  # no --tangential-model
     assert not (tmp_path / "c2.lmp").exists() and not (tmp_path / "c3.lmp").exists()
+
+
+def test_lammps_fit_auto_ranks_the_tangential_laws_and_writes_the_best(tmp_path, capsys, monkeypatch):
+    # '--tangential-model auto': mu of every law the stiffness options allow (here the four mindlin
+    # laws, --shear-modulus), ranked by AIC; rebounds of mindlin/force at 3-12 deg, where the contact
+    # sticks while it unloads and the laws differ (u_out / u_in apart by 0.01-0.07), with noise 0.005
+    import pandas as pd
+
+    from microimpact.analysis.dem_fit import dem_law_contact
+    from microimpact.cli import main
+    from microimpact.io.materials import read_materials
+
+    pair = read_materials()["ammonium_fluorescein_on_silicon"]
+    rng = np.random.default_rng(3)
+    base = dem_law_contact(pair, 2e-6, "hertz", "coeff_restitution", 0.6)
+    c = base.with_(friction=0.2, tangential_model="lammps_mindlin_force", shear_modulus=1e9)
+    angle = np.linspace(3.0, 12.0, 8)
+    e_t = [simulate_impact(c, 1.0, a).velocity_out[1] / math.sin(math.radians(a)) for a in angle]
+    monkeypatch.chdir(tmp_path)
+    pd.DataFrame({"material_pair": "ammonium_fluorescein_on_silicon", "radius [um]": 2.0, "speed [m/s]": 1.0,
+                  "incidence_angle [deg]": angle, "e_n [1]": 0.6 + rng.normal(0.0, 0.01, 8), "e_n_uncertainty [1]": 0.01,
+                  "tangential_restitution [1]": np.array(e_t) + rng.normal(0.0, 0.005, 8),
+                  "tangential_restitution_uncertainty [1]": 0.005}).to_csv("impacts.csv", index=False)
+    argv = ["lammps", "fit", "impacts.csv", "--material-pair", "ammonium_fluorescein_on_silicon", "--law",
+            "hertz+coeff_restitution", "--tangential-model", "auto", "--shear-modulus", "1e9", "--out", "contact.lmp"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert all(law in out for law in ("lammps_mindlin_rescale", "lammps_mindlin_force", "akaike_weight"))
+    text = (tmp_path / "contact.lmp").read_text()
+    assert "(lammps_mindlin_force; best by AIC: " in text
+    fix = text.splitlines()[-1].split()
+    assert fix[fix.index("tangential") + 1] == "mindlin/force"
+    capsys.readouterr()
+    assert main(argv[:9] + ["--out", "c2.lmp"]) == 2  # auto without a stiffness option
+    assert "needs --tangential-stiffness" in capsys.readouterr().err and not (tmp_path / "c2.lmp").exists()

@@ -641,46 +641,75 @@ def _dem_law(text: str) -> tuple[str, str]:
     return law
 
 
-def _lammps_tangential_fields(args) -> dict:
-    """The tangential law's Contact fields from the options of ``lammps fit`` (UsageError if one is missing)."""
-    fields_ = {"tangential_model": args.tangential_model, "tangential_damping": args.tangential_damping}
-    other = "--shear-modulus" if args.tangential_model == "linear_history" else "--tangential-stiffness"
-    if (args.shear_modulus if other == "--shear-modulus" else args.tangential_stiffness) is not None:
-        raise UsageError(f"{other} does not belong to --tangential-model {args.tangential_model}")
-    if args.tangential_model == "linear_history":
+#: --tangential-model of ``lammps fit`` that fits every law its stiffness options allow and ranks them
+AUTO_TANGENTIAL = "auto"
+
+
+def _lammps_tangential_fields(args, law: str) -> dict:
+    """The Contact fields of tangential law ``law`` from the options of ``lammps fit`` (UsageError if
+    one is missing, or, for a law named by --tangential-model, one of the other law's is given)."""
+    fields_ = {"tangential_model": law, "tangential_damping": args.tangential_damping}
+    other = "--shear-modulus" if law == "linear_history" else "--tangential-stiffness"
+    if args.tangential_model != AUTO_TANGENTIAL and (args.shear_modulus if other == "--shear-modulus"
+                                                     else args.tangential_stiffness) is not None:
+        raise UsageError(f"{other} does not belong to --tangential-model {law}")
+    if law == "linear_history":
         if args.tangential_stiffness is None:
             raise UsageError("--tangential-model linear_history needs --tangential-stiffness (k_t [N/m])")
         fields_["tangential_stiffness"] = args.tangential_stiffness
     else:
         if args.shear_modulus is None:
-            raise UsageError(f"--tangential-model {args.tangential_model} needs --shear-modulus (G* [Pa]; LAMMPS's k_t = 8 G*)")
+            raise UsageError(f"--tangential-model {law} needs --shear-modulus (G* [Pa]; LAMMPS's k_t = 8 G*)")
         fields_["shear_modulus"] = args.shear_modulus
     return fields_
 
 
+def _lammps_tangential_laws(args) -> dict:
+    """{law: its Contact fields}: the one --tangential-model names, or with ``auto`` every LAMMPS
+    tangential law whose stiffness is given (linear_history with --tangential-stiffness, the four
+    mindlin laws with --shear-modulus)."""
+    if args.tangential_model != AUTO_TANGENTIAL:
+        return {args.tangential_model: _lammps_tangential_fields(args, args.tangential_model)}
+    laws = [law for law in DEM_TANGENTIAL_MODELS
+            if (args.tangential_stiffness if law == "linear_history" else args.shear_modulus) is not None]
+    if not laws:
+        raise UsageError("--tangential-model auto needs --tangential-stiffness (for linear_history) and/or "
+                         "--shear-modulus (for the mindlin laws)")
+    return {law: _lammps_tangential_fields(args, law) for law in laws}
+
+
 def _lammps_fit_friction(args, table, chosen):
     """(contact with the fitted mu, header note), or (None, None) after one line saying why mu is not
-    determined; mu of LAMMPS's tangential law fitted to the oblique columns, the normal law fixed."""
+    determined; mu of LAMMPS's tangential law fitted to the oblique columns, the normal law fixed
+    (with ``--tangential-model auto`` each law's, ranked by AIC, the best one written)."""
     import numpy as np
 
-    from microimpact.analysis.oblique import fit_dem_friction
+    from microimpact.analysis.oblique import rank_dem_tangential_laws
 
-    tangential = _lammps_tangential_fields(args)
+    laws = _lammps_tangential_laws(args)
     try:
-        fit = fit_dem_friction(table, lambda r: chosen.contact(r).with_(**tangential), rtol=args.rtol,
-                               progress=True)
+        ranked, fits = rank_dem_tangential_laws(
+            table, {law: (lambda r, f=f: chosen.contact(r).with_(**f)) for law, f in laws.items()}, rtol=args.rtol,
+            progress=True)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
+    if len(laws) > 1:
+        print(ranked[["law", "status", "friction", "interval_low", "interval_high", "chisqr", "delta_aic",
+                      "akaike_weight"]].to_string(index=False, float_format=lambda x: f"{x:.6g}"))
+    law = str(ranked["law"].iloc[0])
+    fit = fits[law]
     print(fit.report())
     status = fit.identifiability["friction"]
     if not status.determined:
         print(f"microimpact: error: the oblique data do not determine the friction of LAMMPS's "
-              f"{args.tangential_model} law ({status.describe()}); no LAMMPS input written", file=sys.stderr)
+              f"{law} law ({status.describe()}); no LAMMPS input written", file=sys.stderr)
         return None, None
     radius = float(np.median(np.asarray(table["radius"], dtype=float)))
-    note = (f"{fit.friction:.6g} ({args.tangential_model}; 95% profile-likelihood interval {status.lower:.6g} to "
-            f"{status.upper:.6g}; {fit.n_points} oblique entries, the normal law at its fitted values)")
-    return chosen.contact(radius).with_(friction=fit.friction, **tangential), note
+    others = ", ".join(f"{o} dAIC {d:.3g}" for o, d in zip(ranked["law"].iloc[1:], ranked["delta_aic"].iloc[1:]))
+    note = (f"{fit.friction:.6g} ({law}{'; best by AIC: ' + others if others else ''}; 95% profile-likelihood "
+            f"interval {status.lower:.6g} to {status.upper:.6g}; {fit.n_points} oblique entries, the normal law at "
+            "its fitted values)")
+    return chosen.contact(radius).with_(friction=fit.friction, **laws[law]), note
 
 
 def _cmd_lammps_fit(args) -> int:
@@ -699,7 +728,7 @@ def _cmd_lammps_fit(args) -> int:
         if given:
             raise UsageError(f"{', '.join(given)} belong to a tangential law: give --tangential-model too")
     else:
-        _lammps_tangential_fields(args)  # a missing stiffness is refused before the fits run
+        _lammps_tangential_laws(args)  # a missing stiffness is refused before the fits run
     if args.fit_adhesion and args.law and args.law[0] == "hertz":
         raise UsageError(f"--fit-adhesion: the law {'+'.join(args.law)} has no work of adhesion to fit; give a "
                          "jkr_force or dmt law, or no --law")
@@ -847,9 +876,10 @@ def register_lammps(sub) -> None:
                         "instead of taking the material pair's (which may then have none)")
     f.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto",
                    help="auto: the stated e_n uncertainties when given, else the scatter (default auto)")
-    f.add_argument("--tangential-model", choices=tuple(DEM_TANGENTIAL_MODELS), default=None,
+    f.add_argument("--tangential-model", choices=(*DEM_TANGENTIAL_MODELS, AUTO_TANGENTIAL), default=None,
                    help="also fit the friction mu of this LAMMPS tangential law to the oblique columns (after the "
-                        "normal law), and write it; needs --tangential-stiffness or --shear-modulus")
+                        "normal law), and write it; needs --tangential-stiffness or --shear-modulus; auto: fit every "
+                        "law those allow, rank them by AIC and write the best")
     f.add_argument("--tangential-stiffness", type=_positive_float, default=None, metavar="SI",
                    help="k_t of linear_history [N/m]")
     f.add_argument("--shear-modulus", type=_positive_float, default=None, metavar="SI",

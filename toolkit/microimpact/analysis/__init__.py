@@ -29,7 +29,7 @@ _HOMES = {
     **dict.fromkeys(("kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
                      "KHARAZ_CONDITIONS"), "kharaz"),
     **dict.fromkeys(("compare_normal_models", "normal_model_restitution", "DEFAULT_MODELS"), "model_comparison"),
-    **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "oblique_model", "rebound_state",
+    **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "rank_dem_tangential_laws", "oblique_model", "rebound_state",
                      "effective_sigma", "TANGENTIAL_PARAMETERS", "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"), "oblique"),
     **dict.fromkeys(("Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "posterior_contacts",
                      "restitution_bands", "capture_velocity_interval", "sweep_bands", "posterior_dataset",
@@ -42,7 +42,7 @@ _HOMES = {
                      "make_synthetic_oblique", "write_synthetic_impacts"), "synthetic"),
     **dict.fromkeys(("DampingTarget", "damping_from_target"), "target"),
     **dict.fromkeys(("DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws",
-                     "dem_fit_coverage", "INTERVAL_LEVEL", "ADEQUACY_P"), "dem_fit"),
+                     "ranked_by_aic", "information_criteria", "dem_fit_coverage", "INTERVAL_LEVEL", "ADEQUACY_P"), "dem_fit"),
 }
 #: the modules, importable as attributes
 _MODULES = tuple(sorted(set(_HOMES.values())))

@@ -55,7 +55,7 @@ from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
 from microimpact.solvers import DEFAULT_RTOL
 
-__all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "dem_fit_coverage",
+__all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "ranked_by_aic", "information_criteria", "dem_fit_coverage",
            "INTERVAL_LEVEL", "ADEQUACY_P"]
 
 #: the (normal law, damping law) pairs a LAMMPS user chooses among; "hertz" is Hertz without
@@ -444,8 +444,22 @@ def _polish(chi, start, lo_u, hi_u, lo_x, hi_x):
     return min(candidates, key=lambda c: c[1])
 
 
-def _information_criteria(chi_min, n, sigma_known, k=1):
-    """(AIC, BIC) of a least-squares fit with k parameters (Burnham & Anderson 2002)."""
+def information_criteria(chi_min: float, n: int, sigma_known: bool, k: int = 1) -> tuple[float, float]:
+    """(AIC, BIC) of a least-squares fit with k parameters to n points. [-]
+
+    chi^2 + 2 k and chi^2 + k ln n where the uncertainties are stated (the likelihood's own scale);
+    n ln(chi^2 / n) + 2 k and + k ln n where the scatter estimates them.
+
+    References
+    ----------
+    Burnham, K. P. and Anderson, D. R. (2002), Model Selection and Multimodel Inference, Springer,
+    Sec. 2.2 and 6.4.
+
+    Examples
+    --------
+    >>> information_criteria(8.0, 10, True)
+    (10.0, 10.302585092994047)
+    """
     base = chi_min if sigma_known else n * math.log(max(chi_min, 1e-300) / n)
     return base + 2 * k, base + k * math.log(n)
 
@@ -550,7 +564,7 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
         interval, status, best = _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x)
     if sigma_known and n > 1 and stats.chi2.sf(chi_min, n - 1) < ADEQUACY_P:
         status = "inadequate"
-    aic, bic = _information_criteria(chi_min, n, sigma_known)
+    aic, bic = information_criteria(chi_min, n, sigma_known)
     return DemLawFit(normal_model, damping_model, best if status == "determined" else math.nan, interval, status,
                      float(chi_min), int(n), sigma_known, float(aic), float(bic), best, mat, src)
 
@@ -564,7 +578,7 @@ def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, h
         model, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x)
     if sigma_known and n > 2 and stats.chi2.sf(chi_min, n - 2) < ADEQUACY_P:
         status = w_status = "inadequate"
-    aic, bic = _information_criteria(chi_min, n, sigma_known, k=2)
+    aic, bic = information_criteria(chi_min, n, sigma_known, k=2)
     return DemLawFit(model.normal_model, model.damping_model, best if status == "determined" else math.nan, interval,
                      status, float(chi_min), int(n), sigma_known, float(aic), float(bic), best,
                      {**mat, "work_of_adhesion": w_best}, src, adhesion_fitted=True,
@@ -644,12 +658,33 @@ def rank_dem_laws(table, material, laws=None, *, fit_adhesion: bool = False, wei
     df = pd.DataFrame(rows)
     interval_ends = [c for c in ("interval_low", "interval_high", "w_low", "w_high") if c in df]
     df.loc[df["status"] == "inadequate", interval_ends] = math.nan  # no number to print
+    # laws of one family (tsuji and coeff_restitution: the same e_n for every speed) tie to round-off:
+    # the order of DEM_LAWS decides them
+    return ranked_by_aic(df), fits
+
+
+def ranked_by_aic(table):
+    """The rows of ``table`` (one per candidate law, with an ``aic`` column) best first, with
+    ``delta_aic`` and the Akaike weight exp(-dAIC / 2) normalised over the rows; ties to 1e-6 keep
+    the rows' order.
+
+    References
+    ----------
+    Burnham, K. P. and Anderson, D. R. (2002), Model Selection and Multimodel Inference, Springer,
+    Sec. 2.9.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> r = ranked_by_aic(pd.DataFrame({"law": ["a", "b"], "aic": [12.0, 10.0]}))
+    >>> list(r["law"]), [round(w, 4) for w in r["akaike_weight"]]
+    (['b', 'a'], [0.7311, 0.2689])
+    """
+    df = table.copy()
     df["delta_aic"] = df["aic"] - df["aic"].min()
     w = np.exp(-0.5 * df["delta_aic"].to_numpy())
     df["akaike_weight"] = w / w.sum()
-    # laws of one family (tsuji and coeff_restitution: the same e_n for every speed) tie to round-off:
-    # the order of DEM_LAWS decides them
-    return df.sort_values("aic", kind="stable", key=lambda a: a.round(6)).reset_index(drop=True), fits
+    return df.sort_values("aic", kind="stable", key=lambda a: a.round(6)).reset_index(drop=True)
 
 
 def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, seed: int = 0, rtol: float = 1e-8,

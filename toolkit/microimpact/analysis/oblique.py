@@ -55,7 +55,7 @@ from microimpact.io.progress import progress_bar
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 from microimpact.solvers import DEFAULT_RTOL, Deadline, engine_threads
 
-__all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
+__all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "rank_dem_tangential_laws", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
            "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"]
 
 #: Contact.tangential_model -> the Contact fields fitted from oblique data (the compliance hook)
@@ -668,8 +668,8 @@ DEM_REFINE_POINTS = 32
 
 def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress: bool = False,
                      time_budget: float | None = None) -> FrictionFit:
-    """Fit the Coulomb coefficient mu of a DEM tangential law (LAMMPS's ``linear_history`` or
-    ``mindlin``, :mod:`microimpact.model.dem_tangential`) to the oblique columns.
+    """Fit the Coulomb coefficient mu of a DEM tangential law (LAMMPS's ``linear_history`` or a
+    ``mindlin`` variant, :mod:`microimpact.model.dem_tangential`) to the oblique columns.
 
     The rest of the contact (normal law, damping, tangential stiffness and damping) is given, e.g.
     by :func:`microimpact.analysis.dem_fit.fit_dem_law` for the normal law and the material's G*.
@@ -679,8 +679,9 @@ def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress:
     table : pandas.DataFrame
         Impacts from :func:`microimpact.io.read_impacts` with an oblique column.
     contact_of : callable
-        radius [m] -> Contact with ``tangential_model`` "linear_history" or "lammps_mindlin" (its
-        ``friction`` is replaced by each trial mu).
+        radius [m] -> Contact with a DEM ``tangential_model`` (one of
+        :data:`~microimpact.model.dem_tangential.DEM_TANGENTIAL_MODELS`; its ``friction`` is
+        replaced by each trial mu).
     rtol : float
         Relative tolerance of the solves. [-]
     progress : bool
@@ -749,6 +750,73 @@ def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress:
             objective.hold_effective_sigma(best.value)
             best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
     return _friction_result(problem, objective, best, 0.0, {}, weighted, contact.tangential_model, t0)
+
+
+def rank_dem_tangential_laws(table, contacts_of, *, rtol: float = DEFAULT_RTOL, progress: bool = False,
+                             time_budget: float | None = None):
+    """Fit mu of each DEM tangential law to the same oblique columns and rank the laws by AIC.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        As :func:`fit_dem_friction`.
+    contacts_of : mapping
+        tangential_model -> (radius [m] -> Contact with that law), the rest of the contact given.
+    rtol, progress
+        As :func:`fit_dem_friction`.
+    time_budget : float or Deadline, optional
+        Wall-clock budget of all the fits; None: no limit. [s]
+
+    Returns
+    -------
+    (pandas.DataFrame, dict)
+        One row per law, best first: law, status (:class:`~microimpact.analysis.identifiability.ParameterStatus`),
+        friction (NaN unless determined) and its 95 % profile interval (or a one-sided bound and
+        the end of the range; NaN where not determined), chi^2, AIC, BIC (one
+        parameter each), dAIC and the Akaike weight; and ``{law: FrictionFit}``. Laws within a
+        dAIC of 2 are not told apart by the data (Burnham & Anderson 2002, Sec. 2.6).
+
+    References
+    ----------
+    Burnham, K. P. and Anderson, D. R. (2002), Model Selection and Multimodel Inference, Springer.
+
+    Examples
+    --------
+    Rebounds of LAMMPS's ``mindlin/force`` law at 3-12 deg, where the contact sticks while it
+    unloads and the variants differ, rank it first:
+
+    >>> import numpy as np, pandas as pd
+    >>> from microimpact import Contact, simulate_impact
+    >>> base = Contact(1e-6, 2000.0, 1e9, 0.0, friction=0.2, shear_modulus=3e8)
+    >>> laws = ["lammps_mindlin", "lammps_mindlin_force"]
+    >>> angles = np.linspace(3.0, 12.0, 8)
+    >>> truth = base.with_(tangential_model="lammps_mindlin_force")
+    >>> e_t = [simulate_impact(truth, 1.0, a).velocity_out[1] / np.sin(np.radians(a)) for a in angles]
+    >>> table = pd.DataFrame({"radius": 1e-6, "speed": 1.0, "incidence_deg": angles, "e_n": 1.0,
+    ...                       "tangential_restitution": e_t, "tangential_restitution_uncertainty": 0.01})
+    >>> ranked, fits = rank_dem_tangential_laws(table, {m: (lambda r, m=m: base.with_(tangential_model=m)) for m in laws})
+    >>> ranked["law"][0], bool(ranked["delta_aic"][1] > 10)
+    ('lammps_mindlin_force', True)
+    """
+    import pandas as pd
+
+    from microimpact.analysis.dem_fit import information_criteria, ranked_by_aic
+
+    deadline = Deadline.start(time_budget, "tangential laws fitted")
+    fits, rows = {}, []
+    for law, contact_of in contacts_of.items():
+        fit = fit_dem_friction(table, contact_of, rtol=rtol, progress=progress, time_budget=deadline)
+        if fit.tangential_model != law:
+            raise ValueError(f"contacts_of[{law!r}] gives tangential_model={fit.tangential_model!r}")
+        fits[law] = fit
+        status = fit.identifiability["friction"]
+        aic, bic = information_criteria(fit.chisqr, fit.n_points, fit.weighted)
+        shown = status.status != "not_determined"  # an interval, or a one-sided bound and the range's end
+        rows.append({"law": law, "status": status.status, "friction": fit.friction if status.determined else math.nan,
+                     "interval_low": status.lower if shown else math.nan,
+                     "interval_high": status.upper if shown else math.nan,
+                     "chisqr": fit.chisqr, "aic": aic, "bic": bic})
+    return ranked_by_aic(pd.DataFrame(rows)), fits
 
 
 class _DemFrictionObjective(_FrictionObjective):
