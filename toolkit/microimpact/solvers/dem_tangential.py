@@ -40,10 +40,11 @@ Events are located by sign changes between the ends of a step, and after a switc
 starts on the limit (the switch function is 0 to rounding): a crossing inside one step, in the
 step that ends the contact, or after a restart rounded to the wrong side was lost, and the
 outcome then depended on the tolerance (4 of 300 random impacts moved by up to 0.25 between rtol
-1e-8 and 1e-10, LAMMPS siding with the finer). Each stick phase is therefore integrated with dense
-output and its maxima of |F| - mu F_n0 and its last instant are checked (``_crossing_inside_a_step``);
-600 random impacts now move by less than 1e-7 (tests/test_dem_tangential.py). A switch undone at
-once is ridden through (``_CHATTER_SPAN``).
+1e-8 and 1e-10, LAMMPS siding with the finer). Each phase is therefore integrated with dense
+output, and the extrema of its switch function towards leaving (maxima of |F| - mu F_n0 in stick,
+minima of the trial force's excess rate in slide) and its last instant are checked
+(``_crossing_inside_a_step``); 600 random impacts now move by less than 1e-7
+(tests/test_dem_tangential.py). A switch undone at once is ridden through (``_CHATTER_SPAN``).
 
 A captured sphere (JKR, DMT) ends at rest on the wall, with the limit 2 mu F_po > 0 there: the
 slip stops in finite time and the sphere rolls, so its tangential outcome is the rolling state,
@@ -85,6 +86,8 @@ _MAX_EVALUATIONS = 2_000_000
 _CHATTER_SPAN = 1e-7
 #: span of the Sundman variable given to scipy: the contact ends by its event long before
 _SIGMA_SPAN = 1e7
+#: step (relative to the Sundman variable) of the central difference of slide's switch function
+_RATE_STEP = 1e-7
 #: points of the dense output scanned for the force inside the limit after a restart on it
 _SCAN_POINTS = 257
 #: JKR's state where LAMMPS's contact breaks, q^3 = 3 (F = -F_c)
@@ -296,10 +299,20 @@ def _integrate(law, u0, rtol, tau_scale, z_scale):
             return -1.0 if mode == _STICK else 1.0
         return _rhs_and_switch(law, state, mode)[1]
 
-    def peak(_, state):  # a maximum of |F| - mu F_n0 in stick (its rate falls through 0)
+    def peak(_, state):
+        """Falls through 0 where the switch function is farthest towards leaving the mode: a maximum
+        of |F| - mu F_n0 in stick (its rate, exact), a minimum of slide's switch function (its rate
+        along the motion, a central difference over a step of _RATE_STEP along the right-hand side)."""
         if _separation(law, state) <= 0.0:
             return 1.0
-        return _rhs_and_switch(law, state, _STICK)[2]
+        if mode == _STICK:
+            return _rhs_and_switch(law, state, _STICK)[2]
+        rate = _rhs_and_switch(law, state, _SLIDE)[0]
+        h = _RATE_STEP * max(1.0, abs(sigma))
+        ahead, behind = state + h * rate, state - h * rate
+        if _separation(law, ahead) <= 0.0 or _separation(law, behind) <= 0.0:
+            return 1.0
+        return -(_rhs_and_switch(law, ahead, _SLIDE)[1] - _rhs_and_switch(law, behind, _SLIDE)[1])
 
     separation.terminal, separation.direction = True, -1.0
     switch.terminal = True
@@ -313,15 +326,15 @@ def _integrate(law, u0, rtol, tau_scale, z_scale):
         # the limit's, h = 0 touched without crossing): the motion is the same in both to first
         # order, so the new mode is kept over a short stretch with its switch event off
         span = _CHATTER_SPAN * max(sigma, 1.0) if repeats >= 2 else _SIGMA_SPAN
-        watch = mode == _STICK and repeats < 2
+        watch = repeats < 2
         sol = solve_ivp(rhs, (sigma, sigma + span), x, method="DOP853", rtol=rtol, atol=atol, dense_output=watch,
-                        events=(separation,) if repeats >= 2 else (separation, switch, peak) if watch else (separation, switch))
+                        events=(separation, switch, peak) if watch else (separation,))
         if sol.status == 0 and repeats >= 2:  # the stretch is done: watch for switches again
             sigma, x, repeats = float(sol.t[-1]), sol.y[:, -1].copy(), 0
             continue
         if sol.status != 1:
             raise DemTangentialError(f"DEM tangential integration stopped: {sol.message}")
-        missed = _crossing_inside_a_step(sol, sigma, switch) if watch else None
+        missed = _crossing_inside_a_step(sol, sigma, switch, 1.0 if mode == _STICK else -1.0) if watch else None
         if missed is not None:
             sigma, x = missed
         elif sol.t_events[0].size:
@@ -349,18 +362,23 @@ def _integrate(law, u0, rtol, tau_scale, z_scale):
             slide_end = x[6]
 
 
-def _crossing_inside_a_step(sol, start, switch):
-    """(sigma, state) where stick's force first reached the limit unseen by the events, or None.
+def _crossing_inside_a_step(sol, start, switch, sign):
+    """(sigma, state) where the mode should first have been left unseen by the events, or None.
 
-    scipy's events see a sign change of the switch function only between the ends of a step, and
-    past the end of contact the switch function is held negative (the law is not defined there).
-    A crossing of the limit in the step that ends the contact, or an excursion of |F| above
-    mu F_n0 that begins and ends inside one step, was therefore lost (LAMMPS's JKR with
+    ``sign`` is +1 in stick (left where the switch function rises through 0: |F| reaches the limit)
+    and -1 in slide (left where it falls through 0: the trial force turns inwards). scipy's events
+    see a sign change only between the ends of a step, and past the end of contact the switch
+    function is held on the side of staying. A crossing in the step that ends the contact, or an
+    excursion that begins and ends inside one step, was therefore lost (LAMMPS's JKR with
     mindlin/force, 0.13 m/s, 20 deg: stuck to the end with |F| 9 % above the limit there, e_t
-    0.8998 against LAMMPS's 0.9029). Each maximum of |F| - mu F_n0 (``peak``) and the last
-    instant of contact are therefore checked on the dense output; where one lies above the
-    limit, the first crossing before it is the switch."""
+    0.8998 against LAMMPS's 0.9029; DMT + mass_velocity mindlin, 27 m/s, 47 deg: a stick inside one
+    slide step missed at rtol 1e-10, e_t 6e-6 off). Each extremum of the switch function towards
+    leaving (``peak``) and the last instant of contact are therefore checked on the dense output;
+    where one lies past 0, the first crossing before it is the switch."""
     from scipy.optimize import brentq
+
+    def leaving(t):
+        return sign * switch(t, sol.sol(t))
 
     tops = list(sol.t_events[2])
     if sol.t_events[0].size:  # the contact ended: look just inside its end
@@ -368,20 +386,20 @@ def _crossing_inside_a_step(sol, start, switch):
         tops = [t for t in tops if t < end] + [end - 1e-9 * (end - start)]
     lo = start
     for top in tops:
-        if top <= lo or switch(top, sol.sol(top)) <= 0.0:
+        if top <= lo or leaving(top) <= 0.0:
             lo = max(lo, top)
             continue
-        if switch(lo, sol.sol(lo)) > 0.0:
-            # on the limit at the start (just stuck again), above it by rounding: the events saw no
-            # sign change. Where the force went inside the limit, the crossing is after that; where
-            # it never did, the contact slides on at once (DMT, mass_velocity, 47 deg: the crossing
-            # 0.4 contact times in was lost this way, e_t 0.8070 at rtol 1e-8 against 0.7344, LAMMPS's
-            # 0.73441 at 2000 and 16000 steps)
-            inside = next((t for t in np.linspace(lo, top, _SCAN_POINTS)[1:-1] if switch(t, sol.sol(t)) < 0.0), None)
+        if leaving(lo) > 0.0:
+            # on the switch at the start (a restart on the limit), past it by rounding: the events
+            # saw no sign change. Where the motion went back inside, the crossing is after that;
+            # where it never did, the mode is left at once (DMT, mass_velocity, 47 deg: the
+            # crossing 0.4 contact times in was lost this way, e_t 0.8070 at rtol 1e-8 against
+            # 0.7344, LAMMPS's 0.73441 at 2000 and 16000 steps)
+            inside = next((t for t in np.linspace(lo, top, _SCAN_POINTS)[1:-1] if leaving(t) < 0.0), None)
             if inside is None:
                 return lo, sol.sol(lo)
             lo = inside
-        root = brentq(lambda t: switch(t, sol.sol(t)), lo, top, xtol=1e-15 * max(abs(top), 1.0), rtol=1e-15)
+        root = brentq(leaving, lo, top, xtol=1e-15 * max(abs(top), 1.0), rtol=1e-15)
         return root, sol.sol(root)
     return None
 
