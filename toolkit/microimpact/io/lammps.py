@@ -18,6 +18,8 @@ no friction (f = 0)                    ``tangential linear_nohistory 0.0 0.0``
 ``tangential_model="lammps_mindlin"``  ``tangential mindlin 8G* x_gamma,t f`` (and its variants
                                        ``mindlin_rescale``, ``mindlin/force``, ``mindlin_rescale/force``)
                                        (:mod:`microimpact.model.dem_tangential`)
+``rolling_model="lammps_sds"``         ``rolling sds k_roll gamma_roll mu_roll``
+                                       (:mod:`microimpact.model.dem_rolling`)
 =====================================  ==========================================================
 
 Conversions. LAMMPS mixes the wall's modulus with the particle's as for two particles of the same
@@ -39,8 +41,9 @@ gives the same impact:
   LAMMPS's ``mindlin`` variants only while the contact slides throughout (above about 60 deg
   incidence for f = 0.3; docs/guide/lammps.md); choose LAMMPS's own laws, ``linear_history`` or
   ``lammps_mindlin``;
-* rolling resistance: microimpact's constant torque mu_r r |F_n| is not LAMMPS's spring-dashpot-slider
-  (``rolling sds``).
+* rolling resistance with microimpact's constant torque mu_r r |F_n| (``rolling_model="torque"``): it
+  is not LAMMPS's spring-dashpot-slider; ``rolling_model="lammps_sds"`` is, and is written as
+  ``rolling sds k_roll gamma_roll mu_roll``.
 
 Units. The numbers are written in one of LAMMPS's unit styles ``si``, ``cgs``, ``micro`` or
 ``nano`` (:data:`LAMMPS_UNITS`), named in the header; the including script sets that style.
@@ -66,6 +69,7 @@ from dataclasses import dataclass, fields
 
 from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import restitution_of_damping_factor, tsuji_damping_factor
+from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 
 __all__ = ["LAMMPS_UNITS", "DEFAULT_POISSON", "LammpsExportError", "LammpsWallModel", "lammps_wall_model",
@@ -125,6 +129,9 @@ class LammpsWallModel:
         x_gamma,t. [-]
     friction : float
         mu. [-]
+    rolling_stiffness, rolling_damping, rolling_friction : float
+        k_roll [N/m], gamma_roll [N s/m] and mu_roll [-] of ``rolling sds``
+        (:mod:`microimpact.model.dem_rolling`); ``rolling_stiffness`` 0: no rolling law written.
     """
 
     normal: str
@@ -137,6 +144,9 @@ class LammpsWallModel:
     tangential_stiffness: float = 0.0
     tangential_damping: float = 0.0
     friction: float = 0.0
+    rolling_stiffness: float = 0.0
+    rolling_damping: float = 0.0
+    rolling_friction: float = 0.0
 
     def granular_args(self, units: str = "si") -> str:
         """The model arguments after ``granular`` of ``fix wall/gran``, in LAMMPS units ``units``."""
@@ -153,7 +163,11 @@ class LammpsWallModel:
         else:
             stiffness_unit = mass / time**2 if self.tangential == "linear_history" else pressure  # N/m, or Pa
             tangential = f"{self.tangential_stiffness / stiffness_unit:.15g} {tangential}"
-        return f"{normal} damping {self.damping_model} tangential {self.tangential} {tangential}"
+        args = f"{normal} damping {self.damping_model} tangential {self.tangential} {tangential}"
+        if self.rolling_stiffness > 0.0:  # k_roll in force / distance, gamma_roll in force time / distance
+            args += (f" rolling sds {self.rolling_stiffness / (mass / time**2):.15g} "
+                     f"{self.rolling_damping / (mass / time):.15g} {self.rolling_friction:.15g}")
+        return args
 
 
 def _check_units(units: str) -> tuple[float, float, float]:
@@ -216,7 +230,7 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
         refused.append(f"friction={contact.friction:g} with tangential_model={contact.tangential_model!r}: no LAMMPS "
                        "tangential law gives the same impacts (microimpact's Mindlin laws agree with LAMMPS's "
                        "mindlin only while the contact slides throughout)")
-    if contact.rolling_friction > 0.0:
+    if contact.rolling_friction > 0.0 and contact.rolling_model == "torque":
         refused.append(f"rolling_friction={contact.rolling_friction:g}: microimpact's constant rolling torque is "
                        "not LAMMPS's spring-dashpot-slider (rolling sds)")
     if refused:
@@ -233,8 +247,10 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
     if contact.friction > 0.0:
         tangential = DEM_TANGENTIAL_MODELS[contact.tangential_model]
         stiffness = contact.tangential_stiffness if tangential == "linear_history" else 8.0 * contact.shear_modulus
+    rolling = (contact.rolling_stiffness, contact.rolling_damping, contact.rolling_friction) \
+        if contact.rolling_model in DEM_ROLLING_MODELS else (0.0, 0.0, 0.0)
     return LammpsWallModel(normal, youngs, float(poisson), gamma, damping, tangential, damping_model, stiffness,
-                           contact.tangential_damping if contact.friction > 0.0 else 0.0, contact.friction)
+                           contact.tangential_damping if contact.friction > 0.0 else 0.0, contact.friction, *rolling)
 
 
 def lammps_expressible(contact: Contact, poisson: float = DEFAULT_POISSON) -> Contact:
@@ -285,7 +301,8 @@ def lammps_expressible(contact: Contact, poisson: float = DEFAULT_POISSON) -> Co
             shear = float(effective_shear_modulus(g, poisson, g, poisson))
         friction = {"friction": contact.friction, "tangential_model": "lammps_mindlin", "shear_modulus": shear}
     return contact.with_(normal_model="jkr_force" if contact.adhesion_line_force > 0.0 else "ring",
-                         zeta_hertz=0.0, zeta_adhesion=0.0, rolling_friction=0.0, friction_model="net",
+                         zeta_hertz=0.0, zeta_adhesion=0.0, friction_model="net",
+                         rolling_friction=contact.rolling_friction if contact.rolling_model != "torque" else 0.0,
                          tangential_stiffness=None, tangential_damping=0.0, **friction)
 
 
@@ -356,6 +373,9 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
         unit = "N/m" if model.tangential == "linear_history" else "Pa (8 G*)"
         lines.append(f"# tangential {model.tangential}: k_t = {model.tangential_stiffness:.10g} {unit}, "
                      f"x_gamma,t = {model.tangential_damping:g}, mu = {model.friction:g}")
+    if model.rolling_stiffness > 0.0:
+        lines.append(f"# rolling sds: k_roll = {model.rolling_stiffness:.10g} N/m, gamma_roll = "
+                     f"{model.rolling_damping:.10g} N s/m, mu_roll = {model.rolling_friction:g}")
     if contact.damping_model == "tsuji":
         lines.append(f"# damping tsuji e = {contact.damping_coefficient:g} (with the sqrt(2) of LAMMPS's development source) "
                      f"is written as the identical law coeff_restitution e = {model.damping:.10g}")

@@ -24,6 +24,7 @@ from functools import cached_property
 
 import numpy as np
 
+from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 
 __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_representable"]
@@ -36,12 +37,14 @@ __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_
 #: "mindlin_deresiewicz" the same with the loading/unloading/reloading memory (hysteresis),
 #: "linear_history" and the "lammps_mindlin*" variants LAMMPS GRANULAR's history laws (model.dem_tangential);
 #: "net" is the paper's Coulomb limit f |F_n|, "pulloff" an adhesion-aware limit that does not vanish
-#: at the adhesive equilibrium.
+#: at the adhesive equilibrium; "torque" is the constant rolling torque mu_r r |F_n| (with
+#: rolling_friction > 0), "lammps_sds" LAMMPS GRANULAR's rolling spring-dashpot-slider (model.dem_rolling).
 SUB_MODELS: dict[str, tuple[str, ...]] = {
     "normal_model": ("ring", "jkr", "dmt", "jkr_force"),
     "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", *DEM_TANGENTIAL_MODELS),
     "friction_model": ("net", "pulloff"),
     "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
+    "rolling_model": ("torque", *DEM_ROLLING_MODELS),
 }
 
 #: full citation of the paper, for the ``references`` attribute of the toolkit's results
@@ -125,7 +128,7 @@ def _check_poisson(name: str, value: float) -> None:
 
 
 #: fields that may be None (not given)
-_OPTIONAL = ("damping_reference_speed", "shear_modulus", "tangential_stiffness")
+_OPTIONAL = ("damping_reference_speed", "shear_modulus", "tangential_stiffness", "rolling_stiffness")
 
 
 def _sub_model(name: str, value) -> str:
@@ -175,7 +178,8 @@ class Contact:
     rolling_friction : float
         Rolling-resistance coefficient mu_r of the torque mu_r r |F_n| against the rolling (Zhou et
         al. 1999); 0 (the paper's, no rolling resistance) by default. Needs a compliant tangential
-        model (:mod:`microimpact.model.tangential_compliance`). [-]
+        model (:mod:`microimpact.model.tangential_compliance`). With ``rolling_model="lammps_sds"``
+        it is LAMMPS's mu_roll, the limit mu_roll F_n0 of the rolling pseudo-force. [-]
     shear_modulus : float or None
         Effective shear modulus G* of the pair, 1/G* = (2 - nu1)/G1 + (2 - nu2)/G2, needed by the
         "mindlin" tangential model (tangential stiffness 8 G* a); None when not given. [Pa]
@@ -193,6 +197,14 @@ class Contact:
     tangential_damping : float
         x_gamma,t of the DEM tangential laws: their tangential damping is x_gamma,t times the
         normal damping coefficient of ``damping_model`` (LAMMPS's convention); 0 by default. [-]
+    rolling_model : {"torque", "lammps_sds"}
+        Rolling resistance: "torque" (default) is the constant torque of ``rolling_friction``
+        (none while it is 0, the paper's); "lammps_sds" LAMMPS's ``rolling sds k_roll gamma_roll
+        mu_roll`` (:mod:`microimpact.model.dem_rolling`), with a DEM tangential law only. [-]
+    rolling_stiffness : float or None
+        k_roll of "lammps_sds"; None otherwise. [N/m]
+    rolling_damping : float
+        gamma_roll of "lammps_sds"; 0 by default. [N s/m]
 
     Raises
     ------
@@ -223,6 +235,9 @@ class Contact:
     damping_coefficient: float = 0.0
     tangential_stiffness: float | None = None
     tangential_damping: float = 0.0
+    rolling_model: str = "torque"
+    rolling_stiffness: float | None = None
+    rolling_damping: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -236,7 +251,7 @@ class Contact:
         for name in ("radius", "density", "stiffness"):
             check_positive(name, getattr(self, name))
         for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction", "rolling_friction",
-                     "damping_coefficient", "tangential_damping"):
+                     "damping_coefficient", "tangential_damping", "rolling_damping"):
             _check_non_negative(name, getattr(self, name))
         for name in _OPTIONAL:
             if getattr(self, name) is not None:
@@ -245,6 +260,7 @@ class Contact:
             raise ValueError(f"tangential_model={self.tangential_model!r} needs shear_modulus "
                              "(the effective shear modulus G* [Pa])")
         self._check_dem_tangential()
+        self._check_dem_rolling()
         self._check_damping_model()
         self._check_scales()
 
@@ -265,13 +281,28 @@ class Contact:
             other.append("normal_model='jkr' (use 'jkr_force', LAMMPS's break)")
         if self.normal_model == "ring" and self.adhesion_line_force > 0.0:
             other.append(f"the ring adhesion force (adhesion_line_force={self.adhesion_line_force!r}; use 'jkr_force' or 'dmt')")
-        other += [f"{n}={getattr(self, n)!r}" for n in ("zeta_hertz", "zeta_adhesion", "rolling_friction")
-                  if getattr(self, n) != 0.0]
+        other += [f"{n}={getattr(self, n)!r}" for n in ("zeta_hertz", "zeta_adhesion") if getattr(self, n) != 0.0]
+        if self.rolling_model == "torque" and self.rolling_friction != 0.0:
+            other.append(f"rolling_friction={self.rolling_friction!r} of the constant rolling torque (use "
+                         "rolling_model='lammps_sds', LAMMPS's rolling resistance)")
         if self.friction_model != "net":
             other.append(f"friction_model={self.friction_model!r} (the limit is LAMMPS's own)")
         if other:
             raise ValueError(f"tangential_model={model!r} is LAMMPS's law and runs with LAMMPS's normal laws and "
                              f"damping only; not with {', '.join(other)}")
+
+    def _check_dem_rolling(self) -> None:
+        """LAMMPS's rolling law with its own parameters and a DEM tangential law (model.dem_rolling)."""
+        sds = self.rolling_model in DEM_ROLLING_MODELS
+        if sds != (self.rolling_stiffness is not None):
+            raise ValueError("rolling_stiffness (k_roll [N/m]) belongs to rolling_model='lammps_sds', and that law "
+                             f"needs it: got rolling_model={self.rolling_model!r}, rolling_stiffness={self.rolling_stiffness!r}")
+        if self.rolling_damping != 0.0 and not sds:
+            raise ValueError(f"rolling_damping={self.rolling_damping!r} (gamma_roll) belongs to rolling_model='lammps_sds', "
+                             f"got rolling_model={self.rolling_model!r}")
+        if sds and self.tangential_model not in DEM_TANGENTIAL_MODELS:
+            raise ValueError(f"rolling_model={self.rolling_model!r} is LAMMPS's law and runs with its tangential laws "
+                             f"({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}), got tangential_model={self.tangential_model!r}")
 
     def _check_damping_model(self) -> None:
         """One damping law at a time, with the normal laws it is defined for (model.dem_damping)."""

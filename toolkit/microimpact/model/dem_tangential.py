@@ -56,8 +56,9 @@ across it; the contact sticks again when the trial force's rate along e falls be
 limit (the trial force would move inside the limit). This is LAMMPS's return mapping as its step
 goes to zero; its first-order convergence to it is tested (tests/test_dem_tangential.py).
 
-Twisting and rolling resistance (LAMMPS ``twisting``, ``rolling``) are not modelled with these
-laws: the spin about the normal is unchanged, as with LAMMPS's default ``twisting none``.
+Rolling resistance is LAMMPS's ``rolling sds`` (:mod:`microimpact.model.dem_rolling`,
+``Contact.rolling_model="lammps_sds"``). Twisting (LAMMPS ``twisting``) is not modelled: the spin
+about the normal is unchanged, as with LAMMPS's default ``twisting none``.
 
 References
 ----------

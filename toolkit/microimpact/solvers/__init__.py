@@ -25,6 +25,7 @@ import sys
 import time
 from dataclasses import dataclass
 
+from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 
 #: The one default relative tolerance of every entry point (API, CLI, pipeline config ``rtol``).
@@ -187,11 +188,13 @@ SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
     "engine": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"),
                "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", *DEM_TANGENTIAL_MODELS),
                "friction_model": ("net", "pulloff"),
-               "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution")},
+               "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
+               "rolling_model": ("torque", *DEM_ROLLING_MODELS)},
     "reference": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"), "tangential_model": ("rigid",), "friction_model": ("net",),
-                  "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution")},
+                  "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
+                  "rolling_model": ("torque",)},
     "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",),
-            "damping_model": ("paper",)},
+            "damping_model": ("paper",), "rolling_model": ("torque",)},
 }
 #: solver paths that model rolling resistance (Contact.rolling_friction > 0): the engine's coupled
 #: solver (.coupled), with a compliant tangential model (ROLLING_RESISTANCE_TANGENTIAL_MODELS)
@@ -214,7 +217,8 @@ def check_sub_models(contact, method: str) -> None:
     if contact.rolling_friction > 0.0 and method not in ROLLING_RESISTANCE_METHODS:
         hint = f"; use method={ROLLING_RESISTANCE_METHODS[0]!r}" if ROLLING_RESISTANCE_METHODS else "; no solver implements it yet"
         raise ValueError(f"rolling_friction={contact.rolling_friction!r} is not covered by method={method!r}{hint}")
-    if contact.rolling_friction > 0.0 and contact.tangential_model not in ROLLING_RESISTANCE_TANGENTIAL_MODELS:
+    if (contact.rolling_friction > 0.0 and contact.rolling_model == "torque"
+            and contact.tangential_model not in ROLLING_RESISTANCE_TANGENTIAL_MODELS):
         raise ValueError(f"rolling_friction={contact.rolling_friction!r} needs a compliant tangential model "
                          f"(tangential_model one of {', '.join(map(repr, ROLLING_RESISTANCE_TANGENTIAL_MODELS))}), "
                          f"got tangential_model={contact.tangential_model!r}")

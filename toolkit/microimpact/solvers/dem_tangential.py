@@ -19,9 +19,16 @@ kappa = 1 + m r^2 / I (the slip responds to a tangential force F as du/dt = kapp
 * slide: F = mu F_n0 e, du / dt = kappa F, de / dt = (1 - e e^T) G' / (mu F_n0), G' the rate of the
   trial force F_e(H) - eta_t u with H the history of the elastic part F + eta_t u.
 
-The tangential problem is one-dimensional: the wall is isotropic, the history starts at 0 and the
-force acts on the slip alone (no twisting or rolling torque), so xi, u and F stay on the line of the
-initial slip u_in. It is integrated in a frame whose first axis is u_in, where the components
+With LAMMPS's rolling law (:mod:`microimpact.model.dem_rolling`) a second spring of the same kind
+(constant stiffness k_roll, damping gamma_roll, limit mu_roll F_n0) acts on the rolling velocity
+w = R omega x n_w; its state (history or direction, and w) follows the slip's in the state vector,
+and the slip feels its torque: du/dt = kappa F / m - (kappa - 1) F_r / m, dw/dt = (kappa - 1)
+(F_r - F) / m. Each spring sticks and slides on its own, with its own events.
+
+Without rolling resistance the tangential problem is one-dimensional: the wall is isotropic, the
+history starts at 0 and the force acts on the slip alone, so xi, u and F stay on the line of the
+initial slip u_in. (So does it with the rolling law where w_in is parallel to u_in: spin about t'
+only, the planar impact.) It is integrated in a frame whose first axis is u_in, where the components
 across are exactly 0 and the direction e is +-1 (in the wall's frame rounding noise across the slip,
 divided by a vanishing limit, made the steps fail near a Hertz separation); the solver keeps the
 two-component form, which is exact for any direction.
@@ -31,7 +38,11 @@ limit; slide ends where e . G' falls below the rate of the limit (the trial forc
 the contact ends where the normal law separates (s = 0, or q^3 = 3 for LAMMPS's JKR). At a switch
 the state is mapped (e = F / |F|; xi = -(F + eta_t u) / k) and the integration restarts.
 
-Method: scipy's DOP853 (Hairer et al. 1993) at the toolkit's rtol, per impact in Python. It is an
+Method: scipy's DOP853 (Hairer et al. 1993) at the toolkit's rtol, per impact in Python; Radau
+(implicit) where the rolling velocity has a part across the slip, whose force directions turn at
+rates |G'| / (mu F_n0) that an explicit method cannot follow where a limit is small. There a
+rolling limit far below the friction's (mu_roll <= 1e-6 beside mu 0.3) still fails, with a
+:class:`DemTangentialError`; a rolling law whose largest effect is below the tolerance is dropped. It is an
 integrator of its own beside the compiled ones (the one-core issue, docs/guide/lammps.md), slower
 (tens of ms per impact) and without the engine's overdamped limits: an impact whose normal motion
 creeps (tens of thousands of critical dampings) ends in a :class:`DemTangentialError`.
@@ -67,6 +78,7 @@ import math
 import numpy as np
 
 from microimpact.model import adhesion_models as am
+from microimpact.model.dem_rolling import DEM_ROLLING_MODELS, lammps_rolling_velocity
 from microimpact.model.dem_tangential import (DEM_TANGENTIAL_MODELS, FORCE_HISTORY_MODELS, lammps_critical_normal_force,
                                               lammps_critical_normal_force_rate, lammps_elastic_force,
                                               lammps_pulloff_force, lammps_history_of_force, lammps_history_rate,
@@ -130,8 +142,15 @@ class _Law:
         self.k1 = lammps_tangential_stiffness(self.model, self.k_param, self.a_unit) / self.k_unit - self.k0
         self.x_t = contact.tangential_damping
         self.mu = contact.friction
-        self.kappa = 1.0 + contact.mass * contact.radius**2 / contact.moment_of_inertia
-        self.cap_floor = 0.0  # set by _integrate from its tolerance
+        self.spin = contact.mass * contact.radius**2 / contact.moment_of_inertia
+        self.kappa = 1.0 + self.spin
+        # LAMMPS's rolling law (model.dem_rolling): k_roll in F / L, gamma_roll in F / (L / T)
+        self.rolling = contact.rolling_model in DEM_ROLLING_MODELS
+        self.k_r = contact.rolling_stiffness / self.k_unit if self.rolling else 0.0
+        self.gamma_r = contact.rolling_damping * float(sc.speed) / force
+        self.mu_r = contact.rolling_friction if self.rolling else 0.0
+        self.cap_floor = self.cap_floor_r = 0.0  # set by _integrate from its tolerance
+        self.method = "DOP853"
 
     def normal(self, z, y):
         """(g = dtau/dsigma, dz/dsigma, a, da/dsigma, eta_n, deta_n/dsigma, dy/dsigma, F_n0, dF_n0/dsigma)
@@ -163,67 +182,106 @@ class _Law:
         return lammps_tangential_stiffness(self.model, self.k_param, a * self.a_unit) / self.k_unit
 
 
-def _rhs_and_switch(law, x, mode):
-    """(d/dsigma of the state, the switch function of ``mode``, the rate of stick's switch) at x.
+def _spring(model, mode, s1, s2, v1, v2, k, eta, cap):
+    """(force, direction e, history, stick's switch) of one history spring with its Coulomb limit
+    (the tangential law on the slip u, or the rolling law on the rolling velocity), from its state
+    (s1, s2): the history H in stick, the direction e in slide. Slide's switch is its rate's
+    (``_spring_rates``); ``None`` is returned for it here."""
+    if mode == _STICK:
+        h1, h2 = s1, s2
+        f1 = lammps_elastic_force(model, h1, k) - eta * v1
+        f2 = lammps_elastic_force(model, h2, k) - eta * v2
+        size = math.hypot(f1, f2)
+        e1, e2 = (f1 / size, f2 / size) if size > 0.0 else (0.0, 0.0)
+        switch = (size - cap) / (size + cap) if size + cap > 0.0 else -1.0
+        return f1, f2, e1, e2, h1, h2, switch
+    norm = math.hypot(s1, s2)
+    e1, e2 = s1 / norm, s2 / norm
+    f1, f2 = cap * e1, cap * e2
+    # the history the force on the limit leaves (model.dem_tangential: LAMMPS resets it to the
+    # elastic part of the scaled force)
+    fe1, fe2 = f1 + eta * v1, f2 + eta * v2
+    if model in FORCE_HISTORY_MODELS or k > 0.0:
+        h1, h2 = lammps_history_of_force(model, fe1, k), lammps_history_of_force(model, fe2, k)
+    else:  # first touch of a Mindlin spring (a = 0): no history yet
+        h1 = h2 = 0.0
+    return f1, f2, e1, e2, h1, h2, None
 
-    The switch functions are relative, in [-1, 1]: (|F| - mu F_n0) / (|F| + mu F_n0) in stick, and
-    (e . G' - (mu F_n0)') / (|e . G'| + |(mu F_n0)'|) in slide, so that their zeros stay well
-    conditioned where force and limit both vanish (Hertz at touch and separation, like s^3). The
-    third value is that of slide with e = F / |F| in stick: the sign of the rate of |F| - mu F_n0,
-    whose maxima ``_integrate`` watches for a crossing of the limit inside one step."""
-    z, y, s1, s2, u1, u2 = x[0], x[1], x[2], x[3], x[4], x[5]
+
+def _spring_rates(model, mode, spring, v1, v2, dv1, dv2, g, k, dk, eta, deta, cap, dcap, radius_rate, floor):
+    """(d/dsigma of the spring's state, the rate of slide's switch) from ``_spring``'s ``spring``.
+
+    G' is the rate of the trial force F_e(H) - eta v; slide's switch is (e . G' - (mu F_n0)') /
+    (|e . G'| + |(mu F_n0)'|), which stays well conditioned where force and limit both vanish
+    (Hertz at touch and separation, like s^3). In stick the state moves at dH/dsigma; in slide the
+    direction turns at (1 - e e^T) G' / (mu F_n0), where the limit is below ``floor`` (a
+    tolerance's part of the largest limit) at ``floor``: a force that small moves the outcome by
+    less than the tolerance whatever its direction, while 1 / (mu F_n0) near a Hertz separation
+    (F_n0 ~ s^3) turned rounding noise into steps below the spacing of doubles (23 of 120 random
+    planar impacts before)."""
+    _, _, e1, e2, h1, h2, _ = spring
+    dh1 = lammps_history_rate(model, h1, g * v1, k, radius_rate)
+    dh2 = lammps_history_rate(model, h2, g * v2, k, radius_rate)
+    if model in FORCE_HISTORY_MODELS:
+        dfe1, dfe2 = dh1, dh2
+    else:
+        dfe1, dfe2 = -dk * h1 - k * dh1, -dk * h2 - k * dh2
+    g1 = dfe1 - deta * v1 - eta * dv1
+    g2 = dfe2 - deta * v2 - eta * dv2
+    along = e1 * g1 + e2 * g2
+    rate = (along - dcap) / (abs(along) + abs(dcap)) if abs(along) + abs(dcap) > 0.0 else 1.0
+    if mode == _STICK:
+        return dh1, dh2, rate
+    turn = max(cap, floor)
+    if turn == 0.0:  # a spring without friction (mu = 0 beside a rolling law): no force, whatever e is
+        return 0.0, 0.0, rate
+    return (g1 - along * e1) / turn, (g2 - along * e2) / turn, rate
+
+
+def _rhs_and_switch(law, x, mode):
+    """(d/dsigma of the state, the switch functions of ``mode``, the rates of stick's switches) at x.
+
+    ``mode`` is (tangential, rolling), each _STICK or _SLIDE; the switch functions and rates are
+    pairs in that order (the rolling ones -1 without a rolling law). The switch functions are
+    relative, in [-1, 1]: (|F| - mu F_n0) / (|F| + mu F_n0) in stick, the rate of ``_spring_rates``
+    in slide. The rate of stick's switch is that of slide with e = F / |F|: the sign of the rate
+    of |F| - mu F_n0, whose maxima ``_integrate`` watches for a crossing of the limit inside one
+    step.
+
+    With LAMMPS's rolling law (model.dem_rolling) the state carries the rolling history and the
+    rolling velocity w after the slip u; the slip responds to both pseudo-forces, du/dtau =
+    kappa F - (kappa - 1) F_r, and dw/dtau = (kappa - 1) (F_r - F) (unit mass; the rolling
+    pseudo-force acts through its torque R n_w x F_r only)."""
+    z, y, u1, u2 = x[0], x[1], x[4], x[5]
     g, dz, a, da, eta, deta, dy, n0, dn0 = law.normal(z, y)
     cap, dcap = law.mu * n0, law.mu * dn0
     eta_t, deta_t = law.x_t * eta, law.x_t * deta
     k = law.stiffness(a)
-    out = np.empty(7)
+    tangential = _spring(law.model, mode[0], x[2], x[3], u1, u2, k, eta_t, cap)
+    f1, f2 = tangential[0], tangential[1]
+    out = np.empty(11 if law.rolling else 7)
     out[0], out[1], out[6] = dz, dy, g
     # (da/dsigma) / a, for the rescaled histories (model.dem_tangential.lammps_history_rate)
     radius_rate = da / a if a > 0.0 else 0.0
-    if mode == _STICK:
-        h1, h2 = s1, s2
-        f1 = lammps_elastic_force(law.model, h1, k) - eta_t * u1
-        f2 = lammps_elastic_force(law.model, h2, k) - eta_t * u2
-        size = math.hypot(f1, f2)
-        e1, e2 = (f1 / size, f2 / size) if size > 0.0 else (0.0, 0.0)
-        switch = (size - cap) / (size + cap) if size + cap > 0.0 else -1.0
+    if law.rolling:
+        w1, w2 = x[9], x[10]
+        rcap, drcap = law.mu_r * n0, law.mu_r * dn0
+        rolling = _spring("linear_history", mode[1], x[7], x[8], w1, w2, law.k_r, law.gamma_r, rcap)
+        r1, r2 = rolling[0], rolling[1]
+        du1, du2 = g * (law.kappa * f1 - law.spin * r1), g * (law.kappa * f2 - law.spin * r2)
+        dw1, dw2 = g * law.spin * (r1 - f1), g * law.spin * (r2 - f2)
+        out[7], out[8], rate_r = _spring_rates("linear_history", mode[1], rolling, w1, w2, dw1, dw2, g, law.k_r,
+                                               0.0, law.gamma_r, 0.0, rcap, drcap, 0.0, law.cap_floor_r)
+        out[9], out[10] = dw1, dw2
+        switch_r = rolling[6] if mode[1] == _STICK else rate_r
     else:
-        norm = math.hypot(s1, s2)
-        e1, e2 = s1 / norm, s2 / norm
-        f1, f2 = cap * e1, cap * e2
-        # the history the force on the limit leaves (model.dem_tangential: LAMMPS resets it to the
-        # elastic part of the scaled force)
-        fe1, fe2 = f1 + eta_t * u1, f2 + eta_t * u2
-        if law.force_history or k > 0.0:
-            h1, h2 = lammps_history_of_force(law.model, fe1, k), lammps_history_of_force(law.model, fe2, k)
-        else:  # first touch of a Mindlin spring (a = 0): no history yet
-            h1 = h2 = 0.0
-    du1, du2 = g * law.kappa * f1, g * law.kappa * f2
-    dh1 = lammps_history_rate(law.model, h1, g * u1, k, radius_rate)
-    dh2 = lammps_history_rate(law.model, h2, g * u2, k, radius_rate)
-    # G', the rate of the trial force F_e(H) - eta_t u
-    if law.force_history:
-        dfe1, dfe2 = dh1, dh2
-    else:
-        dk = law.k1 * da
-        dfe1, dfe2 = -dk * h1 - k * dh1, -dk * h2 - k * dh2
-    g1 = dfe1 - deta_t * u1 - eta_t * du1
-    g2 = dfe2 - deta_t * u2 - eta_t * du2
-    along = e1 * g1 + e2 * g2
-    rate = (along - dcap) / (abs(along) + abs(dcap)) if abs(along) + abs(dcap) > 0.0 else 1.0
-    if mode == _STICK:
-        out[2], out[3] = dh1, dh2
-    else:
-        # the direction turns at (1 - e e^T) G' / (mu F_n0); where the limit is below cap_floor (a
-        # tolerance's part of the largest limit) the turning is taken at cap_floor: a force that small
-        # moves the outcome by less than the tolerance whatever its direction, while 1 / (mu F_n0)
-        # near a Hertz separation (F_n0 ~ s^3) turned rounding noise into steps below the spacing of
-        # doubles (23 of 120 random planar impacts before)
-        turn = max(cap, law.cap_floor)
-        out[2], out[3] = (g1 - along * e1) / turn, (g2 - along * e2) / turn
-        switch = rate
+        du1, du2 = g * law.kappa * f1, g * law.kappa * f2
+        switch_r = rate_r = -1.0
+    out[2], out[3], rate = _spring_rates(law.model, mode[0], tangential, u1, u2, du1, du2, g, k, law.k1 * da,
+                                         eta_t, deta_t, cap, dcap, radius_rate, law.cap_floor)
     out[4], out[5] = du1, du2
-    return out, switch, rate
+    switch = tangential[6] if mode[0] == _STICK else rate
+    return out, (switch, switch_r), (rate, rate_r)
 
 
 def _separation(law, x):
@@ -232,12 +290,14 @@ def _separation(law, x):
 
 
 def _start_mode(law, x):
-    """Stick or slide at first touch: the stuck trial force against the limit just after touch.
+    """(mode, initial state) at first touch: each spring sticks or slides as its stuck trial force
+    compares with its limit just after touch.
 
     At touch the history is 0 and, for Hertz, force and limit both vanish, while their ratio does
     not (for the Mindlin spring it is k u / (mu y) with k = dk/da, the incidence parameter of Maw et
     al. 1976); so they are compared at a state a short way in, from the leading terms of the motion
-    (s = y sigma / 2, tau = y sigma^2 / 4; JKR: q = q0 + y sigma, tau = g sigma) and xi = u tau.
+    (s = y sigma / 2, tau = y sigma^2 / 4; JKR: q = q0 + y sigma, tau = g sigma) and xi = u tau
+    (the rolling history: w tau).
     """
     sigma = 1e-6
     probe = x.copy()
@@ -251,138 +311,196 @@ def _start_mode(law, x):
     if law.force_history:  # H = -int k u dt, with k ~ a ~ t^(1/2) for Hertz and DMT, ~ const for JKR
         k = law.stiffness(law.normal(probe[0], probe[1])[2])
         probe[2:4] *= -k * (1.0 if law.jkr else 2.0 / 3.0)
-    switch = _rhs_and_switch(law, probe, _STICK)[1]
-    if switch <= 0.0:
-        return _STICK, 0.0
-    # sliding from touch; against the slip, except where LAMMPS's Mindlin spring starts at a = 0
-    # under a damping that does not vanish as fast as a (mass_velocity, tsuji, coeff_restitution):
-    # its history, reset to -(mu F_n0 e + eta_t u) / (k a), is then ~ a^(p - 1) and the spring
-    # force k a xi it gives grows with a / a_touch, which carries the trial force across the limit
-    # at once: the force starts at the limit along the slip (LAMMPS converges to this as its step
-    # falls: e_t 0.73763, 0.73631, 0.73628 at 500, 8000, 128000 steps per contact, DMT, 60 deg)
-    # (a force history is reset to the elastic force itself, without the 1 / a: no such start)
-    forward = (law.k1 > 0.0 and not law.force_history and not law.jkr and law.c3 > 0.0 and law.p3 < 1.0
-               and law.x_t > 0.0)
-    return _SLIDE, (1.0 if forward else -1.0)
+    if law.rolling:
+        probe[7:9] = x[9:11] * tau
+    switch = _rhs_and_switch(law, probe, (_STICK, _STICK))[1]
+    x = x.copy()
+    tangential = rolling = _STICK
+    if switch[0] > 0.0:
+        # sliding from touch; against the slip, except where LAMMPS's Mindlin spring starts at a = 0
+        # under a damping that does not vanish as fast as a (mass_velocity, tsuji, coeff_restitution):
+        # its history, reset to -(mu F_n0 e + eta_t u) / (k a), is then ~ a^(p - 1) and the spring
+        # force k a xi it gives grows with a / a_touch, which carries the trial force across the limit
+        # at once: the force starts at the limit along the slip (LAMMPS converges to this as its step
+        # falls: e_t 0.73763, 0.73631, 0.73628 at 500, 8000, 128000 steps per contact, DMT, 60 deg)
+        # (a force history is reset to the elastic force itself, without the 1 / a: no such start)
+        forward = (law.k1 > 0.0 and not law.force_history and not law.jkr and law.c3 > 0.0 and law.p3 < 1.0
+                   and law.x_t > 0.0)
+        tangential = _SLIDE
+        x[2:4] = (1.0 if forward else -1.0) * x[4:6] / math.hypot(x[4], x[5])
+    if law.rolling and switch[1] > 0.0:  # the rolling spring (constant k) slides against the rolling
+        rolling = _SLIDE
+        x[7:9] = -x[9:11] / math.hypot(x[9], x[10])
+    return (tangential, rolling), x
 
 
-def _integrate(law, u0, rtol, tau_scale, z_scale):
-    """(u at separation, contact time, end of the last slide or NaN, switches, whether it ends
-    stuck), in the law's units."""
+def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
+    """(state at separation, end of the last tangential slide or NaN, switches, whether the
+    tangential spring ends stuck), in the law's units; ``w0`` the rolling velocity (with a rolling
+    law)."""
     from scipy.integrate import solve_ivp
 
     peak = z_scale**6 / 6.0 + 3.0 if law.jkr else z_scale**3 + 2.0 * law.pulloff  # F_n0 at the largest approach
-    law.cap_floor = rtol * law.mu * max(peak, 1.0)
+    # the direction's floor (_spring_rates) is a tolerance's part of the larger of the two limits: a
+    # rolling limit far below the friction's (mu_roll 1e-12) moves the outcome by less than the
+    # tolerance, while 1 / (mu_roll F_n0) made its direction turn too fast to follow (2-D rolling)
+    law.cap_floor = law.cap_floor_r = rtol * max(law.mu, law.mu_r) * max(peak, 1.0)
     z0 = am.JKR_Q_FORMATION if law.jkr else 0.0
-    x = np.array([z0, law.y0, 0.0, 0.0, u0[0], u0[1], 0.0])
-    mode, direction = _start_mode(law, x)
-    if mode == _SLIDE:
-        x[2:4] = direction * np.asarray(u0) / math.hypot(*u0)
-    speed = max(math.hypot(*u0), 1e-300)
+    x = np.array([z0, law.y0, 0.0, 0.0, u0[0], u0[1], 0.0] + ([0.0, 0.0, w0[0], w0[1]] if law.rolling else []))
+    mode, x = _start_mode(law, x)
+    speed = max(math.hypot(*u0), math.hypot(*w0) if law.rolling else 0.0, 1e-300)
     history = speed * tau_scale  # a displacement's scale; a force history's is k at the largest contact
     if law.force_history:
         history *= law.stiffness(z_scale**2 if law.jkr else z_scale)
+    springs = (0, 1) if law.rolling else (0,)
     evaluations = [0]
+    budget = _MAX_EVALUATIONS if law.method == "DOP853" else _MAX_EVALUATIONS // 10  # Radau's cost ~10 DOP853's
     sigma, switches, events, slide_end = 0.0, 0, 0, math.nan
 
     def rhs(_, state):
         evaluations[0] += 1
-        if evaluations[0] > _MAX_EVALUATIONS:
-            raise DemTangentialError(f"DEM tangential integration: more than {_MAX_EVALUATIONS} evaluations")
+        if evaluations[0] > budget:
+            raise DemTangentialError(f"DEM tangential integration ({law.method}): more than {budget} evaluations")
         return _rhs_and_switch(law, state, mode)[0]
 
     def separation(_, state):
         return _separation(law, state)
 
-    def switch(_, state):
-        if _separation(law, state) <= 0.0:  # past the end of contact: the law is not defined there
-            return -1.0 if mode == _STICK else 1.0
-        return _rhs_and_switch(law, state, mode)[1]
+    def switch_of(i):
+        def switch(_, state):
+            if _separation(law, state) <= 0.0:  # past the end of contact: the law is not defined there
+                return -1.0 if mode[i] == _STICK else 1.0
+            return _rhs_and_switch(law, state, mode)[1][i]
+        switch.terminal = True
+        return switch
 
-    def peak(_, state):
-        """Falls through 0 where the switch function is farthest towards leaving the mode: a maximum
-        of |F| - mu F_n0 in stick (its rate, exact), a minimum of slide's switch function (its rate
-        along the motion, a central difference over a step of _RATE_STEP along the right-hand side)."""
-        if _separation(law, state) <= 0.0:
-            return 1.0
-        if mode == _STICK:
-            return _rhs_and_switch(law, state, _STICK)[2]
-        rate = _rhs_and_switch(law, state, _SLIDE)[0]
-        h = _RATE_STEP * max(1.0, abs(sigma))
-        ahead, behind = state + h * rate, state - h * rate
-        if _separation(law, ahead) <= 0.0 or _separation(law, behind) <= 0.0:
-            return 1.0
-        return -(_rhs_and_switch(law, ahead, _SLIDE)[1] - _rhs_and_switch(law, behind, _SLIDE)[1])
+    def peak_of(i):
+        def peak(_, state):  # falls through 0 where spring i's switch function is farthest towards leaving:
+            # a maximum of |F| - mu F_n0 in stick (its rate, exact), a minimum of slide's switch function
+            # (its rate along the motion, a central difference over _RATE_STEP along the right-hand side)
+            if _separation(law, state) <= 0.0:
+                return 1.0
+            if mode[i] == _STICK:
+                return _rhs_and_switch(law, state, mode)[2][i]
+            rate = _rhs_and_switch(law, state, mode)[0]
+            h = _RATE_STEP * max(1.0, abs(sigma))
+            ahead, behind = state + h * rate, state - h * rate
+            if _separation(law, ahead) <= 0.0 or _separation(law, behind) <= 0.0:
+                return 1.0
+            return -(_rhs_and_switch(law, ahead, mode)[1][i] - _rhs_and_switch(law, behind, mode)[1][i])
+        peak.direction = -1.0
+        return peak
 
     separation.terminal, separation.direction = True, -1.0
-    switch.terminal = True
-    peak.direction = -1.0
+    switches_ = [switch_of(i) for i in springs]
+    # scipy's order of events: separation, then (switch, peak) of each spring
+    watched = [separation] + [f for i in springs for f in (switches_[i], peak_of(i))]
     last, repeats = -math.inf, 0
     while True:
-        switch.direction = 1.0 if mode == _STICK else -1.0
-        atol = rtol * np.array([z_scale, law.y0, history if mode == _STICK else 1.0,
-                                history if mode == _STICK else 1.0, speed, speed, tau_scale])
+        for i in springs:
+            switches_[i].direction = 1.0 if mode[i] == _STICK else -1.0
+        atol = [z_scale, law.y0, *[history if mode[0] == _STICK else 1.0] * 2, speed, speed, tau_scale]
+        if law.rolling:
+            atol += [speed * tau_scale if mode[1] == _STICK else 1.0] * 2 + [speed, speed]
+        atol = rtol * np.array(atol)
         # a switch that is undone at once (both modes ask to leave where the trial force's rate equals
         # the limit's, h = 0 touched without crossing): the motion is the same in both to first
         # order, so the new mode is kept over a short stretch with its switch event off
         span = _CHATTER_SPAN * max(sigma, 1.0) if repeats >= 2 else _SIGMA_SPAN
         watch = repeats < 2
-        sol = solve_ivp(rhs, (sigma, sigma + span), x, method="DOP853", rtol=rtol, atol=atol, dense_output=watch,
-                        events=(separation, switch, peak) if watch else (separation,))
+        try:
+            with np.errstate(over="ignore"):  # Radau's difference Jacobian probes far steps; it recovers
+                sol = solve_ivp(rhs, (sigma, sigma + span), x, method=law.method, rtol=rtol, atol=atol,
+                                dense_output=watch, events=watched if watch else (separation,))
+        except ValueError as exc:  # scipy's event location on a switch function that jumps (2-D, tiny limit)
+            raise DemTangentialError(f"DEM tangential integration ({law.method}) failed to locate an event: {exc}") from None
         if sol.status == 0 and repeats >= 2:  # the stretch is done: watch for switches again
             sigma, x, repeats = float(sol.t[-1]), sol.y[:, -1].copy(), 0
             continue
         if sol.status != 1:
             raise DemTangentialError(f"DEM tangential integration stopped: {sol.message}")
-        missed = _crossing_inside_a_step(sol, sigma, switch, 1.0 if mode == _STICK else -1.0) if watch else None
-        if missed is not None:
-            sigma, x = missed
-        elif sol.t_events[0].size:
-            end = sol.y_events[0][0]
-            return end[4:6], end[6], (slide_end if mode == _STICK else math.nan), switches, mode == _STICK
-        else:
-            sigma, x = float(sol.t_events[1][0]), sol.y_events[1][0].copy()
+        first = _first_switch(sol, sigma, switches_, mode) if watch else None
+        if first is None:  # the contact ended
+            return sol.y_events[0][0], (slide_end if mode[0] == _STICK else math.nan), switches, mode[0] == _STICK
+        sigma, x, spring = first
         repeats = repeats + 1 if sigma - last <= 1e-12 * max(sigma, 1.0) else 0
         last = sigma
         events += 1
         if events > _MAX_EVENTS:
             raise DemTangentialError(f"DEM tangential integration: more than {_MAX_EVENTS} stick-slip events")
-        _, _, a, _, eta, _, _, n0, _ = law.normal(x[0], x[1])
-        eta_t = law.x_t * eta
-        if mode == _STICK:  # the force reached the limit: slide along it, unless it only grazes it
-            f = lammps_elastic_force(law.model, x[2:4], law.stiffness(a)) - eta_t * x[4:6]
-            sliding = x.copy()
-            sliding[2:4] = f / math.hypot(*f)
-            if _rhs_and_switch(law, sliding, _SLIDE)[1] > 0.0:
-                x, mode, switches = sliding, _SLIDE, switches + 1
-        else:  # the trial force turns inwards: stick, with the history of the force on the limit
-            e = x[2:4] / math.hypot(*x[2:4])
-            x[2:4] = lammps_history_of_force(law.model, law.mu * n0 * e + eta_t * x[4:6], law.stiffness(a))
-            mode, switches = _STICK, switches + 1
+        mode, x, switched = _switch(law, x, mode, spring)
+        switches += switched and spring == 0
+        if switched and spring == 0 and mode[0] == _STICK:
             slide_end = x[6]
 
 
-def _crossing_inside_a_step(sol, start, switch, sign):
+def _first_switch(sol, start, switch_events, mode):
+    """(sigma, state, spring) of the first switch in the solve ``sol`` from ``start``: a crossing
+    the events missed inside a step (``_crossing_inside_a_step``), else the first switch event;
+    None where the contact ended first. ``sol``'s events are separation, then (switch, peak) of
+    each spring."""
+    end = float(sol.t_events[0][0]) if sol.t_events[0].size else None
+    springs = range(len(switch_events))
+    stopped_by = next((j for j in springs if sol.t_events[1 + 2 * j].size), None)
+    first = None
+    for i in springs:
+        # the last instant is checked where the contact ended or the other spring switched (a
+        # restart on this spring's limit, rounded outside it, showed no sign change: the rolling
+        # force stayed above its limit for half a contact, 2-D rolling at 30 deg)
+        last_instant = end if end is not None else (sol.t[-1] if stopped_by not in (None, i) else None)
+        missed = _crossing_inside_a_step(sol, start, switch_events[i], 1.0 if mode[i] == _STICK else -1.0,
+                                         sol.t_events[2 + 2 * i], last_instant)
+        if missed is not None and (first is None or missed[0] < first[0]):
+            first = (*missed, i)
+    if first is None and stopped_by is not None:
+        first = (float(sol.t_events[1 + 2 * stopped_by][0]), sol.y_events[1 + 2 * stopped_by][0].copy(), stopped_by)
+    return first
+
+
+def _switch(law, x, mode, spring):
+    """(mode, state, whether it changed) after spring ``spring`` (0 tangential, 1 rolling) reached
+    its switch: from stick to slide along the force unless it only grazes the limit; from slide to
+    stick with the history of the force on the limit."""
+    _, _, a, _, eta, _, _, n0, _ = law.normal(x[0], x[1])
+    x = x.copy()
+    if spring == 0:
+        model, k, eta_v, mu, state, velocity = law.model, law.stiffness(a), law.x_t * eta, law.mu, slice(2, 4), slice(4, 6)
+    else:
+        model, k, eta_v, mu, state, velocity = "linear_history", law.k_r, law.gamma_r, law.mu_r, slice(7, 9), slice(9, 11)
+    if mode[spring] == _STICK:
+        f = lammps_elastic_force(model, x[state], k) - eta_v * x[velocity]
+        sliding = x.copy()
+        sliding[state] = f / math.hypot(*f)
+        new = (_SLIDE, mode[1]) if spring == 0 else (mode[0], _SLIDE)
+        if _rhs_and_switch(law, sliding, new)[1][spring] > 0.0:
+            return new, sliding, True
+        return mode, x, False
+    e = x[state] / math.hypot(*x[state])
+    x[state] = lammps_history_of_force(model, mu * n0 * e + eta_v * x[velocity], k)
+    return ((_STICK, mode[1]) if spring == 0 else (mode[0], _STICK)), x, True
+
+
+def _crossing_inside_a_step(sol, start, switch, sign, tops, end):
     """(sigma, state) where the mode should first have been left unseen by the events, or None.
 
     ``sign`` is +1 in stick (left where the switch function rises through 0: |F| reaches the limit)
-    and -1 in slide (left where it falls through 0: the trial force turns inwards). scipy's events
-    see a sign change only between the ends of a step, and past the end of contact the switch
-    function is held on the side of staying. A crossing in the step that ends the contact, or an
-    excursion that begins and ends inside one step, was therefore lost (LAMMPS's JKR with
-    mindlin/force, 0.13 m/s, 20 deg: stuck to the end with |F| 9 % above the limit there, e_t
-    0.8998 against LAMMPS's 0.9029; DMT + mass_velocity mindlin, 27 m/s, 47 deg: a stick inside one
-    slide step missed at rtol 1e-10, e_t 6e-6 off). Each extremum of the switch function towards
-    leaving (``peak``) and the last instant of contact are therefore checked on the dense output;
-    where one lies past 0, the first crossing before it is the switch."""
+    and -1 in slide (left where it falls through 0: the trial force turns inwards); ``tops`` the
+    extrema of the switch function towards leaving (the ``peak`` events), ``end`` the end of
+    contact (None if the solve stopped at a switch). scipy's events see a sign change only between
+    the ends of a step, and past the end of contact the switch function is held on the side of
+    staying (``end`` is also the instant where the other spring switched). A crossing in the step that ends the contact, or an excursion that begins and ends
+    inside one step, was therefore lost (LAMMPS's JKR with mindlin/force, 0.13 m/s, 20 deg: stuck
+    to the end with |F| 9 % above the limit there, e_t 0.8998 against LAMMPS's 0.9029; DMT +
+    mass_velocity mindlin, 27 m/s, 47 deg: a stick inside one slide step missed at rtol 1e-10, e_t
+    6e-6 off). Each extremum and the last instant of contact are therefore checked on the dense
+    output; where one lies past 0, the first crossing before it is the switch."""
     from scipy.optimize import brentq
 
     def leaving(t):
         return sign * switch(t, sol.sol(t))
 
-    tops = list(sol.t_events[2])
-    if sol.t_events[0].size:  # the contact ended: look just inside its end
-        end = float(sol.t_events[0][0])
+    tops = list(tops)
+    if end is not None:  # the contact ended: look just inside its end
         tops = [t for t in tops if t < end] + [end - 1e-9 * (end - start)]
     lo = start
     for top in tops:
@@ -399,7 +517,11 @@ def _crossing_inside_a_step(sol, start, switch, sign):
             if inside is None:
                 return lo, sol.sol(lo)
             lo = inside
-        root = brentq(leaving, lo, top, xtol=1e-15 * max(abs(top), 1.0), rtol=1e-15)
+        try:
+            root = brentq(leaving, lo, top, xtol=1e-15 * max(abs(top), 1.0), rtol=1e-15)
+        except ValueError:  # the switch function gave both signs at lo (2-D rolling with a tiny limit)
+            raise DemTangentialError("DEM tangential integration: a stick-slip switch could not be located "
+                                     f"(switch function {leaving(lo):.3g} and {leaving(top):.3g} at its ends)") from None
         return root, sol.sol(root)
     return None
 
@@ -460,23 +582,21 @@ def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict
     slip = (v_t + r * w_tp, v_tp - r * w_t)
     kappa = 1.0 / m + r * r / inertia
     switches, slip_ended, slip_end_time = 0, False, math.nan
+    if contact.rolling_model in DEM_ROLLING_MODELS and contact.rolling_friction > 0.0:  # mu_roll = 0: no torque
+        return _with_rolling(contact, normal, (v_n, v_t, v_tp), (w_n, w_t, w_tp), rtol)
     if contact.friction == 0.0 or slip == (0.0, 0.0):
         impulse = (0.0, 0.0)
     elif normal.outcome == "capture":  # the sphere ends rolling (module docstring)
         impulse = (-slip[0] / kappa, -slip[1] / kappa)
         slip_ended = True
     else:
-        law = _Law(contact, -v_n)
+        law, unit, tau_scale, z_scale = _impact_law(contact, normal, v_n)
         sc = law.scales
-        unit = float(sc.speed)
-        tau_scale = normal.contact_time / float(sc.time)
-        peak = normal.max_penetration / float(sc.length)
-        z_scale = max(1.0, am.jkr_q_from_approach(peak) if law.jkr else math.sqrt(peak))
         # integrated along the initial slip (module docstring): its components across stay exactly 0
         size = math.hypot(*slip)
-        u_end, _, slide_end, switches, slip_ended = _integrate(law, (size / unit, 0.0), min(rtol, TANGENTIAL_RTOL),
-                                                               tau_scale, z_scale)
-        along = float(u_end[0]) * unit / size  # u_out / u_in
+        end, slide_end, switches, slip_ended = _integrate(law, (size / unit, 0.0), min(rtol, TANGENTIAL_RTOL),
+                                                          tau_scale, z_scale)
+        along = float(end[4]) * unit / size  # u_out / u_in
         impulse = ((along - 1.0) * slip[0] / kappa, (along - 1.0) * slip[1] / kappa)
         slip_end_time = slide_end * float(sc.time) if math.isfinite(slide_end) else math.nan
     j_t, j_tp = impulse
@@ -487,5 +607,88 @@ def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict
         "slip_ended": slip_ended,
         "slip_end_time": slip_end_time,
         "tangential_impulse": (j_t, j_tp),
+        "switches": switches,
+    }
+
+
+def _impact_law(contact, normal, v_n):
+    """(the law, its speed unit [m/s], the contact time and the largest approach's z, in its units)."""
+    law = _Law(contact, -v_n)
+    sc = law.scales
+    peak = normal.max_penetration / float(sc.length)
+    z_scale = max(1.0, am.jkr_q_from_approach(peak) if law.jkr else math.sqrt(peak))
+    return law, float(sc.speed), normal.contact_time / float(sc.time), z_scale
+
+
+def _with_rolling(contact, normal, velocity_in, omega_in, rtol):
+    """``solve_dem_tangential`` with LAMMPS's rolling law: slip u and rolling velocity w together.
+
+    Integrated in the frame of the initial slip (of the rolling velocity where the sphere does not
+    slip); a rolling velocity parallel to it to rounding (1e-13) is put exactly on it, so that a
+    planar impact stays exactly planar. Outcome: v_t changes by the tangential impulse over m,
+    du + dw; w by dw, and the spin by w = (-R omega_t', R omega_t) (model.dem_rolling)."""
+    m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
+    v_n, v_t, v_tp = velocity_in
+    w_n, w_t, w_tp = omega_in
+    slip = np.array([v_t + r * w_tp, v_tp - r * w_t])
+    roll = np.array(lammps_rolling_velocity(r, w_t, w_tp), dtype=float)
+    spin = m * r * r / inertia  # kappa - 1
+    switches, slip_ended, slip_end_time = 0, False, math.nan
+    mu, mu_r = contact.friction, contact.rolling_friction
+    if (mu == 0.0 and mu_r == 0.0) or not (slip.any() or roll.any()):
+        du, dw = np.zeros(2), np.zeros(2)
+    elif normal.outcome == "capture":
+        # at rest on the wall both limits stay > 0 (2 mu F_po): the slip stops, and the rolling where
+        # mu_roll > 0 (as the slip alone does without it, module docstring); a stuck vibration of the
+        # springs is left, which averages to zero. du = kappa J - (kappa - 1) J_r, dw = (kappa - 1) (J_r - J)
+        # per unit mass: with one of the impulses 0 the other follows from the velocity that stops
+        if mu > 0.0 and mu_r > 0.0:
+            du, dw = -slip, -roll
+        elif mu > 0.0:
+            du = -slip
+            dw = -spin / (1.0 + spin) * du
+        else:
+            dw = -roll
+            du = -dw
+        slip_ended = mu > 0.0
+    else:
+        law, unit, tau_scale, z_scale = _impact_law(contact, normal, v_n)
+        sc = law.scales
+        first = slip if slip.any() else roll
+        e1 = first / math.hypot(*first)
+        e2 = np.array([-e1[1], e1[0]])
+        u0 = np.array([slip @ e1, slip @ e2]) / unit
+        w0 = np.array([roll @ e1, roll @ e2]) / unit
+        u0[1] = 0.0  # the frame's first axis is the slip (or the slip is 0)
+        if abs(w0[1]) <= 1e-13 * abs(w0[0]):
+            w0[1] = 0.0
+        tol = min(rtol, TANGENTIAL_RTOL)
+        # the rolling pseudo-force changes w by at most (kappa - 1) mu_roll int F_n0 dt, F_n0 at most
+        # twice its elastic peak (damping): below the tolerance of the impact's speeds it is dropped (LAMMPS's
+        # rolling law with mu_roll 1e-12 beside friction 0.3 moved nothing, but made a 2-D solve fail)
+        most = 2.0 * law.spin * law.mu_r * (z_scale**6 / 6.0 + 3.0 if law.jkr else z_scale**3 + 2.0 * law.pulloff) * tau_scale
+        if most <= tol * max(math.hypot(*u0), math.hypot(*w0), law.y0):
+            return solve_dem_tangential(contact.with_(rolling_model="torque", rolling_stiffness=None, rolling_friction=0.0,
+                                                      rolling_damping=0.0), velocity_in, omega_in, rtol=rtol)
+        if w0[1] != 0.0:
+            # rolling across the slip: the directions of both forces turn, at rates |G'| / (mu F_n0) that
+            # made DOP853 take millions of steps where a limit is small; Radau (implicit) follows them
+            # (mu_roll >= 1e-4 at 5 deg in about 1 s; below that, at 1e-6, it fails: DemTangentialError)
+            law.method = "Radau"
+        end, slide_end, switches, slip_ended = _integrate(law, tuple(u0), tol, tau_scale, z_scale, w0=tuple(w0))
+        du_f, dw_f = (end[4:6] - u0) * unit, (end[9:11] - w0) * unit
+        du, dw = du_f[0] * e1 + du_f[1] * e2, dw_f[0] * e1 + dw_f[1] * e2
+        slip_end_time = slide_end * float(sc.time) if math.isfinite(slide_end) else math.nan
+    impulse = m * (du + dw)
+    v_out, w_out = np.array([v_t, v_tp]) + du + dw, roll + dw
+    if normal.outcome == "capture" and mu > 0.0 and mu_r > 0.0:
+        v_out, w_out = np.zeros(2), np.zeros(2)  # at rest (above), free of the sums' rounding
+    return {
+        "normal": normal,
+        "velocity_out": (normal.e_n * -v_n if normal.outcome == "rebound" else 0.0, float(v_out[0]), float(v_out[1])),
+        "omega_out": (w_n, float(w_out[1] / r), float(-w_out[0] / r) + 0.0),
+        "slip_ended": slip_ended,
+        "slip_end_time": slip_end_time,
+        "tangential_impulse": (float(impulse[0]), float(impulse[1])),
         "switches": switches,
     }
