@@ -32,7 +32,7 @@ REPO = Path(__file__).resolve().parents[1]
 KILLERS = ["tests/test_params.py", "tests/test_engine.py", "tests/test_adhesion_models.py",
            "tests/test_contact_models.py", "tests/test_dynamics.py", "tests/test_independent_physics.py",
            "tests/test_agreement.py", "tests/test_reference.py", "tests/test_dem_damping.py",
-           "tests/test_dem_tangential.py"]
+           "tests/test_dem_tangential.py", "tests/test_dem_rolling.py"]
 
 #: (file under toolkit/microimpact, text that occurs exactly once, its mutation, what it breaks)
 MUTATIONS = [
@@ -88,6 +88,12 @@ MUTATIONS = [
     ("model/dem_tangential.py", "rate = -stiffness * slip_velocity if tangential_model in FORCE_HISTORY_MODELS",
      "rate = -0.99 * stiffness * slip_velocity if tangential_model in FORCE_HISTORY_MODELS",
      "LAMMPS's mindlin/force, dF = -k u dt"),
+    ("model/dem_rolling.py", "return -radius * omega_tp, radius * omega_t", "return radius * omega_tp, radius * omega_t",
+     "LAMMPS's rolling velocity R omega x n_w"),
+    ("solvers/dem_tangential.py", "dw1, dw2 = g * law.spin * (r1 - f1), g * law.spin * (r2 - f2)",
+     "dw1, dw2 = g * law.spin * (r1 + f1), g * law.spin * (r2 + f2)", "rolling velocity's response to both forces"),
+    ("solvers/dem_tangential.py", "rcap, drcap = law.mu_r * n0, law.mu_r * dn0",
+     "rcap, drcap = 1.01 * law.mu_r * n0, 1.01 * law.mu_r * dn0", "LAMMPS's rolling limit mu_roll F_n0"),
 ]
 
 
