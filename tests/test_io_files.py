@@ -277,8 +277,7 @@ def test_a_signal_between_two_moves_into_place_lands_after_both(tmp_path, monkey
         return real(directory)
 
     monkeypatch.setattr(files, "_fsync_dir", signal_after_first_move)
-    before = len(files.committed_outputs())
-    with pytest.raises(KeyboardInterrupt):
+    with pytest.raises(KeyboardInterrupt), files.recorded_outputs() as written:
         with files.all_or_nothing():
             with atomic_write(tmp_path / "a.csv") as f:
                 f.write("a")
@@ -286,7 +285,7 @@ def test_a_signal_between_two_moves_into_place_lands_after_both(tmp_path, monkey
                 f.write("b")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.csv", "b.nc"]
     assert (tmp_path / "b.nc").read_text() == "b"
-    assert files.committed_outputs()[before:] == (tmp_path / "a.csv", tmp_path / "b.nc")
+    assert written == [tmp_path / "a.csv", tmp_path / "b.nc"]
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
 

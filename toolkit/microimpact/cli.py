@@ -1163,11 +1163,16 @@ def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | N
 
 
 def main(argv=None) -> int:
-    from microimpact.io.files import committed_outputs
+    from microimpact.io.files import recorded_outputs
 
+    with recorded_outputs() as written:
+        return _main(argv, written)
+
+
+def _main(argv, written) -> int:
+    """``main`` with ``written``, the list of the outputs moved into place so far (for Ctrl-C's line)."""
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
-    already = len(committed_outputs())
     try:
         unknown = _unknown_option(parser, argv)
         if unknown:
@@ -1183,7 +1188,6 @@ def main(argv=None) -> int:
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
     except KeyboardInterrupt:  # Ctrl-C: one line, the shell's status for SIGINT, no traceback
-        written = committed_outputs()[already:]
         print(interrupted_after_writing(written) if written else INTERRUPTED_LINE, file=sys.stderr)
         return EXIT_INTERRUPTED
     except BrokenPipeError:  # the reader went away (| head): stop quietly, as POSIX tools do

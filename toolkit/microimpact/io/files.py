@@ -29,7 +29,7 @@ import numpy as np
 
 from microimpact.io.variables import VARIABLES, udunits
 
-__all__ = ["atomic_path", "atomic_write", "all_or_nothing", "committed_outputs", "deferred_signals", "interrupt_at_checkpoints", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
+__all__ = ["atomic_path", "atomic_write", "all_or_nothing", "recorded_outputs", "deferred_signals", "interrupt_at_checkpoints", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
            "CONVENTIONS", "read_netcdf_groups", "restore_label_coordinates", "LABEL_OF"]
 
 #: encoding added to every numeric, non-scalar NetCDF variable
@@ -210,26 +210,35 @@ def atomic_path(path) -> Iterator[Path]:
         raise
 
 
-#: every output this process has moved into place, in order (see :func:`committed_outputs`)
-_COMMITTED: list[Path] = []
+#: the lists of :func:`recorded_outputs` blocks now running, each collecting the outputs moved into place
+_RECORDINGS: list[list[Path]] = []
 
 
-def committed_outputs() -> tuple[Path, ...]:
-    """The files this process has moved into place so far, in order.
+@contextlib.contextmanager
+def recorded_outputs():
+    """Collect the files moved into place inside the block, in order: yields the list they are
+    appended to (it keeps its contents after the block).
 
     A command that is interrupted reports from it what it had written (a Ctrl-C that lands after
-    its outputs were moved into place must not be answered with "nothing was written").
+    its outputs were moved into place must not be answered with "nothing was written"). Only
+    running blocks record: a long-lived process that writes many files keeps no list of them.
 
     Examples
     --------
     >>> import tempfile, pathlib
     >>> target = pathlib.Path(tempfile.mkdtemp()) / "a.txt"
-    >>> with atomic_write(target) as f:
-    ...     _ = f.write("a")
-    >>> committed_outputs()[-1] == target
+    >>> with recorded_outputs() as written:
+    ...     with atomic_write(target) as f:
+    ...         _ = f.write("a")
+    >>> written == [target]
     True
     """
-    return tuple(_COMMITTED)
+    record: list[Path] = []
+    _RECORDINGS.append(record)
+    try:
+        yield record
+    finally:
+        _RECORDINGS.remove(record)
 
 
 def _commit(moves) -> None:
@@ -241,7 +250,8 @@ def _commit(moves) -> None:
         for tmp, path, mode, directory in moves:
             os.chmod(tmp, mode)
             os.replace(tmp, path)
-            _COMMITTED.append(path)
+            for record in _RECORDINGS:
+                record.append(path)
             _fsync_dir(directory)
 
 
