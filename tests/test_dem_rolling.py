@@ -140,3 +140,41 @@ def test_a_captured_sphere_ends_at_rest_when_both_limits_hold_it():
 def test_rolling_parameters_out_of_place_are_refused_by_name(changes, named):
     with pytest.raises(ValueError, match=named):
         Contact(**SPHERE, friction=0.3, **(MINDLIN | changes))
+
+
+def test_lammps_fit_holds_a_given_rolling_law_while_it_fits_mu_and_writes_both(tmp_path, capsys, monkeypatch):
+    # data made with LAMMPS's rolling sds beside mindlin: 'lammps fit' given the same rolling law fits
+    # mu around the true 0.3 and writes 'rolling sds' with the given values; rolling options without
+    # --rolling-stiffness, or without --tangential-model, are refused with status 2, nothing written
+    import pandas as pd
+
+    from microimpact.analysis.dem_fit import dem_law_contact
+    from microimpact.cli import main
+    from microimpact.io.materials import read_materials
+
+    pair = read_materials()["ammonium_fluorescein_on_silicon"]
+    rng = np.random.default_rng(5)
+    base = dem_law_contact(pair, 2e-6, "hertz", "coeff_restitution", 0.6)
+    c = base.with_(friction=0.3, tangential_model="lammps_mindlin", shear_modulus=1e9, rolling_model="lammps_sds",
+                   rolling_stiffness=200.0, rolling_damping=0.0, rolling_friction=0.2)
+    speed, angle = np.geomspace(0.3, 10.0, 8), np.linspace(10.0, 60.0, 8)
+    e_t = [simulate_impact(c, v, a).velocity_out[1] / (v * math.sin(math.radians(a))) for v, a in zip(speed, angle)]
+    monkeypatch.chdir(tmp_path)
+    pd.DataFrame({"material_pair": "ammonium_fluorescein_on_silicon", "radius [um]": 2.0, "speed [m/s]": speed,
+                  "incidence_angle [deg]": angle, "e_n [1]": 0.6 + rng.normal(0.0, 0.01, 8), "e_n_uncertainty [1]": 0.01,
+                  "tangential_restitution [1]": np.array(e_t) + rng.normal(0.0, 0.01, 8),
+                  "tangential_restitution_uncertainty [1]": 0.01}).to_csv("impacts.csv", index=False)
+    argv = ["lammps", "fit", "impacts.csv", "--material-pair", "ammonium_fluorescein_on_silicon", "--law",
+            "hertz+coeff_restitution", "--tangential-model", "lammps_mindlin", "--shear-modulus", "1e9",
+            "--rolling-stiffness", "200", "--rolling-friction", "0.2", "--out", "contact.lmp"]
+    assert main(argv) == 0
+    text = (tmp_path / "contact.lmp").read_text()
+    low, high = (float(x) for x in text.split("95% profile-likelihood interval ")[1].split(";")[0].split(" to "))
+    assert low < 0.3 < high
+    assert text.splitlines()[-1].split(" rolling sds ")[1].split()[:3] == ["200", "0", "0.2"]
+    capsys.readouterr()
+    assert main(argv[:-6] + ["--rolling-friction", "0.2", "--out", "c2.lmp"]) == 2  # no --rolling-stiffness
+    assert "give --rolling-stiffness too" in capsys.readouterr().err
+    assert main(argv[:7] + ["--rolling-stiffness", "200", "--out", "c3.lmp"]) == 2  # no --tangential-model
+    assert "give --tangential-model too" in capsys.readouterr().err
+    assert not (tmp_path / "c2.lmp").exists() and not (tmp_path / "c3.lmp").exists()

@@ -649,6 +649,9 @@ def _lammps_tangential_fields(args, law: str) -> dict:
     """The Contact fields of tangential law ``law`` from the options of ``lammps fit`` (UsageError if
     one is missing, or, for a law named by --tangential-model, one of the other law's is given)."""
     fields_ = {"tangential_model": law, "tangential_damping": args.tangential_damping}
+    if args.rolling_stiffness is not None:  # LAMMPS's rolling sds, held at the given values while mu is fitted
+        fields_ |= {"rolling_model": "lammps_sds", "rolling_stiffness": args.rolling_stiffness,
+                    "rolling_damping": args.rolling_damping, "rolling_friction": args.rolling_friction}
     other = "--shear-modulus" if law == "linear_history" else "--tangential-stiffness"
     if args.tangential_model != AUTO_TANGENTIAL and (args.shear_modulus if other == "--shear-modulus"
                                                      else args.tangential_stiffness) is not None:
@@ -724,11 +727,14 @@ def _cmd_lammps_fit(args) -> int:
     out = check_outputs({"--out": args.out}, _inputs(args))["--out"]
     if args.tangential_model is None:
         given = [o for o, v in (("--tangential-stiffness", args.tangential_stiffness), ("--shear-modulus", args.shear_modulus),
-                                ("--tangential-damping", args.tangential_damping or None)) if v is not None]
+                                ("--tangential-damping", args.tangential_damping or None),
+                                ("--rolling-stiffness", args.rolling_stiffness)) if v is not None]
         if given:
             raise UsageError(f"{', '.join(given)} belong to a tangential law: give --tangential-model too")
     else:
         _lammps_tangential_laws(args)  # a missing stiffness is refused before the fits run
+    if args.rolling_stiffness is None and (args.rolling_damping or args.rolling_friction):
+        raise UsageError("--rolling-damping and --rolling-friction belong to LAMMPS's rolling sds: give --rolling-stiffness too")
     if args.fit_adhesion and args.law and args.law[0] == "hertz":
         raise UsageError(f"--fit-adhesion: the law {'+'.join(args.law)} has no work of adhesion to fit; give a "
                          "jkr_force or dmt law, or no --law")
@@ -886,6 +892,13 @@ def register_lammps(sub) -> None:
                    help="G* of the lammps_mindlin laws [Pa] (LAMMPS's k_t = 8 G*)")
     f.add_argument("--tangential-damping", type=_non_negative_float, default=0.0, metavar="X",
                    help="x_gamma,t of the tangential law (default 0)")
+    f.add_argument("--rolling-stiffness", type=_positive_float, default=None, metavar="SI",
+                   help="k_roll [N/m] of LAMMPS's rolling sds, held while mu is fitted and written with it "
+                        "(with --rolling-damping gamma_roll [N s/m] and --rolling-friction mu_roll)")
+    f.add_argument("--rolling-damping", type=_non_negative_float, default=0.0, metavar="SI",
+                   help="gamma_roll of rolling sds [N s/m] (default 0)")
+    f.add_argument("--rolling-friction", type=_non_negative_float, default=0.0, metavar="X",
+                   help="mu_roll of rolling sds (default 0)")
     f.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")
     _add_rtol(f)
     f.add_argument("--out", required=True, help="output LAMMPS input file")
