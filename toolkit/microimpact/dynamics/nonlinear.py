@@ -192,6 +192,12 @@ def equilibria():
         (see :func:`jacobian`); (1, 0) is the static adhesive equilibrium x = X, whose nature
         depends on C = C1 + C2 (:func:`equilibrium_eigenvalues`).
 
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eq. (33) and its equilibria
+
     Examples
     --------
     >>> equilibria().tolist()
@@ -236,6 +242,12 @@ def nondimensional_energy(xi, y):
     The dimensional energy of :func:`microimpact.model.law.contact_potential_energy` plus the normal
     kinetic energy is e m X^2 / T^2. e < 0 means captured (the sphere can no longer reach xi = 0);
     e = -4/15 at the equilibrium (1, 0).
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eq. (33) (its first integral without damping)
 
     Examples
     --------
@@ -424,6 +436,12 @@ def critical_velocity_numeric(contact: Contact, *, xtol: float = 1e-14) -> float
     ------
     ValueError
         As :func:`critical_velocity_closed_form`.
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (34)-(38)
 
     Examples
     --------
@@ -624,6 +642,12 @@ def capture_bracket(
     outcome exact up to the solver tolerance, which only matters within a band much narrower than
     the default tolerances (e_n is ~1e-3 at 1e-7 relative above the capture velocity).
 
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, the capture of Fig. 5 and the Conclusions
+
     Examples
     --------
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
@@ -682,6 +706,12 @@ def capture_velocity(contact: Contact, *, xtol: float = 1e-9, rtol: float = 1e-7
     Returns 0.0 when no impact can be captured: f0 = 0 (no adhesion, the contact energy stays
     >= 0) or zeta_H = zeta_A = 0 (energy conserved, e_n = 1 at every speed).
 
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, the capture of Fig. 5 and the Conclusions
+
     Examples
     --------
     Table 1 row 2 (the paper's microsphere):
@@ -701,6 +731,12 @@ def motion_type(outcome: str, equilibrium: str) -> str:
 
     "rebound"; "capture with oscillation" (captured, spiral sink); "capture without oscillation"
     (captured, sink or critical).
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Fig. 5 and the Conclusions (three types of motion)
 
     Examples
     --------
@@ -961,6 +997,12 @@ def phase_portraits(contact: Contact, speeds: Sequence[float], **kwargs) -> list
     list of xarray.Dataset
         One trajectory per speed, in the order given.
 
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Fig. 5
+
     Examples
     --------
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
@@ -985,6 +1027,12 @@ def save_phase_portraits(portraits: Sequence[xr.Dataset], path) -> Path:
     compliance-checker 6.1's ``check_invalid_same_named_dimension_across_groups`` compares the
     ``time`` dimensions of the root's child groups and flags any two (ioos/compliance-checker#1215
     reports the same check failing on files without groups).
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Fig. 5
 
     Examples
     --------
@@ -1024,6 +1072,12 @@ def dynamics_summary(contact: Contact, speeds: Sequence[float]) -> xr.Dataset:
         ``capture_velocity`` (largest captured normal speed, by bisection) [m/s]; along ``speed``
         [m/s]: ``C1``, ``C2``, ``C`` (Eqs. (31)-(35)) [-], ``equilibrium_type`` (text) and
         ``asymptotic_frequency`` omega_f (NaN for C >= 2) [rad/s].
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (29)-(38)
 
     Examples
     --------

@@ -361,6 +361,11 @@ def jkr_q_from_approach(approach_ratio):
     approach_ratio : array_like
         delta / L_J >= -3 (delta_c / L_J = -3). [-]
 
+    References
+    ----------
+    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
+    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+
     Examples
     --------
     >>> q = jkr_q_from_approach([-3.0, 0.0, 10.0])
@@ -430,6 +435,11 @@ def jkr_hysteresis(normal_model: str = "jkr") -> float:
     U(q_break) - U(4^(1/3)) with the break of ``normal_model`` (:data:`JKR_Q_BREAK`): 4.2098 for the
     displacement-controlled break ("jkr"), 2.0791 for the force-controlled one ("jkr_force").
 
+    References
+    ----------
+    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
+    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+
     Examples
     --------
     >>> round(jkr_hysteresis("jkr"), 4), round(jkr_hysteresis("jkr_force"), 4)
@@ -493,6 +503,11 @@ def jkr_nondimensional_force(q, y, c1, c2):
     The repulsive part q^6 / 6 and the adhesive part -q^3 carry the damping forms of Eq. (27);
     C1 = C_H L_J / T, C2 = C_A L_J / T.
 
+    References
+    ----------
+    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
+    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+
     Examples
     --------
     Zero at the zero-load equilibrium q^3 = 6 at rest; -5/6 at the displacement-controlled break q = 1:
@@ -508,6 +523,11 @@ def jkr_nondimensional_force(q, y, c1, c2):
 
 def jkr_nondimensional_potential(q):
     """U / (F_J L_J) = q^10 / 15 - 2 q^7 / 3 + q^4, dU/d(delta/L_J) = F / F_J undamped. [-]
+
+    References
+    ----------
+    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
+    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
 
     Examples
     --------
@@ -536,6 +556,12 @@ def jkr_nondimensional_dissipation_rate(q, y, c1, c2):
 def dmt_nondimensional_force(s, y, c1, c2):
     """F / F_D = s^3 (1 + C1 y) - (1 - C2 y), s = sqrt(delta / L_D), in contact. [-]
 
+    References
+    ----------
+    Derjaguin, B. V., Muller, V. M. and Toporov, Yu. P. (1975), Effect of contact deformations on
+    the adhesion of particles, J. Colloid Interface Sci. 53:314-326,
+    doi:10.1016/0021-9797(75)90018-1
+
     Examples
     --------
     >>> dmt_nondimensional_force(1.0, 0.0, 0.3, 0.3), dmt_nondimensional_force(0.0, 0.0, 0.3, 0.3)
@@ -546,6 +572,12 @@ def dmt_nondimensional_force(s, y, c1, c2):
 
 def dmt_nondimensional_potential(s):
     """U / (F_D L_D) = (2/5) s^5 - s^2 (contact energy relative to first touch). [-]
+
+    References
+    ----------
+    Derjaguin, B. V., Muller, V. M. and Toporov, Yu. P. (1975), Effect of contact deformations on
+    the adhesion of particles, J. Colloid Interface Sci. 53:314-326,
+    doi:10.1016/0021-9797(75)90018-1
 
     Examples
     --------

@@ -131,6 +131,11 @@ def restitution_of_damping_factor(factor: float) -> float:
     factor : float
         beta in [0, sqrt(5)). [-]
 
+    References
+    ----------
+    LAMMPS documentation, ``pair_style granular``, damping models,
+    https://docs.lammps.org/pair_granular.html
+
     Examples
     --------
     >>> round(restitution_of_damping_factor(restitution_damping_factor(0.3)), 12)
@@ -191,6 +196,11 @@ def critical_damping_coefficient(contact, normal_speed: float) -> float:
         With ``damping_model`` "mass_velocity" or "viscoelastic".
     normal_speed : float
         [m/s]
+
+    References
+    ----------
+    LAMMPS documentation, ``pair_style granular``, damping models,
+    https://docs.lammps.org/pair_granular.html
 
     Examples
     --------

@@ -183,6 +183,12 @@ def contact_potential_energy(contact, penetration):
     penetration : array_like
         x = -n. [m]
     
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (2) and (5) (the forces it integrates) and (27)
+
     Examples
     --------
     At the equilibrium X = 2 pi f0 / K the Hertz and adhesion forces cancel and
@@ -244,6 +250,12 @@ def twist_friction_torque(friction, contact_radius_, normal_force_):
     2 pi f p0 int_0^a sqrt(1 - rho^2/a^2) rho^2 d rho = (3 pi / 16) f a |F_n|.
     The torque opposes the twist spin omega_n and stops when omega_n reaches zero.
     
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eq. (18)
+
     Examples
     --------
     >>> import math

@@ -191,6 +191,10 @@ def effective_shear_modulus(shear_sphere, poisson_sphere, shear_surface, poisson
     With it the Mindlin (1949) tangential stiffness of a contact of radius a is k_t = 8 G* a
     (Johnson 1985, Eq. 7.42 summed over both bodies; Di Renzo & Di Maio 2004, Table 1).
     
+    References
+    ----------
+    Mindlin, R. D. (1949), Compliance of elastic bodies in contact, J. Appl. Mech. 16:259-268
+
     Examples
     --------
     Two equal glass bodies (E = 70 GPa, nu = 0.22): G* = G / (2 (2 - nu)):
@@ -292,6 +296,12 @@ def pulloff_force(contact):
     ----------
     contact : Contact
 
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (2) and (5) (the ring law whose largest tension it is)
+
     Examples
     --------
     The paper's microsphere (Table 1 row 2); the largest tension of the static law is at x = X/3:
@@ -320,6 +330,12 @@ def nondimensional_pulloff_force(a_h, a_a):
     a_h, a_a : float
         Hertz and adhesion coefficients of :func:`microimpact.model.law.nondimensional_acceleration`. [-]
 
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (2), (5) and (28)-(30)
+
     Examples
     --------
     >>> round(nondimensional_pulloff_force(1.0, 1.0), 4), nondimensional_pulloff_force(1.25, 0.0)
@@ -342,6 +358,14 @@ def nondimensional_tangential_stiffness(contact, scales) -> float:
         Must have ``shear_modulus`` (G*). [Pa]
     scales : microimpact.model.law.Scales
         L [m] and T_c [s] of the impact.
+
+    References
+    ----------
+    Mindlin, R. D. (1949), Compliance of elastic bodies in contact, J. Appl. Mech. 16:259-268
+
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (29)-(30) (the units)
 
     Examples
     --------
@@ -534,6 +558,11 @@ def md_turning_span(force_ratio, new_sign):
         T / F_lim at the turning point, :func:`md_force_ratio`. [-]
     new_sign : float
         s' = +1 or -1. [-]
+
+    References
+    ----------
+    Mindlin, R. D. and Deresiewicz, H. (1953), Elastic spheres in contact under varying oblique
+    forces, J. Appl. Mech. 20:327-344
 
     Examples
     --------

@@ -139,6 +139,12 @@ def engine_scales(contact, normal_speed):
     contact : Contact
     normal_speed : float or ndarray
         Incident normal speed, > 0. [m/s]
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (28)-(32)
     """
     sc, y0, c1, c2 = nondimensional_impact(contact, normal_speed)
     if type(y0) is float and (y0 <= MAX_ADHESIVE_SPEED or not sc.a_adhesion > 0.0):
@@ -1132,6 +1138,8 @@ def solve_normal(
 ) -> NormalSolution:
     """Solve the normal contact, Eq. (27), of one impact.
 
+    Length: the docstring (parameters, returns, references, examples); the body is short.
+
     Parameters
     ----------
     contact : Contact
@@ -1174,6 +1182,18 @@ def solve_normal(
     EngineError
         ``max_steps`` reached, step-size underflow, or e_n outside [0, 1] (never returned).
     
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eq. (27)
+
+    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
+    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+
+    Hairer, E., Norsett, S. P. and Wanner, G. (1993), Solving Ordinary Differential Equations I, 2nd
+    ed., Springer, Sec. II.5 (dense output) and II.6 (event location)
+
     Examples
     --------
     The paper's microsphere at 2 m/s, against the independent 3-D reference integration:
@@ -1238,6 +1258,12 @@ def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, fr
     n_steps, n_rejected : int
     trajectory : ndarray, shape (n, 3), optional
         Rows (tau, s, y) at the accepted steps. [-]
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (21) and (29)-(30)
     """
     u = scales.speed
     j_unit = contact.mass * u  # N s
@@ -1288,6 +1314,18 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     dict with arrays ``captured`` (bool), ``e_n`` [-], ``contact_time`` [s], ``capture_time`` [s],
     ``max_penetration`` [m], ``friction_impulse`` [N s], ``twist_impulse`` [N m s],
     ``dissipated_energy`` [J], ``final_energy`` [J], ``n_steps``.
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eq. (27)
+
+    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
+    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+
+    Hairer, E., Norsett, S. P. and Wanner, G. (1993), Solving Ordinary Differential Equations I, 2nd
+    ed., Springer, Sec. II.5 (dense output) and II.6 (event location)
     """
     v = np.ascontiguousarray(normal_speed, dtype=float).ravel()
     if v.size and (not np.all(np.isfinite(v)) or np.any(v <= 0.0)):

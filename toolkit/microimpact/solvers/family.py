@@ -427,6 +427,15 @@ def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = 
     -------
     NormalFamily
 
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eq. (27)
+
+    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
+    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+
     Examples
     --------
     >>> import microimpact as mi
@@ -552,6 +561,15 @@ def normal_restitution(contact, normal_speed, *, rtol: float = DEFAULT_RTOL, fam
     """e_n at many normal speeds [m/s] (a fit's model): one direct engine solve per distinct speed,
     or, for many distinct speeds, a restitution-only family (``family`` None chooses, True/False
     force) when it costs fewer than half as many solves. [-]
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (21) and (27)
+
+    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
+    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
 
     Examples
     --------

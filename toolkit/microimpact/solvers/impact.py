@@ -261,6 +261,18 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
         slip or twist): the RKG stops at the capture test and does not follow the captured
         oscillation whose friction impulse the map needs (use "engine" or "reference").
 
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221
+
+    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
+    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+
+    Hairer, E., Norsett, S. P. and Wanner, G. (1993), Solving Ordinary Differential Equations I, 2nd
+    ed., Springer, Sec. II.5 (dense output) and II.6 (event location)
+
     Examples
     --------
     An undamped, non-adhesive Hertz sphere rebounds with e_n = 1; with friction 0.2 at 60 deg it
@@ -640,6 +652,18 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     vectorised tangential map), which cannot stop midway. A long computation made of batches
     checks its budget between them (:func:`microimpact.studies.sweeps.run_sweep` solves its speeds
     in blocks then; :class:`microimpact.solvers.Deadline`).
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221
+
+    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
+    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+
+    Hairer, E., Norsett, S. P. and Wanner, G. (1993), Solving Ordinary Differential Equations I, 2nd
+    ed., Springer, Sec. II.5 (dense output) and II.6 (event location)
 
     Examples
     --------

@@ -797,6 +797,18 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     Parameters as there: ``normal_speed`` [m/s] (1-D, > 0), ``need_tail`` per speed,
     ``friction_impulse_stop`` [N s] and ``twist_impulse_stop`` [N m s] per speed.
 
+    References
+    ----------
+    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
+    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+
+    Derjaguin, B. V., Muller, V. M. and Toporov, Yu. P. (1975), Effect of contact deformations on
+    the adhesion of particles, J. Colloid Interface Sci. 53:314-326,
+    doi:10.1016/0021-9797(75)90018-1
+
+    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
+    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+
     Examples
     --------
     An undamped JKR impact at twice the sticking velocity v_s rebounds with
@@ -854,6 +866,15 @@ def settled_contact_energy(contact) -> float:
     JKR: U(6^(1/3)) - U(4^(1/3)) (contact forms at delta = 0 without work); DMT: U(1). In units
     F L of :func:`~microimpact.model.adhesion_models.adhesion_scales`.
 
+    References
+    ----------
+    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
+    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+
+    Derjaguin, B. V., Muller, V. M. and Toporov, Yu. P. (1975), Effect of contact deformations on
+    the adhesion of particles, J. Colloid Interface Sci. 53:314-326,
+    doi:10.1016/0021-9797(75)90018-1
+
     Examples
     --------
     The JKR well, -0.6 (6^(4/3) - 4^(4/3)) F_J L_J, and the DMT well, -0.6 F_D L_D:
@@ -883,11 +904,26 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
                            max_time: float = 1e5) -> NormalSolution:
     """Independent check of :func:`solve_normal`: the JKR or DMT law in the approach delta and time.
 
+    Length: the docstring (parameters, returns, references, examples); the body is short.
+
     :func:`scipy.integrate.solve_ivp` (DOP853) integrates delta/L, its rate and J, J_a, D in
     nondimensional time (no Sundman change), the JKR contact radius from delta by Newton's method
     (:func:`~microimpact.model.adhesion_models.jkr_contact_radius`); separation and capture are
     solve_ivp events. A captured sphere with ``need_tail`` is followed until J, J_a reach the stops
     or ``max_time`` (in units of T). Parameters as :func:`solve_normal`. [m/s], [-], [N s], [N m s]
+
+    References
+    ----------
+    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
+    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+
+    Derjaguin, B. V., Muller, V. M. and Toporov, Yu. P. (1975), Effect of contact deformations on
+    the adhesion of particles, J. Colloid Interface Sci. 53:314-326,
+    doi:10.1016/0021-9797(75)90018-1
+
+    Virtanen, P. et al. (2020), SciPy 1.0: fundamental algorithms for scientific computing in
+    Python, Nat. Methods 17:261-272, doi:10.1038/s41592-019-0686-2 (``solve_ivp``, DOP853,
+    ``brentq``)
 
     Examples
     --------

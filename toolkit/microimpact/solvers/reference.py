@@ -420,6 +420,16 @@ def simulate_reference(
     derived twist torque (3 pi / 16) f a |F_n|; with f0 = 0 the Hertz scales replace X, T. The
     paper used a fixed-step Runge-Kutta-Gill method; this uses adaptive solve_ivp with events.
 
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (8)-(20) and (27)
+
+    Virtanen, P. et al. (2020), SciPy 1.0: fundamental algorithms for scientific computing in
+    Python, Nat. Methods 17:261-272, doi:10.1038/s41592-019-0686-2 (``solve_ivp``, DOP853,
+    ``brentq``)
+
     Examples
     --------
     The independent yardstick of the compiled solvers (scipy): they agree to ~1e-8 at the default
@@ -736,6 +746,16 @@ def reference_trajectory(
     Returns
     -------
     ReferenceTrajectory
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eq. (27)
+
+    Virtanen, P. et al. (2020), SciPy 1.0: fundamental algorithms for scientific computing in
+    Python, Nat. Methods 17:261-272, doi:10.1038/s41592-019-0686-2 (``solve_ivp``, DOP853,
+    ``brentq``)
     """
     normal_speed = _validate_speed("normal_speed", normal_speed)
     rtol, atol, _ = _validate_common(rtol, atol, None)

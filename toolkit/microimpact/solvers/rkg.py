@@ -150,13 +150,28 @@ def rkg_state(y0: float, c1: float, c2: float, a_hertz: float, a_adhesion: float
     Started at first contact (xi0 = 0) the solution has a (tau)^(5/2) term (Hertz) or a
     (tau)^(3/2) term (adhesion), so the global order of any fixed-step Runge-Kutta method drops
     from 4 to 2.5 (Hertz) or lower; started inside the contact it is smooth and RKG is 4th order.
+
+    References
+    ----------
+    Gill, S. (1951), A process for the step-by-step integration of differential equations in an
+    automatic computing machine, Proc. Camb. Philos. Soc. 47:96-108, doi:10.1017/S0305004100026414
     """
     return _rkg_state_core(float(xi0), float(y0), float(c1), float(c2), float(a_hertz), float(a_adhesion),
                            float(dtau), int(n_steps))
 
 
 def rkg_setup(contact, speeds):
-    """Nondimensional y0, C1, C2, a_h, a_a and the estimated contact duration (tau) per speed."""
+    """Nondimensional y0, C1, C2, a_h, a_a and the estimated contact duration (tau) per speed.
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eqs. (28)-(33)
+
+    Gill, S. (1951), A process for the step-by-step integration of differential equations in an
+    automatic computing machine, Proc. Camb. Philos. Soc. 47:96-108, doi:10.1017/S0305004100026414
+    """
     speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
     sc, y0, c1, c2 = nondimensional_impact(contact, speeds)
     y0, c1, c2, t_c = (np.ascontiguousarray(np.broadcast_to(a, speeds.shape), dtype=float)
@@ -185,6 +200,15 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> d
     -------
     dict with ``e_n`` [-] (0 if captured, NaN if no outcome in 20 N steps), ``captured`` (bool),
     ``n_steps`` (int) and ``tau`` (nondimensional separation time; NaN if captured) [-].
+
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221
+
+    Gill, S. (1951), A process for the step-by-step integration of differential equations in an
+    automatic computing machine, Proc. Camb. Philos. Soc. 47:96-108, doi:10.1017/S0305004100026414
     """
     y0, c1, c2, ah, aa, dur = setup if setup is not None else rkg_setup(contact, speeds)
     h = dur / steps_per_contact
@@ -229,6 +253,15 @@ def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS
     EngineError
         If no outcome is reached within 20 contact durations' worth of steps.
     
+    References
+    ----------
+    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
+    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
+    doi:10.1080/02786820290092221, Eq. (27) and its fixed-step Runge-Kutta-Gill solution
+
+    Gill, S. (1951), A process for the step-by-step integration of differential equations in an
+    automatic computing machine, Proc. Camb. Philos. Soc. 47:96-108, doi:10.1017/S0305004100026414
+
     Examples
     --------
     The paper's fixed-step method against the adaptive engine at a tight tolerance:
