@@ -283,7 +283,7 @@ def test_lammps_tangential_laws_agree_with_microimpact(changes, units, speeds):
 # pseudo-force acts through its torque, so it shows in the rebound spin and, through the slip, in
 # e_t; without incident spin the rolling comes from the friction's torque. Measured (2000/4000
 # steps): Hertz, JKR, DMT + mass_velocity at 5-80 deg, 0.01-10 m/s: largest difference 8.4e-4,
-# each within 2 % of LAMMPS's step error
+# each above 1e-6 within 4 % of LAMMPS's step error
 @pytest.mark.parametrize("changes, units, speeds", [
     ({"tangential_model": "lammps_mindlin", "shear_modulus": 3e8}, "micro", (0.1, 10.0)),
     ({"tangential_model": "linear_history", "tangential_stiffness": 50.0, "work_of_adhesion": 0.02,
