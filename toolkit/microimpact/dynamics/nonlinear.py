@@ -194,9 +194,7 @@ def equilibria():
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eq. (33) and its equilibria
+    Cheng, Brach & Dunn (2002), Eq. (33) and its equilibria
 
     Examples
     --------
@@ -245,9 +243,7 @@ def nondimensional_energy(xi, y):
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eq. (33) (its first integral without damping)
+    Cheng, Brach & Dunn (2002), Eq. (33) (its first integral without damping)
 
     Examples
     --------
@@ -439,9 +435,7 @@ def critical_velocity_numeric(contact: Contact, *, xtol: float = 1e-14) -> float
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (34)-(38)
+    Cheng, Brach & Dunn (2002), Eqs. (34)-(38)
 
     Examples
     --------
@@ -644,9 +638,7 @@ def capture_bracket(
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, the capture of Fig. 5 and the Conclusions
+    Cheng, Brach & Dunn (2002), the capture of Fig. 5 and the Conclusions
 
     Examples
     --------
@@ -708,9 +700,7 @@ def capture_velocity(contact: Contact, *, xtol: float = 1e-9, rtol: float = 1e-7
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, the capture of Fig. 5 and the Conclusions
+    Cheng, Brach & Dunn (2002), the capture of Fig. 5 and the Conclusions
 
     Examples
     --------
@@ -734,9 +724,7 @@ def motion_type(outcome: str, equilibrium: str) -> str:
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Fig. 5 and the Conclusions (three types of motion)
+    Cheng, Brach & Dunn (2002), Fig. 5 and the Conclusions (three types of motion)
 
     Examples
     --------
@@ -999,9 +987,7 @@ def phase_portraits(contact: Contact, speeds: Sequence[float], **kwargs) -> list
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Fig. 5
+    Cheng, Brach & Dunn (2002), Fig. 5
 
     Examples
     --------
@@ -1030,9 +1016,7 @@ def save_phase_portraits(portraits: Sequence[xr.Dataset], path) -> Path:
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Fig. 5
+    Cheng, Brach & Dunn (2002), Fig. 5
 
     Examples
     --------
@@ -1075,9 +1059,7 @@ def dynamics_summary(contact: Contact, speeds: Sequence[float]) -> xr.Dataset:
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (29)-(38)
+    Cheng, Brach & Dunn (2002), Eqs. (29)-(38)
 
     Examples
     --------

@@ -363,8 +363,7 @@ def jkr_q_from_approach(approach_ratio):
 
     References
     ----------
-    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
-    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+    Johnson, Kendall & Roberts (1971)
 
     Examples
     --------
@@ -437,8 +436,7 @@ def jkr_hysteresis(normal_model: str = "jkr") -> float:
 
     References
     ----------
-    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
-    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+    Johnson, Kendall & Roberts (1971)
 
     Examples
     --------
@@ -505,8 +503,7 @@ def jkr_nondimensional_force(q, y, c1, c2):
 
     References
     ----------
-    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
-    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+    Johnson, Kendall & Roberts (1971)
 
     Examples
     --------
@@ -526,8 +523,7 @@ def jkr_nondimensional_potential(q):
 
     References
     ----------
-    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
-    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+    Johnson, Kendall & Roberts (1971)
 
     Examples
     --------

@@ -40,9 +40,7 @@ def incident_velocity(speed: float, incidence_deg: float, azimuth_deg: float) ->
     
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Fig. 1 (the frame n, t, t')
+    Cheng, Brach & Dunn (2002), Fig. 1 (the frame n, t, t')
 
     Examples
     --------

@@ -185,9 +185,7 @@ def contact_potential_energy(contact, penetration):
     
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (2) and (5) (the forces it integrates) and (27)
+    Cheng, Brach & Dunn (2002), Eqs. (2) and (5) (the forces it integrates) and (27)
 
     Examples
     --------
@@ -252,9 +250,7 @@ def twist_friction_torque(friction, contact_radius_, normal_force_):
     
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eq. (18)
+    Cheng, Brach & Dunn (2002), Eq. (18)
 
     Examples
     --------

@@ -89,9 +89,7 @@ def table2_case(name: str) -> dict:
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Table 2
+    Cheng, Brach & Dunn (2002), Table 2
 
     Examples
     --------

@@ -193,7 +193,7 @@ def effective_shear_modulus(shear_sphere, poisson_sphere, shear_surface, poisson
     
     References
     ----------
-    Mindlin, R. D. (1949), Compliance of elastic bodies in contact, J. Appl. Mech. 16:259-268
+    Mindlin (1949)
 
     Examples
     --------
@@ -218,7 +218,7 @@ def tangential_stiffness(shear_modulus, contact_radius):
 
     References
     ----------
-    Mindlin, R. D. (1949), Compliance of elastic bodies in contact, J. Appl. Mech. 16:259-268;
+    Mindlin (1949);
     Johnson, K. L. (1985), Contact Mechanics, Cambridge University Press, Sec. 7.2.
 
     Examples
@@ -298,9 +298,7 @@ def pulloff_force(contact):
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (2) and (5) (the ring law whose largest tension it is)
+    Cheng, Brach & Dunn (2002), Eqs. (2) and (5) (the ring law whose largest tension it is)
 
     Examples
     --------
@@ -332,9 +330,7 @@ def nondimensional_pulloff_force(a_h, a_a):
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (2), (5) and (28)-(30)
+    Cheng, Brach & Dunn (2002), Eqs. (2), (5) and (28)-(30)
 
     Examples
     --------
@@ -361,11 +357,9 @@ def nondimensional_tangential_stiffness(contact, scales) -> float:
 
     References
     ----------
-    Mindlin, R. D. (1949), Compliance of elastic bodies in contact, J. Appl. Mech. 16:259-268
+    Mindlin (1949)
 
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (29)-(30) (the units)
+    Cheng, Brach & Dunn (2002), Eqs. (29)-(30) (the units)
 
     Examples
     --------
@@ -488,8 +482,7 @@ def md_force_ratio(branch_coordinate, branch_sign, branch_span):
 
     References
     ----------
-    Mindlin, R. D. and Deresiewicz, H. (1953), Elastic spheres in contact under varying oblique forces,
-    J. Appl. Mech. 20:327-344; Thornton, C. (1991), Interparticle sliding in the presence of adhesion,
+    Mindlin & Deresiewicz (1953); Thornton, C. (1991), Interparticle sliding in the presence of adhesion,
     J. Phys. D 24:1942-1946.
 
     Examples

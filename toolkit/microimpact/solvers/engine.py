@@ -142,9 +142,7 @@ def engine_scales(contact, normal_speed):
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (28)-(32)
+    Cheng, Brach & Dunn (2002), Eqs. (28)-(32)
     """
     sc, y0, c1, c2 = nondimensional_impact(contact, normal_speed)
     if type(y0) is float and (y0 <= MAX_ADHESIVE_SPEED or not sc.a_adhesion > 0.0):
@@ -1184,15 +1182,11 @@ def solve_normal(
     
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eq. (27)
+    Cheng, Brach & Dunn (2002), Eq. (27)
 
-    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
-    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+    Dormand & Prince (1980)
 
-    Hairer, E., Norsett, S. P. and Wanner, G. (1993), Solving Ordinary Differential Equations I, 2nd
-    ed., Springer, Sec. II.5 (dense output) and II.6 (event location)
+    Hairer, Norsett & Wanner (1993), Secs. II.5-II.6
 
     Examples
     --------
@@ -1261,9 +1255,7 @@ def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, fr
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (21) and (29)-(30)
+    Cheng, Brach & Dunn (2002), Eqs. (21) and (29)-(30)
     """
     u = scales.speed
     j_unit = contact.mass * u  # N s
@@ -1317,15 +1309,11 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eq. (27)
+    Cheng, Brach & Dunn (2002), Eq. (27)
 
-    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
-    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+    Dormand & Prince (1980)
 
-    Hairer, E., Norsett, S. P. and Wanner, G. (1993), Solving Ordinary Differential Equations I, 2nd
-    ed., Springer, Sec. II.5 (dense output) and II.6 (event location)
+    Hairer, Norsett & Wanner (1993), Secs. II.5-II.6
     """
     v = np.ascontiguousarray(normal_speed, dtype=float).ravel()
     if v.size and (not np.all(np.isfinite(v)) or np.any(v <= 0.0)):

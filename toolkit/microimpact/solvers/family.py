@@ -429,12 +429,9 @@ def normal_family(contact, speed_min: float, speed_max: float, *, rtol: float = 
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eq. (27)
+    Cheng, Brach & Dunn (2002), Eq. (27)
 
-    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
-    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+    Dormand & Prince (1980)
 
     Examples
     --------
@@ -564,12 +561,9 @@ def normal_restitution(contact, normal_speed, *, rtol: float = DEFAULT_RTOL, fam
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (21) and (27)
+    Cheng, Brach & Dunn (2002), Eqs. (21) and (27)
 
-    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
-    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+    Dormand & Prince (1980)
 
     Examples
     --------

@@ -263,15 +263,11 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221
+    Cheng, Brach & Dunn (2002)
 
-    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
-    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+    Dormand & Prince (1980)
 
-    Hairer, E., Norsett, S. P. and Wanner, G. (1993), Solving Ordinary Differential Equations I, 2nd
-    ed., Springer, Sec. II.5 (dense output) and II.6 (event location)
+    Hairer, Norsett & Wanner (1993), Secs. II.5-II.6
 
     Examples
     --------
@@ -655,15 +651,11 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221
+    Cheng, Brach & Dunn (2002)
 
-    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
-    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+    Dormand & Prince (1980)
 
-    Hairer, E., Norsett, S. P. and Wanner, G. (1993), Solving Ordinary Differential Equations I, 2nd
-    ed., Springer, Sec. II.5 (dense output) and II.6 (event location)
+    Hairer, Norsett & Wanner (1993), Secs. II.5-II.6
 
     Examples
     --------

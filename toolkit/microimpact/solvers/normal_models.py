@@ -799,15 +799,13 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
 
     References
     ----------
-    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
-    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+    Johnson, Kendall & Roberts (1971)
 
     Derjaguin, B. V., Muller, V. M. and Toporov, Yu. P. (1975), Effect of contact deformations on
     the adhesion of particles, J. Colloid Interface Sci. 53:314-326,
     doi:10.1016/0021-9797(75)90018-1
 
-    Dormand, J. R. and Prince, P. J. (1980), A family of embedded Runge-Kutta formulae, J. Comput.
-    Appl. Math. 6:19-26, doi:10.1016/0771-050X(80)90013-3
+    Dormand & Prince (1980)
 
     Examples
     --------
@@ -868,8 +866,7 @@ def settled_contact_energy(contact) -> float:
 
     References
     ----------
-    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
-    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+    Johnson, Kendall & Roberts (1971)
 
     Derjaguin, B. V., Muller, V. M. and Toporov, Yu. P. (1975), Effect of contact deformations on
     the adhesion of particles, J. Colloid Interface Sci. 53:314-326,
@@ -914,8 +911,7 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
 
     References
     ----------
-    Johnson, K. L., Kendall, K. and Roberts, A. D. (1971), Surface energy and the contact of elastic
-    solids, Proc. R. Soc. Lond. A 324:301-313, doi:10.1098/rspa.1971.0141
+    Johnson, Kendall & Roberts (1971)
 
     Derjaguin, B. V., Muller, V. M. and Toporov, Yu. P. (1975), Effect of contact deformations on
     the adhesion of particles, J. Colloid Interface Sci. 53:314-326,

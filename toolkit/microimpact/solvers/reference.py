@@ -422,9 +422,7 @@ def simulate_reference(
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (8)-(20) and (27)
+    Cheng, Brach & Dunn (2002), Eqs. (8)-(20) and (27)
 
     Virtanen, P. et al. (2020), SciPy 1.0: fundamental algorithms for scientific computing in
     Python, Nat. Methods 17:261-272, doi:10.1038/s41592-019-0686-2 (``solve_ivp``, DOP853,
@@ -749,9 +747,7 @@ def reference_trajectory(
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eq. (27)
+    Cheng, Brach & Dunn (2002), Eq. (27)
 
     Virtanen, P. et al. (2020), SciPy 1.0: fundamental algorithms for scientific computing in
     Python, Nat. Methods 17:261-272, doi:10.1038/s41592-019-0686-2 (``solve_ivp``, DOP853,

@@ -153,8 +153,7 @@ def rkg_state(y0: float, c1: float, c2: float, a_hertz: float, a_adhesion: float
 
     References
     ----------
-    Gill, S. (1951), A process for the step-by-step integration of differential equations in an
-    automatic digital computing machine, Proc. Camb. Philos. Soc. 47:96-108, doi:10.1017/S0305004100026414
+    Gill (1951)
     """
     return _rkg_state_core(float(xi0), float(y0), float(c1), float(c2), float(a_hertz), float(a_adhesion),
                            float(dtau), int(n_steps))
@@ -165,12 +164,9 @@ def rkg_setup(contact, speeds):
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eqs. (28)-(33)
+    Cheng, Brach & Dunn (2002), Eqs. (28)-(33)
 
-    Gill, S. (1951), A process for the step-by-step integration of differential equations in an
-    automatic digital computing machine, Proc. Camb. Philos. Soc. 47:96-108, doi:10.1017/S0305004100026414
+    Gill (1951)
     """
     speeds = np.atleast_1d(np.asarray(speeds, dtype=float))
     sc, y0, c1, c2 = nondimensional_impact(contact, speeds)
@@ -203,12 +199,9 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> d
 
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221
+    Cheng, Brach & Dunn (2002)
 
-    Gill, S. (1951), A process for the step-by-step integration of differential equations in an
-    automatic digital computing machine, Proc. Camb. Philos. Soc. 47:96-108, doi:10.1017/S0305004100026414
+    Gill (1951)
     """
     y0, c1, c2, ah, aa, dur = setup if setup is not None else rkg_setup(contact, speeds)
     h = dur / steps_per_contact
@@ -255,12 +248,9 @@ def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS
     
     References
     ----------
-    Cheng, W., Brach, R. M. and Dunn, P. F. (2002), Three-Dimensional Modeling of Microsphere
-    Contact/Impact with Smooth, Flat Surfaces, Aerosol Sci. Technol. 36(11):1081-1093,
-    doi:10.1080/02786820290092221, Eq. (27) and its fixed-step Runge-Kutta-Gill solution
+    Cheng, Brach & Dunn (2002), Eq. (27) and its fixed-step Runge-Kutta-Gill solution
 
-    Gill, S. (1951), A process for the step-by-step integration of differential equations in an
-    automatic digital computing machine, Proc. Camb. Philos. Soc. 47:96-108, doi:10.1017/S0305004100026414
+    Gill (1951)
 
     Examples
     --------
