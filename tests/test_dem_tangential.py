@@ -353,6 +353,71 @@ def test_a_design_that_cannot_tell_mu_says_so():
     assert "friction         =" not in fit.report()  # no value printed as an estimate
 
 
+def _normal_and_oblique_table(contact, speeds, angles, e_n_noise, noise, rng):
+    """Rebounds of ``contact`` as measured: e_n and e_t, each with its stated noise."""
+    import pandas as pd
+
+    res = [simulate_impact(contact, v, a) for v, a in zip(speeds, angles)]
+    vn = speeds * np.cos(np.radians(angles))
+    e_n = np.array([abs(r.velocity_out[0]) for r in res]) / vn
+    e_t = np.array([r.velocity_out[1] for r in res]) / (speeds * np.sin(np.radians(angles)))
+    return pd.DataFrame({"radius": contact.radius, "speed": speeds, "incidence_deg": angles, "normal_speed": vn,
+                         "e_n": e_n + rng.normal(0.0, e_n_noise, len(angles)), "e_n_uncertainty": e_n_noise,
+                         "tangential_restitution": e_t + rng.normal(0.0, noise, len(angles)),
+                         "tangential_restitution_uncertainty": noise})
+
+
+def test_the_normal_laws_uncertainty_reaches_mu():
+    # Hertz + coeff_restitution (e = 0.6) fitted from noisy e_n, then mu of LAMMPS's mindlin law at
+    # 40-75 deg (gross sliding: mu J_0 sets the tangential impulse, J_0 grows with e, so a larger e
+    # means a smaller mu: d mu / d e < 0). The propagated effect must equal half the spread of two
+    # independent full profile fits of mu with e at the ends of its 68 % interval, to 1e-3 (their
+    # polish tolerance); the interval and the standard error must widen by exactly that in quadrature.
+    from microimpact.analysis.dem_fit import dem_law_contact, fit_dem_law
+    from microimpact.analysis.oblique import fit_dem_friction
+
+    mat = {**SPHERE, "work_of_adhesion": 0.0}
+    tang = {"friction": 0.15, "tangential_model": "lammps_mindlin", "shear_modulus": 3e8}
+    truth = dem_law_contact(mat, 1e-6, "hertz", "coeff_restitution", 0.6).with_(**tang)
+    rng = np.random.default_rng(0)
+    table = _normal_and_oblique_table(truth, np.full(4, 1.0), np.linspace(40.0, 75.0, 4), 0.02, 0.002, rng)
+    normal = fit_dem_law(table, mat, "hertz", "coeff_restitution")
+    assert normal.status == "determined"
+    fit = fit_dem_friction(table, lambda r: normal.contact(r).with_(**tang), normal_fit=normal)
+    held = fit_dem_friction(table, lambda r: normal.contact(r).with_(**tang))
+    lo, hi = normal.interval
+    ends = [fit_dem_friction(table, lambda r, e=e: normal.contact(r, coefficient=e).with_(**tang)).friction
+            for e in (lo, hi)]
+    gradient = fit.info["damping_gradient"]["friction"]["coefficient"]
+    assert gradient < 0 and gradient == pytest.approx((ends[1] - ends[0]) / (hi - lo), rel=1e-3, abs=0)
+    added = math.sqrt(fit.stderr["friction"] ** 2 - fit.stderr_conditional["friction"] ** 2)
+    assert added == pytest.approx(abs(ends[1] - ends[0]) / 2, rel=1e-3, abs=0)
+    assert fit.friction == held.friction and fit.stderr_conditional == held.stderr
+    st, st0 = fit.identifiability["friction"], held.identifiability["friction"]
+    assert st.upper - fit.friction == pytest.approx(math.hypot(st0.upper - fit.friction, 1.959964 * added), rel=1e-6, abs=0)
+    assert fit.info["normal_propagated"] == "coefficient" and "uncertainty of the normal law included" in fit.report()
+    assert "held at its values" in held.report()
+
+
+def test_a_normal_fit_of_another_law_or_without_an_interval_is_refused():
+    from microimpact.analysis.dem_fit import dem_law_contact, fit_dem_law
+    from microimpact.analysis.oblique import fit_dem_friction
+
+    mat = {**SPHERE, "work_of_adhesion": 0.0}
+    tang = {"friction": 0.15, "tangential_model": "lammps_mindlin", "shear_modulus": 3e8}
+    truth = dem_law_contact(mat, 1e-6, "hertz", "coeff_restitution", 0.6).with_(**tang)
+    table = _normal_and_oblique_table(truth, np.full(3, 1.0), [40.0, 50.0, 60.0], 0.02, 0.002, np.random.default_rng(1))
+    normal = fit_dem_law(table, mat, "hertz", "coeff_restitution")
+    other = lambda r: dem_law_contact(mat, r, "hertz", "coeff_restitution", 0.5).with_(**tang)  # noqa: E731
+    with pytest.raises(ValueError, match="damping_coefficient=0.5"):
+        fit_dem_friction(table, other, normal_fit=normal)
+    flat = table.assign(e_n=1e-5, e_n_uncertainty=0.5)  # e_n says nothing: e not determined
+    unknown = fit_dem_law(flat, mat, "hertz", "coeff_restitution")
+    assert unknown.status == "not determined"
+    with pytest.raises(ValueError, match="coefficient is not determined"):
+        fit_dem_friction(flat, lambda r: unknown.contact(r).with_(**tang), normal_fit=unknown)
+
+
 @pytest.mark.slow
 def test_the_friction_interval_covers_the_truth_over_random_designs():
     # random designs: 4-13 impacts at speeds 0.1-10 m/s, angles over a random range in 0-85 deg,

@@ -692,8 +692,8 @@ def _lammps_fit_friction(args, table, chosen):
     laws = _lammps_tangential_laws(args)
     try:
         ranked, fits = rank_dem_tangential_laws(
-            table, {law: (lambda r, f=f: chosen.contact(r).with_(**f)) for law, f in laws.items()}, rtol=args.rtol,
-            progress=True)
+            table, {law: (lambda r, f=f: chosen.contact(r).with_(**f)) for law, f in laws.items()}, normal_fit=chosen,
+            rtol=args.rtol, progress=True)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     if len(laws) > 1:
@@ -710,8 +710,8 @@ def _lammps_fit_friction(args, table, chosen):
     radius = float(np.median(np.asarray(table["radius"], dtype=float)))
     others = ", ".join(f"{o} dAIC {d:.3g}" for o, d in zip(ranked["law"].iloc[1:], ranked["delta_aic"].iloc[1:]))
     note = (f"{fit.friction:.6g} ({law}{'; best by AIC: ' + others if others else ''}; 95% profile-likelihood "
-            f"interval {status.lower:.6g} to {status.upper:.6g}; {fit.n_points} oblique entries, the normal law at "
-            "its fitted values)")
+            f"interval {status.lower:.6g} to {status.upper:.6g}; the normal law's uncertainty included; "
+            f"{fit.n_points} oblique entries)")
     return chosen.contact(radius).with_(friction=fit.friction, **laws[law]), note
 
 

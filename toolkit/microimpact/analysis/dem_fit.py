@@ -180,9 +180,21 @@ class DemLawFit:
         return (f"{self.law}: damping_coefficient not determined by these data (eta_n0 >= {lo:.6g}{unit}, 68%: "
                 "the data cannot tell it from a stronger damping)")
 
-    def contact(self, radius: float) -> Contact:
-        """The fitted law's contact at ``radius`` [m] (the best value, also when not determined)."""
-        return dem_law_contact(self.material, radius, self.normal_model, self.damping_model, self.best)
+    def contact(self, radius: float, *, coefficient: float | None = None,
+                work_of_adhesion: float | None = None) -> Contact:
+        """The fitted law's contact at ``radius`` [m]: the best values (also when not determined),
+        or the damping ``coefficient`` and ``work_of_adhesion`` [J/m^2] given instead."""
+        mat = self.material if work_of_adhesion is None else {**self.material, "work_of_adhesion": work_of_adhesion}
+        return dem_law_contact(mat, radius, self.normal_model, self.damping_model,
+                               self.best if coefficient is None else coefficient)
+
+    def interval_ends(self) -> dict:
+        """``{parameter: (low, high)}``: the 68 % interval of every fitted parameter, keyed by the
+        :meth:`contact` keyword it moves (``coefficient``; ``work_of_adhesion`` when fitted)."""
+        ends = {"coefficient": tuple(map(float, self.interval))}
+        if self.adhesion_fitted:
+            ends["work_of_adhesion"] = tuple(map(float, self.work_of_adhesion_interval))
+        return ends
 
 
 def dem_law_contact(material, radius: float, normal_model: str, damping_model: str, coefficient: float) -> Contact:

@@ -42,7 +42,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -345,7 +345,8 @@ class FrictionFit(ReportHTML):
         Fitted tangential parameters (``friction`` [-]).
     stderr : dict
         Standard errors including the propagated damping covariance, same units (for a DEM
-        tangential law, :func:`fit_dem_friction`, at the given normal law: nothing propagated).
+        tangential law, :func:`fit_dem_friction`: the normal fit's uncertainty where it was given,
+        ``info["normal_propagated"]`` naming its parameters; else at the given normal law).
     stderr_conditional : dict
         Standard errors with the damping held at its fitted values.
     tangential_model : str
@@ -400,8 +401,11 @@ class FrictionFit(ReportHTML):
     def report(self) -> str:
         """Plain-text summary: a value with its interval only where the data determine it."""
         dem = self.tangential_model in DEM_TANGENTIAL_MODELS
-        lines = [f"Friction fit (LAMMPS's {self.tangential_model} tangential law), the normal law held at its values"
+        held = dem and not self.info.get("normal_propagated")  # fit_dem_friction without normal_fit
+        lines = [f"Friction fit (LAMMPS's {self.tangential_model} tangential law), the normal law "
+                 + ("held at its values" if held else "fitted before (its uncertainty included)")
                  if dem else f"Friction fit ({self.tangential_model} tangential model, Eqs. (16)-(20)), after the damping fit"]
+        before = "the normal law" if dem else "the damping"
         for k, v in self.values.items():
             st = self.identifiability.get(k)
             if st is not None and not st.determined:
@@ -410,13 +414,13 @@ class FrictionFit(ReportHTML):
             from microimpact.io.statuses import stderr_is_meaningful
 
             if stderr_is_meaningful(v, self.stderr[k]) and stderr_is_meaningful(v, self.stderr_conditional[k]):
-                lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr[k]:.3g}" + (" (at the normal law's values)" if dem else
-                             f" (with the damping uncertainty; {self.stderr_conditional[k]:.3g} at fixed damping)"))
+                lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr[k]:.3g}" + (" (at the normal law's values)" if held else
+                             f" (with the uncertainty of {before}; {self.stderr_conditional[k]:.3g} at its best values)"))
             else:  # a standard error above 100 % says nothing the interval does not say better
                 lines.append(f"  {k:<17}= {v:.6g} (standard error above 100 %: see the interval)")
             if st is not None:
                 lines.append(f"  {'':<17}  95 % interval [{st.lower:.6g}, {st.upper:.6g}] ({st.method}"
-                             + (")" if dem else ", damping uncertainty included)"))
+                             + (")" if held else f", uncertainty of {before} included)"))
         qs = ", ".join(f"{q} ({int((self.data['quantity'] == q).sum())})" for q in dict.fromkeys(self.data["quantity"]))
         lines.append(f"  data        : {self.n_points} entries: {qs}; "
                      f"{'stated uncertainties + effective variance' if self.weighted else 'unweighted'}")
@@ -433,12 +437,14 @@ class FrictionFit(ReportHTML):
             ds.update(status_variables(st, "1"))
         for k, v in self.values.items():
             ds[k] = xr.DataArray(v, attrs={"units": "1", "long_name": f"fitted {k} ({self.tangential_model} tangential model)"})
-            dem = self.tangential_model in DEM_TANGENTIAL_MODELS  # fit_dem_friction: no propagation
+            dem = self.tangential_model in DEM_TANGENTIAL_MODELS
+            held = dem and not self.info.get("normal_propagated")  # fit_dem_friction without normal_fit
             ds[f"{k}_stderr"] = xr.DataArray(self.stderr[k], attrs={
-                "units": "1", "long_name": f"standard error of {k}, " + ("at the given normal law" if dem
-                                                                        else "damping uncertainty propagated")})
+                "units": "1", "long_name": f"standard error of {k}, " + (
+                    "at the given normal law" if held else
+                    f"{'normal law' if dem else 'damping'} uncertainty propagated")})
             ds[f"{k}_stderr_conditional"] = xr.DataArray(self.stderr_conditional[k], attrs={
-                "units": "1", "long_name": f"standard error of {k} at the fitted damping"})
+                "units": "1", "long_name": f"standard error of {k} at the fitted {'normal law' if dem else 'damping'}"})
         ds["row"] = ("entry", d["row"].to_numpy(dtype=np.int64), {"units": "1", "long_name": "data row in the impact CSV"})
         ds.update(label_variables(d[[c for c in d.columns if c not in _ENTRY_COLUMNS]], "entry"))
         ds["quantity"] = ("entry", d["quantity"].to_numpy(dtype=str).astype(object), {"long_name": "measured quantity"})
@@ -666,7 +672,7 @@ DEM_PROFILE_POINTS = 48
 DEM_REFINE_POINTS = 32
 
 
-def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress: bool = False,
+def fit_dem_friction(table, contact_of, *, normal_fit=None, rtol: float = DEFAULT_RTOL, progress: bool = False,
                      time_budget: float | None = None) -> FrictionFit:
     """Fit the Coulomb coefficient mu of a DEM tangential law (LAMMPS's ``linear_history`` or a
     ``mindlin`` variant, :mod:`microimpact.model.dem_tangential`) to the oblique columns.
@@ -682,6 +688,10 @@ def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress:
         radius [m] -> Contact with a DEM ``tangential_model`` (one of
         :data:`~microimpact.model.dem_tangential.DEM_TANGENTIAL_MODELS`; its ``friction`` is
         replaced by each trial mu).
+    normal_fit : DemLawFit, optional
+        The fit of the normal law that ``contact_of`` holds (:func:`~microimpact.analysis.dem_fit.fit_dem_law`):
+        its uncertainty is propagated into mu (Notes). None: mu at the given normal law, nothing
+        propagated.
     rtol : float
         Relative tolerance of the solves. [-]
     progress : bool
@@ -692,13 +702,14 @@ def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress:
     Returns
     -------
     FrictionFit
-        As :func:`fit_friction`, its ``tangential_model`` the DEM law's; the normal parameters are
-        held at their given values (no damping uncertainty is propagated).
+        As :func:`fit_friction` (``info["damping_gradient"]``: d mu / d normal parameter), its
+        ``tangential_model`` the DEM law's.
 
     Raises
     ------
     ValueError
-        No oblique data, or a contact without a DEM tangential law (naming it).
+        No oblique data, no DEM tangential law, or a ``normal_fit`` of another law or with a
+        parameter not determined (each named).
     TimeBudgetExceeded
         The fit ran past ``time_budget``.
 
@@ -711,6 +722,10 @@ def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress:
     stated speed or angle uncertainties the effective variance is evaluated once, at a first fit
     with the stated uncertainties alone, and held for the second (it depends on mu only through the
     model's slopes).
+
+    With ``normal_fit``, mu is refitted with each normal parameter at the ends of its 68 % interval;
+    half their difference is its one-sigma effect s_k, the variance added (sum_k s_k)^2 (delta
+    method, bounding every correlation of two parameters), the interval widened in quadrature.
 
     References
     ----------
@@ -742,18 +757,100 @@ def fit_dem_friction(table, contact_of, *, rtol: float = DEFAULT_RTOL, progress:
     if not uses_dem_tangential(contact):
         raise ValueError(f"fit_dem_friction fits a DEM tangential law ({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}); the "
                          f"contact has tangential_model={contact.tangential_model!r} (use fit_friction)")
+    ends = _normal_fit_ends(normal_fit, contact_of, problem) if normal_fit is not None else {}
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
-    with progress_bar(2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20), "friction fit", progress) as advance:
+    total = 2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20) + 2 * len(ends) * _REFIT_EVALUATIONS
+    with progress_bar(total, "friction fit", progress) as advance:
         objective = _DemFrictionObjective(problem, contact_of, weighted, rtol, advance)
         best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
         if weighted and (np.any(problem.sigma_speed > 0) or np.any(problem.sigma_angle > 0)):
             objective.hold_effective_sigma(best.value)
             best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
-    return _friction_result(problem, objective, best, 0.0, {}, weighted, contact.tangential_model, t0)
+        variance, gradient = 0.0, {}
+        if ends and _friction_status(best, objective, 0.0).determined:
+            variance, gradient = _normal_law_variance(objective, contact_of, normal_fit, ends, best, deadline)
+    fit = _friction_result(problem, objective, best, variance, {"friction": gradient} if gradient else {}, weighted,
+                           contact.tangential_model, t0)
+    return replace(fit, info=fit.info | {"normal_propagated": ", ".join(gradient)})
 
 
-def rank_dem_tangential_laws(table, contacts_of, *, rtol: float = DEFAULT_RTOL, progress: bool = False,
-                             time_budget: float | None = None):
+#: most objective evaluations of one refit of :func:`_normal_law_variance`
+_REFIT_EVALUATIONS = 60
+
+
+def _normal_fit_ends(normal_fit, contact_of, problem) -> dict:
+    """The 68 % interval ends of the normal fit's parameters, checked: its law must be the one
+    ``contact_of`` holds, and every end finite (ValueError naming what differs)."""
+    r = float(problem.radius[0])
+    given, fitted = contact_of(r), normal_fit.contact(r)
+    for name in ("normal_model", "damping_model", "damping_coefficient", "adhesion_line_force", "stiffness", "density"):
+        a, b = getattr(given, name), getattr(fitted, name)
+        if a != b and not (isinstance(a, float) and math.isclose(a, b, rel_tol=1e-12)):
+            raise ValueError(f"normal_fit: contact_of({r:g}) has {name}={a!r}, the fitted law ({normal_fit.law}) "
+                             f"{b!r}; build contact_of from normal_fit.contact")
+    ends = normal_fit.interval_ends()
+    statuses = {"coefficient": normal_fit.status, "work_of_adhesion": normal_fit.adhesion_status}
+    for name, (lo, hi) in ends.items():
+        if statuses[name] in ("not determined", "inadequate"):
+            raise ValueError(f"normal_fit: the {normal_fit.law} fit's {name} is {statuses[name]} ("
+                             f"{normal_fit.describe()}): mu cannot carry its uncertainty; fit mu at a given normal "
+                             "law (normal_fit=None) or measure what determines it")
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+            raise ValueError(f"normal_fit: the {normal_fit.law} fit's {name} has no finite 68 % interval "
+                             f"({lo:.6g} to {hi:.6g}, status {normal_fit.status!r}): its uncertainty cannot be propagated")
+    return ends
+
+
+def _normal_law_variance(objective, contact_of, normal_fit, ends, best, deadline) -> tuple[float, dict]:
+    """(variance of mu from the normal fit, {parameter: d mu / d parameter}).
+
+    mu is refitted (at the held effective variance) with each fitted normal parameter at the two
+    ends of its 68 % interval, the others at their best; half the difference of the two refits is
+    that parameter's one-standard-deviation effect s_k on mu (delta method; the ends, not a
+    symmetric step, carry an asymmetric interval). The variance is (sum_k s_k)^2: with one parameter
+    s^2, with two (the damping and a fitted work of adhesion, whose correlation the normal fit does
+    not report) the bound of g^T C g over every correlation. :func:`_friction_status` widens the
+    95 % profile interval in quadrature by 1.96 times its square root, as :func:`fit_friction` does
+    with the damping fit.
+
+    Each refit is a bounded Brent search over +-10 conditional standard errors about the estimate,
+    to 1e-3 of one (its error in the added variance is negligible beside the variance itself); a
+    minimum at an end of that bracket is searched again over [mu / 2, 2 mu]."""
+    from scipy.optimize import minimize_scalar
+
+    _, lo_lim, hi_lim = PARAMETER_BOUNDS["friction"]
+    f = best.value
+    width = 10.0 * best.stderr if math.isfinite(best.stderr) and best.stderr > 0 else 0.5 * f
+    brackets = [(max(lo_lim, f - width), min(hi_lim, f + width)), (max(lo_lim, 0.5 * f), min(hi_lim, 2.0 * f))]
+    effects, gradient = [], {}
+    for name, (lo, hi) in ends.items():
+        refits = []
+        for end in (lo, hi):
+            def shifted(r, name=name, end=end):
+                law = normal_fit.contact(r, **{name: end})
+                return contact_of(r).with_(damping_coefficient=law.damping_coefficient,
+                                           adhesion_line_force=law.adhesion_line_force)
+
+            moved = _DemFrictionObjective(objective.problem, shifted, objective.weighted, objective.rtol, objective.advance)
+            moved._sigma = objective.sigma(f)  # the effective variance held at the estimate's
+            for a, b in brackets:
+                res = minimize_scalar(moved.deviance, bounds=(a, b), method="bounded",
+                                      options={"xatol": 1e-4 * width, "maxiter": _REFIT_EVALUATIONS})
+                inside = res.success and min(res.x - a, b - res.x) > 1e-3 * width
+                if inside:
+                    break
+            if not inside:
+                raise RuntimeError(f"the refit of mu at the normal law's {name} = {end:.6g} found no minimum in "
+                                   f"[{a:.6g}, {b:.6g}] ({res.message})")
+            refits.append(float(res.x))
+            deadline.check(f"the refits of mu at the normal law's {name}")
+        effects.append(0.5 * abs(refits[1] - refits[0]))
+        gradient[name] = (refits[1] - refits[0]) / (hi - lo)
+    return sum(effects) ** 2, gradient
+
+
+def rank_dem_tangential_laws(table, contacts_of, *, normal_fit=None, rtol: float = DEFAULT_RTOL,
+                             progress: bool = False, time_budget: float | None = None):
     """Fit mu of each DEM tangential law to the same oblique columns and rank the laws by AIC.
 
     Parameters
@@ -762,8 +859,8 @@ def rank_dem_tangential_laws(table, contacts_of, *, rtol: float = DEFAULT_RTOL, 
         As :func:`fit_dem_friction`.
     contacts_of : mapping
         tangential_model -> (radius [m] -> Contact with that law), the rest of the contact given.
-    rtol, progress
-        As :func:`fit_dem_friction`.
+    normal_fit, rtol, progress
+        As :func:`fit_dem_friction` (the normal fit's uncertainty propagated into every law's mu).
     time_budget : float or Deadline, optional
         Wall-clock budget of all the fits; None: no limit. [s]
 
@@ -805,7 +902,8 @@ def rank_dem_tangential_laws(table, contacts_of, *, rtol: float = DEFAULT_RTOL, 
     deadline = Deadline.start(time_budget, "tangential laws fitted")
     fits, rows = {}, []
     for law, contact_of in contacts_of.items():
-        fit = fit_dem_friction(table, contact_of, rtol=rtol, progress=progress, time_budget=deadline)
+        fit = fit_dem_friction(table, contact_of, normal_fit=normal_fit, rtol=rtol, progress=progress,
+                               time_budget=deadline)
         if fit.tangential_model != law:
             raise ValueError(f"contacts_of[{law!r}] gives tangential_model={fit.tangential_model!r}")
         fits[law] = fit
