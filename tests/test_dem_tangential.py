@@ -516,3 +516,29 @@ def test_lammps_fit_auto_ranks_the_tangential_laws_and_writes_the_best(tmp_path,
     capsys.readouterr()
     assert main(argv[:9] + ["--out", "c2.lmp"]) == 2  # auto without a stiffness option
     assert "needs --tangential-stiffness" in capsys.readouterr().err and not (tmp_path / "c2.lmp").exists()
+
+
+def test_a_stated_angle_uncertainty_enters_the_dem_friction_fit_as_effective_variance():
+    # sigma_eff^2 = sigma^2 + (d e_t / d theta sigma_theta)^2 with the slope of the law itself: here
+    # from central differences of simulate_impact (step 0.1 deg; the fit's own step is 0.05 deg, so
+    # the two slopes agree to their O(h^2) truncation, 1e-3), at the fitted mu of noise-free data
+    import pandas as pd
+
+    from microimpact.analysis.oblique import fit_dem_friction
+
+    c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.2, tangential_model="lammps_mindlin", shear_modulus=3e8)
+    angles = np.array([20.0, 35.0, 50.0])
+
+    def e_t(contact, a):
+        return simulate_impact(contact, 1.0, a).velocity_out[1] / math.sin(math.radians(a))
+
+    table = pd.DataFrame({"radius": 1e-6, "speed": 1.0, "incidence_deg": angles, "e_n": 1.0,
+                          "tangential_restitution": [e_t(c, a) for a in angles],
+                          "tangential_restitution_uncertainty": 0.01, "incidence_deg_uncertainty": 5.0})
+    fit = fit_dem_friction(table, lambda r: c)
+    assert fit.friction == pytest.approx(0.2, rel=1e-6, abs=0)
+    h = 0.1
+    slope = np.array([(e_t(c, a + h) - e_t(c, a - h)) / (2 * h) for a in angles])  # per degree
+    expected = np.sqrt(0.01 ** 2 + (slope * 5.0) ** 2)
+    assert np.all(np.abs(slope * 5.0) > 0.015)  # the angle term dominates: a fit that drops it fails
+    assert fit.data["sigma"].to_numpy() == pytest.approx(expected, rel=1e-3, abs=0)

@@ -618,14 +618,19 @@ class _FrictionObjective:
 
     def sigma(self, f) -> np.ndarray:
         """Effective standard uncertainty of every entry at friction f (ones when unweighted)."""
-        p = self.problem
         if not self.weighted:
-            return np.ones(p.size)
+            return np.ones(self.problem.size)
+        return self._effective_sigma(f, "v+" in self.states, "a+" in self.states)
+
+    def _effective_sigma(self, f, speed: bool, angle: bool) -> np.ndarray:
+        """sqrt(sigma^2 + (dy/dv sigma_v)^2 + (dy/dtheta sigma_theta)^2), the slopes by central
+        differences of the model (the speed and the angle terms where asked for)."""
+        p = self.problem
         terms = p.sigma_measured ** 2
-        if "v+" in self.states:
+        if speed:
             slope = (self.model(f, "v+") - self.model(f, "v-")) / (2 * _H_SPEED * p.speed)
             terms = terms + (np.nan_to_num(slope) * p.sigma_speed) ** 2
-        if "a+" in self.states:
+        if angle:
             step = p.incidence_deg + _H_ANGLE - np.maximum(p.incidence_deg - _H_ANGLE, 0.0)
             slope = (self.model(f, "a+") - self.model(f, "a-")) / step
             terms = terms + (np.nan_to_num(slope) * p.sigma_angle) ** 2
@@ -963,11 +968,8 @@ class _DemFrictionObjective(_FrictionObjective):
 
     def hold_effective_sigma(self, f) -> None:
         """Evaluate the effective variance at ``f`` and hold it for every trial mu."""
-        self._sigma = None
-        self.states = {"v+": None, "v-": None} if np.any(self.problem.sigma_speed > 0) else {}
-        if np.any(self.problem.sigma_angle > 0):
-            self.states |= {"a+": None, "a-": None}
-        self._sigma = _FrictionObjective.sigma(self, f)
+        p = self.problem
+        self._sigma = self._effective_sigma(f, bool(np.any(p.sigma_speed > 0)), bool(np.any(p.sigma_angle > 0)))
 
     def sigma(self, f) -> np.ndarray:
         if self._sigma is not None:
