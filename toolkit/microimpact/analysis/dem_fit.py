@@ -55,7 +55,7 @@ from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
 from microimpact.solvers import DEFAULT_RTOL
 
-__all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "ranked_by_aic", "information_criteria", "dem_fit_coverage",
+__all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "ranked_by_aic", "information_criteria", "dem_fit_coverage", "dem_friction_coverage",
            "INTERVAL_LEVEL", "ADEQUACY_P"]
 
 #: the (normal law, damping law) pairs a LAMMPS user chooses among; "hertz" is Hertz without
@@ -768,3 +768,106 @@ def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, s
     return {"trials": trials, "determined": determined, "covered": covered,
             "coverage": covered / determined if determined else math.nan, "undetermined": undetermined,
             "adequate": adequate, "interval_covered": interval_covered, "adhesion_determined": adhesion_determined}
+
+
+#: the tangential laws and the normal laws :func:`dem_friction_coverage` draws from
+_COVERAGE_TANGENTIAL = ("linear_history", "lammps_mindlin", "lammps_mindlin_rescale", "lammps_mindlin_force",
+                        "lammps_mindlin_rescale_force")
+_COVERAGE_NORMAL = (("hertz", "coeff_restitution"), ("hertz", "viscoelastic"), ("jkr_force", "viscoelastic"),
+                    ("dmt", "mass_velocity"))
+
+
+def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = True, rtol: float = DEFAULT_RTOL):
+    """Coverage of the 95 % interval of mu of a LAMMPS tangential law fitted after its normal law,
+    both from the same noisy data, over random experiment designs.
+
+    Each trial draws a tangential law (any of LAMMPS's five, a random k_t 10^0.5-10^3 N/m or G*
+    10^8-10^8.8 Pa), a normal law (Hertz + ``coeff_restitution`` with e uniform 0.3-0.95; Hertz or
+    JKR + ``viscoelastic``, DMT + ``mass_velocity``, with eta_n0 log-uniform 0.01-0.2 critical
+    dampings at 1 m/s and w_A log-uniform 1e-3-3e-2 J/m^2), mu log-uniform 0.05-1 and a design of
+    4-13 impacts of a 1 um sphere (2000 kg/m^3, 1 GPa) at 0.1-10 m/s over a random angle range in
+    0-85 deg, with stated Gaussian noise 0.005-0.05 on e_n and on e_t. Captures are left out (a
+    design with fewer than three rebounds is skipped); the normal law is fitted by
+    :func:`fit_dem_law`, then mu by :func:`~microimpact.analysis.oblique.fit_dem_friction` at the
+    fitted normal law, its uncertainty propagated or not.
+
+    Parameters
+    ----------
+    trials : int
+        Designs drawn.
+    seed : int
+        Seed of the generator (the same seed draws the same designs with and without ``propagate``).
+    propagate : bool
+        Pass the normal fit as ``normal_fit`` (its uncertainty in mu's interval).
+    rtol : float
+        Solver tolerance. [-]
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per design fitted: normal and tangential law, true and fitted damping coefficient,
+        its status, true mu, n, the noises, mu's status, value and interval, and ``covered``.
+
+    References
+    ----------
+    LAMMPS documentation, ``pair_style granular``, https://docs.lammps.org/pair_granular.html.
+
+    Examples
+    --------
+    >>> d = dem_friction_coverage(trials=1, seed=11)
+    >>> d[["normal_law", "tangential_model", "status", "covered"]].values.tolist()
+    [['hertz+coeff_restitution', 'linear_history', 'determined', True]]
+    """
+    import pandas as pd
+
+    from microimpact.analysis.oblique import fit_dem_friction
+    from microimpact.model.dem_damping import critical_damping_coefficient
+    from microimpact.solvers.impact import simulate_impact
+
+    rng = np.random.default_rng(seed)
+    rows = []
+    for _ in range(trials):
+        law = str(rng.choice(_COVERAGE_TANGENTIAL))
+        normal, damping = _COVERAGE_NORMAL[int(rng.integers(0, len(_COVERAGE_NORMAL)))]
+        mat = {"density": 2000.0, "stiffness": 1e9,
+               "work_of_adhesion": 0.0 if normal == "hertz" else float(10 ** rng.uniform(-3, -1.5))}
+        if damping in RESTITUTION_DAMPING_MODELS:
+            coef = float(rng.uniform(0.3, 0.95))
+        else:
+            unit = critical_damping_coefficient(dem_law_contact(mat, 1e-6, normal, damping, 1.0), 1.0)
+            coef = float(10 ** rng.uniform(-2, -0.7)) * unit
+        mu = float(10 ** rng.uniform(-1.3, 0))
+        stiffness = ({"tangential_stiffness": float(10 ** rng.uniform(0.5, 3))} if law == "linear_history"
+                     else {"shear_modulus": float(1e9 * 10 ** rng.uniform(-1, -0.2))})
+        n = int(rng.integers(4, 14))
+        lo = rng.uniform(0, 70)
+        hi = min(lo + rng.uniform(5, 60), 85)
+        angles, speeds = rng.uniform(lo, hi, n), 10 ** rng.uniform(-1, 1, n)
+        noise_t, noise_n = float(10 ** rng.uniform(-2.3, -1.3)), float(10 ** rng.uniform(-2.3, -1.3))
+        tangential = {"friction": mu, "tangential_model": law, **stiffness}
+        truth = dem_law_contact(mat, 1e-6, normal, damping, coef).with_(**tangential)
+        results = [simulate_impact(truth, v, a, rtol=rtol) for v, a in zip(speeds, angles)]
+        keep = np.array([r.outcome == "rebound" for r in results])
+        if keep.sum() < 3:
+            continue
+        results = [r for r, k in zip(results, keep) if k]
+        speeds, angles, n = speeds[keep], angles[keep], int(keep.sum())
+        vn = speeds * np.cos(np.radians(angles))
+        e_n = np.array([abs(r.velocity_out[0]) for r in results]) / vn
+        e_t = np.array([r.velocity_out[1] for r in results]) / (speeds * np.sin(np.radians(angles)))
+        table = pd.DataFrame({"radius": 1e-6, "speed": speeds, "incidence_deg": angles, "normal_speed": vn,
+                              "e_n": e_n + rng.normal(0, noise_n, n), "e_n_uncertainty": noise_n,
+                              "tangential_restitution": e_t + rng.normal(0, noise_t, n),
+                              "tangential_restitution_uncertainty": noise_t})
+        normal_fit = fit_dem_law(table, mat, normal, damping, rtol=rtol)
+        row = {"normal_law": f"{normal}+{damping}", "tangential_model": law, "coefficient": coef,
+               "coefficient_fitted": normal_fit.best, "normal_status": normal_fit.status, "mu": mu, "n": n,
+               "noise_e_n": noise_n, "noise_e_t": noise_t}
+        if normal_fit.status == "determined":
+            fit = fit_dem_friction(table, lambda r, f=normal_fit, t=tangential: f.contact(r).with_(**t),
+                                   normal_fit=normal_fit if propagate else None, rtol=rtol)
+            st = fit.identifiability["friction"]
+            row |= {"status": st.status, "value": fit.friction, "lower": st.lower, "upper": st.upper,
+                    "covered": bool(st.lower <= mu <= st.upper)}
+        rows.append(row)
+    return pd.DataFrame(rows)
