@@ -483,6 +483,7 @@ def test_lammps_fit_writes_the_fitted_friction_of_a_tangential_law(tmp_path, cap
     assert not (tmp_path / "c2.lmp").exists() and not (tmp_path / "c3.lmp").exists()
 
 
+@pytest.mark.slow  # four laws' profiles and their normal-law refits: 1.5-3 min
 def test_lammps_fit_auto_ranks_the_tangential_laws_and_writes_the_best(tmp_path, capsys, monkeypatch):
     # '--tangential-model auto': mu of every law the stiffness options allow (here the four mindlin
     # laws, --shear-modulus), ranked by AIC; rebounds of mindlin/force at 3-12 deg, where the contact
