@@ -777,7 +777,8 @@ _COVERAGE_NORMAL = (("hertz", "coeff_restitution"), ("hertz", "viscoelastic"), (
                     ("dmt", "mass_velocity"))
 
 
-def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = True, rtol: float = DEFAULT_RTOL):
+def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = True, fit_adhesion: bool = False,
+                          rtol: float = DEFAULT_RTOL):
     """Coverage of the 95 % interval of mu of a LAMMPS tangential law fitted after its normal law,
     both from the same noisy data, over random experiment designs.
 
@@ -799,14 +800,18 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
         Seed of the generator (the same seed draws the same designs with and without ``propagate``).
     propagate : bool
         Pass the normal fit as ``normal_fit`` (its uncertainty in mu's interval).
+    fit_adhesion : bool
+        Draw the adhesive normal laws only (JKR, DMT) and fit the work of adhesion with the damping
+        (two normal parameters propagated).
     rtol : float
         Solver tolerance. [-]
 
     Returns
     -------
     pandas.DataFrame
-        One row per design fitted: normal and tangential law, true and fitted damping coefficient,
-        its status, true mu, n, the noises, mu's status, value and interval, and ``covered``.
+        One row per design fitted: normal and tangential law, true and fitted damping coefficient
+        (and work of adhesion), the normal fit's status, true mu, n, the noises, mu's status, value
+        and interval, and ``covered`` (designs whose normal fit is not determined: no mu).
 
     References
     ----------
@@ -826,9 +831,10 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
 
     rng = np.random.default_rng(seed)
     rows = []
+    normal_laws = _COVERAGE_NORMAL[2:] if fit_adhesion else _COVERAGE_NORMAL
     for _ in range(trials):
         law = str(rng.choice(_COVERAGE_TANGENTIAL))
-        normal, damping = _COVERAGE_NORMAL[int(rng.integers(0, len(_COVERAGE_NORMAL)))]
+        normal, damping = normal_laws[int(rng.integers(0, len(normal_laws)))]
         mat = {"density": 2000.0, "stiffness": 1e9,
                "work_of_adhesion": 0.0 if normal == "hertz" else float(10 ** rng.uniform(-3, -1.5))}
         if damping in RESTITUTION_DAMPING_MODELS:
@@ -859,11 +865,14 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
                               "e_n": e_n + rng.normal(0, noise_n, n), "e_n_uncertainty": noise_n,
                               "tangential_restitution": e_t + rng.normal(0, noise_t, n),
                               "tangential_restitution_uncertainty": noise_t})
-        normal_fit = fit_dem_law(table, mat, normal, damping, rtol=rtol)
+        normal_fit = fit_dem_law(table, mat, normal, damping, fit_adhesion=fit_adhesion, rtol=rtol)
         row = {"normal_law": f"{normal}+{damping}", "tangential_model": law, "coefficient": coef,
                "coefficient_fitted": normal_fit.best, "normal_status": normal_fit.status, "mu": mu, "n": n,
                "noise_e_n": noise_n, "noise_e_t": noise_t}
-        if normal_fit.status == "determined":
+        if fit_adhesion:
+            row |= {"work_of_adhesion": mat["work_of_adhesion"], "work_of_adhesion_fitted": normal_fit.material["work_of_adhesion"],
+                    "adhesion_status": normal_fit.adhesion_status}
+        if normal_fit.determined:
             fit = fit_dem_friction(table, lambda r, f=normal_fit, t=tangential: f.contact(r).with_(**t),
                                    normal_fit=normal_fit if propagate else None, rtol=rtol)
             st = fit.identifiability["friction"]
