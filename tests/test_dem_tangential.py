@@ -411,6 +411,8 @@ def test_a_normal_fit_of_another_law_or_without_an_interval_is_refused():
     other = lambda r: dem_law_contact(mat, r, "hertz", "coeff_restitution", 0.5).with_(**tang)  # noqa: E731
     with pytest.raises(ValueError, match="damping_coefficient=0.5"):
         fit_dem_friction(table, other, normal_fit=normal)
+    with pytest.raises(TypeError, match="normal_fit must be the DemLawFit of fit_dem_law, not dict"):
+        fit_dem_friction(table, other, normal_fit={"coefficient": 0.6})
     flat = table.assign(e_n=1e-5, e_n_uncertainty=0.5)  # e_n says nothing: e not determined
     unknown = fit_dem_law(flat, mat, "hertz", "coeff_restitution")
     assert unknown.status == "not determined"

@@ -786,6 +786,10 @@ _REFIT_EVALUATIONS = 60
 def _normal_fit_ends(normal_fit, contact_of, problem) -> dict:
     """The 68 % interval ends of the normal fit's parameters, checked: its law must be the one
     ``contact_of`` holds, and every end finite (ValueError naming what differs)."""
+    from microimpact.analysis.dem_fit import DemLawFit
+
+    if not isinstance(normal_fit, DemLawFit):
+        raise TypeError(f"normal_fit must be the DemLawFit of fit_dem_law, not {type(normal_fit).__name__}")
     r = float(problem.radius[0])
     given, fitted = contact_of(r), normal_fit.contact(r)
     for name in ("normal_model", "damping_model", "damping_coefficient", "adhesion_line_force", "stiffness", "density"):
