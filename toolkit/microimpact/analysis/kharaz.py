@@ -80,6 +80,11 @@ def default_kharaz_path() -> Path:
     Read through :mod:`importlib.resources`, so it is found in an installed wheel as well as in a
     clone. It is byte-identical to the repository's ``data/kharaz2001_oblique.csv``, which the
     pipeline reads (``tests/test_packaging.py`` checks that the two copies agree).
+
+    Examples
+    --------
+    >>> default_kharaz_path().name
+    'kharaz2001_oblique.csv'
     """
     return Path(str(files("microimpact") / "data" / "kharaz2001_oblique.csv"))
 
@@ -87,11 +92,27 @@ def default_kharaz_path() -> Path:
 def read_kharaz(path=None) -> pd.DataFrame:
     """Read the Kharaz et al. (2001) table (columns quantity, incidence_angle_deg, value, units).
 
+    Parameters
+    ----------
+    path : str or Path, optional
+        The CSV; default the bundled copy (:func:`default_kharaz_path`).
+
     Raises
     ------
     ValueError
         For an unknown quantity, a unit that is not the documented one, or a non-numeric value
         (names the file and line).
+
+    References
+    ----------
+    Kharaz, A. H., Gorham, D. A. and Salman, A. D. (2001), An experimental study of the elastic
+    rebound of spheres, Powder Technol. 120:281-291, doi:10.1016/S0032-5910(01)00283-2.
+
+    Examples
+    --------
+    >>> t = read_kharaz()
+    >>> sorted(t["quantity"].unique()), float(t.loc[0, "incidence_angle_deg"]), float(t.loc[0, "value"])
+    (['rebound_angle', 'rebound_spin', 'tangential_restitution'], 1.84, 0.79344)
     """
     path = Path(path) if path is not None else default_kharaz_path()
     df = pd.read_csv(path, dtype={"quantity": str, "units": str})

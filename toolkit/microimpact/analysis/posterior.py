@@ -317,6 +317,11 @@ def prior_bounds(names, best: dict) -> dict:
 
     zeta_H, zeta_A and w_A (relative to its fitted value) over the ranges the fit searches
     (:data:`microimpact.analysis.fitting.DAMPING_RANGES`), the friction over [0, FRICTION_PRIOR_MAX].
+
+    Examples
+    --------
+    >>> prior_bounds(["zeta_hertz", "friction"], {"zeta_hertz": 0.1, "friction": 0.2})
+    {'zeta_hertz': (0.0, 1000.0), 'friction': (0.0, 10.0)}
     """
     from microimpact.analysis.fitting import DAMPING_RANGES
 
