@@ -24,7 +24,14 @@ PRESETS: dict[str, Contact] = {
 
 
 def get_preset(name: str) -> Contact:
-    """The preset called ``name`` (case-insensitive); ValueError listing the known names otherwise."""
+    """The preset called ``name`` (case-insensitive); ValueError listing the known names otherwise.
+
+    Examples
+    --------
+    >>> c = get_preset("WALL1990")
+    >>> c.radius, c.adhesion_line_force, c.zeta_hertz, c.zeta_adhesion
+    (3.45e-06, 7.422, 0.5, 29.0)
+    """
     try:
         return PRESETS[name.lower()]
     except KeyError:
@@ -44,6 +51,14 @@ def named_contact(spec: str | Mapping) -> tuple[Contact, str]:
     -------
     (Contact, str)
         The contact and ``"preset: <name>"`` or ``"config"``.
+
+    Examples
+    --------
+    >>> named_contact("wall1990")[1]
+    'preset: wall1990'
+    >>> c, source = named_contact({"radius": 2e-6, "density": 1350.0, "stiffness": 1.776e9, "adhesion_line_force": 7.0})
+    >>> source, c.radius
+    ('config', 2e-06)
     """
     if isinstance(spec, str):
         return get_preset(spec), preset_parameter_source(spec.lower())

@@ -216,6 +216,18 @@ class Contact:
         the friction coefficient is negative; or if the values are so extreme together that a
         derived scale (mass, X, T, the solvers' impulse and energy units) under- or overflows the
         floating-point range. The message names the fields and the values.
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (1)-(15) and Table 1.
+
+    Examples
+    --------
+    The paper's microsphere (Table 1 row 2): m = 4/3 pi r^3 rho, and the paper's laws by default:
+
+    >>> c = Contact(radius=3.45e-6, density=1350.0, stiffness=1.776e9, adhesion_line_force=7.422)
+    >>> f"{c.mass:.4e} kg", c.normal_model, c.tangential_model
+    ('2.3221e-13 kg', 'ring', 'rigid')
     """
 
     radius: float

@@ -111,7 +111,15 @@ class DemTangentialError(SolverError):
 
 
 def uses_dem_tangential(contact) -> bool:
-    """Whether ``contact`` selects a DEM tangential law (:data:`~microimpact.model.dem_tangential.DEM_TANGENTIAL_MODELS`)."""
+    """Whether ``contact`` selects a DEM tangential law (:data:`~microimpact.model.dem_tangential.DEM_TANGENTIAL_MODELS`).
+
+    Examples
+    --------
+    >>> from microimpact.model.contact import Contact
+    >>> c = Contact(1e-6, 2000.0, 1e9, 0.0)
+    >>> uses_dem_tangential(c), uses_dem_tangential(c.with_(tangential_model="lammps_mindlin", shear_modulus=3e8))
+    (False, True)
+    """
     return contact.tangential_model in DEM_TANGENTIAL_MODELS
 
 
