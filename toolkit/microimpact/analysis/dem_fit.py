@@ -827,7 +827,6 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
 
     from microimpact.analysis.oblique import fit_dem_friction
     from microimpact.model.dem_damping import critical_damping_coefficient
-    from microimpact.solvers.impact import simulate_impact
 
     rng = np.random.default_rng(seed)
     rows = []
@@ -852,19 +851,10 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
         noise_t, noise_n = float(10 ** rng.uniform(-2.3, -1.3)), float(10 ** rng.uniform(-2.3, -1.3))
         tangential = {"friction": mu, "tangential_model": law, **stiffness}
         truth = dem_law_contact(mat, 1e-6, normal, damping, coef).with_(**tangential)
-        results = [simulate_impact(truth, v, a, rtol=rtol) for v, a in zip(speeds, angles)]
-        keep = np.array([r.outcome == "rebound" for r in results])
-        if keep.sum() < 3:
+        table = _measured_rebounds(truth, speeds, angles, noise_n, noise_t, rng, rtol)
+        if len(table) < 3:
             continue
-        results = [r for r, k in zip(results, keep) if k]
-        speeds, angles, n = speeds[keep], angles[keep], int(keep.sum())
-        vn = speeds * np.cos(np.radians(angles))
-        e_n = np.array([abs(r.velocity_out[0]) for r in results]) / vn
-        e_t = np.array([r.velocity_out[1] for r in results]) / (speeds * np.sin(np.radians(angles)))
-        table = pd.DataFrame({"radius": 1e-6, "speed": speeds, "incidence_deg": angles, "normal_speed": vn,
-                              "e_n": e_n + rng.normal(0, noise_n, n), "e_n_uncertainty": noise_n,
-                              "tangential_restitution": e_t + rng.normal(0, noise_t, n),
-                              "tangential_restitution_uncertainty": noise_t})
+        n = len(table)
         normal_fit = fit_dem_law(table, mat, normal, damping, fit_adhesion=fit_adhesion, rtol=rtol)
         row = {"normal_law": f"{normal}+{damping}", "tangential_model": law, "coefficient": coef,
                "coefficient_fitted": normal_fit.best, "normal_status": normal_fit.status, "mu": mu, "n": n,
@@ -880,3 +870,25 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
                     "covered": bool(st.lower <= mu <= st.upper)}
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def _measured_rebounds(truth, speeds, angles, noise_n, noise_t, rng, rtol):
+    """The rebounds of ``truth`` as an impact table with Gaussian noise of the stated sigma on e_n
+    and e_t (captures left out: nothing rebounds to be measured)."""
+    import pandas as pd
+
+    from microimpact.solvers.impact import simulate_impact
+
+    results = [simulate_impact(truth, v, a, rtol=rtol) for v, a in zip(speeds, angles)]
+    keep = np.array([r.outcome == "rebound" for r in results])
+    results = [r for r, k in zip(results, keep) if k]
+    speeds, angles, n = speeds[keep], angles[keep], int(keep.sum())
+    vn = speeds * np.cos(np.radians(angles))
+    e_n = np.array([abs(r.velocity_out[0]) for r in results]) / vn
+    e_t = np.array([r.velocity_out[1] for r in results]) / (speeds * np.sin(np.radians(angles)))
+    if n < 3:  # no noise drawn: the caller skips the design (as the study always has)
+        return pd.DataFrame({"speed": speeds})
+    return pd.DataFrame({"radius": truth.radius, "speed": speeds, "incidence_deg": angles, "normal_speed": vn,
+                         "e_n": e_n + rng.normal(0, noise_n, n), "e_n_uncertainty": noise_n,
+                         "tangential_restitution": e_t + rng.normal(0, noise_t, n),
+                         "tangential_restitution_uncertainty": noise_t})
