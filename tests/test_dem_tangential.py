@@ -397,6 +397,11 @@ def test_the_normal_laws_uncertainty_reaches_mu():
     assert st.upper - fit.friction == pytest.approx(math.hypot(st0.upper - fit.friction, 1.959964 * added), rel=1e-6, abs=0)
     assert fit.info["normal_propagated"] == "coefficient" and "uncertainty of the normal law included" in fit.report()
     assert "held at its values" in held.report()
+    # with a fitted work of adhesion the interval undercovers (docs/guide/lammps.md): the report says so
+    from dataclasses import replace
+
+    both = replace(fit, info=fit.info | {"normal_propagated": "coefficient, work_of_adhesion"})
+    assert "less often than 95 %" in both.report() and "less often" not in fit.report()
 
 
 def test_a_normal_fit_of_another_law_or_without_an_interval_is_refused():
