@@ -398,10 +398,15 @@ class FrictionFit(ReportHTML):
         return estimates_repr("FrictionFit", self.values, self.stderr, tangential_model=self.tangential_model,
                               n_points=int(self.n_points))
 
+    @property
+    def _held_normal_law(self) -> bool:
+        """A DEM law's mu at a given normal law (fit_dem_friction without normal_fit): nothing propagated."""
+        return self.tangential_model in DEM_TANGENTIAL_MODELS and not self.info.get("normal_propagated")
+
     def report(self) -> str:
         """Plain-text summary: a value with its interval only where the data determine it."""
         dem = self.tangential_model in DEM_TANGENTIAL_MODELS
-        held = dem and not self.info.get("normal_propagated")  # fit_dem_friction without normal_fit
+        held = self._held_normal_law
         lines = [f"Friction fit (LAMMPS's {self.tangential_model} tangential law), the normal law "
                  + ("held at its values" if held else "fitted before (its uncertainty included)")
                  if dem else f"Friction fit ({self.tangential_model} tangential model, Eqs. (16)-(20)), after the damping fit"]
@@ -438,10 +443,9 @@ class FrictionFit(ReportHTML):
 
         for st in self.identifiability.values():
             ds.update(status_variables(st, "1"))
+        dem, held = self.tangential_model in DEM_TANGENTIAL_MODELS, self._held_normal_law
         for k, v in self.values.items():
             ds[k] = xr.DataArray(v, attrs={"units": "1", "long_name": f"fitted {k} ({self.tangential_model} tangential model)"})
-            dem = self.tangential_model in DEM_TANGENTIAL_MODELS
-            held = dem and not self.info.get("normal_propagated")  # fit_dem_friction without normal_fit
             ds[f"{k}_stderr"] = xr.DataArray(self.stderr[k], attrs={
                 "units": "1", "long_name": f"standard error of {k}, " + (
                     "at the given normal law" if held else
