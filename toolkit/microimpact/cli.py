@@ -29,6 +29,7 @@ from microimpact.io.paths import (PathError, check_input_file, check_output_dir,
                                   reporting_os_errors, same_file)
 from microimpact.model.contact import SUB_MODELS, Contact
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
+from microimpact.model.dem_twisting import DEM_TWISTING_MODELS
 from microimpact.model.parameters import TABLE2_CASES
 from microimpact.presets import PRESETS, get_preset
 from microimpact.solvers import DEFAULT_RTOL, METHODS, TimeBudgetExceeded
@@ -652,6 +653,11 @@ def _lammps_tangential_fields(args, law: str) -> dict:
     if args.rolling_stiffness is not None:  # LAMMPS's rolling sds, held at the given values while mu is fitted
         fields_ |= {"rolling_model": "lammps_sds", "rolling_stiffness": args.rolling_stiffness,
                     "rolling_damping": args.rolling_damping, "rolling_friction": args.rolling_friction}
+    if args.twisting_model is not None:  # LAMMPS's twisting law: no effect on e_n, e_t; written with mu
+        fields_["twisting_model"] = args.twisting_model
+        if args.twisting_model == "lammps_sds":
+            fields_ |= {"twisting_stiffness": args.twisting_stiffness, "twisting_damping": args.twisting_damping,
+                        "twisting_friction": args.twisting_friction}
     other = "--shear-modulus" if law == "linear_history" else "--tangential-stiffness"
     if args.tangential_model != AUTO_TANGENTIAL and (args.shear_modulus if other == "--shear-modulus"
                                                      else args.tangential_stiffness) is not None:
@@ -728,13 +734,20 @@ def _cmd_lammps_fit(args) -> int:
     if args.tangential_model is None:
         given = [o for o, v in (("--tangential-stiffness", args.tangential_stiffness), ("--shear-modulus", args.shear_modulus),
                                 ("--tangential-damping", args.tangential_damping or None),
-                                ("--rolling-stiffness", args.rolling_stiffness)) if v is not None]
+                                ("--rolling-stiffness", args.rolling_stiffness),
+                                ("--twisting-model", args.twisting_model)) if v is not None]
         if given:
             raise UsageError(f"{', '.join(given)} belong to a tangential law: give --tangential-model too")
     else:
         _lammps_tangential_laws(args)  # a missing stiffness is refused before the fits run
     if args.rolling_stiffness is None and (args.rolling_damping or args.rolling_friction):
         raise UsageError("--rolling-damping and --rolling-friction belong to LAMMPS's rolling sds: give --rolling-stiffness too")
+    sds_twist = [o for o, v in (("--twisting-stiffness", args.twisting_stiffness), ("--twisting-damping", args.twisting_damping),
+                                ("--twisting-friction", args.twisting_friction)) if v]
+    if args.twisting_model == "lammps_sds" and args.twisting_stiffness is None:
+        raise UsageError("--twisting-model lammps_sds needs --twisting-stiffness (k_twist [N m/rad])")
+    if args.twisting_model != "lammps_sds" and sds_twist:
+        raise UsageError(f"{', '.join(sds_twist)} belong to --twisting-model lammps_sds")
     if args.fit_adhesion and args.law and args.law[0] == "hertz":
         raise UsageError(f"--fit-adhesion: the law {'+'.join(args.law)} has no work of adhesion to fit; give a "
                          "jkr_force or dmt law, or no --law")
@@ -899,6 +912,17 @@ def register_lammps(sub) -> None:
                    help="gamma_roll of rolling sds [N s/m] (default 0)")
     f.add_argument("--rolling-friction", type=_non_negative_float, default=0.0, metavar="X",
                    help="mu_roll of rolling sds (default 0)")
+    f.add_argument("--twisting-model", choices=tuple(DEM_TWISTING_MODELS), default=None,
+                   help="LAMMPS's twisting law written with the tangential law (it does not change e_n or e_t, so "
+                        "it is not fitted): lammps_marshall from the tangential law, or lammps_sds with "
+                        "--twisting-stiffness k_twist [N m/rad], --twisting-damping gamma_twist [N m s/rad] and "
+                        "--twisting-friction mu_twist [m]")
+    f.add_argument("--twisting-stiffness", type=_positive_float, default=None, metavar="SI",
+                   help="k_twist of twisting sds [N m/rad]")
+    f.add_argument("--twisting-damping", type=_non_negative_float, default=0.0, metavar="SI",
+                   help="gamma_twist of twisting sds [N m s/rad] (default 0)")
+    f.add_argument("--twisting-friction", type=_non_negative_float, default=0.0, metavar="SI",
+                   help="mu_twist of twisting sds, a length [m] (default 0)")
     f.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")
     _add_rtol(f)
     f.add_argument("--out", required=True, help="output LAMMPS input file")

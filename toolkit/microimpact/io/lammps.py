@@ -20,6 +20,9 @@ no friction (f = 0)                    ``tangential linear_nohistory 0.0 0.0``
                                        (:mod:`microimpact.model.dem_tangential`)
 ``rolling_model="lammps_sds"``         ``rolling sds k_roll gamma_roll mu_roll``
                                        (:mod:`microimpact.model.dem_rolling`)
+``twisting_model="lammps_sds"``        ``twisting sds k_twist gamma_twist mu_twist``
+``twisting_model="lammps_marshall"``   ``twisting marshall`` (:mod:`microimpact.model.dem_twisting`;
+                                       not written without friction, where it has no effect)
 =====================================  ==========================================================
 
 Conversions. LAMMPS mixes the wall's modulus with the particle's as for two particles of the same
@@ -70,6 +73,7 @@ from dataclasses import dataclass, fields
 from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import restitution_of_damping_factor, tsuji_damping_factor
 from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
+from microimpact.model.dem_twisting import DEM_TWISTING_MODELS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 
 __all__ = ["LAMMPS_UNITS", "DEFAULT_POISSON", "LammpsExportError", "LammpsWallModel", "lammps_wall_model",
@@ -132,6 +136,11 @@ class LammpsWallModel:
     rolling_stiffness, rolling_damping, rolling_friction : float
         k_roll [N/m], gamma_roll [N s/m] and mu_roll [-] of ``rolling sds``
         (:mod:`microimpact.model.dem_rolling`); ``rolling_stiffness`` 0: no rolling law written.
+    twisting : str
+        LAMMPS's twisting keyword: ``"none"`` (nothing written), ``"sds"`` or ``"marshall"``
+        (:mod:`microimpact.model.dem_twisting`).
+    twisting_stiffness, twisting_damping, twisting_friction : float
+        k_twist [N m/rad], gamma_twist [N m s/rad] and mu_twist [m] of ``twisting sds``.
     """
 
     normal: str
@@ -147,6 +156,10 @@ class LammpsWallModel:
     rolling_stiffness: float = 0.0
     rolling_damping: float = 0.0
     rolling_friction: float = 0.0
+    twisting: str = "none"
+    twisting_stiffness: float = 0.0
+    twisting_damping: float = 0.0
+    twisting_friction: float = 0.0
 
     def granular_args(self, units: str = "si") -> str:
         """The model arguments after ``granular`` of ``fix wall/gran``, in LAMMPS units ``units``."""
@@ -167,6 +180,12 @@ class LammpsWallModel:
         if self.rolling_stiffness > 0.0:  # k_roll in force / distance, gamma_roll in force time / distance
             args += (f" rolling sds {self.rolling_stiffness / (mass / time**2):.15g} "
                      f"{self.rolling_damping / (mass / time):.15g} {self.rolling_friction:.15g}")
+        if self.twisting == "sds":  # k_twist a torque (energy), gamma_twist energy time, mu_twist a distance
+            energy = mass * length**2 / time**2
+            args += (f" twisting sds {self.twisting_stiffness / energy:.15g} "
+                     f"{self.twisting_damping / (energy * time):.15g} {self.twisting_friction / length:.15g}")
+        elif self.twisting == "marshall":
+            args += " twisting marshall"
         return args
 
 
@@ -249,8 +268,14 @@ def lammps_wall_model(contact: Contact, poisson: float = DEFAULT_POISSON) -> Lam
         stiffness = contact.tangential_stiffness if tangential == "linear_history" else 8.0 * contact.shear_modulus
     rolling = (contact.rolling_stiffness, contact.rolling_damping, contact.rolling_friction) \
         if contact.rolling_model in DEM_ROLLING_MODELS else (0.0, 0.0, 0.0)
+    twisting = DEM_TWISTING_MODELS.get(contact.twisting_model, "none")
+    if twisting == "marshall" and contact.friction == 0.0:  # its limit 2 a mu / 3 is 0: no torque
+        twisting = "none"
+    twisting_sds = (contact.twisting_stiffness, contact.twisting_damping, contact.twisting_friction) \
+        if twisting == "sds" else (0.0, 0.0, 0.0)
     return LammpsWallModel(normal, youngs, float(poisson), gamma, damping, tangential, damping_model, stiffness,
-                           contact.tangential_damping if contact.friction > 0.0 else 0.0, contact.friction, *rolling)
+                           contact.tangential_damping if contact.friction > 0.0 else 0.0, contact.friction, *rolling,
+                           twisting, *twisting_sds)
 
 
 def lammps_expressible(contact: Contact, poisson: float = DEFAULT_POISSON) -> Contact:
@@ -293,7 +318,8 @@ def lammps_expressible(contact: Contact, poisson: float = DEFAULT_POISSON) -> Co
     """
     from microimpact.model.tangential_compliance import effective_shear_modulus, shear_modulus_from_elastic
 
-    friction = {"friction": 0.0, "tangential_model": "rigid", "shear_modulus": None}
+    friction = {"friction": 0.0, "tangential_model": "rigid", "shear_modulus": None, "twisting_model": "none",
+                "twisting_stiffness": None, "twisting_damping": 0.0, "twisting_friction": 0.0}
     if contact.friction > 0.0:
         shear = contact.shear_modulus
         if shear is None:
@@ -376,6 +402,12 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
     if model.rolling_stiffness > 0.0:
         lines.append(f"# rolling sds: k_roll = {model.rolling_stiffness:.10g} N/m, gamma_roll = "
                      f"{model.rolling_damping:.10g} N s/m, mu_roll = {model.rolling_friction:g}")
+    if model.twisting == "sds":
+        lines.append(f"# twisting sds: k_twist = {model.twisting_stiffness:.10g} N m/rad, gamma_twist = "
+                     f"{model.twisting_damping:.10g} N m s/rad, mu_twist = {model.twisting_friction:.10g} m")
+    elif model.twisting == "marshall":
+        lines.append("# twisting marshall: k_twist = k_t a^2 / 2, gamma_twist = eta_t a^2 / 2, mu_twist = 2 a mu / 3 "
+                     "(from the tangential law)")
     if contact.damping_model == "tsuji":
         lines.append(f"# damping tsuji e = {contact.damping_coefficient:g} (with the sqrt(2) of LAMMPS's development source) "
                      f"is written as the identical law coeff_restitution e = {model.damping:.10g}")

@@ -25,6 +25,7 @@ from functools import cached_property
 import numpy as np
 
 from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
+from microimpact.model.dem_twisting import DEM_TWISTING_MODELS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 
 __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_representable"]
@@ -38,13 +39,16 @@ __all__ = ["Contact", "PAPER_REFERENCE", "SUB_MODELS", "check_positive", "check_
 #: "linear_history" and the "lammps_mindlin*" variants LAMMPS GRANULAR's history laws (model.dem_tangential);
 #: "net" is the paper's Coulomb limit f |F_n|, "pulloff" an adhesion-aware limit that does not vanish
 #: at the adhesive equilibrium; "torque" is the constant rolling torque mu_r r |F_n| (with
-#: rolling_friction > 0), "lammps_sds" LAMMPS GRANULAR's rolling spring-dashpot-slider (model.dem_rolling).
+#: rolling_friction > 0), "lammps_sds" LAMMPS GRANULAR's rolling spring-dashpot-slider (model.dem_rolling);
+#: "none" leaves the spin about the normal to the tangential law (the paper's twist torque, or none with
+#: LAMMPS's laws), "lammps_sds" and "lammps_marshall" are LAMMPS GRANULAR's twisting laws (model.dem_twisting).
 SUB_MODELS: dict[str, tuple[str, ...]] = {
     "normal_model": ("ring", "jkr", "dmt", "jkr_force"),
     "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", *DEM_TANGENTIAL_MODELS),
     "friction_model": ("net", "pulloff"),
     "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
     "rolling_model": ("torque", *DEM_ROLLING_MODELS),
+    "twisting_model": ("none", *DEM_TWISTING_MODELS),
 }
 
 #: full citation of the paper, for the ``references`` attribute of the toolkit's results
@@ -128,7 +132,8 @@ def _check_poisson(name: str, value: float) -> None:
 
 
 #: fields that may be None (not given)
-_OPTIONAL = ("damping_reference_speed", "shear_modulus", "tangential_stiffness", "rolling_stiffness")
+_OPTIONAL = ("damping_reference_speed", "shear_modulus", "tangential_stiffness", "rolling_stiffness",
+             "twisting_stiffness")
 
 
 def _sub_model(name: str, value) -> str:
@@ -205,6 +210,18 @@ class Contact:
         k_roll of "lammps_sds"; None otherwise. [N/m]
     rolling_damping : float
         gamma_roll of "lammps_sds"; 0 by default. [N s/m]
+    twisting_model : {"none", "lammps_sds", "lammps_marshall"}
+        Twisting resistance with a DEM tangential law: "none" (default; LAMMPS's default too: the
+        spin about the normal is kept), LAMMPS's ``twisting sds k_twist gamma_twist mu_twist`` or
+        ``twisting marshall`` (coefficients from the tangential law, Marshall 2009;
+        :mod:`microimpact.model.dem_twisting`). [-]
+    twisting_stiffness : float or None
+        k_twist of "lammps_sds"; None otherwise. [N m/rad]
+    twisting_damping : float
+        gamma_twist of "lammps_sds"; 0 by default. [N m s/rad]
+    twisting_friction : float
+        mu_twist of "lammps_sds", a length: the limit of the twisting torque is mu_twist F_n0; 0 by
+        default. [m]
 
     Raises
     ------
@@ -250,6 +267,10 @@ class Contact:
     rolling_model: str = "torque"
     rolling_stiffness: float | None = None
     rolling_damping: float = 0.0
+    twisting_model: str = "none"
+    twisting_stiffness: float | None = None
+    twisting_damping: float = 0.0
+    twisting_friction: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -263,7 +284,8 @@ class Contact:
         for name in ("radius", "density", "stiffness"):
             check_positive(name, getattr(self, name))
         for name in ("adhesion_line_force", "zeta_hertz", "zeta_adhesion", "friction", "rolling_friction",
-                     "damping_coefficient", "tangential_damping", "rolling_damping"):
+                     "damping_coefficient", "tangential_damping", "rolling_damping", "twisting_damping",
+                     "twisting_friction"):
             _check_non_negative(name, getattr(self, name))
         for name in _OPTIONAL:
             if getattr(self, name) is not None:
@@ -273,6 +295,7 @@ class Contact:
                              "(the effective shear modulus G* [Pa])")
         self._check_dem_tangential()
         self._check_dem_rolling()
+        self._check_dem_twisting()
         self._check_damping_model()
         self._check_scales()
 
@@ -314,6 +337,21 @@ class Contact:
                              f"got rolling_model={self.rolling_model!r}")
         if sds and self.tangential_model not in DEM_TANGENTIAL_MODELS:
             raise ValueError(f"rolling_model={self.rolling_model!r} is LAMMPS's law and runs with its tangential laws "
+                             f"({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}), got tangential_model={self.tangential_model!r}")
+
+    def _check_dem_twisting(self) -> None:
+        """LAMMPS's twisting laws with their own parameters and a DEM tangential law (model.dem_twisting)."""
+        model = self.twisting_model
+        sds = model == "lammps_sds"
+        if sds != (self.twisting_stiffness is not None):
+            raise ValueError("twisting_stiffness (k_twist [N m/rad]) belongs to twisting_model='lammps_sds', and that "
+                             f"law needs it: got twisting_model={model!r}, twisting_stiffness={self.twisting_stiffness!r}")
+        for name in ("twisting_damping", "twisting_friction"):
+            if getattr(self, name) != 0.0 and not sds:
+                raise ValueError(f"{name}={getattr(self, name)!r} belongs to twisting_model='lammps_sds', "
+                                 f"got twisting_model={model!r}")
+        if model != "none" and self.tangential_model not in DEM_TANGENTIAL_MODELS:
+            raise ValueError(f"twisting_model={model!r} is LAMMPS's law and runs with its tangential laws "
                              f"({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}), got tangential_model={self.tangential_model!r}")
 
     def _check_damping_model(self) -> None:

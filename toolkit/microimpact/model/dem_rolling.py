@@ -29,8 +29,8 @@ a constant torque mu_r R |F_n| against the rolling, Zhou et al. 1999): the SDS t
 the rolling displacement (spring) and rate (dashpot) and reaches mu_roll F_n0 R only when the spring
 slides, so small or short rolling is resisted less, and its limit is LAMMPS's F_n0, not |F_n|.
 
-The velocity uses Wang et al. (2015), Eq. (31), as LAMMPS does; twisting (LAMMPS ``twisting``) is
-not modelled: the spin about the normal is unchanged.
+The velocity uses Wang et al. (2015), Eq. (31), as LAMMPS does; the spin about the normal enters
+neither it nor the slip (twisting: :mod:`microimpact.model.dem_twisting`).
 
 References
 ----------

@@ -57,8 +57,9 @@ limit (the trial force would move inside the limit). This is LAMMPS's return map
 goes to zero; its first-order convergence to it is tested (tests/test_dem_tangential.py).
 
 Rolling resistance is LAMMPS's ``rolling sds`` (:mod:`microimpact.model.dem_rolling`,
-``Contact.rolling_model="lammps_sds"``). Twisting (LAMMPS ``twisting``) is not modelled: the spin
-about the normal is unchanged, as with LAMMPS's default ``twisting none``.
+``Contact.rolling_model="lammps_sds"``), twisting LAMMPS's ``twisting sds`` or ``marshall``
+(:mod:`microimpact.model.dem_twisting`, ``Contact.twisting_model``); without it the spin about the
+normal is unchanged, as with LAMMPS's default ``twisting none``.
 
 References
 ----------

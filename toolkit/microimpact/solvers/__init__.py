@@ -26,6 +26,7 @@ import time
 from dataclasses import dataclass
 
 from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
+from microimpact.model.dem_twisting import DEM_TWISTING_MODELS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 
 #: The one default relative tolerance of every entry point (API, CLI, pipeline config ``rtol``).
@@ -189,12 +190,12 @@ SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
                "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", *DEM_TANGENTIAL_MODELS),
                "friction_model": ("net", "pulloff"),
                "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
-               "rolling_model": ("torque", *DEM_ROLLING_MODELS)},
+               "rolling_model": ("torque", *DEM_ROLLING_MODELS), "twisting_model": ("none", *DEM_TWISTING_MODELS)},
     "reference": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"), "tangential_model": ("rigid",), "friction_model": ("net",),
                   "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
-                  "rolling_model": ("torque",)},
+                  "rolling_model": ("torque",), "twisting_model": ("none",)},
     "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",),
-            "damping_model": ("paper",), "rolling_model": ("torque",)},
+            "damping_model": ("paper",), "rolling_model": ("torque",), "twisting_model": ("none",)},
 }
 #: solver paths that model rolling resistance (Contact.rolling_friction > 0): the engine's coupled
 #: solver (.coupled), with a compliant tangential model (ROLLING_RESISTANCE_TANGENTIAL_MODELS)

@@ -25,6 +25,12 @@ w = R omega x n_w; its state (history or direction, and w) follows the slip's in
 and the slip feels its torque: du/dt = kappa F / m - (kappa - 1) F_r / m, dw/dt = (kappa - 1)
 (F_r - F) / m. Each spring sticks and slides on its own, with its own events.
 
+With LAMMPS's twisting law (:mod:`microimpact.model.dem_twisting`) the spin about the normal has a
+spring of its own, scalar, on the twist rate Omega: it feels neither the slip nor the rolling, nor
+they it, so it is integrated on its own with the normal law (``_twist``): state (xi, Omega) in
+stick, Omega in slide (torque -mu_twist F_n0 sgn(Omega)); events where |M| reaches the limit, where
+the sliding trial torque turns inside it, and where the sliding twist stops (Omega = 0).
+
 Without rolling resistance the tangential problem is one-dimensional: the wall is isotropic, the
 history starts at 0 and the force acts on the slip alone, so xi, u and F stay on the line of the
 initial slip u_in. (So does it with the rolling law where w_in is parallel to u_in: spin about t'
@@ -79,6 +85,7 @@ import numpy as np
 
 from microimpact.model import adhesion_models as am
 from microimpact.model.dem_rolling import DEM_ROLLING_MODELS, lammps_rolling_velocity
+from microimpact.model.dem_twisting import DEM_TWISTING_MODELS, lammps_marshall_twisting_coefficients
 from microimpact.model.dem_tangential import (DEM_TANGENTIAL_MODELS, FORCE_HISTORY_MODELS, lammps_critical_normal_force,
                                               lammps_critical_normal_force_rate, lammps_elastic_force,
                                               lammps_pulloff_force, lammps_history_of_force, lammps_history_rate,
@@ -583,10 +590,20 @@ def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict
     """
     from microimpact.solvers.normal_models import solve_normal
 
+    normal = solve_normal(contact, -float(velocity_in[0]), rtol=rtol)
+    result = _slip(contact, normal, velocity_in, omega_in, rtol)
+    if contact.twisting_model in DEM_TWISTING_MODELS:
+        twist, twist_switches = _twist(contact, normal, float(velocity_in[0]), float(omega_in[0]), rtol)
+        result["omega_out"] = (twist, *result["omega_out"][1:])
+        result["twist_switches"] = twist_switches
+    return result
+
+
+def _slip(contact, normal, velocity_in, omega_in, rtol):
+    """``solve_dem_tangential`` without the twisting law: the slip (and the rolling) of one impact."""
     m, inertia, r = contact.mass, contact.moment_of_inertia, contact.radius
     v_n, v_t, v_tp = (float(v) for v in velocity_in)
     w_n, w_t, w_tp = (float(w) for w in omega_in)
-    normal = solve_normal(contact, -v_n, rtol=rtol)
     slip = (v_t + r * w_tp, v_tp - r * w_t)
     kappa = 1.0 / m + r * r / inertia
     switches, slip_ended, slip_end_time = 0, False, math.nan
@@ -676,8 +693,8 @@ def _with_rolling(contact, normal, velocity_in, omega_in, rtol):
         # rolling law with mu_roll 1e-12 beside friction 0.3 moved nothing, but made a 2-D solve fail)
         most = 2.0 * law.spin * law.mu_r * (z_scale**6 / 6.0 + 3.0 if law.jkr else z_scale**3 + 2.0 * law.pulloff) * tau_scale
         if most <= tol * max(math.hypot(*u0), math.hypot(*w0), law.y0):
-            return solve_dem_tangential(contact.with_(rolling_model="torque", rolling_stiffness=None, rolling_friction=0.0,
-                                                      rolling_damping=0.0), velocity_in, omega_in, rtol=rtol)
+            return _slip(contact.with_(rolling_model="torque", rolling_stiffness=None, rolling_friction=0.0,
+                                       rolling_damping=0.0), normal, velocity_in, omega_in, rtol)
         if w0[1] != 0.0:
             # rolling across the slip: the directions of both forces turn, at rates |G'| / (mu F_n0) that
             # made DOP853 take millions of steps where a limit is small; Radau (implicit) follows them
@@ -700,3 +717,143 @@ def _with_rolling(contact, normal, velocity_in, omega_in, rtol):
         "tangential_impulse": (float(impulse[0]), float(impulse[1])),
         "switches": switches,
     }
+
+
+class _Twist:
+    """LAMMPS's twisting law of one impact (model.dem_twisting) in the normal law's units: torque
+    unit F L, twist rate unit 1 / T; ``gain`` turns a torque into d Omega / d tau (F L T^2 / I)."""
+
+    def __init__(self, contact, law):
+        sc = law.scales
+        force, length, time = float(sc.force), float(sc.length), float(sc.time)
+        torque = force * length
+        self.law = law
+        self.gain = torque * time * time / contact.moment_of_inertia
+        self.sds = contact.twisting_model == "lammps_sds"
+        if self.sds:
+            self.k = contact.twisting_stiffness / torque
+            self.gamma = contact.twisting_damping / (torque * time)
+            self.mu = contact.twisting_friction / length  # the limit mu_twist F_n0 in F L
+        else:  # Marshall: the coefficients at a = 1 law unit of radius, scaled by a^2, a^2, a below
+            a_unit = law.a_unit
+            k1, g1, m1 = lammps_marshall_twisting_coefficients(a_unit, law.k_param, 1.0, law.mu)
+            self.k = float(k1) / torque
+            self.gamma = float(g1) * force / (float(sc.speed) * torque * time)  # per unit eta_t in F / (L / T)
+            self.mu = float(m1) / length
+
+    def coefficients(self, z, y):
+        """(g, dz, dy, k, dk, gamma, dgamma, limit, dlimit), d/dsigma, at the normal state (z, y)."""
+        law = self.law
+        g, dz, a, da, eta, deta, dy, n0, dn0 = law.normal(z, y)
+        if self.sds:
+            return g, dz, dy, self.k, 0.0, self.gamma, 0.0, self.mu * n0, self.mu * dn0
+        # k ~ a^2, gamma ~ eta_t a^2 (eta_t = x_t eta), limit ~ a F_n0 (lammps_marshall_twisting_coefficients)
+        eta_t, deta_t = law.x_t * eta, law.x_t * deta
+        return (g, dz, dy, self.k * a * a, 2.0 * self.k * a * da, self.gamma * eta_t * a * a,
+                self.gamma * (deta_t * a * a + 2.0 * eta_t * a * da), self.mu * a * n0, self.mu * (da * n0 + a * dn0))
+
+
+def _twist_rates(twist, x, mode, sign):
+    """(d/dsigma of [z, y, tau, xi, Omega], the switch function of ``mode``) at x.
+
+    Stick: torque -k xi - gamma Omega, switch (|M| - limit) / (|M| + limit), leaving upwards. Slide:
+    torque -limit sgn(Omega) (``sign``), switch the rate of the trial torque's size (its history at
+    the reset value) less that of the limit, leaving downwards (the trial torque turns inside)."""
+    g, dz, dy, k, dk, gamma, dgamma, limit, dlimit = twist.coefficients(x[0], x[1])
+    w = x[4]
+    out = np.empty(5)
+    out[0], out[1], out[2] = dz, dy, g
+    if mode == _STICK:
+        torque = -k * x[3] - gamma * w
+        out[3], out[4] = g * w, g * twist.gain * torque
+        size = abs(torque) + limit
+        return out, ((abs(torque) - limit) / size if size > 0.0 else -1.0)
+    torque = -limit * sign
+    out[3], out[4] = 0.0, g * twist.gain * torque
+    if k <= 0.0:  # a = 0 (Marshall at a Hertz touch): no spring to stick with
+        return out, 1.0
+    xi = (limit * sign - gamma * w) / k
+    trial_rate = -(dk * xi + k * g * w) - (dgamma * w + gamma * out[4])
+    return out, -sign * trial_rate - dlimit
+
+
+def _twist(contact, normal, v_n, omega_n, rtol):
+    """(spin about the normal after the impact [rad/s], twisting stick-slip switches) of LAMMPS's
+    twisting law (model.dem_twisting), integrated with the normal law in its Sundman variable.
+
+    The sliding twist may stop (Omega = 0) while the limit falls faster than the dashpot can hold the
+    spring at it: LAMMPS's torque -mu_twist F_n0 sgn(Omega) then chatters about Omega = 0 at its step,
+    and its limit as the step falls is Omega = 0 with zero mean torque, which stays so (a spring at
+    rest, xi = 0, Omega = 0, is a solution of the stuck law). That is the outcome here. A captured
+    sphere ends with Omega = 0 where the limit at rest is > 0 (its stuck elastic vibration averages
+    to zero), as the slip does."""
+    from scipy.integrate import solve_ivp
+
+    if omega_n == 0.0:
+        return 0.0, 0
+    law, unit, tau_scale, z_scale = _impact_law(contact, normal, v_n)
+    twist = _Twist(contact, law)
+    limit_at_rest = twist.mu > 0.0 and (twist.sds or law.mu > 0.0)
+    if normal.outcome == "capture":
+        return (0.0 if limit_at_rest else omega_n), 0
+    time = float(law.scales.time)
+    w0 = omega_n * time
+    tol = min(rtol, TANGENTIAL_RTOL)
+    x = np.array([am.JKR_Q_FORMATION if law.jkr else 0.0, law.y0, 0.0, 0.0, w0])
+    # stick or slide from touch: compared a short way in (as _start_mode), xi = Omega tau
+    probe = x.copy()
+    sigma_probe = 1e-6
+    if law.jkr:
+        probe[0], probe[2] = x[0] + x[1] * sigma_probe, 4.0 * (x[0] ** 3 - 1.0) * sigma_probe
+    else:
+        probe[0], probe[2] = 0.5 * x[1] * sigma_probe, 0.25 * x[1] * sigma_probe**2
+    probe[3] = w0 * probe[2]
+    mode = _SLIDE if _twist_rates(twist, probe, _STICK, 0.0)[1] > 0.0 else _STICK
+    sign = math.copysign(1.0, w0)
+    sigma, switches = 0.0, 0
+    atol = tol * np.array([z_scale, law.y0, tau_scale, abs(w0) * tau_scale, abs(w0)])
+
+    def rhs(_, state):
+        return _twist_rates(twist, state, mode, sign)[0]
+
+    def separation(_, state):
+        return _separation(law, state)
+
+    def switch(_, state):
+        if _separation(law, state) <= 0.0:
+            return -1.0 if mode == _STICK else 1.0
+        return _twist_rates(twist, state, mode, sign)[1]
+
+    def stopped(_, state):  # the sliding twist reaches Omega = 0
+        return state[4] * sign if mode == _SLIDE else 1.0
+
+    separation.terminal, separation.direction = True, -1.0
+    switch.terminal = stopped.terminal = True
+    stopped.direction = -1.0
+    while True:
+        switch.direction = 1.0 if mode == _STICK else -1.0
+        sol = solve_ivp(rhs, (sigma, sigma + _SIGMA_SPAN), x, method="DOP853", rtol=tol, atol=atol,
+                        events=(separation, switch, stopped))
+        if sol.status != 1:
+            raise DemTangentialError(f"DEM twisting integration stopped: {sol.message}")
+        hits = [(float(t[0]), i) for i, t in enumerate(sol.t_events) if len(t)]
+        t_hit, which = min(hits)
+        x = sol.y_events[which][0].copy()
+        sigma = t_hit
+        if which == 0:
+            return float(x[4]) / time, switches
+        switches += 1
+        if switches > _MAX_EVENTS:
+            raise DemTangentialError(f"DEM twisting integration: more than {_MAX_EVENTS} stick-slip events")
+        if which == 2:
+            # Omega = 0 in slide, the slide's switch function still > 0: it is continuous in Omega and at
+            # Omega = 0 it is the rate at which a stuck spring held at the limit would leave it, so
+            # neither mode holds: the chattering end of the docstring, Omega = 0 from here on
+            return 0.0, switches
+        g, dz, dy, k, dk, gamma, dgamma, limit, dlimit = twist.coefficients(x[0], x[1])
+        if mode == _STICK:  # the torque reaches the limit: slide against the twist rate
+            mode = _SLIDE
+            sign = math.copysign(1.0, x[4]) if x[4] != 0.0 else math.copysign(1.0, -(-k * x[3]))
+        else:  # the trial torque turns inside the limit: stick with the history at the reset value
+            mode = _STICK
+            x[3] = (limit * sign - gamma * x[4]) / k

@@ -447,7 +447,9 @@ def _coupled_impact_result(contact, v_in, w_in, res) -> ImpactResult:
         slip_end_time=float(one["slip_end_time"]), friction_impulse=float(one["friction_impulse"]),
         dissipated_energy=float(one["dissipated_energy"]),
         final_contact_energy=settled_contact_energy(contact) if captured else 0.0,
-        method=(f"engine:dem_tangential ({contact.tangential_model})" if uses_dem_tangential(contact)
+        method=(f"engine:dem_tangential ({contact.tangential_model}"
+                + (f", twisting {contact.twisting_model})" if contact.twisting_model != "none" else ")")
+                if uses_dem_tangential(contact)
                 else f"engine:coupled ({contact.tangential_model}, {contact.friction_model})"),
         stop_reason="separation" if not captured else "capture" if (stops_at_capture(contact) or uses_dem_tangential(contact)) else "settled",
     )

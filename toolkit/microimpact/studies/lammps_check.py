@@ -53,6 +53,9 @@ STICKING_MULTIPLES = (0.1, 0.5, 2.0, 5.0, 10.0)
 NON_ADHESIVE_SPEEDS = (0.01, 0.1, 1.0, 10.0)
 #: a sphere not separated after this many contact times is captured
 CAPTURE_CONTACT_TIMES = 60.0
+#: spin about the wall normal given to each impact of a contact with a twisting law, as
+#: omega_n r / speed (the twist rate compared is omega_n after / before)
+TWIST_SPIN = 0.1
 
 
 class LammpsUnavailable(RuntimeError):
@@ -114,16 +117,19 @@ class LammpsImpact:
         Spin about the axis t' of rolling, positive when the sphere rolls forward. [rad/s]
     steps : int
         LAMMPS steps run.
+    twist_out : float
+        Spin about the wall normal after the impact, of the same sign as the spin given. [rad/s]
     """
 
     outcome: str
     velocity_out: tuple
     omega_out: float
     steps: int
+    twist_out: float = 0.0
 
 
 def lammps_impact(lammps, text: str, contact, units: str, speed: float, incidence_deg: float, timestep: float,
-                  time_limit: float) -> LammpsImpact:
+                  time_limit: float, twist: float = 0.0) -> LammpsImpact:
     """Run one sphere of ``contact`` against the wall of the LAMMPS input ``text``.
 
     Parameters
@@ -142,6 +148,8 @@ def lammps_impact(lammps, text: str, contact, units: str, speed: float, incidenc
         LAMMPS step. [s]
     time_limit : float
         Time after which a sphere still near the wall counts as captured. [s]
+    twist : float
+        Spin about the wall normal before the impact (any sign). [rad/s]
     """
     scale = lammps_scales(units)
     radius = contact.radius / scale["length"]
@@ -170,6 +178,7 @@ create_box 1 box
 create_atoms 1 single 0 0 {radius + 0.5 * v_n * dt} units box
 set atom 1 diameter {2.0 * radius} density {contact.density / scale['density']}
 velocity all set {v_t} 0 {-v_n} units box
+set atom 1 omega 0 0 {twist / scale['angular_speed']}
 """)
         lmp.commands_string(text)
         lmp.commands_string(f"""
@@ -190,7 +199,7 @@ timestep {dt}
                 break
         omega = lmp.numpy.extract_atom("omega")[0]
         return LammpsImpact(outcome, (float(v[2]) * scale["speed"], float(v[0]) * scale["speed"]),
-                            float(omega[1]) * scale["angular_speed"], steps)
+                            float(omega[1]) * scale["angular_speed"], steps, float(omega[2]) * scale["angular_speed"])
     finally:
         lmp.close()
 
@@ -227,8 +236,9 @@ def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, step
     Returns
     -------
     pandas.DataFrame
-        One row per impact: speed, incidence, outcomes, e_n, e_t and the spin ratio
-        omega r / v_t of both, LAMMPS's step error (coarse minus fine run), the disagreement and
+        One row per impact: speed, incidence, outcomes, e_n, e_t, the spin ratio omega r / v_t and,
+        with a twisting law, the twist ratio omega_n after / before (given ``TWIST_SPIN`` speed / r)
+        of both, LAMMPS's step error (coarse minus fine run), the disagreement and
         whether it is within ``tolerance``. ``attrs`` hold the tolerance, the steps, the LAMMPS
         version and ``passed``.
 
@@ -253,7 +263,7 @@ def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, step
             if progress is not None:
                 progress()
     table = pd.DataFrame(rows)
-    quantities = ("e_n", "e_t", "spin")
+    quantities = ("e_n", "e_t", "spin", "twist")
     table["difference"] = np.nanmax(np.abs(np.stack([table[f"{q}_lammps"] - table[f"{q}_microimpact"]
                                                      for q in quantities])), axis=0)
     table["step_error"] = np.nanmax(np.abs(np.stack([table[f"{q}_lammps"] - table[f"{q}_lammps_coarse"]
@@ -277,11 +287,16 @@ def _ratios(v_n_out, v_t_out, omega, speed, angle, radius):
 
 
 def _compare(lammps, text, contact, units, speed, angle, steps, simulate_impact) -> dict:
-    result = simulate_impact(contact, speed, angle)
+    from microimpact.io.lammps import lammps_wall_model
+
+    twisting = lammps_wall_model(contact).twisting != "none"
+    twist = TWIST_SPIN * speed / contact.radius if twisting else 0.0
+    result = simulate_impact(contact, speed, angle, omega=(twist, 0.0, 0.0))
     v_n = speed * math.cos(math.radians(angle))
     t_c = result.contact_time if math.isfinite(result.contact_time) else hertz_contact_time(contact, v_n)
     limit = CAPTURE_CONTACT_TIMES * max(t_c, hertz_contact_time(contact, v_n))
-    runs = [lammps_impact(lammps, text, contact, units, speed, angle, t_c / n, limit) for n in (steps, 2 * steps)]
+    # LAMMPS's z is the wall's normal out of the wall, microimpact's n points into it: omega_z = -omega_n
+    runs = [lammps_impact(lammps, text, contact, units, speed, angle, t_c / n, limit, -twist) for n in (steps, 2 * steps)]
     # microimpact's (n, t, t') frame: n into the wall, t' = n x t, so rolling forward is omega_t' < 0
     mine = _ratios(abs(result.velocity_out[0]), result.velocity_out[1], -result.omega_out[2], speed, angle,
                    contact.radius)
@@ -292,8 +307,10 @@ def _compare(lammps, text, contact, units, speed, angle, steps, simulate_impact)
         row[f"{q}_microimpact"] = 0.0 if (q == "e_n" and result.outcome == "capture") else mine[i]
         row[f"{q}_lammps"] = 0.0 if (q == "e_n" and runs[1].outcome == "capture") else theirs[1][i]
         row[f"{q}_lammps_coarse"] = 0.0 if (q == "e_n" and runs[0].outcome == "capture") else theirs[0][i]
+    row["twist_microimpact"] = result.omega_out[0] / twist if twisting else math.nan
+    row["twist_lammps"], row["twist_lammps_coarse"] = ((r.twist_out / -twist if twisting else math.nan) for r in runs[::-1])
     if result.outcome == "capture" or runs[1].outcome == "capture":  # tangential values of a captured sphere
-        for q in ("e_t", "spin"):
+        for q in ("e_t", "spin", "twist"):
             row[f"{q}_microimpact"] = row[f"{q}_lammps"] = row[f"{q}_lammps_coarse"] = math.nan
     return row
 
