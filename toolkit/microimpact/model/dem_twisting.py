@@ -27,6 +27,10 @@ spring-slider written from the physics, followed here so that an exported input 
   8 G* a. So with a Mindlin law the twisting stiffness is 4 G* a^2 [N], a factor a below Marshall's
   (2009) Eq. (32) with the Mindlin stiffness (4 G* a^3, [N m]); LAMMPS's version is the one here.
 
+The ``marshall`` stiffness follows the contact radius, so a stuck spring's energy k xi^2 / 2 changes
+with it at fixed xi: the normal motion can pump the twist, and |Omega| after the impact can exceed
+|Omega| before (docs/guide/lammps.md; LAMMPS gives the same).
+
 Units: k_twist [N m/rad], gamma_twist [N m s/rad], and mu_twist a length [m] (the limit
 mu_twist F_n0 is a torque; Marshall's mu_twist = 2 a mu / 3). ``Contact.twisting_stiffness``,
 ``twisting_damping``, ``twisting_friction`` hold those of ``sds``; ``marshall`` has no parameters of its

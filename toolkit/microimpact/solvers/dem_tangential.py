@@ -433,7 +433,7 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
             sigma, x, repeats = float(sol.t[-1]), sol.y[:, -1].copy(), 0
             continue
         if sol.status != 1:
-            raise DemTangentialError(f"DEM tangential integration stopped: {sol.message}")
+            raise DemTangentialError(_stopped("tangential", sol))
         first = _first_switch(sol, sigma, switches_, mode) if watch else None
         if first is None:  # the contact ended
             return sol.y_events[0][0], (slide_end if mode[0] == _STICK else math.nan), switches, mode[0] == _STICK
@@ -447,6 +447,16 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
         switches += switched and spring == 0
         if switched and spring == 0 and mode[0] == _STICK:
             slide_end = x[6]
+
+
+def _stopped(what, sol) -> str:
+    """The message of an integration that ended without the contact's end: scipy's own where it
+    failed; where it ran through its whole span (status 0, which scipy calls a success) the contact
+    did not end, which is a normal motion creeping into its equilibrium (module docstring)."""
+    if sol.status == 0:
+        return (f"DEM {what} integration: the contact did not end within {_SIGMA_SPAN:g} units of the Sundman "
+                "variable (a strongly damped normal motion creeping to rest; the DEM laws have no overdamped limit yet)")
+    return f"DEM {what} integration failed: {sol.message}"
 
 
 def _first_switch(sol, start, switch_events, mode):
@@ -835,7 +845,7 @@ def _twist(contact, normal, v_n, omega_n, rtol):
         sol = solve_ivp(rhs, (sigma, sigma + _SIGMA_SPAN), x, method="DOP853", rtol=tol, atol=atol,
                         events=(separation, switch, stopped))
         if sol.status != 1:
-            raise DemTangentialError(f"DEM twisting integration stopped: {sol.message}")
+            raise DemTangentialError(_stopped("twisting", sol))
         hits = [(float(t[0]), i) for i, t in enumerate(sol.t_events) if len(t)]
         t_hit, which = min(hits)
         x = sol.y_events[which][0].copy()
