@@ -338,6 +338,26 @@ def fit_damping(
     C = zeta (r^3 K sqrt(v_n) / m)^(-2/5), Eqs. (14)-(15), and f0(r) = (9/(2 pi) K r w_A^2)^(1/3),
     Eq. (7). The model e_n is 0 below the capture velocity and continuous there, so plain
     residuals are used for every point (see the module docstring).
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Eqs. (7), (14)-(15), (21), (27); Newville, M. et al., LMFIT:
+    Non-Linear Least-Squares Minimization and Curve-Fitting for Python, doi:10.5281/zenodo.11813.
+
+    Examples
+    --------
+    Twelve noise-free rebounds of 3.45 um spheres made with zeta_H = 0.5, zeta_A = 29 (the
+    synthetic data set's values) give them back:
+
+    >>> from microimpact.analysis.synthetic import make_synthetic_impacts
+    >>> from microimpact.io import read_materials
+    >>> raw = make_synthetic_impacts(e_n_rel_sd=0.0, speed_rel_sd=0.0, angle_sd_deg=0.0, radii=(3.45e-6,),
+    ...                              n_per_radius=12)
+    >>> table = pd.DataFrame({"radius": raw["radius [um]"] * 1e-6, "normal_speed": raw.attrs["true_normal_speed"],
+    ...                       "e_n": raw.attrs["true_e_n"]})
+    >>> fit = fit_damping(table, read_materials()["ammonium_fluorescein_on_silicon"], confidence_intervals=False)
+    >>> round(fit.values["zeta_hertz"], 6), round(fit.values["zeta_adhesion"], 5)
+    (0.5, 29.0)
     """
     deadline = Deadline.start(time_budget, "fit")
     if threads is None:

@@ -525,6 +525,39 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
     value; scaled by the reduced chi-square when no uncertainties are stated), widened in quadrature
     by the damping uncertainty (delta method, g^T Cov(zeta) g with g = d f_hat / d zeta from refits at
     zeta +/- one standard error).
+
+    References
+    ----------
+    Cheng, Brach & Dunn (2002), Sec. 4 (the tangential impulse map, Eqs. 32-41); Venzon, D. J. and
+    Moolgavkar, S. H. (1988), A method for computing profile-likelihood-based confidence intervals,
+    J. R. Stat. Soc. C 37(1):87-94, doi:10.2307/2347496.
+
+    Examples
+    --------
+    The damping fitted to twelve noise-free normal rebounds, then six oblique rebounds at 20 m/s
+    made with f = 0.3 (each slides throughout), stated to 0.01 in e_t:
+
+    >>> from microimpact import simulate_impact
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import make_synthetic_impacts
+    >>> from microimpact.io import read_materials
+    >>> raw = make_synthetic_impacts(e_n_rel_sd=0.0, speed_rel_sd=0.0, angle_sd_deg=0.0, radii=(3.45e-6,),
+    ...                              n_per_radius=12)
+    >>> normal = pd.DataFrame({"radius": 3.45e-6, "normal_speed": raw.attrs["true_normal_speed"],
+    ...                        "e_n": raw.attrs["true_e_n"]})
+    >>> damping = fit_damping(normal, read_materials()["ammonium_fluorescein_on_silicon"], confidence_intervals=False)
+    >>> angles = np.linspace(50.0, 75.0, 6)
+    >>> rebounds = [simulate_impact(damping.contact(3.45e-6).with_(friction=0.3), 20.0, a) for a in angles]
+    >>> oblique = pd.DataFrame({"radius": 3.45e-6, "speed": 20.0, "incidence_deg": angles,
+    ...                         "e_n": [r.e_n for r in rebounds],
+    ...                         "tangential_restitution": [r.velocity_out[1] / (20.0 * np.sin(np.radians(a)))
+    ...                                                    for r, a in zip(rebounds, angles)],
+    ...                         "tangential_restitution_uncertainty": 0.01})
+    >>> fit = fit_friction(oblique, damping)
+    >>> print(fit.identifiability["friction"].describe())
+    friction = 0.3, 95 % interval [0.2835, 0.3164]
+
+    At 10-40 deg every impact ends rolling, and the data only bound f from below: no value is given.
     """
     import lmfit  # only when fitting
 

@@ -607,6 +607,22 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     ImpactDataWarning
         For a column that is not part of the format but whose name is close to one that is (a
         likely typo); it is kept as text like every other column of the analyst's own.
+
+    References
+    ----------
+    The format: data/README.md, "Measured-impact CSV format" (units in the header, as in the CF
+    conventions' ``units`` attribute, https://cfconventions.org).
+
+    Examples
+    --------
+    Two impacts, radius in micrometres: SI units come back, with the normal speed v cos(theta):
+
+    >>> import pathlib, tempfile
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "impacts.csv"
+    >>> _ = path.write_text("radius [um],speed [m/s],incidence_angle [deg],e_n [1]\\n3.45,2.0,0,0.61\\n3.45,4.0,30,0.72\\n")
+    >>> t = read_impacts(path)
+    >>> [float(x) for x in t["radius"]], [round(float(x), 6) for x in t["normal_speed"]], list(t["row"])
+    ([3.45e-06, 3.45e-06], [2.0, 3.464102], [1, 2])
     """
     source = os.fspath(path)
     if materials is not None and not isinstance(materials, Mapping):
