@@ -166,9 +166,12 @@ def test_lammps_fit_holds_a_given_rolling_law_while_it_fits_mu_and_writes_both(t
                   "tangential_restitution_uncertainty [1]": 0.01}).to_csv("impacts.csv", index=False)
     argv = ["lammps", "fit", "impacts.csv", "--material-pair", "ammonium_fluorescein_on_silicon", "--law",
             "hertz+coeff_restitution", "--tangential-model", "lammps_mindlin", "--shear-modulus", "1e9",
+            "--twisting-model", "lammps_sds", "--twisting-stiffness", "1e-12", "--twisting-friction", "3e-8",
             "--rolling-stiffness", "200", "--rolling-friction", "0.2", "--out", "contact.lmp"]
     assert main(argv) == 0
     text = (tmp_path / "contact.lmp").read_text()
+    # a twisting law given with it is written beside it (it changes neither e_n nor e_t: not fitted)
+    assert text.splitlines()[-1].split(" twisting sds ")[1].split()[:3] == ["1e-12", "0", "3e-08"]
     low, high = (float(x) for x in text.split("95% profile-likelihood interval ")[1].split(";")[0].split(" to "))
     assert low < 0.3 < high
     assert text.splitlines()[-1].split(" rolling sds ")[1].split()[:3] == ["200", "0", "0.2"]
