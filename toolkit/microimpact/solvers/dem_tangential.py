@@ -792,20 +792,21 @@ def _twist(contact, normal, v_n, omega_n, rtol):
     twisting law (model.dem_twisting), integrated with the normal law in its Sundman variable.
 
     The sliding twist may stop (Omega = 0) while the limit falls faster than the dashpot can hold the
-    spring at it: LAMMPS's torque -mu_twist F_n0 sgn(Omega) then chatters about Omega = 0 at its step,
-    and its limit as the step falls is Omega = 0 with zero mean torque, which stays so (a spring at
-    rest, xi = 0, Omega = 0, is a solution of the stuck law). That is the outcome here. A captured
-    sphere ends with Omega = 0 where the limit at rest is > 0 (its stuck elastic vibration averages
-    to zero), as the slip does."""
+    spring at it: neither mode holds, and LAMMPS's torque -mu_twist F_n0 sgn(Omega) chatters about
+    Omega = 0 at its step. Where the limit ends at 0 (Hertz) LAMMPS converges to Omega = 0; where it
+    does not (JKR, DMT) its chattering leaves a stuck vibration, of amplitude up to
+    mu_twist F_n0 / sqrt(k_twist I), whose phase at separation depends on its step
+    (docs/guide/lammps.md). microimpact takes the mean, Omega = 0 from there on (a spring at rest,
+    xi = 0, Omega = 0, solves the stuck law). A captured sphere ends with Omega = 0 where the limit
+    at rest is > 0 (its stuck elastic vibration averages to zero), as the slip does."""
     from scipy.integrate import solve_ivp
 
     if omega_n == 0.0:
         return 0.0, 0
     law, unit, tau_scale, z_scale = _impact_law(contact, normal, v_n)
     twist = _Twist(contact, law)
-    limit_at_rest = twist.mu > 0.0 and (twist.sds or law.mu > 0.0)
-    if normal.outcome == "capture":
-        return (0.0 if limit_at_rest else omega_n), 0
+    if normal.outcome == "capture":  # at rest on the wall: held where the limit is > 0
+        return (0.0 if twist.mu > 0.0 else omega_n), 0
     time = float(law.scales.time)
     w0 = omega_n * time
     tol = min(rtol, TANGENTIAL_RTOL)
@@ -863,7 +864,7 @@ def _twist(contact, normal, v_n, omega_n, rtol):
         g, dz, dy, k, dk, gamma, dgamma, limit, dlimit = twist.coefficients(x[0], x[1])
         if mode == _STICK:  # the torque reaches the limit: slide against the twist rate
             mode = _SLIDE
-            sign = math.copysign(1.0, x[4]) if x[4] != 0.0 else math.copysign(1.0, -(-k * x[3]))
+            sign = math.copysign(1.0, x[4]) if x[4] != 0.0 else math.copysign(1.0, x[3])  # at rest: the spring's way
         else:  # the trial torque turns inside the limit: stick with the history at the reset value
             mode = _STICK
             x[3] = (limit * sign - gamma * x[4]) / k
