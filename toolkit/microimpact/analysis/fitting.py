@@ -281,6 +281,8 @@ def fit_damping(
 ) -> DampingFit:
     """Fit zeta_H, zeta_A (and optionally w_A) to measured e_n(v_n), jointly over particle sizes.
 
+    Length: the docstring of an entry point (parameters, notes, an example); the body is short.
+
     Parameters
     ----------
     table : pandas.DataFrame

@@ -479,6 +479,8 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
                  propagate_damping: bool = True, progress: bool = False, time_budget: float | None = None) -> FrictionFit:
     """Fit the tangential parameters (friction f) to the oblique columns, after the damping fit.
 
+    Length: the docstring of an entry point (parameters, notes, examples); the body is short.
+
     Parameters
     ----------
     table : pandas.DataFrame
