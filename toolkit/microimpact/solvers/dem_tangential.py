@@ -304,6 +304,15 @@ def _separation(law, x):
     return x[0] - _Q_BREAK if law.jkr else x[0]
 
 
+def _just_after_touch(law, z0, y0):
+    """(z, tau) a short way (sigma = 1e-6) after first touch, from the leading terms of the normal
+    motion: s = y sigma / 2, tau = y sigma^2 / 4; JKR: q = q0 + y sigma, tau = g sigma."""
+    sigma = 1e-6
+    if law.jkr:
+        return z0 + y0 * sigma, 4.0 * (z0**3 - 1.0) * sigma
+    return 0.5 * y0 * sigma, 0.25 * y0 * sigma * sigma
+
+
 def _start_mode(law, x):
     """(mode, initial state) at first touch: each spring sticks or slides as its stuck trial force
     compares with its limit just after touch.
@@ -311,17 +320,10 @@ def _start_mode(law, x):
     At touch the history is 0 and, for Hertz, force and limit both vanish, while their ratio does
     not (for the Mindlin spring it is k u / (mu y) with k = dk/da, the incidence parameter of Maw et
     al. 1976); so they are compared at a state a short way in, from the leading terms of the motion
-    (s = y sigma / 2, tau = y sigma^2 / 4; JKR: q = q0 + y sigma, tau = g sigma) and xi = u tau
-    (the rolling history: w tau).
+    (:func:`_just_after_touch`) and xi = u tau (the rolling history: w tau).
     """
-    sigma = 1e-6
     probe = x.copy()
-    if law.jkr:
-        probe[0] = x[0] + x[1] * sigma
-        tau = 4.0 * (x[0] ** 3 - 1.0) * sigma
-    else:
-        probe[0] = 0.5 * x[1] * sigma
-        tau = 0.25 * x[1] * sigma * sigma
+    probe[0], tau = _just_after_touch(law, x[0], x[1])
     probe[2:4] = x[4:6] * tau
     if law.force_history:  # H = -int k u dt, with k ~ a ~ t^(1/2) for Hertz and DMT, ~ const for JKR
         k = law.stiffness(law.normal(probe[0], probe[1])[2])
@@ -813,11 +815,7 @@ def _twist(contact, normal, v_n, omega_n, rtol):
     x = np.array([am.JKR_Q_FORMATION if law.jkr else 0.0, law.y0, 0.0, 0.0, w0])
     # stick or slide from touch: compared a short way in (as _start_mode), xi = Omega tau
     probe = x.copy()
-    sigma_probe = 1e-6
-    if law.jkr:
-        probe[0], probe[2] = x[0] + x[1] * sigma_probe, 4.0 * (x[0] ** 3 - 1.0) * sigma_probe
-    else:
-        probe[0], probe[2] = 0.5 * x[1] * sigma_probe, 0.25 * x[1] * sigma_probe**2
+    probe[0], probe[2] = _just_after_touch(law, x[0], x[1])
     probe[3] = w0 * probe[2]
     mode = _SLIDE if _twist_rates(twist, probe, _STICK, 0.0)[1] > 0.0 else _STICK
     sign = math.copysign(1.0, w0)
