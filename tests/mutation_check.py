@@ -94,6 +94,10 @@ MUTATIONS = [
      "dw1, dw2 = g * law.spin * (r1 + f1), g * law.spin * (r2 + f2)", "rolling velocity's response to both forces"),
     ("solvers/dem_tangential.py", "rcap, drcap = law.mu_r * n0, law.mu_r * dn0",
      "rcap, drcap = 1.01 * law.mu_r * n0, 1.01 * law.mu_r * dn0", "LAMMPS's rolling limit mu_roll F_n0"),
+    ("solvers/dopri.py", "B1, B3, B4, B5, B6 = 35.0 / 384.0, 500.0 / 1113.0", "B1, B3, B4, B5, B6 = 35.0 / 384.0, 500.0 / 1131.0",
+     "Dormand-Prince weight b3 (the core's order)"),
+    ("solvers/dopri.py", "return math.sqrt(scaled_error_sum(u0, u1, err, atol, rtol, n) / n)",
+     "return 1e-3 * math.sqrt(scaled_error_sum(u0, u1, err, atol, rtol, n) / n)", "the core's error norm"),
 ]
 
 

@@ -249,6 +249,26 @@ LAWS_CAPTURED_TAIL = {"jkr": 1e-7, "jkr_force": 1e-7, "dmt": 1e-7, "mindlin": 1e
 #: (microimpact.solvers.normal_models._restitution). Measured: one row moved (dmt, row 18, e_n 0.0334)
 #: by 3.8e-9; the scipy reference at rtol 1e-13 puts the new value 6.8e-12 from it, the old 3.8e-9.
 LAWS_SMALL_REBOUND = {"jkr": 1e-8, "jkr_force": 1e-8, "dmt": 1e-8}
+#: Changed on purpose since the baseline (issue 26, one Dormand-Prince core, solvers/dopri.py): every
+#: law but the ring law takes a different step sequence, so its results move by its own error, not
+#: by round-off. The JKR/DMT/Hertz solver now controls the root-mean-square error (as the engine
+#: and the coupled solver always did) instead of the largest component, and ends a step where the
+#: net force changes sign (a kink of |F_n| in J); the coupled solver finds its event roots by the
+#: Illinois method instead of plain regula falsi. Measured against this baseline (rtol 1e-9): rebound
+#: rows moved by at most 1.0e-7 of the scale (mindlin_deresiewicz omega_out_1; JKR/DMT up to 8.9e-8),
+#: the normal quantities of captured rows by at most 3e-8, the tangential ones of captured rows by
+#: up to 1.8e-6 (a JKR row's omega_out_0) and 7.2e-6 (a Mindlin-Deresiewicz friction impulse); the
+#: JKR/DMT rebounds are now closer to the new code's solution at rtol 1e-12 (largest error 3.5e-10 against 9.4e-9
+#: for DMT at rtol 1e-10). The ring law (the engine) is bit for bit unchanged.
+ONE_CORE = {"rebound": 300 * 1e-9, "captured": 1e-5}
+#: Rows whose tangential outcome does not converge with the tolerance, in the old code or the new: the
+#: captured, weakly damped row 34 of md_pulloff_rolling (a rolling-resistance tail; its omega_out_2
+#: was 3.6e6, -5.3e5, 3.8e4 rad/s at rtol 1e-6, 1e-8, 1e-10 before the one core, and the coupled
+#: solver reaches its step limit at 1e-12). Its normal quantities are compared; its tangential ones
+#: cannot be, by any solver change. An open defect of issue 26.
+UNCONVERGED_ROWS = {"md_pulloff_rolling": (34,)}
+TANGENTIAL = ("mu_t", "mu_tp", "friction_impulse", "velocity_out_1", "velocity_out_2", "omega_out_0", "omega_out_1",
+              "omega_out_2")
 
 
 @pytest.fixture(scope="module")
@@ -274,8 +294,58 @@ def test_every_law_against_its_baseline(laws_now, selection):
     noise = np.where(captured, LAWS_CAPTURED_TAIL.get(selection, LAWS_NOISE), LAWS_NOISE)
     e_old = old[:, list(base["quantity"].values).index("e_n")]
     noise = np.where(~captured & (e_old < 0.1), np.maximum(noise, LAWS_SMALL_REBOUND.get(selection, 0.0)), noise)
+    if selection != "ring":
+        noise = np.maximum(noise, np.where(captured, ONE_CORE["captured"], ONE_CORE["rebound"]))
     for j, name in enumerate(base["quantity"].values):
         ok = np.isfinite(old[:, j])
+        if name in TANGENTIAL:
+            ok[list(UNCONVERGED_ROWS.get(selection, ()))] = False
         scale = np.max(np.abs(old[ok, j]), initial=0.0)
         excess = np.abs(new[ok, j] - old[ok, j]) - noise[ok] * scale
         assert np.all(excess <= 0.0), f"{selection} {name}: moved by more than allowed (scale {scale:.3g})"
+
+
+# --------------------------------------------------------------------------- the one core (issue 26)
+#: Allowed change against tests/regression/baseline/integrators.nc (the every-law impacts at rtol
+#: 1e-6, 1e-8, 1e-10, solved by the three steppers before the one core), in units of rtol times each
+#: quantity's scale. Why they move at all: see ONE_CORE. Measured: rebound rows by at most 165 rtol
+#: (JKR, rtol 1e-10), the normal quantities of captured rows by at most 11 rtol (jkr_force, 1e-6).
+#: The tangential outcomes of captured rows are not compared: they come from a tail whose error is
+#: 1e-2 of themselves (the closed-form tail, measured against rtol 1e-12), not from the stepper.
+CORE_REBOUND_RTOLS = 300.0
+CORE_CAPTURED_NORMAL_RTOLS = 30.0
+
+
+@pytest.fixture(scope="module")
+def integrators_base():
+    return _cases_module("integrator_cases"), xr.load_dataset(BASELINE / "integrators.nc")
+
+
+@pytest.mark.parametrize("selection", ["ring", "jkr", "jkr_force", "dmt", "mindlin", "mindlin_deresiewicz",
+                                       "mindlin_pulloff", "md_pulloff_rolling"])
+def test_one_core_against_the_three_steppers(integrators_base, selection):
+    """Every law through the one Dormand-Prince core (solvers/dopri.py) against the baseline of the
+    three steppers it replaced, at three tolerances: the ring law (the engine, whose arithmetic the
+    core keeps) bit for bit; the others with the same outcomes and moved by their own error only."""
+    import warnings
+
+    cases, base = integrators_base
+    names = list(base["quantity"].values)
+    normal = [names.index(n) for n in ("e_n", "contact_time", "capture_time", "max_penetration", "velocity_out_0")]
+    for i, rtol in enumerate(base["rtol"].values):
+        old = base[selection].values[i]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            new = np.array([cases.solve(c, selection, float(rtol)) for c in cases._laws_cases().cases()])
+        assert np.array_equal(np.isnan(new), np.isnan(old)), f"{selection} rtol {rtol:g}: outcomes changed"
+        if selection == "ring":
+            assert np.array_equal(new, old, equal_nan=True), f"ring rtol {rtol:g}: the engine's numbers moved"
+            continue
+        captured = np.isnan(old[:, names.index("mu_t")])
+        for j, name in enumerate(names):
+            rows = np.isfinite(old[:, j]) & (~captured | (j in normal))
+            scale = np.max(np.abs(old[np.isfinite(old[:, j]), j]), initial=0.0)
+            allowed = np.where(captured, CORE_CAPTURED_NORMAL_RTOLS, CORE_REBOUND_RTOLS)[rows] * rtol * scale
+            moved = np.abs(new[rows, j] - old[rows, j])
+            assert np.all(moved <= allowed), (
+                f"{selection} {name} rtol {rtol:g}: moved by {np.max(moved / (rtol * scale)):.3g} rtol of the scale")

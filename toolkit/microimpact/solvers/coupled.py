@@ -14,7 +14,7 @@ solver is used only where a scene selects something else, so the paper's model p
   spins. The twist about n keeps its closed form (its torque depends on the normal solve only).
 * ``tangential_model="mindlin_deresiewicz"``: the hysteretic law; the state z[10] is the branch
   coordinate p (smooth right-hand side), the branch (s, c) and the slip direction e are carried
-  beside the state, and each turning point (s u.e changes sign) is located by secant iteration on
+  beside the state, and each turning point (s u.e changes sign) is located by the Illinois method on
   the step length, where the branch switches with the force continuous.
 * ``rolling_friction > 0`` (with either compliant model): the torque mu_r r |F_n| against
   (omega_t, omega_t'). A step within which omega_r reverses is ended where it reaches zero, and
@@ -26,12 +26,12 @@ sigma, d tau = s d sigma with s = sqrt(xi), which keeps the right-hand side smoo
 starts and ends. State (s, y, tau, D, J, J_a, v_t, v_t', w_t, w_t', delta_t, delta_t') with v the
 centre velocity and w = r omega the rim speeds in units of L / T_c, delta the tangential
 displacement of the contact in L, J = int load dtau and J_a = int s load dtau (load =
-:func:`friction_load`). Dormand-Prince 5(4) with error control on every state; the kinks of the
+:func:`friction_load`). Dormand-Prince 5(4) (the one core, :mod:`.dopri`) with error control on every state; the kinks of the
 load are resolved by step rejection (the Mindlin force reaches its limit with zero slope, so gross
 slip starts smoothly). After every accepted step the displacement is held at delta* in gross slip,
 and the steps of the elastic Mindlin contact end where gross slip starts and ends
 (:func:`_end_at_slip_change`: a step across either converged only first order). Separation (s = 0,
-y < 0) and the largest penetration (y = 0, :func:`_root_state`) are located by secant iteration on
+y < 0) and the largest penetration (y = 0, :func:`_root_state`) are located by the Illinois method on
 the step length; capture is the exact energy test of the engine.
 
 Hysteretic law where the Coulomb limit vanishes: the rate of p is ~ 1 / F_lim, and F_lim = f |F_n|
@@ -39,7 +39,7 @@ passes through zero twice in every impact with adhesion (and twice in every peri
 sphere's oscillation about the adhesive equilibrium, where F_n = 0). There T = 0 whatever p, so
 (i) the error of p is measured as that of the force it makes, scaled by F_lim / F_ref (F_ref =
 f max(1, a_a, y0^1.2), the order of the largest limit), and (ii) a zero of the limit within a step
-is located (secant on the step length, on the normal state alone, which does not depend on p) and
+is located (Illinois method on the step length, on the normal state alone, which does not depend on p) and
 the branch restarts there as at first contact (:func:`_restart_branch`). Without them the steps
 shrank geometrically towards each zero of F_lim and a captured impact reached the step limit. A
 zero is looked for from the side of the load on which the branch was started, so that a root found
@@ -84,7 +84,7 @@ from microimpact.model import law as _law
 from microimpact.model import tangential_compliance as _tc
 from microimpact.model.kinematics import flat_broadcast
 from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form maps
-from microimpact.solvers import SolverError
+from microimpact.solvers import SolverError, dopri
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _linear_tail_variation, _slow_twist
 
@@ -108,18 +108,6 @@ _CREEPING = 2
 #: outcome code of a captured impact stopped after a twentieth of the step budget (its tail in
 #: closed form: averaged when weakly damped, else linear; the engine's policy)
 _LONG_TAIL = 3
-
-_A = np.array([
-    [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [1.0 / 5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
-    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
-    [19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0, 0.0, 0.0],
-    [9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0, 0.0],
-])
-_B = np.array([35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0])
-_E = np.array([71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0])
-
 
 class CoupledError(SolverError):
     """The coupled solver could not finish an impact (step limit or step-size underflow).
@@ -152,13 +140,14 @@ def _md_terms(z, p, hist, s, xi_dd, load):
 
 
 @njit(cache=True)
-def _rhs(z, p, hist, out):
-    """d/dsigma of the state z.
+def _rhs(z, out, args):
+    """d/dsigma of the state z; args = (p, hist).
 
     p = (c1, c2, a_h, a_a, f, F_po, adhesion_aware, kappa, k_rot, tangential mode (0 rigid,
     1 mindlin, 2 mindlin_deresiewicz), mu_r); hist = (s, c, e_t, e_t') the branch of the hysteretic
     law and the initial slip direction (hist[4:6]: see :func:`_end_at_rolling_stop`).
     """
+    p, hist = args
     c1, c2, ah, aa, f, fpo, aware, kappa, krot = p[0], p[1], p[2], p[3], p[4], p[5], p[6] > 0.5, p[7], p[8]
     mode = p[9]
     s = z[_S]
@@ -207,29 +196,8 @@ def _rhs(z, p, hist, out):
             out[_WTP] *= held
 
 
-@njit(cache=True)
-def _step(z, k1, h, p, hist, k, tmp, z1, err):
-    """One Dormand-Prince 5(4) step of length h from z (derivative k1); k[6] = f(z1)."""
-    for i in range(_N):
-        k[0, i] = k1[i]
-    for st in range(1, 6):
-        for i in range(_N):
-            acc = 0.0
-            for j in range(st):
-                acc += _A[st, j] * k[j, i]
-            tmp[i] = z[i] + h * acc
-        _rhs(tmp, p, hist, k[st])
-    for i in range(_N):
-        acc = 0.0
-        for j in range(6):
-            acc += _B[j] * k[j, i]
-        z1[i] = z[i] + h * acc
-    _rhs(z1, p, hist, k[6])
-    for i in range(_N):
-        acc = 0.0
-        for j in range(7):
-            acc += _E[j] * k[j, i]
-        err[i] = h * acc
+#: one Dormand-Prince 5(4) step of the coupled model (the core's, :mod:`microimpact.solvers.dopri`)
+_step = dopri.make_step(_rhs, _N)
 
 
 @njit(cache=True)
@@ -358,7 +326,8 @@ _EV_DEPTH, _EV_IMPULSE, _EV_ENERGY = np.int64(6), np.int64(7), np.int64(8)
 
 
 @njit(cache=True)
-def _event_value(code, z, p, hist):
+def _event_value(z, code, args):
+    p, hist = args
     if code == _EV_LOAD:
         return _load_argument(z, p)
     if code == _EV_SEPARATION:
@@ -378,38 +347,27 @@ def _event_value(code, z, p, hist):
     return _branch_slip(z, hist)
 
 
+#: the step length at which an event value reaches its target, solved on the step (Illinois method)
+_root = dopri.make_root_on_step(_step, _event_value)
+
+
 @njit(cache=True)
 def _restep_to_root(code, target, fa, fb, tol, h, z, k1, p, hist, k, tmp, z1, err):
-    """Re-step from z to where event ``code`` reaches ``target`` within the step h (regula falsi on
-    the step length; fa, fb its values less target at the start and end of the step, opposite
-    signs); z1 then holds the state there. Stops at |value - target| <= tol or a bracket below
-    1e-14 h; returns the step length."""
-    a, b = 0.0, h
-    hs = h
-    for _ in range(60):
-        hs = b - fb * (b - a) / (fb - fa)
-        if not (a < hs < b):
-            hs = 0.5 * (a + b)
-        _step(z, k1, hs, p, hist, k, tmp, z1, err)
-        g = _event_value(code, z1, p, hist) - target
-        if abs(g) <= tol or (b - a) < 1e-14 * h:
-            break
-        if (g > 0.0) == (fa > 0.0):
-            a, fa = hs, g
-        else:
-            b, fb = hs, g
-    return hs
+    """Re-step from z to where event ``code`` reaches ``target`` within the step h (fa, fb its
+    values less target at the start and end of the step, opposite signs); z1 then holds the state
+    there. Stops at |value - target| <= tol or a bracket below 1e-14 h; returns the step length."""
+    return _root(code, target, fa, fb, tol, h, z, k1, (p, hist), (p, hist), k, tmp, z1, err)
 
 
 @njit(cache=True)
 def _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp):
     """A trial step from z to z1 within which the Coulomb limit passes through zero (load argument
-    ``gb`` at z1): if the normal motion is accurate, end the step at the zero (secant on the step
+    ``gb`` at z1): if the normal motion is accurate, end the step at the zero (Illinois method on the step
     length; at z itself if z is the zero within rounding) and have the branch restarted there;
     else reject the step. Accepting it on the error of all states, as before, let a zero pass
     without a restart (results then jumped by 1e-5 between tolerances). Returns (the error sum
     that decides the step, restart)."""
-    if _scaled_error_sum(z, z1, err, atol, rtol, _VT) > _VT:
+    if dopri.scaled_error_sum(z, z1, err, atol, rtol, _VT) > _VT:
         return max(en, 4.0 * _N), False  # rejected
     ga = _load_argument(z, p)
     if ga * gb < 0.0:
@@ -421,21 +379,12 @@ def _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp):
 
 
 @njit(cache=True, inline="always")
-def _scaled_error_sum(z, z1, err, atol, rtol, n):
-    """Sum of the squared scaled errors of the first n states of a step z -> z1."""
-    en = 0.0
-    for i in range(n):
-        en += (err[i] / (atol[i] + rtol * max(abs(z[i]), abs(z1[i])))) ** 2
-    return en
-
-
-@njit(cache=True, inline="always")
 def _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref):
     """Sum of the squared scaled errors of a step z -> z1 (the error of p as that of the force it
     makes, see the module docstring)."""
     if hysteretic:
         err[_FT] *= min(1.0, p[4] * abs(_load_argument(z1, p)) / lim_ref)
-    return _scaled_error_sum(z, z1, err, atol, rtol, _N)
+    return dopri.scaled_error_sum(z, z1, err, atol, rtol, _N)
 
 
 @njit(cache=True)
@@ -446,7 +395,7 @@ def _end_at_rolling_stop(h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hystere
     chatters about omega_r = 0 (600,000 steps, or the step limit, and a rest state set by rounding).
     At rest the torque is set-valued, as friction is: it holds omega_r = 0 while the other torques
     stay within its limit (:func:`_rhs`). So the step is ended where the component of omega_r
-    along its direction at z vanishes (regula falsi on the step length), and the caller sets
+    along its direction at z vanishes (Illinois method on the step length), and the caller sets
     omega_r = 0 there if what is left of it is within the step's tolerance.
 
     Returns (the step's error sum, rest reached, step length); a step whose end is not at rest
@@ -467,7 +416,7 @@ def _end_at_rolling_stop(h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hystere
 def _end_at_slip_change(slipping, h, en, z, z1, k1, err, atol, rtol, p, hist, k, tmp, lim_ref):
     """A trial step z -> z1 of the elastic Mindlin contact within which gross slip starts
     (|delta| reaches delta*) or, ``slipping``, ends (the slip along delta falls below the growth of
-    delta*): end the step there (regula falsi on the step length).
+    delta*): end the step there (Illinois method on the step length).
 
     The force F_lim [1 - (1 - |delta|/delta*)^(3/2)] has an unbounded second derivative at
     |delta| = delta*, and the projection after a step in gross slip keeps the slip beyond delta*
@@ -488,7 +437,7 @@ def _end_at_slip_change(slipping, h, en, z, z1, k1, err, atol, rtol, p, hist, k,
         # a change at the start of the step: a value a rounding error off zero where F_lim ~ 0 (a
         # captured sphere with the paper's friction, twice per period); ending the step there
         # repeated it with zero-length steps, so the step is kept whole and the projection decides
-        _step(z, k1, h, p, hist, k, tmp, z1, err)
+        _step(z, k1, h, (p, hist), k, tmp, z1, err)
         return en, False, h
     return _error_sum(z, z1, err, atol, rtol, p, False, lim_ref), True, hs
 
@@ -507,10 +456,10 @@ def _hold_rolling(z, k1, tol, p, hist):
     if wm == 0.0 or wm > tol:
         return
     z[_WT] = z[_WTP] = 0.0
-    _rhs(z, p, hist, k1)
+    _rhs(z, k1, (p, hist))
     if k1[_WT] != 0.0 or k1[_WTP] != 0.0:  # not held: omega_r leaves rest
         z[_WT], z[_WTP] = wt, wtp
-        _rhs(z, p, hist, k1)
+        _rhs(z, k1, (p, hist))
 
 
 @njit(cache=True)
@@ -529,7 +478,7 @@ def _root_state(code, target, h, z, z1, k1, p, hist):
     """
     zs, tmp, err = np.empty(_N), np.empty(_N), np.empty(_N)
     ks = np.empty((7, _N))
-    fa, fb = _event_value(code, z, p, hist) - target, _event_value(code, z1, p, hist) - target
+    fa, fb = _event_value(z, code, (p, hist)) - target, _event_value(z1, code, (p, hist)) - target
     _restep_to_root(code, target, fa, fb, 1e-13 * (abs(fa) + abs(fb)), h, z, k1, p, hist, ks, tmp, zs, err)
     return zs
 
@@ -572,7 +521,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     err = np.zeros(_N)
     k1 = np.zeros(_N)
     hist = _initial_branch(z, p)
-    _rhs(z, p, hist, k1)
+    _rhs(z, k1, (p, hist))
     ah, aa = p[2], p[3]
     yref = max(1.0, y0)
     sref = max(1.0, y0 ** 0.4)
@@ -622,7 +571,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         if n >= max_steps:
             status = _MAX_STEPS
             break
-        _step(z, k1, h, p, hist, k, tmp, z1, err)
+        _step(z, k1, h, (p, hist), k, tmp, z1, err)
         en = _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref)
         n += 1
         restart = False
@@ -647,7 +596,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                     at_rest = False
         en = math.sqrt(en / _N)
         if en > 1.0:
-            h *= max(0.2, 0.9 * en ** -0.2)
+            h = dopri.shrunk_step(h, en)
             if h < 1e-300:
                 status = _UNDERFLOW
                 break
@@ -655,7 +604,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         if not peaked and z[_Y] > 0.0 and z1[_Y] <= 0.0:
             smax = max(smax, _root_state(_EV_DEPTH, 0.0, h_end, z, z1, k1, p, hist)[_S])
             peaked = True
-        if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: secant on the step length
+        if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: its root on the step length
             _restep_to_root(_EV_SEPARATION, 0.0, z[_S], z1[_S], 1e-14 * sref, h_end, z, k1, p, hist, k, tmp, z1, err)
             z1[_S] = 0.0
             if conservative:  # leaves with its energy: U(0) = 0
@@ -668,7 +617,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             break
         turned = False
         if not restart and hysteretic and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
-            # turning point of the hysteretic law within the step: secant on the step length
+            # turning point of the hysteretic law within the step: its root on the step length
             ga, gb = _branch_slip(z, hist), _branch_slip(z1, hist)
             _restep_to_root(_EV_TURN, 0.0, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h_end, z, k1, p, hist, k, tmp, z1, err)
             turned = True
@@ -709,13 +658,13 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
                 g = _load_argument(z, p)
                 load_side = 0.0 if g == 0.0 else (1.0 if g > 0.0 else -1.0)
             z[_FT] = min(max(z[_FT], 0.0), 1.0)
-            _rhs(z, p, hist, k1)
+            _rhs(z, k1, (p, hist))
         elif elastic:
             projected = _project(z, p)
             slipping = (not slipping) if slip_change else projected
-            _rhs(z, p, hist, k1)
+            _rhs(z, k1, (p, hist))
         elif refresh:
-            _rhs(z, p, hist, k1)
+            _rhs(z, k1, (p, hist))
         else:
             for i in range(_N):
                 k1[i] = k[6, i]
@@ -742,7 +691,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             if not rolling and peaked and 20 * n >= max_steps:
                 outcome = _LONG_TAIL
                 break
-        h *= 5.0 if en == 0.0 else min(5.0, max(0.2, 0.9 * en ** -0.2))
+        h = dopri.grown_step(h, en)
     if outcome >= 1 and not peaked:  # crept into the equilibrium without turning: its supremum
         smax = max(smax, math.sqrt(xe))
     return status, outcome, z, smax * smax, tau_cap, tau_j, n, n_turn

@@ -27,7 +27,8 @@ d tau = s d sigma the system becomes polynomial, hence smooth everywhere, includ
 Separation is the simple root s = 0 (with y < 0). The friction impulse J is the total variation
 of y, because the nondimensional normal force is -dy/dtau: it is summed exactly over the monotone
 pieces of y, whose ends (the zeros of dy/dsigma) are located as events. J_a and the damping
-dissipation D are integrated as extra states. Integration is Dormand-Prince 5(4) with error control
+dissipation D are integrated as extra states. Integration is Dormand-Prince 5(4) (the one core of the
+compiled solvers, :mod:`.dopri`) with error control
 on all states; events are located by re-stepping from the start of the step (Illinois method), so
 their accuracy is that of the integrator.
 
@@ -69,6 +70,8 @@ from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL, ModelDomainError, SolverError
 from microimpact.model.law import Scales, hertz_impact_scales, nondimensional_impact, nondimensional_scales  # nondimensional_scales: re-exported
 from microimpact.solvers import compiled_law as law
+from microimpact.solvers import dopri
+from microimpact.solvers.dopri import hermite, illinois_point, illinois_update
 
 __all__ = ["NormalSolution", "EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
 
@@ -91,25 +94,6 @@ _NSTATE = 5  # s, y, tau, D, J_a
 _EV_S, _EV_Y, _EV_DY, _EV_ENERGY = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
 _SLOW_ENERGY, _SLOW_Y = np.int64(0), np.int64(1)
 _MAX_STEPS_DEFAULT = 2_000_000
-
-# Dormand-Prince 5(4) tableau (Dormand & Prince 1980, J. Comput. Appl. Math. 6:19-26).
-_C2, _C3, _C4, _C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
-_A21 = 1.0 / 5.0
-_A31, _A32 = 3.0 / 40.0, 9.0 / 40.0
-_A41, _A42, _A43 = 44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0
-_A51, _A52, _A53, _A54 = 19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0
-_A61, _A62, _A63, _A64, _A65 = 9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0
-_B1, _B3, _B4, _B5, _B6 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0
-# error coefficients: b - b_hat
-_E1, _E3, _E4, _E5, _E6, _E7 = (
-    71.0 / 57600.0,
-    -71.0 / 16695.0,
-    71.0 / 1920.0,
-    -17253.0 / 339200.0,
-    22.0 / 525.0,
-    -1.0 / 40.0,
-)
-
 
 #: Smallest nondimensional incident speed y0 = v_n T / X (adhesive contact) the engine resolves.
 #: Below about 1e-39 the incident energy y0^2 / 2 is lost in round-off against the contact well
@@ -236,55 +220,14 @@ def _derivatives(s, y, c1, c2, ah, aa, sgn):
 
 
 @njit(cache=True, inline="always")
-def _rhs_row(u, c1, c2, ah, aa, sgn, k, j):
-    """d/dsigma of the state u, written into row j of k."""
-    k[j, 0], k[j, 1], k[j, 2], k[j, 3], k[j, 4] = _derivatives(u[0], u[1], c1, c2, ah, aa, sgn)
-
-
-@njit(cache=True)
-def _rhs(u, c1, c2, ah, aa, sgn, out):
+def _rhs(u, out, args):
+    c1, c2, ah, aa, sgn = args
     """d/dsigma of the state u, written into out."""
     out[0], out[1], out[2], out[3], out[4] = _derivatives(u[0], u[1], c1, c2, ah, aa, sgn)
 
 
-@njit(cache=True)
-def _step(u0, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err):
-    """One DP5 step from u0 (derivative k1) over h; writes u1, err and k[6] = f(u1)."""
-    n = _NSTATE  # a compile-time constant lets LLVM unroll the stage loops
-    for i in range(n):
-        k[0, i] = k1[i]
-    for i in range(n):
-        tmp[i] = u0[i] + h * _A21 * k[0, i]
-    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 1)
-    for i in range(n):
-        tmp[i] = u0[i] + h * (_A31 * k[0, i] + _A32 * k[1, i])
-    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 2)
-    for i in range(n):
-        tmp[i] = u0[i] + h * (_A41 * k[0, i] + _A42 * k[1, i] + _A43 * k[2, i])
-    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 3)
-    for i in range(n):
-        tmp[i] = u0[i] + h * (_A51 * k[0, i] + _A52 * k[1, i] + _A53 * k[2, i] + _A54 * k[3, i])
-    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 4)
-    for i in range(n):
-        tmp[i] = u0[i] + h * (
-            _A61 * k[0, i] + _A62 * k[1, i] + _A63 * k[2, i] + _A64 * k[3, i] + _A65 * k[4, i]
-        )
-    _rhs_row(tmp, c1, c2, ah, aa, sgn, k, 5)
-    for i in range(n):
-        u1[i] = u0[i] + h * (_B1 * k[0, i] + _B3 * k[2, i] + _B4 * k[3, i] + _B5 * k[4, i] + _B6 * k[5, i])
-    _rhs_row(u1, c1, c2, ah, aa, sgn, k, 6)
-    for i in range(n):
-        err[i] = h * (
-            _E1 * k[0, i] + _E3 * k[2, i] + _E4 * k[3, i] + _E5 * k[4, i] + _E6 * k[5, i] + _E7 * k[6, i]
-        )
-
-
-@njit(cache=True)
-def _hermite(p0, p1, d0, d1, h, th):
-    """Cubic Hermite interpolant on a step of length h at the fraction th."""
-    th2 = th * th
-    th3 = th2 * th
-    return (2.0 * th3 - 3.0 * th2 + 1.0) * p0 + (th3 - 2.0 * th2 + th) * h * d0 + (3.0 * th2 - 2.0 * th3) * p1 + (th3 - th2) * h * d1
+#: one Dormand-Prince 5(4) step of the ring law (the core's, :mod:`microimpact.solvers.dopri`)
+_step = dopri.make_step(_rhs, _NSTATE)
 
 
 @njit(cache=True)
@@ -292,35 +235,13 @@ def _event_on_interpolant(code, target, th, u0, k1, u1, k7, h, ah, aa):
     if code == _EV_DY:  # d/dth of the y interpolant (proportional to dy/dsigma)
         y0, y1, d0, d1 = u0[1], u1[1], k1[1], k7[1]
         return (6.0 * th * th - 6.0 * th) * (y0 - y1) + (3.0 * th * th - 4.0 * th + 1.0) * h * d0 + (3.0 * th * th - 2.0 * th) * h * d1
-    s = _hermite(u0[0], u1[0], k1[0], k7[0], h, th)
+    s = hermite(u0[0], u1[0], k1[0], k7[0], h, th)
     if code == _EV_S:
         return s
-    y = _hermite(u0[1], u1[1], k1[1], k7[1], h, th)
+    y = hermite(u0[1], u1[1], k1[1], k7[1], h, th)
     if code == _EV_Y:
         return y - target
     return law.nondimensional_energy(s, y, ah, aa) - target
-
-
-@njit(cache=True, inline="always")
-def illinois_point(a, fa, b, fb):
-    """The regula falsi point of a bracket [a, b] with f(a) = fa, f(b) = fb of opposite signs (its
-    midpoint where rounding puts that point outside)."""
-    x = (a * fb - b * fa) / (fb - fa)
-    return x if a < x < b else 0.5 * (a + b)
-
-
-@njit(cache=True, inline="always")
-def illinois_update(a, fa, b, fb, x, fx, side):
-    """The bracket after f(x) = fx, keeping the sign change; an end kept twice in a row has its
-    value halved (the Illinois method: superlinear where plain regula falsi stalls at one end).
-    ``side`` (0 at the start) records which end moved last; returns (a, fa, b, fb, side)."""
-    if (fx > 0.0) == (fb > 0.0):
-        if side == -1:
-            fa *= 0.5
-        return a, fa, x, fx, -1
-    if side == 1:
-        fb *= 0.5
-    return x, fx, b, fb, 1
 
 
 @njit(cache=True)
@@ -350,31 +271,22 @@ def _locate(code, target, u0, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, er
             break
         a, fa, b, fb, side = illinois_update(a, fa, b, fb, th, fs, side)
     hs = th * h
-    _step(u0, k1, hs, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+    _step(u0, k1, hs, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
     return hs
 
 
 @njit(cache=True)
-def _energy_crossing(target, u0, k1, h, f0, f1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
-    """Step length in (0, h] at which the contact energy reaches ``target`` (f0, f1: energy less
-    target at the step's ends, opposite signs), by the Illinois method on the step itself rather
-    than on its interpolant; u1 then holds the step to there.
+def _energy(u, code, args):
+    ah, aa = args
+    """The contact energy at the state u (the one event function solved on the step itself)."""
+    return law.nondimensional_energy(u[0], u[1], ah, aa)
 
-    The time at which E first falls below zero is recorded where E falls slowly (near the capture
-    speed), so a small error of E is a large one of the time: on the cubic Hermite interpolant,
-    as :func:`_locate` finds it, the capture time was 1e-6 off at rtol 1e-9.
-    """
-    a, b = 0.0, h
-    side = 0
-    hs = h
-    for _ in range(60):
-        hs = illinois_point(a, f0, b, f1)
-        _step(u0, k1, hs, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-        f = law.nondimensional_energy(u1[0], u1[1], ah, aa) - target
-        if f == 0.0 or (b - a) < 1e-14 * h:
-            break
-        a, f0, b, f1, side = illinois_update(a, f0, b, f1, hs, f, side)
-    return hs
+
+#: the step length at which the contact energy reaches a target, solved on the step itself rather
+#: than on its interpolant: the time at which E first falls below zero is recorded where E falls
+#: slowly (near the capture speed), so a small error of E is a large one of the time; on the cubic
+#: Hermite interpolant, as :func:`_locate` finds it, the capture time was 1e-6 off at rtol 1e-9
+_energy_crossing = dopri.make_root_on_step(_step, _energy)
 
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
@@ -718,7 +630,7 @@ def _mirror_undamped(u, u1, k1, hev, J, j_target, tau_jtarget, y0, c1, c2, ah, a
     ja_turn = u1[4]
     if math.isnan(tau_jtarget) and 0.0 < j_target <= j_turn:
         # reached on the way in, within this step (the way out is left to the caller)
-        _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
         yt = u[1] - (j_target - J)
         _locate(_EV_Y, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         tau_jtarget = u1[2]
@@ -845,7 +757,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
     k1 = np.zeros(_NSTATE)
     kend = np.zeros(_NSTATE)
     sgn = _first_sign(y0, c1, c2, ah, aa)
-    _rhs(u, c1, c2, ah, aa, sgn, k1)
+    _rhs(u, k1, (c1, c2, ah, aa, sgn))
     atol = _absolute_tolerances(y0, rtol)
     noise = 10.0 * (atol[0] + atol[1])
     damped = c1 > 0.0 or (c2 > 0.0 and aa > 0.0)  # adhesion damping needs adhesion
@@ -863,15 +775,11 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         if n_steps + n_rej >= max_steps:
             status = _MAX_STEPS
             break
-        _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-        en = 0.0
-        for i in range(_NSTATE):
-            sc = atol[i] + rtol * max(abs(u[i]), abs(u1[i]))
-            en += (err[i] / sc) ** 2
-        en = math.sqrt(en / _NSTATE)
+        _step(u, k1, h, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+        en = dopri.error_norm(u, u1, err, atol, rtol, _NSTATE)
         if not en <= 1.0:  # (a NaN error norm, from an overflowing trial step, is a rejection too)
             n_rej += 1
-            h *= max(0.2, 0.9 * en ** -0.2)
+            h = dopri.shrunk_step(h, en)
             if h < 1e-300:
                 status = _STEP_UNDERFLOW
                 break
@@ -885,7 +793,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         if u[0] > 0.0 and u1[0] <= 0.0:
             hev = _locate(_EV_S, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
             code = 0
-            _step(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            _step(u, k1, h, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
         # an extremum of y: dy/dsigma leaves its expected sign (comparing with the expected sign,
         # not with g0, keeps the root just found at the start of this step from being found again)
         if u[0] > 0.0 and g1 * sgn < 0.0:
@@ -895,7 +803,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             if code < 0 or hh < hev:
                 hev, code = hh, 2
         if code >= 0:
-            _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
             # dy/dsigma ~ s^2 vanishes at the surface too, so an extremum found at the end of
             # contact is the separation itself
             if code == 2 and u1[0] <= 0.0 and u1[1] < 0.0:
@@ -918,12 +826,13 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         # 1e-9, where E falls slowly: near the capture speed)
         if not captured and damped and aa > 0.0:
             if recorded:
-                _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
                 recorded = False
             e0 = law.nondimensional_energy(u[0], u[1], ah, aa)
             e1 = law.nondimensional_energy(u1[0], u1[1], ah, aa)
             if math.isnan(tau_zero) and e0 >= 0.0 and e1 < 0.0:
-                _energy_crossing(0.0, u, k1, hev, e0, e1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                _energy_crossing(_EV_ENERGY, 0.0, e0, e1, 0.0, hev, u, k1, (c1, c2, ah, aa, sgn), (ah, aa), k, tmp, u1,
+                                 err)
                 tau_zero = u1[2]
                 recorded = True
             if e0 >= ecap and e1 < ecap:
@@ -935,7 +844,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 tau_capture = tau_zero
         if math.isnan(tau_jtarget) and j_target > 0.0:  # end of sliding
             if recorded:
-                _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+                _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
                 recorded = False
             dj = abs(u1[1] - u[1])  # y is monotone within the (possibly shortened) step
             if J < j_target and J + dj >= j_target:
@@ -944,7 +853,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 tau_jtarget = u1[2]
                 recorded = True
         if recorded:
-            _step(u, k1, hev, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
         # |dy| rather than sgn * dy: robust to an extremum that falls between two steps unnoticed
         # (a signed sum would then subtract; measured: more convergence failures in the stress sweep)
         J += abs(u1[1] - u[1])
@@ -957,7 +866,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         if code == 2 or code == 0:
             if code == 2:
                 sgn = -sgn
-            _rhs(u, c1, c2, ah, aa, sgn, kend)
+            _rhs(u, kend, (c1, c2, ah, aa, sgn))
             for i in range(_NSTATE):
                 k1[i] = kend[i]
         else:
@@ -1022,7 +931,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 g = law.nondimensional_acceleration(s2, s2 * s2, u[1], c1, c2, ah, aa)
                 if g != 0.0:
                     sgn = 1.0 if g > 0.0 else -1.0
-                _rhs(u, c1, c2, ah, aa, sgn, kend)
+                _rhs(u, kend, (c1, c2, ah, aa, sgn))
                 for i in range(_NSTATE):
                     k1[i] = kend[i]
                 continue
@@ -1037,7 +946,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 if not turned and xe > smax * smax:
                     smax = math.sqrt(xe)  # approached the equilibrium without turning: its supremum
                 break
-        h *= 5.0 if en == 0.0 else min(5.0, max(0.2, 0.9 * en ** -0.2))  # next step size
+        h = dopri.grown_step(h, en)
     e_end = law.nondimensional_energy(u[0], u[1], ah, aa)
     return (status, outcome, u[1], u[2], u[3], J, u[4], smax * smax, tau_capture, tau_jtarget, e_end,
             n_steps, n_rej, n_rec)
