@@ -3,8 +3,9 @@
 The engine (:mod:`microimpact.solvers.engine`), the coupled tangential solver
 (:mod:`microimpact.solvers.coupled`) and the JKR/DMT/Hertz solver
 (:mod:`microimpact.solvers.normal_models`) integrate their contact laws with the same explicit
-Runge-Kutta pair of Dormand & Prince (1980), written here once: the tableau, the step, the error
-norm, the step-size control, the Illinois root finder and the cubic Hermite interpolant of a step.
+Runge-Kutta pair of Dormand & Prince (1980) [1]_, written here once: the tableau, the step, the error
+norm and the step-size control [2]_, the Illinois root finder [3]_ and the cubic Hermite interpolant of
+a step.
 Each solver plugs its law in as a compiled right-hand side and keeps its own events (which differ
 by law: separation, turning point, capture, the change of slip, the rolling stop).
 
