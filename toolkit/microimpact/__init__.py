@@ -32,8 +32,8 @@ def _announce_numba_compiles() -> None:
             module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
             if not self.done and module.startswith("microimpact."):
                 self.done = True
-                print("microimpact: compiling the solvers with numba (first run only, about 20 s; "
-                      "cached for later runs)", file=sys.stderr, flush=True)
+                print("microimpact: compiling the solvers with numba (first run only, 5-15 s per "
+                      "solver; cached for later runs)", file=sys.stderr, flush=True)
 
         def on_end(self, ev):
             pass

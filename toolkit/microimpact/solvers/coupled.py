@@ -117,19 +117,20 @@ class CoupledError(SolverError):
     """
 
 
+# helpers compiled as calls, not numba-inlined: see the note in normal_models.py
 @njit(cache=True)
 def _branch_slip(z, hist):
     """s u.e: the contact-point slip along the current branch of the hysteretic law."""
     return hist[0] * ((z[_VT] + z[_WTP]) * hist[2] + (z[_VTP] - z[_WT]) * hist[3])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _load_rate(s, y, xi_dd, c1, c2, ah, aa):
     """dF_n/dsigma of F_n = a_h s^3 (1 + c1 y) - a_a s (1 - c2 y), with ds = y/2, dy = s xi''."""
     return (3.0 * ah * s * s * (1.0 + c1 * y) - aa * (1.0 - c2 * y)) * 0.5 * y + (ah * c1 * s * s * s + aa * c2 * s) * s * xi_dd
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _md_terms(z, p, hist, s, xi_dd, load):
     """(F_lim, dF_lim/dsigma, s s_b u.e) of the hysteretic law at the state z (nondimensional)."""
     c1, c2, ah, aa, f, fpo, aware = p[0], p[1], p[2], p[3], p[4], p[5], p[6] > 0.5
@@ -378,7 +379,7 @@ def _end_at_limit_zero(en, gb, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp):
     return float(_N), True  # accepted; the next step keeps the length h
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref):
     """Sum of the squared scaled errors of a step z -> z1 (the error of p as that of the force it
     makes, see the module docstring)."""
@@ -483,7 +484,7 @@ def _root_state(code, target, h, z, z1, k1, p, hist):
     return zs
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _impulse_time(z, z1, j_stop, tau_j, h, k1, p, hist):
     """tau at which J reaches j_stop within the step z -> z1 of length h (``tau_j`` if known)."""
     if math.isnan(tau_j) and z[_J] < j_stop <= z1[_J]:

@@ -86,19 +86,24 @@ _OK, _MAX_STEPS, _STEP_UNDERFLOW = 0, 1, 2
 _N = 6  # state: z (q or s), y, tau, D, J, J_a
 _MAX_STEPS_DEFAULT = 2_000_000
 
-_jkr_force = njit(inline="always", cache=True)(am.jkr_nondimensional_force)
-_jkr_potential = njit(inline="always", cache=True)(am.jkr_nondimensional_potential)
-_jkr_dissipation = njit(inline="always", cache=True)(am.jkr_nondimensional_dissipation_rate)
-_dmt_force = njit(inline="always", cache=True)(am.dmt_nondimensional_force)
-_dmt_potential = njit(inline="always", cache=True)(am.dmt_nondimensional_potential)
-_dmt_dissipation = njit(inline="always", cache=True)(am.dmt_nondimensional_dissipation_rate)
-_hertz_force = njit(inline="always", cache=True)(am.hertz_nondimensional_force)
-_hertz_potential = njit(inline="always", cache=True)(am.hertz_nondimensional_potential)
-_hertz_dissipation = njit(inline="always", cache=True)(am.hertz_nondimensional_dissipation_rate)
-_dem_force = njit(inline="always", cache=True)(dd.dem_damping_nondimensional_force)
+# The helpers of this solver are compiled as calls, not inlined by numba (``inline="always"``):
+# numba's inlining copies and re-types a helper at every call site (the right-hand side sits in the
+# seven stages of the unrolled step), which made the first JKR impact compile in 21 s instead of 8 s;
+# LLVM still inlines them when it links the kernel, so the compiled code runs as fast and gives the
+# same numbers bit for bit (README, "Compiled kernels").
+_jkr_force = njit(cache=True)(am.jkr_nondimensional_force)
+_jkr_potential = njit(cache=True)(am.jkr_nondimensional_potential)
+_jkr_dissipation = njit(cache=True)(am.jkr_nondimensional_dissipation_rate)
+_dmt_force = njit(cache=True)(am.dmt_nondimensional_force)
+_dmt_potential = njit(cache=True)(am.dmt_nondimensional_potential)
+_dmt_dissipation = njit(cache=True)(am.dmt_nondimensional_dissipation_rate)
+_hertz_force = njit(cache=True)(am.hertz_nondimensional_force)
+_hertz_potential = njit(cache=True)(am.hertz_nondimensional_potential)
+_hertz_dissipation = njit(cache=True)(am.hertz_nondimensional_dissipation_rate)
+_dem_force = njit(cache=True)(dd.dem_damping_nondimensional_force)
 
 # --------------------------------------------------------------------------- compiled core
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _terms(u, args):
     """(d tau/d sigma, dz/d sigma, the net force F, the dissipation rate, the contact radius a) at
     the state u, in the model's units; args = (model, c1, c2, c3, p3)."""
@@ -126,7 +131,7 @@ def _terms(u, args):
     return g, dz, f + fd, p + fd * y, a
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _rhs(u, out, args):
     """d/dsigma of the state u = (z, y, tau, D, J, J_a), written into out."""
     g, dz, f, p, a = _terms(u, args)
@@ -138,13 +143,13 @@ def _rhs(u, out, args):
     out[5] = g * a * abs(f)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _is_jkr(model):
     """Whether the model's state is JKR's q (else DMT's or Hertz's s)."""
     return model == _JKR or model == _JKR_FORCE
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _energy(model, z, y):
     """Contact energy y^2/2 + U(z) in the model's units. [-]"""
     if _is_jkr(model):
@@ -177,7 +182,7 @@ _SLOW_CELLS = 600  # cells of the path, geometric in the distance to the equilib
 _SLOW_DECADES = 12.0  # the path ends 1e-12 of its length before the equilibrium (y_m is then ~0)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _static_and_damping(model, z, c1, c2, c3, p3):
     """(E, C) of F = E(z) + C(z) y: the undamped force and the damping rate (the dissipation rate
     at y = 1). [-]"""
@@ -189,26 +194,26 @@ def _static_and_damping(model, z, c1, c2, c3, p3):
     return _hertz_force(z, 0.0, c1), _hertz_dissipation(z, 1.0, c1) + dem
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _approach(model, z):
     """x = delta / L of the model's z (q^4 - 4 q for JKR, s^2 for DMT). [-]"""
     return z**4 - 4.0 * z if _is_jkr(model) else z * z
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _radius(model, z):
     """Contact radius in the model's unit (q^2 for JKR, s for DMT). [-]"""
     return z * z if _is_jkr(model) else z
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _slow_speed(model, z, c1, c2, c3, p3):
     """y_m(z) = -E / C, the rate on the slow manifold. [-]"""
     e, c = _static_and_damping(model, z, c1, c2, c3, p3)
     return -e / c if c > 0.0 else math.nan  # undamped here (a DEM damping that vanishes with a): no manifold
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _difference_step(model, z):
     """Step of the central differences along the slow path: relative to z for Hertz, whose path
     ends at s = 0 (where x = s^2 is flat in s, so a step larger than z gives a wrong slope)."""
@@ -245,7 +250,7 @@ def _slow_time_between(model, z0, z1, c1, c2, c3, p3):
     return t
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _point_value(model, kind, z, target, ya, c1, c2, c3, p3):
     """What :func:`_slow_point` brings to zero: U(z) - target (kind _EV_U), the energy on the slow
     manifold - target (_EV_ENERGY), or target - |y_m(z) - ya| (_EV_J)."""
