@@ -202,17 +202,19 @@ def test_every_law_passes_the_sweep(law):
     law but the ring law before the JKR/DMT and coupled solvers took the inertia-free limit and the
     closed-form tails; and f = 0 with the pulloff limit (cases 2, 35, 36: omega_out was NaN).
 
-    With rolling resistance the coupled solver still has no closed form of the tail (its torque
-    acts all through it): 10 of the 40 cases, the strongly damped ones and slow, weakly damped
-    captures, end in the step limit. The test holds that line: no other kind of failure and no more
-    cases."""
+    With rolling resistance every case now gets a result (10 of these 40 ended in the step limit
+    before the coupled solver took the closed-form tails under the pulloff friction too). Two
+    captured spheres held by friction (cases 20 and 33) still fail the convergence check: their
+    final rolling depends on where the tail's integration stops (:func:`_rolling_tail` of
+    ``solvers/coupled.py`` says why their tail has no closed form). The test holds that line: no
+    other kind of failure and no more cases."""
     report = stress.stress_sweep(40, seed=0, reference_every=0, law=law)
     s = report.summary
     assert s["law"] == law and s["cases_run"] == 40
-    held = {"mindlin_deresiewicz_pulloff_rolling": 10}
+    held = {"mindlin_deresiewicz_pulloff_rolling": 2}
     if law in held:
         kinds = {k for k, n in s["failures_by_kind"].items() if n}
-        assert kinds <= {"exception"}, s["failed_cases"]
+        assert kinds <= {"convergence"}, s["failed_cases"]
         assert s["cases_failed"] <= held[law], [c["inputs"]["case"] for c in s["failed_cases"]]
     else:
         assert s["cases_failed"] == 0, s["failed_cases"]
