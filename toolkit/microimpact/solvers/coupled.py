@@ -740,7 +740,15 @@ _DEFAULT_MAX_STEPS = 2_000_000
 def stops_at_capture(contact) -> bool:
     """Whether a captured impact of ``contact`` ends at its capture (past the largest penetration):
     a compliant contact with the pulloff limit and no rolling resistance, whose result is then
-    fixed by its angular momentum about the contact point (module docstring)."""
+    fixed by its angular momentum about the contact point (module docstring).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> held = c.with_(tangential_model="mindlin", shear_modulus=0.3 * c.stiffness, friction_model="pulloff")
+    >>> stops_at_capture(held), stops_at_capture(held.with_(rolling_friction=0.01)), stops_at_capture(c)
+    (True, False, False)
+    """
     return contact.tangential_model != "rigid" and contact.friction_model == "pulloff" and contact.rolling_friction == 0.0
 
 

@@ -127,6 +127,15 @@ def engine_scales(contact, normal_speed):
     References
     ----------
     Cheng, Brach & Dunn (2002), Eqs. (28)-(32)
+
+    Examples
+    --------
+    The paper's scales: a_h = a_a = 1, and y0 the incident speed in the unit X/T:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> sc, y0, c1, c2 = engine_scales(c, 2.0)
+    >>> (sc.a_hertz, sc.a_adhesion), round(y0, 4), y0 == 2.0 / sc.speed
+    ((1.0, 1.0), 1.5875, True)
     """
     sc, y0, c1, c2 = nondimensional_impact(contact, normal_speed)
     if type(y0) is float and (y0 <= MAX_ADHESIVE_SPEED or not sc.a_adhesion > 0.0):
