@@ -98,6 +98,10 @@ MUTATIONS = [
      "Dormand-Prince weight b3 (the core's order)"),
     ("solvers/dopri.py", "return math.sqrt(scaled_error_sum(u0, u1, err, atol, rtol, n) / n)",
      "return 1e-3 * math.sqrt(scaled_error_sum(u0, u1, err, atol, rtol, n) / n)", "the core's error norm"),
+    ("solvers/coupled.py", "_rolling_state(states, held, p[0, 8])", "_rolling_state(states, rows, p[0, 8])",
+     "a frictionless captured sphere set rolling"),
+    ("solvers/coupled.py", "loss = p[rows, 8] * p[rows, 10] * j_tail", "loss = p[rows, 10] * j_tail",
+     "rolling resistance of a captured tail without k = m r^2 / I"),
 ]
 
 
