@@ -544,7 +544,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     n_restart = 0
     hysteretic = p[9] > 1.5
     rolling = p[10] > 0.0
-    tail_closed = not rolling or p[6] > 0.5  # a closed form of a captured sphere's tail exists
+    tail_closed = not rolling or p[6] > 0.5  # a captured sphere's tail is taken in closed form
     elastic = 0.5 < p[9] < 1.5  # the elastic Mindlin contact
     # its gross slip (found by the projection at first contact, then by events); a numpy bool, so
     # that _end_at_slip_change is compiled once, not also for the literal False
@@ -687,10 +687,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             # strongly overdamped: it creeps into the equilibrium on the slow manifold, which an
             # explicit solver follows in ~C^2 steps (the step limit at zeta ~ 1e4); the engine's
             # creeping test, and the rest of the normal motion in closed form (_tail_impulses)
-            # (with rolling resistance only under the pulloff friction, which holds the sphere
-            # rolling: its torque then takes the tail's total variation of the normal rate in closed
-            # form, _rolling_tail; under the paper's friction the sphere slides as well, and no closed
-            # form is written)
+            # (with rolling resistance only under the pulloff friction: the tail's rolling resistance
+            # is then taken in closed form for f = 0 and left out for a held sphere, _rolling_tail;
+            # under the paper's friction the sphere slides as well, and no closed form is written)
             if tail_closed and ceq > 2.0 * omega0 and (peaked or z[_S] * z[_S] < xe) and _is_creeping(
                     z, k1, atol[_Y], np.bool_(True), p[0], p[1], ah, aa, xe, omega0, ceq):
                 outcome = _CREEPING
