@@ -42,6 +42,7 @@ comparison uses |omega| (the model's omega_t' is reported too, negative).
 
 from __future__ import annotations
 
+import functools
 import math
 from importlib.resources import files
 from pathlib import Path
@@ -56,11 +57,13 @@ from microimpact.io.materials import default_materials_path, read_materials
 from microimpact.io.files import CONVENTIONS
 from microimpact.io.provenance import materials_parameter_source, stamp_parameters
 from microimpact.io.variables import VARIABLES, attributes
+from microimpact.model.tangential_compliance import MD_UNLOADING_EXPONENTS
 from microimpact.solvers import engine
+from microimpact.solvers.hysteretic_reference import hysteretic_reference
 from microimpact.solvers.impact import simulate_many
 
 __all__ = ["kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
-           "KHARAZ_CONDITIONS"]
+           "KHARAZ_CONDITIONS", "UNLOADING_READINGS"]
 
 #: experimental conditions of the Kharaz et al. (2001) data, SI units
 KHARAZ_CONDITIONS = dict(
@@ -213,7 +216,10 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         (+ ``fitted_friction_stderr``), ``e_n_model``, ``zeta_hertz``, ``rolling_limit`` (5/7) and
         ``transition_angle`` (model sliding/rolling boundary, tan = (7/2) f (1 + e_n)). RMS
         differences per quantity and regime are attributes ``rms_<q>_<sliding|below>[_fitted]``
-        (see :func:`kharaz_summary`).
+        (see :func:`kharaz_summary`). The tangentially compliant models add their variables and
+        RMS with the suffixes ``_compliant`` and ``_hysteretic``; without normal damping (the
+        default), the other readings of a hysteretic turning point held by a falling load add
+        theirs with the suffix ``_md_<reading>`` (:data:`UNLOADING_READINGS`).
     """
     data = read_kharaz(path)
     contact = _base_contact(normal_restitution)
@@ -239,6 +245,8 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
     _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg)
     for suffix in COMPLIANT_MODELS:
         _compare_compliant(ds, data, contact, grid, f_nom, sliding_threshold_deg, suffix)
+    if contact.zeta_hertz == 0.0:  # the readings' integration covers the elastic Hertz contact only
+        _compare_readings(ds, data, contact.with_(tangential_model="mindlin_deresiewicz"), sliding_threshold_deg)
     if contact_models:
         allowed = {"tangential_model", "friction_model", "rolling_friction"}
         unknown = set(contact_models) - allowed
@@ -353,6 +361,86 @@ def _compare_compliant(ds, data, compliant, grid, friction, sliding_threshold_de
         "units": "Pa", "long_name": "effective shear modulus G* of the compliant model (materials config)"})
 
 
+#: the readings of a hysteretic turning point held by a falling load compared beside the solvers'
+#: ("limit", the ``_hysteretic`` variables): suffix ``_md_<reading>`` -> what the held force does
+UNLOADING_READINGS = {
+    "rescaled_displacement": "falls as a^2 (displacement scaled with the contact radius, LAMMPS mindlin_rescale)",
+    "displacement": "falls as a (displacement kept, LAMMPS mindlin)",
+    "force": "kept (Thornton's law read literally at theta = 1, LAMMPS mindlin/force)",
+}
+
+
+#: incidence angles of the readings' curves [deg]: beyond the model's sliding/rolling boundary
+#: (32.8 deg at f = 0.092, e_n = 1) the contact slides throughout, has no turning point, and every
+#: reading is the "limit" curve (``_hysteretic``)
+READING_CURVE_DEG = np.arange(1.0, 35.0001, 1.0)
+
+
+@functools.lru_cache(maxsize=4096)
+def _reading_run(contact, angle, unloading):
+    """:func:`~microimpact.solvers.hysteretic_reference.hysteretic_reference` of the Kharaz impact
+    at this angle [deg] with this reading, at rtol 1e-8 (within 3e-8 of the compiled solver for
+    "limit"); cached, since every comparison of one session integrates the same impacts."""
+    return hysteretic_reference(contact, KHARAZ_CONDITIONS["speed"], angle, unloading=unloading, rtol=1e-8)
+
+
+def _reading_runs(contact, angles, unloading) -> list:
+    """:func:`_reading_run` at these angles [deg]. Where the "limit" run had no turning point the
+    reading is never consulted, and that run is reused."""
+    out = []
+    for a in np.clip(np.asarray(angles, dtype=float), 0.0, 89.999):
+        run = _reading_run(contact, float(a), "limit")
+        out.append(_reading_run(contact, float(a), unloading) if run.slip_ended else run)
+    return out
+
+
+def _reading_quantities(runs, angles) -> dict:
+    """Tangential restitution, rebound spin and rebound angle of these runs."""
+    vel = np.array([r.velocity_out for r in runs]).reshape(-1, 3)
+    omega = np.array([r.omega_out for r in runs]).reshape(-1, 3)
+    vt_in = KHARAZ_CONDITIONS["speed"] * np.sin(np.radians(np.clip(np.asarray(angles, dtype=float), 0.0, 89.999)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        tr = vel[:, 1] / vt_in
+    return {"tangential_restitution": tr, "rebound_spin": np.sqrt((omega**2).sum(axis=1)),
+            "rebound_angle": np.degrees(np.arctan2(vel[:, 1], vel[:, 0]))}
+
+
+def _compare_readings(ds, data, contact, sliding_threshold_deg) -> None:
+    """Add the hysteretic law's other readings of a turning point held by a falling load
+    (:data:`UNLOADING_READINGS`) beside the solvers' ("limit"), from the independent scipy
+    integration: ``q_model_md_<reading>``, ``q_difference_md_<reading>``, ``q_curve_md_<reading>``
+    (on ``reading_incidence_deg``, :data:`READING_CURVE_DEG`) and
+    ``rms_<q>_<regime>_md_<reading>``; ``hysteretic_reference_difference``, the largest
+    |tangential restitution| difference between that integration with the "limit" reading and the
+    compiled solver at the measured angles."""
+    q0 = "tangential_restitution"
+    a0 = data[data["quantity"] == q0]["incidence_angle_deg"].to_numpy()
+    limit = _reading_quantities(_reading_runs(contact, a0, "limit"), a0)[q0]
+    diff = np.abs(limit - ds[f"{q0}_model_hysteretic"].values)
+    ds.attrs["hysteretic_reference_difference"] = float(np.max(diff)) if diff.size else math.nan
+    ds.coords["reading_incidence_deg"] = ("reading_incidence_deg", READING_CURVE_DEG, attributes(
+        "incidence_deg", long_name="incidence angle from the surface normal (curves of the hysteretic readings)"))
+    for reading, what in UNLOADING_READINGS.items():
+        label = f"hysteretic, held turning point's force {what}, friction {contact.friction:g} (scipy integration)"
+        suffix = f"_md_{reading}"
+        curve = _reading_quantities(_reading_runs(contact, READING_CURVE_DEG, reading), READING_CURVE_DEG)
+        for q, (units, long_name) in _QUANTITIES.items():
+            sub = data[data["quantity"] == q]
+            a = sub["incidence_angle_deg"].to_numpy()
+            mod = _reading_quantities(_reading_runs(contact, a, reading), a)[q]
+            ds[f"{q}_curve{suffix}"] = ("reading_incidence_deg", curve[q], {
+                "units": units, "long_name": f"model {long_name}, {label}"})
+            ds[f"{q}_model{suffix}"] = ((q,), mod, {"units": units, "long_name": f"model {long_name}, {label}"})
+            d = mod - sub["value"].to_numpy()
+            ds[f"{q}_difference{suffix}"] = ((q,), d, {"units": units, "long_name": f"{label}: model - measured"})
+            sliding = a > sliding_threshold_deg
+            for regime, mask in (("sliding", sliding), ("below", ~sliding), ("all", np.ones_like(sliding))):
+                ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
+    ds.attrs["unloading_readings"] = "; ".join(
+        ["limit (k = 1, _hysteretic): the held force keeps its ratio to the Coulomb limit (the solvers' law)"]
+        + [f"{r} (k = {MD_UNLOADING_EXPONENTS[r]:.3g}, _md_{r}): the held force {w}" for r, w in UNLOADING_READINGS.items()])
+
+
 def _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg) -> None:
     """Add the scalar results (frictions, e_n, zeta_H, rolling limit, transition angle) to ``ds``."""
     ds["friction"] = ((), f_nom, attributes("friction", long_name="Coulomb friction coefficient of the nominal model (source value)"))
@@ -370,7 +458,9 @@ def _scalars(ds, contact, f_nom, f_fit, f_err, e_n, sliding_threshold_deg) -> No
 def kharaz_summary(ds: xr.Dataset) -> pd.DataFrame:
     """RMS model - measured per quantity and regime as a table: the rigid model with the nominal
     and the fitted friction, and the tangentially compliant models, elastic micro-slip
-    ("compliant") and hysteretic ("hysteretic"), with the nominal friction."""
+    ("compliant") and hysteretic ("hysteretic"), with the nominal friction; ``rms_md_<reading>``
+    the hysteretic law's other readings of a turning point held by a falling load
+    (:data:`UNLOADING_READINGS`, NaN when the comparison has normal damping)."""
     rows = []
     th = ds.attrs["sliding_threshold_deg"]
     for q, (units, _) in _QUANTITIES.items():
@@ -380,7 +470,9 @@ def kharaz_summary(ds: xr.Dataset) -> pd.DataFrame:
                          "rms_nominal_friction": ds.attrs.get(f"rms_{q}_{regime}", math.nan),
                          "rms_fitted_friction": ds.attrs.get(f"rms_{q}_{regime}_fitted", math.nan),
                          "rms_compliant": ds.attrs.get(f"rms_{q}_{regime}_compliant", math.nan),
-                         "rms_hysteretic": ds.attrs.get(f"rms_{q}_{regime}_hysteretic", math.nan)})
+                         "rms_hysteretic": ds.attrs.get(f"rms_{q}_{regime}_hysteretic", math.nan),
+                         **{f"rms_md_{r}": ds.attrs.get(f"rms_{q}_{regime}_md_{r}", math.nan)
+                            for r in UNLOADING_READINGS}})
     return pd.DataFrame(rows)
 
 

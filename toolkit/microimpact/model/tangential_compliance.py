@@ -70,6 +70,41 @@ flat is isotropic and starts from zero force, so the force stays along the initi
 and a scalar law along e is exact (with rolling resistance about another axis, only the slip along
 e is resisted).
 
+A turning point while the load falls (the reading chosen, and the alternatives)
+-------------------------------------------------------------------------------
+Right after a turning point the contact sticks everywhere (theta = 1, p = 0). If the normal load then
+falls faster than the elastic reloading raises the force, the rate above would take p below 0; the
+law needs a rule for the force there, and Thornton (1991) can be read in more than one way. Its
+incremental form has no load term at theta = 1 (s f dL (1 - theta) = 0), which read literally keeps
+the force; its update of the turning point, T* <- T* +- f dL, moves the turning point with the
+limit. The force held at a turning point falls as F_lim^k (:func:`md_held_span_rate`,
+:data:`MD_UNLOADING_EXPONENTS`):
+
+* k = 1, "limit" (chosen; the solvers' law): the force keeps its ratio to the limit, so p is held at
+  0 with c fixed. It is Thornton's own turning-point update applied at the turning point, where
+  force and turning point coincide, and needs no further rule: the force can never leave the limit.
+* k = 2/3, "rescaled_displacement": the stored displacement shrinks with the contact radius (T ~ a^2
+  for Hertz without adhesion, a ~ F_lim^(1/3)), as LAMMPS's ``mindlin_rescale`` does on unloading.
+* k = 1/3, "displacement": the displacement is kept and the stiffness 8 G* a falls (LAMMPS
+  ``mindlin``).
+* k = 0, "force": the force is kept (the literal reading; LAMMPS ``mindlin/force``, the force
+  history of Thornton et al. 2013).
+
+For k < 1 the force falls more slowly than the limit and can reach it; from there it follows the
+limit (c = 2). The energy stored in a stuck Hertz-Mindlin contact is of order T^2 / k_t, which
+scales as a^(6k - 1) while the contact shrinks: for k < 1/6 it GROWS as the load falls, that is the
+contact creates energy. Measured with the independent scipy integration
+(:func:`microimpact.solvers.hysteretic_reference.hysteretic_reference`) on the Kharaz et al. (2001)
+conditions (5 mm alumina on glass, 3.9 m/s, e_n = 1, f = 0.092): the "force" reading returns up to
+22 % MORE tangential kinetic energy than came in (0.1 deg incidence; a gain at every angle up to
+1 deg), the other three never gain. That rules out k = 0 on physical grounds; among the remaining
+ones "limit" is the one that follows from the law itself rather than from a DEM code's bookkeeping.
+The Kharaz comparison shows all four (:mod:`microimpact.analysis.kharaz`, variables
+``*_md_<reading>``): all-angle RMS of the tangential restitution 0.027 (limit), 0.038
+(rescaled_displacement), 0.051 (displacement), 0.064 (force); the readings differ only below about
+10 deg, where the contact sticks before the load peaks. The choice was made before this comparison
+and is not tuned to it.
+
 Rolling resistance
 ------------------
 Optional (``Contact.rolling_friction`` mu_r > 0, off by default): the constant directional torque
@@ -149,6 +184,8 @@ __all__ = [
     "md_force_ratio",
     "md_branch_rate",
     "md_turning_span",
+    "MD_UNLOADING_EXPONENTS",
+    "md_held_span_rate",
     "rolling_deceleration",
 ]
 
@@ -563,6 +600,66 @@ def md_turning_span(force_ratio, new_sign):
     (2.0, 1.0)
     """
     return max(1.0 - new_sign * force_ratio, 1e-9)
+
+
+#: Readings of a turning point held by a falling load (p = 0 while the Coulomb limit falls faster
+#: than the elastic reloading): the force there falls as F_lim^k. "limit" (k = 1, the solvers'
+#: law) keeps T / F_lim; the others are compared with it in :mod:`microimpact.analysis.kharaz`
+#: (:func:`microimpact.solvers.hysteretic_reference.hysteretic_reference`). For a Hertz contact
+#: without adhesion a ~ F_lim^(1/3), so k = 2/3 is the stored displacement scaled with the contact
+#: radius (LAMMPS ``mindlin_rescale``), k = 1/3 the displacement kept (LAMMPS ``mindlin``:
+#: T = 8 G* a delta) and k = 0 the force kept (LAMMPS ``mindlin/force``; Thornton's incremental law
+#: read literally at theta = 1, where its load term s f dL (1 - theta) vanishes). [-]
+MD_UNLOADING_EXPONENTS = {"limit": 1.0, "rescaled_displacement": 2.0 / 3.0, "displacement": 1.0 / 3.0,
+                          "force": 0.0}
+
+
+def md_held_span_rate(branch_span, limit, limit_rate, exponent):
+    """dc/dt of a branch held at its turning point (p = 0) while the Coulomb limit falls. [1/s]
+
+    At p = 0 the force is T = s F_lim (1 - c) (:func:`md_force_ratio`). If T falls as F_lim^k
+    while the limit falls, then (1 - c) ~ F_lim^(k - 1) and
+
+        dc/dt = (1 - k) (1 - c) (dF_lim/dt) / F_lim,
+
+    which is 0 for k = 1 (the force keeps its ratio to the limit, :data:`MD_UNLOADING_EXPONENTS`
+    "limit") and positive for k < 1 (the force falls more slowly than the limit, so the branch
+    span c = 1 - s T / F_lim grows). At c = 2 the force has reached the opposite limit; there it
+    can only follow the limit, and the rate is 0.
+
+    Parameters
+    ----------
+    branch_span : float
+        c of the held branch. [-]
+    limit : float
+        F_lim. [N] or nondimensional
+    limit_rate : float
+        dF_lim/dt, negative while the load falls. [N/s] or nondimensional
+    exponent : float
+        k, the power of F_lim the held force follows (:data:`MD_UNLOADING_EXPONENTS`). [-]
+
+    References
+    ----------
+    Thornton, C. (1991), Interparticle sliding in the presence of adhesion, J. Phys. D
+    24:1942-1946 (the incremental law this reads at theta = 1).
+    Thornton, C., Cummins, S. J. and Cleary, P. W. (2013), An investigation of the comparative
+    behaviour of alternative contact force models during inelastic collisions, Powder Technol.
+    233:30-46, doi:10.1016/j.powtec.2012.08.012 (force-history and rescaled forms).
+
+    Examples
+    --------
+    A force held constant (k = 0) at T = -F_lim / 2 (c = 1.5) while the limit falls by 10 % per
+    second: (1 - c) ~ 1 / F_lim grows in size at 10 % per second, dc/dt = 0.05; the limit reading
+    keeps c, and a branch at the opposite limit stays there:
+
+    >>> round(md_held_span_rate(1.5, 1.0, -0.1, 0.0), 12), md_held_span_rate(1.5, 1.0, -0.1, 1.0)
+    (0.05, 0.0)
+    >>> md_held_span_rate(2.0, 1.0, -0.1, 0.0)
+    0.0
+    """
+    if branch_span >= 2.0 or limit <= 0.0:
+        return 0.0
+    return (1.0 - exponent) * (1.0 - branch_span) * limit_rate / limit
 
 
 def rolling_deceleration(rolling_friction, normal_force, mass):

@@ -82,6 +82,36 @@ def kharaz_section(lay: Layout, kh: xr.Dataset) -> None:
               headers={"nominal": "rigid, nominal f", "fitted": "rigid, fitted f", "compliant": "elastic MS, nom. f",
                        "hysteretic": "hysteretic, nom. f"},
               size=7.2)
+    readings = _kharaz_readings(kh)
+    if len(readings):
+        lay.heading("Hysteretic law: a turning point held by a falling load")
+        lay.paragraph(
+            "Right after a turning point the contact sticks everywhere; when the normal load then falls, "
+            "the force there must follow some rule, and Thornton's (1991) law can be read in several ways. "
+            "The solvers keep the force's ratio to the Coulomb limit (k = 1, 'limit'); the others keep a "
+            "falling share of it, T ~ F_lim^k, as DEM codes do with their tangential history. k = 0 (the "
+            "force kept) makes a shrinking stuck contact create energy (stored energy ~ a^(6k - 1)). The "
+            "alternatives come from an independent scipy integration of the law, whose 'limit' reading "
+            f"reproduces the compiled solver to {kh.attrs.get('hysteretic_reference_difference', math.nan):.1g} "
+            "in the tangential restitution. RMS of the tangential restitution, nominal friction, nothing fitted:")
+        lay.table(readings, {"reading": 22, "k": 6, "held force": 46, "sliding": 9, "below": 9, "all": 9},
+                  size=7.2)
+
+
+def _kharaz_readings(kh: xr.Dataset) -> pd.DataFrame:
+    """RMS of the tangential restitution per reading of a held hysteretic turning point: the
+    solvers' ("limit", ``_hysteretic``) and the ``_md_<reading>`` attributes; empty if absent."""
+    text = kh.attrs.get("unloading_readings", "")
+    rows = []
+    for item in filter(None, (t.strip() for t in text.split(";"))):
+        m = re.fullmatch(r"(\w+) \(k = ([\d.]+), (_\w+)\): the held force (.+)", item)
+        if not m:
+            continue
+        name, k, suffix, what = m.groups()
+        rows.append({"reading": name, "k": k, "held force": what,
+                     **{regime: float(kh.attrs.get(f"rms_tangential_restitution_{regime}{suffix}", math.nan))
+                        for regime in ("sliding", "below", "all")}})
+    return pd.DataFrame(rows, columns=["reading", "k", "held force", "sliding", "below", "all"])
 
 
 def _kharaz_rms(kh: xr.Dataset) -> pd.DataFrame:
