@@ -102,6 +102,13 @@ MUTATIONS = [
      "a frictionless captured sphere set rolling"),
     ("solvers/coupled.py", "loss = p[rows, 8] * p[rows, 10] * j_tail", "loss = p[rows, 10] * j_tail",
      "rolling resistance of a captured tail without k = m r^2 / I"),
+    ("model/tangential_compliance.py", "rate = (branch_slip * stiffness / (1.5 * branch_span)",
+     "rate = (branch_slip * stiffness / (1.4 * branch_span)", "hysteretic branch rate, dT = k_t theta d delta"),
+    ("model/tangential_compliance.py", "(branch_coordinate <= 0.0 and rate < 0.0)",
+     "(branch_coordinate <= -1.0 and rate < 0.0)", "hysteretic turning point held while the load falls"),
+    ("model/tangential_compliance.py", "return (1.0 - exponent) * (1.0 - branch_span) * limit_rate / limit",
+     "return (1.0 - 0.5 * exponent) * (1.0 - branch_span) * limit_rate / limit",
+     "held turning point's force ~ F_lim^k (the readings compared with Kharaz)"),
 ]
 
 

@@ -815,6 +815,11 @@ def plot_work_precision(ds: xr.Dataset) -> Plot:
 
 
 # ----------------------------------------------------------------------------- Kharaz et al. (2001)
+#: the other readings of the hysteretic law drawn in the Kharaz figure (tangential restitution
+#: panel): reading -> (line style, legend text); the table in the report has all of them
+_KHARAZ_READINGS = {"rescaled_displacement": (":", "k = 2/3"), "force": ("-.", "k = 0 (force kept)")}
+
+
 @_rc
 def plot_kharaz(ds: xr.Dataset) -> Plot:
     """Model against the oblique-impact measurements of Kharaz et al. (2001).
@@ -825,7 +830,8 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
         From :func:`microimpact.analysis.kharaz.kharaz_comparison`: model curves ``<q>_curve`` (and
         ``<q>_curve_fitted``, fitted friction, drawn dashed when present; ``<q>_curve_compliant``, the
         tangentially compliant model, drawn green, and ``<q>_curve_hysteretic``, the hysteretic one,
-        drawn orange, when present) on ``curve_incidence_deg``
+        drawn orange, when present) on ``curve_incidence_deg``; ``tangential_restitution_curve_md_<reading>``
+        (other readings of the hysteretic law, thin orange, when present) on ``reading_incidence_deg``
         for q = ``tangential_restitution`` [1], ``rebound_spin`` [rad/s], ``rebound_angle`` [deg];
         measured ``<q>_measured`` at the angles ``<q>_incidence_deg``.
     """
@@ -841,6 +847,7 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
     f_fit = float(ds["fitted_friction"]) if "fitted_friction" in ds else math.nan
     fig = _figure(WIDTH, 2.5)
     axes = np.atleast_1d(fig.subplots(1, len(names)))
+    readings = []  # the other readings' lines, added to the legend
     for k, (ax, name) in enumerate(zip(axes, names)):
         ax.plot(angles, ds[f"{name}_curve"].values, color="C0",
                 label="model" + (f", f = {f:.3g}" if f is not None else ""))
@@ -853,6 +860,10 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
         if f"{name}_curve_hysteretic" in ds:
             ax.plot(angles, ds[f"{name}_curve_hysteretic"].values, color="C1", lw=1.1,
                     label="hysteretic (Mindlin-Deresiewicz)" + (f", f = {f:.3g}" if f is not None else ""))
+        readings += [ax.plot(ds["reading_incidence_deg"].values, ds[f"{name}_curve_md_{reading}"].values,
+                            color="C1", lw=0.8, ls=style, label=f"hysteretic, {text}")[0]
+                    for reading, (style, text) in _KHARAZ_READINGS.items()
+                    if name == "tangential_restitution" and f"{name}_curve_md_{reading}" in ds]
         if f"{name}_measured" in ds:
             ax.plot(ds[f"{name}_incidence_deg"].values, ds[f"{name}_measured"].values, "o", ms=4,
                     color="C3", mfc="none", mew=1.0, label="Kharaz et al. (2001)")
@@ -862,7 +873,9 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
         ax.set_ylabel(labels[name])
         _panel_label(ax, f"({'abc'[k]}) " + name.replace("_", " "))
         ax.set_xlim(0, lim)
-    axes[names.index("rebound_angle") if "rebound_angle" in names else 0].legend(frameon=False, loc="upper left")
+    target = axes[names.index("rebound_angle") if "rebound_angle" in names else 0]
+    handles, texts = target.get_legend_handles_labels()
+    target.legend(handles + readings, texts + [line.get_label() for line in readings], frameon=False, loc="upper left")
     speed = ds.attrs.get("impact_speed")
     zeta = float(ds["zeta_hertz"]) if "zeta_hertz" in ds else None
     e_n = float(ds["e_n_model"]) if "e_n_model" in ds else None
@@ -880,6 +893,9 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
            if any(f"{n}_curve_fitted" in ds for n in names) and math.isfinite(f_fit) else "")
         + ". Below about 30 deg the measurements show effects of tangential compliance that a rigid "
         "Coulomb contact does not have."
+        + (" Thin orange lines: other readings of the hysteretic law at a turning point held by a falling "
+           "load, T ~ F_lim^k (the solvers' law: k = 1)."
+           if any(f"tangential_restitution_curve_md_{r}" in ds for r in _KHARAZ_READINGS) else "")
     )
     return Plot(fig, caption, None)
 
