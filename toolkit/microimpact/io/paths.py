@@ -37,6 +37,14 @@ class PathError(ValueError):
     """A path that a command cannot use; ``option`` and ``path`` name the culprit.
 
     Subclass of ValueError: the command line reports it in one line with exit status 2.
+
+    Examples
+    --------
+    The option and the path come first, so that a command line prints one line that names both:
+
+    >>> err = PathError("--out", "fit.nc", "is a directory")
+    >>> str(err), err.option, isinstance(err, ValueError)
+    ("--out 'fit.nc': is a directory", '--out', True)
     """
 
     def __init__(self, option: str, path, reason: str):
@@ -164,7 +172,20 @@ def _probe(option: str, text: str, directory: Path, name: str, *, make_dir: bool
 
 
 def check_output_dir(option: str, path) -> Path:
-    """``Path(path)`` if it is a writable directory or can be created (with its parents)."""
+    """``Path(path)`` if it is a writable directory or can be created (with its parents).
+
+    Examples
+    --------
+    A directory that does not exist yet is accepted (and not created); a file in its place is not:
+
+    >>> check_output_dir("--out", "results/run1"), Path("results").exists()
+    (PosixPath('results/run1'), False)
+    >>> _ = Path("data.csv").write_text("x")
+    >>> check_output_dir("--out", "data.csv")
+    Traceback (most recent call last):
+    ...
+    microimpact.io.paths.PathError: --out 'data.csv': exists and is not a directory
+    """
     text = _text(option, path)
     p = Path(text)
     _check_lengths(option, text, p)
@@ -228,6 +249,16 @@ def check_outputs(outputs: Mapping[str, object], inputs: Mapping[str, object] | 
     ------
     PathError
         Naming the output option, and the input option it collides with.
+
+    Examples
+    --------
+    >>> _ = Path("impacts.csv").write_text("x")
+    >>> check_outputs({"--out": "fit.nc", "--report": None}, {"DATA": "impacts.csv"})
+    {'--out': PosixPath('fit.nc')}
+    >>> check_outputs({"--out": "impacts.csv"}, {"DATA": "impacts.csv"})
+    Traceback (most recent call last):
+    ...
+    microimpact.io.paths.PathError: --out 'impacts.csv': is the input DATA ('impacts.csv'); an output never replaces an input: ...
     """
     given = {k: v for k, v in outputs.items() if v is not None}
     checked = {k: check_output_file(k, v) for k, v in given.items()}
@@ -274,7 +305,16 @@ def _culprit(outputs: Mapping[str, object], filename) -> tuple[str, object]:
 @contextlib.contextmanager
 def reporting_os_errors(outputs: Mapping[str, object]) -> Iterator[None]:
     """Turn an OSError raised inside the block (writing ``outputs``: option name -> path) into a
-    :class:`PathError` that names the option and the path it was writing."""
+    :class:`PathError` that names the option and the path it was writing.
+
+    Examples
+    --------
+    >>> with reporting_os_errors({"--out": "missing/dir/fit.nc"}):
+    ...     _ = open("missing/dir/fit.nc", "w")
+    Traceback (most recent call last):
+    ...
+    microimpact.io.paths.PathError: --out 'missing/dir/fit.nc': cannot write: No such file or directory
+    """
     try:
         yield
     except PathError:

@@ -58,7 +58,15 @@ INTERNAL_UNIT: MappingProxyType = MappingProxyType(
 
 
 class UnitError(ValueError):
-    """A unit that is not in :data:`UNITS` for the dimension asked for."""
+    """A unit that is not in :data:`UNITS` for the dimension asked for.
+
+    Examples
+    --------
+    >>> to_internal([1.0], "furlong", "length")
+    Traceback (most recent call last):
+    ...
+    microimpact.io.units.UnitError: unit 'furlong' is not accepted for a length; accepted units: m, mm, um, ...
+    """
 
 
 def _normalise(unit: str) -> str:

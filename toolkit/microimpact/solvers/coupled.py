@@ -117,6 +117,13 @@ class CoupledError(SolverError):
 
     Not expected for valid input: every impact ends by separation or by the settle criterion of
     the module docstring; this error reports a solver defect, with the normal speed of the impact.
+
+    Examples
+    --------
+    One ``except`` catches the failure of any solver:
+
+    >>> issubclass(CoupledError, SolverError), issubclass(CoupledError, RuntimeError)
+    (True, True)
     """
 
 

@@ -114,7 +114,15 @@ _Q_BREAK = am.JKR_Q_BREAK["jkr_force"]
 
 
 class DemTangentialError(SolverError):
-    """The DEM tangential integration did not reach the end of the contact (step budget, chattering)."""
+    """The DEM tangential integration did not reach the end of the contact (step budget, chattering).
+
+    Examples
+    --------
+    One ``except`` catches the failure of any solver:
+
+    >>> issubclass(DemTangentialError, SolverError), issubclass(DemTangentialError, RuntimeError)
+    (True, True)
+    """
 
 
 def uses_dem_tangential(contact) -> bool:

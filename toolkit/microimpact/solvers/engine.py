@@ -216,7 +216,20 @@ def _failure(status) -> str:
 class EngineError(SolverError):
     """The compiled solver could not finish an impact (a caller's step limit, step-size underflow,
     or a result that failed its own check). Not raised for valid input at the default step limit:
-    the stress sweep of the extended domain checks this."""
+    the stress sweep of the extended domain checks this.
+
+    Examples
+    --------
+    A step limit far below what an impact needs (the default is 2,000,000):
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> solve_normal_many(c, [1.0], max_steps=5)
+    Traceback (most recent call last):
+    ...
+    microimpact.solvers.engine.EngineError: engine failed for normal speed 1.0 m/s: step limit reached
+    >>> issubclass(EngineError, SolverError)  # one ``except SolverError`` catches every solver's failure
+    True
+    """
 
 
 # --------------------------------------------------------------------------- compiled core

@@ -128,7 +128,15 @@ _S, _Y, _VT, _VTP, _WN, _WT, _WTP, _D, _J, _TAU = range(10)
 
 
 class ReferenceSolverError(SolverError):
-    """The reference integration failed or ran out of time without an outcome."""
+    """The reference integration failed or ran out of time without an outcome.
+
+    Examples
+    --------
+    One ``except`` catches the failure of any solver:
+
+    >>> issubclass(ReferenceSolverError, SolverError), issubclass(ReferenceSolverError, RuntimeError)
+    (True, True)
+    """
 
 
 # --------------------------------------------------------------------------- validation
