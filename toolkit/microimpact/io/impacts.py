@@ -231,6 +231,19 @@ class ImpactDataError(ValueError):
     problems : tuple of Problem
         All problems, in the order found (the message lists the first
         :data:`MAX_LISTED_PROBLEMS`).
+
+    Examples
+    --------
+    Every problem is reported at once, each naming its line and column:
+
+    >>> from pathlib import Path
+    >>> _ = Path("i.csv").write_text("radius [m],normal_speed [m/s],e_n [1]\\n1e-6,1.0,abc\\n")
+    >>> try:
+    ...     read_impacts("i.csv")
+    ... except ImpactDataError as err:
+    ...     print(err.source); print(str(err).splitlines()[1])
+    i.csv
+      - i.csv, row 1 (line 2), column 'e_n [1]', value 'abc': is not a number; ...
     """
 
     def __init__(self, source: str, problems):

@@ -85,7 +85,21 @@ MATERIALS_SCHEMA: dict = {
 
 
 class MaterialsError(ValueError):
-    """A materials config that cannot be used; the message lists every problem with its key path."""
+    """A materials config that cannot be used; the message lists every problem with its key path.
+
+    Examples
+    --------
+    Every problem of the file is listed, each with its key path:
+
+    >>> from pathlib import Path
+    >>> _ = Path("m.yaml").write_text("pairs:\\n  a: {density: -1}\\n")
+    >>> try:
+    ...     read_materials("m.yaml")
+    ... except MaterialsError as err:
+    ...     print(err.source, len(err.problems)); print(err.problems[-1])
+    m.yaml 3
+    m.yaml: pairs.a.density: -1 is not > 0
+    """
 
     def __init__(self, source: str, problems: list[str]):
         self.source = str(source)

@@ -76,7 +76,17 @@ NO_FIGURE = {
 
 
 class UnknownResultError(ValueError):
-    """A file that is not a microimpact result file, or one without a standard figure."""
+    """A file that is not a microimpact result file, or one without a standard figure.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> _ = Path("x.nc").write_text("not netcdf")
+    >>> result_kind("x.nc")
+    Traceback (most recent call last):
+    ...
+    microimpact.report.standard.UnknownResultError: x.nc: not a readable NetCDF result file: it is a text file
+    """
 
 
 def _unreadable(path) -> str:

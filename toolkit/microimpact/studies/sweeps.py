@@ -86,7 +86,15 @@ _META_KEYS = ("description", "chunk")
 
 
 class SweepSpecError(ValueError):
-    """A sweep spec is malformed; the message names the key and says what is accepted."""
+    """A sweep spec is malformed; the message names the key and says what is accepted.
+
+    Examples
+    --------
+    >>> resolve_spec({"speed": "fast"})
+    Traceback (most recent call last):
+    ...
+    microimpact.studies.sweeps.SweepSpecError: spec['speed']: the value must be a number, got the text 'fast'
+    """
 
 
 # ----------------------------------------------------------------------------- spec handling
