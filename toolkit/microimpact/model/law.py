@@ -405,6 +405,19 @@ class Scales:
         T_c: T of Eq. (30) (corrected) with adhesion, else t* = x* / v. [s]
     a_hertz, a_adhesion : float
         a_h, a_a of :func:`nondimensional_acceleration`: 1, 1 or 5/4, 0. [-]
+
+    Examples
+    --------
+    With adhesion the length is X = 2 pi f0 / K of Eq. (29); without it the Hertz x* and time x* / v:
+
+    >>> import math
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> s = nondimensional_scales(c, 1.0)
+    >>> round(s.length / (2 * math.pi * c.adhesion_line_force / c.stiffness), 12), s.a_hertz, s.a_adhesion
+    (1.0, 1.0, 1.0)
+    >>> h = nondimensional_scales(c.with_(adhesion_line_force=0.0), 2.0)
+    >>> round(h.time * 2.0 / h.length, 12), h.a_hertz, h.a_adhesion
+    (1.0, 1.25, 0.0)
     """
 
     length: float

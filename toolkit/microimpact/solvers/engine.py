@@ -1245,6 +1245,20 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     Dormand & Prince (1980)
 
     Hairer, Norsett & Wanner (1993), Secs. II.5-II.6
+
+    Examples
+    --------
+    An elastic Hertz impact (no adhesion, no damping) rebounds with e_n = 1 after the contact time
+    2 B(2/5, 1/2) / (5/2) x_max / v = 2.94328 x_max / v, x_max = (5 m v^2 / (4 k))^(2/5):
+
+    >>> import math
+    >>> from scipy.special import beta
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> h = c.with_(zeta_hertz=0.0, zeta_adhesion=0.0, adhesion_line_force=0.0)
+    >>> r = solve_normal_many(h, [0.5, 2.0])
+    >>> x_max = (1.25 * h.mass * 2.0**2 / (math.sqrt(h.radius) * h.stiffness)) ** 0.4
+    >>> r["e_n"].tolist(), round(float(r["contact_time"][1]) * 2.0 / x_max / (0.8 * beta(0.4, 0.5)), 7)
+    ([1.0, 1.0], 1.0)
     """
     v = np.ascontiguousarray(normal_speed, dtype=float).ravel()
     if v.size and (not np.all(np.isfinite(v)) or np.any(v <= 0.0)):
