@@ -1257,7 +1257,7 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     >>> h = c.with_(zeta_hertz=0.0, zeta_adhesion=0.0, adhesion_line_force=0.0)
     >>> r = solve_normal_many(h, [0.5, 2.0])
     >>> x_max = (1.25 * h.mass * 2.0**2 / (math.sqrt(h.radius) * h.stiffness)) ** 0.4
-    >>> r["e_n"].tolist(), round(float(r["contact_time"][1]) * 2.0 / x_max / (0.8 * beta(0.4, 0.5)), 7)
+    >>> r["e_n"].tolist(), round(float(r["contact_time"][1] * 2.0 / x_max / (0.8 * beta(0.4, 0.5))), 7)
     ([1.0, 1.0], 1.0)
     """
     v = np.ascontiguousarray(normal_speed, dtype=float).ravel()
