@@ -180,6 +180,23 @@ def atomic_path(path) -> Iterator[Path]:
     ------
     FileNotFoundError
         If the directory of ``path`` does not exist, or the block created no file.
+
+    Examples
+    --------
+    The file appears only when the block ends normally; an interrupted write leaves nothing:
+
+    >>> with atomic_path("a.txt") as tmp:
+    ...     _ = tmp.write_text("done")
+    >>> Path("a.txt").read_text()
+    'done'
+    >>> try:
+    ...     with atomic_path("b.txt") as tmp:
+    ...         _ = tmp.write_text("half")
+    ...         raise KeyboardInterrupt
+    ... except KeyboardInterrupt:
+    ...     pass
+    >>> sorted(p.name for p in Path(".").iterdir() if p.name.startswith("b"))
+    []
     """
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
@@ -519,6 +536,16 @@ def write_netcdf_groups(groups: Mapping, path) -> Path:
     ------
     ValueError
         If no group is given, or an integer variable holds values outside the int32 range.
+
+    Examples
+    --------
+    >>> import numpy as np, xarray as xr, netCDF4
+    >>> fit = xr.Dataset({"e_n": ("speed", np.array([0.5, 0.6]))}, coords={"speed": [1.0, 2.0]})
+    >>> flags = xr.Dataset({"flag": ("row", np.array([True, False]))})
+    >>> _ = write_netcdf_groups({None: fit, "flags": flags}, "r.nc")
+    >>> with netCDF4.Dataset("r.nc") as nc:
+    ...     print(nc.Conventions, list(nc.groups), nc["e_n"].units, nc["flags"]["flag"].dtype)
+    CF-1.10 ['flags'] 1 int8
     """
     import xarray as xr
 
@@ -584,6 +611,17 @@ def read_netcdf_groups(path) -> list:
     list of xarray.Dataset
         One Dataset per group with variables (the root first if it has any), with its own
         coordinates and attributes.
+
+    Examples
+    --------
+    A round trip (booleans come back as the int8 they are stored as):
+
+    >>> import numpy as np, xarray as xr
+    >>> fit = xr.Dataset({"e_n": ("speed", np.array([0.5, 0.6]))}, coords={"speed": [1.0, 2.0]})
+    >>> flags = xr.Dataset({"flag": ("row", np.array([True, False]))})
+    >>> root, group = read_netcdf_groups(write_netcdf_groups({None: fit, "flags": flags}, "r.nc"))
+    >>> root["e_n"].values.tolist(), root["speed"].values.tolist(), group["flag"].values.tolist()
+    ([0.5, 0.6], [1.0, 2.0], [1, 0])
     """
     # imported here: io.files serves every writer, also the CSV-only ones, which need neither
     import netCDF4

@@ -25,7 +25,16 @@ _REDRAW_S = 0.1
 
 
 def wants_progress(progress) -> bool:
-    """Whether a bar should be drawn: ``progress`` is True (or a truthy flag) and stderr is a terminal."""
+    """Whether a bar should be drawn: ``progress`` is True (or a truthy flag) and stderr is a terminal.
+
+    Examples
+    --------
+    Never when not asked for, and not when stderr is not a terminal (as under doctest, in a pipe or a
+    log file):
+
+    >>> wants_progress(False), wants_progress(True)
+    (False, False)
+    """
     if not progress:
         return False
     try:
@@ -53,6 +62,18 @@ def progress_bar(total: int, label: str, enabled=True):
         Shown before the bar.
     enabled : bool
         The caller's wish (e.g. the CLI passes True); a bar is drawn only on a terminal.
+
+    Examples
+    --------
+    Off a terminal (here stderr is a string buffer) the bar is not drawn and ``advance`` only counts:
+
+    >>> import contextlib, io
+    >>> err = io.StringIO()
+    >>> with contextlib.redirect_stderr(err), progress_bar(3, "cases", enabled=True) as advance:
+    ...     for _ in range(3):
+    ...         advance()
+    >>> err.getvalue()
+    ''
     """
     if not wants_progress(enabled):
         yield lambda n=1: None
