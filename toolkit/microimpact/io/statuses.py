@@ -44,6 +44,19 @@ class ParameterStatus:
         Why, in the terms of the data (empty for an ordinary determined parameter).
     method : str
         How the interval was found: ``profile`` or ``covariance``.
+
+    Examples
+    --------
+    A parameter the data bound from below only is printed as a bound, never as a number:
+
+    >>> s = ParameterStatus("friction", "lower_bound", math.nan, 0.27, 10.0,
+    ...                     reason="every impact ends in rolling above it")
+    >>> s.determined, s.contains(0.5), s.contains(0.1)
+    (False, True, False)
+    >>> s.describe()
+    'friction >= 0.27 (95 % bound; no upper limit up to 10 from these data): every impact ends ...'
+    >>> ParameterStatus("zeta_hertz", "determined", 0.5, 0.45, 0.56).describe()
+    'zeta_hertz = 0.5, 95 % interval [0.45, 0.56]'
     """
 
     name: str
@@ -178,6 +191,16 @@ def status_from_variables(ds, name: str, value: float) -> ParameterStatus | None
         Parameter name.
     value : float
         The stored estimate (used where the status is ``determined``).
+
+    Examples
+    --------
+    A round trip through the file's variables:
+
+    >>> import xarray as xr
+    >>> s = ParameterStatus("friction", "lower_bound", math.nan, 0.27, 10.0, reason="all roll above it")
+    >>> back = status_from_variables(xr.Dataset(status_variables(s, "1")), "friction", math.nan)
+    >>> back.status, back.lower, back.upper, back.reason
+    ('lower_bound', 0.27, 10.0, 'all roll above it')
     """
     if f"{name}_status" not in ds:
         return None
