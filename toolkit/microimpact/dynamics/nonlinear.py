@@ -568,6 +568,18 @@ class CaptureBracket:
         Stopping rule: rebound_speed - captured_speed <= xtol + rtol * rebound_speed. [m/s], [-]
     evaluations : int
         Number of normal solves.
+
+    Examples
+    --------
+    The bracket of the paper's microsphere closes within its stopping rule, and the rebound at its
+    upper end barely leaves (e_n tends to 0 at the capture velocity):
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> b = capture_bracket(c)
+    >>> b.rebound_speed - b.captured_speed <= b.xtol + b.rtol * b.rebound_speed, b.rebound_e_n < 1e-3
+    (True, True)
+    >>> round(b.captured_speed, 6)
+    1.449241
     """
 
     captured_speed: float

@@ -135,6 +135,18 @@ class AdhesionRegimeWarning(UserWarning):
     JKR is meant for mu_T > ~5 (compliant, large, strongly adhering contacts), DMT for mu_T < ~0.1
     (stiff, small, weakly adhering ones) (Johnson & Greenwood 1997). Outside, the results are a
     model's extrapolation; the warning names the contact's mu_T and the regime.
+
+    Examples
+    --------
+    The paper's microsphere is a JKR contact (mu_T = 11.2); DMT is outside its regime there:
+
+    >>> import warnings
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     _ = check_adhesion_regime(c.with_(normal_model="dmt"))
+    >>> caught[0].category.__name__, str(caught[0].message)
+    ('AdhesionRegimeWarning', "normal_model='dmt' with Tabor parameter mu_T = 11.2 > 0.1 (z0 = 4e-10 m): outside the DMT regime (Johnson & Greenwood 1997)")
     """
 
 
@@ -152,6 +164,21 @@ class AdhesionScales:
         sqrt(m L / F). [s]
     radius : float
         Contact radius unit: a_c (JKR: a = a_c q^2) or sqrt(R L_D) (DMT: a = sqrt(R L_D) s). [m]
+
+    Examples
+    --------
+    The JKR force unit is pi w R (DMT: 2 pi w R), the contact-radius unit a_c with L_J = a_c^2 / R, and
+    the time unit sqrt(m L / F):
+
+    >>> import math
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> s = adhesion_scales(c.with_(normal_model="jkr"))
+    >>> round(s.force / (math.pi * c.work_of_adhesion * c.radius), 12), round(s.radius**2 / c.radius / s.length, 12)
+    (1.0, 1.0)
+    >>> round(s.time**2 * s.force / (c.mass * s.length), 12)
+    1.0
+    >>> round(adhesion_scales(c.with_(normal_model="dmt")).force / (2 * math.pi * c.work_of_adhesion * c.radius), 12)
+    1.0
     """
 
     length: float
