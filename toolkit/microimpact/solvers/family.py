@@ -92,7 +92,16 @@ _OUTPUTS = (("e_n_squared", False), ("time", True), ("max_penetration", True), (
 
 
 class FamilyBudgetExceeded(RuntimeError):
-    """The family would need more normal solves than the budget (solving directly is cheaper)."""
+    """The family would need more normal solves than the budget (solving directly is cheaper).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> normal_family(c, 0.5, 20.0, max_solves=5)
+    Traceback (most recent call last):
+    ...
+    microimpact.solvers.family.FamilyBudgetExceeded: the family needs more than 5 normal solves
+    """
 
 
 def _lobatto_matrix(n: int) -> np.ndarray:
@@ -282,6 +291,20 @@ class NormalFamily:
         (absolute or relative as above). [-]
     restitution_only : bool
         Only e_n (and the outcome) is interpolated; the other outputs are NaN.
+
+    Examples
+    --------
+    A family of a damped Hertz contact over 1-10 m/s interpolates the direct solves within its
+    tolerance:
+
+    >>> import numpy as np
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> from microimpact.solvers.engine import solve_normal_many
+    >>> h = c.with_(adhesion_line_force=0.0, zeta_adhesion=0.0)
+    >>> fam = normal_family(h, 1.0, 10.0, rtol=1e-6)
+    >>> v = np.array([1.5, 3.0, 7.0])
+    >>> fam.capture_speeds, bool(np.max(np.abs(fam.evaluate(v)["e_n"] - solve_normal_many(h, v)["e_n"])) < 1e-6)
+    ((), True)
     """
 
     contact: object

@@ -713,6 +713,15 @@ class ReferenceTrajectory:
         "rebound", "capture" or "in contact" (duration reached before either).
     capture_time : float
         Time at which E first fell below 0; NaN if it did not. [s]
+
+    Examples
+    --------
+    See :func:`reference_trajectory`; the arrays share the solver's time points:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> tr = reference_trajectory(c, 1.0)  # below the capture velocity, 1.449 m/s
+    >>> len(tr.time) == len(tr.penetration) == len(tr.energy), tr.outcome
+    (True, 'capture')
     """
 
     time: np.ndarray
@@ -760,6 +769,20 @@ def reference_trajectory(
     Virtanen, P. et al. (2020), SciPy 1.0: fundamental algorithms for scientific computing in
     Python, Nat. Methods 17:261-272, doi:10.1038/s41592-019-0686-2 (``solve_ivp``, DOP853,
     ``brentq``)
+
+    Examples
+    --------
+    An elastic Hertz impact: no energy dissipated, contact time 2.94328 x_max / v (x_max =
+    (5 m v^2 / (4 k))^(2/5)); the largest penetration among the solver's steps is a little short of
+    x_max (the steps do not land on it):
+
+    >>> import math
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> h = c.with_(zeta_hertz=0.0, zeta_adhesion=0.0, adhesion_line_force=0.0)
+    >>> tr = reference_trajectory(h, 1.0)
+    >>> x_max = (1.25 * h.mass / (math.sqrt(h.radius) * h.stiffness)) ** 0.4
+    >>> tr.outcome, round(float(tr.time[-1]) / x_max, 6), float(tr.dissipated_energy[-1]), bool(tr.penetration.max() <= x_max)
+    ('rebound', 2.943275, 0.0, True)
     """
     normal_speed = _validate_speed("normal_speed", normal_speed)
     rtol, atol, _ = _validate_common(rtol, atol, None)
