@@ -136,6 +136,17 @@ class MaterialPair:
         E / (2 (1 + nu)) (:attr:`effective_shear_modulus`). [Pa]
     description, reference : str
         Free text.
+
+    Examples
+    --------
+    A pair of the bundled config and the contact it gives at a radius:
+
+    >>> pair = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> pair.density, pair.work_of_adhesion, pair.friction
+    (1350.0, 0.215834, 0.15)
+    >>> c = pair.contact(3.45e-6)
+    >>> c.radius, c.stiffness == pair.stiffness, round(c.work_of_adhesion / pair.work_of_adhesion, 12)
+    (3.45e-06, True, 1.0)
     """
 
     name: str
