@@ -29,7 +29,17 @@ __all__ = ["contact_attributes", "stamp_parameters", "fit_parameter_source", "so
 
 
 def contact_attributes(contacts: Contact | Sequence[Contact]) -> dict:
-    """``contact_<field>`` attributes of one contact (floats) or of one contact per size (arrays)."""
+    """``contact_<field>`` attributes of one contact (floats) or of one contact per size (arrays).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> a = contact_attributes(c)
+    >>> a["contact_radius"], a["contact_normal_model"], a["contact_damping_reference_speed"]
+    (3.45e-06, 'ring', 'per-impact normal speed')
+    >>> contact_attributes([c, c.with_(radius=1e-6)])["contact_radius"].tolist()  # one per size
+    [3.45e-06, 1e-06]
+    """
     many = not isinstance(contacts, Contact)
     group = list(contacts) if many else [contacts]
     attrs = {}
@@ -47,7 +57,19 @@ def contact_attributes(contacts: Contact | Sequence[Contact]) -> dict:
 
 
 def stamp_parameters(ds: xr.Dataset, contacts: Contact | Sequence[Contact], source: str) -> xr.Dataset:
-    """A copy of ``ds`` with the ``contact_*`` attributes of ``contacts`` and ``parameter_source``."""
+    """A copy of ``ds`` with the ``contact_*`` attributes of ``contacts`` and ``parameter_source``.
+
+    Examples
+    --------
+    The Dataset passed in is not modified:
+
+    >>> import xarray as xr
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> ds = xr.Dataset()
+    >>> out = stamp_parameters(ds, c, preset_parameter_source("paper"))
+    >>> out.attrs["parameter_source"], out.attrs["contact_density"], len(ds.attrs)
+    ('preset: paper', 1350.0, 0)
+    """
     out = ds.copy()
     out.attrs.update(contact_attributes(contacts))
     out.attrs["parameter_source"] = source
@@ -70,7 +92,16 @@ def fit_parameter_source(source, sha256) -> str:
 
 
 def source_of_fit(fit: xr.Dataset) -> str:
-    """The ``parameter_source`` of a fit Dataset (``DampingFit.to_dataset`` or its file)."""
+    """The ``parameter_source`` of a fit Dataset (``DampingFit.to_dataset`` or its file).
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> source_of_fit(xr.Dataset(attrs={"fit_source": "impacts.csv", "fit_sha256": "ab" * 32}))[:28]
+    'fit: impacts.csv abababababa'
+    >>> source_of_fit(xr.Dataset(attrs={"parameter_source": "preset: wall1990"}))
+    'preset: wall1990'
+    """
     return fit.attrs.get("parameter_source") or fit_parameter_source(fit.attrs.get("fit_source"),
                                                                      fit.attrs.get("fit_sha256"))
 
