@@ -199,6 +199,16 @@ class Problem:
         Header field as written in the file.
     value : str or None
         The offending cell or header text as written.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> _ = Path("k.csv").write_text("radius [m],normal_speed [m/s],e_n [1]\\n1e-6,-1.0,0.5\\n")
+    >>> try:
+    ...     read_impacts("k.csv")
+    ... except ImpactDataError as err:
+    ...     print(err.problems[0])
+    Problem(message='must be > 0 (speeds are magnitudes)', row=1, line=2, column='normal_speed [m/s]', value='-1.0')
     """
 
     message: str
@@ -260,7 +270,24 @@ class ImpactDataError(ValueError):
 
 
 class ImpactDataWarning(UserWarning):
-    """Something in an impact file that was ignored (e.g. an unknown column)."""
+    """Something in an impact file that was ignored (e.g. an unknown column).
+
+    Examples
+    --------
+    A measurement is data: e_n = 1.004 +/- 0.01 is kept as measured, with a warning naming its row:
+
+    >>> import warnings
+    >>> from pathlib import Path
+    >>> _ = Path("w.csv").write_text("radius [m],normal_speed [m/s],e_n [1],e_n_uncertainty [1]\\n"
+    ...                              "1e-6,1.0,1.004,0.01\\n1e-6,2.0,0.6,0.01\\n")
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     table = read_impacts("w.csv")
+    >>> table["e_n"].tolist(), caught[0].category.__name__
+    ([1.004, 0.6], 'ImpactDataWarning')
+    >>> str(caught[0].message)
+    'w.csv: 1 measurement(s) outside the physical range by no more than 4 stated standard uncertainties, kept as measured (e_n [1]: rows 1)'
+    """
 
 
 # --------------------------------------------------------------------------- bytes and text
@@ -1244,7 +1271,18 @@ def label_variables(labels: pd.DataFrame, dim: str) -> dict:
 
 
 def labels_from_dataset(ds, dim: str) -> pd.DataFrame:
-    """The labels :func:`label_variables` wrote along ``dim``, as :func:`row_labels` gives them."""
+    """The labels :func:`label_variables` wrote along ``dim``, as :func:`row_labels` gives them.
+
+    Examples
+    --------
+    The inverse of :func:`label_variables`:
+
+    >>> import xarray as xr
+    >>> t = pd.DataFrame({"id": ["a", "b"], "batch no.": ["7", "8"]})
+    >>> ds = xr.Dataset(label_variables(t, "point"))
+    >>> labels_from_dataset(ds, "point").to_dict("list")
+    {'id': ['a', 'b'], 'batch no.': ['7', '8']}
+    """
     cols = {}
     for name, var in ds.data_vars.items():
         if var.dims == (dim,) and (name == "id" or CSV_COLUMN_ATTR in var.attrs):
