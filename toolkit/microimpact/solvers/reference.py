@@ -716,12 +716,17 @@ class ReferenceTrajectory:
 
     Examples
     --------
-    See :func:`reference_trajectory`; the arrays share the solver's time points:
+    An elastic Hertz impact: no energy dissipated, contact time 2.94328 x_max / v (x_max =
+    (5 m v^2 / (4 k))^(2/5)); the largest penetration among the solver's steps is a little short of
+    x_max (the steps do not land on it):
 
+    >>> import math
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
-    >>> tr = reference_trajectory(c, 1.0)  # below the capture velocity, 1.449 m/s
-    >>> len(tr.time) == len(tr.penetration) == len(tr.energy), tr.outcome
-    (True, 'capture')
+    >>> h = c.with_(zeta_hertz=0.0, zeta_adhesion=0.0, adhesion_line_force=0.0)
+    >>> tr = reference_trajectory(h, 1.0)
+    >>> x_max = (1.25 * h.mass / (math.sqrt(h.radius) * h.stiffness)) ** 0.4
+    >>> tr.outcome, round(float(tr.time[-1]) / x_max, 6), float(tr.dissipated_energy[-1]), bool(tr.penetration.max() <= x_max)
+    ('rebound', 2.943275, 0.0, True)
     """
 
     time: np.ndarray
@@ -733,16 +738,9 @@ class ReferenceTrajectory:
     capture_time: float
 
 
-def reference_trajectory(
-    contact: Contact,
-    normal_speed: float,
-    *,
-    duration: float | None = None,
-    rtol: float = DEFAULT_RTOL,
-    atol: float = 1e-13,
-    method: str = "DOP853",
-    max_step: float = math.inf,
-) -> ReferenceTrajectory:
+def reference_trajectory(contact: Contact, normal_speed: float, *, duration: float | None = None,
+                         rtol: float = DEFAULT_RTOL, atol: float = 1e-13, method: str = "DOP853",
+                         max_step: float = math.inf) -> ReferenceTrajectory:
     """Normal motion, Eq. (27), of an impact at the solver's steps.
 
     The normal motion does not depend on the tangential state, so only (xi, y, D) are integrated.
@@ -772,17 +770,12 @@ def reference_trajectory(
 
     Examples
     --------
-    An elastic Hertz impact: no energy dissipated, contact time 2.94328 x_max / v (x_max =
-    (5 m v^2 / (4 k))^(2/5)); the largest penetration among the solver's steps is a little short of
-    x_max (the steps do not land on it):
+    The arrays share the solver's time points:
 
-    >>> import math
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
-    >>> h = c.with_(zeta_hertz=0.0, zeta_adhesion=0.0, adhesion_line_force=0.0)
-    >>> tr = reference_trajectory(h, 1.0)
-    >>> x_max = (1.25 * h.mass / (math.sqrt(h.radius) * h.stiffness)) ** 0.4
-    >>> tr.outcome, round(float(tr.time[-1]) / x_max, 6), float(tr.dissipated_energy[-1]), bool(tr.penetration.max() <= x_max)
-    ('rebound', 2.943275, 0.0, True)
+    >>> tr = reference_trajectory(c, 1.0)  # below the capture velocity, 1.449 m/s
+    >>> len(tr.time) == len(tr.penetration) == len(tr.energy), tr.outcome
+    (True, 'capture')
     """
     normal_speed = _validate_speed("normal_speed", normal_speed)
     rtol, atol, _ = _validate_common(rtol, atol, None)
