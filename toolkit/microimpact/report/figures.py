@@ -106,6 +106,13 @@ class Plot:
         Plain-text caption (what is plotted, units, line styles, data provenance).
     paper_figure : str or None
         Number of the paper's figure this is an analogue of, e.g. "7".
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> p = Plot(Figure(), "An empty figure.")
+    >>> len(p.figure.axes), p.caption, p.paper_figure
+    (0, 'An empty figure.', None)
     """
 
     figure: Figure
@@ -783,6 +790,19 @@ def plot_work_precision(ds: xr.Dataset) -> Plot:
         Dimensions ``method`` (labels) and ``setting`` (e.g. tolerance levels); variables
         ``time_per_impact`` [s], ``max_error_e_n`` [-] and ``max_error_mu`` [-] on (method, setting).
         Non-positive or missing values are left out (log axes).
+
+    Examples
+    --------
+    Two error variables give two panels with log axes.
+
+    >>> import xarray as xr
+    >>> ds = xr.Dataset(
+    ...     {k: (("method", "setting"), [[1e-3, 1e-2], [2e-3, 2e-2]])
+    ...      for k in ("time_per_impact", "max_error_e_n", "max_error_mu")},
+    ...     coords={"method": ["a", "b"], "setting": [1e-6, 1e-8]})
+    >>> p = plot_work_precision(ds)
+    >>> len(p.figure.axes), p.figure.axes[0].get_xlabel(), p.figure.axes[0].get_yscale()
+    (2, 'time per impact [s]', 'log')
     """
     errors = [k for k in ("max_error_e_n", "max_error_mu") if k in ds]
     if "time_per_impact" not in ds or not errors:

@@ -74,7 +74,19 @@ def check_inputs(inputs: Mapping, *, keys=None, required=None) -> dict:
     """``inputs`` as a dict without None values; raise on an unknown or a missing required key.
 
     ``keys`` limits the accepted keys (default: all of :data:`INPUT_KEYS`); ``required`` replaces
-    the required ones (default: those of :data:`INPUT_KEYS`)."""
+    the required ones (default: those of :data:`INPUT_KEYS`).
+
+    Examples
+    --------
+    None values are dropped; a missing required key is an error.
+
+    >>> check_inputs({"fit": "fit.nc", "flags": None})
+    {'fit': 'fit.nc'}
+    >>> check_inputs({"flags": "flags.csv"})
+    Traceback (most recent call last):
+    ...
+    KeyError: "build_report: missing required input(s) ['fit'] ..."
+    """
     accepted = INPUT_KEYS if keys is None else {k: INPUT_KEYS[k] for k in keys}
     unknown = sorted(set(inputs) - set(accepted))
     if unknown:
@@ -101,12 +113,32 @@ def read_dataset(obj) -> xr.Dataset:
 
 
 def read_table(obj) -> pd.DataFrame:
-    """A CSV file (empty cells are NaN, "NA" stays text), or the DataFrame itself."""
+    """A CSV file (empty cells are NaN, "NA" stays text), or the DataFrame itself.
+
+    Examples
+    --------
+    >>> with open("t.csv", "w") as f:
+    ...     _ = f.write("a,b\\n1,NA\\n2,\\n")
+    >>> t = read_table("t.csv")
+    >>> t["b"].tolist()
+    ['NA', nan]
+    """
     return obj if isinstance(obj, pd.DataFrame) else pd.read_csv(obj, keep_default_na=False, na_values=[""])
 
 
 def read_json(obj) -> dict:
-    """A JSON file, or the mapping itself."""
+    """A JSON file, or the mapping itself.
+
+    Examples
+    --------
+    A round trip through a file gives the input back.
+
+    >>> import json
+    >>> with open("s.json", "w") as f:
+    ...     json.dump({"cases": 3}, f)
+    >>> read_json("s.json") == {"cases": 3}
+    True
+    """
     if isinstance(obj, Mapping):
         return dict(obj)
     with open(obj, encoding="utf-8") as f:
@@ -129,7 +161,13 @@ def read_portraits(obj) -> list[xr.Dataset]:
 
 
 def as_list(obj) -> list:
-    """One path or Dataset -> a list of one; a sequence -> a list; None -> []."""
+    """One path or Dataset -> a list of one; a sequence -> a list; None -> [].
+
+    Examples
+    --------
+    >>> as_list("a.nc"), as_list(("a.nc", "b.nc")), as_list(None)
+    (['a.nc'], ['a.nc', 'b.nc'], [])
+    """
     if obj is None:
         return []
     if isinstance(obj, (str, os.PathLike, xr.Dataset)):
@@ -139,13 +177,29 @@ def as_list(obj) -> list:
 
 # =============================================================================== attributes
 def parameter_source(*datasets) -> str:
-    """The ``parameter_source`` attribute(s) of result Datasets, distinct values joined by "; "."""
+    """The ``parameter_source`` attribute(s) of result Datasets, distinct values joined by "; ".
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> a = xr.Dataset(attrs={"parameter_source": "fit"})
+    >>> parameter_source(a, a, xr.Dataset(attrs={"parameter_source": "paper"}))
+    'fit; paper'
+    """
     found = [str(ds.attrs["parameter_source"]) for ds in datasets if "parameter_source" in ds.attrs]
     return "; ".join(dict.fromkeys(found)) or "not recorded in the result file (no parameter_source attribute)"
 
 
 def per_radius(ds: xr.Dataset, name: str) -> np.ndarray:
-    """Attribute ``name`` as one value per ``radius`` of ``ds`` (a scalar attribute is repeated)."""
+    """Attribute ``name`` as one value per ``radius`` of ``ds`` (a scalar attribute is repeated).
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> ds = xr.Dataset(coords={"radius": [1e-6, 2e-6, 3e-6]}, attrs={"contact_c1": 0.5})
+    >>> per_radius(ds, "contact_c1").tolist()
+    [0.5, 0.5, 0.5]
+    """
     value = np.atleast_1d(np.asarray(ds.attrs.get(name, np.nan)))
     n = ds.sizes.get("radius", 1)
     return np.broadcast_to(value if value.size == n else value[:1], (n,))
@@ -167,7 +221,15 @@ def at_radius(ds: xr.Dataset, k: int) -> xr.Dataset:
 # =============================================================================== provenance
 def is_synthetic(data_path, flag="auto") -> bool:
     """Whether a data file is synthetic: ``flag`` if it is a bool; for "auto", True when the file
-    name contains "synthetic" (the bundled data/synthetic_microspheres.csv does)."""
+    name contains "synthetic" (the bundled data/synthetic_microspheres.csv does).
+
+    Examples
+    --------
+    >>> is_synthetic("data/synthetic_microspheres.csv"), is_synthetic("measured.csv")
+    (True, False)
+    >>> is_synthetic("measured.csv", flag=True)
+    True
+    """
     if isinstance(flag, bool):
         return flag
     if flag != "auto":

@@ -44,7 +44,13 @@ SOURCE_COLOR = "#1f4e8c"
 
 
 def wrap(text: str, width: int) -> list[str]:
-    """``text`` wrapped to ``width`` characters, its own line breaks kept."""
+    """``text`` wrapped to ``width`` characters, its own line breaks kept.
+
+    Examples
+    --------
+    >>> wrap("one two three\\nfour", 8)
+    ['one two', 'three', 'four']
+    """
     lines: list[str] = []
     for para in str(text).split("\n"):
         lines.extend(textwrap.wrap(para, width=width, break_long_words=True, break_on_hyphens=False) or [""])
@@ -57,7 +63,15 @@ def _chars_per_line(size: float, mono: bool = False) -> int:
 
 @dataclass
 class Page:
-    """One A4 page: its figure, the section named in its header, the next free line [in from the top]."""
+    """One A4 page: its figure, the section named in its header, the next free line [in from the top].
+
+    Examples
+    --------
+    >>> from matplotlib.figure import Figure
+    >>> p = Page(Figure(figsize=PAGE_SIZE), "Fit", 1.0)
+    >>> p.section, p.y, p.figure.get_size_inches().round(2).tolist()
+    ('Fit', 1.0, [8.27, 11.69])
+    """
 
     figure: Figure
     section: str
@@ -75,6 +89,15 @@ class Layout:
     pages : list of Page
     contents : list of (str, int)
         Section title and the index of its page, for the table of contents.
+
+    Examples
+    --------
+    Asking for room on an empty layout starts the first page.
+
+    >>> lay = Layout("Report")
+    >>> _ = lay.ensure(1.0)
+    >>> len(lay.pages), lay.title
+    (1, 'Report')
     """
 
     title: str
@@ -357,6 +380,11 @@ def fork_map(func, items: list, workers: int = 1) -> list:
     The workers inherit ``func`` and ``items`` (matplotlib figures, open datasets): nothing is
     pickled but the index and the result. With one worker, one item, or where ``fork`` is not
     available, the items are processed here in turn; the results are the same.
+
+    Examples
+    --------
+    >>> fork_map(lambda x: x * x, [1, 2, 3])
+    [1, 4, 9]
     """
     if workers <= 1 or len(items) < 2 or "fork" not in multiprocessing.get_all_start_methods():
         return [func(x) for x in items]
@@ -373,5 +401,14 @@ def render_figures(figures: list, workers: int = 1) -> list:
 
     Drawing the figures is most of the report's time (about 0.4 s each); they are independent, so
     forked workers draw them side by side.
+
+    Examples
+    --------
+    A 1 in x 0.5 in figure becomes an image of DPI x DPI/2 pixels, 4 channels.
+
+    >>> from matplotlib.figure import Figure
+    >>> (image,) = render_figures([Figure(figsize=(1, 0.5))])
+    >>> image.shape == (DPI // 2, DPI, 4)
+    True
     """
     return fork_map(_render, figures, workers)

@@ -116,6 +116,15 @@ def result_kind(path) -> str:
     UnknownResultError
         The file cannot be read as NetCDF, or its content is none of the known kinds; the message
         names the file.
+
+    Examples
+    --------
+    A file with a ``time_per_impact`` variable is a work-precision benchmark.
+
+    >>> import xarray as xr
+    >>> xr.Dataset({"time_per_impact": ("solver", [1e-3])}).to_netcdf("bench.nc")
+    >>> result_kind("bench.nc")
+    'benchmark'
     """
     import netCDF4
 
@@ -223,7 +232,13 @@ def standard_figure(path, *, curves=None, variant: str | None = None) -> figures
 @dataclass(frozen=True)
 class FigureFile:
     """One standard figure to save: the result file, the figure file (its suffix gives the format:
-    png, pdf or svg) and the options of :func:`standard_figure`."""
+    png, pdf or svg) and the options of :func:`standard_figure`.
+
+    Examples
+    --------
+    >>> FigureFile("fit.nc", "fig/fit.png")
+    FigureFile(result='fit.nc', out='fig/fit.png', curves=None, variant=None)
+    """
 
     result: str
     out: str
