@@ -319,6 +319,21 @@ def _compare_quantity(ds, q, sub, contact, curves, frictions, sliding_threshold_
             ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
 
 
+def _add_model_quantity(ds, q, suffix, curve, mod, sub, label, difference_label, sliding_threshold_deg) -> None:
+    """Add a model's curve ``q_curve<suffix>`` (``curve``: its dimension and values), its values
+    ``q_model<suffix>`` and differences ``q_difference<suffix>`` at the measured angles of ``sub``,
+    and the attributes ``rms_<q>_<sliding|below|all><suffix>``."""
+    units, long_name = _QUANTITIES[q]
+    a = sub["incidence_angle_deg"].to_numpy()
+    ds[f"{q}_curve{suffix}"] = (curve[0], curve[1], {"units": units, "long_name": f"model {long_name}, {label}"})
+    ds[f"{q}_model{suffix}"] = ((q,), mod, {"units": units, "long_name": f"model {long_name}, {label}"})
+    d = mod - sub["value"].to_numpy()
+    ds[f"{q}_difference{suffix}"] = ((q,), d, {"units": units, "long_name": difference_label})
+    sliding = a > sliding_threshold_deg
+    for regime, mask in (("sliding", sliding), ("below", ~sliding), ("all", np.ones_like(sliding))):
+        ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
+
+
 #: the tangentially compliant models compared: suffix of their variables -> (tangential_model, label)
 COMPLIANT_MODELS = {
     "_compliant": ("mindlin", "tangentially compliant, elastic micro-slip (Mindlin)"),
@@ -343,18 +358,12 @@ def _compare_compliant(ds, data, compliant, grid, friction, sliding_threshold_de
         what = (f"selected sub-models ({compliant.tangential_model}, {compliant.friction_model}, "
                 f"mu_r = {compliant.rolling_friction:g})")
     curve = _model(compliant, grid, friction)
-    for q, (units, long_name) in _QUANTITIES.items():
+    for q in _QUANTITIES:
         sub = data[data["quantity"] == q]
-        a = sub["incidence_angle_deg"].to_numpy()
-        mod = _model(compliant, a, friction)[q]
+        mod = _model(compliant, sub["incidence_angle_deg"].to_numpy(), friction)[q]
         label = f"{what} (G* = {compliant.shear_modulus / 1e9:.4g} GPa), friction {friction:g}"
-        ds[f"{q}_curve{suffix}"] = ("curve_incidence_deg", curve[q], {"units": units, "long_name": f"model {long_name}, {label}"})
-        ds[f"{q}_model{suffix}"] = ((q,), mod, {"units": units, "long_name": f"model {long_name}, {label}"})
-        d = mod - sub["value"].to_numpy()
-        ds[f"{q}_difference{suffix}"] = ((q,), d, {"units": units, "long_name": f"{what} model - measured"})
-        sliding = a > sliding_threshold_deg
-        for regime, mask in (("sliding", sliding), ("below", ~sliding), ("all", np.ones_like(sliding))):
-            ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
+        _add_model_quantity(ds, q, suffix, ("curve_incidence_deg", curve[q]), mod, sub, label,
+                            f"{what} model - measured", sliding_threshold_deg)
         rigid = ds[f"{q}_difference"].values
         ds.attrs[f"rms_{q}_all"] = float(np.sqrt(np.mean(rigid**2)))
     ds["effective_shear_modulus"] = ((), compliant.shear_modulus, {
@@ -424,18 +433,12 @@ def _compare_readings(ds, data, contact, sliding_threshold_deg) -> None:
         label = f"hysteretic, held turning point's force {what}, friction {contact.friction:g} (scipy integration)"
         suffix = f"_md_{reading}"
         curve = _reading_quantities(_reading_runs(contact, READING_CURVE_DEG, reading), READING_CURVE_DEG)
-        for q, (units, long_name) in _QUANTITIES.items():
+        for q in _QUANTITIES:
             sub = data[data["quantity"] == q]
             a = sub["incidence_angle_deg"].to_numpy()
             mod = _reading_quantities(_reading_runs(contact, a, reading), a)[q]
-            ds[f"{q}_curve{suffix}"] = ("reading_incidence_deg", curve[q], {
-                "units": units, "long_name": f"model {long_name}, {label}"})
-            ds[f"{q}_model{suffix}"] = ((q,), mod, {"units": units, "long_name": f"model {long_name}, {label}"})
-            d = mod - sub["value"].to_numpy()
-            ds[f"{q}_difference{suffix}"] = ((q,), d, {"units": units, "long_name": f"{label}: model - measured"})
-            sliding = a > sliding_threshold_deg
-            for regime, mask in (("sliding", sliding), ("below", ~sliding), ("all", np.ones_like(sliding))):
-                ds.attrs[f"rms_{q}_{regime}{suffix}"] = float(np.sqrt(np.mean(d[mask] ** 2))) if mask.any() else math.nan
+            _add_model_quantity(ds, q, suffix, ("reading_incidence_deg", curve[q]), mod, sub, label,
+                                f"{label}: model - measured", sliding_threshold_deg)
     ds.attrs["unloading_readings"] = "; ".join(
         ["limit (k = 1, _hysteretic): the held force keeps its ratio to the Coulomb limit (the solvers' law)"]
         + [f"{r} (k = {MD_UNLOADING_EXPONENTS[r]:.3g}, _md_{r}): the held force {w}" for r, w in UNLOADING_READINGS.items()])
