@@ -79,6 +79,20 @@ def njit(*args, **kwargs):
     """:func:`numba.njit`, with the package's cache directory for ``cache=True`` (module docstring).
 
     Used as ``@njit(cache=True, ...)`` or ``njit(inline="always", cache=True)(func)``.
+
+    Examples
+    --------
+    A compiled function gives what its Python source gives; the package's cached kernels keep
+    their compiled code under :func:`cache_directory`:
+
+    >>> @njit
+    ... def squared_norm(x, y):
+    ...     return x * x + y * y
+    >>> squared_norm(3.0, 4.0), squared_norm.py_func(3.0, 4.0)
+    (25.0, 25.0)
+    >>> from microimpact.solvers import engine
+    >>> engine._energy._cache.cache_path.startswith(cache_directory())
+    True
     """
     if len(args) == 1 and callable(args[0]) and not kwargs:  # bare @njit
         return _decorate(args[0], ())

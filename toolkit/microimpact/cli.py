@@ -229,6 +229,27 @@ def _cmd_simulate(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The parser of the ``microimpact`` command line: one sub-command per command, each with its
+    function as ``func``; an error raises ``UsageError`` (one line) instead of exiting.
+
+    Examples
+    --------
+    Defaults fill what is not given, a negative number is a value, not an option, and a
+    required option that is missing is named:
+
+    >>> parser = build_parser()
+    >>> args = parser.parse_args(["simulate", "--speed", "2", "--radius", "-1e-6"])
+    >>> args.speed, args.radius, args.incidence_deg, args.method, args.func.__name__
+    (2.0, -1e-06, 0.0, 'engine', '_cmd_simulate')
+    >>> parser.parse_args(["simulate", "--speed", "-2"])
+    Traceback (most recent call last):
+    ...
+    microimpact.cli.UsageError: argument --speed: must be a finite number > 0, got '-2'
+    >>> parser.parse_args(["simulate"])
+    Traceback (most recent call last):
+    ...
+    microimpact.cli.UsageError: the following arguments are required: --speed
+    """
     parser = _Parser(prog="microimpact", description="Microsphere contact/impact with smooth, flat surfaces.",
                      epilog=f"Exit status: 0 success; 2 bad arguments or inputs, or a solver failure; "
                             f"{EXIT_TIME_BUDGET} the computation ran past --time-budget (fit, flags, sweep, "
@@ -1201,6 +1222,46 @@ def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | N
 
 
 def main(argv=None) -> int:
+    """Run the command line ``microimpact ARGV...`` and return its exit status (module docstring).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after the program's name; default ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        0 success; 2 bad arguments, inputs or a solver failure (one line on stderr); 3 past
+        ``--time-budget``; 130 Ctrl-C; 141 stdout closed early.
+
+    Examples
+    --------
+    One impact as JSON, the same as the library's; e_n is the normal speed out over the speed in:
+
+    >>> import contextlib, io, json
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.solvers.impact import simulate_impact
+    >>> out = io.StringIO()
+    >>> with contextlib.redirect_stdout(out):
+    ...     status = main(["simulate", "--preset", "wall1990", "--speed", "2", "--json"])
+    >>> result = json.loads(out.getvalue())
+    >>> status, result["outcome"], result["velocity_in"]
+    (0, 'rebound', [-2.0, 0.0, 0.0])
+    >>> result["e_n"] == simulate_impact(WALL_1990, 2.0).e_n
+    True
+    >>> round(result["velocity_out"][0] / 2.0 - result["e_n"], 12)
+    0.0
+
+    A misspelt option: one line on stderr, status 2:
+
+    >>> err = io.StringIO()
+    >>> with contextlib.redirect_stderr(err):
+    ...     main(["simulate", "--sped", "2"])
+    2
+    >>> print(err.getvalue().strip())
+    microimpact: error: unrecognized option --sped (did you mean --speed?)
+    """
     from microimpact.io.files import recorded_outputs
 
     with recorded_outputs() as written:

@@ -576,7 +576,8 @@ class CaptureBracket:
 
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
     >>> b = capture_bracket(c)
-    >>> b.rebound_speed - b.captured_speed <= b.xtol + b.rtol * b.rebound_speed, b.rebound_e_n < 1e-3
+    >>> width = b.rebound_speed - b.captured_speed
+    >>> width <= b.xtol + b.rtol * b.rebound_speed, b.rebound_e_n < 1e-3
     (True, True)
     >>> round(b.captured_speed, 6)
     1.449241

@@ -208,7 +208,8 @@ class Problem:
     ...     read_impacts("k.csv")
     ... except ImpactDataError as err:
     ...     print(err.problems[0])
-    Problem(message='must be > 0 (speeds are magnitudes)', row=1, line=2, column='normal_speed [m/s]', value='-1.0')
+    Problem(message='must be > 0 (speeds are magnitudes)', row=1, line=2,
+            column='normal_speed [m/s]', value='-1.0')
     """
 
     message: str
@@ -286,7 +287,8 @@ class ImpactDataWarning(UserWarning):
     >>> table["e_n"].tolist(), caught[0].category.__name__
     ([1.004, 0.6], 'ImpactDataWarning')
     >>> str(caught[0].message)
-    'w.csv: 1 measurement(s) outside the physical range by no more than 4 stated standard uncertainties, kept as measured (e_n [1]: rows 1)'
+    'w.csv: 1 measurement(s) outside the physical range by no more than 4 stated standard
+     uncertainties, kept as measured (e_n [1]: rows 1)'
     """
 
 

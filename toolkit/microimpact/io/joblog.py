@@ -24,7 +24,27 @@ RESUME = "snakemake --cores 2 --rerun-incomplete"
 
 class JobTerminated(Exception):
     """SIGTERM arrived: raised in the main thread so that the job unwinds (atomic writers abandon
-    their temporary files) instead of dying where it stands."""
+    their temporary files) instead of dying where it stands.
+
+    Examples
+    --------
+    :func:`log_job` installs the SIGTERM handler that raises it (called here directly, not by a
+    signal):
+
+    >>> import signal, sys
+    >>> from types import SimpleNamespace
+    >>> saved = (sys.stdout, sys.stderr, sys.excepthook, sys.unraisablehook,
+    ...          signal.signal(signal.SIGTERM, signal.SIG_DFL))
+    >>> log_job(SimpleNamespace(rule="fit", log=["fit.log"]))
+    >>> handler = signal.getsignal(signal.SIGTERM)
+    >>> sys.stdout.close()
+    >>> sys.stdout, sys.stderr, sys.excepthook, sys.unraisablehook = saved[:4]
+    >>> _ = signal.signal(signal.SIGTERM, saved[4])
+    >>> handler(signal.SIGTERM, None)
+    Traceback (most recent call last):
+    ...
+    microimpact.io.joblog.JobTerminated: SIGTERM
+    """
 
 
 def _redeliver(unraisable) -> None:
@@ -96,6 +116,30 @@ def log_job(snakemake, *, keep_stderr: bool = False) -> None:
     keep_stderr : bool
         Leave stderr on the terminal, and show a failure's whole message there (a job whose error
         message is itself meant for the analyst, such as the data validation's list of problems).
+
+    Examples
+    --------
+    A job's printout goes to its log; an uncaught exception puts its traceback in the log and one
+    line on the terminal (here the example's output), a Ctrl-C the line that says how to resume:
+
+    >>> import signal, sys
+    >>> from pathlib import Path
+    >>> from types import SimpleNamespace
+    >>> saved = (sys.stdout, sys.stderr, sys.excepthook, sys.unraisablehook,
+    ...          signal.getsignal(signal.SIGTERM))
+    >>> sys.stderr = sys.stdout  # the terminal
+    >>> log_job(SimpleNamespace(rule="fit", log=["fit.log"]))
+    >>> print("fitting 12 impacts")
+    >>> sys.excepthook(ValueError, ValueError("row 3: bad value"), None)
+    microimpact: rule fit failed: ValueError: row 3: bad value (traceback: fit.log)
+    >>> sys.excepthook(KeyboardInterrupt, KeyboardInterrupt(), None)
+    microimpact: rule fit interrupted (SIGINT); its outputs were not written ... --rerun-incomplete
+    >>> sys.stdout.close()
+    >>> sys.stdout, sys.stderr, sys.excepthook, sys.unraisablehook = saved[:4]
+    >>> _ = signal.signal(signal.SIGTERM, saved[4])
+    >>> Path("fit.log").read_text().splitlines()
+    ['fitting 12 impacts', 'ValueError: row 3: bad value',
+     'microimpact: rule fit interrupted (SIGINT); its outputs were not written ...']
     """
     log_path = str(snakemake.log[0])
     log = open(log_path, "w", buffering=1)  # noqa: SIM115  (open for the job's lifetime)

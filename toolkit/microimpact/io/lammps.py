@@ -104,14 +104,15 @@ class LammpsExportError(ValueError):
 
     Examples
     --------
-    The paper's contact (ring adhesion, nonlinear damping, rigid Coulomb friction) has no LAMMPS form;
-    every refused field is named:
+    The paper's contact (ring adhesion, nonlinear damping, rigid Coulomb friction) has no LAMMPS
+    form; every refused field is named:
 
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
     >>> lammps_wall_model(c)
     Traceback (most recent call last):
     ...
-    microimpact.io.lammps.LammpsExportError: cannot be written as LAMMPS GRANULAR input: adhesion_line_force=7.422 with normal_model='ring': ...
+    microimpact.io.lammps.LammpsExportError: cannot be written as LAMMPS GRANULAR input:
+    adhesion_line_force=7.422 with normal_model='ring': ...
     """
 
 
@@ -156,11 +157,12 @@ class LammpsWallModel:
 
     Examples
     --------
-    See :func:`lammps_wall_model`, which builds it from a contact. Sphere and wall get the same E and
-    nu, so that K = (4/3) E / (2 (1 - nu^2)), i.e. E = 1.5 K (1 - nu^2):
+    See :func:`lammps_wall_model`, which builds it from a contact. Sphere and wall get the same E
+    and nu, so that K = (4/3) E / (2 (1 - nu^2)), i.e. E = 1.5 K (1 - nu^2):
 
     >>> from microimpact import Contact
-    >>> m = lammps_wall_model(Contact(radius=3.45e-6, density=1350.0, stiffness=1e10, adhesion_line_force=0.0))
+    >>> m = lammps_wall_model(Contact(radius=3.45e-6, density=1350.0, stiffness=1e10,
+    ...                               adhesion_line_force=0.0))
     >>> m.normal, m.tangential, round(m.youngs_modulus / (1.5 * 1e10 * (1.0 - m.poisson**2)), 12)
     ('hertz/material', 'linear_nohistory', 1.0)
     """

@@ -145,7 +145,8 @@ class MaterialPair:
     >>> pair.density, pair.work_of_adhesion, pair.friction
     (1350.0, 0.215834, 0.15)
     >>> c = pair.contact(3.45e-6)
-    >>> c.radius, c.stiffness == pair.stiffness, round(c.work_of_adhesion / pair.work_of_adhesion, 12)
+    >>> ratio = c.work_of_adhesion / pair.work_of_adhesion
+    >>> c.radius, c.stiffness == pair.stiffness, round(ratio, 12)
     (3.45e-06, True, 1.0)
     """
 

@@ -42,9 +42,13 @@ class PathError(ValueError):
     --------
     The option and the path come first, so that a command line prints one line that names both:
 
+    >>> check_input_file("--data", "missing.csv")
+    Traceback (most recent call last):
+    ...
+    microimpact.io.paths.PathError: --data 'missing.csv': does not exist or is not a file
     >>> err = PathError("--out", "fit.nc", "is a directory")
-    >>> str(err), err.option, isinstance(err, ValueError)
-    ("--out 'fit.nc': is a directory", '--out', True)
+    >>> str(err), err.option, err.path
+    ("--out 'fit.nc': is a directory", '--out', 'fit.nc')
     """
 
     def __init__(self, option: str, path, reason: str):
@@ -258,7 +262,8 @@ def check_outputs(outputs: Mapping[str, object], inputs: Mapping[str, object] | 
     >>> check_outputs({"--out": "impacts.csv"}, {"DATA": "impacts.csv"})
     Traceback (most recent call last):
     ...
-    microimpact.io.paths.PathError: --out 'impacts.csv': is the input DATA ('impacts.csv'); an output never replaces an input: ...
+    microimpact.io.paths.PathError: --out 'impacts.csv': is the input DATA ('impacts.csv');
+    an output never replaces an input: ...
     """
     given = {k: v for k, v in outputs.items() if v is not None}
     checked = {k: check_output_file(k, v) for k, v in given.items()}
@@ -313,7 +318,8 @@ def reporting_os_errors(outputs: Mapping[str, object]) -> Iterator[None]:
     ...     _ = open("missing/dir/fit.nc", "w")
     Traceback (most recent call last):
     ...
-    microimpact.io.paths.PathError: --out 'missing/dir/fit.nc': cannot write: No such file or directory
+    microimpact.io.paths.PathError: --out 'missing/dir/fit.nc': cannot write:
+    No such file or directory
     """
     try:
         yield

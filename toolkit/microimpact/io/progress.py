@@ -65,7 +65,8 @@ def progress_bar(total: int, label: str, enabled=True):
 
     Examples
     --------
-    Off a terminal (here stderr is a string buffer) the bar is not drawn and ``advance`` only counts:
+    Off a terminal (here stderr is a string buffer) the bar is not drawn and ``advance`` only
+    counts:
 
     >>> import contextlib, io
     >>> err = io.StringIO()

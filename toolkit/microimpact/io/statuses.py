@@ -197,7 +197,8 @@ def status_from_variables(ds, name: str, value: float) -> ParameterStatus | None
     A round trip through the file's variables:
 
     >>> import xarray as xr
-    >>> s = ParameterStatus("friction", "lower_bound", math.nan, 0.27, 10.0, reason="all roll above it")
+    >>> s = ParameterStatus("friction", "lower_bound", math.nan, 0.27, 10.0,
+    ...                     reason="all roll above it")
     >>> back = status_from_variables(xr.Dataset(status_variables(s, "1")), "friction", math.nan)
     >>> back.status, back.lower, back.upper, back.reason
     ('lower_bound', 0.27, 10.0, 'all roll above it')

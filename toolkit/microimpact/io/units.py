@@ -65,7 +65,8 @@ class UnitError(ValueError):
     >>> to_internal([1.0], "furlong", "length")
     Traceback (most recent call last):
     ...
-    microimpact.io.units.UnitError: unit 'furlong' is not accepted for a length; accepted units: m, mm, um, ...
+    microimpact.io.units.UnitError: unit 'furlong' is not accepted for a length;
+    accepted units: m, mm, um, ...
     """
 
 

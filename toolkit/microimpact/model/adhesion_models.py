@@ -146,7 +146,8 @@ class AdhesionRegimeWarning(UserWarning):
     ...     warnings.simplefilter("always")
     ...     _ = check_adhesion_regime(c.with_(normal_model="dmt"))
     >>> caught[0].category.__name__, str(caught[0].message)
-    ('AdhesionRegimeWarning', "normal_model='dmt' with Tabor parameter mu_T = 11.2 > 0.1 (z0 = 4e-10 m): outside the DMT regime (Johnson & Greenwood 1997)")
+    ('AdhesionRegimeWarning', "normal_model='dmt' with Tabor parameter mu_T = 11.2 > 0.1
+    (z0 = 4e-10 m): outside the DMT regime (Johnson & Greenwood 1997)")
     """
 
 
@@ -167,17 +168,18 @@ class AdhesionScales:
 
     Examples
     --------
-    The JKR force unit is pi w R (DMT: 2 pi w R), the contact-radius unit a_c with L_J = a_c^2 / R, and
-    the time unit sqrt(m L / F):
+    The JKR force unit is pi w R (DMT: 2 pi w R), the contact-radius unit a_c with L_J = a_c^2 / R,
+    and the time unit sqrt(m L / F):
 
     >>> import math
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
     >>> s = adhesion_scales(c.with_(normal_model="jkr"))
-    >>> round(s.force / (math.pi * c.work_of_adhesion * c.radius), 12), round(s.radius**2 / c.radius / s.length, 12)
+    >>> w, r = c.work_of_adhesion, c.radius
+    >>> round(s.force / (math.pi * w * r), 12), round(s.radius**2 / r / s.length, 12)
     (1.0, 1.0)
     >>> round(s.time**2 * s.force / (c.mass * s.length), 12)
     1.0
-    >>> round(adhesion_scales(c.with_(normal_model="dmt")).force / (2 * math.pi * c.work_of_adhesion * c.radius), 12)
+    >>> round(adhesion_scales(c.with_(normal_model="dmt")).force / (2 * math.pi * w * r), 12)
     1.0
     """
 

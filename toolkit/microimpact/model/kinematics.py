@@ -144,17 +144,20 @@ class ImpactResult:
 
     Examples
     --------
-    An oblique rebound of the paper's microsphere: the energy balance of ``dissipated_energy`` closes
-    to the solver's tolerance, and ``to_dict`` is valid JSON (the NaN capture time becomes null):
+    An oblique rebound of the paper's microsphere: the energy balance of ``dissipated_energy``
+    closes to the solver's tolerance, and ``to_dict`` is valid JSON (the NaN capture time becomes
+    null):
 
     >>> import json
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
     >>> from microimpact.solvers.impact import simulate_impact
     >>> r = simulate_impact(c, 2.0, 30.0)
     >>> def kinetic(v, w):
-    ...     return 0.5 * c.mass * sum(x * x for x in v) + 0.5 * c.moment_of_inertia * sum(x * x for x in w)
+    ...     squares = sum(x * x for x in v), sum(x * x for x in w)
+    ...     return 0.5 * (c.mass * squares[0] + c.moment_of_inertia * squares[1])
     >>> ke_in = kinetic(r.velocity_in, r.omega_in)
-    >>> balance = ke_in - kinetic(r.velocity_out, r.omega_out) - r.dissipated_energy - r.final_contact_energy
+    >>> ke_out = kinetic(r.velocity_out, r.omega_out)
+    >>> balance = ke_in - ke_out - r.dissipated_energy - r.final_contact_energy
     >>> r.outcome, abs(balance) / ke_in < 1e-6, json.loads(json.dumps(r.to_dict()))["capture_time"]
     ('rebound', True, None)
     """

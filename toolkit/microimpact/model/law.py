@@ -408,12 +408,14 @@ class Scales:
 
     Examples
     --------
-    With adhesion the length is X = 2 pi f0 / K of Eq. (29); without it the Hertz x* and time x* / v:
+    With adhesion the length is X = 2 pi f0 / K of Eq. (29); without it the Hertz x* and time
+    x* / v:
 
     >>> import math
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
     >>> s = nondimensional_scales(c, 1.0)
-    >>> round(s.length / (2 * math.pi * c.adhesion_line_force / c.stiffness), 12), s.a_hertz, s.a_adhesion
+    >>> x = 2 * math.pi * c.adhesion_line_force / c.stiffness
+    >>> round(s.length / x, 12), s.a_hertz, s.a_adhesion
     (1.0, 1.0, 1.0)
     >>> h = nondimensional_scales(c.with_(adhesion_line_force=0.0), 2.0)
     >>> round(h.time * 2.0 / h.length, 12), h.a_hertz, h.a_adhesion

@@ -226,8 +226,12 @@ class EngineError(SolverError):
     >>> solve_normal_many(c, [1.0], max_steps=5)
     Traceback (most recent call last):
     ...
-    microimpact.solvers.engine.EngineError: engine failed for normal speed 1.0 m/s: step limit reached
-    >>> issubclass(EngineError, SolverError)  # one ``except SolverError`` catches every solver's failure
+    microimpact.solvers.engine.EngineError: engine failed for normal speed 1.0 m/s:
+    step limit reached
+
+    One ``except SolverError`` catches every solver's failure:
+
+    >>> issubclass(EngineError, SolverError)
     True
     """
 
@@ -1027,6 +1031,33 @@ class NormalSolution:
         Accepted and rejected integration steps.
     time, penetration, penetration_rate : numpy.ndarray or None
         Trajectory at the accepted steps, when asked for. [s], [m], [m/s]
+
+    Examples
+    --------
+    The paper's microsphere at 2 m/s rebounds: of the incident kinetic energy it keeps e_n^2, and
+    that plus what the damping dissipated is all of it; the trajectory starts at the incident
+    speed and ends at the separation:
+
+    >>> from microimpact.presets import WALL_1990 as c
+    >>> from microimpact.solvers.engine import solve_normal
+    >>> s = solve_normal(c, 2.0, trajectory=True)
+    >>> kinetic = 0.5 * c.mass * 2.0**2
+    >>> s.outcome, round(s.final_energy / kinetic - s.e_n**2, 12)
+    ('rebound', 0.0)
+    >>> round((s.final_energy + s.dissipated_energy) / kinetic, 6)
+    1.0
+    >>> s.time.shape == s.penetration.shape, round(float(s.penetration_rate[0]), 12)
+    (True, 2.0)
+    >>> end, deepest = s.time[-1] / s.contact_time, s.penetration.max() / s.max_penetration
+    >>> round(float(end), 12), round(float(deepest), 4)
+    (1.0, 1.0)
+
+    At 1 cm/s it is captured: no restitution, no end of contact, and the energy left is negative
+    (bound by adhesion):
+
+    >>> s = solve_normal(c, 0.01)
+    >>> s.outcome, s.e_n, s.contact_time, s.final_energy < 0.0, s.time is None
+    ('capture', 0.0, inf, True, True)
     """
 
     outcome: str
@@ -1187,6 +1218,25 @@ def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, fr
     References
     ----------
     Cheng, Brach & Dunn (2002), Eqs. (21) and (29)-(30)
+
+    Examples
+    --------
+    A rebound at half the incident nondimensional speed: e_n = 0.5, the times in units of T_c, the
+    lengths of L, and the final energy, (1/2) (y0/2)^2 in units of m (L/T_c)^2, is e_n^2 = 1/4 of
+    the incident kinetic energy:
+
+    >>> import math
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> from microimpact.solvers.engine import REBOUND, engine_scales
+    >>> sc, y0, c1, c2 = engine_scales(c, 2.0)
+    >>> s = normal_solution(c, sc, y0, REBOUND, -0.5 * y0, 3.0, 0.0, 0.0, 0.0, 1.2, math.nan,
+    ...                     math.nan, 0.125 * y0**2, 40, 2)
+    >>> s.outcome, s.e_n, round(s.contact_time / sc.time, 12)
+    ('rebound', 0.5, 3.0)
+    >>> round(s.max_penetration / sc.length, 12)
+    1.2
+    >>> round(s.final_energy / (0.5 * c.mass * 2.0**2), 12), s.n_steps, s.time
+    (0.25, 40, None)
     """
     u = scales.speed
     j_unit = contact.mass * u  # N s
@@ -1257,7 +1307,8 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     >>> h = c.with_(zeta_hertz=0.0, zeta_adhesion=0.0, adhesion_line_force=0.0)
     >>> r = solve_normal_many(h, [0.5, 2.0])
     >>> x_max = (1.25 * h.mass * 2.0**2 / (math.sqrt(h.radius) * h.stiffness)) ** 0.4
-    >>> r["e_n"].tolist(), round(float(r["contact_time"][1] * 2.0 / x_max / (0.8 * beta(0.4, 0.5))), 7)
+    >>> t_c = r["contact_time"][1]
+    >>> r["e_n"].tolist(), round(float(t_c * 2.0 / x_max / (0.8 * beta(0.4, 0.5))), 7)
     ([1.0, 1.0], 1.0)
     """
     v = np.ascontiguousarray(normal_speed, dtype=float).ravel()
