@@ -27,7 +27,7 @@ _HOMES = {
                      "status_variables", "status_from_variables", "status_from_interval", "DEFAULT_LEVEL"),
                     "identifiability"),
     **dict.fromkeys(("kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
-                     "KHARAZ_CONDITIONS"), "kharaz"),
+                     "KHARAZ_CONDITIONS", "UNLOADING_READINGS"), "kharaz"),
     **dict.fromkeys(("compare_normal_models", "normal_model_restitution", "DEFAULT_MODELS"), "model_comparison"),
     **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "rank_dem_tangential_laws", "oblique_model", "rebound_state",
                      "effective_sigma", "TANGENTIAL_PARAMETERS", "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"), "oblique"),
