@@ -167,13 +167,19 @@ def _model(contact, angles, friction):
     v = KHARAZ_CONDITIONS["speed"]
     a = np.asarray(angles, dtype=float)
     ds = simulate_many(contact, v, np.clip(a, 0.0, 89.999), 0.0, friction=friction)
-    vt_in = v * np.sin(np.radians(np.clip(a, 0.0, 89.999)))
+    out = _rebound_quantities(a, *(ds[f"velocity_out_{c}"].values for c in ("n", "t")),
+                              *(ds[f"omega_out_{c}"].values for c in ("n", "t", "tp")))
+    return out | {"omega_out_tp": ds["omega_out_tp"].values, "e_n": ds["e_n"].values}
+
+
+def _rebound_quantities(angles, v_n, v_t, w_n, w_t, w_tp) -> dict:
+    """Tangential restitution [-], rebound spin |omega| [rad/s] and rebound angle [deg] of rebounds
+    at these incidence angles [deg] (velocities [m/s] and spins [rad/s] after the impact)."""
+    vt_in = KHARAZ_CONDITIONS["speed"] * np.sin(np.radians(np.clip(np.asarray(angles, dtype=float), 0.0, 89.999)))
     with np.errstate(invalid="ignore", divide="ignore"):
-        tr = ds["velocity_out_t"].values / vt_in
-    spin = np.sqrt(ds["omega_out_n"].values ** 2 + ds["omega_out_t"].values ** 2 + ds["omega_out_tp"].values ** 2)
-    angle = np.degrees(np.arctan2(ds["velocity_out_t"].values, ds["velocity_out_n"].values))
-    return {"tangential_restitution": tr, "rebound_spin": spin, "rebound_angle": angle,
-            "omega_out_tp": ds["omega_out_tp"].values, "e_n": ds["e_n"].values}
+        tr = v_t / vt_in
+    return {"tangential_restitution": tr, "rebound_spin": np.sqrt(w_n**2 + w_t**2 + w_tp**2),
+            "rebound_angle": np.degrees(np.arctan2(v_t, v_n))}
 
 
 def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, sliding_threshold_deg: float = 30.0,
@@ -407,11 +413,7 @@ def _reading_quantities(runs, angles) -> dict:
     """Tangential restitution, rebound spin and rebound angle of these runs."""
     vel = np.array([r.velocity_out for r in runs]).reshape(-1, 3)
     omega = np.array([r.omega_out for r in runs]).reshape(-1, 3)
-    vt_in = KHARAZ_CONDITIONS["speed"] * np.sin(np.radians(np.clip(np.asarray(angles, dtype=float), 0.0, 89.999)))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        tr = vel[:, 1] / vt_in
-    return {"tangential_restitution": tr, "rebound_spin": np.sqrt((omega**2).sum(axis=1)),
-            "rebound_angle": np.degrees(np.arctan2(vel[:, 1], vel[:, 0]))}
+    return _rebound_quantities(angles, vel[:, 0], vel[:, 1], *omega.T)
 
 
 def _compare_readings(ds, data, contact, sliding_threshold_deg) -> None:
