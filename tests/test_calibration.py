@@ -40,6 +40,7 @@ def quick():
     return [run_design(draw_design(seed)) for seed in range(500, 512)]
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_quick_study_is_calibrated(quick):
     assert not [r["error"] for r in quick if "error" in r]
     summary = summarise(quick)
@@ -85,6 +86,7 @@ def test_committed_study_meets_its_targets():
     assert s["zeta_adhesion"]["least_squares"]["determined"]["covered"] == sum(r["covered"] for r in recs)
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_committed_study_reproduces_its_first_designs():
     d = json.loads(COMMITTED.read_text())
     for want in d["designs"][:2]:

@@ -206,6 +206,7 @@ def test_writer_refuses_integers_outside_int32(tmp_path):
     assert not (tmp_path / "big.nc").exists()
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_every_netcdf_the_cli_writes_passes_the_cf_checker_to_the_end(tmp_path):
     """fit, flags, sweep and target as the CLI writes them: no failed check and no exception of the
     checker (the fit's text coordinate 'parameter' made compliance-checker exit 2)."""

@@ -96,6 +96,7 @@ def test_workflow_config_paths_are_the_users_relative_to_where_they_typed_them(t
     assert f"--config=kharaz_data={tmp_path / 'impacts.csv'}" in command
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_a_workflow_refused_at_start_leaves_no_run_directory_behind(tmp_path, capsys):
     """A bad config value stops Snakemake before any job; the run directory the command made for
     it is removed again (issue 28: an empty directory was left)."""

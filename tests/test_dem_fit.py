@@ -264,6 +264,7 @@ def test_joint_fit_counts_two_parameters_and_refuses_hertz():
         fit_dem_law(t, ADHESIVE, "hertz", "viscoelastic", fit_adhesion=True)
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_cli_fit_adhesion_writes_the_fitted_work_of_adhesion(tmp_path, capsys, monkeypatch):
     """``lammps fit --fit-adhesion``: the material pair's w_A (0.216 J/m^2) is replaced by the
     fitted one (truth 0.05), recorded with its interval in the header and written as LAMMPS's

@@ -142,6 +142,7 @@ def test_rolling_parameters_out_of_place_are_refused_by_name(changes, named):
         Contact(**SPHERE, friction=0.3, **(MINDLIN | changes))
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_lammps_fit_holds_a_given_rolling_law_while_it_fits_mu_and_writes_both(tmp_path, capsys, monkeypatch):
     # data made with LAMMPS's rolling sds beside mindlin: 'lammps fit' given the same rolling law fits
     # mu around the true 0.3 and writes 'rolling sds' with the given values; rolling options without

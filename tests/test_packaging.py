@@ -4,7 +4,7 @@ The Kharaz et al. (2001) data and the format documentation that error messages c
 (``data/README.md``) are package data, read through :mod:`importlib.resources`, so the library
 works from an installed wheel outside the clone. The repository keeps its ``data/`` copies for the
 pipeline and the reader; these tests hold the two copies byte-identical. ``.ci/run`` runs this
-file (and the whole suite) against the installed wheel with ``MICROIMPACT_TEST_INSTALLED=1``,
+file (and the tests of what an install can break) against the installed wheel with ``MICROIMPACT_TEST_INSTALLED=1``,
 which also checks that ``import microimpact`` is the installed package, not the clone's sources.
 """
 

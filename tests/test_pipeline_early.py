@@ -107,6 +107,7 @@ def test_rtol_has_the_bounds_of_the_cli(root):
     refused(dry_run(root, "rtol=1.0e-300"), root, "'rtol'", ">= 2.22e-14")
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_missing_and_broken_materials_config_are_refused(root):
     refused(dry_run(root, "materials=data/none.yaml"), root, "'materials'", "does not exist")
     (root / "data" / "bad_materials.yaml").write_text("pairs:\n  x_on_y: {density: -1}\n")
@@ -125,6 +126,7 @@ def test_fit_time_budget_is_checked_at_start(tmp_path):
     refused(dry_run(other), other, "'fit'", "time_budget", "nan")
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_a_failing_job_says_why_in_one_line_and_leaves_no_result(tmp_path):
     """A job that fails while running (here the fit, past a tiny time budget) prints one line on the
     terminal naming the rule, the exception and its message, keeps the traceback in its log, and
@@ -151,6 +153,7 @@ def test_a_failing_job_says_why_in_one_line_and_leaves_no_result(tmp_path):
     assert not analyst.exists() or not any(analyst.iterdir()), list(analyst.iterdir())  # no partial output
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_the_lammps_check_follows_its_config(root):
     """lammps.enabled: false leaves the job out, true asks for it (refused at start without LAMMPS),
     auto (the default: test_the_unchanged_config_passes) runs it where LAMMPS is installed; anything

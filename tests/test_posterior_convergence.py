@@ -66,6 +66,7 @@ def test_an_independent_sample_has_rhat_one_and_full_ess():
     assert ess_bulk(x) == pytest.approx(8000, rel=0.15)
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_default_chain_converges_and_says_so(small):
     _, table, fit = small
     post = sample_posterior(table, fit, seed=11)
@@ -118,6 +119,7 @@ def test_cli_refuses_an_unconverged_posterior_and_writes_nothing(small, tmp_path
     assert "--full-chain was removed" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_a_parameter_the_data_only_bound_is_reported_by_its_bound(tmp_path, pairs):
     # every impact rolls for f above ~0.04: the posterior above that follows the flat prior, whose
     # end (10) is arbitrary; the report gives the fit's profile bound, which holds the truth (0.6)

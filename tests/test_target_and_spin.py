@@ -83,6 +83,7 @@ def oblique_run(tmp_path_factory):
     return pd.read_csv(flags), spun + 1, d
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_flags_say_which_row_was_spun_and_by_how_much(oblique_run):
     flags, spun_row, _ = oblique_run
     r = flags.set_index("row")

@@ -558,6 +558,7 @@ def test_an_interrupted_run_resumes_as_the_readme_says(tmp_path, signame):
     assert "Nothing to be done" in again.stdout, again.stdout[-3000:]
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_nested_config_overrides_arrive_as_numbers(tmp_path):
     """snakemake --config passes nested values as text; the Snakefile types them before the schema
     sees them, so the overrides that config.yaml describes work (and bad ones are still refused)."""
@@ -679,6 +680,7 @@ def test_snakefile_runs_from_another_working_directory(tmp_path):
     assert not (elsewhere / "results").exists()  # a dry run writes no result
 
 
+@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_microimpact_workflow_runs_the_packaged_pipeline(tmp_path):
     """microimpact workflow --directory DIR: a dry run of the whole pipeline with the config
     defaults, then one real job (the validation of the bundled data) in DIR."""

@@ -1261,6 +1261,13 @@ def main(argv=None) -> int:
     2
     >>> print(err.getvalue().strip())
     microimpact: error: unrecognized option --sped (did you mean --speed?)
+
+    ``--version`` prints the version and returns 0 (argparse would raise ``SystemExit``):
+
+    >>> with contextlib.redirect_stdout(io.StringIO()) as out:
+    ...     status = main(["--version"])
+    >>> status, out.getvalue().split()[0]
+    (0, 'microimpact')
     """
     from microimpact.io.files import recorded_outputs
 
@@ -1286,6 +1293,8 @@ def _main(argv, written) -> int:
         status = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
+    except SystemExit as exc:  # argparse's --help, --version and usage errors: a status, as documented
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
     except KeyboardInterrupt:  # Ctrl-C: one line, the shell's status for SIGINT, no traceback
         print(interrupted_after_writing(written) if written else INTERRUPTED_LINE, file=sys.stderr)
         return EXIT_INTERRUPTED
