@@ -43,6 +43,16 @@ class ObliqueCase:
 
     speed [m/s], incidence_deg [deg], azimuth_deg [deg]; spins as multiples of the rolling spin
     v sin(alpha) / r about (n, t, t') [-]; friction [-].
+
+    Examples
+    --------
+    Spin given as a multiple of the rolling spin v sin(alpha) / r: one rolling spin about t' of a
+    2 um sphere at 2 m/s and 30 deg is 2 * 0.5 / 2e-6 = 5e5 rad/s:
+
+    >>> case = ObliqueCase(speed=2.0, incidence_deg=30.0, azimuth_deg=0.0, spin_n=0.0, spin_t=0.0,
+    ...                    spin_tp=1.0, friction=0.15)
+    >>> [round(w, 6) for w in case.omega(2e-6)]
+    [0.0, 0.0, 500000.0]
     """
 
     speed: float
@@ -86,6 +96,14 @@ class BenchmarkConfig:
     ``time_limit`` [s] is the time per impact after which a scipy setting and the tighter ones
     are dropped; an oblique case over ``oblique_time_limit`` [s] is marked timed out (and said
     so in the notes); ``reference_rtols`` are the loose and the tight rtol of the reference.
+
+    Examples
+    --------
+    The quick preset measures fewer speeds and every other setting of the engine:
+
+    >>> quick, full = BenchmarkConfig.quick_(), BenchmarkConfig.full()
+    >>> (quick.n_speeds, quick.engine_levels), (full.n_speeds, len(full.engine_levels))
+    ((6, (0, 2, 4, 6, 8)), (10, 9))
     """
 
     quick: bool
@@ -150,12 +168,24 @@ class BenchmarkConfig:
 
 
 def level_rtol(k: int) -> float:
-    """rtol of setting k for the adaptive methods: 10^-(4+k). [-]"""
+    """rtol of setting k for the adaptive methods: 10^-(4+k). [-]
+
+    Examples
+    --------
+    >>> level_rtol(0), level_rtol(4)
+    (0.0001, 1e-08)
+    """
     return 10.0 ** -(4 + k)
 
 
 def level_steps(k: int) -> int:
-    """Steps per contact of setting k for the Runge-Kutta-Gill method: 25 * 2^k."""
+    """Steps per contact of setting k for the Runge-Kutta-Gill method: 25 * 2^k.
+
+    Examples
+    --------
+    >>> [level_steps(k) for k in range(4)]
+    [25, 50, 100, 200]
+    """
     return 25 * 2**k
 
 
@@ -169,11 +199,27 @@ def normal_speed_set(contact=WALL_1990, n: int = 10, max_speed: float = 100.0, m
     capture_speed : float
         Capture velocity of a normal impact, :func:`microimpact.dynamics.capture_velocity` to
         1e-12 relative with engine solves at rtol 1e-12. [m/s]
+
+    Examples
+    --------
+    Four speeds from just above the capture speed of the 1990 wall sphere (1.449 m/s) to 100 m/s:
+
+    >>> speeds, v_cap = normal_speed_set(n=4)
+    >>> round(v_cap, 4), round(float(speeds[0] / v_cap), 6), float(speeds[-1])
+    (1.4492, 1.02, 100.0)
     """
     v_cap = capture_velocity(contact, xtol=0.0, rtol=1e-12, solver_rtol=1e-12)
     return np.geomspace(margin * v_cap, max_speed, n), v_cap
 
 
 def oblique_cases(quick: bool = False) -> tuple:
-    """The oblique test cases (:class:`ObliqueCase`), six of them in quick mode."""
+    """The oblique test cases (:class:`ObliqueCase`), six of them in quick mode.
+
+    Examples
+    --------
+    >>> len(oblique_cases(quick=True)) < len(oblique_cases())
+    True
+    >>> oblique_cases(quick=True)[0].incidence_deg
+    10.0
+    """
     return _OBLIQUE_QUICK if quick else _OBLIQUE
