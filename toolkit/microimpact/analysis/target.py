@@ -49,6 +49,15 @@ class DampingTarget:
         uncertainties were given).
     info : dict
         ``material``, ``rtol``, ``chisqr``.
+
+    Examples
+    --------
+    See :func:`damping_from_target`; one target gives a curve of (zeta_H, zeta_A) and no point:
+
+    >>> from microimpact.presets import WALL_1990
+    >>> target = damping_from_target(0.5, 3.0, WALL_1990, n_points=5)
+    >>> target.best is None, target.curves.sizes["curve_point"]
+    (True, 5)
     """
 
     targets: pd.DataFrame
@@ -210,6 +219,21 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
         For an e_n outside (0, 1), a speed <= 0, mismatched lengths, or no radius; and for an e_n
         that no damping reaches at its speed (at or above the undamped e_n, e.g. below the capture
         velocity), naming the target and the reachable range.
+
+    Examples
+    --------
+    Two restitution coefficients simulated with the 1990 wall sphere's Table 1 damping
+    (zeta_H = 0.5, zeta_A = 29) give that damping back (two targets, two unknowns: exact):
+
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.solvers.impact import simulate_impact
+    >>> speeds = [2.0, 5.0]
+    >>> e_n = [simulate_impact(WALL_1990, v).e_n for v in speeds]
+    >>> target = damping_from_target(e_n, speeds, WALL_1990, n_points=9)
+    >>> round(target.best["zeta_hertz"], 8), round(target.best["zeta_adhesion"], 8)
+    (0.5, 29.0)
+    >>> target
+    DampingTarget(2 target(s), 9 curve points, exact(zeta_hertz=0.5, zeta_adhesion=29))
     """
     from microimpact.solvers import Deadline
 
