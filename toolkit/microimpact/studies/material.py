@@ -57,7 +57,15 @@ def stamp_fitted(ds: xr.Dataset, fit: xr.Dataset) -> xr.Dataset:
 
 
 def measured_speed_range(fit: xr.Dataset) -> tuple[float, float]:
-    """Smallest and largest measured normal impact speed of the fitted points. [m/s]"""
+    """Smallest and largest measured normal impact speed of the fitted points. [m/s]
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> fit = xr.Dataset({"normal_speed": ("point", [2.0, 0.7, 5.5])})
+    >>> measured_speed_range(fit)
+    (0.7, 5.5)
+    """
     v = np.asarray(fit["normal_speed"].values, dtype=float)
     return float(v.min()), float(v.max())
 
