@@ -281,6 +281,24 @@ def rebound_state(contact, speed, incidence_deg, spin, rtol: float = DEFAULT_RTO
     -------
     dict of arrays: ``captured`` (bool), ``velocity_out_n``, ``velocity_out_t`` [m/s],
     ``omega_out_n``, ``omega_out_t``, ``omega_out_tp`` [rad/s].
+
+    Examples
+    --------
+    At 20 deg the sphere ends rolling: v_t,out = 5/7 v_t,in and the contact point is at rest
+    (v_t + r omega_t' = 0); at 60 deg it slides throughout. The same numbers as ``simulate_impact``:
+
+    >>> import numpy as np
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.solvers.impact import simulate_impact
+    >>> out = rebound_state(WALL_1990, np.array([30.0, 30.0]), np.array([20.0, 60.0]), np.zeros(2))
+    >>> v_t_in = 30.0 * np.sin(np.radians(20.0))
+    >>> abs(float(out["velocity_out_t"][0] / v_t_in) - 5 / 7) < 1e-12
+    True
+    >>> abs(float(out["velocity_out_t"][0] + WALL_1990.radius * out["omega_out_tp"][0])) < 1e-9
+    True
+    >>> r = simulate_impact(WALL_1990, 30.0, incidence_deg=60.0)
+    >>> abs(float(out["velocity_out_t"][1]) - r.velocity_out[1]) < 1e-9 * 30.0
+    True
     """
     return rebound_from_impulses(contact, normal_impulses(contact, speed, incidence_deg, rtol), spin)
 
