@@ -189,6 +189,18 @@ def standard_figure(path, *, curves=None, variant: str | None = None) -> figures
     UnknownResultError
         For an unknown file, a file of a kind without a figure, or ``curves`` given for another
         kind; the message names the file.
+
+    Examples
+    --------
+    The standard figure of a small sweep, with its caption:
+
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.studies.sweeps import run_sweep, save_sweep
+    >>> path = save_sweep(run_sweep(WALL_1990, {"speed": [2.0, 4.0, 8.0]}), "sweep.nc")
+    >>> standard_figure(path).caption.split(".")[0]
+    'Restitution coefficient and tangential impulse ratios'
+    >>> standard_figure(path, variant="energy_loss").caption.split(".")[0]
+    'Kinetic energy loss ratios'
     """
     kind = result_kind(path)
     if kind in NO_FIGURE:
@@ -248,7 +260,18 @@ class FigureFile:
 
 def save_standard_figure(file: FigureFile, dpi: float = 150.0) -> str:
     """Draw the standard figure of ``file.result`` and write it to ``file.out`` atomically (its
-    directory is made if missing); returns the caption."""
+    directory is made if missing); returns the caption.
+
+    Examples
+    --------
+    >>> import os
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.studies.sweeps import run_sweep, save_sweep
+    >>> path = save_sweep(run_sweep(WALL_1990, {"speed": [2.0, 4.0]}), "sweep.nc")
+    >>> caption = save_standard_figure(FigureFile(str(path), "fig/sweep.png"))
+    >>> os.path.getsize("fig/sweep.png") > 0, caption.startswith("Restitution coefficient")
+    (True, True)
+    """
     plot = standard_figure(file.result, curves=file.curves, variant=file.variant)
     out = Path(file.out)
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -260,5 +283,18 @@ def save_standard_figure(file: FigureFile, dpi: float = 150.0) -> str:
 def save_standard_figures(files, *, workers: int = 1, dpi: float = 150.0) -> list[str]:
     """:func:`save_standard_figure` for each of ``files``, by ``workers`` forked processes (one
     process start and one import for a whole set of figures: the HTML report's figures cost about
-    0.3 s each this way, against 1.5-2 s as one job each). Returns the captions in order."""
+    0.3 s each this way, against 1.5-2 s as one job each). Returns the captions in order.
+
+    Examples
+    --------
+    Two figures of one file (a PNG and a PDF), their captions in order:
+
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.studies.sweeps import run_sweep, save_sweep
+    >>> path = str(save_sweep(run_sweep(WALL_1990, {"speed": [2.0, 4.0]}), "sweep.nc"))
+    >>> files = [FigureFile(path, "fig/a.png"), FigureFile(path, "fig/b.pdf", variant="energy_loss")]
+    >>> captions = save_standard_figures(files)
+    >>> [c.split(".")[0] for c in captions]
+    ['Restitution coefficient and tangential impulse ratios', 'Kinetic energy loss ratios']
+    """
     return fork_map(lambda f: save_standard_figure(f, dpi), list(files), workers)
