@@ -717,7 +717,21 @@ def write_stress_summary(summary: dict, path) -> None:
 
 
 def main(argv=None) -> int:
-    """Command line; exit status 1 when a case failed a check (notes do not count), else 0."""
+    """Command line; exit status 1 when a case failed a check (notes do not count), 2 for a usage
+    error (argparse's message on stderr), else 0.
+
+    Examples
+    --------
+    Three cases, the summary written as JSON (its one-line account goes to stderr):
+
+    >>> import json
+    >>> main(["--cases", "3", "--reference-every", "0", "--no-progress", "--out", "stress.json"])
+    0
+    >>> json.load(open("stress.json"))["cases_run"]
+    3
+    >>> main(["--cases", "-1"])
+    2
+    """
     p = argparse.ArgumentParser(prog="python -m microimpact.studies.stress",
                                 description="Seeded random stress sweep of the impact engine.")
     p.add_argument("--cases", type=int, default=1000, help="number of random impacts")
@@ -731,9 +745,12 @@ def main(argv=None) -> int:
     p.add_argument("--out", default=None, help="write the summary as JSON here (atomically)")
     p.add_argument("--netcdf", default=None, help="write the per-case dataset as NetCDF here (atomically)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (drawn only on a terminal anyway)")
-    args = p.parse_args(argv)
-    if args.cases < 0 or args.reference_every < 0 or not args.case_time_limit > 0 or not args.reference_budget > 0:
-        p.error("--cases and --reference-every must be >= 0, --case-time-limit and --reference-budget > 0")
+    try:
+        args = p.parse_args(argv)
+        if args.cases < 0 or args.reference_every < 0 or not args.case_time_limit > 0 or not args.reference_budget > 0:
+            p.error("--cases and --reference-every must be >= 0, --case-time-limit and --reference-budget > 0")
+    except SystemExit as exc:  # --help and usage errors as a status (argparse raises), as calibration's main
+        return int(exc.code or 0)
 
     with progress_bar(args.cases, "stress", enabled=not args.no_progress) as advance:
         report = stress_sweep(args.cases, args.seed, reference_every=args.reference_every,
