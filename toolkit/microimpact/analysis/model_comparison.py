@@ -61,6 +61,19 @@ def normal_model_restitution(problem: FitProblem, normal_model: str, zeta_hertz,
         Relative tolerance of the normal solves. [-]
     normal_speed, radius : array_like, optional
         Evaluate at these (broadcast) instead of the data points. [m/s], [m]
+
+    Examples
+    --------
+    Without damping the ring and DMT laws are conservative (e_n = 1 with adhesion too); JKR loses the
+    energy of its hysteresis, less with LAMMPS's force criterion (contact breaks earlier, at F = -F_c):
+
+    >>> from microimpact.analysis.fitting import FitProblem
+    >>> from microimpact.io import default_materials_path, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> problem = FitProblem.from_arrays([3.45e-6] * 3, [0.5, 1.0, 2.0], material)
+    >>> {m: normal_model_restitution(problem, m, 0.0, 0.0, 0.215834).round(4).tolist()
+    ...  for m in ("ring", "dmt", "jkr", "jkr_force")}
+    {'ring': [1.0, 1.0, 1.0], 'dmt': [1.0, 1.0, 1.0], 'jkr': [0.4277, 0.892, 0.9741], 'jkr_force': [0.7723, 0.9482, 0.9873]}
     """
     from microimpact.solvers import engine, normal_models
 
