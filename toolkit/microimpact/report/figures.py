@@ -351,6 +351,17 @@ def plot_energy_loss(ds: xr.Dataset, *, hue: str | None = None) -> Plot:
         Three panels: (a) K_L, Eq. (25); (b) K_t, Eq. (24); (c) K_L - K_t. Solid: rebound; dotted:
         captured (ratios of the final state of a captured sphere, which may roll on); grey band:
         speeds at which the sphere is captured.
+
+    Examples
+    --------
+    Three panels, one curve per incidence angle:
+
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.studies.sweeps import run_sweep
+    >>> ds = run_sweep(WALL_1990, {"speed": [2.0, 4.0, 8.0], "incidence_deg": [0.0, 30.0]})
+    >>> plot = plot_energy_loss(ds, hue="incidence_deg")
+    >>> len(plot.figure.axes), plot.caption.split(".")[0]
+    (3, 'Kinetic energy loss ratios')
     """
     hue = _hue_dim(ds, hue)
     curves = _curves(ds, hue)
@@ -439,6 +450,17 @@ def plot_restitution_and_impulse(ds: xr.Dataset, *, hue: str | None = None, pane
     Plot
         e_n, Eq. (21) (0 when captured); mu_t, mu_t', Eqs. (22)-(23), left undefined (gaps) for
         captured impacts, as in the paper.
+
+    Examples
+    --------
+    e_n and mu_t (no spin, so mu_t' = 0 is left out):
+
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.studies.sweeps import run_sweep
+    >>> ds = run_sweep(WALL_1990, {"speed": [2.0, 4.0, 8.0], "incidence_deg": [0.0, 30.0]})
+    >>> plot = plot_restitution_and_impulse(ds, hue="incidence_deg")
+    >>> len(plot.figure.axes), plot.caption.split(".")[0]
+    (2, 'Restitution coefficient and tangential impulse ratios')
     """
     hue = _hue_dim(ds, hue)
     curves = _curves(ds, hue)
@@ -854,6 +876,13 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
         (other readings of the hysteretic law, thin orange, when present) on ``reading_incidence_deg``
         for q = ``tangential_restitution`` [1], ``rebound_spin`` [rad/s], ``rebound_angle`` [deg];
         measured ``<q>_measured`` at the angles ``<q>_incidence_deg``.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.kharaz import kharaz_comparison
+    >>> plot = plot_kharaz(kharaz_comparison())
+    >>> len(plot.figure.axes), plot.caption.split(":")[0]
+    (3, 'Oblique impact of 5 mm alumina spheres on glass at 3.9 m/s')
     """
     names = [n for n in ("tangential_restitution", "rebound_spin", "rebound_angle") if f"{n}_curve" in ds]
     labels = {

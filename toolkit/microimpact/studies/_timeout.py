@@ -14,7 +14,20 @@ __all__ = ["TimeLimitExceeded", "time_limit"]
 
 class TimeLimitExceeded(TimeBudgetExceeded):
     """Raised inside a :func:`time_limit` block that ran out of time (a
-    :class:`microimpact.solvers.TimeBudgetExceeded`, so one type covers every time budget)."""
+    :class:`microimpact.solvers.TimeBudgetExceeded`, so one type covers every time budget).
+
+    Examples
+    --------
+    A busy loop stopped after 0.2 s (SIGALRM, main thread):
+
+    >>> try:
+    ...     with time_limit(0.2, "the loop"):
+    ...         while True:
+    ...             pass
+    ... except TimeLimitExceeded as exc:
+    ...     print(exc)
+    the loop: time budget of 0.2 s exceeded
+    """
 
 
 @contextlib.contextmanager
