@@ -619,6 +619,14 @@ def plot_phase_portraits(portraits) -> Plot:
     Plot
         Penetration rate against penetration, in the paper's sign convention n = -x (n < 0 in
         contact, dn/dt < 0 on approach). Circle: start; square: end; cross: equilibrium n_e = -X.
+
+    Examples
+    --------
+    >>> from microimpact.dynamics.nonlinear import phase_portraits
+    >>> from microimpact.presets import WALL_1990
+    >>> plot = plot_phase_portraits(phase_portraits(WALL_1990, [1.0, 2.0]))
+    >>> len(plot.figure.axes), plot.caption.split(":")[0]
+    (2, 'Phase portraits of normal impacts (analogue of Fig. 5)')
     """
     portraits = list(portraits)
     if not portraits:
@@ -678,6 +686,13 @@ def plot_bifurcation_plane(ds: xr.Dataset, *, label_points: bool = True) -> Plot
         and, per ``case`` (label coordinate), ``case_C1``, ``case_C2``, ``case_speed`` [m/s].
     label_points : bool
         Number the points and list the labels in the legend.
+
+    Examples
+    --------
+    >>> from microimpact.dynamics.nonlinear import bifurcation_plane
+    >>> plot = plot_bifurcation_plane(bifurcation_plane(n_c1=21, n_c2=21))
+    >>> plot.caption.startswith("Bifurcation on the (C1, C2) parameter plane (analogue of Fig. 4)")
+    True
     """
     c1 = ds["C1"].values
     c2 = ds["C2"].values
