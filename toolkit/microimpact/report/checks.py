@@ -134,7 +134,18 @@ def _kharaz_rms(kh: xr.Dataset) -> pd.DataFrame:
 
 # =============================================================================== benchmark
 def benchmark_section(lay: Layout, wp: xr.Dataset | None) -> None:
-    """The work-precision diagram of the solvers and the most accurate setting of each."""
+    """The work-precision diagram of the solvers and the most accurate setting of each.
+
+    Examples
+    --------
+    Switched off in the configuration, the section says so and how to include it:
+
+    >>> from microimpact.report.layout import Layout
+    >>> lay = Layout("Report")
+    >>> benchmark_section(lay, None)
+    >>> lay.contents, "benchmark={enabled: true}" in lay.page.figure.texts[-1].get_text()
+    ([('1. Work-precision benchmark', 0)], True)
+    """
     lay.section("Work-precision benchmark", new_page=False, keep=3.0)
     if wp is None:
         lay.paragraph("The work-precision benchmark was switched off in the configuration (benchmark.enabled: "
@@ -228,7 +239,23 @@ def _optional(value) -> str:
 
 # =============================================================================== stress sweep
 def stress_section(lay: Layout, s: Mapping | None, settings: Mapping | None) -> None:
-    """The seeded stress sweep of the engine: what was checked, the worst values, the failed cases."""
+    """The seeded stress sweep of the engine: what was checked, the worst values, the failed cases.
+
+    Examples
+    --------
+    A sweep of four cases, and a sweep switched off (the section says how to switch it on):
+
+    >>> from microimpact.report.layout import Layout
+    >>> from microimpact.studies.stress import stress_sweep
+    >>> lay = Layout("Report")
+    >>> stress_section(lay, stress_sweep(4, seed=0, reference_every=0).summary, {"cases": 4})
+    >>> [t.get_text() for t in lay.page.figure.texts if t.get_text().startswith("Result")]
+    ['Result: all 4 cases passed every check.']
+    >>> off = Layout("Report")
+    >>> stress_section(off, None, {"enabled": False})
+    >>> "stress.enabled: false" in off.page.figure.texts[-1].get_text()
+    True
+    """
     lay.section("Numerical stability (stress sweep)", new_page=False, keep=2.5)
     settings = dict(settings or {})
     if s is None:
@@ -348,7 +375,16 @@ def _plain(obj):
 
 
 def config_section(lay: Layout, config: Mapping) -> None:
-    """The configuration the report was made with, as YAML."""
+    """The configuration the report was made with, as YAML.
+
+    Examples
+    --------
+    >>> from microimpact.report.layout import Layout
+    >>> lay = Layout("Report")
+    >>> config_section(lay, {"data": "data/impacts.csv", "stress": {"cases": 10}})
+    >>> lay.contents, lay.page.figure.texts[-1].get_text().splitlines()
+    ([('1. Appendix: configuration', 0)], ['data: data/impacts.csv', 'stress:', '  cases: 10'])
+    """
     lay.section("Appendix: configuration", new_page=False, keep=1.5)
     lay.paragraph("The configuration this report was made with (workflow/config/config.yaml merged with "
                   "command-line overrides), validated against workflow/schemas/config.schema.yaml.")
