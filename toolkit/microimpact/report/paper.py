@@ -20,7 +20,21 @@ __all__ = ["dynamics_section", "portraits_section", "paper_sweeps_section", "rep
 
 
 def dynamics_section(lay: Layout, bif: xr.Dataset | None, dyn: xr.Dataset | None) -> None:
-    """The (C1, C2) plane (Fig. 4) and the damping and equilibrium at the phase-portrait speeds."""
+    """The (C1, C2) plane (Fig. 4) and the damping and equilibrium at the phase-portrait speeds.
+
+    Examples
+    --------
+    The 1990 wall sphere's scales (m, X, T of Eqs. (29)-(30)) in the section's first paragraph:
+
+    >>> from microimpact.dynamics.nonlinear import bifurcation_plane, dynamics_summary
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.report.layout import Layout
+    >>> lay = Layout("Report")
+    >>> dynamics_section(lay, bifurcation_plane(n_c1=21, n_c2=21), dynamics_summary(WALL_1990, [1.0, 2.0]))
+    >>> text = " ".join(t.get_text() for t in lay.page.figure.texts)
+    >>> "m = 2.322e-13 kg, X = 2.626e-08 m" in text
+    True
+    """
     lay.section("Nonlinear dynamics of the normal contact (Figs. 4, 5)")
     if dyn is not None:
         lay.source(parameter_source(dyn))
@@ -56,7 +70,20 @@ def _equilibria(dyn: xr.Dataset) -> pd.DataFrame:
 
 
 def portraits_section(lay: Layout, portraits: list[xr.Dataset]) -> None:
-    """Phase portraits (Fig. 5), at most two panels per figure (four on a page width are unreadable)."""
+    """Phase portraits (Fig. 5), at most two panels per figure (four on a page width are unreadable).
+
+    Examples
+    --------
+    Three portraits take two figures (at most two panels each):
+
+    >>> from microimpact.dynamics.nonlinear import phase_portraits
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.report.layout import Layout
+    >>> lay = Layout("Report")
+    >>> portraits_section(lay, phase_portraits(WALL_1990, [1.0, 2.0, 4.0]))
+    >>> lay.contents, len(lay.page.figure.axes)
+    ([('1. Phase portraits (analogue of Fig. 5)', 0)], 2)
+    """
     lay.section("Phase portraits (analogue of Fig. 5)", new_page=False, keep=3.6)
     lay.source(parameter_source(*portraits))
     for i in range(0, len(portraits), 2):
@@ -85,7 +112,18 @@ def paper_sweeps_section(lay: Layout, sweeps: list[xr.Dataset]) -> None:
 
 
 def reproduction_section(lay: Layout, repro: pd.DataFrame) -> None:
-    """The paper's numbers and statements against the toolkit's, with agreement."""
+    """The paper's numbers and statements against the toolkit's, with agreement.
+
+    Examples
+    --------
+    >>> from microimpact.report.layout import Layout
+    >>> from microimpact.studies.reproduction import reproduction_table
+    >>> repro = reproduction_table()
+    >>> lay = Layout("Report")
+    >>> reproduction_section(lay, repro)
+    >>> f"{len(repro)} rows: {int((repro['agree'] == True).sum())} agree" in lay.pages[0].figure.texts[1].get_text()
+    True
+    """
     lay.section("Reproduction of the paper's numbers and statements", new_page=False, keep=1.5)
     agree = repro["agree"].astype(str).str.lower()
     n_yes = int(agree.isin(["true", "yes"]).sum())
