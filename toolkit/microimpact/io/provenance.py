@@ -37,6 +37,8 @@ def contact_attributes(contacts: Contact | Sequence[Contact]) -> dict:
     >>> a = contact_attributes(c)
     >>> a["contact_radius"], a["contact_normal_model"], a["contact_damping_reference_speed"]
     (3.45e-06, 'ring', 'per-impact normal speed')
+    >>> a["contact_shear_modulus"], a["contact_tangential_stiffness"], a["contact_rolling_stiffness"]
+    ('not given', 'not given', 'not given')
     >>> contact_attributes([c, c.with_(radius=1e-6)])["contact_radius"].tolist()  # one per size
     [3.45e-06, 1e-06]
     """
@@ -47,10 +49,11 @@ def contact_attributes(contacts: Contact | Sequence[Contact]) -> dict:
         values = [getattr(c, f.name) for c in group]
         if f.name in SUB_MODELS:  # a sub-model name, one per file (sizes share it)
             attrs[f"contact_{f.name}"] = ", ".join(sorted(set(values)))
-        elif f.name == "shear_modulus" and any(v is None for v in values):
-            attrs[f"contact_{f.name}"] = "not given"
-        elif any(v is None for v in values):  # damping reference speed: each impact's own
-            attrs[f"contact_{f.name}"] = "per-impact normal speed"
+        elif any(v is None for v in values):
+            # None: the damping reference speed is each impact's own; any other optional field
+            # (G*, the DEM springs) is not given, its law not being selected
+            attrs[f"contact_{f.name}"] = ("per-impact normal speed" if f.name == "damping_reference_speed"
+                                          else "not given")
         else:
             attrs[f"contact_{f.name}"] = np.array(values, dtype=float) if many else float(values[0])
     return attrs
