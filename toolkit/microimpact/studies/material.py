@@ -37,7 +37,22 @@ __all__ = [
 
 
 def fitted_contacts(fit: xr.Dataset, radii: Sequence[float] | None = None) -> dict[float, Contact]:
-    """The fitted contact of every measured sphere size (or of the given radii). [m] -> Contact"""
+    """The fitted contact of every measured sphere size (or of the given radii). [m] -> Contact
+
+    Examples
+    --------
+    The fitted contact of the one measured size (six synthetic impacts of 3.45 um spheres):
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> path = write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
+    >>> fit = fit_damping(read_impacts(path), material, confidence_intervals=False).to_dataset()
+    >>> contacts = fitted_contacts(fit)
+    >>> list(contacts), round(contacts[3.45e-6].zeta_hertz, 4), round(contacts[3.45e-6].zeta_adhesion, 3)
+    ([3.45e-06], 0.5964, 28.39)
+    """
     model = DampingFit.from_dataset(fit)
     sizes = np.unique(fit["radius"].values) if radii is None else np.asarray(radii, dtype=float)
     return {float(r): model.contact(float(r)) for r in sizes}
@@ -46,7 +61,21 @@ def fitted_contacts(fit: xr.Dataset, radii: Sequence[float] | None = None) -> di
 def stamp_fitted(ds: xr.Dataset, fit: xr.Dataset) -> xr.Dataset:
     """``ds`` with the fit's ``parameter_source``, the fitted contact of every measured size, and what
     the data did not determine: ``undetermined_parameters`` (each with the fit's statement) and
-    ``friction_source`` (which friction the simulations use, and why, where the fit had oblique data)."""
+    ``friction_source`` (which friction the simulations use, and why, where the fit had oblique data).
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> path = write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
+    >>> fit = fit_damping(read_impacts(path), material, confidence_intervals=False).to_dataset()
+    >>> from microimpact.studies.sweeps import run_sweep
+    >>> sweep = stamp_fitted(run_sweep(fitted_contacts(fit)[3.45e-6], {"speed": [2.0]}), fit)
+    >>> sweep.attrs["parameter_source"].split()[:2], sweep.attrs["undetermined_parameters"]
+    (['fit:', 'six.csv'], 'none')
+    """
     out = stamp_parameters(ds, list(fitted_contacts(fit).values()), source_of_fit(fit))
     notes = [f"{n}: {fit[f'{n}_status'].attrs.get('reason', '')}" for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
              if f"{n}_status" in fit and int(fit[f"{n}_status"]) != 0]
@@ -103,6 +132,22 @@ def material_sweep(fit: xr.Dataset, spec: Mapping, *, case: str | None = None,
         The sweep with a leading ``radius`` dimension [m] (one fitted contact per size), the
         capture speed per size, ``parameter_source`` = ``"fit: <file> <sha256>"`` and
         ``contact_*`` attributes as arrays along ``radius``.
+
+    Examples
+    --------
+    Case 2.1's speed axis moved onto the measured speeds (1.56-99.6 m/s), three points:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> path = write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
+    >>> fit = fit_damping(read_impacts(path), material, confidence_intervals=False).to_dataset()
+    >>> from microimpact.studies.sweeps import case_spec
+    >>> spec = case_spec("2.1", {"speed": {"start": 1, "stop": 2, "num": 3}, "incidence_deg": [0.0]})
+    >>> ds = material_sweep(fit, spec, case="2.1")
+    >>> dict(ds.sizes), ds["speed"].values.round(2).tolist()
+    ({'radius': 1, 'speed': 3, 'incidence_deg': 1}, [1.56, 50.6, 99.65])
     """
     contacts = fitted_contacts(fit)
     grid = _on_measured_speeds(spec, measured_speed_range(fit))
@@ -131,6 +176,18 @@ def material_dynamics(fit: xr.Dataset, *, rtol: float = DEFAULT_RTOL, time_budge
         ``critical_velocity`` and ``capture_velocity`` [m/s] along ``radius`` [m], with
         ``parameter_source`` and ``contact_*`` attributes (arrays along ``radius``). A size
         without adhesion (f0 = 0) has capture velocity 0 and critical velocity NaN.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> path = write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
+    >>> fit = fit_damping(read_impacts(path), material, confidence_intervals=False).to_dataset()
+    >>> dyn = material_dynamics(fit)
+    >>> round(float(dyn["capture_velocity"][0]), 3), float(dyn["critical_velocity"][0]) < 1e-4
+    (1.432, True)
     """
     contacts = fitted_contacts(fit)
     radii = np.array(list(contacts))

@@ -608,6 +608,18 @@ def restitution_curves(fit_dataset: xr.Dataset, speed=None, *, radius=None, rtol
     -------
     xarray.Dataset
         ``e_n`` and ``outcome`` on dims (``radius`` [m], ``speed`` [m/s], the normal speed).
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> path = write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
+    >>> fit = fit_damping(read_impacts(path), material, confidence_intervals=False).to_dataset()
+    >>> curves = restitution_curves(fit, [1.0, 2.0, 5.0])
+    >>> curves["e_n"].values.round(4).tolist()
+    [[0.0, 0.4516, 0.672]]
     """
 
     fit = DampingFit.from_dataset(fit_dataset)
