@@ -279,6 +279,22 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
         ``spin_bound`` [rad/s], ``angle_uncertainty_deg`` [deg]; flags ``rotation_sensitive``,
         ``angle_sensitive``, ``near_capture`` (int8 0/1). Thresholds and sample counts are
         attributes. ``ds.to_dataframe()`` gives one row per impact.
+
+    Examples
+    --------
+    Two normal impacts of synthetic data (no spin in them): an unmeasured spin or an angle error of
+    the stated size moves the predicted e_n by less than the e_n threshold, so neither is flagged:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> flags = flag_measurements(table.head(2), fit, n_spin=4, spin_fractions=(1.0,))
+    >>> spread = (flags["e_n_max"] - flags["e_n_min"]).values
+    >>> bool((spread < flags.attrs["threshold_e_n"]).all()), flags["probably_spun"].values.tolist()
+    (True, [0, 0])
     """
     deadline = Deadline.start(time_budget, "flags")
     th = _thresholds(thresholds)
@@ -416,6 +432,20 @@ def write_flags(ds: xr.Dataset, csv_path, nc_path=None):
     -------
     tuple of pathlib.Path
         The files written.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> flags = flag_measurements(table.head(2), fit, n_spin=4, spin_fractions=(1.0,))
+    >>> csv_path, nc_path = write_flags(flags, "flags.csv", "flags.nc")
+    >>> import pandas as pd
+    >>> pd.read_csv(csv_path)["row"].tolist(), nc_path.name
+    ([1, 2], 'flags.nc')
     """
     from microimpact.io.impacts import CSV_COLUMN_ATTR
 
