@@ -29,7 +29,25 @@ _PARAMETERS = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
 # =============================================================================== fit
 def fit_section(lay: Layout, fit: xr.Dataset, curves: xr.Dataset | None, data: pd.DataFrame | None,
                 synthetic: bool) -> None:
-    """The damping fit: method, Fig. 3 analogue, parameter table, fit statistics, data by size."""
+    """The damping fit: method, Fig. 3 analogue, parameter table, fit statistics, data by size.
+
+    Examples
+    --------
+    The section of a fit of six synthetic impacts names the data as synthetic:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> from microimpact.report.layout import Layout
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False).to_dataset()
+    >>> lay = Layout("Report")
+    >>> fit_section(lay, fit, None, table, synthetic=True)
+    >>> text = " ".join(t.get_text() for t in lay.pages[0].figure.texts)
+    >>> lay.contents, "SYNTHETIC data generated with known parameters" in " ".join(text.split())
+    ([('1. Damping fit (analogue of Fig. 3)', 0)], True)
+    """
     lay.section("Damping fit (analogue of Fig. 3)")
     a = fit.attrs
     src = a.get("fit_source", "the data")
@@ -213,7 +231,23 @@ def _friction_statement(obl: xr.Dataset) -> str:
 
 # =============================================================================== dynamics per size
 def analyst_dynamics_section(lay: Layout, dyn: xr.Dataset) -> None:
-    """Capture and critical velocity and the fitted contact of each measured sphere size."""
+    """Capture and critical velocity and the fitted contact of each measured sphere size.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> from microimpact.report.layout import Layout
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False).to_dataset()
+    >>> from microimpact.studies.material import material_dynamics
+    >>> lay = Layout("Report")
+    >>> analyst_dynamics_section(lay, material_dynamics(fit))
+    >>> lay.contents
+    [('1. Capture and critical velocity of the measured sizes', 0)]
+    """
     lay.section("Capture and critical velocity of the measured sizes", new_page=False)
     lay.paragraph(
         "For each measured sphere radius, the contact built from the fitted zeta_H, zeta_A and w_A (f0 from "
@@ -258,7 +292,19 @@ def analyst_sweeps_section(lay: Layout, sweeps: list[xr.Dataset], dyn: xr.Datase
 
 # =============================================================================== flags
 def flags_section(lay: Layout, flags: pd.DataFrame, data: pd.DataFrame | None) -> None:
-    """Which measured impacts are sensitive to unmeasured spin, to the angle error, or near capture."""
+    """Which measured impacts are sensitive to unmeasured spin, to the angle error, or near capture.
+
+    Examples
+    --------
+    An empty flags table says so:
+
+    >>> import pandas as pd
+    >>> from microimpact.report.layout import Layout
+    >>> lay = Layout("Report")
+    >>> flags_section(lay, pd.DataFrame(), None)
+    >>> lay.page.figure.texts[-1].get_text()
+    'No impacts in the flags table.'
+    """
     lay.section("Measurement flags")
     if flags.empty:
         lay.paragraph("No impacts in the flags table.")
