@@ -539,6 +539,21 @@ def plot_size_dependence(sweep: xr.Dataset, dynamics: xr.Dataset | None = None) 
     Plot
         (a) e_n(v), one curve per diameter, captured impacts (e_n = 0) dotted; (b) normal capture
         velocity (and the critical velocity of Eq. (38)) against the diameter, log-log.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("two.csv", radii=(1.72e-6, 3.45e-6), n_per_radius=4, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False).to_dataset()
+    >>> from microimpact.studies.material import material_dynamics, material_sweep
+    >>> from microimpact.studies.sweeps import case_spec
+    >>> spec = case_spec("2.1", {"speed": {"start": 1, "stop": 2, "num": 3}, "incidence_deg": [0.0]})
+    >>> plot = plot_size_dependence(material_sweep(fit, spec, case="2.1"), material_dynamics(fit))
+    >>> len(plot.figure.axes), plot.caption.split(".")[0]
+    (2, 'The measured material at each measured sphere size, with the contact fitted to the data')
     """
     ds = _normal_incidence(sweep)
     radii = np.asarray(ds["radius"].values, float)
@@ -758,6 +773,21 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
     curves : xarray.Dataset, optional
         Smooth model lines from :func:`microimpact.studies.sweeps.restitution_curves` (``e_n`` on
         ``radius`` x ``speed``). Without it the model is drawn at the data points, joined.
+
+    Examples
+    --------
+    A fit of eight synthetic impacts of two sizes, with its model curves:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("two.csv", radii=(1.72e-6, 3.45e-6), n_per_radius=4, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False).to_dataset()
+    >>> from microimpact.studies.sweeps import restitution_curves
+    >>> plot = plot_fit(fit, restitution_curves(fit, [1.0, 2.0, 5.0]))
+    >>> len(plot.figure.axes), plot.caption.split(" (")[0]
+    (2, 'Normal restitution coefficient e_n against incident normal speed [m/s]')
     """
     fig = _figure(WIDTH * 0.72, 4.2)
     ax, res_ax = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": (3, 1)})
