@@ -103,6 +103,18 @@ class Posterior(ReportHTML):
     info : dict
         ``errors_in_variables``, ``latent_rows`` (CSV rows with the latent-speed likelihood),
         ``elapsed_s``, ``converged`` (bool), ``convergence`` (text), ``source``.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> post.names, post.converged
+    (('zeta_hertz', 'zeta_adhesion'), False)
     """
 
     names: tuple
@@ -293,6 +305,13 @@ class PosteriorError(RuntimeError):
     """The chain collapsed or did not converge within its budget: no posterior to report.
 
     The message is one line: what happened, the numbers, and what to do.
+
+    Examples
+    --------
+    See :func:`sample_posterior`; a RuntimeError, so the command line reports it in one line:
+
+    >>> issubclass(PosteriorError, RuntimeError)
+    True
     """
 
 
@@ -401,6 +420,26 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     ----------
     Foreman-Mackey, D. et al. (2013). emcee: the MCMC hammer. PASP 125, 306. doi:10.1086/670067;
     Vehtari, A. et al. (2021). doi:10.1214/20-BA1221 (R-hat, effective sample size).
+
+    Examples
+    --------
+    Six synthetic impacts. A chain whose budget is too small is refused, saying why, rather than
+    returned as a result; ``require_convergence=False`` returns it marked as not converged (the
+    default chain, 16 walkers until converged, takes about 20 s here and converges):
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> sample_posterior(table, fit, walkers=8, max_steps=60)
+    Traceback (most recent call last):
+    ...
+    microimpact.analysis.posterior.PosteriorError: the posterior has not converged after 60 steps of 8 walkers ...
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> post
+    Posterior(zeta_hertz, zeta_adhesion; 8 walkers x 60 steps, burn-in 20, seed 2002, converged=False)
     """
     from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX
     from microimpact.solvers import engine_threads
@@ -606,7 +645,23 @@ def _autocorr(chain: np.ndarray) -> np.ndarray:
 
 # =============================================================================== what it implies
 def posterior_contacts(posterior: Posterior, damping_fit, radius: float, n_draws: int = 64, seed=None) -> list:
-    """Contacts of one radius [m] for ``n_draws`` posterior draws (f0 from Eq. (7) per draw)."""
+    """Contacts of one radius [m] for ``n_draws`` posterior draws (f0 from Eq. (7) per draw).
+
+    Examples
+    --------
+    Eight contacts drawn from the chain, each with the fit's material and a drawn damping:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> contacts = posterior_contacts(post, fit, 3.45e-6, n_draws=8)
+    >>> len(contacts), {c.density for c in contacts}, len({c.zeta_adhesion for c in contacts}) > 1
+    (8, {1350.0}, True)
+    """
     return [_contact(damping_fit, radius, d) for d in posterior.draws(n_draws, seed)]
 
 
@@ -629,6 +684,19 @@ def restitution_bands(posterior: Posterior, damping_fit, speeds=None, *, n_draws
     xarray.Dataset
         ``e_n_band(radius, band_speed, quantile)`` [1]; the credible band of the model e_n (the
         spread of the curve over the posterior, without the measurement noise).
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> bands = restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8)
+    >>> bands["e_n_band"].dims, bands["quantile"].values.tolist()
+    (('radius', 'band_speed', 'quantile'), [0.025, 0.16, 0.5, 0.84, 0.975])
     """
     from microimpact.solvers import engine
 
@@ -662,6 +730,19 @@ def capture_velocity_interval(posterior: Posterior, damping_fit, *, n_draws: int
     -------
     xarray.Dataset
         ``capture_velocity_quantile(radius, quantile)`` [m/s] over ``n_draws`` draws.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> q = capture_velocity_interval(post, fit, n_draws=8)["capture_velocity_quantile"]
+    >>> bool((q.diff("quantile") >= 0).all()), 1.3 < float(q.sel(quantile=0.5)[0]) < 1.5
+    (True, True)
     """
     from microimpact.dynamics.nonlinear import capture_velocity
 
@@ -763,6 +844,19 @@ def posterior_dataset(posterior: Posterior, *extra: xr.Dataset) -> xr.Dataset:
     ``<name>_quantile(quantile)``, ``<name>_autocorr_time``, ``acceptance_fraction(walker)``;
     attributes ``burn_in``, ``seed``, ``converged``, ``convergence``, ``errors_in_variables``,
     ``fixed_<name>``.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> ds = posterior_dataset(post)
+    >>> [v for v in ds.data_vars if v.startswith("chain_")]
+    ['chain_zeta_hertz', 'chain_zeta_adhesion']
     """
     steps, walkers, _ = posterior.chain.shape
     ds = xr.Dataset(coords={
@@ -804,7 +898,20 @@ def posterior_dataset(posterior: Posterior, *extra: xr.Dataset) -> xr.Dataset:
 
 
 def posterior_from_dataset(ds: xr.Dataset) -> Posterior:
-    """Inverse of :func:`posterior_dataset` (the chain part; also of the Dataset read back from its file)."""
+    """Inverse of :func:`posterior_dataset` (the chain part; also of the Dataset read back from its file).
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> posterior_from_dataset(posterior_dataset(post))
+    Posterior(zeta_hertz, zeta_adhesion; 8 walkers x 60 steps, burn-in 20, seed 2002, converged=False)
+    """
     from microimpact.io.files import restore_label_coordinates
 
     ds = restore_label_coordinates(ds)
@@ -855,6 +962,17 @@ def load_posterior(path) -> Posterior | None:
     ValueError
         If the file is not a posterior file at all (a fit, a sweep, ...): it is not taken for "no
         posterior" in silence.
+
+    Examples
+    --------
+    See :func:`save_posterior`.
+
+    A file that is not there is an error, not "no posterior":
+
+    >>> load_posterior("no_such_file.nc")
+    Traceback (most recent call last):
+    ...
+    FileNotFoundError: ...
     """
     from microimpact.io.kinds import file_kind
 
@@ -877,12 +995,40 @@ def load_posterior(path) -> Posterior | None:
 
 
 def save_posterior(ds: xr.Dataset, path):
-    """Write a :func:`posterior_dataset` atomically."""
+    """Write a :func:`posterior_dataset` atomically.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> save_posterior(posterior_dataset(post), "posterior.nc").name
+    'posterior.nc'
+    >>> load_posterior("posterior.nc").converged
+    False
+    """
     return write_netcdf(ds, path)
 
 
 def summary_table(posterior: Posterior) -> pd.DataFrame:
-    """One row per sampled parameter: median, 95 % interval, autocorrelation time."""
+    """One row per sampled parameter: median, 95 % interval, autocorrelation time.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> summary_table(post)["parameter"].tolist()
+    ['zeta_hertz', 'zeta_adhesion']
+    """
     rows = []
     for n in posterior.names:
         lo, hi = posterior.interval(n)
