@@ -23,7 +23,22 @@ _LABEL = {"zeta_hertz": r"$\zeta_H$", "zeta_adhesion": r"$\zeta_A$", "work_of_ad
 
 
 def posterior_names(post: xr.Dataset) -> list[str]:
-    """The sampled parameters of a posterior file (attribute ``sampled``)."""
+    """The sampled parameters of a posterior file (attribute ``sampled``).
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.posterior import posterior_dataset, restitution_bands, sample_posterior
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> ds = posterior_dataset(post, restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8))
+    >>> posterior_names(ds)
+    ['zeta_hertz', 'zeta_adhesion']
+    """
     return str(post.attrs.get("sampled", "")).split()
 
 
@@ -38,7 +53,23 @@ def _q(post: xr.Dataset, var: str, q: float) -> xr.DataArray:
 
 @_rc
 def plot_fit_bands(fit: xr.Dataset, post: xr.Dataset) -> Plot:
-    """Measured e_n with error bars, the best fit, and the posterior 95 % band of the model per size."""
+    """Measured e_n with error bars, the best fit, and the posterior 95 % band of the model per size.
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.posterior import posterior_dataset, restitution_bands, sample_posterior
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> ds = posterior_dataset(post, restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8))
+    >>> plot = plot_fit_bands(fit.to_dataset(), ds)
+    >>> len(plot.figure.axes), plot.caption.startswith("Measured e_n (1-sigma error bars)")
+    (1, True)
+    """
     fig = _figure(WIDTH * 0.72, 3.3)
     ax = fig.subplots()
     radius = fit["radius"].values
@@ -71,7 +102,25 @@ def _convergence(post: xr.Dataset) -> str:
 
 @_rc
 def plot_corner(post: xr.Dataset) -> Plot:
-    """Corner plot of the post-burn-in samples: marginal histograms and pairwise scatter."""
+    """Corner plot of the post-burn-in samples: marginal histograms and pairwise scatter.
+
+    Examples
+    --------
+    Two parameters: two histograms and one scatter panel (and an empty corner):
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.posterior import posterior_dataset, restitution_bands, sample_posterior
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> ds = posterior_dataset(post, restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8))
+    >>> plot = plot_corner(ds)
+    >>> len(plot.figure.axes), plot.caption.split(" (")[0]
+    (4, 'Corner plot of the posterior')
+    """
     names = posterior_names(post)
     k = len(names)
     fig = _figure(min(WIDTH * 0.75, 1.9 * k + 0.6), min(WIDTH * 0.75, 1.9 * k + 0.6))
