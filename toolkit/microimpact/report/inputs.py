@@ -163,6 +163,14 @@ def read_portraits(obj) -> list[xr.Dataset]:
 
     The ``parameter_source`` attribute of the file's root group is copied to each trajectory
     that has none.
+
+    Examples
+    --------
+    >>> from microimpact.dynamics.nonlinear import phase_portraits, save_phase_portraits
+    >>> from microimpact.presets import WALL_1990
+    >>> path = save_phase_portraits(phase_portraits(WALL_1990, [1.0, 2.0]), "portraits.nc")
+    >>> len(read_portraits(path))
+    2
     """
     if not isinstance(obj, (str, os.PathLike)):
         return list(obj)

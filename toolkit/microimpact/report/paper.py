@@ -91,7 +91,22 @@ def portraits_section(lay: Layout, portraits: list[xr.Dataset]) -> None:
 
 
 def paper_sweeps_section(lay: Layout, sweeps: list[xr.Dataset]) -> None:
-    """The Table 2 cases (Figs. 7-14), one page per case."""
+    """The Table 2 cases (Figs. 7-14), one page per case.
+
+    Examples
+    --------
+    Case 2.1 on a small grid: its subsection and its two figures (energy loss, Fig. 7; restitution
+    and impulse ratios, Fig. 8):
+
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.report.layout import Layout
+    >>> from microimpact.studies.sweeps import case_spec, run_sweep
+    >>> sweep = run_sweep(WALL_1990, case_spec("2.1", {"speed": [2.0, 4.0], "incidence_deg": [0.0, 30.0]}), case="2.1")
+    >>> lay = Layout("Report")
+    >>> paper_sweeps_section(lay, [sweep])
+    >>> lay.contents, len(lay.page.figure.axes)
+    ([('1. Sensitivity to the initial conditions (Table 2, Figs. 7-14)', 0), ('1.1 Table 2 case 2.1 (Figs. 7, 8)', 0)], 2)
+    """
     lay.section("Sensitivity to the initial conditions (Table 2, Figs. 7-14)")
     lay.paragraph(
         "Each Table 2 case is swept over the incident speed and one curve-family parameter with the fast "
