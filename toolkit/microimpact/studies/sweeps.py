@@ -279,6 +279,8 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
               time_budget: float | None = None) -> xr.Dataset:
     """Simulate every impact of a sweep grid with :func:`microimpact.solvers.impact.simulate_many`.
 
+    Length: the docstring (parameters, examples); the body is 53 lines.
+
     Parameters
     ----------
     contact : Contact
