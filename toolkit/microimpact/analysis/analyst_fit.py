@@ -48,6 +48,22 @@ class AnalystFit(ReportHTML):
     posterior : Posterior or None
     posterior_dataset : xarray.Dataset or None
         Chain, summary, diagnostics and bands (:func:`~microimpact.analysis.posterior.posterior_dataset`).
+
+    Examples
+    --------
+    Six synthetic impacts without oblique columns: no friction fit, and the oblique file says why:
+
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> result = analyse_impacts(table, material)
+    >>> result.friction is None, result.posterior is None
+    (True, True)
+    >>> result.oblique_dataset().attrs["comment"]
+    'the impact table has no oblique columns: no friction fit'
+    >>> [p.name for p in result.save("fit.nc", oblique_path="oblique.nc")]
+    ['fit.nc', 'oblique.nc']
     """
 
     damping: object
@@ -136,6 +152,27 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
         A stage ran past ``time_budget``; the message names the stage and how far it got.
     PosteriorError
         The posterior collapsed or did not converge (:func:`~microimpact.analysis.posterior.sample_posterior`).
+
+    Examples
+    --------
+    Six synthetic impacts made with zeta_H = 0.5, zeta_A = 29 (w_A fixed at the material's): the
+    fitted values are within two standard errors of them:
+
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = analyse_impacts(table, material).damping
+    >>> {k: bool(abs(fit.values[k] - truth) < 2 * fit.stderr[k])
+    ...  for k, truth in (("zeta_hertz", 0.5), ("zeta_adhesion", 29.0))}
+    {'zeta_hertz': True, 'zeta_adhesion': True}
+
+    A misspelt posterior option is refused, naming the known ones (after the damping fit):
+
+    >>> analyse_impacts(table, material, posterior={"wlakers": 8})
+    Traceback (most recent call last):
+    ...
+    ValueError: unknown posterior option(s) ['wlakers']; known: ['burn', 'max_steps', 'n_draws', 'seed', 'steps', 'walkers']
     """
     from microimpact.analysis.fitting import fit_damping
     from microimpact.analysis.oblique import ObliqueProblem, fit_friction
