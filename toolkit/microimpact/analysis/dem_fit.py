@@ -111,6 +111,26 @@ class DemLawFit:
         density [kg/m^3], stiffness [Pa], work_of_adhesion [J/m^2] the law was fitted with.
     source : str
         Where the data came from.
+
+    Examples
+    --------
+    Three impacts of e_n = 0.71 +/- 0.01: the constant-restitution law is determined, and its contact
+    carries the fitted coefficient; impacts at e_n ~ 1 give only a bound (consistent with no damping):
+
+    >>> import pandas as pd
+    >>> t = pd.DataFrame({"radius": [3.45e-6] * 3, "normal_speed": [0.5, 1.0, 2.0], "e_n": [0.70, 0.72, 0.71],
+    ...                   "e_n_uncertainty": [0.01] * 3})
+    >>> material = {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0}
+    >>> f = fit_dem_law(t, material)
+    >>> f.determined, f.law, round(f.contact(3.45e-6).damping_coefficient, 4)
+    (True, 'hertz+coeff_restitution', 0.71)
+    >>> f.describe()
+    'hertz+coeff_restitution: damping_coefficient = 0.71 (68% interval 0.704227 to 0.715774)'
+    >>> g = fit_dem_law(t.assign(e_n=[1.0, 0.995, 1.0]), material)
+    >>> g.status, g.determined
+    ('upper limit', False)
+    >>> g.describe()
+    'hertz+coeff_restitution: consistent with no damping; the data give only e >= 0.99256 (68%)'
     """
 
     normal_model: str
