@@ -11,6 +11,7 @@ and the Kharaz et al. (2001) comparison.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -530,6 +531,67 @@ def test_hysteretic_sweep_finishes(which, alumina):
         assert np.all(np.isfinite(ds[q].values)), q
     incident = 0.5 * c.mass * speeds[:, None] ** 2
     assert np.all(ds["dissipated_energy"].values >= -1e-9 * incident)
+
+
+# =============================================================================== held rolling: said when undetermined
+def _held_rolling_case(index):
+    """Case ``index`` of the stress sweep (seed 0) under the hysteretic law with the pulloff limit
+    and rolling resistance mu_r = 0.01, and its simulate_impact arguments."""
+    from microimpact.studies import stress
+
+    case = stress.draw_cases(index + 1, seed=0)[index]
+    contact = stress.contact_of(case, "mindlin_deresiewicz_pulloff_rolling")
+    return contact, (case["speed"], case["incidence_deg"], case["azimuth_deg"],
+                     (case["omega_n"], case["omega_t"], case["omega_tp"]))
+
+
+def _tangential_speeds(res, r):
+    return np.array([res.velocity_out[1], res.velocity_out[2], r * res.omega_out[1], r * res.omega_out[2]])
+
+
+def test_held_rolling_that_the_tolerance_does_not_settle_is_said():
+    """Case 20 (a 0.58 um sphere at 6 um/s spinning at 65 x its rolling spin, captured and held by
+    friction f = 1.89): its final rolling moves with rtol (measured v_t / v = -3.14, -0.78, -2.16 at
+    rtol 1e-8, 1e-10, 1e-12), because the rolling torque reverses with the held contact's vibration.
+    The solver must say so (a warning and ``not_determined``), and the saying must be true: an
+    independent run at rtol 1e-10 differs from the rtol-1e-8 result by more than the tolerance it
+    states, HELD_ROLLING_TOLERANCE of the speed scale."""
+    from microimpact.solvers import UndeterminedOutcomeWarning
+    from microimpact.solvers.coupled import HELD_ROLLING_TOLERANCE
+
+    contact, args = _held_rolling_case(20)
+    with pytest.warns(UndeterminedOutcomeWarning, match="held by friction with rolling resistance"):
+        res = simulate_impact(contact, *args, rtol=1e-8)
+    assert res.outcome == "capture" and "error estimate" in res.not_determined
+    with pytest.warns(UndeterminedOutcomeWarning):
+        tight = simulate_impact(contact, *args, rtol=1e-10)
+    r = contact.radius
+    scale = args[0] * math.sin(math.radians(args[1])) + r * math.hypot(args[3][1], args[3][2])
+    moved = np.max(np.abs(_tangential_speeds(res, r) - _tangential_speeds(tight, r)))
+    assert moved > HELD_ROLLING_TOLERANCE * scale  # measured 0.2 of the scale
+    # the batch path says how many
+    with pytest.warns(UndeterminedOutcomeWarning, match="1 of 1 impacts"):
+        simulate_many(contact, args[0], args[1], args[2], args[3])
+
+
+def test_held_rolling_that_converges_is_not_flagged():
+    """The paper's microsphere (Table 1 row 2) with Mindlin-Deresiewicz contact (G* = 0.3 K), the
+    pulloff limit and mu_r = 0.01, captured at 0.05 m/s and 40 deg: its rolling reverses on the
+    held contact too, but converges (v_t / v = 0.301155, 0.301151 at rtol 1e-8, 1e-10, measured):
+    no warning, ``not_determined`` empty, and the two tolerances agree within what it claims."""
+    from microimpact.model.parameters import TABLE1_ROW2
+    from microimpact.solvers.coupled import HELD_ROLLING_TOLERANCE
+
+    c = TABLE1_ROW2.with_(tangential_model="mindlin_deresiewicz", shear_modulus=0.3 * TABLE1_ROW2.stiffness,
+                          friction_model="pulloff", rolling_friction=0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        a = simulate_impact(c, 0.05, 40.0, rtol=1e-8)
+        b = simulate_impact(c, 0.05, 40.0, rtol=1e-10)
+    assert a.outcome == "capture" and a.not_determined == "" and b.not_determined == ""
+    assert a.velocity_out[1] / 0.05 == pytest.approx(0.3011, abs=2e-4)  # rolls on: not a trivial rest
+    moved = np.max(np.abs(_tangential_speeds(a, c.radius) - _tangential_speeds(b, c.radius)))
+    assert moved < HELD_ROLLING_TOLERANCE * 0.05 * math.sin(math.radians(40.0))
 
 
 # =============================================================================== the settled state

@@ -156,6 +156,8 @@ COUPLED_CHANGED = ("max_penetration", "capture_time", "slip_end_time", "friction
 #: without rolling resistance and 1.8e-4 with it (README, "Tangential compliance"), so no real
 #: change of the model hides below these. Velocities are compared relative to the incident speed.
 COUPLED_NOISE = {0.0: 1e-5, 0.01: 2e-4}
+#: Outputs added since the baseline (the held-rolling check: tests/test_contact_models.py)
+COUPLED_NEW = ("tangential_error", "not_determined")
 N_COUPLED = 60  # impacts of the baseline (tests/regression/coupled_cases.py)
 
 
@@ -196,7 +198,7 @@ def test_coupled_solver_against_its_baseline(coupled_now):
     speed = np.sqrt(sum(np.square(x) for x in v))
     for tangential, friction, rolling in cases.SELECTIONS:
         name = f"{tangential}-{friction}-{rolling}"
-        res = {k: np.asarray(x, dtype=float) for k, x in now[name].items()}
+        res = {k: np.asarray(x, dtype=float) for k, x in now[name].items() if k not in COUPLED_NEW}
         old = {k: base[f"{name}:{k}"].values for k in res}
         captured = old["captured"].astype(bool)
         noise = COUPLED_NOISE[rolling]

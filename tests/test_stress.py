@@ -204,20 +204,16 @@ def test_every_law_passes_the_sweep(law):
 
     With rolling resistance every case now gets a result (10 of these 40 ended in the step limit
     before the coupled solver took the closed-form tails under the pulloff friction too). Two
-    captured spheres held by friction (cases 20 and 33) still fail the convergence check: their
-    final rolling depends on where the tail's integration stops (:func:`_rolling_tail` of
-    ``solvers/coupled.py`` says why their tail has no closed form). The test holds that line: no
-    other kind of failure and no more cases."""
+    captured spheres held by friction (cases 20 and 33) miss the convergence tolerance, and the
+    solver says so itself (``not_determined``, an UndeterminedOutcomeWarning): a note, not a
+    failure. No law may fail a case."""
     report = stress.stress_sweep(40, seed=0, reference_every=0, law=law)
     s = report.summary
     assert s["law"] == law and s["cases_run"] == 40
-    held = {"mindlin_deresiewicz_pulloff_rolling": 2}
-    if law in held:
-        kinds = {k for k, n in s["failures_by_kind"].items() if n}
-        assert kinds <= {"convergence"}, s["failed_cases"]
-        assert s["cases_failed"] <= held[law], [c["inputs"]["case"] for c in s["failed_cases"]]
-    else:
-        assert s["cases_failed"] == 0, s["failed_cases"]
+    assert s["cases_failed"] == 0, s["failed_cases"]
+    said = {"mindlin_deresiewicz_pulloff_rolling": {20, 33}}.get(law, set())
+    noted = {c["inputs"]["case"] for c in s["noted_cases"] if any(n["kind"] == "not_determined" for n in c["notes"])}
+    assert noted == said
 
 
 def test_compliant_law_gets_the_shear_modulus_of_its_stiffness():

@@ -141,6 +141,12 @@ class ImpactResult:
         Why the integration stopped: "separation" (rebound), "capture" (the energy test, nothing
         tangential left that the rest of the motion could change), "settled" or "slip and twist
         ended" (a captured sphere followed for its tangential outcome).
+    not_determined : str
+        What the solver could not determine to its tolerance, with its error estimate; empty when
+        every value is determined. Set for a captured sphere held by friction with rolling
+        resistance whose final tangential velocity and spin moved beyond
+        :data:`~microimpact.solvers.coupled.HELD_ROLLING_TOLERANCE` between two tolerances (an
+        :class:`~microimpact.solvers.UndeterminedOutcomeWarning` is issued as well).
 
     Examples
     --------
@@ -182,6 +188,7 @@ class ImpactResult:
     final_contact_energy: float
     method: str
     stop_reason: str
+    not_determined: str = ""
 
     def to_dict(self) -> dict:
         """Plain dict; non-finite floats become None so that the result is valid JSON."""

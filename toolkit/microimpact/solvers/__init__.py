@@ -46,6 +46,25 @@ class SolverError(RuntimeError):
     failure of any solver."""
 
 
+class UndeterminedOutcomeWarning(UserWarning):
+    """A result the solver returns but cannot determine to its tolerance: the message says which
+    values, how many impacts and the error estimate; each :class:`~microimpact.model.kinematics.ImpactResult`
+    says it in ``not_determined``. Issued for captured spheres held by friction with rolling
+    resistance whose final rolling the rolling torque's reversals leave undetermined
+    (:func:`microimpact.solvers.coupled._held_rolling_error`).
+
+    Examples
+    --------
+    Turn it into an error where an undetermined number must not pass:
+
+    >>> import warnings
+    >>> with warnings.catch_warnings():
+    ...     warnings.simplefilter("error", UndeterminedOutcomeWarning)
+    ...     issubclass(UndeterminedOutcomeWarning, UserWarning)
+    True
+    """
+
+
 class ModelDomainError(ValueError):
     """Valid numbers whose impact leaves the domain of the model: a result in SI units would not be
     representable (e.g. a twist impulse beyond 1.8e308 N m s at a penetration 1e64 m into a 3 um

@@ -426,6 +426,8 @@ def _coupled_results(contact, v_in, w_in, f, rtol) -> dict:
         # everything the sphere lost: kinetic energy in - out, less the contact energy it keeps when captured
         "dissipated_energy": kinetic(v_in, w_in) - kinetic(v_out, w_out) - np.where(captured, settled, 0.0),
         "capture_time": c["capture_time"], "slip_end_time": c["slip_end_time"],
+        "tangential_error": c.get("tangential_error", np.zeros(captured.size)),
+        "not_determined": c.get("not_determined", np.zeros(captured.size, dtype=bool)),
     }
 
 
@@ -452,6 +454,8 @@ def _coupled_impact_result(contact, v_in, w_in, res) -> ImpactResult:
                 if uses_dem_tangential(contact)
                 else f"engine:coupled ({contact.tangential_model}, {contact.friction_model})"),
         stop_reason="separation" if not captured else "capture" if (stops_at_capture(contact) or uses_dem_tangential(contact)) else "settled",
+        not_determined=(f"final tangential velocity and spin (error estimate {float(one['tangential_error']):.3g} m/s: "
+                        "the rolling torque reverses with the held contact's vibration)" if one["not_determined"] else ""),
     )
 
 

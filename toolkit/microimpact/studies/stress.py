@@ -24,7 +24,7 @@ fails is a *failure* of the engine (``summary["failures_by_kind"]``; the command
     the engine took longer than ``case_time_limit`` seconds for the case (measured: it cannot be
     interrupted inside compiled code; its own time box is its step limit).
 
-Three findings are reported separately (``summary["notes_by_kind"]``, ``summary["noted_cases"]``)
+Four findings are reported separately (``summary["notes_by_kind"]``, ``summary["noted_cases"]``)
 and do not fail the run, because they say nothing about the engine:
 
 ``reference_timeout``
@@ -38,6 +38,12 @@ and do not fail the run, because they say nothing about the engine:
 ``slow_convergence``
     the results at rtol 1e-8 and 1e-10 differ by more than the tolerance, but the result
     converges: see "Convergence criterion".
+``not_determined``
+    the results at rtol 1e-8 and 1e-10 differ by more than the tolerance, and the solver said so
+    itself: the result's ``not_determined`` names the values and its error estimate, and an
+    :class:`~microimpact.solvers.UndeterminedOutcomeWarning` was issued (a captured sphere held
+    by friction with rolling resistance, :data:`microimpact.solvers.coupled.HELD_ROLLING_TOLERANCE`).
+    A result that misses the tolerance without saying so remains a ``convergence`` failure.
 
 Energy scale
 ------------
@@ -101,6 +107,7 @@ from microimpact.solvers import TimeBudgetExceeded, check_sub_models
 from microimpact.solvers.reference import simulate_reference
 from microimpact.studies._timeout import time_limit
 from microimpact.model.adhesion_models import AdhesionRegimeWarning
+from microimpact.solvers import UndeterminedOutcomeWarning
 
 __all__ = ["LAWS", "POISSON", "TOLERANCES", "INPUT_RANGES", "FAILURE_KINDS", "NOTE_KINDS", "draw_cases", "contact_of", "check_case",
            "stress_sweep", "StressReport", "result_distance", "energy_scale", "energy_error", "kinetic_energy",
@@ -167,7 +174,7 @@ TOLERANCES = {
 #: Findings that fail the sweep (the engine is wrong or too slow).
 FAILURE_KINDS = ("exception", "nonfinite", "restitution", "energy", "convergence", "reference", "timeout")
 #: Findings reported apart that do not fail it (module docstring).
-NOTE_KINDS = ("reference_timeout", "reference_failed", "slow_convergence")
+NOTE_KINDS = ("reference_timeout", "reference_failed", "slow_convergence", "not_determined")
 
 #: Time budget of one reference solve [s] (at most ``case_time_limit``). The pure-Python reference
 #: needs minutes on the strongly damped cases of the extended domain, where the engine takes its
@@ -417,8 +424,14 @@ def _convergence_check(contact: Contact, args: tuple, fine, coarse, tol: dict, o
     if not math.isfinite(conv):
         out["failures"].append(("convergence", found))
         return
+    said = fine.not_determined or coarse.not_determined
+    if said:  # the solver reported it (UndeterminedOutcomeWarning): a note on the model, not a silent miss
+        out["notes"].append(("not_determined", f"{found}; the solver: {said}"))
+        return
     try:
-        tight = simulate_impact(*args, rtol=_RTOL_TIGHT)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UndeterminedOutcomeWarning)
+            tight = simulate_impact(*args, rtol=_RTOL_TIGHT)
     except Exception as exc:  # noqa: BLE001 - any exception is a finding
         out["failures"].append(("exception", f"rtol={_RTOL_TIGHT:g}: {type(exc).__name__}: {exc}"))
         return
@@ -511,8 +524,9 @@ def check_case(case: dict, *, reference: bool = False, case_time_limit: float = 
     args = (contact, case["speed"], case["incidence_deg"], case["azimuth_deg"], _omega(case))
     t0 = time.perf_counter()
     try:
-        with warnings.catch_warnings():  # (the DMT regime warning: a statement on the model, not the solver)
-            warnings.simplefilter("ignore", AdhesionRegimeWarning)
+        with warnings.catch_warnings():  # (the DMT regime warning: a statement on the model, not the solver;
+            warnings.simplefilter("ignore", AdhesionRegimeWarning)  # an undetermined outcome: a note, below)
+            warnings.simplefilter("ignore", UndeterminedOutcomeWarning)
             fine = simulate_impact(*args, rtol=_RTOL_FINE)
             coarse = simulate_impact(*args, rtol=_RTOL_COARSE)
     except Exception as exc:  # noqa: BLE001 - any exception is a finding
@@ -651,6 +665,7 @@ def stress_sweep(n_cases: int = 1000, seed: int = 0, *, reference_every: int = 2
     if cases:
         with warnings.catch_warnings(), contextlib.suppress(Exception):  # (a case's failure is found by the case)
             warnings.simplefilter("ignore", AdhesionRegimeWarning)
+            warnings.simplefilter("ignore", UndeterminedOutcomeWarning)
             simulate_impact(contact_of({**cases[0], "friction": 0.5}, law), 1.0, 30.0, 0.0, (1.0, 1.0, 1.0))
     rows = []
     for i, case in enumerate(cases):
