@@ -147,7 +147,35 @@ def _data_by_size(t: pd.DataFrame) -> pd.DataFrame:
 
 # =============================================================================== posterior
 def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset) -> None:
-    """The posterior: summary table, e_n bands, corner plot, capture velocity interval, sweep bands."""
+    """The posterior: summary table, e_n bands, corner plot, capture velocity interval, sweep bands.
+
+    Examples
+    --------
+    A short chain (an illustration, not converged): a row per sampled parameter in the table, the
+    band and corner figures, and the chain's own statement that it has not converged. A posterior
+    file that was not computed gives one line instead:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.posterior import posterior_dataset, restitution_bands, sample_posterior
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> from microimpact.report.layout import Layout
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> lay = Layout("Report")
+    >>> posterior_section(lay, fit.to_dataset(), posterior_dataset(post, restitution_bands(post, fit, [1.0, 2.0], n_draws=8)))
+    >>> text = " ".join(" ".join(t.get_text() for t in p.figure.texts) for p in lay.pages)
+    >>> [name in text for name in ("zeta_hertz", "zeta_adhesion", "NOT converged")]
+    [True, True, True]
+    >>> sum(len(p.figure.axes) for p in lay.pages)  # e_n bands and corner plot
+    2
+    >>> lay = Layout("Report")
+    >>> posterior_section(lay, None, xr.Dataset(attrs={"comment": "posterior not computed"}))
+    >>> lay.page.figure.texts[-1].get_text()
+    '(No posterior: posterior not computed.)'
+    """
     lay.section("Posterior of the fitted parameters", new_page=False)
     if "sampled" not in post.attrs:
         lay.paragraph(f"(No posterior: {post.attrs.get('comment', 'not computed')}.)", color="0.4")
@@ -201,7 +229,35 @@ def _posterior_rows(post: xr.Dataset) -> pd.DataFrame:
 
 # =============================================================================== oblique
 def oblique_section(lay: Layout, obl: xr.Dataset) -> None:
-    """The friction fit from the oblique columns: measured against fitted per angle."""
+    """The friction fit from the oblique columns: measured against fitted per angle.
+
+    Examples
+    --------
+    Eight synthetic oblique impacts made with f = 0.15 (friction fitted without propagating the
+    damping covariance, to keep the example short): the section states the fitted f and its 95 %
+    interval, which contains 0.15, and shows one figure. A table without oblique columns gets one
+    line instead of a section:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.oblique import fit_friction
+    >>> from microimpact.analysis.synthetic import make_synthetic_oblique
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials, write_csv
+    >>> from microimpact.report.layout import Layout
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> data = make_synthetic_oblique(radii=(3.45e-6,), speeds=(15.0, 30.0), incidence_deg=(35.0, 50.0, 60.0, 70.0))
+    >>> table = read_impacts(write_csv(data, "oblique.csv"))
+    >>> friction = fit_friction(table, fit_damping(table, material, confidence_intervals=False), propagate_damping=False)
+    >>> lay = Layout("Report")
+    >>> oblique_section(lay, friction.to_dataset())
+    >>> lay.contents, len(lay.page.figure.axes)
+    ([('1. Friction from the oblique columns', 0)], 1)
+    >>> print(lay.page.figure.texts[1].get_text().split("interval. ")[1])
+    f = 0.15895, 95 % profile-likelihood interval [0.1442, 0.17363] (standard error 0.00757).
+    >>> lay = Layout("Report")
+    >>> oblique_section(lay, xr.Dataset(attrs={"comment": "the impact table has no oblique columns: no friction fit"}))
+    >>> lay.contents, lay.page.figure.texts[-1].get_text()
+    ([], 'Friction: the impact table has no oblique columns: no friction fit.')
+    """
     if "friction" not in obl:
         # one line under the fit, not a section of its own (a heading and this line once filled a page)
         lay.paragraph(f"Friction: {obl.attrs.get('comment', 'no friction fit')}.", color="0.4")
@@ -269,7 +325,29 @@ def analyst_dynamics_section(lay: Layout, dyn: xr.Dataset) -> None:
 
 # =============================================================================== sweeps at the measured sizes
 def analyst_sweeps_section(lay: Layout, sweeps: list[xr.Dataset], dyn: xr.Dataset | None) -> None:
-    """The Table 2 cases with the fitted contact: all sizes in one figure, each case at the median size."""
+    """The Table 2 cases with the fitted contact: all sizes in one figure, each case at the median size.
+
+    Examples
+    --------
+    Case 2.1 of a fit of six impacts of one size (three speeds, two angles): the size-dependence
+    figure and the case's two figures (analogues of Figs. 7 and 8), at the median size d = 6.9 um:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> from microimpact.report.layout import Layout
+    >>> from microimpact.studies.material import material_sweep
+    >>> from microimpact.studies.sweeps import case_spec
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False).to_dataset()
+    >>> spec = case_spec("2.1", {"speed": {"start": 1, "stop": 2, "num": 3}, "incidence_deg": [0.0, 30.0]})
+    >>> lay = Layout("Report")
+    >>> analyst_sweeps_section(lay, [material_sweep(fit, spec, case="2.1")], None)
+    >>> text = " ".join(" ".join(t.get_text() for t in p.figure.texts) for p in lay.pages)
+    >>> sum(len(p.figure.axes) for p in lay.pages), "Table 2 case 2.1 at d = 6.9 um" in text
+    (3, True)
+    """
     sweeps = sorted(sweeps, key=lambda d: str(d.attrs.get("case", "")))
     radii = sweeps[0]["radius"].values
     k = len(radii) // 2
