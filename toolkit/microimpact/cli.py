@@ -25,6 +25,7 @@ from pathlib import Path
 
 from microimpact import __version__
 from microimpact._entry import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_after_writing
+from microimpact._usage import exit_status
 from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,
                                   reporting_os_errors, same_file)
 from microimpact.model.contact import SUB_MODELS, Contact
@@ -1294,7 +1295,7 @@ def _main(argv, written) -> int:
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status
     except SystemExit as exc:  # argparse's --help, --version and usage errors: a status, as documented
-        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
+        return exit_status(exc)
     except KeyboardInterrupt:  # Ctrl-C: one line, the shell's status for SIGINT, no traceback
         print(interrupted_after_writing(written) if written else INTERRUPTED_LINE, file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -55,6 +55,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from microimpact._usage import parse_or_status
+
 __all__ = ["draw_design", "run_design", "calibration_study", "summarise", "plot_calibration", "markdown_tables", "main",
            "FITTED", "LEVEL"]
 
@@ -506,10 +508,9 @@ def main(argv=None) -> int:
     p.add_argument("--time-budget", type=float, default=None, metavar="SECONDS", help="stop past this wall-clock time")
     p.add_argument("--out", required=True, help="output JSON")
     p.add_argument("--figure", default=None, help="also draw the coverage figure here (.png or .pdf)")
-    try:
-        args = p.parse_args(argv)
-    except SystemExit as exc:
-        return int(exc.code or 0)
+    args, status = parse_or_status(p, argv)
+    if args is None:
+        return status
     for name in ("designs", "workers"):
         if getattr(args, name) < 1:
             print(f"calibration: error: --{name} must be >= 1", file=sys.stderr)

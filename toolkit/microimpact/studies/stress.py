@@ -108,6 +108,7 @@ from microimpact.solvers.reference import simulate_reference
 from microimpact.studies._timeout import time_limit
 from microimpact.model.adhesion_models import AdhesionRegimeWarning
 from microimpact.solvers import UndeterminedOutcomeWarning
+from microimpact._usage import parse_or_status
 
 __all__ = ["LAWS", "POISSON", "TOLERANCES", "INPUT_RANGES", "FAILURE_KINDS", "NOTE_KINDS", "draw_cases", "contact_of", "check_case",
            "stress_sweep", "StressReport", "result_distance", "energy_scale", "energy_error", "kinetic_energy",
@@ -760,12 +761,13 @@ def main(argv=None) -> int:
     p.add_argument("--out", default=None, help="write the summary as JSON here (atomically)")
     p.add_argument("--netcdf", default=None, help="write the per-case dataset as NetCDF here (atomically)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar (drawn only on a terminal anyway)")
-    try:
-        args = p.parse_args(argv)
+    def check(args):
         if args.cases < 0 or args.reference_every < 0 or not args.case_time_limit > 0 or not args.reference_budget > 0:
             p.error("--cases and --reference-every must be >= 0, --case-time-limit and --reference-budget > 0")
-    except SystemExit as exc:  # --help and usage errors as a status (argparse raises), as calibration's main
-        return int(exc.code or 0)
+
+    args, status = parse_or_status(p, argv, check)
+    if args is None:
+        return status
 
     with progress_bar(args.cases, "stress", enabled=not args.no_progress) as advance:
         report = stress_sweep(args.cases, args.seed, reference_every=args.reference_every,
