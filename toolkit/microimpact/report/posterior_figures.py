@@ -158,7 +158,27 @@ def plot_corner(post: xr.Dataset) -> Plot:
 
 @_rc
 def plot_sweep_bands(post: xr.Dataset) -> Plot:
-    """Posterior bands (95 %) of e_n, mu_t and K_L along each Table 2 sweep of the analyst's material."""
+    """Posterior bands (95 %) of e_n, mu_t and K_L along each Table 2 sweep of the analyst's material.
+
+    Examples
+    --------
+    Case 2.1 for four draws of a short, not converged chain (an illustration): three panels (e_n,
+    mu_t, K_L), the sweep's size in the caption:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.posterior import sample_posterior, sweep_bands
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False)
+    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+    >>> plot = plot_sweep_bands(sweep_bands(post, fit, cases=["2.1"], n_draws=4, n_speeds=5))
+    >>> print(" | ".join(ax.get_ylabel() for ax in plot.figure.axes))
+    $e_n$ [-] | $\\mu_t$ [-] | $K_L$ [-]
+    >>> "at d = 6.9 µm" in plot.caption
+    True
+    """
     fig = _figure(WIDTH, 2.5)
     axes = fig.subplots(1, 3)
     v = post["sweep_speed"].values
@@ -184,7 +204,25 @@ def plot_sweep_bands(post: xr.Dataset) -> Plot:
 
 @_rc
 def plot_oblique(obl: xr.Dataset) -> Plot:
-    """Measured (with 1-sigma effective uncertainty) against fitted tangential quantity, per incidence angle."""
+    """Measured (with 1-sigma effective uncertainty) against fitted tangential quantity, per incidence angle.
+
+    Examples
+    --------
+    Eight synthetic oblique impacts (friction fitted without propagating the damping covariance, to
+    keep the example short): one panel of the measured column, the fitted f in the caption:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.oblique import fit_friction
+    >>> from microimpact.analysis.synthetic import make_synthetic_oblique
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials, write_csv
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> data = make_synthetic_oblique(radii=(3.45e-6,), speeds=(15.0, 30.0), incidence_deg=(35.0, 50.0, 60.0, 70.0))
+    >>> table = read_impacts(write_csv(data, "oblique.csv"))
+    >>> friction = fit_friction(table, fit_damping(table, material, confidence_intervals=False), propagate_damping=False)
+    >>> plot = plot_oblique(friction.to_dataset())
+    >>> [ax.get_ylabel() for ax in plot.figure.axes], "fitted friction f = 0.1589" in plot.caption
+    (['tangential_restitution [1]'], True)
+    """
     quantities = list(dict.fromkeys(str(q) for q in obl["quantity"].values))
     fig = _figure(WIDTH * 0.75, 2.6 * len(quantities))
     axes = np.atleast_1d(fig.subplots(len(quantities), 1, squeeze=False)[:, 0])
