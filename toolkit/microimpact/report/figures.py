@@ -1020,6 +1020,28 @@ def plot_flags(ds: xr.Dataset) -> Plot:
     Plot
         e_n against the speed ratio (log axis), a vertical bar for each impact's range, rings in
         the colour of each flag raised.
+
+    Examples
+    --------
+    Six synthetic impacts, the first made at 1.1 times the capture velocity: it alone is flagged near
+    capture (speed ratio below 1.5); a dataset without the flags variables is refused, naming them:
+
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.flags import flag_measurements
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> flags = flag_measurements(table, fit_damping(table, material, confidence_intervals=False))
+    >>> flags["near_capture"].values.tolist(), round(float(flags["capture_speed_ratio"][0]), 2)
+    ([1, 0, 0, 0, 0, 0], 1.09)
+    >>> plot = plot_flags(flags)
+    >>> plot.caption.split("flags raised (")[1].split(";")[0]
+    '0 rotation-sensitive, 0 angle-sensitive, 1 near capture'
+    >>> plot_flags(flags.drop_vars(["e_n_min", "near_capture"]))
+    Traceback (most recent call last):
+    ...
+    ValueError: plot_flags needs the variables e_n_min, near_capture of a flags file
     """
     missing = [k for k in ("e_n", "e_n_min", "e_n_max", "capture_speed_ratio", *_FLAG_STYLE) if k not in ds]
     if missing:

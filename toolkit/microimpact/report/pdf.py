@@ -174,6 +174,28 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
     ------
     KeyError
         For an unknown key or a missing ``fit``.
+
+    Examples
+    --------
+    A report of a damping fit alone (the data table given in memory): the title page, the fit's
+    section, and Part C with its empty benchmark and stress sections; without a fit it is refused:
+
+    >>> from pypdf import PdfReader
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+    >>> fit = fit_damping(table, material, confidence_intervals=False).to_dataset()
+    >>> pdf = PdfReader(build_report("report.pdf", {"fit": fit, "data_table": table}))
+    >>> len(pdf.pages), pdf.metadata.title
+    (4, 'Microsphere contact/impact report')
+    >>> "1. Damping fit (analogue of Fig. 3)" in pdf.pages[1].extract_text()
+    True
+    >>> build_report("report.pdf", {"data_table": table})
+    Traceback (most recent call last):
+    ...
+    KeyError: "build_report: missing required input(s) ['fit'] (fit: damping fit NetCDF (DampingFit.to_dataset))"
     """
     if pairs is None:
         inputs = check_inputs(inputs)
