@@ -599,6 +599,38 @@ def test_a_rolling_held_at_rest_within_a_step_converges_at_tight_tolerances():
     assert abs(a.velocity_out[1] - b.velocity_out[1]) < 1e-4 * args[0]
 
 
+def test_a_failed_check_leaves_the_result_and_says_it_is_not_determined(monkeypatch):
+    """If the check's second solve fails (a CoupledError), the impact still gets its result (valid
+    input always does), flagged not determined with an infinite error estimate; the other impacts
+    of the batch keep their own checks."""
+    from microimpact.model.parameters import TABLE1_ROW2
+    from microimpact.solvers import UndeterminedOutcomeWarning
+    from microimpact.solvers import coupled
+
+    c = TABLE1_ROW2.with_(tangential_model="mindlin_deresiewicz", shear_modulus=0.3 * TABLE1_ROW2.stiffness,
+                          friction_model="pulloff", rolling_friction=0.01)
+    v = np.array([0.05, 0.05])
+    a = np.radians([40.0, 41.0])
+    args = ((-v * np.cos(a), v * np.sin(a), 0 * v), (0 * v, 0 * v, 0 * v), np.full(2, c.friction))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        good = coupled.solve_coupled(c, *args, rtol=1e-8)
+    assert not good["not_determined"].any() and np.all(np.isfinite(good["tangential_error"]))
+    real = coupled.solve_coupled
+
+    def failing_check(contact, velocity_in, omega_in, friction, *, rtol, max_steps=2_000_000, check_held_rolling=True):
+        if not check_held_rolling and np.any(np.abs(velocity_in[1] - 0.05 * math.sin(math.radians(41.0))) < 1e-12):
+            raise coupled.CoupledError("step limit reached (test)")
+        return real(contact, velocity_in, omega_in, friction, rtol=rtol, max_steps=max_steps,
+                    check_held_rolling=check_held_rolling)
+
+    monkeypatch.setattr(coupled, "solve_coupled", failing_check)
+    with pytest.warns(UndeterminedOutcomeWarning, match="1 of 2 impacts"):
+        res = failing_check(c, *args, rtol=1e-8)
+    assert list(res["not_determined"]) == [False, True] and math.isinf(res["tangential_error"][1])
+    np.testing.assert_array_equal(res["v_t"], good["v_t"])  # the results stand
+
+
 def test_held_rolling_that_converges_is_not_flagged():
     """The paper's microsphere (Table 1 row 2) with Mindlin-Deresiewicz contact (G* = 0.3 K), the
     pulloff limit and mu_r = 0.01, captured at 0.05 m/s and 40 deg: its rolling reverses on the

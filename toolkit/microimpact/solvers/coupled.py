@@ -81,6 +81,7 @@ does not depend on when the integration stopped:
 
 from __future__ import annotations
 
+import contextlib
 import math
 import warnings
 
@@ -888,6 +889,30 @@ def _held_rolling_tail_bound(states, captured, outcome, p):
     return bound
 
 
+def _second_solve_difference(contact, v_in, w_in, f, out, rows, rtol, max_steps):
+    """Largest difference of (v_t, v_t', r omega_t, r omega_t') [m/s] between ``out`` and a second
+    solve of ``rows`` at ``rtol``; inf for an impact whose second solve fails (then it is not
+    determined, and the first result still stands)."""
+    def again(sel):
+        return solve_coupled(contact, tuple(x[sel] for x in v_in), tuple(x[sel] for x in w_in), f[sel],
+                             rtol=rtol, max_steps=max_steps, check_held_rolling=False)
+
+    def difference(res, sel):
+        d = np.zeros(len(sel))
+        for key, scale in (("v_t", 1.0), ("v_tp", 1.0), ("omega_t", contact.radius), ("omega_tp", contact.radius)):
+            d = np.maximum(d, scale * np.abs(out[key][sel] - res[key]))
+        return d
+
+    try:
+        return difference(again(rows), rows)
+    except CoupledError:  # one at a time, to keep the checks of the others
+        diff = np.full(rows.size, np.inf)
+        for j in range(rows.size):
+            with contextlib.suppress(CoupledError):
+                diff[j] = difference(again(rows[j:j + 1]), rows[j:j + 1])[0]
+        return diff
+
+
 def _held_rolling_error(contact, v_in, w_in, f, out, captured, info, tail_bound, rtol, max_steps, check):
     """Error estimate [m/s] of the final tangential velocity and rim speed of captured spheres held
     by friction with rolling resistance, and whether it exceeds :data:`HELD_ROLLING_TOLERANCE`.
@@ -930,14 +955,8 @@ def _held_rolling_error(contact, v_in, w_in, f, out, captured, info, tail_bound,
     if check and rows.size:
         # coarser where that is still a tolerance the solver is meant for, else finer
         coarse = HELD_ROLLING_CHECK_FACTOR * rtol
-        again = solve_coupled(contact, tuple(x[rows] for x in v_in), tuple(x[rows] for x in w_in), f[rows],
-                              rtol=coarse if coarse <= 1e-4 else rtol / HELD_ROLLING_CHECK_FACTOR,
-                              max_steps=max_steps, check_held_rolling=False)
-        r = contact.radius
-        diff = np.zeros(rows.size)
-        for key, scale in (("v_t", 1.0), ("v_tp", 1.0), ("omega_t", r), ("omega_tp", r)):
-            diff = np.maximum(diff, scale * np.abs(out[key][rows] - again[key]))
-        error[rows] += diff
+        check_rtol = coarse if coarse <= 1e-4 else rtol / HELD_ROLLING_CHECK_FACTOR
+        error[rows] += _second_solve_difference(contact, v_in, w_in, f, out, rows, check_rtol, max_steps)
     scale = np.maximum(np.hypot(v_in[1], v_in[2]) + contact.radius * np.hypot(w_in[1], w_in[2]),
                        np.hypot(out["v_t"], out["v_tp"]) + contact.radius * np.hypot(out["omega_t"], out["omega_tp"]))
     undetermined = held & (error > HELD_ROLLING_TOLERANCE * scale)
