@@ -37,6 +37,25 @@ def benchmark_json(ds: xr.Dataset) -> dict:
 
     NaN becomes None and infinities the strings "inf" / "-inf"; attributes holding JSON text are
     decoded.
+
+    Examples
+    --------
+    A made-up benchmark Dataset of one method at three settings, the last without a result: two
+    records, NaN written as None, the JSON text of an attribute decoded:
+
+    >>> ds = xr.Dataset({"time_per_impact": (("method", "setting"), [[2e-5, 1e-5, np.nan]]),
+    ...                  "status": (("method", "setting"), [["ok", "ok", ""]]),
+    ...                  "e_n_reference": ("normal_speed", [0.44, 0.67])},
+    ...                 coords={"method": ["engine"], "setting": [0, 2, 4], "normal_speed": [2.0, 5.0]},
+    ...                 attrs={"notes": '["one note"]'})
+    >>> for name in set(_JSON_VARIABLES) - set(ds.data_vars):  # the other variables: no value (NaN)
+    ...     ds[name] = (("method", "setting"), np.full((1, 3), np.nan))
+    >>> ds["rtol"][:] = [[1e-4, 1e-6, 1e-8]]
+    >>> js = benchmark_json(ds)
+    >>> [(r["setting"], r["rtol"], r["time_per_impact"], r["max_error_e_n"]) for r in js["results"]]
+    [(0, 0.0001, 2e-05, None), (2, 1e-06, 1e-05, None)]
+    >>> js["attrs"], js["e_n_reference"]
+    ({'notes': ['one note']}, {'normal_speed_m_s': [2.0, 5.0], 'e_n': [0.44, 0.67]})
     """
     rows = []
     for i, m in enumerate(ds["method"].values):

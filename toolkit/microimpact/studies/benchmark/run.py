@@ -305,6 +305,17 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
         ``max_rel_error_e_n``, ``max_error_mu``, ``max_error_K_L`` [1], ``n_impacts``, ``rtol``,
         ``steps_per_contact``, ``mean_steps`` (engine and RKG), ``status``; attributes with the
         machine, versions, the reference error bound, targets and ratios.
+
+    Examples
+    --------
+    The full run takes minutes and the quick one about a minute (``python -m
+    microimpact.studies.benchmark --quick``); a time budget that is not a positive number is refused
+    before anything runs:
+
+    >>> run_benchmark(quick=True, time_budget=0)
+    Traceback (most recent call last):
+    ...
+    ValueError: time_budget must be a number of seconds > 0 (or None: no limit), got 0
     """
     cfg = config or (BenchmarkConfig.quick_() if quick else BenchmarkConfig.full())
     time_budget = check_time_budget(time_budget)

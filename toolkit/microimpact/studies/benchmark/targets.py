@@ -60,6 +60,29 @@ def accuracy_targets(tpi, err, cfg: BenchmarkConfig, reference_bound: float) -> 
         Time per impact [s] and max e_n error [-], dims (method, setting).
     reference_bound : float
         Error bound of the reference e_n. [-]
+
+    Examples
+    --------
+    A made-up work-precision table (nine settings, the error ten times smaller at each, the time 1.5
+    times larger): DOP853 and the batch engine reach the target error 1e-8 at the same setting, the
+    engine 500 times faster, which meets the target ratio; an engine whose error rises tenfold at one
+    tightening does not converge:
+
+    >>> import numpy as np
+    >>> from microimpact.studies.benchmark.cases import ALL_METHODS, BenchmarkConfig
+    >>> tpi, err = np.full((len(ALL_METHODS), 9), np.nan), np.full((len(ALL_METHODS), 9), np.nan)
+    >>> for method, t, e in (("engine", 1e-5, 1e-4), ("engine_batch", 2e-6, 1e-4), ("rkg", 1e-5, 1e-3),
+    ...                      ("DOP853", 1e-3, 1e-4)):
+    ...     tpi[ALL_METHODS.index(method)] = t * 1.5 ** np.arange(9)
+    ...     err[ALL_METHODS.index(method)] = e * 0.1 ** np.arange(9)
+    >>> cfg = BenchmarkConfig.quick_()
+    >>> t = accuracy_targets(tpi, err, cfg, reference_bound=1e-12)
+    >>> round(t["ratio_dop853_to_engine_batch"]), t["target_ratio"], t["target_ratio_met_batch"], t["engine_converges"]
+    (500, 300.0, True, True)
+    >>> err[ALL_METHODS.index("engine"), 4] = 10 * err[ALL_METHODS.index("engine"), 2]
+    >>> t = accuracy_targets(tpi, err, cfg, reference_bound=1e-12)
+    >>> t["engine_converges"], t["engine_error_increases"]
+    (False, '[10.0]')
     """
     t_dop, e_dop, note = _dop853_at_target(tpi, err)
     t_eng, e_eng = _cheapest(tpi, err, "engine", TARGET_ERROR)
@@ -94,7 +117,23 @@ def accuracy_targets(tpi, err, cfg: BenchmarkConfig, reference_bound: float) -> 
 
 def throughput_targets(contact, cfg: BenchmarkConfig, verbose: bool = False) -> dict:
     """Throughput of simulate_many (scaled to 100,000 impacts) and growth of its peak memory
-    against the growth of its output."""
+    against the growth of its output.
+
+    Examples
+    --------
+    500 impacts (scaled to 100,000, so marked extrapolated) and the memory of 200 and 400 impacts,
+    whose output doubles:
+
+    >>> import dataclasses
+    >>> from microimpact.presets import WALL_1990
+    >>> from microimpact.studies.benchmark.cases import BenchmarkConfig
+    >>> cfg = dataclasses.replace(BenchmarkConfig.quick_(), throughput_impacts=500, memory_sizes=(200, 400))
+    >>> t = throughput_targets(WALL_1990, cfg)
+    >>> t["throughput_impacts"], t["throughput_distinct_normal_speeds"], t["target_throughput_extrapolated"]
+    (500, 500, True)
+    >>> t["memory_output_growth"], t["memory_sizes"]
+    (2.0, '[200, 400]')
+    """
     log(f"throughput: {cfg.throughput_impacts} oblique impacts through simulate_many", verbose)
     thr = measure_throughput(contact, cfg.throughput_impacts, cfg.throughput_repeats)
     mems = [measure_memory(contact, n) for n in cfg.memory_sizes]
