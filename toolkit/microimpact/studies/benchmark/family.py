@@ -145,6 +145,16 @@ def _status_bytes(key: str) -> int:
     return 0
 
 
+def _growth(before: int, after: int) -> float:
+    """after / before, NaN where the smaller measurement is 0 (below the resolution of the peak
+    resident set size: small batches fit in pages already resident), so no target is met on it.
+
+    >>> _growth(1000, 8000), _growth(0, 8000)
+    (8.0, nan)
+    """
+    return after / before if before > 0 else math.nan
+
+
 def family_targets(contact, cfg: BenchmarkConfig, tpi, err, verbose: bool = False) -> dict:
     """The million-impact target of the family path, its e_n error and memory growth."""
     n = cfg.family_impacts
@@ -179,14 +189,14 @@ def family_targets(contact, cfg: BenchmarkConfig, tpi, err, verbose: bool = Fals
         # smaller run, as --quick, amortizes the family's build over fewer impacts: harder to meet)
         "family_target_ratio": 1e6 / FAMILY_TARGET_DOP853_IMPACTS,
         "family_target_met": bool(t_dop / (t / n) >= 1e6 / FAMILY_TARGET_DOP853_IMPACTS and e_err <= FAMILY_TARGET_ERROR),
-        "family_memory_peak_growth": p1 / p0,
+        "family_memory_peak_growth": _growth(p0, p1),
         "family_memory_output_growth": o1 / o0,
         # the peak at the larger batch as a fraction of its output: below 1, memory is bounded by
         # what the caller gets back
         "family_memory_peak_fraction_of_output": p1 / o1,
         # growing no faster than the output (10 % allowance for the allocator's granularity: the
         # smaller batch's arrays stay in numpy's allocator, the larger's are memory maps)
-        "family_memory_target_met": bool(p1 / p0 <= 1.1 * o1 / o0),
+        "family_memory_target_met": bool(_growth(p0, p1) <= 1.1 * o1 / o0),
     }
 
 
