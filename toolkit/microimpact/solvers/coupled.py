@@ -923,9 +923,9 @@ def _held_rolling_error(contact, v_in, w_in, f, out, captured, info, tail_bound,
     after the capture, counted by :func:`coupled_kernel`), and each reversal is a discontinuity of
     model A's torque that the integration must resolve. Measured on the stress sweep (law
     ``mindlin_deresiewicz_pulloff_rolling``, seed 0, 300 cases): before omega_r was held at rest
-    within a step (:func:`_hold_rolling`), 13 results moved by more than this tolerance between rtol
-    1e-8 and 1e-10 (case 20: v_t / v = -3.14, -0.78, -2.16 at rtol 1e-8, 1e-10, 1e-12; now -0.021,
-    -0.033, -0.033); now 5 do. In those, omega_r circles rest in the plane at ~1e-9 of the speed
+    within a step (:func:`_hold_rolling`), this check flagged 13 results (the sweep's own
+    convergence check failed 10; case 20: v_t / v = -3.14, -0.78, -2.16 at rtol 1e-8, 1e-10, 1e-12;
+    now -0.021, -0.033, -0.033); now it flags 5, and the sweep fails none. In those, omega_r circles rest in the plane at ~1e-9 of the speed
     scale with steps of |omega_r| / |d omega_r / dt|, a stage of each step on either side of rest,
     until the integration stops at a twentieth of the step budget and the rolling resistance still
     to come is left out. Others with hundreds of reversals converge to 1e-7, as the paper's
