@@ -873,16 +873,21 @@ HELD_ROLLING_TOLERANCE = 1e-3
 HELD_ROLLING_CHECK_FACTOR = 10.0
 
 
-def _held_rolling_tail_bound(states, captured, outcome, p):
+def _held_rolling(contact, captured, f):
+    """Captured impacts held by friction (the pulloff limit, f > 0) with rolling resistance."""
+    return captured & (contact.friction_model == "pulloff") & (f > 0.0) & (contact.rolling_friction > 0.0)
+
+
+def _held_rolling_tail_bound(states, held, outcome, p):
     """Bound on what the rolling resistance left out after the stop can still change the rolling
-    speed of captured spheres held by friction (nondimensional; 0 elsewhere).
+    speed of the ``held`` impacts (:func:`_held_rolling`; nondimensional, 0 elsewhere).
 
     The torque mu_r r |F_n| changes only the angular momentum about the contact point, by at most
     mu_r r R, where R is the rest of int |F_n| dt (:func:`_tail_impulses`); the rolling speed at that
     angular momentum (:func:`_rolling_state`) by k mu_r R / (k + 1), k = m r^2 / I.
     """
-    bound = np.zeros(captured.size)
-    rows = np.flatnonzero(captured & (p[:, 6] > 0.5) & (p[:, 4] > 0.0) & (p[:, 10] > 0.0))
+    bound = np.zeros(held.size)
+    rows = np.flatnonzero(held)
     if rows.size:
         j_tail, _ = _tail_impulses(states[rows, _S], states[rows, _Y], p[rows], outcome[rows])
         bound[rows] = p[rows, 8] * p[rows, 10] * j_tail / (p[rows, 8] + 1.0)
@@ -913,7 +918,7 @@ def _second_solve_difference(contact, v_in, w_in, f, out, rows, rtol, max_steps)
         return diff
 
 
-def _held_rolling_error(contact, v_in, w_in, f, out, captured, info, tail_bound, rtol, max_steps, check):
+def _held_rolling_error(contact, v_in, w_in, f, out, held, info, tail_bound, rtol, max_steps, check):
     """Error estimate [m/s] of the final tangential velocity and rim speed of captured spheres held
     by friction with rolling resistance, and whether it exceeds :data:`HELD_ROLLING_TOLERANCE`.
 
@@ -947,7 +952,6 @@ def _held_rolling_error(contact, v_in, w_in, f, out, captured, info, tail_bound,
     """
     from microimpact.solvers import UndeterminedOutcomeWarning
 
-    held = captured & (contact.friction_model == "pulloff") & (f > 0.0) & (contact.rolling_friction > 0.0)
     reversed_ = info[:, 7] > 0
     # without reversals the torque stays against the mean rolling: it can at most stop it
     error = np.where(reversed_, tail_bound, np.minimum(tail_bound, np.hypot(out["v_t"], out["v_tp"])))
@@ -1060,7 +1064,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
                   check_held_rolling: bool = True) -> dict:
     """Impacts of a contact that selects tangential compliance or adhesion-aware friction.
 
-    Length: the docstring (parameters, returns); the body is 61 lines.
+    Length: the docstring (parameters, returns); the body is 62 lines.
 
     Parameters
     ----------
@@ -1139,11 +1143,12 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     if aware and not mindlin:  # sliding that ends at rest, after the integration stopped
         late = captured & np.isnan(info[:, 4]) & np.isfinite(j_stop) & (states[:, _J] < j_stop)
         info[late, 4] = states[late, _TAU] + (j_stop[late] - states[late, _J]) / (2.0 * p[late, 5])
-    tail_bound = _held_rolling_tail_bound(states, captured, info[:, 1], p) * u
+    held = _held_rolling(contact, captured, f)
+    tail_bound = _held_rolling_tail_bound(states, held, info[:, 1], p) * u
     j_map, ja_map = _settle_captured(contact, states, captured, info[:, 1], p, u, j_unit, ja_unit, jl, jal)
     out, slip_ended, slip_end_time = _tangential_si(contact, mindlin, states, info, f, (v_n, v_t, v_tp),
                                                     (w_n, w_t, w_tp), slip, j_map, ja_map, u, time)
-    error, undetermined = _held_rolling_error(contact, (v_n, v_t, v_tp), (w_n, w_t, w_tp), f, out, captured, info,
+    error, undetermined = _held_rolling_error(contact, (v_n, v_t, v_tp), (w_n, w_t, w_tp), f, out, held, info,
                                               tail_bound, rtol, max_steps, check_held_rolling)
     return {
         "captured": captured,

@@ -414,6 +414,17 @@ def _result_checks(contact: Contact, fine, coarse, tol: dict, out: dict) -> None
         out["failures"].append(("energy", f"energy balance off by {err:.3g} of the energy scale"))
 
 
+@contextlib.contextmanager
+def _model_warnings_ignored():
+    """Silence the warnings that state something about the model, not the solver: the DMT regime
+    (AdhesionRegimeWarning) and an outcome the solver reports as not determined
+    (UndeterminedOutcomeWarning, which the sweep records as a note from the result itself)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", AdhesionRegimeWarning)
+        warnings.simplefilter("ignore", UndeterminedOutcomeWarning)
+        yield
+
+
 def _convergence_check(contact: Contact, args: tuple, fine, coarse, tol: dict, out: dict) -> None:
     """The convergence criterion of the module docstring; findings appended to ``out``."""
     conv = result_distance(contact, fine, coarse)
@@ -430,8 +441,7 @@ def _convergence_check(contact: Contact, args: tuple, fine, coarse, tol: dict, o
         out["notes"].append(("not_determined", f"{found}; the solver: {said}"))
         return
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UndeterminedOutcomeWarning)
+        with _model_warnings_ignored():
             tight = simulate_impact(*args, rtol=_RTOL_TIGHT)
     except Exception as exc:  # noqa: BLE001 - any exception is a finding
         out["failures"].append(("exception", f"rtol={_RTOL_TIGHT:g}: {type(exc).__name__}: {exc}"))
@@ -525,9 +535,7 @@ def check_case(case: dict, *, reference: bool = False, case_time_limit: float = 
     args = (contact, case["speed"], case["incidence_deg"], case["azimuth_deg"], _omega(case))
     t0 = time.perf_counter()
     try:
-        with warnings.catch_warnings():  # (the DMT regime warning: a statement on the model, not the solver;
-            warnings.simplefilter("ignore", AdhesionRegimeWarning)  # an undetermined outcome: a note, below)
-            warnings.simplefilter("ignore", UndeterminedOutcomeWarning)
+        with _model_warnings_ignored():
             fine = simulate_impact(*args, rtol=_RTOL_FINE)
             coarse = simulate_impact(*args, rtol=_RTOL_COARSE)
     except Exception as exc:  # noqa: BLE001 - any exception is a finding
@@ -664,9 +672,7 @@ def stress_sweep(n_cases: int = 1000, seed: int = 0, *, reference_every: int = 2
     # compile (or load) the engine before the first case's clock starts: a first-run numba
     # compilation takes ~20 s, more on a loaded machine, and is no property of any case
     if cases:
-        with warnings.catch_warnings(), contextlib.suppress(Exception):  # (a case's failure is found by the case)
-            warnings.simplefilter("ignore", AdhesionRegimeWarning)
-            warnings.simplefilter("ignore", UndeterminedOutcomeWarning)
+        with _model_warnings_ignored(), contextlib.suppress(Exception):  # (a case's failure is found by the case)
             simulate_impact(contact_of({**cases[0], "friction": 0.5}, law), 1.0, 30.0, 0.0, (1.0, 1.0, 1.0))
     rows = []
     for i, case in enumerate(cases):
