@@ -10,6 +10,7 @@ alarm in about 1 of 2000 runs, while an interval half as wide (coverage 0.38) or
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -227,6 +228,42 @@ def test_joint_fit_coverage_over_random_designs():
     assert adequate >= 36
     assert 5 <= determined_w < adequate  # designs of both kinds were drawn
     assert _within_binomial(covered, 2 * adequate), (covered, adequate)
+
+
+def test_the_confidence_region_lies_on_its_chi2_contour_and_projects_to_the_profile_intervals():
+    """Every point the region returns has chi^2 = chi^2_min + Delta, recomputed here from
+    dem_law_restitution (to 1e-6 of Delta: Brent's xtol); at 68.27 % its projection on each parameter
+    is that parameter's profile interval, which fit_dem_law finds by minimising over the other
+    (another algorithm): no point beyond an end (by 1e-6 relative), and the extreme points within 5 %
+    of each half-width of the ends (12 rays: 3.4 % for an elliptic region, cos 15 deg). At 95 % the
+    one-parameter region is the two ends where chi^2 has risen by 3.84."""
+    from microimpact.analysis.dem_fit import dem_law_restitution
+
+    t, _ = _adhesive_table("jkr_force", "viscoelastic", 0.05, 0.03, np.geomspace(0.02, 3.0, 8), rng=np.random.default_rng(1))
+    f = fit_dem_law(t, ADHESIVE, "jkr_force", "viscoelastic", fit_adhesion=True)
+    assert f.determined
+    points = f.confidence_region(INTERVAL_LEVEL)
+    assert len(points) == 12
+    for p in points:
+        e = dem_law_restitution({**ADHESIVE, "work_of_adhesion": p["work_of_adhesion"]}, t["radius"], t["normal_speed"],
+                                "jkr_force", "viscoelastic", p["coefficient"], rtol=1e-8)
+        chi2 = float(np.sum(((t["e_n"] - e) / t["e_n_uncertainty"]) ** 2))
+        assert chi2 - f.chisqr == pytest.approx(1.0, abs=1e-6)
+    for name, (lo, hi) in f.interval_ends().items():
+        values = np.array([p[name] for p in points])
+        half = (hi - lo) / 2
+        assert values.min() >= lo * (1 - 1e-6) and values.max() <= hi * (1 + 1e-6)
+        assert values.min() - lo < 0.05 * half and hi - values.max() < 0.05 * half, (name, values.min(), values.max(), lo, hi)
+    t3 = pd.DataFrame({"radius": [3.45e-6] * 3, "normal_speed": [0.5, 1.0, 2.0], "e_n": [0.70, 0.72, 0.71],
+                       "e_n_uncertainty": [0.01] * 3})
+    g = fit_dem_law(t3, {**ADHESIVE, "work_of_adhesion": 0.0})
+    ends = [p["coefficient"] for p in g.confidence_region(0.95)]
+    # e constant: chi^2(e) = sum ((e_i - e) / 0.01)^2, minimum at the mean, rises by 3.8415 at +-1.96 sigma / sqrt 3;
+    # the solver's e_n of this law is e to its rtol (1e-8), hence 5e-8
+    z = 1.959963984540054
+    assert ends == pytest.approx([0.71 - z * 0.01 / math.sqrt(3), 0.71 + z * 0.01 / math.sqrt(3)], abs=5e-8)
+    with pytest.raises(ValueError, match="carries no data"):
+        dataclasses.replace(g, _data=()).confidence_region()
 
 
 def test_joint_fit_says_what_the_data_cannot_tell():

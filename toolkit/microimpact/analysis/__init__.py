@@ -42,7 +42,7 @@ _HOMES = {
                      "make_synthetic_oblique", "write_synthetic_impacts"), "synthetic"),
     **dict.fromkeys(("DampingTarget", "damping_from_target"), "target"),
     **dict.fromkeys(("DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws",
-                     "ranked_by_aic", "information_criteria", "dem_fit_coverage", "dem_friction_coverage", "INTERVAL_LEVEL", "ADEQUACY_P"), "dem_fit"),
+                     "ranked_by_aic", "information_criteria", "dem_fit_coverage", "dem_friction_coverage", "INTERVAL_LEVEL", "ADEQUACY_P", "REGION_RAYS"), "dem_fit"),
 }
 #: the modules, importable as attributes
 _MODULES = tuple(sorted(set(_HOMES.values())))

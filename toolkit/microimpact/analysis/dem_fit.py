@@ -56,7 +56,7 @@ from microimpact.model.dem_damping import RESTITUTION_DAMPING_MODELS, critical_d
 from microimpact.solvers import DEFAULT_RTOL
 
 __all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "ranked_by_aic", "information_criteria", "dem_fit_coverage", "dem_friction_coverage",
-           "INTERVAL_LEVEL", "ADEQUACY_P"]
+           "INTERVAL_LEVEL", "ADEQUACY_P", "REGION_RAYS"]
 
 #: the (normal law, damping law) pairs a LAMMPS user chooses among; "hertz" is Hertz without
 #: adhesion, "jkr_force" LAMMPS's jkr, "dmt" LAMMPS's dmt
@@ -79,6 +79,14 @@ _DECADES = {"viscoelastic": (-4.0, math.log10(3.0)), "mass_velocity": (-4.0, 0.0
 #: changes its e_n by less than 1e-3 at 0.05 m/s and above (measured)
 _ADHESION_DECADES = (-5.0, 0.0)
 _PROFILE_GRID = 21  # start grid of each inner and outer minimisation of the joint fit
+#: rays traced from the best fit to the boundary of a two-parameter confidence region
+#: (:meth:`DemLawFit.confidence_region`): in coordinates where the region is near a circle, a linear
+#: function's extreme over 12 equally spaced boundary points is within cos(15 deg) = 0.966 of its
+#: extreme over the whole boundary
+REGION_RAYS = 12
+#: step of the finite-difference Hessian of chi^2 that whitens the region's coordinates, in units
+#: of each parameter's 68 % half-width
+_HESSIAN_STEP = 0.25
 
 
 @dataclass(frozen=True)
@@ -150,6 +158,8 @@ class DemLawFit:
     work_of_adhesion: float = math.nan
     work_of_adhesion_interval: tuple[float, float] = (math.nan, math.nan)
     adhesion_status: str = ""
+    #: (the e_n model, measured e_n, sigma) the fit minimised over, for :meth:`confidence_region`
+    _data: tuple = field(default=(), repr=False, compare=False)
 
     @property
     def determined(self) -> bool:
@@ -215,6 +225,130 @@ class DemLawFit:
         if self.adhesion_fitted:
             ends["work_of_adhesion"] = tuple(map(float, self.work_of_adhesion_interval))
         return ends
+
+    def confidence_region(self, level: float = 0.95, rays: int = REGION_RAYS) -> list[dict]:
+        """Points on the boundary of the fitted parameters' joint confidence region, as
+        :meth:`contact` keywords.
+
+        The region is {chi^2 - chi^2_min <= Delta}, Delta the one-parameter threshold at ``level``
+        (chi^2_1 quantile with stated uncertainties, s^2 t^2 with n - k degrees of freedom without):
+        its projection on any one function of the parameters is that function's profile-likelihood
+        interval at ``level`` when the model is linear (Press et al. 2007, Sec. 15.6.5), which is
+        what carrying the normal law's uncertainty into a quantity fitted after it needs. With one
+        parameter the boundary is the two ends of its interval at ``level``; with two (the damping
+        and the work of adhesion) ``rays`` points, traced from the best fit along directions spaced
+        evenly in coordinates that make the region near a circle (log10 w_A and the damping's fit
+        coordinate, whitened by a finite-difference Hessian of chi^2; the valley is narrow and
+        oblique, because both parameters lower e_n). A ray that leaves the searched range before
+        chi^2 rises enough ends at the range's edge (e = 1 or eta_n0 at the strongest damping
+        searched, w_A at 1e-5 or 1 J/m^2): the data do not bound the region there.
+
+        Parameters
+        ----------
+        level : float
+            Probability content of the one-parameter interval the region projects to. [-]
+        rays : int
+            Boundary points of a two-parameter region.
+
+        Returns
+        -------
+        list of dict
+            ``{"coefficient": ...}`` (and ``"work_of_adhesion"`` [J/m^2] when fitted) per point.
+
+        Raises
+        ------
+        ValueError
+            A fit not made by :func:`fit_dem_law` (no data), or a two-parameter fit whose best point
+            has no damping or no adhesion (no interior to trace rays from).
+
+        References
+        ----------
+        Press, W. H. et al. (2007), Numerical Recipes, 3rd ed., Cambridge University Press, Sec. 15.6.
+
+        Examples
+        --------
+        At 68.27 % the one-parameter region is the reported interval; at 95 % it is wider:
+
+        >>> import pandas as pd
+        >>> t = pd.DataFrame({"radius": [3.45e-6] * 3, "normal_speed": [0.5, 1.0, 2.0], "e_n": [0.70, 0.72, 0.71],
+        ...                   "e_n_uncertainty": [0.01] * 3})
+        >>> f = fit_dem_law(t, {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0})
+        >>> [round(p["coefficient"], 4) for p in f.confidence_region(INTERVAL_LEVEL)]
+        [0.7042, 0.7158]
+        >>> [round(p["coefficient"], 4) for p in f.confidence_region(0.95)]
+        [0.6987, 0.7213]
+        """
+        if not self._data:
+            raise ValueError(f"confidence_region: this {self.law} fit carries no data (make it with fit_dem_law)")
+        model, e_meas, sig = self._data
+        to_coef, from_coef, lo_x, hi_x = _coordinate(model)
+        threshold = _interval_threshold(self.chisqr, self.n, self.sigma_known, k=self.parameters, level=level)
+        if self.adhesion_fitted:
+            return _region_boundary(self, model, e_meas, sig, threshold, rays)
+
+        def rise(x):
+            return _chisqr(model, to_coef(x), e_meas, sig) - self.chisqr - threshold
+
+        if model.restitution:
+            (lo, hi), _, _ = _restitution_interval(rise, from_coef(self.best), lo_x)
+        else:
+            (lo, hi), _, _ = _damping_interval(rise, lambda c: _chisqr(model, c, e_meas, sig) - self.chisqr - threshold,
+                                               to_coef, from_coef(self.best), lo_x, hi_x)
+            hi = min(hi, to_coef(hi_x))
+        return [{"coefficient": float(lo)}, {"coefficient": float(hi)}]
+
+
+def _region_boundary(fit, model, e_meas, sig, threshold, rays) -> list[dict]:
+    """:meth:`DemLawFit.confidence_region` of a two-parameter fit (u = log10 w_A, x the damping's
+    coordinate): rays from the best point, evenly spaced after whitening, each ended by Brent's
+    method where chi^2 has risen by ``threshold`` (or at the searched range's edge)."""
+    from scipy import optimize
+
+    to_coef, from_coef, lo_x, hi_x = _coordinate(model)
+    lo = np.array([_ADHESION_DECADES[0], lo_x])
+    hi = np.array([_ADHESION_DECADES[1], hi_x])
+    centre = np.array([_log10(fit.material["work_of_adhesion"]), from_coef(fit.best)])
+    if not np.all(np.isfinite(centre)):
+        raise ValueError(f"confidence_region: the {fit.law} fit's best point has no adhesion or no damping "
+                         f"({fit.describe()}); its region has no interior to trace rays from")
+    ends = fit.interval_ends()
+    half = np.array([(_log10(ends["work_of_adhesion"][1]) - _log10(ends["work_of_adhesion"][0])) / 2.0,
+                     (from_coef(ends["coefficient"][1]) - from_coef(ends["coefficient"][0])) / 2.0])
+    scale = np.where(np.isfinite(half) & (half > 0.0), half, 0.1)  # a one-sided interval: 0.1 in its coordinate
+
+    def point(z):
+        return np.clip(centre + scale * z, lo, hi)
+
+    def chi(z):
+        u, x = point(z)
+        return _chisqr(model, to_coef(x), e_meas, sig, 10.0**u)
+
+    h, f0 = _HESSIAN_STEP, chi(np.zeros(2))
+    fx = [chi(np.array(v)) for v in ((h, 0.0), (-h, 0.0), (0.0, h), (0.0, -h))]
+    fxy = [chi(np.array(v)) for v in ((h, h), (h, -h), (-h, h), (-h, -h))]
+    hessian = np.array([[fx[0] - 2 * f0 + fx[1], (fxy[0] - fxy[1] - fxy[2] + fxy[3]) / 4.0],
+                        [0.0, fx[2] - 2 * f0 + fx[3]]]) / h**2
+    hessian[1, 0] = hessian[0, 1]
+    curvature, axes = np.linalg.eigh(hessian / 2.0)
+    basis = axes / np.sqrt(curvature) if np.all(curvature > 0.0) else np.eye(2)  # near a circle of radius sqrt(Delta)
+    points = []
+    for theta in 2.0 * np.pi * np.arange(rays) / rays:
+        d = basis @ np.array([math.cos(theta), math.sin(theta)])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            reach = np.where(d > 0, (hi - centre) / (scale * d), np.where(d < 0, (lo - centre) / (scale * d), np.inf))
+        t_edge = float(np.min(reach))
+
+        def rise(t, d=d):
+            return chi(t * d) - fit.chisqr - threshold
+
+        inside, t = 0.0, min(math.sqrt(threshold), t_edge)
+        while rise(t) <= 0.0 and t < t_edge:
+            inside, t = t, min(2.0 * t, t_edge)
+        if rise(t) > 0.0:
+            t = optimize.brentq(rise, inside, t, xtol=1e-6 * t)
+        u, x = point(t * d)
+        points.append({"coefficient": float(to_coef(x)), "work_of_adhesion": float(10.0**u)})
+    return points
 
 
 def dem_law_contact(material, radius: float, normal_model: str, damping_model: str, coefficient: float) -> Contact:
@@ -354,17 +488,17 @@ def _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x):
     return (float(weak), float(strong)), status, (float(to_coef(x_best)) if math.isfinite(x_best) else 0.0)
 
 
-def _interval_threshold(chi_min, n, sigma_known, k=1):
-    """The rise of chi^2 that bounds the 68.27 % profile-likelihood interval of one parameter:
-    Delta chi^2 = 1 with stated uncertainties, s^2 t^2 (n - k degrees of freedom) without."""
+def _interval_threshold(chi_min, n, sigma_known, k=1, level=INTERVAL_LEVEL):
+    """The rise of chi^2 that bounds the profile-likelihood interval of one parameter at ``level``
+    (68.27 %: Delta chi^2 = 1 with stated uncertainties), s^2 t^2 (n - k degrees of freedom) without."""
     from scipy import stats
 
     from microimpact.analysis.identifiability import chi2_threshold
 
     if sigma_known:
-        return chi2_threshold(INTERVAL_LEVEL)
+        return chi2_threshold(level)
     if n > k:
-        return chi_min / (n - k) * stats.t.ppf(0.5 + INTERVAL_LEVEL / 2.0, n - k) ** 2
+        return chi_min / (n - k) * stats.t.ppf(0.5 + level / 2.0, n - k) ** 2
     return math.inf
 
 
@@ -598,7 +732,8 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
         status = "inadequate"
     aic, bic = information_criteria(chi_min, n, sigma_known)
     return DemLawFit(normal_model, damping_model, best if status == "determined" else math.nan, interval, status,
-                     float(chi_min), int(n), sigma_known, float(aic), float(bic), best, mat, src)
+                     float(chi_min), int(n), sigma_known, float(aic), float(bic), best, mat, src,
+                     _data=(model, e_meas, sig))
 
 
 def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x, src) -> DemLawFit:
@@ -615,7 +750,7 @@ def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, h
                      status, float(chi_min), int(n), sigma_known, float(aic), float(bic), best,
                      {**mat, "work_of_adhesion": w_best}, src, adhesion_fitted=True,
                      work_of_adhesion=w_best if w_status == "determined" else math.nan,
-                     work_of_adhesion_interval=w_interval, adhesion_status=w_status)
+                     work_of_adhesion_interval=w_interval, adhesion_status=w_status, _data=(model, e_meas, sig))
 
 
 def candidate_laws(material, fit_adhesion: bool = False) -> list[tuple[str, str]]:

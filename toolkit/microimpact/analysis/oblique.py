@@ -675,9 +675,18 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
     return _friction_result(problem, objective, best, var_damping, gradient, weighted, model_name, t0)
 
 
-def _friction_result(problem, objective, best, var_damping, gradient, weighted, model_name, t0) -> "FrictionFit":
-    """The FrictionFit of a profile fit: status, value and errors only where f is determined."""
-    status = _friction_status(best, objective, var_damping)
+def _friction_result(problem, objective, best, var_damping, gradient, weighted, model_name, t0,
+                     shift=None) -> "FrictionFit":
+    """The FrictionFit of a profile fit: status, value and errors only where f is determined.
+    ``shift``: the 95 % (down, up) widening by a normal law's region (:func:`_normal_law_shift`),
+    in place of ``var_damping``; its standard error is the mean shift / 1.96."""
+    if shift is not None:
+        from scipy import stats
+
+        from microimpact.analysis.identifiability import DEFAULT_LEVEL
+
+        var_damping = (0.5 * sum(shift) / stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2)) ** 2
+    status = _friction_status(best, objective, var_damping, shift)
     p = {"friction": float(best.value)}
     sigma = objective.sigma(best.value)
     model = objective.model(best.value)
@@ -853,9 +862,9 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, rtol: float = DEFAUL
     with the stated uncertainties alone, and held for the second (it depends on mu only through the
     model's slopes).
 
-    With ``normal_fit``, mu is refitted with each normal parameter at the ends of its 68 % interval;
-    half their difference is its one-sigma effect s_k, the variance added (sum_k s_k)^2 (delta
-    method, bounding every correlation of two parameters), the interval widened in quadrature.
+    With ``normal_fit``, mu is refitted over the boundary of the normal law's 95 % confidence region
+    (:meth:`~microimpact.analysis.dem_fit.DemLawFit.confidence_region`) and each end of its 95 %
+    interval widened in quadrature by how far the refits move it that way (:func:`_normal_law_shift`).
 
     References
     ----------
@@ -889,22 +898,29 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, rtol: float = DEFAUL
                          f"contact has tangential_model={contact.tangential_model!r} (use fit_friction)")
     ends = _normal_fit_ends(normal_fit, contact_of, problem) if normal_fit is not None else {}
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
-    total = 2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20) + 2 * len(ends) * _REFIT_EVALUATIONS
+    total = 2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20) + _region_refits(ends) * _REFIT_EVALUATIONS
     with progress_bar(total, "friction fit", progress) as advance:
         objective = _DemFrictionObjective(problem, contact_of, weighted, rtol, advance)
         best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
         if weighted and (np.any(problem.sigma_speed > 0) or np.any(problem.sigma_angle > 0)):
             objective.hold_effective_sigma(best.value)
             best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
-        variance, gradient = 0.0, {}
+        shift, gradient = None, {}
         if ends and _friction_status(best, objective, 0.0).determined:
-            variance, gradient = _normal_law_variance(objective, contact_of, normal_fit, ends, best, deadline)
-    fit = _friction_result(problem, objective, best, variance, {"friction": gradient} if gradient else {}, weighted,
-                           contact.tangential_model, t0)
+            shift, gradient = _normal_law_shift(objective, contact_of, normal_fit, best, deadline)
+    fit = _friction_result(problem, objective, best, 0.0, {"friction": gradient} if gradient else {}, weighted,
+                           contact.tangential_model, t0, shift=shift)
     return replace(fit, info=fit.info | {"normal_propagated": ", ".join(gradient)})
 
 
-#: most objective evaluations of one refit of :func:`_normal_law_variance`
+def _region_refits(ends) -> int:
+    """How many refits :func:`_normal_law_shift` makes for a normal fit with these interval ends."""
+    from microimpact.analysis.dem_fit import REGION_RAYS
+
+    return {0: 0, 1: 2}.get(len(ends), REGION_RAYS)
+
+
+#: most objective evaluations of one refit of :func:`_normal_law_shift`
 _REFIT_EVALUATIONS = 60
 
 
@@ -935,52 +951,59 @@ def _normal_fit_ends(normal_fit, contact_of, problem) -> dict:
     return ends
 
 
-def _normal_law_variance(objective, contact_of, normal_fit, ends, best, deadline) -> tuple[float, dict]:
-    """(variance of mu from the normal fit, {parameter: d mu / d parameter}).
+def _normal_law_shift(objective, contact_of, normal_fit, best, deadline) -> tuple[tuple[float, float], dict]:
+    """((down, up), {parameter: d mu / d parameter}): how far mu moves over the normal law's 95 %
+    confidence region.
 
-    mu is refitted (at the held effective variance) with each fitted normal parameter at the two
-    ends of its 68 % interval, the others at their best; half the difference of the two refits is
-    that parameter's one-standard-deviation effect s_k on mu (delta method; the ends, not a
-    symmetric step, carry an asymmetric interval). The variance is (sum_k s_k)^2: with one parameter
-    s^2, with two (the damping and a fitted work of adhesion, whose correlation the normal fit does
-    not report) the bound of g^T C g over every correlation. :func:`_friction_status` widens the
-    95 % profile interval in quadrature by 1.96 times its square root, as :func:`fit_friction` does
-    with the damping fit.
+    mu is refitted (at the held effective variance) at every point of
+    :meth:`~microimpact.analysis.dem_fit.DemLawFit.confidence_region` (the two ends of the
+    damping's 95 % interval, or 12 points around the joint region of the damping and a fitted work
+    of adhesion); ``down`` and ``up`` are how far the lowest and highest refit lie below and above
+    the estimate. For a linear model this is 1.96 sqrt(g^T C g) both ways (the delta method with
+    the normal fit's covariance C, correlation included); beyond it the refits follow the model:
+    a work of adhesion whose interval is wide in log10 w_A moves mu further one way than the other.
+    :func:`_friction_status` widens each end of the 95 % profile interval in quadrature by its
+    side's shift. The gradient is the least-squares slope of the refits over the points.
 
     Each refit is a bounded Brent search over +-10 conditional standard errors about the estimate,
-    to 1e-3 of one (its error in the added variance is negligible beside the variance itself); a
-    minimum at an end of that bracket is searched again over [mu / 2, 2 mu]."""
+    to 1e-3 of one; a minimum at an end of that bracket is searched again over [mu / 2, 2 mu]."""
     from scipy.optimize import minimize_scalar
+
+    from microimpact.analysis.identifiability import DEFAULT_LEVEL
 
     _, lo_lim, hi_lim = PARAMETER_BOUNDS["friction"]
     f = best.value
     width = 10.0 * best.stderr if math.isfinite(best.stderr) and best.stderr > 0 else 0.5 * f
     brackets = [(max(lo_lim, f - width), min(hi_lim, f + width)), (max(lo_lim, 0.5 * f), min(hi_lim, 2.0 * f))]
-    effects, gradient = [], {}
-    for name, (lo, hi) in ends.items():
-        refits = []
-        for end in (lo, hi):
-            def shifted(r, name=name, end=end):
-                law = normal_fit.contact(r, **{name: end})
-                return contact_of(r).with_(damping_coefficient=law.damping_coefficient,
-                                           adhesion_line_force=law.adhesion_line_force)
+    points = normal_fit.confidence_region(DEFAULT_LEVEL)
+    refits = []
+    for keywords in points:
+        def shifted(r, keywords=keywords):
+            law = normal_fit.contact(r, **keywords)
+            return contact_of(r).with_(damping_coefficient=law.damping_coefficient,
+                                       adhesion_line_force=law.adhesion_line_force)
 
-            moved = _DemFrictionObjective(objective.problem, shifted, objective.weighted, objective.rtol, objective.advance)
-            moved._sigma = objective.sigma(f)  # the effective variance held at the estimate's
-            for a, b in brackets:
-                res = minimize_scalar(moved.deviance, bounds=(a, b), method="bounded",
-                                      options={"xatol": 1e-4 * width, "maxiter": _REFIT_EVALUATIONS})
-                inside = res.success and min(res.x - a, b - res.x) > 1e-3 * width
-                if inside:
-                    break
-            if not inside:
-                raise RuntimeError(f"the refit of mu at the normal law's {name} = {end:.6g} found no minimum in "
-                                   f"[{a:.6g}, {b:.6g}] ({res.message})")
-            refits.append(float(res.x))
-            deadline.check(f"the refits of mu at the normal law's {name}")
-        effects.append(0.5 * abs(refits[1] - refits[0]))
-        gradient[name] = (refits[1] - refits[0]) / (hi - lo)
-    return sum(effects) ** 2, gradient
+        moved = _DemFrictionObjective(objective.problem, shifted, objective.weighted, objective.rtol, objective.advance)
+        moved._sigma = objective.sigma(f)  # the effective variance held at the estimate's
+        for a, b in brackets:
+            res = minimize_scalar(moved.deviance, bounds=(a, b), method="bounded",
+                                  options={"xatol": 1e-4 * width, "maxiter": _REFIT_EVALUATIONS})
+            inside = res.success and min(res.x - a, b - res.x) > 1e-3 * width
+            if inside:
+                break
+        if not inside:
+            where = ", ".join(f"{k} = {v:.6g}" for k, v in keywords.items())
+            raise RuntimeError(f"the refit of mu at the normal law's {where} found no minimum in "
+                               f"[{a:.6g}, {b:.6g}] ({res.message})")
+        refits.append(float(res.x))
+        deadline.check("the refits of mu over the normal law's confidence region")
+    refits = np.array(refits)
+    names = list(points[0])
+    best_point = {"coefficient": normal_fit.best, "work_of_adhesion": normal_fit.material.get("work_of_adhesion", 0.0)}
+    design = np.array([[p[k] - best_point[k] for k in names] for p in points])
+    slope = np.linalg.lstsq(design, refits - f, rcond=None)[0]
+    shift = (max(0.0, f - float(refits.min())), max(0.0, float(refits.max()) - f))
+    return shift, dict(zip(names, map(float, slope)))
 
 
 def rank_dem_tangential_laws(table, contacts_of, *, normal_fit=None, rtol: float = DEFAULT_RTOL,
@@ -1206,19 +1229,21 @@ def _profile_fit(objective: _FrictionObjective, lmfit, deadline, points: int = P
                        rolling, sliding)
 
 
-def _friction_status(best: _ProfileFit, objective: _FrictionObjective, var_damping: float):
-    """The identifiability of f: profile interval, widened by the damping uncertainty, classified."""
+def _friction_status(best: _ProfileFit, objective: _FrictionObjective, var_damping: float, shift=None):
+    """The identifiability of f: profile interval, widened by the damping uncertainty (1.96 times
+    the square root of ``var_damping`` each way, or the 95 % (down, up) ``shift``), classified."""
     from microimpact.analysis.identifiability import (DEFAULT_LEVEL, chi2_threshold, profile_interval,
                                                       status_from_interval)
     from scipy import stats
 
     _, lo_lim, hi_lim = PARAMETER_BOUNDS["friction"]
     _, lo, hi, _ = profile_interval(best.grid, best.chi2, chi2_threshold(DEFAULT_LEVEL))
-    if math.isfinite(var_damping) and var_damping > 0:
-        zd = float(stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2)) * math.sqrt(var_damping)
+    if shift is None and math.isfinite(var_damping) and var_damping > 0:
+        shift = (float(stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2)) * math.sqrt(var_damping),) * 2
+    if shift is not None:
         f = best.value
-        lo = lo if lo <= lo_lim else max(lo_lim, f - math.hypot(f - lo, zd))
-        hi = hi if hi >= hi_lim else min(hi_lim, f + math.hypot(hi - f, zd))
+        lo = lo if lo <= lo_lim else max(lo_lim, f - math.hypot(f - lo, shift[0]))
+        hi = hi if hi >= hi_lim else min(hi_lim, f + math.hypot(hi - f, shift[1]))
     roll = best.rolling_above
     reasons = {
         "lower_bound": (f"every impact ends in rolling for f above {roll:.3g}, where the rebound no longer depends "
