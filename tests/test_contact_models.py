@@ -570,9 +570,12 @@ def test_held_rolling_that_the_tolerance_does_not_settle_is_said():
     scale = args[0] * math.sin(math.radians(args[1])) + r * math.hypot(args[3][1], args[3][2])
     moved = np.max(np.abs(_tangential_speeds(res, r) - _tangential_speeds(tight, r)))
     assert moved > HELD_ROLLING_TOLERANCE * scale  # measured 180 x the scale
-    # the batch path says how many
-    with pytest.warns(UndeterminedOutcomeWarning, match="1 of 1 impacts"):
-        simulate_many(contact, args[0], args[1], args[2], args[3])
+    # the batch path says how many, and which: a per-impact flag (the second impact, at 0.05 m/s, rebounds)
+    with pytest.warns(UndeterminedOutcomeWarning, match="1 of 2 impacts"):
+        ds = simulate_many(contact, [args[0], 0.05], args[1], args[2], args[3])
+    assert ds["not_determined"].values.tolist() == [1, 0] and ds["outcome"].values.tolist() == [1, 0]
+    assert ds["not_determined"].attrs["flag_meanings"] == "determined not_determined"
+    assert ds.attrs["not_determined"].startswith("1 impacts: final tangential velocity and spin not settled")
 
 
 def test_a_rolling_held_at_rest_within_a_step_converges_at_tight_tolerances():

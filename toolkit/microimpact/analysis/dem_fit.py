@@ -342,9 +342,11 @@ def _region_boundary(fit, model, e_meas, sig, threshold, rays) -> list[dict]:
             return chi(t * d) - fit.chisqr - threshold
 
         inside, t = 0.0, min(math.sqrt(threshold), t_edge)
-        while rise(t) <= 0.0 and t < t_edge:
+        outside = rise(t) > 0.0
+        while not outside and t < t_edge:
             inside, t = t, min(2.0 * t, t_edge)
-        if rise(t) > 0.0:
+            outside = rise(t) > 0.0
+        if outside:
             t = optimize.brentq(rise, inside, t, xtol=1e-6 * t)
         u, x = point(t * d)
         points.append({"coefficient": float(to_coef(x)), "work_of_adhesion": float(10.0**u)})

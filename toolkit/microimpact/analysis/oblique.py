@@ -963,7 +963,7 @@ def _normal_law_shift(objective, contact_of, normal_fit, best, deadline) -> tupl
     the normal fit's covariance C, correlation included); beyond it the refits follow the model:
     a work of adhesion whose interval is wide in log10 w_A moves mu further one way than the other.
     :func:`_friction_status` widens each end of the 95 % profile interval in quadrature by its
-    side's shift. The gradient is the least-squares slope of the refits over the points.
+    side's shift. The gradient is the slope of the least-squares plane through the refits.
 
     Each refit is a bounded Brent search over +-10 conditional standard errors about the estimate,
     to 1e-3 of one; a minimum at an end of that bracket is searched again over [mu / 2, 2 mu]."""
@@ -1000,8 +1000,8 @@ def _normal_law_shift(objective, contact_of, normal_fit, best, deadline) -> tupl
     refits = np.array(refits)
     names = list(points[0])
     best_point = {"coefficient": normal_fit.best, "work_of_adhesion": normal_fit.material.get("work_of_adhesion", 0.0)}
-    design = np.array([[p[k] - best_point[k] for k in names] for p in points])
-    slope = np.linalg.lstsq(design, refits - f, rcond=None)[0]
+    design = np.array([[1.0, *(p[k] - best_point[k] for k in names)] for p in points])
+    slope = np.linalg.lstsq(design, refits, rcond=None)[0][1:]  # a plane through the refits (two: the secant)
     shift = (max(0.0, f - float(refits.min())), max(0.0, float(refits.max()) - f))
     return shift, dict(zip(names, map(float, slope)))
 

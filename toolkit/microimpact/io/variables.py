@@ -47,6 +47,7 @@ VARIABLES: dict[str, tuple[str | None, str]] = {
     "slip_ended": ("1", "1 if sliding ended and the sphere rolls"),
     "friction_impulse": ("N s", "integral of |F_n| over the contact"),
     "dissipated_energy": ("J", "energy dissipated by damping and friction (to rest if captured)"),
+    "not_determined": ("1", "1 if the solver cannot settle the final tangential velocity and spin to its tolerance"),
     "capture_normal_speed": ("m s-1", "normal capture velocity: largest normal speed that is captured"),
     # ------------------------------------------------------------- fitted parameters
     "zeta_hertz": ("1", "nondimensional Hertzian damping coefficient zeta_H, Eq. (15)"),

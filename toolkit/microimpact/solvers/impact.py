@@ -39,7 +39,7 @@ __all__ = ["simulate_impact", "simulate_many", "check_rtol", "RESULT_VARIABLES",
 RESULT_VARIABLES: tuple[str, ...] = (
     "outcome", "e_n", "mu_t", "mu_tp", "K_L", "K_t", "velocity_out_n", "velocity_out_t",
     "velocity_out_tp", "omega_out_n", "omega_out_t", "omega_out_tp", "contact_time",
-    "max_penetration", "slip_ended", "friction_impulse", "dissipated_energy",
+    "max_penetration", "slip_ended", "friction_impulse", "dissipated_energy", "not_determined",
 )
 
 
@@ -701,11 +701,16 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         v_in = (-v * np.cos(alpha), v * np.sin(alpha) * np.cos(theta), v * np.sin(alpha) * np.sin(theta))
         results = _coupled_results(contact, v_in, (flat["omega_n"], flat["omega_t"], flat["omega_tp"]),
                                    flat["friction"], rtol)
-        results = {k: results[k] for k in RESULT_VARIABLES}
+        error = results["tangential_error"][results["not_determined"]]
+        results = {k: results[k] for k in RESULT_VARIABLES} | {"not_determined": results["not_determined"].astype(np.int8)}
         n_solves, path = int(v.size), "coupled: one normal-tangential solve per impact"
-    else:
+    else:  # the closed-form tangential map settles every impact the normal solve does
         results, n_solves, path = _solve_batch(contact, flat, rtol, family)
+        results["not_determined"], error = np.zeros(flat["speed"].size, dtype=np.int8), np.zeros(0)
     ds = _batch_dataset(arrays, results)
+    if error.size:  # which impacts: the not_determined flag; how far off: the largest estimate
+        ds.attrs["not_determined"] = (f"{error.size} impacts: final tangential velocity and spin not settled "
+                                      f"(largest error estimate {float(error.max()):.3g} m/s); see not_determined")
     ds.attrs.update(contact_attributes(contact))
     ds.attrs["solver"] = f"microimpact engine (Dormand-Prince 5(4), rtol={rtol:g})"
     if contact.normal_model != "ring":
@@ -861,4 +866,5 @@ def _batch_dataset(arrays, results: dict) -> xr.Dataset:
     ds = xr.Dataset(data, coords=coords)
     ds["outcome"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="rebound capture")
     ds["slip_ended"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="sliding rolling")
+    ds["not_determined"].attrs.update(flag_values=np.array([0, 1], dtype=np.int8), flag_meanings="determined not_determined")
     return ds
