@@ -178,3 +178,16 @@ def test_oblique_values_the_fit_cannot_use_are_named(tmp_path):
     text = " ".join(str(w.message) for w in rec)
     assert "2 measured tangential_restitution value(s) not used" in text
     assert "rows 1 at 0 deg incidence" in text and "rows 3 captured" in text
+
+
+def test_a_refit_that_leaves_its_brackets_is_found_over_the_whole_range():
+    """mu refitted at a point of the normal law's region can move beyond [mu / 2, 2 mu]: the refit
+    then searches the whole range (minimum at 5 found to its xatol), and where the deviance still
+    falls at the range's end it returns that end (mu moves at least so far) instead of failing."""
+    from microimpact.analysis.oblique import _refit
+
+    brackets = [(0.1, 0.3), (0.1, 0.4)]
+    assert _refit(lambda x: (x - 5.0) ** 2, brackets, 0.1, 0.0, 10.0) == pytest.approx(5.0, abs=1e-4)
+    assert _refit(lambda x: -x, brackets, 0.1, 0.0, 10.0) == 10.0
+    assert _refit(lambda x: x, brackets, 0.1, 0.0, 10.0) == 0.0
+    assert _refit(lambda x: (x - 0.2) ** 2, brackets, 0.1, 0.0, 10.0) == pytest.approx(0.2, abs=1e-4)

@@ -913,6 +913,28 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, rtol: float = DEFAUL
     return replace(fit, info=fit.info | {"normal_propagated": ", ".join(gradient)})
 
 
+def _refit(deviance, brackets, width, lo_lim, hi_lim) -> float:
+    """The minimiser of ``deviance`` over mu: bounded Brent in each bracket in turn until its minimum
+    lies inside; else (the normal law moved mu further) from the best point of a grid over the whole
+    range [lo_lim, hi_lim], an end of which is returned when the minimum lies there (mu moves at
+    least that far, and the widened interval reaches the range's end)."""
+    from scipy.optimize import minimize_scalar
+
+    for a, b in brackets:
+        res = minimize_scalar(deviance, bounds=(a, b), method="bounded",
+                              options={"xatol": 1e-4 * width, "maxiter": _REFIT_EVALUATIONS})
+        if res.success and min(res.x - a, b - res.x) > 1e-3 * width:
+            return float(res.x)
+    grid = np.concatenate([[lo_lim], np.geomspace(max(lo_lim, 1e-3), hi_lim, 41)])
+    values = [deviance(x) for x in grid]
+    i = int(np.argmin(values))
+    if i in (0, grid.size - 1):
+        return float(grid[i])
+    res = minimize_scalar(deviance, bounds=(grid[i - 1], grid[i + 1]), method="bounded",
+                          options={"xatol": 1e-4 * width, "maxiter": _REFIT_EVALUATIONS})
+    return float(res.x) if res.fun <= values[i] else float(grid[i])
+
+
 def _region_refits(ends) -> int:
     """How many refits :func:`_normal_law_shift` makes for a normal fit with these interval ends."""
     from microimpact.analysis.dem_fit import REGION_RAYS
@@ -965,10 +987,9 @@ def _normal_law_shift(objective, contact_of, normal_fit, best, deadline) -> tupl
     :func:`_friction_status` widens each end of the 95 % profile interval in quadrature by its
     side's shift. The gradient is the slope of the least-squares plane through the refits.
 
-    Each refit is a bounded Brent search over +-10 conditional standard errors about the estimate,
-    to 1e-3 of one; a minimum at an end of that bracket is searched again over [mu / 2, 2 mu]."""
-    from scipy.optimize import minimize_scalar
-
+    Each refit (:func:`_refit`) is a bounded Brent search over +-10 conditional standard errors about
+    the estimate, to 1e-3 of one; a minimum at an end of that bracket is searched again over
+    [mu / 2, 2 mu], then over the whole range."""
     from microimpact.analysis.identifiability import DEFAULT_LEVEL
 
     _, lo_lim, hi_lim = PARAMETER_BOUNDS["friction"]
@@ -985,17 +1006,7 @@ def _normal_law_shift(objective, contact_of, normal_fit, best, deadline) -> tupl
 
         moved = _DemFrictionObjective(objective.problem, shifted, objective.weighted, objective.rtol, objective.advance)
         moved._sigma = objective.sigma(f)  # the effective variance held at the estimate's
-        for a, b in brackets:
-            res = minimize_scalar(moved.deviance, bounds=(a, b), method="bounded",
-                                  options={"xatol": 1e-4 * width, "maxiter": _REFIT_EVALUATIONS})
-            inside = res.success and min(res.x - a, b - res.x) > 1e-3 * width
-            if inside:
-                break
-        if not inside:
-            where = ", ".join(f"{k} = {v:.6g}" for k, v in keywords.items())
-            raise RuntimeError(f"the refit of mu at the normal law's {where} found no minimum in "
-                               f"[{a:.6g}, {b:.6g}] ({res.message})")
-        refits.append(float(res.x))
+        refits.append(_refit(moved.deviance, brackets, width, lo_lim, hi_lim))
         deadline.check("the refits of mu over the normal law's confidence region")
     refits = np.array(refits)
     names = list(points[0])
