@@ -80,9 +80,9 @@ _DECADES = {"viscoelastic": (-4.0, math.log10(3.0)), "mass_velocity": (-4.0, 0.0
 _ADHESION_DECADES = (-5.0, 0.0)
 _PROFILE_GRID = 21  # start grid of each inner and outer minimisation of the joint fit
 #: rays traced from the best fit to the boundary of a two-parameter confidence region
-#: (:meth:`DemLawFit.confidence_region`): in coordinates where the region is near a circle, a linear
-#: function's extreme over 12 equally spaced boundary points is within cos(15 deg) = 0.966 of its
-#: extreme over the whole boundary
+#: (:meth:`DemLawFit.confidence_region`, which adds the four ends of the profile intervals): in
+#: coordinates where the region is near a circle, a linear function's extreme over 12 equally
+#: spaced boundary points is within cos(15 deg) = 0.966 of its extreme over the whole boundary
 REGION_RAYS = 12
 #: step of the finite-difference Hessian of chi^2 that whitens the region's coordinates, in units
 #: of each parameter's 68 % half-width
@@ -239,9 +239,12 @@ class DemLawFit:
         and the work of adhesion) ``rays`` points, traced from the best fit along directions spaced
         evenly in coordinates that make the region near a circle (log10 w_A and the damping's fit
         coordinate, whitened by a finite-difference Hessian of chi^2; the valley is narrow and
-        oblique, because both parameters lower e_n). A ray that leaves the searched range before
+        oblique, because both parameters lower e_n), and the four ends of the two parameters'
+        profile intervals at ``level``, which rays miss where the region curves. A ray that leaves the searched range before
         chi^2 rises enough ends at the range's edge (e = 1 or eta_n0 at the strongest damping
-        searched, w_A at 1e-5 or 1 J/m^2): the data do not bound the region there.
+        searched, w_A at 1e-5 or 1 J/m^2): the data do not bound the region there. A best fit
+        without adhesion or damping traces its rays from the searched range's low edge (w_A =
+        1e-5 J/m^2, eta_n0 = 1e-4 critical dampings).
 
         Parameters
         ----------
@@ -253,13 +256,13 @@ class DemLawFit:
         Returns
         -------
         list of dict
-            ``{"coefficient": ...}`` (and ``"work_of_adhesion"`` [J/m^2] when fitted) per point.
+            ``{"coefficient": ...}`` (and ``"work_of_adhesion"`` [J/m^2] when fitted) per point:
+            2, or ``rays`` + 4.
 
         Raises
         ------
         ValueError
-            A fit not made by :func:`fit_dem_law` (no data), or a two-parameter fit whose best point
-            has no damping or no adhesion (no interior to trace rays from).
+            A fit not made by :func:`fit_dem_law` (no data).
 
         References
         ----------
@@ -307,10 +310,9 @@ def _region_boundary(fit, model, e_meas, sig, threshold, rays) -> list[dict]:
     to_coef, from_coef, lo_x, hi_x = _coordinate(model)
     lo = np.array([_ADHESION_DECADES[0], lo_x])
     hi = np.array([_ADHESION_DECADES[1], hi_x])
-    centre = np.array([_log10(fit.material["work_of_adhesion"]), from_coef(fit.best)])
-    if not np.all(np.isfinite(centre)):
-        raise ValueError(f"confidence_region: the {fit.law} fit's best point has no adhesion or no damping "
-                         f"({fit.describe()}); its region has no interior to trace rays from")
+    # a best fit without adhesion or damping (-inf) starts at the searched range's low edge
+    # (_ADHESION_DECADES, _DECADES): the nearest point the rays can be traced from
+    centre = np.clip(np.array([_log10(fit.material["work_of_adhesion"]), from_coef(fit.best)]), lo, hi)
     ends = fit.interval_ends()
     half = np.array([(_log10(ends["work_of_adhesion"][1]) - _log10(ends["work_of_adhesion"][0])) / 2.0,
                      (from_coef(ends["coefficient"][1]) - from_coef(ends["coefficient"][0])) / 2.0])
@@ -350,7 +352,36 @@ def _region_boundary(fit, model, e_meas, sig, threshold, rays) -> list[dict]:
             t = optimize.brentq(rise, inside, t, xtol=1e-6 * t)
         u, x = point(t * d)
         points.append({"coefficient": float(to_coef(x)), "work_of_adhesion": float(10.0**u)})
-    return points
+    tips = _profile_tips(lambda u, x: _chisqr(model, to_coef(x), e_meas, sig, 10.0**u), centre, lo, hi,
+                         fit.chisqr + threshold)
+    return points + [{"coefficient": float(to_coef(x)), "work_of_adhesion": float(10.0**u)} for u, x in tips]
+
+
+def _profile_tips(chi, centre, lo, hi, level):
+    """The four points of the region {chi(u, x) <= level} that reach furthest in u and in x: for
+    each coordinate and side, where the profile (chi minimised over the other coordinate, -inf
+    included) crosses ``level``, or the searched range's edge if it stays below. These are the ends
+    of each parameter's profile-likelihood interval; rays from the best point miss them where the
+    region is curved (a banana in log10 w_A, whose upper end lies decades from the best fit)."""
+    from scipy import optimize
+
+    tips = []
+    for k in (0, 1):
+        hint = [float(centre[1 - k])]
+
+        def profile(v, k=k, hint=hint):
+            f = (lambda y: chi(v, y)) if k == 0 else (lambda y: chi(y, v))
+            y, value = _minimum(f, lo[1 - k], hi[1 - k], _PROFILE_GRID, hint[-1:])
+            hint.append(y)
+            return value - level
+
+        for end in (lo[k], hi[k]):
+            v = float(end)
+            if end != centre[k] and profile(v) > 0.0:
+                v = optimize.brentq(profile, float(centre[k]), v, xtol=1e-5)
+            profile(v)  # the other coordinate's minimiser at the tip
+            tips.append((v, hint[-1]) if k == 0 else (hint[-1], v))
+    return tips
 
 
 def dem_law_contact(material, radius: float, normal_model: str, damping_model: str, coefficient: float) -> Contact:
