@@ -406,6 +406,41 @@ def test_the_normal_laws_uncertainty_reaches_mu():
     assert "held at its values" in held.report()
 
 
+@pytest.mark.slow  # a propagated fit over 16 region points and two more fits of mu: about 2 min
+def test_a_fitted_work_of_adhesion_widens_mu_by_at_least_its_profile_ends():
+    # JKR (LAMMPS's jkr) + viscoelastic, w_A and the damping fitted jointly from noisy e_n at
+    # 0.3-3 m/s, then mu of LAMMPS's mindlin law at 30-70 deg: the friction limit mu (F_ne + 2 F_po)
+    # depends on w_A. The region the propagation refits over includes the ends of w_A's 95 % profile
+    # interval (the damping profiled); two independent full fits of mu there bound how far mu must
+    # move, so each end of mu's interval lies at least that far out (in quadrature with the
+    # conditional interval; 1e-3: their polish tolerance), and the report names both parameters.
+    from microimpact.analysis.dem_fit import dem_law_contact, fit_dem_law
+    from microimpact.analysis.oblique import fit_dem_friction
+
+    from microimpact.model.dem_damping import critical_damping_coefficient
+
+    mat = {**SPHERE, "work_of_adhesion": 0.02}
+    tang = {"friction": 0.3, "tangential_model": "lammps_mindlin", "shear_modulus": 3e8}
+    eta = 0.05 * critical_damping_coefficient(dem_law_contact(mat, 1e-6, "jkr_force", "viscoelastic", 1.0), 1.0)
+    truth = dem_law_contact(mat, 1e-6, "jkr_force", "viscoelastic", eta).with_(**tang)
+    speeds, angles = np.geomspace(0.3, 3.0, 8), np.linspace(30.0, 70.0, 8)
+    table = _normal_and_oblique_table(truth, speeds, angles, 0.01, 0.01, np.random.default_rng(4))
+    normal = fit_dem_law(table, mat, "jkr_force", "viscoelastic", fit_adhesion=True)
+    assert normal.determined, normal.describe()
+    fit = fit_dem_friction(table, lambda r: normal.contact(r).with_(**tang), normal_fit=normal)
+    held = fit_dem_friction(table, lambda r: normal.contact(r).with_(**tang))
+    assert fit.info["normal_propagated"] == "coefficient, work_of_adhesion"
+    tips = normal.confidence_region(0.95)[-4:-2]  # w_A's two profile ends
+    assert tips[0]["work_of_adhesion"] < normal.work_of_adhesion_interval[0] < normal.work_of_adhesion_interval[1] < tips[1]["work_of_adhesion"]
+    moved = [fit_dem_friction(table, lambda r, p=p: normal.contact(r, **p).with_(**tang)).friction for p in tips]
+    st, st0, f = fit.identifiability["friction"], held.identifiability["friction"], fit.friction
+    down, up = max(0.0, f - min(moved)), max(0.0, max(moved) - f)
+    assert max(down, up) > 0.1 * (st0.upper - st0.lower)  # w_A's uncertainty matters here
+    assert st.upper - f >= math.hypot(st0.upper - f, up) * (1 - 1e-3)
+    assert f - st.lower >= math.hypot(f - st0.lower, down) * (1 - 1e-3)
+    assert "uncertainty of the normal law included" in fit.report() and "held at its values" in held.report()
+
+
 def test_a_normal_fit_of_another_law_or_without_an_interval_is_refused():
     from microimpact.analysis.dem_fit import dem_law_contact, fit_dem_law
     from microimpact.analysis.oblique import fit_dem_friction
