@@ -510,8 +510,9 @@ class FrictionFit(ReportHTML):
                 lines.append(f"  {'':<17}  95 % interval [{st.lower:.6g}, {st.upper:.6g}] ({st.method}"
                              + (")" if held else f", uncertainty of {before} included)"))
         if "work_of_adhesion" in self.info.get("normal_propagated", ""):
-            lines.append("  note        : with the work of adhesion fitted too, this interval covered the true mu less often than "
-                         "95 % in the calibration study (docs/guide/lammps.md, dem_friction_coverage(fit_adhesion=True))")
+            lines.append("  note        : with the work of adhesion fitted too, this interval covered the true mu in 42 of 46 "
+                         "random designs (0.91) in the calibration study (docs/guide/lammps.md, "
+                         "dem_friction_coverage(fit_adhesion=True))")
         qs = ", ".join(f"{q} ({int((self.data['quantity'] == q).sum())})" for q in dict.fromkeys(self.data["quantity"]))
         lines.append(f"  data        : {self.n_points} entries: {qs}; "
                      f"{'stated uncertainties + effective variance' if self.weighted else 'unweighted'}")
