@@ -287,7 +287,7 @@ class DemLawFit:
         to_coef, from_coef, lo_x, hi_x = _coordinate(model)
         threshold = _interval_threshold(self.chisqr, self.n, self.sigma_known, k=self.parameters, level=level)
         if self.adhesion_fitted:
-            return _region_boundary(self, model, e_meas, sig, threshold, rays)
+            return _region_boundary(self, model, e_meas, sig, threshold, rays, (to_coef, from_coef, lo_x, hi_x))
 
         def rise(x):
             return _chisqr(model, to_coef(x), e_meas, sig) - self.chisqr - threshold
@@ -301,13 +301,14 @@ class DemLawFit:
         return [{"coefficient": float(lo)}, {"coefficient": float(hi)}]
 
 
-def _region_boundary(fit, model, e_meas, sig, threshold, rays) -> list[dict]:
+def _region_boundary(fit, model, e_meas, sig, threshold, rays, coordinate) -> list[dict]:
     """:meth:`DemLawFit.confidence_region` of a two-parameter fit (u = log10 w_A, x the damping's
     coordinate): rays from the best point, evenly spaced after whitening, each ended by Brent's
-    method where chi^2 has risen by ``threshold`` (or at the searched range's edge)."""
+    method where chi^2 has risen by ``threshold`` (or at the searched range's edge); ``coordinate``
+    is :func:`_coordinate` of the model."""
     from scipy import optimize
 
-    to_coef, from_coef, lo_x, hi_x = _coordinate(model)
+    to_coef, from_coef, lo_x, hi_x = coordinate
     lo = np.array([_ADHESION_DECADES[0], lo_x])
     hi = np.array([_ADHESION_DECADES[1], hi_x])
     # a best fit without adhesion or damping (-inf) starts at the searched range's low edge
