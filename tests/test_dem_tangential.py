@@ -593,3 +593,93 @@ def test_a_stated_angle_uncertainty_enters_the_dem_friction_fit_as_effective_var
     expected = np.sqrt(0.01 ** 2 + (slope * 5.0) ** 2)
     assert np.all(np.abs(slope * 5.0) > 0.015)  # the angle term dominates: a fit that drops it fails
     assert fit.data["sigma"].to_numpy() == pytest.approx(expected, rel=1e-3, abs=0)
+
+
+def test_the_stiffness_factors_are_the_step_and_the_95_percent_ends():
+    from microimpact.analysis.oblique import STIFFNESS_STEP, _stiffness_factors
+
+    assert _stiffness_factors(None) == (1.0 - STIFFNESS_STEP, 1.0 + STIFFNESS_STEP) == (0.9, 1.1)
+    assert _stiffness_factors(0.05)[2:] == pytest.approx((1.0 - 1.959964 * 0.05, 1.0 + 1.959964 * 0.05), abs=1e-7)
+    assert len(_stiffness_factors(0.0)) == 2  # nothing to propagate
+    for bad in (0.5, -0.01, math.nan):
+        with pytest.raises(ValueError, match="stiffness_uncertainty"):
+            _stiffness_factors(bad)
+
+
+def _dem_friction_fit(info, lower=0.234, upper=0.264):
+    """A FrictionFit of LAMMPS's mindlin law at mu = 0.249 with the given info (no solve)."""
+    import pandas as pd
+
+    from microimpact.analysis.identifiability import status_from_interval
+    from microimpact.analysis.oblique import FrictionFit
+
+    status = status_from_interval("friction", 0.249, lower, upper, 0.0, 10.0, method="profile")
+    data = pd.DataFrame({"row": np.arange(4), "quantity": "tangential_restitution", "radius": 1e-6, "speed": 1.0,
+                         "incidence_deg": np.linspace(10.0, 70.0, 4), "measured": 0.5, "sigma": 0.01, "model": 0.5,
+                         "residual": 0.0})
+    return FrictionFit(values={"friction": 0.249}, stderr={"friction": 0.0075}, stderr_conditional={"friction": 0.0075},
+                       tangential_model="lammps_mindlin", chisqr=0.43, redchi=0.14, n_points=4, weighted=True,
+                       data=data, info=info, identifiability={"friction": status})
+
+
+def test_the_report_says_how_mu_depends_on_the_held_stiffness():
+    moved = {"field": "shear_modulus", "value": 3e8, "step": 0.1, "friction_low": 0.2716, "friction_high": 0.2209}
+    text = _dem_friction_fit({"stiffness_sensitivity": moved}).report()
+    assert "G* (k_t = 8 G* a) held at 3e+08 Pa, not fitted; mu = 0.2716 with it 10 % lower, 0.2209 10 % higher" in text
+    assert "holds at this stiffness only: a 10 % change moves mu out of it" in text
+    within = moved | {"friction_low": 0.25, "friction_high": 0.248}
+    assert "holds at this stiffness (its uncertainty not included)" in _dem_friction_fit(
+        {"stiffness_sensitivity": within}).report()
+    text = _dem_friction_fit({"stiffness_sensitivity": moved, "stiffness_uncertainty": 0.05}).report()
+    assert "its relative uncertainty 0.05 is included in the interval" in text and "moves mu out" not in text
+    k_t = moved | {"field": "tangential_stiffness", "value": 250.0}
+    assert "k_t held at 250 N/m, not fitted" in _dem_friction_fit({"stiffness_sensitivity": k_t}).report()
+    assert "stiffness" not in _dem_friction_fit({}).report()  # not a DEM fit's sensitivity: no line
+    ds = _dem_friction_fit({"stiffness_sensitivity": moved, "stiffness_uncertainty": 0.05}).to_dataset()
+    assert ds.attrs["held_stiffness_field"] == "shear_modulus" and ds.attrs["friction_at_lower_stiffness"] == 0.2716
+    assert ds.attrs["stiffness_uncertainty"] == 0.05
+
+
+def test_lammps_fit_refuses_a_stiffness_uncertainty_it_cannot_use(tmp_path, capsys, monkeypatch):
+    # refused before any fit runs: exit status 2, one line naming the option, nothing written
+    from microimpact.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "impacts.csv").write_text("radius [um],speed [m/s],e_n [1]\n2.0,1.0,0.6\n")
+    base = ["lammps", "fit", "impacts.csv", "--material-pair", "ammonium_fluorescein_on_silicon", "--out", "c.lmp"]
+    assert main(base + ["--stiffness-uncertainty", "0.05"]) == 2
+    assert "--stiffness-uncertainty belongs to a tangential law" in capsys.readouterr().err
+    assert main(base + ["--tangential-model", "lammps_mindlin", "--shear-modulus", "1e9",
+                        "--stiffness-uncertainty", "0.6"]) == 2
+    assert "--stiffness-uncertainty: must be a relative standard uncertainty in [0, 0.5)" in capsys.readouterr().err
+    assert not (tmp_path / "c.lmp").exists()
+
+
+@pytest.mark.slow  # six full profile fits of mu: about 1.5 min
+def test_the_held_stiffness_moves_mu_as_independent_fits_do_and_its_uncertainty_widens_the_interval():
+    # LAMMPS's mindlin law, mu = 0.25, four noisy rebounds at 10-70 deg (the low ones stick: e_t
+    # depends on G*). The sensitivity refits at 0.9 and 1.1 G* must equal two independent full fits
+    # of mu there (to 1e-4: the refit's Brent tolerance is 1e-4 of 10 standard errors); with a
+    # relative uncertainty u = 0.05, each end of the interval must widen in quadrature by how far two
+    # independent fits at (1 -+ 1.96 u) G* move mu (to 1e-3 relative, their polish).
+    from microimpact.analysis.oblique import fit_dem_friction
+
+    c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.25, tangential_model="lammps_mindlin", shear_modulus=3e8)
+    table = _oblique_table(c, np.full(4, 1.0), np.linspace(10.0, 70.0, 4), 0.01, np.random.default_rng(0))
+    fit = fit_dem_friction(table, lambda r: c, stiffness_uncertainty=0.05)
+    held = fit_dem_friction(table, lambda r: c)
+
+    def at(factor):
+        return fit_dem_friction(table, lambda r: c.with_(shear_modulus=factor * 3e8)).friction
+
+    k = fit.info["stiffness_sensitivity"]
+    assert k["field"] == "shear_modulus" and k["value"] == 3e8
+    assert k["friction_low"] == pytest.approx(at(0.9), abs=1e-4) and k["friction_high"] == pytest.approx(at(1.1), abs=1e-4)
+    st, st0 = fit.identifiability["friction"], held.identifiability["friction"]
+    assert not st0.lower <= k["friction_high"] < k["friction_low"] <= st0.upper  # 10 % moves mu out of it
+    ends = sorted(at(1.0 + s * 1.959964 * 0.05) for s in (-1, 1))
+    down, up = fit.friction - ends[0], ends[1] - fit.friction
+    assert down > 0 and up > 0 and fit.friction == held.friction
+    assert st.upper - fit.friction == pytest.approx(math.hypot(st0.upper - fit.friction, up), rel=1e-3, abs=0)
+    assert fit.friction - st.lower == pytest.approx(math.hypot(fit.friction - st0.lower, down), rel=1e-3, abs=0)
+    assert "relative uncertainty 0.05 is included" in fit.report() and "moves mu out of it" in held.report()

@@ -89,6 +89,13 @@ def _non_negative_float(text: str) -> float:
     return value
 
 
+def _relative_uncertainty(text: str) -> float:
+    value = _finite_float(text)
+    if not 0.0 <= value < 0.5:
+        raise argparse.ArgumentTypeError(f"must be a relative standard uncertainty in [0, 0.5), got {text!r}")
+    return value
+
+
 def _rtol(text: str) -> float:
     from microimpact.solvers.impact import check_rtol
 
@@ -721,7 +728,7 @@ def _lammps_fit_friction(args, table, chosen):
     try:
         ranked, fits = rank_dem_tangential_laws(
             table, {law: (lambda r, f=f: chosen.contact(r).with_(**f)) for law, f in laws.items()}, normal_fit=chosen,
-            rtol=args.rtol, progress=True)
+            stiffness_uncertainty=args.stiffness_uncertainty, rtol=args.rtol, progress=True)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
     if len(laws) > 1:
@@ -737,8 +744,13 @@ def _lammps_fit_friction(args, table, chosen):
         return None, None
     radius = float(np.median(np.asarray(table["radius"], dtype=float)))
     others = ", ".join(f"{o} dAIC {d:.3g}" for o, d in zip(ranked["law"].iloc[1:], ranked["delta_aic"].iloc[1:]))
+    k = fit.info.get("stiffness_sensitivity")
+    held = ("" if not k else f"; the stiffness's relative uncertainty {args.stiffness_uncertainty:g} included"
+            if args.stiffness_uncertainty else
+            f"; at the given stiffness, not fitted (mu {k['friction_low']:.6g} / {k['friction_high']:.6g} with it "
+            f"{100 * k['step']:.0f}% lower / higher)")
     note = (f"{fit.friction:.6g} ({law}{'; best by AIC: ' + others if others else ''}; 95% profile-likelihood "
-            f"interval {status.lower:.6g} to {status.upper:.6g}; the normal law's uncertainty included; "
+            f"interval {status.lower:.6g} to {status.upper:.6g}; the normal law's uncertainty included{held}; "
             f"{fit.n_points} oblique entries)")
     return chosen.contact(radius).with_(friction=fit.friction, **laws[law]), note
 
@@ -770,6 +782,8 @@ def _cmd_lammps_fit(args) -> int:
         raise UsageError("--twisting-model lammps_sds needs --twisting-stiffness (k_twist [N m/rad])")
     if args.twisting_model != "lammps_sds" and sds_twist:
         raise UsageError(f"{', '.join(sds_twist)} belong to --twisting-model lammps_sds")
+    if args.stiffness_uncertainty is not None and args.tangential_model is None:
+        raise UsageError("--stiffness-uncertainty belongs to a tangential law: give --tangential-model too")
     if args.fit_adhesion and args.law and args.law[0] == "hertz":
         raise UsageError(f"--fit-adhesion: the law {'+'.join(args.law)} has no work of adhesion to fit; give a "
                          "jkr_force or dmt law, or no --law")
@@ -925,6 +939,10 @@ def register_lammps(sub) -> None:
                    help="k_t of linear_history [N/m]")
     f.add_argument("--shear-modulus", type=_positive_float, default=None, metavar="SI",
                    help="G* of the lammps_mindlin laws [Pa] (LAMMPS's k_t = 8 G*)")
+    f.add_argument("--stiffness-uncertainty", type=_relative_uncertainty, default=None, metavar="U",
+                   help="relative standard uncertainty of --tangential-stiffness / --shear-modulus, propagated into "
+                        "mu's interval (default: none, mu's interval then holds at the given stiffness; the report "
+                        "shows mu at the stiffness 10 %% lower and higher)")
     f.add_argument("--tangential-damping", type=_non_negative_float, default=0.0, metavar="X",
                    help="x_gamma,t of the tangential law (default 0)")
     f.add_argument("--rolling-stiffness", type=_positive_float, default=None, metavar="SI",

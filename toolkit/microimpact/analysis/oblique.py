@@ -427,7 +427,8 @@ class FrictionFit(ReportHTML):
     info : dict
         ``nfev``, ``elapsed_s``, ``source``, ``method``, ``damping_gradient``, ``rolling_above``
         (every entry rolls for f above it), ``sliding_below`` (every entry slides below it),
-        ``success`` (True only where f is determined).
+        ``success`` (True only where f is determined); of :func:`fit_dem_friction` also
+        ``normal_propagated``, ``stiffness_sensitivity`` and ``stiffness_uncertainty``.
     identifiability : dict
         ``{"friction": ParameterStatus}``: whether the data determine f (value and 95 % interval),
         bound it from one side, or cannot tell it (:mod:`microimpact.analysis.identifiability`).
@@ -509,6 +510,7 @@ class FrictionFit(ReportHTML):
             if st is not None:
                 lines.append(f"  {'':<17}  95 % interval [{st.lower:.6g}, {st.upper:.6g}] ({st.method}"
                              + (")" if held else f", uncertainty of {before} included)"))
+        lines += self._stiffness_lines()
         if "work_of_adhesion" in self.info.get("normal_propagated", ""):
             lines.append("  note        : with the work of adhesion fitted too, this interval covered the true mu in 42 of 46 "
                          "random designs (0.91) in the calibration study (docs/guide/lammps.md, "
@@ -518,6 +520,27 @@ class FrictionFit(ReportHTML):
                      f"{'stated uncertainties + effective variance' if self.weighted else 'unweighted'}")
         lines.append(f"  chi-square  : {self.chisqr:.4g}, reduced {self.redchi:.4g}")
         return "\n".join(lines)
+
+    def _stiffness_lines(self) -> list[str]:
+        """The report's lines on the held tangential stiffness of a DEM law (fit_dem_friction)."""
+        k = self.info.get("stiffness_sensitivity")
+        if not k:
+            return []
+        unit, what = ("N/m", "k_t") if k["field"] == "tangential_stiffness" else ("Pa", "G* (k_t = 8 G* a)")
+        step = f"{100 * k['step']:.0f} %"
+        lines = [f"  stiffness   : {what} held at {k['value']:.6g} {unit}, not fitted; mu = {k['friction_low']:.6g} "
+                 f"with it {step} lower, {k['friction_high']:.6g} {step} higher"]
+        u = self.info.get("stiffness_uncertainty")
+        st = self.identifiability.get("friction")
+        if u:
+            lines.append(f"{'':<16}its relative uncertainty {u:.3g} is included in the interval")
+        elif st is not None and not (st.lower <= min(k["friction_low"], k["friction_high"])
+                                     and max(k["friction_low"], k["friction_high"]) <= st.upper):
+            lines.append(f"{'':<16}the interval holds at this stiffness only: a {step} change moves mu out of it "
+                         "(give its uncertainty: stiffness_uncertainty, --stiffness-uncertainty)")
+        else:
+            lines.append(f"{'':<16}the interval holds at this stiffness (its uncertainty not included)")
+        return lines
 
     def to_dataset(self) -> xr.Dataset:
         """CF form: scalar ``friction`` (+ ``friction_stderr``) and the entries along ``entry``."""
@@ -552,6 +575,12 @@ class FrictionFit(ReportHTML):
                          "tangential_model": self.tangential_model, "chisqr": self.chisqr, "redchi": self.redchi,
                          "n_points": self.n_points, "weighted": int(self.weighted),
                          "source": str(self.info.get("source", ""))})
+        k = self.info.get("stiffness_sensitivity")
+        if k:  # the held stiffness and how mu depends on it (fit_dem_friction)
+            ds.attrs.update({"held_stiffness_field": k["field"], "held_stiffness": k["value"],
+                             "stiffness_step": k["step"], "friction_at_lower_stiffness": k["friction_low"],
+                             "friction_at_higher_stiffness": k["friction_high"],
+                             "stiffness_uncertainty": float(self.info.get("stiffness_uncertainty") or 0.0)})
         return ds
 
     def save(self, path):
@@ -810,15 +839,21 @@ class _FrictionObjective:
 #: points added where it lies near its minimum (the interval's ends)
 DEM_PROFILE_POINTS = 48
 DEM_REFINE_POINTS = 32
+#: relative change of the held tangential stiffness at which :func:`fit_dem_friction` refits mu to
+#: show how much mu depends on it (the data of a DEM law's fit do not determine the stiffness)
+STIFFNESS_STEP = 0.1
 
 
-def fit_dem_friction(table, contact_of, *, normal_fit=None, rtol: float = DEFAULT_RTOL, progress: bool = False,
+def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertainty: float | None = None,
+                     rtol: float = DEFAULT_RTOL, progress: bool = False,
                      time_budget: float | None = None) -> FrictionFit:
     """Fit the Coulomb coefficient mu of a DEM tangential law (LAMMPS's ``linear_history`` or a
     ``mindlin`` variant, :mod:`microimpact.model.dem_tangential`) to the oblique columns.
 
     The rest of the contact (normal law, damping, tangential stiffness and damping) is given, e.g.
     by :func:`microimpact.analysis.dem_fit.fit_dem_law` for the normal law and the material's G*.
+
+    Length: the docstring (parameters, notes, example); the body is about 30 lines.
 
     Parameters
     ----------
@@ -832,6 +867,10 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, rtol: float = DEFAUL
         The fit of the normal law that ``contact_of`` holds (:func:`~microimpact.analysis.dem_fit.fit_dem_law`):
         its uncertainty is propagated into mu (Notes). None: mu at the given normal law, nothing
         propagated.
+    stiffness_uncertainty : float, optional
+        Relative standard uncertainty of the held tangential stiffness (``tangential_stiffness`` of
+        ``linear_history``, ``shear_modulus`` of the mindlin laws), in [0, 0.5): propagated into mu
+        (Notes). None: mu at the given stiffness. [-]
     rtol : float
         Relative tolerance of the solves. [-]
     progress : bool
@@ -843,7 +882,9 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, rtol: float = DEFAUL
     -------
     FrictionFit
         As :func:`fit_friction` (``info["damping_gradient"]``: d mu / d normal parameter), its
-        ``tangential_model`` the DEM law's.
+        ``tangential_model`` the DEM law's; where mu is determined, ``info["stiffness_sensitivity"]``:
+        the held stiffness (``field``, ``value``) and mu refitted at :data:`STIFFNESS_STEP` below and
+        above it (``friction_low``, ``friction_high``).
 
     Raises
     ------
@@ -866,6 +907,14 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, rtol: float = DEFAUL
     With ``normal_fit``, mu is refitted over the boundary of the normal law's 95 % confidence region
     (:meth:`~microimpact.analysis.dem_fit.DemLawFit.confidence_region`) and each end of its 95 %
     interval widened in quadrature by how far the refits move it that way (:func:`_normal_law_shift`).
+
+    The data do not determine the tangential stiffness, and mu depends on it where the contact
+    sticks (low incidence): mu is refitted at the stiffness 10 % below and above the given one, and
+    the report states both. With ``stiffness_uncertainty`` u, mu is also refitted at (1 -+ 1.96 u)
+    times it and each end of the interval widened in quadrature by how far that moves mu, as for
+    the normal law. Without it the interval holds at the given stiffness only: on four noisy
+    rebounds at 10-70 deg (LAMMPS's Mindlin law, mu = 0.25) half and twice the true G* gave
+    mu = 0.36 and a lower bound of 9.9, far outside the interval [0.234, 0.264] at the true G*.
 
     References
     ----------
@@ -898,20 +947,27 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, rtol: float = DEFAUL
         raise ValueError(f"fit_dem_friction fits a DEM tangential law ({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}); the "
                          f"contact has tangential_model={contact.tangential_model!r} (use fit_friction)")
     ends = _normal_fit_ends(normal_fit, contact_of, problem) if normal_fit is not None else {}
+    factors = _stiffness_factors(stiffness_uncertainty)
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
-    total = 2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20) + _region_refits(ends) * _REFIT_EVALUATIONS
+    total = (2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20)
+             + (_region_refits(ends) + len(factors)) * _REFIT_EVALUATIONS)
     with progress_bar(total, "friction fit", progress) as advance:
         objective = _DemFrictionObjective(problem, contact_of, weighted, rtol, advance)
         best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
         if weighted and (np.any(problem.sigma_speed > 0) or np.any(problem.sigma_angle > 0)):
             objective.hold_effective_sigma(best.value)
             best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
-        shift, gradient = None, {}
-        if ends and _friction_status(best, objective, 0.0).determined:
-            shift, gradient = _normal_law_shift(objective, contact_of, normal_fit, best, deadline)
+        shift, gradient, sensitivity = None, {}, {}
+        if _friction_status(best, objective, 0.0).determined:
+            if ends:
+                shift, gradient = _normal_law_shift(objective, contact_of, normal_fit, best, deadline)
+            sensitivity, stiffness_shift = _stiffness_shift(objective, contact_of, best, factors, deadline)
+            if stiffness_shift is not None:
+                shift = stiffness_shift if shift is None else tuple(map(math.hypot, shift, stiffness_shift))
     fit = _friction_result(problem, objective, best, 0.0, {"friction": gradient} if gradient else {}, weighted,
                            contact.tangential_model, t0, shift=shift)
-    return replace(fit, info=fit.info | {"normal_propagated": ", ".join(gradient)})
+    return replace(fit, info=fit.info | {"normal_propagated": ", ".join(gradient), "stiffness_sensitivity": sensitivity,
+                                         "stiffness_uncertainty": stiffness_uncertainty if sensitivity else None})
 
 
 def _refit(deviance, brackets, width, lo_lim, hi_lim) -> float:
@@ -974,6 +1030,74 @@ def _normal_fit_ends(normal_fit, contact_of, problem) -> dict:
     return ends
 
 
+def _refits(objective, contacts_of, best, deadline, what: str) -> np.ndarray:
+    """mu refitted by :func:`_refit`, at the effective variance held at the estimate's, with each of
+    ``contacts_of`` (radius -> Contact) in place of the fit's contact; ``what`` names them for the
+    deadline's message.
+
+    Each refit is a bounded Brent search over +-10 conditional standard errors about the estimate,
+    to 1e-3 of one; a minimum at an end of that bracket is searched again over [mu / 2, 2 mu], then
+    over the whole range."""
+    _, lo_lim, hi_lim = PARAMETER_BOUNDS["friction"]
+    f = best.value
+    width = 10.0 * best.stderr if math.isfinite(best.stderr) and best.stderr > 0 else 0.5 * f
+    brackets = [(max(lo_lim, f - width), min(hi_lim, f + width)), (max(lo_lim, 0.5 * f), min(hi_lim, 2.0 * f))]
+    out = []
+    for contact_of in contacts_of:
+        moved = _DemFrictionObjective(objective.problem, contact_of, objective.weighted, objective.rtol, objective.advance)
+        moved._sigma = objective.sigma(f)
+        out.append(_refit(moved.deviance, brackets, width, lo_lim, hi_lim))
+        deadline.check(what)
+    return np.array(out)
+
+
+def _stiffness_field(tangential_model: str) -> str:
+    """The Contact field of a DEM tangential law's stiffness (linear_history: k_t [N/m]; the
+    mindlin laws: G* [Pa], their k_t being 8 G* a)."""
+    return "tangential_stiffness" if tangential_model == "linear_history" else "shear_modulus"
+
+
+def _stiffness_factors(uncertainty) -> tuple:
+    """Factors on the held stiffness at which mu is refitted: 1 -+ :data:`STIFFNESS_STEP`, then
+    1 -+ 1.96 ``uncertainty`` where given (ValueError outside [0, 0.5))."""
+    from scipy import stats
+
+    from microimpact.analysis.identifiability import DEFAULT_LEVEL
+
+    factors = (1.0 - STIFFNESS_STEP, 1.0 + STIFFNESS_STEP)
+    if uncertainty is None:
+        return factors
+    u = float(uncertainty)
+    if not (0.0 <= u < 0.5):
+        raise ValueError(f"stiffness_uncertainty must be a relative standard uncertainty in [0, 0.5), got {uncertainty!r}")
+    z = float(stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2))
+    return factors + ((1.0 - z * u, 1.0 + z * u) if u > 0 else ())
+
+
+def _stiffness_shift(objective, contact_of, best, factors, deadline) -> tuple[dict, tuple | None]:
+    """(sensitivity, shift): mu refitted with the held tangential stiffness times each of
+    ``factors`` (:func:`_stiffness_factors`). ``sensitivity``: the stiffness's field and value and
+    the refits at the first two factors ({} where the law has no stiffness); ``shift``: the 95 %
+    (down, up) widening by the last two, None without them."""
+    first = contact_of(float(objective.problem.radius[0]))
+    name = _stiffness_field(first.tangential_model)
+    value = getattr(first, name)
+    if not value:
+        return {}, None
+
+    def scaled(factor):
+        return lambda r: contact_of(r).with_(**{name: factor * getattr(contact_of(r), name)})
+
+    refits = _refits(objective, [scaled(x) for x in factors], best, deadline,
+                     "the refits of mu at the changed tangential stiffness")
+    sensitivity = {"field": name, "value": float(value), "step": STIFFNESS_STEP,
+                   "friction_low": float(refits[0]), "friction_high": float(refits[1])}
+    if len(factors) < 4:
+        return sensitivity, None
+    f = best.value
+    return sensitivity, (max(0.0, f - float(refits[2:].min())), max(0.0, float(refits[2:].max()) - f))
+
+
 def _normal_law_shift(objective, contact_of, normal_fit, best, deadline) -> tuple[tuple[float, float], dict]:
     """((down, up), {parameter: d mu / d parameter}): how far mu moves over the normal law's 95 %
     confidence region.
@@ -986,30 +1110,22 @@ def _normal_law_shift(objective, contact_of, normal_fit, best, deadline) -> tupl
     the normal fit's covariance C, correlation included); beyond it the refits follow the model:
     a work of adhesion whose interval is wide in log10 w_A moves mu further one way than the other.
     :func:`_friction_status` widens each end of the 95 % profile interval in quadrature by its
-    side's shift. The gradient is the slope of the least-squares plane through the refits.
-
-    Each refit (:func:`_refit`) is a bounded Brent search over +-10 conditional standard errors about
-    the estimate, to 1e-3 of one; a minimum at an end of that bracket is searched again over
-    [mu / 2, 2 mu], then over the whole range."""
+    side's shift. The gradient is the slope of the least-squares plane through the refits
+    (:func:`_refits`)."""
     from microimpact.analysis.identifiability import DEFAULT_LEVEL
 
-    _, lo_lim, hi_lim = PARAMETER_BOUNDS["friction"]
     f = best.value
-    width = 10.0 * best.stderr if math.isfinite(best.stderr) and best.stderr > 0 else 0.5 * f
-    brackets = [(max(lo_lim, f - width), min(hi_lim, f + width)), (max(lo_lim, 0.5 * f), min(hi_lim, 2.0 * f))]
     points = normal_fit.confidence_region(DEFAULT_LEVEL)
-    refits = []
-    for keywords in points:
-        def shifted(r, keywords=keywords):
+
+    def shifted(keywords):
+        def contact(r):
             law = normal_fit.contact(r, **keywords)
             return contact_of(r).with_(damping_coefficient=law.damping_coefficient,
                                        adhesion_line_force=law.adhesion_line_force)
+        return contact
 
-        moved = _DemFrictionObjective(objective.problem, shifted, objective.weighted, objective.rtol, objective.advance)
-        moved._sigma = objective.sigma(f)  # the effective variance held at the estimate's
-        refits.append(_refit(moved.deviance, brackets, width, lo_lim, hi_lim))
-        deadline.check("the refits of mu over the normal law's confidence region")
-    refits = np.array(refits)
+    refits = _refits(objective, [shifted(k) for k in points], best, deadline,
+                     "the refits of mu over the normal law's confidence region")
     names = list(points[0])
     best_point = {"coefficient": normal_fit.best, "work_of_adhesion": normal_fit.material.get("work_of_adhesion", 0.0)}
     design = np.array([[1.0, *(p[k] - best_point[k] for k in names)] for p in points])
@@ -1018,8 +1134,8 @@ def _normal_law_shift(objective, contact_of, normal_fit, best, deadline) -> tupl
     return shift, dict(zip(names, map(float, slope)))
 
 
-def rank_dem_tangential_laws(table, contacts_of, *, normal_fit=None, rtol: float = DEFAULT_RTOL,
-                             progress: bool = False, time_budget: float | None = None):
+def rank_dem_tangential_laws(table, contacts_of, *, normal_fit=None, stiffness_uncertainty: float | None = None,
+                             rtol: float = DEFAULT_RTOL, progress: bool = False, time_budget: float | None = None):
     """Fit mu of each DEM tangential law to the same oblique columns and rank the laws by AIC.
 
     Parameters
@@ -1028,8 +1144,9 @@ def rank_dem_tangential_laws(table, contacts_of, *, normal_fit=None, rtol: float
         As :func:`fit_dem_friction`.
     contacts_of : mapping
         tangential_model -> (radius [m] -> Contact with that law), the rest of the contact given.
-    normal_fit, rtol, progress
-        As :func:`fit_dem_friction` (the normal fit's uncertainty propagated into every law's mu).
+    normal_fit, stiffness_uncertainty, rtol, progress
+        As :func:`fit_dem_friction` (the normal fit's and the stiffness's uncertainty propagated into
+        every law's mu).
     time_budget : float or Deadline, optional
         Wall-clock budget of all the fits; None: no limit. [s]
 
@@ -1071,8 +1188,8 @@ def rank_dem_tangential_laws(table, contacts_of, *, normal_fit=None, rtol: float
     deadline = Deadline.start(time_budget, "tangential laws fitted")
     fits, rows = {}, []
     for law, contact_of in contacts_of.items():
-        fit = fit_dem_friction(table, contact_of, normal_fit=normal_fit, rtol=rtol, progress=progress,
-                               time_budget=deadline)
+        fit = fit_dem_friction(table, contact_of, normal_fit=normal_fit, stiffness_uncertainty=stiffness_uncertainty,
+                               rtol=rtol, progress=progress, time_budget=deadline)
         if fit.tangential_model != law:
             raise ValueError(f"contacts_of[{law!r}] gives tangential_model={fit.tangential_model!r}")
         fits[law] = fit
