@@ -967,7 +967,7 @@ _COVERAGE_NORMAL = (("hertz", "coeff_restitution"), ("hertz", "viscoelastic"), (
 
 
 def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = True, fit_adhesion: bool = False,
-                          rtol: float = DEFAULT_RTOL):
+                          stiffness_uncertainty: float = 0.0, rtol: float = DEFAULT_RTOL):
     """Coverage of the 95 % interval of mu of a LAMMPS tangential law fitted after its normal law,
     both from the same noisy data, over random experiment designs.
 
@@ -981,6 +981,9 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
     :func:`fit_dem_law`, then mu by :func:`~microimpact.analysis.oblique.fit_dem_friction` at the
     fitted normal law, its uncertainty propagated or not.
 
+    Length: the docstring, and one loop that draws a design, fits it and records the row, each
+    step of which reads the draws before it.
+
     Parameters
     ----------
     trials : int
@@ -992,6 +995,10 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
     fit_adhesion : bool
         Draw the adhesive normal laws only (JKR, DMT) and fit the work of adhesion with the damping
         (two normal parameters propagated).
+    stiffness_uncertainty : float
+        > 0: the fit of mu is given the true tangential stiffness times (1 + u z), z standard normal
+        (from a generator of its own, so the designs are those of the same seed without it), and
+        ``stiffness_uncertainty=u``. 0: the true stiffness. [-]
     rtol : float
         Solver tolerance. [-]
 
@@ -1000,7 +1007,8 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
     pandas.DataFrame
         One row per design fitted: normal and tangential law, true and fitted damping coefficient
         (and work of adhesion), the normal fit's status, true mu, n, the noises, mu's status, value
-        and interval, and ``covered`` (designs whose normal fit is not determined: no mu).
+        and interval, and ``covered`` (designs whose normal fit is not determined: no mu); with
+        ``stiffness_uncertainty``, ``stiffness_given``: the given stiffness over the true one.
 
     References
     ----------
@@ -1021,6 +1029,7 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
     from microimpact.model.dem_damping import critical_damping_coefficient
 
     rng = np.random.default_rng(seed)
+    errors = np.random.default_rng([seed, 1])  # the stiffness errors: the designs stay those of the seed
     rows = []
     normal_laws = _COVERAGE_NORMAL[2:] if fit_adhesion else _COVERAGE_NORMAL
     for _ in range(trials):
@@ -1054,9 +1063,15 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
         if fit_adhesion:
             row |= {"work_of_adhesion": mat["work_of_adhesion"], "work_of_adhesion_fitted": normal_fit.material["work_of_adhesion"],
                     "adhesion_status": normal_fit.adhesion_status}
+        if stiffness_uncertainty > 0:
+            given = 1.0 + stiffness_uncertainty * float(errors.standard_normal())
+            (name, value), = stiffness.items()
+            tangential = tangential | {name: given * value}
+            row["stiffness_given"] = given
         if normal_fit.determined:
             fit = fit_dem_friction(table, lambda r, f=normal_fit, t=tangential: f.contact(r).with_(**t),
-                                   normal_fit=normal_fit if propagate else None, rtol=rtol)
+                                   normal_fit=normal_fit if propagate else None,
+                                   stiffness_uncertainty=stiffness_uncertainty or None, rtol=rtol)
             st = fit.identifiability["friction"]
             row |= {"status": st.status, "value": fit.friction, "lower": st.lower, "upper": st.upper,
                     "covered": bool(st.lower <= mu <= st.upper)}
