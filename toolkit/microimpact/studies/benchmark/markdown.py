@@ -325,7 +325,34 @@ def _sub_model_section(a: dict) -> list[str]:
 
 def benchmark_markdown(ds: xr.Dataset) -> str:
     """A Markdown summary of the benchmark: reference and bound, the results table, engine and RKG
-    notes, timing modes, targets, throughput and memory, notes and run time."""
+    notes, timing modes, targets, throughput and memory, notes and run time.
+
+    Sections without data are left out: throughput, memory and the families of impacts appear only
+    when :func:`run_benchmark` measured them (``throughput=True``), the notes only when there are any.
+
+    Examples
+    --------
+    A tiny benchmark (two normal speeds, one oblique case, the loosest setting of each method, no
+    throughput runs; about a second): its sections, and one row per method in the results table
+    holding the Dataset's numbers:
+
+    >>> import dataclasses
+    >>> from microimpact.studies.benchmark import BenchmarkConfig, oblique_cases, run_benchmark
+    >>> cfg = dataclasses.replace(
+    ...     BenchmarkConfig.quick_(), n_speeds=2, max_speed=10.0, engine_levels=(0,), scipy_levels=(0,),
+    ...     rkg_levels=(0,), oblique=oblique_cases(quick=True)[:1], repeats_single=1, repeats_batch=1,
+    ...     batch_size=10, family_size=10, time_limit=5.0, oblique_time_limit=12.0, reference_rtols=(1e-8, 1e-9))
+    >>> ds = run_benchmark(config=cfg, throughput=False)
+    >>> md = benchmark_markdown(ds)
+    >>> heads = [line for line in md.splitlines() if line.startswith("#")]
+    >>> heads[:5]  # a "## Notes" section may follow where a solve ran past its time limit
+    ['# Work-precision benchmark', '## Reference and its error bound', '## Results', '## Targets', '## Cost of the sub-models']
+    >>> rows = [line.split(" | ") for line in md.splitlines() if line.endswith(" | ok |")]
+    >>> [row[0].lstrip("| ") for row in rows] == ds["method"].values.tolist()
+    True
+    >>> rows[0][:2], rows[0][3] == _n(float(ds["max_error_e_n"].sel({"method": "engine", "setting": 0})))
+    (['| engine', 'rtol 1e-04'], True)
+    """
     a = ds.attrs
     js = benchmark_json(ds)
     lines = _header(ds) + _reference_section(a)

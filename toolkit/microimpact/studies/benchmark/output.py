@@ -36,6 +36,35 @@ def write_benchmark(ds: xr.Dataset, out_dir, *, figure=None, docs_dir=None) -> d
     Returns
     -------
     dict of name -> pathlib.Path
+
+    Examples
+    --------
+    The files of a tiny benchmark (two normal speeds, one oblique case, the loosest setting of
+    each method, no throughput runs; about a second) with an empty figure: the NetCDF file reads
+    back the Dataset's numbers, the JSON file has one record per method run, and the docs copy of
+    the summary is the summary:
+
+    >>> import dataclasses, json, tempfile
+    >>> import numpy as np
+    >>> from matplotlib.figure import Figure
+    >>> from microimpact.studies.benchmark import BenchmarkConfig, oblique_cases, run_benchmark
+    >>> cfg = dataclasses.replace(
+    ...     BenchmarkConfig.quick_(), n_speeds=2, max_speed=10.0, engine_levels=(0,), scipy_levels=(0,),
+    ...     rkg_levels=(0,), oblique=oblique_cases(quick=True)[:1], repeats_single=1, repeats_batch=1,
+    ...     batch_size=10, family_size=10, time_limit=5.0, oblique_time_limit=12.0, reference_rtols=(1e-8, 1e-9))
+    >>> ds = run_benchmark(config=cfg, throughput=False)
+    >>> figure = Figure(figsize=(1, 1))  # an empty stand-in for plot_work_precision(ds).figure
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     paths = write_benchmark(ds, Path(tmp) / "out", figure=figure, docs_dir=Path(tmp) / "docs")
+    ...     with xr.open_dataset(paths["netcdf"]) as back:
+    ...         same = np.array_equal(back["time_per_impact"].values, ds["time_per_impact"].values, equal_nan=True)
+    ...     records = json.loads(paths["json"].read_text())["results"]
+    ...     docs_same = paths["docs_markdown"].read_text() == paths["markdown"].read_text()
+    ...     written = all(path.stat().st_size > 0 for path in paths.values())
+    >>> sorted(paths), written
+    (['docs_markdown', 'docs_png', 'json', 'markdown', 'netcdf', 'pdf', 'png'], True)
+    >>> same, [r["method"] for r in records] == ds["method"].values.tolist(), docs_same
+    (True, True, True)
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
