@@ -524,6 +524,7 @@ def test_lammps_fit_writes_the_fitted_friction_of_a_tangential_law(tmp_path, cap
     mu = float(text.split("# fitted friction: ")[1].split()[0])
     low, high = (float(x) for x in text.split("95% profile-likelihood interval ")[1].split(";")[0].split(" to "))
     assert low < 0.3 < high and high - low < 0.1 and low < mu < high
+    assert "at the given stiffness, not fitted (mu " in text and "% lower / higher)" in text  # G* not fitted
     fix = text.splitlines()[-1].split()
     i = fix.index("tangential")
     assert fix[i + 1:i + 4] == ["mindlin", "8000000000", "0"] and float(fix[i + 4]) == pytest.approx(mu, rel=1e-5, abs=0)
