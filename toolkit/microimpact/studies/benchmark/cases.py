@@ -161,6 +161,24 @@ class BenchmarkConfig:
             family_memory_sizes=(20_000, 200_000), fit_rows=10_000, family_oblique=False,
         )
 
+    @classmethod
+    def tiny_(cls) -> "BenchmarkConfig":
+        """A benchmark of about a second, for examples: two normal speeds, one oblique case, the
+        loosest setting of each method, loose time limits (a slow solve is not cut short).
+
+        Examples
+        --------
+        >>> c = BenchmarkConfig.tiny_()
+        >>> c.n_speeds, len(c.oblique), c.n_settings
+        (2, 1, 1)
+        """
+        import dataclasses
+
+        return dataclasses.replace(
+            cls.quick_(), n_speeds=2, max_speed=10.0, engine_levels=(0,), scipy_levels=(0,), rkg_levels=(0,),
+            oblique=_OBLIQUE_QUICK[:1], repeats_single=1, repeats_batch=1, batch_size=10, family_size=10,
+            time_limit=5.0, oblique_time_limit=12.0, reference_rtols=(1e-8, 1e-9))
+
     @property
     def n_settings(self) -> int:
         """Length of the ``setting`` dimension: the largest level of any method plus one."""

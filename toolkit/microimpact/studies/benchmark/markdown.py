@@ -336,13 +336,8 @@ def benchmark_markdown(ds: xr.Dataset) -> str:
     throughput runs; about a second): its sections, and one row per method in the results table
     holding the Dataset's numbers:
 
-    >>> import dataclasses
-    >>> from microimpact.studies.benchmark import BenchmarkConfig, oblique_cases, run_benchmark
-    >>> cfg = dataclasses.replace(
-    ...     BenchmarkConfig.quick_(), n_speeds=2, max_speed=10.0, engine_levels=(0,), scipy_levels=(0,),
-    ...     rkg_levels=(0,), oblique=oblique_cases(quick=True)[:1], repeats_single=1, repeats_batch=1,
-    ...     batch_size=10, family_size=10, time_limit=5.0, oblique_time_limit=12.0, reference_rtols=(1e-8, 1e-9))
-    >>> ds = run_benchmark(config=cfg, throughput=False)
+    >>> from microimpact.studies.benchmark import BenchmarkConfig, run_benchmark
+    >>> ds = run_benchmark(config=BenchmarkConfig.tiny_(), throughput=False)
     >>> md = benchmark_markdown(ds)
     >>> heads = [line for line in md.splitlines() if line.startswith("#")]
     >>> heads[:5]  # a "## Notes" section may follow where a solve ran past its time limit

@@ -44,15 +44,11 @@ def write_benchmark(ds: xr.Dataset, out_dir, *, figure=None, docs_dir=None) -> d
     back the Dataset's numbers, the JSON file has one record per method run, and the docs copy of
     the summary is the summary:
 
-    >>> import dataclasses, json, tempfile
+    >>> import json, tempfile
     >>> import numpy as np
     >>> from matplotlib.figure import Figure
-    >>> from microimpact.studies.benchmark import BenchmarkConfig, oblique_cases, run_benchmark
-    >>> cfg = dataclasses.replace(
-    ...     BenchmarkConfig.quick_(), n_speeds=2, max_speed=10.0, engine_levels=(0,), scipy_levels=(0,),
-    ...     rkg_levels=(0,), oblique=oblique_cases(quick=True)[:1], repeats_single=1, repeats_batch=1,
-    ...     batch_size=10, family_size=10, time_limit=5.0, oblique_time_limit=12.0, reference_rtols=(1e-8, 1e-9))
-    >>> ds = run_benchmark(config=cfg, throughput=False)
+    >>> from microimpact.studies.benchmark import BenchmarkConfig, run_benchmark
+    >>> ds = run_benchmark(config=BenchmarkConfig.tiny_(), throughput=False)
     >>> figure = Figure(figsize=(1, 1))  # an empty stand-in for plot_work_precision(ds).figure
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     paths = write_benchmark(ds, Path(tmp) / "out", figure=figure, docs_dir=Path(tmp) / "docs")
