@@ -512,8 +512,8 @@ class FrictionFit(ReportHTML):
                              + (")" if held else f", uncertainty of {before} included)"))
         lines += self._stiffness_lines()
         if "work_of_adhesion" in self.info.get("normal_propagated", ""):
-            lines.append("  note        : with the work of adhesion fitted too, this interval covered the true mu in 42 of 46 "
-                         "random designs (0.91) in the calibration study (docs/guide/lammps.md, "
+            lines.append("  note        : with the work of adhesion fitted too, this interval covered the true mu in 63 of 68 "
+                         "random designs (0.93) in the calibration study (docs/guide/lammps.md, "
                          "dem_friction_coverage(fit_adhesion=True))")
         qs = ", ".join(f"{q} ({int((self.data['quantity'] == q).sum())})" for q in dict.fromkeys(self.data["quantity"]))
         lines.append(f"  data        : {self.n_points} entries: {qs}; "
