@@ -533,7 +533,8 @@ class FrictionFit(ReportHTML):
         u = self.info.get("stiffness_uncertainty")
         st = self.identifiability.get("friction")
         if u:
-            lines.append(f"{'':<16}its relative uncertainty {u:.3g} is included in the interval")
+            lines.append(f"{'':<16}its relative uncertainty {u:.3g} is included in the interval (to first order: with "
+                         "u = 0.1 it covered the true mu in 14 of 17 random designs, docs/guide/lammps.md)")
         elif st is not None and not (st.lower <= min(k["friction_low"], k["friction_high"])
                                      and max(k["friction_low"], k["friction_high"]) <= st.upper):
             lines.append(f"{'':<16}the interval holds at this stiffness only: a {step} change moves mu out of it "
