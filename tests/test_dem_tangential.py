@@ -596,15 +596,51 @@ def test_a_stated_angle_uncertainty_enters_the_dem_friction_fit_as_effective_var
     assert fit.data["sigma"].to_numpy() == pytest.approx(expected, rel=1e-3, abs=0)
 
 
-def test_the_stiffness_factors_are_the_step_and_the_95_percent_ends():
-    from microimpact.analysis.oblique import STIFFNESS_STEP, _stiffness_factors
+def test_the_stiffness_uncertainty_is_checked_and_the_parabola_vertex_is_exact():
+    from microimpact.analysis.oblique import _parabola_vertex, _stiffness_uncertainty
 
-    assert _stiffness_factors(None) == (1.0 - STIFFNESS_STEP, 1.0 + STIFFNESS_STEP) == (0.9, 1.1)
-    assert _stiffness_factors(0.05)[2:] == pytest.approx((1.0 - 1.959964 * 0.05, 1.0 + 1.959964 * 0.05), abs=1e-7)
-    assert len(_stiffness_factors(0.0)) == 2  # nothing to propagate
+    assert _stiffness_uncertainty(None) is None and _stiffness_uncertainty(0.0) is None  # nothing to profile
+    assert _stiffness_uncertainty(0.05) == 0.05
     for bad in (0.5, -0.01, math.nan):
         with pytest.raises(ValueError, match="stiffness_uncertainty"):
-            _stiffness_factors(bad)
+            _stiffness_uncertainty(bad)
+    # y = 3 (x - 0.7)^2 + 1 through any three points: the vertex 0.7; clipped to the range; a
+    # parabola opening downwards: the end on the lower outer point's side
+    y = lambda x: 3.0 * (x - 0.7) ** 2 + 1.0  # noqa: E731
+    assert _parabola_vertex((-2.0, 0.0, 2.0), [y(-2.0), y(0.0), y(2.0)], -4, 4) == pytest.approx(0.7, abs=1e-12)
+    assert _parabola_vertex((0.1, 0.3, 1.9), [y(0.1), y(0.3), y(1.9)], -4, 4) == pytest.approx(0.7, abs=1e-12)
+    assert _parabola_vertex((-2.0, 0.0, 2.0), [y(-2.0), y(0.0), y(2.0)], -4, 0.5) == 0.5
+    assert _parabola_vertex((-2.0, 0.0, 2.0), [-4.0, 0.0, -3.0], -3.5, 4) == -3.5
+    assert _parabola_vertex((-2.0, 0.0, 2.0), [-3.0, 0.0, -4.0], -3.5, 4) == 4
+
+
+def test_the_profiled_stiffness_finds_the_least_penalised_deviance():
+    # LAMMPS's mindlin law, three noisy rebounds at 8-40 deg (the low ones stick: e_t depends on
+    # G*), the stiffness given 20 % low with u = 0.1: at each mu the profile's deviance must equal
+    # an independent bounded search over z of the data's deviance at (1 + 0.1 z) G* plus z^2 (to
+    # 5e-3: 0.1 % of the 3.84 threshold; the profile takes the least of five parabola points), lie
+    # below the deviance at the given stiffness, and its stiffness must be that search's (to 0.05)
+    from scipy.optimize import minimize_scalar
+
+    from microimpact.analysis.oblique import ObliqueProblem, _DemFrictionObjective, _StiffnessProfile
+
+    truth = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.3, tangential_model="lammps_mindlin", shear_modulus=3e8)
+    given = truth.with_(shear_modulus=0.8 * 3e8)
+    table = _oblique_table(truth, np.full(3, 1.0), np.array([8.0, 20.0, 40.0]), 0.01, np.random.default_rng(1))
+    problem = ObliqueProblem.from_table(table)
+    held = _DemFrictionObjective(problem, lambda r: given, True, 1e-8)
+    profile = _StiffnessProfile(held, lambda r: given, 0.1)
+    for f in (0.25, 0.3, 0.4):
+        def penalised(z):
+            at = _DemFrictionObjective(problem, lambda r: given.with_(shear_modulus=(1 + 0.1 * z) * 0.8 * 3e8), True, 1e-8)
+            return at.deviance(f) + z * z
+
+        z = profile.stiffness_z(f)
+        independent = minimize_scalar(penalised, bounds=(z - 1.0, z + 1.0), method="bounded", options={"xatol": 1e-4})
+        assert z - 0.999 < independent.x < z + 0.999  # inside the bracket: a minimum, not an end
+        assert profile.deviance(f) == pytest.approx(independent.fun, abs=5e-3)
+        assert z == pytest.approx(independent.x, abs=0.05)
+        assert profile.deviance(f) < held.deviance(f)
 
 
 def _dem_friction_fit(info, lower=0.234, upper=0.264):
@@ -624,6 +660,8 @@ def _dem_friction_fit(info, lower=0.234, upper=0.264):
 
 
 def test_the_report_says_how_mu_depends_on_the_held_stiffness():
+    from microimpact.analysis.oblique import STIFFNESS_COVERAGE
+
     moved = {"field": "shear_modulus", "value": 3e8, "step": 0.1, "friction_low": 0.2716, "friction_high": 0.2209}
     text = _dem_friction_fit({"stiffness_sensitivity": moved}).report()
     assert "G* (k_t = 8 G* a) held at 3e+08 Pa, not fitted; mu = 0.2716 with it 10 % lower, 0.2209 10 % higher" in text
@@ -631,14 +669,18 @@ def test_the_report_says_how_mu_depends_on_the_held_stiffness():
     within = moved | {"friction_low": 0.25, "friction_high": 0.248}
     assert "holds at this stiffness (its uncertainty not included)" in _dem_friction_fit(
         {"stiffness_sensitivity": within}).report()
-    text = _dem_friction_fit({"stiffness_sensitivity": moved, "stiffness_uncertainty": 0.05}).report()
-    assert "its relative uncertainty 0.05 is included in the interval" in text and "moves mu out" not in text
+    profiled = moved | {"uncertainty": 0.05, "profiled_factor": 1.0312, "friction_at_given": 0.249}
+    text = _dem_friction_fit({"stiffness_sensitivity": profiled, "stiffness_uncertainty": 0.05}).report()
+    assert ("G* (k_t = 8 G* a) given as 3e+08 Pa with relative uncertainty 0.05 (a Gaussian prior) and profiled out: "
+            "best at 1.031 times it") in text and "moves mu out" not in text
+    assert "mu = 0.2716 with it held 10 % lower, 0.2209 10 % higher; " + STIFFNESS_COVERAGE in text
     k_t = moved | {"field": "tangential_stiffness", "value": 250.0}
     assert "k_t held at 250 N/m, not fitted" in _dem_friction_fit({"stiffness_sensitivity": k_t}).report()
     assert "stiffness" not in _dem_friction_fit({}).report()  # not a DEM fit's sensitivity: no line
-    ds = _dem_friction_fit({"stiffness_sensitivity": moved, "stiffness_uncertainty": 0.05}).to_dataset()
+    ds = _dem_friction_fit({"stiffness_sensitivity": profiled, "stiffness_uncertainty": 0.05}).to_dataset()
     assert ds.attrs["held_stiffness_field"] == "shear_modulus" and ds.attrs["friction_at_lower_stiffness"] == 0.2716
-    assert ds.attrs["stiffness_uncertainty"] == 0.05
+    assert ds.attrs["stiffness_uncertainty"] == 0.05 and ds.attrs["profiled_stiffness_factor"] == 1.0312
+    assert "profiled_stiffness_factor" not in _dem_friction_fit({"stiffness_sensitivity": moved}).to_dataset().attrs
 
 
 def test_lammps_fit_refuses_a_stiffness_uncertainty_it_cannot_use(tmp_path, capsys, monkeypatch):
@@ -656,14 +698,17 @@ def test_lammps_fit_refuses_a_stiffness_uncertainty_it_cannot_use(tmp_path, caps
     assert not (tmp_path / "c.lmp").exists()
 
 
-@pytest.mark.slow  # six full profile fits of mu: about 1.5 min
-def test_the_held_stiffness_moves_mu_as_independent_fits_do_and_its_uncertainty_widens_the_interval():
+@pytest.mark.slow  # five full profile fits of mu (one of them with the stiffness profiled): about 2 min
+def test_the_held_stiffness_moves_mu_as_independent_fits_do_and_its_profile_gives_the_interval():
     # LAMMPS's mindlin law, mu = 0.25, four noisy rebounds at 10-70 deg (the low ones stick: e_t
     # depends on G*). The sensitivity refits at 0.9 and 1.1 G* must equal two independent full fits
-    # of mu there (to 1e-4: the refit's Brent tolerance is 1e-4 of 10 standard errors); with a
-    # relative uncertainty u = 0.05, each end of the interval must widen in quadrature by how far two
-    # independent fits at (1 -+ 1.96 u) G* move mu (to 1e-3 relative, their polish).
-    from microimpact.analysis.oblique import fit_dem_friction
+    # of mu there (to 1e-4: the refit's Brent tolerance is 1e-4 of 10 standard errors). With a
+    # relative uncertainty u = 0.05, at each end of mu's interval an independent minimisation over
+    # z of the deviance at (1 + u z) G* plus z^2 must lie 3.84 (the 95 % threshold) above its value
+    # at the fitted mu (to 0.05: the ends are interpolated on the profile's grid).
+    from scipy.optimize import minimize_scalar
+
+    from microimpact.analysis.oblique import ObliqueProblem, _DemFrictionObjective, fit_dem_friction
 
     c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.25, tangential_model="lammps_mindlin", shear_modulus=3e8)
     table = _oblique_table(c, np.full(4, 1.0), np.linspace(10.0, 70.0, 4), 0.01, np.random.default_rng(0))
@@ -676,11 +721,23 @@ def test_the_held_stiffness_moves_mu_as_independent_fits_do_and_its_uncertainty_
     k = fit.info["stiffness_sensitivity"]
     assert k["field"] == "shear_modulus" and k["value"] == 3e8
     assert k["friction_low"] == pytest.approx(at(0.9), abs=1e-4) and k["friction_high"] == pytest.approx(at(1.1), abs=1e-4)
+    assert k["friction_at_given"] == held.friction
     st, st0 = fit.identifiability["friction"], held.identifiability["friction"]
     assert not st0.lower <= k["friction_high"] < k["friction_low"] <= st0.upper  # 10 % moves mu out of it
-    ends = sorted(at(1.0 + s * 1.959964 * 0.05) for s in (-1, 1))
-    down, up = fit.friction - ends[0], ends[1] - fit.friction
-    assert down > 0 and up > 0 and fit.friction == held.friction
-    assert st.upper - fit.friction == pytest.approx(math.hypot(st0.upper - fit.friction, up), rel=1e-3, abs=0)
-    assert fit.friction - st.lower == pytest.approx(math.hypot(fit.friction - st0.lower, down), rel=1e-3, abs=0)
-    assert "relative uncertainty 0.05 is included" in fit.report() and "moves mu out of it" in held.report()
+    problem = ObliqueProblem.from_table(table)
+
+    def profiled(f):
+        def penalised(z):
+            moved = c.with_(shear_modulus=(1 + 0.05 * z) * 3e8)
+            return _DemFrictionObjective(problem, lambda r: moved, True, 1e-8).deviance(f) + z * z
+        zs = np.linspace(-4.0, 4.0, 17)
+        i = int(np.argmin([penalised(z) for z in zs]))
+        return minimize_scalar(penalised, bounds=(zs[max(i - 1, 0)], zs[min(i + 1, 16)]), method="bounded",
+                               options={"xatol": 1e-5}).fun
+
+    least = profiled(fit.friction)
+    assert profiled(st.lower) - least == pytest.approx(3.8415, abs=0.05)
+    assert profiled(st.upper) - least == pytest.approx(3.8415, abs=0.05)
+    assert st.lower <= 0.25 <= st.upper and k["profiled_factor"] != 1.0
+    assert "with relative uncertainty 0.05 (a Gaussian prior) and profiled out" in fit.report()
+    assert "moves mu out of it" in held.report()

@@ -745,8 +745,8 @@ def _lammps_fit_friction(args, table, chosen):
     radius = float(np.median(np.asarray(table["radius"], dtype=float)))
     others = ", ".join(f"{o} dAIC {d:.3g}" for o, d in zip(ranked["law"].iloc[1:], ranked["delta_aic"].iloc[1:]))
     k = fit.info.get("stiffness_sensitivity")
-    held = ("" if not k else f"; the stiffness's relative uncertainty {args.stiffness_uncertainty:g} included"
-            if args.stiffness_uncertainty else
+    held = ("" if not k else f"; the stiffness profiled with its relative uncertainty {args.stiffness_uncertainty:g} "
+            f"(best at {k['profiled_factor']:.4g} times the given)" if args.stiffness_uncertainty else
             f"; at the given stiffness, not fitted (mu {k['friction_low']:.6g} / {k['friction_high']:.6g} with it "
             f"{100 * k['step']:.0f}% lower / higher)")
     note = (f"{fit.friction:.6g} ({law}{'; best by AIC: ' + others if others else ''}; 95% profile-likelihood "
@@ -940,8 +940,8 @@ def register_lammps(sub) -> None:
     f.add_argument("--shear-modulus", type=_positive_float, default=None, metavar="SI",
                    help="G* of the lammps_mindlin laws [Pa] (LAMMPS's k_t = 8 G*)")
     f.add_argument("--stiffness-uncertainty", type=_relative_uncertainty, default=None, metavar="U",
-                   help="relative standard uncertainty of --tangential-stiffness / --shear-modulus, propagated into "
-                        "mu's interval (default: none, mu's interval then holds at the given stiffness; the report "
+                   help="relative standard uncertainty of --tangential-stiffness / --shear-modulus: the stiffness is "
+                        "profiled out of mu's interval with a Gaussian prior of this width (default: none, mu's interval then holds at the given stiffness; the report "
                         "shows mu at the stiffness 10 %% lower and higher)")
     f.add_argument("--tangential-damping", type=_non_negative_float, default=0.0, metavar="X",
                    help="x_gamma,t of the tangential law (default 0)")

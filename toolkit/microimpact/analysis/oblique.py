@@ -528,15 +528,18 @@ class FrictionFit(ReportHTML):
             return []
         unit, what = ("N/m", "k_t") if k["field"] == "tangential_stiffness" else ("Pa", "G* (k_t = 8 G* a)")
         step = f"{100 * k['step']:.0f} %"
+        u = self.info.get("stiffness_uncertainty")
+        if u:
+            return [f"  stiffness   : {what} given as {k['value']:.6g} {unit} with relative uncertainty {u:.3g} (a Gaussian "
+                    f"prior) and profiled out: best at {k['profiled_factor']:.4g} times it; the interval is mu's "
+                    "profile likelihood",
+                    f"{'':<16}mu = {k['friction_low']:.6g} with it held {step} lower, {k['friction_high']:.6g} {step} "
+                    f"higher; {STIFFNESS_COVERAGE} (docs/guide/lammps.md)"]
         lines = [f"  stiffness   : {what} held at {k['value']:.6g} {unit}, not fitted; mu = {k['friction_low']:.6g} "
                  f"with it {step} lower, {k['friction_high']:.6g} {step} higher"]
-        u = self.info.get("stiffness_uncertainty")
         st = self.identifiability.get("friction")
-        if u:
-            lines.append(f"{'':<16}its relative uncertainty {u:.3g} is included in the interval (to first order: with "
-                         "u = 0.1 it covered the true mu in 14 of 17 random designs, docs/guide/lammps.md)")
-        elif st is not None and not (st.lower <= min(k["friction_low"], k["friction_high"])
-                                     and max(k["friction_low"], k["friction_high"]) <= st.upper):
+        if st is not None and not (st.lower <= min(k["friction_low"], k["friction_high"])
+                                   and max(k["friction_low"], k["friction_high"]) <= st.upper):
             lines.append(f"{'':<16}the interval holds at this stiffness only: a {step} change moves mu out of it "
                          "(give its uncertainty: stiffness_uncertainty, --stiffness-uncertainty)")
         else:
@@ -582,6 +585,8 @@ class FrictionFit(ReportHTML):
                              "stiffness_step": k["step"], "friction_at_lower_stiffness": k["friction_low"],
                              "friction_at_higher_stiffness": k["friction_high"],
                              "stiffness_uncertainty": float(self.info.get("stiffness_uncertainty") or 0.0)})
+            if self.info.get("stiffness_uncertainty"):
+                ds.attrs["profiled_stiffness_factor"] = k["profiled_factor"]
         return ds
 
     def save(self, path):
@@ -854,7 +859,7 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
     The rest of the contact (normal law, damping, tangential stiffness and damping) is given, e.g.
     by :func:`microimpact.analysis.dem_fit.fit_dem_law` for the normal law and the material's G*.
 
-    Length: the docstring (parameters, notes, example); the body is about 30 lines.
+    Length: the docstring (parameters, notes, example); the body is about 40 lines.
 
     Parameters
     ----------
@@ -870,8 +875,9 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
         propagated.
     stiffness_uncertainty : float, optional
         Relative standard uncertainty of the held tangential stiffness (``tangential_stiffness`` of
-        ``linear_history``, ``shear_modulus`` of the mindlin laws), in [0, 0.5): propagated into mu
-        (Notes). None: mu at the given stiffness. [-]
+        ``linear_history``, ``shear_modulus`` of the mindlin laws), in [0, 0.5): the stiffness is
+        profiled out of mu's interval with a Gaussian prior of this width (Notes). None or 0: mu at
+        the given stiffness. [-]
     rtol : float
         Relative tolerance of the solves. [-]
     progress : bool
@@ -885,7 +891,9 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
         As :func:`fit_friction` (``info["damping_gradient"]``: d mu / d normal parameter), its
         ``tangential_model`` the DEM law's; where mu is determined, ``info["stiffness_sensitivity"]``:
         the held stiffness (``field``, ``value``) and mu refitted at :data:`STIFFNESS_STEP` below and
-        above it (``friction_low``, ``friction_high``).
+        above it (``friction_low``, ``friction_high``); with ``stiffness_uncertainty`` also
+        ``profiled_factor`` (the best stiffness over the given one) and ``friction_at_given`` (mu's
+        fit at the given stiffness; NaN where not determined there).
 
     Raises
     ------
@@ -909,13 +917,17 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
     (:meth:`~microimpact.analysis.dem_fit.DemLawFit.confidence_region`) and each end of its 95 %
     interval widened in quadrature by how far the refits move it that way (:func:`_normal_law_shift`).
 
-    The data do not determine the tangential stiffness, and mu depends on it where the contact
-    sticks (low incidence): mu is refitted at the stiffness 10 % below and above the given one, and
-    the report states both. With ``stiffness_uncertainty`` u, mu is also refitted at (1 -+ 1.96 u)
-    times it and each end of the interval widened in quadrature by how far that moves mu, as for
-    the normal law. Without it the interval holds at the given stiffness only: on four noisy
-    rebounds at 10-70 deg (LAMMPS's Mindlin law, mu = 0.25) half and twice the true G* gave
-    mu = 0.36 and a lower bound of 9.9, far outside the interval [0.234, 0.264] at the true G*.
+    The data of a fit rarely determine the tangential stiffness alone, and mu depends on it where
+    the contact sticks (low incidence): mu is refitted at the stiffness 10 % below and above the
+    given one, and the report states both. Without ``stiffness_uncertainty`` the interval holds at
+    the given stiffness only: on four noisy rebounds at 10-70 deg (LAMMPS's Mindlin law, mu = 0.25)
+    half and twice the true G* gave mu = 0.36 and a lower bound of 9.9, far outside the interval
+    [0.234, 0.264] at the true G*. With it (u), the stiffness is a nuisance parameter with a
+    Gaussian prior, (1 + u z) times the given one, z standard normal, profiled out
+    (:class:`_StiffnessProfile`): the interval is mu's profile likelihood over mu and z jointly, so
+    rebounds that constrain the stiffness narrow it and a valley of e_t(mu) that moves with the
+    stiffness is followed. The normal law's shift is measured at the given stiffness and widens
+    this interval as above. Measured calibration: :data:`STIFFNESS_COVERAGE`.
 
     References
     ----------
@@ -948,27 +960,35 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
         raise ValueError(f"fit_dem_friction fits a DEM tangential law ({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}); the "
                          f"contact has tangential_model={contact.tangential_model!r} (use fit_friction)")
     ends = _normal_fit_ends(normal_fit, contact_of, problem) if normal_fit is not None else {}
-    factors = _stiffness_factors(stiffness_uncertainty)
+    u = _stiffness_uncertainty(stiffness_uncertainty)
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
-    total = (2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20)
-             + (_region_refits(ends) + len(factors)) * _REFIT_EVALUATIONS)
+    profile = 2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20)
+    total = profile * (1 + 2 * bool(u)) + (_region_refits(ends) + 2) * _REFIT_EVALUATIONS
     with progress_bar(total, "friction fit", progress) as advance:
         objective = _DemFrictionObjective(problem, contact_of, weighted, rtol, advance)
         best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
         if weighted and (np.any(problem.sigma_speed > 0) or np.any(problem.sigma_angle > 0)):
             objective.hold_effective_sigma(best.value)
             best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
+        held, fitted = best, objective
+        if u:
+            weight = 1.0 if weighted else max(best.chisqr / max(problem.size - 1, 1), 1e-300)
+            fitted = _StiffnessProfile(objective, contact_of, u, weight)
+            best = _profile_fit(fitted, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
         shift, gradient, sensitivity = None, {}, {}
-        if _friction_status(best, objective, 0.0).determined:
-            if ends:
-                shift, gradient = _normal_law_shift(objective, contact_of, normal_fit, best, deadline)
-            sensitivity, stiffness_shift = _stiffness_shift(objective, contact_of, best, factors, deadline)
-            if stiffness_shift is not None:
-                shift = stiffness_shift if shift is None else tuple(map(math.hypot, shift, stiffness_shift))
-    fit = _friction_result(problem, objective, best, 0.0, {"friction": gradient} if gradient else {}, weighted,
+        if _friction_status(best, fitted, 0.0).determined:
+            if ends:  # at the given stiffness, about its own fit: a shift applied to the profiled interval
+                shift, gradient = _normal_law_shift(objective, contact_of, normal_fit, held, deadline)
+            sensitivity = _stiffness_sensitivity(objective, contact_of, held, deadline)
+            if u and sensitivity:
+                z = fitted.stiffness_z(best.value)
+                sensitivity |= {"uncertainty": u, "profiled_factor": 1.0 + u * z,
+                                "friction_at_given": held.value if _friction_status(held, objective, 0.0).determined
+                                else math.nan}
+    fit = _friction_result(problem, fitted, best, 0.0, {"friction": gradient} if gradient else {}, weighted,
                            contact.tangential_model, t0, shift=shift)
     return replace(fit, info=fit.info | {"normal_propagated": ", ".join(gradient), "stiffness_sensitivity": sensitivity,
-                                         "stiffness_uncertainty": stiffness_uncertainty if sensitivity else None})
+                                         "stiffness_uncertainty": u if sensitivity else None})
 
 
 def _refit(deviance, brackets, width, lo_lim, hi_lim) -> float:
@@ -1058,45 +1078,34 @@ def _stiffness_field(tangential_model: str) -> str:
     return "tangential_stiffness" if tangential_model == "linear_history" else "shear_modulus"
 
 
-def _stiffness_factors(uncertainty) -> tuple:
-    """Factors on the held stiffness at which mu is refitted: 1 -+ :data:`STIFFNESS_STEP`, then
-    1 -+ 1.96 ``uncertainty`` where given (ValueError outside [0, 0.5))."""
-    from scipy import stats
-
-    from microimpact.analysis.identifiability import DEFAULT_LEVEL
-
-    factors = (1.0 - STIFFNESS_STEP, 1.0 + STIFFNESS_STEP)
+def _stiffness_uncertainty(uncertainty) -> float | None:
+    """The relative standard uncertainty of the held stiffness, checked (ValueError outside
+    [0, 0.5)); None or 0: none (the stiffness held)."""
     if uncertainty is None:
-        return factors
+        return None
     u = float(uncertainty)
     if not (0.0 <= u < 0.5):
         raise ValueError(f"stiffness_uncertainty must be a relative standard uncertainty in [0, 0.5), got {uncertainty!r}")
-    z = float(stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2))
-    return factors + ((1.0 - z * u, 1.0 + z * u) if u > 0 else ())
+    return u or None
 
 
-def _stiffness_shift(objective, contact_of, best, factors, deadline) -> tuple[dict, tuple | None]:
-    """(sensitivity, shift): mu refitted with the held tangential stiffness times each of
-    ``factors`` (:func:`_stiffness_factors`). ``sensitivity``: the stiffness's field and value and
-    the refits at the first two factors ({} where the law has no stiffness); ``shift``: the 95 %
-    (down, up) widening by the last two, None without them."""
+def _stiffness_sensitivity(objective, contact_of, best, deadline) -> dict:
+    """The held tangential stiffness's field and value, and mu refitted with it
+    :data:`STIFFNESS_STEP` lower and higher (``friction_low``, ``friction_high``); {} where the law
+    has no stiffness."""
     first = contact_of(float(objective.problem.radius[0]))
     name = _stiffness_field(first.tangential_model)
     value = getattr(first, name)
     if not value:
-        return {}, None
+        return {}
 
     def scaled(factor):
         return lambda r: contact_of(r).with_(**{name: factor * getattr(contact_of(r), name)})
 
-    refits = _refits(objective, [scaled(x) for x in factors], best, deadline,
+    refits = _refits(objective, [scaled(1.0 - STIFFNESS_STEP), scaled(1.0 + STIFFNESS_STEP)], best, deadline,
                      "the refits of mu at the changed tangential stiffness")
-    sensitivity = {"field": name, "value": float(value), "step": STIFFNESS_STEP,
-                   "friction_low": float(refits[0]), "friction_high": float(refits[1])}
-    if len(factors) < 4:
-        return sensitivity, None
-    f = best.value
-    return sensitivity, (max(0.0, f - float(refits[2:].min())), max(0.0, float(refits[2:].max()) - f))
+    return {"field": name, "value": float(value), "step": STIFFNESS_STEP,
+            "friction_low": float(refits[0]), "friction_high": float(refits[1])}
 
 
 def _normal_law_shift(objective, contact_of, normal_fit, best, deadline) -> tuple[tuple[float, float], dict]:
@@ -1261,6 +1270,122 @@ class _DemFrictionObjective(_FrictionObjective):
     def rolling_thresholds(self) -> np.ndarray:
         """No closed-form threshold: the profile's grid alone."""
         return np.full(self.problem.size, np.inf)
+
+
+#: the measured calibration of mu's interval with the stiffness profiled (the report states it)
+STIFFNESS_COVERAGE = "its coverage over random designs is not measured yet"
+
+#: the held stiffness's standardised error z = (k / k_given - 1) / u over which
+#: :class:`_StiffnessProfile` profiles it: a prior penalty of 16 at the ends, four times the 95 %
+#: threshold of the profile (3.84)
+STIFFNESS_PRIOR_RANGE = 4.0
+
+
+#: most parabolic steps of :meth:`_StiffnessProfile.stiffness_z` after its three starting points
+_STIFFNESS_STEPS = 10
+
+
+class _StiffnessProfile:
+    """The deviance of mu with the held tangential stiffness profiled out under a Gaussian prior.
+
+    The stiffness is k = (1 + u z) k_given with z standard normal a priori; at each trial mu the
+    deviance is minimised over z of the data's deviance at (mu, z) plus ``weight`` z^2 (the prior's
+    -2 log density; ``weight`` is 1 with stated uncertainties, else the reduced chi-square of the
+    fit at the given stiffness, which the profile is divided by), z within
+    +-:data:`STIFFNESS_PRIOR_RANGE` and k above a tenth of k_given. The interval of mu from this
+    profile is the profile-likelihood interval of mu with the stiffness a nuisance parameter
+    (Pawitan 2001, Sec. 3.4): where the data say nothing about the stiffness the prior alone bounds
+    it, where they do (sticking contacts at small incidence) they narrow it, and a change of
+    e_t(mu)'s valley with the stiffness is followed, not linearised.
+
+    The minimum over z: the penalised deviance at z = -2, 0, 2, then successive parabolic
+    interpolation, each step at the vertex of the parabola through the best point so far and its
+    two neighbours (clipped to the range), until a vertex falls within 1e-3 of a point already
+    solved (or after :data:`_STIFFNESS_STEPS` steps); the least value found. Rebounds at small
+    incidence can pin the stiffness tightly (the deviance rises by hundreds over 2 z), so a single
+    parabola is not enough. The effective variance is that of the given stiffness (held)."""
+
+    def __init__(self, held: _DemFrictionObjective, contact_of, uncertainty: float, weight: float = 1.0):
+        self.held, self.problem, self.weighted, self.rtol = held, held.problem, held.weighted, held.rtol
+        self.advance = held.advance
+        self.uncertainty, self.weight = float(uncertainty), float(weight)
+        self._contact_of = contact_of
+        self.field = _stiffness_field(held.contacts[float(self.problem.radius[0])].tangential_model)
+        self.z_range = (max(-STIFFNESS_PRIOR_RANGE, -0.9 / self.uncertainty), STIFFNESS_PRIOR_RANGE)
+        self._at = {0.0: held}
+        self._best = {}
+
+    @property
+    def nfev(self) -> int:
+        return sum(o.nfev for o in self._at.values())
+
+    def at(self, z: float) -> _DemFrictionObjective:
+        """The objective with the stiffness at (1 + u z) times the given one."""
+        z = float(z)
+        if z not in self._at:
+            factor, name, contact_of = 1.0 + self.uncertainty * z, self.field, self._contact_of
+            moved = _DemFrictionObjective(
+                self.problem, lambda r: contact_of(r).with_(**{name: factor * getattr(contact_of(r), name)}),
+                self.weighted, self.rtol, self.advance)
+            moved._sigma = self.held._sigma
+            self._at[z] = moved
+        return self._at[z]
+
+    def penalised(self, f, z) -> float:
+        """The data's deviance at (mu, z) plus the prior's ``weight`` z^2. [-]"""
+        return self.at(z).deviance(f) + self.weight * float(z) ** 2
+
+    def stiffness_z(self, f) -> float:
+        """z of the least penalised deviance at mu = f (see the class)."""
+        f = float(f)
+        if f not in self._best:
+            lo, hi = self.z_range
+            tried = {z: self.penalised(f, z) for z in (max(lo, -2.0), 0.0, min(hi, 2.0))}
+            for _ in range(_STIFFNESS_STEPS):
+                zs = sorted(tried)
+                k = int(np.argmin([tried[z] for z in zs]))
+                k = min(max(k, 1), len(zs) - 2)
+                vertex = _parabola_vertex(zs[k - 1:k + 2], [tried[z] for z in zs[k - 1:k + 2]], lo, hi)
+                if min(abs(vertex - z) for z in zs) < 1e-3:
+                    break
+                tried[vertex] = self.penalised(f, vertex)
+            self._best[f] = min(tried, key=tried.get)
+        return self._best[f]
+
+    def deviance(self, f) -> float:
+        """The profiled deviance at mu = f. [-]"""
+        return self.penalised(f, self.stiffness_z(f))
+
+    def model(self, f, state="nominal") -> np.ndarray:
+        return self.at(self.stiffness_z(f)).model(f, state)
+
+    def sigma(self, f) -> np.ndarray:
+        return self.held.sigma(f)
+
+    def residual(self, f, sigma=None) -> np.ndarray:
+        """The data's residuals at (mu, z(mu)) and the prior's, sqrt(weight) z. [-]"""
+        z = self.stiffness_z(f)
+        return np.append(self.at(z).residual(f, sigma), math.sqrt(self.weight) * z)
+
+    def chi2(self, f) -> float:
+        """The data's chi-square at (mu, z(mu)) (the prior's term left out). [-]"""
+        r = self.at(self.stiffness_z(f)).residual(f)
+        return float(r @ r)
+
+    def rolling_thresholds(self) -> np.ndarray:
+        return self.held.rolling_thresholds()
+
+
+def _parabola_vertex(x, y, lo, hi) -> float:
+    """The abscissa of the least value of the parabola through three points, within [lo, hi] (an
+    end where it opens downwards or is flat: the end on the side of the lower outer point)."""
+    (x0, x1, x2), (y0, y1, y2) = x, y
+    den = (x0 - x1) * (x0 - x2) * (x1 - x2)
+    a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / den
+    if not a > 0:
+        return float(lo if y0 <= y2 else hi)
+    b = (x2 ** 2 * (y0 - y1) + x1 ** 2 * (y2 - y0) + x0 ** 2 * (y1 - y2)) / den
+    return float(min(max(-b / (2 * a), lo), hi))
 
 
 @dataclass(frozen=True)
