@@ -143,3 +143,47 @@ def test_benchmark_stops_at_its_time_budget_and_writes_nothing(tmp_path, capsys)
     assert "microimpact: error: benchmark: time budget of 3 s exceeded" in err and "--time-budget" in err, err
     assert elapsed < 13.0, elapsed
     assert not out.exists() or not any(out.iterdir())
+
+
+#: one impact of each solver family that `simulate` runs interpreted: ring law rebound and capture,
+#: the hysteretic tangential law (coupled solver), JKR oblique, LAMMPS's Mindlin law
+INTERPRETED_CASES = [
+    ["--speed", "2"],
+    ["--speed", "0.1"],
+    ["--speed", "1", "--incidence-deg", "30", "--tangential-model", "mindlin_deresiewicz", "--shear-modulus", "3e8"],
+    ["--speed", "0.5", "--normal-model", "jkr", "--incidence-deg", "45"],
+    ["--speed", "1", "--incidence-deg", "20", "--tangential-model", "lammps_mindlin", "--shear-modulus", "3e8",
+     "--normal-model", "jkr_force", "--damping-model", "viscoelastic", "--damping-coefficient", "1e-7"],
+]
+
+
+def _simulate_in_a_process(case, **env):
+    import os
+
+    environ = {k: v for k, v in os.environ.items() if k not in ("NUMBA_DISABLE_JIT", "MICROIMPACT_COMPILED")} | env
+    return subprocess.run([sys.executable, "-m", "microimpact._entry", "simulate", *case, "--json"],
+                          capture_output=True, text=True, timeout=300, env=environ)
+
+
+@pytest.mark.parametrize("case", INTERPRETED_CASES, ids=["rebound", "capture", "hysteretic", "jkr", "lammps"])
+def test_the_interpreted_impact_prints_the_compiled_numbers_bit_for_bit(case, capsys):
+    # `simulate` runs its impact interpreted (microimpact._entry._interpreted): its JSON, every float
+    # printed by repr, must equal the compiled solvers' (this process has numba compiling)
+    interpreted = _simulate_in_a_process(case, NUMBA_DISABLE_JIT="1")
+    assert interpreted.returncode == 0, interpreted.stderr
+    status, compiled, _ = run_main(["simulate", *case, "--json"], capsys)
+    assert status == 0 and interpreted.stdout == compiled
+
+
+def test_simulate_runs_interpreted_and_starts_again_compiled_past_its_budget(capsys):
+    from microimpact._entry import _interpreted
+
+    assert _interpreted(["simulate", "--speed", "2"]) is ("numba" not in sys.modules)  # here numba is imported
+    assert not _interpreted(["sweep", "--case", "2.2"])
+    case = INTERPRETED_CASES[2]
+    status, compiled, _ = run_main(["simulate", *case, "--json"], capsys)
+    # a budget of 1 ms runs out while numba imports: the process starts again compiled, prints
+    # the same once, and nothing on stderr but numba's compile note (a cold cache)
+    again = _simulate_in_a_process(case, MICROIMPACT_INTERPRETED_SECONDS="0.001")
+    assert again.returncode == 0 and again.stdout == compiled
+    assert all(line.startswith("microimpact: compiling") for line in again.stderr.splitlines()), again.stderr

@@ -40,6 +40,52 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
           file=sys.stderr if file is None else file)
 
 
+#: ``microimpact simulate`` runs its one impact with numba's compilation switched off
+#: (``NUMBA_DISABLE_JIT``) for at most this long [s], then starts again compiled (see
+#: :func:`_interpreted`); the environment variable ``MICROIMPACT_INTERPRETED_SECONDS`` sets another
+INTERPRETED_SECONDS = 4.0
+_COMPILED = "MICROIMPACT_COMPILED"  # set in the process started again: compiled, no second try
+
+
+class _CompileInstead(BaseException):
+    """The interpreted impact ran past :data:`INTERPRETED_SECONDS` (a BaseException: no handler of
+    the command's errors takes it for one)."""
+
+
+def _too_slow(signum, frame):
+    raise _CompileInstead
+
+
+def _interpreted(argv) -> bool:
+    """Whether this process solves ``simulate``'s impact interpreted.
+
+    One impact takes milliseconds compiled but numba compiles the solvers first (15-20 s after an
+    install on 2 cores) or loads them from its cache (1-2 s); the same Python code run by the
+    interpreter takes 0.1-1 s for an impact of ordinary difficulty, and its numbers are the compiled
+    code's, bit for bit, since no kernel uses fastmath (tests/test_cli.py compares them). An
+    impact that needs more than :data:`INTERPRETED_SECONDS` (millions of steps) is started again
+    compiled, as is one whose interpreted run fails in a way the compiled one might not. Not where
+    numba is already imported (nothing to gain), where the user set ``NUMBA_DISABLE_JIT``, or in
+    the process started again."""
+    return (argv[:1] == ["simulate"] and "numba" not in sys.modules and "NUMBA_DISABLE_JIT" not in os.environ
+            and _COMPILED not in os.environ)
+
+
+def interpreted_budget_over() -> None:
+    """The impact is solved: the interpreted run's clock stops (the output is not cut short)."""
+    if os.environ.get("NUMBA_DISABLE_JIT") == "1" and _COMPILED not in os.environ and hasattr(signal, "setitimer"):
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+
+
+def _start_compiled(argv):
+    """Replace this process by the same command with numba compiling (exec: same pid, no output
+    written yet)."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_JIT"} | {_COMPILED: "1"}
+    os.execve(sys.executable, [sys.executable, "-m", "microimpact._entry", *argv], env)
+
+
 def _interrupted_while_starting(signum, frame):
     print(INTERRUPTED_LINE, file=sys.stderr)
     raise SystemExit(EXIT_INTERRUPTED)
@@ -61,7 +107,23 @@ def main() -> int:
         signal.signal(signal.SIGINT, signal.default_int_handler)
     redeliver_swallowed_signals()
     warnings.showwarning = _show_warning
-    status = cli_main()
+    argv = sys.argv[1:]
+    interpreted = _interpreted(argv) and hasattr(signal, "setitimer")
+    if interpreted:
+        os.environ["NUMBA_DISABLE_JIT"] = "1"  # read by numba when it is first imported, below
+        signal.signal(signal.SIGALRM, _too_slow)
+        signal.setitimer(signal.ITIMER_REAL, float(os.environ.get("MICROIMPACT_INTERPRETED_SECONDS", INTERPRETED_SECONDS)))
+    try:
+        status = cli_main(argv)
+    except _CompileInstead:
+        _start_compiled(argv)
+    except Exception:
+        if not interpreted:
+            raise
+        _start_compiled(argv)  # an error of the interpreted run only: the compiled one decides
+    finally:
+        if interpreted:
+            signal.setitimer(signal.ITIMER_REAL, 0.0)
     if status == EXIT_INTERRUPTED:
         # The one line is printed and nothing was written; skip the interpreter's finalisation.
         # A Ctrl-C that stops numba in the middle of a compile leaves llvmlite objects whose

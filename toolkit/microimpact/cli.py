@@ -24,7 +24,7 @@ from dataclasses import fields
 from pathlib import Path
 
 from microimpact import __version__
-from microimpact._entry import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_after_writing
+from microimpact._entry import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_after_writing, interpreted_budget_over
 from microimpact._usage import exit_status
 from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,
                                   reporting_os_errors, same_file)
@@ -225,6 +225,7 @@ def _cmd_simulate(args) -> int:
     contact = contact_from_args(args)
     result = simulate_impact(contact, args.speed, args.incidence_deg, args.azimuth_deg,
                              (args.omega_n, args.omega_t, args.omega_tp), rtol=args.rtol, method=args.method)
+    interpreted_budget_over()
     record = contact_record(contact, args.contact_note)
     if args.json:
         print(json.dumps(result.to_dict() | {"contact": record}, indent=2))
