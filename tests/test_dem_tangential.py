@@ -643,6 +643,26 @@ def test_the_profiled_stiffness_finds_the_least_penalised_deviance():
         assert profile.deviance(f) < held.deviance(f)
 
 
+def test_an_unweighted_fit_of_mu_has_the_profile_interval_of_its_scatter():
+    # no stated uncertainties: the profile is divided by the reduced chi-square, and the interval's
+    # ends are where the raw chi-square has risen by 3.84 times it. Checked against the chi-square
+    # evaluated independently at the ends (to 0.1 of 3.84: the ends are interpolated on the refined
+    # grid); the refinement once used the raw threshold, and this interval came out 8 times narrow
+    from microimpact.analysis.oblique import ObliqueProblem, _DemFrictionObjective, fit_dem_friction
+
+    c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.25, tangential_model="lammps_mindlin", shear_modulus=3e8)
+    table = _oblique_table(c, np.full(5, 1.0), np.linspace(10.0, 70.0, 5), 0.01, np.random.default_rng(0))
+    table = table.drop(columns="tangential_restitution_uncertainty")
+    fit = fit_dem_friction(table, lambda r: c)
+    st = fit.identifiability["friction"]
+    assert not fit.weighted and st.determined
+    raw = _DemFrictionObjective(ObliqueProblem.from_table(table), lambda r: c, False, 1e-8)
+    least = raw.chi2(fit.friction)
+    for end in (st.lower, st.upper):
+        assert (raw.chi2(end) - least) / (least / 4) == pytest.approx(3.8415, abs=0.1)
+    assert st.lower <= 0.25 <= st.upper
+
+
 def _dem_friction_fit(info, lower=0.234, upper=0.264):
     """A FrictionFit of LAMMPS's mindlin law at mu = 0.249 with the given info (no solve)."""
     import pandas as pd

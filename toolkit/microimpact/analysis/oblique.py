@@ -971,7 +971,7 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
             objective.hold_effective_sigma(best.value)
             best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
         held, fitted = best, objective
-        if u:
+        if u and getattr(contact, _stiffness_field(contact.tangential_model)):
             weight = 1.0 if weighted else max(best.chisqr / max(problem.size - 1, 1), 1e-300)
             fitted = _StiffnessProfile(objective, contact_of, u, weight)
             best = _profile_fit(fitted, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
@@ -1421,7 +1421,12 @@ def _refine_profile(objective, grid, chi2, points):
     grid, chi2 = np.concatenate([grid, found_x]), np.concatenate([chi2, found_c])
     order = np.argsort(grid, kind="stable")
     grid, chi2 = grid[order], chi2[order]
-    near = chi2 <= chi2.min() + 3.0 * 3.84
+    # unweighted, the profile is divided by the reduced chi-square afterwards: the cells within
+    # 3 x 3.84 of the least value in those units (raw, every cell of a fit to 1e-3 scatter was "near",
+    # and the interval's ends were interpolated across 0.06-wide cells: 8 times too narrow)
+    dof = max(objective.problem.size - 1, 1)
+    scale = 1.0 if objective.weighted else max(float(chi2.min()) / dof, 1e-300)
+    near = chi2 <= chi2.min() + 3.0 * 3.84 * scale
     extra = []
     for run in np.split(np.flatnonzero(near), np.flatnonzero(np.diff(np.flatnonzero(near)) > 1) + 1):
         lo, hi = grid[max(run[0] - 1, 0)], grid[min(run[-1] + 1, grid.size - 1)]
@@ -1431,6 +1436,24 @@ def _refine_profile(objective, grid, chi2, points):
     chi2 = np.concatenate([chi2, [objective.deviance(f) for f in extra]])
     order = np.argsort(grid, kind="stable")
     return grid[order], chi2[order]
+
+
+def _threshold_crossings(objective, grid, chi2, dof) -> tuple[np.ndarray, np.ndarray]:
+    """(mu, deviance) where the profile crosses the 95 % threshold, each found by Brent's root
+    search between the two grid points that bracket it (to 1e-6 of mu): the interval's ends exact,
+    not interpolated (a grid of 32 points across cells 0.12 wide put the ends of a 0.01-wide
+    interval where chi-square had risen by 3.3, not 3.84)."""
+    from scipy.optimize import brentq
+
+    from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold
+
+    scale = 1.0 if objective.weighted else max(float(chi2.min()) / dof, 1e-300)
+    level = float(chi2.min()) + chi2_threshold(DEFAULT_LEVEL) * scale
+    above = chi2 > level
+    xs = []
+    for i in np.flatnonzero(above[:-1] != above[1:]):
+        xs.append(brentq(lambda f: objective.deviance(f) - level, grid[i], grid[i + 1], xtol=1e-6 * grid[i + 1]))
+    return np.array(xs), np.array([objective.deviance(x) for x in xs])
 
 
 def _profile_fit(objective: _FrictionObjective, lmfit, deadline, points: int = PROFILE_POINTS,
@@ -1453,6 +1476,10 @@ def _profile_fit(objective: _FrictionObjective, lmfit, deadline, points: int = P
             deadline.check(f"{i} of {grid.size} points of the friction profile")
     if refine:
         grid, chi2 = _refine_profile(objective, grid, chi2, refine)
+    ends = _threshold_crossings(objective, grid, chi2, max(objective.problem.size - 1, 1))
+    grid, chi2 = np.concatenate([grid, ends[0]]), np.concatenate([chi2, ends[1]])
+    order = np.argsort(grid, kind="stable")
+    grid, chi2 = grid[order], chi2[order]
     k = int(np.argmin(chi2))
     a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
     f_best, c_best = float(grid[k]), float(chi2[k])
