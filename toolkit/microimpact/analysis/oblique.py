@@ -676,7 +676,7 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
     ...                         "tangential_restitution_uncertainty": 0.01})
     >>> fit = fit_friction(oblique, damping)
     >>> print(fit.identifiability["friction"].describe())
-    friction = 0.3, 95 % interval [0.2835, 0.3164]
+    friction = 0.3, 95 % interval [0.2831, 0.3169]
 
     At 10-40 deg every impact ends rolling, and the data only bound f from below: no value is given.
     """

@@ -252,7 +252,7 @@ def oblique_section(lay: Layout, obl: xr.Dataset) -> None:
     >>> lay.contents, len(lay.page.figure.axes)
     ([('1. Friction from the oblique columns', 0)], 1)
     >>> print(lay.page.figure.texts[1].get_text().split("interval. ")[1])
-    f = 0.15895, 95 % profile-likelihood interval [0.1442, 0.17363] (standard error 0.00757).
+    f = 0.15895, 95 % profile-likelihood interval [0.14417, 0.17382] (standard error 0.00757).
     >>> lay = Layout("Report")
     >>> oblique_section(lay, xr.Dataset(attrs={"comment": "the impact table has no oblique columns: no friction fit"}))
     >>> lay.contents, lay.page.figure.texts[-1].get_text()
