@@ -1273,7 +1273,7 @@ class _DemFrictionObjective(_FrictionObjective):
 
 
 #: the measured calibration of mu's interval with the stiffness profiled (the report states it)
-STIFFNESS_COVERAGE = "its coverage over random designs is not measured yet"
+STIFFNESS_COVERAGE = "with u = 0.1 this interval covered the true mu in 6 of 7 random designs (too few to call it calibrated)"
 
 #: the held stiffness's standardised error z = (k / k_given - 1) / u over which
 #: :class:`_StiffnessProfile` profiles it: a prior penalty of 16 at the ends, four times the 95 %
