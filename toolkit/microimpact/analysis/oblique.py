@@ -972,7 +972,7 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
             best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
         held, fitted = best, objective
         if u and getattr(contact, _stiffness_field(contact.tangential_model)):
-            weight = 1.0 if weighted else max(best.chisqr / max(problem.size - 1, 1), 1e-300)
+            weight = _profile_scale(objective, best.chisqr, max(problem.size - 1, 1))
             fitted = _StiffnessProfile(objective, contact_of, u, weight)
             best = _profile_fit(fitted, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
         shift, gradient, sensitivity = None, {}, {}
@@ -1089,6 +1089,20 @@ def _stiffness_uncertainty(uncertainty) -> float | None:
     return u or None
 
 
+def _scaled_stiffness(contact_of, name: str, factor: float):
+    """radius -> ``contact_of(radius)`` with its stiffness field ``name`` times ``factor``."""
+    def contact(r):
+        c = contact_of(r)
+        return c.with_(**{name: factor * getattr(c, name)})
+    return contact
+
+
+def _profile_scale(objective, least: float, dof: int) -> float:
+    """What a profile's deviance is divided by: 1 with stated uncertainties; unweighted, the reduced
+    chi-square at its least value (the scatter estimates sigma)."""
+    return 1.0 if objective.weighted else max(least / dof, 1e-300)
+
+
 def _stiffness_sensitivity(objective, contact_of, best, deadline) -> dict:
     """The held tangential stiffness's field and value, and mu refitted with it
     :data:`STIFFNESS_STEP` lower and higher (``friction_low``, ``friction_high``); {} where the law
@@ -1099,10 +1113,8 @@ def _stiffness_sensitivity(objective, contact_of, best, deadline) -> dict:
     if not value:
         return {}
 
-    def scaled(factor):
-        return lambda r: contact_of(r).with_(**{name: factor * getattr(contact_of(r), name)})
-
-    refits = _refits(objective, [scaled(1.0 - STIFFNESS_STEP), scaled(1.0 + STIFFNESS_STEP)], best, deadline,
+    refits = _refits(objective, [_scaled_stiffness(contact_of, name, 1.0 + s * STIFFNESS_STEP) for s in (-1, 1)],
+                     best, deadline,
                      "the refits of mu at the changed tangential stiffness")
     return {"field": name, "value": float(value), "step": STIFFNESS_STEP,
             "friction_low": float(refits[0]), "friction_high": float(refits[1])}
@@ -1323,9 +1335,8 @@ class _StiffnessProfile:
         """The objective with the stiffness at (1 + u z) times the given one."""
         z = float(z)
         if z not in self._at:
-            factor, name, contact_of = 1.0 + self.uncertainty * z, self.field, self._contact_of
             moved = _DemFrictionObjective(
-                self.problem, lambda r: contact_of(r).with_(**{name: factor * getattr(contact_of(r), name)}),
+                self.problem, _scaled_stiffness(self._contact_of, self.field, 1.0 + self.uncertainty * z),
                 self.weighted, self.rtol, self.advance)
             moved._sigma = self.held._sigma
             self._at[z] = moved
@@ -1425,7 +1436,7 @@ def _refine_profile(objective, grid, chi2, points):
     # 3 x 3.84 of the least value in those units (raw, every cell of a fit to 1e-3 scatter was "near",
     # and the interval's ends were interpolated across 0.06-wide cells: 8 times too narrow)
     dof = max(objective.problem.size - 1, 1)
-    scale = 1.0 if objective.weighted else max(float(chi2.min()) / dof, 1e-300)
+    scale = _profile_scale(objective, float(chi2.min()), dof)
     near = chi2 <= chi2.min() + 3.0 * 3.84 * scale
     extra = []
     for run in np.split(np.flatnonzero(near), np.flatnonzero(np.diff(np.flatnonzero(near)) > 1) + 1):
@@ -1447,7 +1458,7 @@ def _threshold_crossings(objective, grid, chi2, dof) -> tuple[np.ndarray, np.nda
 
     from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold
 
-    scale = 1.0 if objective.weighted else max(float(chi2.min()) / dof, 1e-300)
+    scale = _profile_scale(objective, float(chi2.min()), dof)
     level = float(chi2.min()) + chi2_threshold(DEFAULT_LEVEL) * scale
     above = chi2 > level
     xs = []
@@ -1501,7 +1512,7 @@ def _profile_fit(objective: _FrictionObjective, lmfit, deadline, points: int = P
     stderr = float(out.params["friction"].stderr) if out.params["friction"].stderr is not None else math.nan
     chisqr = objective.chi2(f_best)
     dof = max(objective.problem.size - 1, 1)
-    scale = 1.0 if objective.weighted else max(chisqr / dof, 1e-300)  # unweighted: scatter estimates sigma
+    scale = _profile_scale(objective, chisqr, dof)
     grid = np.append(grid, f_best)
     chi2 = np.append(chi2, c_best)
     order = np.argsort(grid, kind="stable")
