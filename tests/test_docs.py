@@ -77,6 +77,9 @@ HOW = {
     "python -m microimpact.studies.calibration --designs 12 --seed 7 --out calibration.json --figure calibration.png": "ci",
     # README.md: one-line mutations of the physics (the CI runs the first 8, without the baseline run)
     "python tests/mutation_check.py --out docs/mutations.json": "study",
+    # README.md: a cold and a warm pipeline, the compile time of each kernel group (CI: smaller forms)
+    "python tests/study_cold_warm.py --pairs 2 --out docs/cold-warm.json": "study",
+    "python tests/study_compile_times.py --repeats 2 --out docs/compile-times.json": "study",
     "microimpact benchmark --quick --out results/benchmark": "ci",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "ci",
     # README.md: the sweep under another contact law (10-120 s per law)
@@ -168,8 +171,20 @@ def test_commands_left_to_a_named_test_are_in_that_test(command):
         assert word in strings, f"{path}::{name} does not run {command!r} ({word!r} missing)"
 
 
+#: studies whose smaller form in .ci/run is not the same script but the CI step named here
+STUDY_IN_CI_AS = {
+    # a cold and a warm pipeline, compared bit for bit: the cold first pipeline run of CI against
+    # its warm SLURM run (.ci/compare_runs.py, tolerance 0); the time ratio needs an idle machine
+    "python tests/study_cold_warm.py --pairs 2 --out docs/cold-warm.json":
+        'NUMBA_CACHE_DIR="$WORK/cold_cache" snakemake --cores 2',
+}
+
+
 @pytest.mark.parametrize("command", [c for c, how in HOW.items() if how == "study"])
 def test_ci_runs_a_smaller_form_of_each_study(command):
+    if command in STUDY_IN_CI_AS:
+        assert STUDY_IN_CI_AS[command] in CI, f".ci/run does not run {STUDY_IN_CI_AS[command]!r} for {command!r}"
+        return
     if command.startswith("pytest "):  # the slow tests: CI runs a selection of them (-k)
         assert f"{command} -k " in CI, f".ci/run does not run a selection of {command!r}"
         return
