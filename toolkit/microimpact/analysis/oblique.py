@@ -1285,7 +1285,8 @@ class _DemFrictionObjective(_FrictionObjective):
 
 
 #: the measured calibration of mu's interval with the stiffness profiled (the report states it)
-STIFFNESS_COVERAGE = "with u = 0.1 this interval covered the true mu in 6 of 7 random designs (too few to call it calibrated)"
+STIFFNESS_COVERAGE = ("with u = 0.1 this interval covered the true mu in 16 of 18 random designs (0.89; consistent with "
+                      "95 %, binomial p = 0.23; both misses excluded by the noise even at the true stiffness)")
 
 #: the held stiffness's standardised error z = (k / k_given - 1) / u over which
 #: :class:`_StiffnessProfile` profiles it: a prior penalty of 16 at the ends, four times the 95 %
