@@ -73,3 +73,48 @@ def test_an_edit_of_the_law_is_never_answered_from_a_stale_cache(tmp_path):
     assert not np.array_equal(before, after), "the edited law was answered from the old cache"
     dirs = sorted(p.name for p in cache.iterdir())
     assert len(dirs) == 2 and all(d.startswith("microimpact-") for d in dirs), dirs
+
+
+THREADS_SCRIPT = """
+import sys
+import numpy as np
+import microimpact as mi
+from microimpact.presets import WALL_1990 as C
+from microimpact.solvers import coupled, engine, family, normal_models, rkg
+v = np.geomspace(0.5, 50.0, 200)
+parts = [mi.simulate_many(C, speed=v, incidence_deg=30.0, omega=(0.0, 0.0, 1e5), family=False),
+         mi.simulate_many(C, speed=v, incidence_deg=30.0, family=True),
+         mi.simulate_many(C.with_(normal_model="jkr"), speed=v, family=False),
+         mi.simulate_many(C.with_(tangential_model="mindlin", shear_modulus=1e10), speed=v[::10], incidence_deg=40.0)]
+values = [np.nan_to_num(ds[k].values.ravel()) for ds in parts for k in ("e_n", "mu_t", "K_L")]
+values.append(rkg.rkg_restitution(C, v[::20], 200)["e_n"])
+np.save(sys.argv[1], np.concatenate(values))
+kernels = [engine._integrate_many, normal_models._integrate_many, coupled.coupled_many, rkg._rkg_many,
+           family._evaluate, family._impacts_kernel, family.normal_speed_range]
+print(" ".join(f"{k.__module__}.{k.__name__}:{k._parallel is not None}:{k._serial is not None}" for k in kernels))
+"""
+
+
+@pytest.mark.slow
+def test_one_thread_compiles_no_parallel_kernel_and_gives_the_numbers_of_two(tmp_path):
+    """A process on one thread (every pipeline rule) runs the plain-loop version of each batch
+    kernel and never compiles the parallel one (microimpact._numba.njit_batch); the impacts of a
+    batch are independent, so two threads give the same numbers bit for bit."""
+    runs = {}
+    for threads in (1, 2):
+        env = dict(os.environ, PYTHONPATH=str(REPO / "toolkit"), NUMBA_CACHE_DIR=str(tmp_path / f"cache{threads}"),
+                   NUMBA_NUM_THREADS=str(threads))
+        done = subprocess.run([sys.executable, "-c", THREADS_SCRIPT, str(tmp_path / f"{threads}.npy")], check=True,
+                              env=env, timeout=900, capture_output=True, text=True)
+        runs[threads] = (np.load(tmp_path / f"{threads}.npy"), dict(
+            (name, (par == "True", ser == "True")) for name, par, ser in
+            (item.split(":") for item in done.stdout.split())))
+    one, two = runs[1][0], runs[2][0]
+    assert one.size > 1000
+    assert np.array_equal(one, two), f"{np.sum(one != two)} of {one.size} values differ"
+    # (parallel compiled, serial compiled) per kernel; family._evaluate is not on these paths
+    used = {k for k, v in runs[1][1].items() if any(v)}
+    assert used == {k for k, v in runs[2][1].items() if any(v)}
+    assert len(used) == 6, runs[1][1]
+    assert all(runs[1][1][k] == (False, True) for k in used), runs[1][1]
+    assert all(runs[2][1][k] == (True, False) for k in used), runs[2][1]

@@ -24,12 +24,13 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import types
 from pathlib import Path
 
 import numba
 from numba.core import config
 
-__all__ = ["njit", "cache_directory", "source_hash"]
+__all__ = ["njit", "njit_batch", "cache_directory", "source_hash"]
 
 _PACKAGE = Path(__file__).resolve().parent
 #: the sources whose compiled code is cached: a change to any of them invalidates every kernel
@@ -108,3 +109,67 @@ def _decorate(func, args, **kwargs):
         return numba.njit(*args, **kwargs)(func)
     finally:
         config.CACHE_DIR = previous
+
+
+def njit_batch(func, *, cache: bool = True):
+    """A loop over a batch (``for i in numba.prange(n)``), compiled for threads only when threads run it.
+
+    Returns a callable that runs ``func`` compiled with ``parallel=True`` when numba has more than
+    one thread (:func:`numba.get_num_threads`), and compiled as a plain loop otherwise. Both
+    versions are compiled, and cached, on first use only: a process on one thread (every rule of
+    the pipeline, the fits and the sampler) never compiles the parallel one, whose parfor passes
+    are its costliest part. The impacts of a batch are independent, so both give the same numbers,
+    bit for bit. ``cache`` as for :func:`numba.njit` (True for the package's kernels).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from numba import prange
+    >>> def squares(x, out):
+    ...     for i in prange(x.shape[0]):
+    ...         out[i] = x[i] * x[i]
+    >>> kernel = njit_batch(squares, cache=False)  # a doctest has no file to cache beside
+    >>> out = np.empty(3)
+    >>> kernel(np.arange(3.0), out)
+    >>> out.tolist()
+    [0.0, 1.0, 4.0]
+    """
+    return _BatchKernel(func, cache)
+
+
+class _BatchKernel:
+    """The two compiled versions of a batch loop (:func:`njit_batch`), each made on first use."""
+
+    def __init__(self, func, cache):
+        functools.update_wrapper(self, func)
+        self.py_func = func
+        self._caching = cache
+        self._parallel = None
+        self._serial = None
+
+    @property
+    def parallel(self):
+        """The version compiled with ``parallel=True`` (prange over numba's threads)."""
+        if self._parallel is None:
+            self._parallel = _decorate(self.py_func, (), cache=self._caching, parallel=True)
+        return self._parallel
+
+    @property
+    def serial(self):
+        """The version compiled as a plain loop.
+
+        numba's cache files are named after the function's qualified name and first line, not
+        its compile options, so the serial version compiles a copy of the function under a name
+        of its own: otherwise the two versions would overwrite each other's cache entries."""
+        if self._serial is None:
+            func = self.py_func
+            copy = types.FunctionType(func.__code__, func.__globals__, func.__name__ + "_serial",
+                                      func.__defaults__, func.__closure__)
+            copy.__qualname__ = func.__qualname__ + "_serial"
+            copy.__module__ = func.__module__
+            self._serial = _decorate(copy, (), cache=self._caching)
+        return self._serial
+
+    def __call__(self, *args):
+        kernel = self.parallel if numba.get_num_threads() > 1 else self.serial
+        return kernel(*args)

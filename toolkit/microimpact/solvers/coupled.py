@@ -88,7 +88,7 @@ import warnings
 import numpy as np
 from numba import prange
 
-from microimpact._numba import njit
+from microimpact._numba import njit, njit_batch
 from microimpact.model import law as _law
 from microimpact.model import tangential_compliance as _tc
 from microimpact.model.kinematics import flat_broadcast
@@ -743,7 +743,7 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     return status, outcome, z, smax * smax, tau_cap, tau_j, n, n_turn, n_held_stops
 
 
-@njit(cache=True, parallel=True)
+@njit_batch
 def coupled_many(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max_steps, out_state, out_info):
     """:func:`coupled_kernel` for many impacts in parallel; p has one row per impact.
 

@@ -65,7 +65,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import prange, set_num_threads
 
-from microimpact._numba import njit
+from microimpact._numba import njit, njit_batch
 from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL, ModelDomainError, SolverError
 from microimpact.model.law import Scales, hertz_impact_scales, nondimensional_impact, nondimensional_scales  # nondimensional_scales: re-exported
@@ -237,6 +237,12 @@ class EngineError(SolverError):
 
 
 # --------------------------------------------------------------------------- compiled core
+# The helpers called at every step (the right-hand side, the law, the stepper's error norm and step
+# control in .dopri) are inlined by numba (``inline="always"``): as plain calls the engine ran 12-18 %
+# slower. Those called once per impact or only in rare regimes (the set-up, the inertia-free limit
+# and its tests, the undamped mirror) are compiled as calls, which LLVM may still inline: numba's
+# inlining copies and re-types a helper at every call site, which cost 3-4 s of _integrate's compile
+# and gained no speed (README, "Compiled kernels").
 @njit(cache=True, inline="always")
 def _derivatives(s, y, c1, c2, ah, aa, sgn):
     """d/dsigma of the state (s, y, tau, D, J_a) at (s, y) (see the module docstring)."""
@@ -368,13 +374,13 @@ RELAXATION_ENTER = 1e3
 RELAXATION_RESUME = 1e2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _slow_speed(xi, c1, c2, ah, aa):
     """Inertia-free speed y_m(xi) = (a_a - a_h xi) / (a_h C1 xi + a_a C2): xi'' = 0 in Eq. (27)."""
     return (aa - ah * xi) / (ah * c1 * xi + aa * c2)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _inertia_ratio(xi, c1, c2, ah, aa):
     """|xi''| / |static force| on the inertia-free path at xi, |y_m'| / (sqrt(xi) (a_h C1 xi + a_a C2)).
 
@@ -383,7 +389,7 @@ def _inertia_ratio(xi, c1, c2, ah, aa):
     return ah * aa * (c1 + c2) / (math.sqrt(xi) * d * d * d)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _relaxation_ratio(xi, c1, c2, ah, aa):
     """Damping rate times transit time on the slow manifold, sqrt(xi) d xi / |y_m|, d = a_h C1 xi +
     a_a C2 (inf at the equilibrium, where y_m = 0)."""
@@ -394,14 +400,14 @@ def _relaxation_ratio(xi, c1, c2, ah, aa):
     return math.sqrt(xi) * d * d * xi / num
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _follows(x, c1, c2, ah, aa):
     """Whether the slow manifold at x is still followed adiabatically (both resume bounds hold)."""
     return (_inertia_ratio(x, c1, c2, ah, aa) <= INERTIA_FREE_RESUME
             and _relaxation_ratio(x, c1, c2, ah, aa) >= RELAXATION_RESUME)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _slow_time(xi0, xi1, c1, c2, ah, aa):
     """tau from xi0 to xi1 along the inertia-free path: int dxi / y_m, in closed form."""
     t = -c1 * (xi1 - xi0)
@@ -410,7 +416,7 @@ def _slow_time(xi0, xi1, c1, c2, ah, aa):
     return t
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _slow_path(x, c1, c2, ah, aa):
     """y on the slow manifold to first order in the inertia ratio: y_m - y_m' y_m / damping, with
     damping = sqrt(xi) (a_h C1 xi + a_a C2) (from xi'' = damping (y_m - y) and xi'' ~ y_m' y_m)."""
@@ -441,7 +447,7 @@ def _slow_twist(xi0, xi1, c1, c2, ah, aa):
     return 0.5 * width * total
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _inertia_free(u, atol_y, c1, c2, ah, aa, xe):
     """Whether the motion follows the inertia-free (overdamped) path: returns (yes, target xi).
 
@@ -597,7 +603,7 @@ def _averaged_tail(e_now, c1, c2, ah, aa, xe):
 
 
 # ------------------------------------------------------------------ pieces of one impact
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _first_sign(y0, c1, c2, ah, aa):
     """Sign of dy/dsigma at first contact, from its leading term in s (xi''/s at s = 0; without
     adhesion, or if that vanishes, the Hertz term decides)."""
@@ -607,7 +613,7 @@ def _first_sign(y0, c1, c2, ah, aa):
     return 1.0 if lead > 0.0 else -1.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _absolute_tolerances(y0, rtol):
     """Absolute tolerances of the states (s, y, tau, D, J_a), scaled with their sizes in an impact."""
     yref = max(1.0, y0)
@@ -621,7 +627,7 @@ def _absolute_tolerances(y0, rtol):
     return atol
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _equilibrium(c1, c2, ah, aa):
     """(xi_e, omega0, C_eq): equilibrium penetration, sqrt(V''(xi_e)) and the damping coefficient
     there, for the tail bound of a captured sphere (xi_e = 0 without adhesion)."""
@@ -635,7 +641,7 @@ def _equilibrium(c1, c2, ah, aa):
     return xe, omega0, ceq
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _initial_step(y0):
     h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
     if y0 < 1.0:
@@ -643,7 +649,7 @@ def _initial_step(y0):
     return h
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _mirror_undamped(u, u1, k1, hev, J, j_target, tau_jtarget, y0, c1, c2, ah, aa, sgn, k, tmp, err):
     """At the turning point of an undamped impact, complete it by symmetry; returns (J, tau_jtarget).
 
@@ -978,7 +984,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
             n_steps, n_rej, n_rec)
 
 
-@njit(cache=True, parallel=True)
+@njit_batch
 def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_stop, ja_stop, out):
     dummy = np.zeros((1, 3))
     for i in prange(y0.shape[0]):

@@ -55,7 +55,7 @@ import numba
 import numpy as np
 from numba import prange
 
-from microimpact._numba import njit
+from microimpact._numba import njit, njit_batch
 from microimpact.model.coefficients import coefficients_kernel
 from microimpact.model.tangential import tangential_kernel
 from microimpact.solvers import DEFAULT_RTOL, engine
@@ -150,7 +150,7 @@ def _clenshaw6(c, t):
             t * a3 - b3 + c[3, 0], t * a4 - b4 + c[4, 0], t * a5 - b5 + c[5, 0])
 
 
-@njit(cache=True, parallel=True)
+@njit_batch
 def _evaluate(x, piece, left, right, coefficients, out):
     for i in prange(x.shape[0]):
         p = piece[i]
@@ -167,7 +167,7 @@ BATCH_VARIABLES = ("outcome", "e_n", "mu_t", "mu_tp", "K_L", "K_t", "velocity_ou
                    "max_penetration", "slip_ended", "friction_impulse", "dissipated_energy")
 
 
-@njit(cache=True, parallel=True)
+@njit_batch
 def normal_speed_range(speed, incidence_deg):
     """(smallest, largest) incident normal speed v cos(incidence) of a batch [m/s, deg] in one
     pass, without the batch-sized temporaries of the numpy expression."""
@@ -190,7 +190,7 @@ def _piece_of(edges, x):
     return lo
 
 
-@njit(cache=True, parallel=True)
+@njit_batch
 def _impacts_kernel(speed, incidence_deg, azimuth_deg, w_n, w_t, w_tp, friction, edges, captured, direct,
                     coefficients, mass, inertia, radius, settled_energy, out, solve_directly):
     """Whole impacts from the family in one compiled pass: incident kinematics, the interpolated

@@ -67,7 +67,7 @@ import math
 import numpy as np
 from numba import prange
 
-from microimpact._numba import njit
+from microimpact._numba import njit, njit_batch
 from microimpact.model import adhesion_models as am
 from microimpact.model import dem_damping as dd
 from microimpact.model.contact import check_positive
@@ -640,7 +640,7 @@ def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j
             float(n_acc), float(n_rej))
 
 
-@njit(cache=True, parallel=True)
+@njit_batch
 def _integrate_many(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_stop, ja_stop, max_steps, out):
     """:func:`_integrate` over arrays of speeds on all cores; row i of out holds impact i."""
     for i in prange(y0.size):

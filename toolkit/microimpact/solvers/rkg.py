@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import prange
 
-from microimpact._numba import njit
+from microimpact._numba import njit, njit_batch
 from microimpact.model.contact import check_positive
 from microimpact.model.law import nondimensional_impact
 from microimpact.solvers import compiled_law as law
@@ -126,7 +126,7 @@ def _rkg_impact(y0, c1, c2, ah, aa, h, max_steps, j_target):
     return math.nan, math.nan, max_steps, -1, jn, ja, xi_max, tau_j, math.nan
 
 
-@njit(cache=True, parallel=True)
+@njit_batch
 def _rkg_many(y0, c1, c2, ah, aa, h, max_steps, out):
     for i in prange(y0.shape[0]):
         y_out, tau, n, outcome, jn, ja, xi_max, tau_j, e_end = _rkg_impact(
