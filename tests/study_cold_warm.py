@@ -65,6 +65,16 @@ def _pipeline(root: Path, cache: Path) -> float:
     return seconds
 
 
+def _rule_seconds(root: Path) -> dict:
+    """Wall time of every job of a run, from Snakemake's ``benchmark:`` files [s]: where a cold
+    run's extra time goes (the critical path of fit, flags, figures and report, or the other core)."""
+    seconds = {}
+    for path in sorted((root / "benchmarks").rglob("*.tsv")):
+        last = path.read_text().strip().splitlines()[-1]
+        seconds[path.relative_to(root / "benchmarks").with_suffix("").as_posix()] = float(last.split("\t")[0])
+    return seconds
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--pairs", type=int, default=2, help="cold/warm pairs (default 2)")
@@ -82,9 +92,11 @@ def main(argv=None) -> int:
             warm = _pipeline(_copy(Path(tmp) / f"warm{i}"), cache)
             compare.LARGEST[0] = 0.0
             problems, files, values = compare.compare(Path(tmp) / f"cold{i}" / "results", Path(tmp) / f"warm{i}" / "results")
+            jobs_cold, jobs_warm = (_rule_seconds(Path(tmp) / f"{kind}{i}") for kind in ("cold", "warm"))
             pairs.append({"cold_seconds": round(cold, 2), "warm_seconds": round(warm, 2), "ratio": round(cold / warm, 3),
                           "files_compared": files, "values_compared": values,
-                          "largest_relative_difference": compare.LARGEST[0], "differences": problems[:20]})
+                          "largest_relative_difference": compare.LARGEST[0], "differences": problems[:20],
+                          "job_seconds_cold_warm": {k: [jobs_cold[k], jobs_warm.get(k)] for k in jobs_cold}})
             print(f"pair {i}: cold {cold:.1f} s, warm {warm:.1f} s, ratio {cold / warm:.3f}; "
                   f"{values} values in {files} files, {len(problems)} differ")
     ratio = statistics.median(p["ratio"] for p in pairs)

@@ -58,9 +58,11 @@ print(time.perf_counter() - start)
 """
 
 
-def _seconds(call: str, cache: Path, toolkit: Path) -> float:
+def _seconds(call: str, cache: Path, toolkit: Path, threads: int | None) -> float:
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(toolkit), PYTHONWARNINGS="ignore")
     env.pop("NUMBA_DISABLE_JIT", None)
+    if threads is not None:
+        env["NUMBA_NUM_THREADS"] = str(threads)
     done = subprocess.run([sys.executable, "-c", SCRIPT.format(call=call)], env=env, capture_output=True, text=True)
     if done.returncode:
         sys.exit(f"study_compile_times: {call} failed:\n{done.stderr[-2000:]}")
@@ -72,8 +74,12 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=1, help="cold/warm pairs per group (default 1)")
     parser.add_argument("--only", type=int, help="the first N groups only")
     parser.add_argument("--toolkit", type=Path, default=REPO / "toolkit", help="the directory holding the package")
+    parser.add_argument("--threads", type=int, help="numba threads of each call (default: numba's, all cores); "
+                        "1 as in every pipeline rule")
     parser.add_argument("--out", type=Path, help="write the table as JSON here")
     args = parser.parse_args(argv)
+    if args.threads is not None and args.threads < 1:
+        parser.error(f"--threads must be at least 1, got {args.threads}")
     if args.repeats < 1:
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
     if args.only is not None and not 1 <= args.only <= len(GROUPS):
@@ -85,15 +91,16 @@ def main(argv=None) -> int:
             cold, warm = [], []
             for r in range(args.repeats):
                 cache = Path(tmp) / f"cache{i}_{r}"
-                cold.append(_seconds(call, cache, args.toolkit.resolve()))
-                warm.append(_seconds(call, cache, args.toolkit.resolve()))
+                cold.append(_seconds(call, cache, args.toolkit.resolve(), args.threads))
+                warm.append(_seconds(call, cache, args.toolkit.resolve(), args.threads))
             c, w = statistics.median(cold), statistics.median(warm)
             rows[name] = {"call": call, "cold_seconds": round(c, 3), "warm_seconds": round(w, 4),
                           "compile_seconds": round(c - w, 3)}
             print(f"{name:48s} {c:9.2f} {w:9.3f} {c - w:11.2f}", flush=True)
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(json.dumps({"groups": rows, "repeats": args.repeats, "machine_cpus": os.cpu_count()},
+        args.out.write_text(json.dumps({"groups": rows, "repeats": args.repeats, "threads": args.threads,
+                                        "machine_cpus": os.cpu_count()},
                                        indent=1) + "\n")
     return 0
 

@@ -78,7 +78,7 @@ HOW = {
     # README.md: one-line mutations of the physics (the CI runs the first 8, without the baseline run)
     "python tests/mutation_check.py --out docs/mutations.json": "study",
     # README.md: a cold and a warm pipeline, the compile time of each kernel group (CI: smaller forms)
-    "python tests/study_cold_warm.py --pairs 2 --out docs/cold-warm.json": "study",
+    "python tests/study_cold_warm.py --pairs 3 --out docs/cold-warm.json": "study",
     "python tests/study_compile_times.py --repeats 2 --out docs/compile-times.json": "study",
     "microimpact benchmark --quick --out results/benchmark": "ci",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "ci",
@@ -175,7 +175,7 @@ def test_commands_left_to_a_named_test_are_in_that_test(command):
 STUDY_IN_CI_AS = {
     # a cold and a warm pipeline, compared bit for bit: the cold first pipeline run of CI against
     # its warm SLURM run (.ci/compare_runs.py, tolerance 0); the time ratio needs an idle machine
-    "python tests/study_cold_warm.py --pairs 2 --out docs/cold-warm.json":
+    "python tests/study_cold_warm.py --pairs 3 --out docs/cold-warm.json":
         'NUMBA_CACHE_DIR="$WORK/cold_cache" snakemake --cores 2',
 }
 
