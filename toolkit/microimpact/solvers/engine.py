@@ -242,8 +242,7 @@ class EngineError(SolverError):
 # slower. Those called once per impact or only in rare regimes (the set-up, the inertia-free limit
 # and its tests, the undamped mirror) are compiled as calls, which LLVM may still inline: numba's
 # inlining copies and re-types a helper at every call site, which cost 3-4 s of _integrate's compile
-# and gained no speed (README, "Compiled kernels"). The right-hand side is inlined into the step but
-# called, as _rhs_at_event, at the loop's few evaluations outside it.
+# and gained no speed (README, "Compiled kernels").
 @njit(cache=True, inline="always")
 def _derivatives(s, y, c1, c2, ah, aa, sgn):
     """d/dsigma of the state (s, y, tau, D, J_a) at (s, y) (see the module docstring)."""
@@ -261,9 +260,6 @@ def _rhs(u, out, args):
 
 #: one Dormand-Prince 5(4) step of the ring law (the core's, :mod:`microimpact.solvers.dopri`)
 _step = dopri.make_step(_rhs, _NSTATE)
-#: _rhs compiled as a call, for the loop's few evaluations outside the step (at the start, after an
-#: event, on leaving the inertia-free limit): inlined there too, it cost compile time, not run time
-_rhs_at_event = njit(cache=True)(_rhs.py_func)
 
 
 @njit(cache=True)
@@ -793,7 +789,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
     k1 = np.zeros(_NSTATE)
     kend = np.zeros(_NSTATE)
     sgn = _first_sign(y0, c1, c2, ah, aa)
-    _rhs_at_event(u, k1, (c1, c2, ah, aa, sgn))
+    _rhs(u, k1, (c1, c2, ah, aa, sgn))
     atol = _absolute_tolerances(y0, rtol)
     noise = 10.0 * (atol[0] + atol[1])
     damped = c1 > 0.0 or (c2 > 0.0 and aa > 0.0)  # adhesion damping needs adhesion
@@ -902,7 +898,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
         if code == 2 or code == 0:
             if code == 2:
                 sgn = -sgn
-            _rhs_at_event(u, kend, (c1, c2, ah, aa, sgn))
+            _rhs(u, kend, (c1, c2, ah, aa, sgn))
             for i in range(_NSTATE):
                 k1[i] = kend[i]
         else:
@@ -967,7 +963,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 g = law.nondimensional_acceleration(s2, s2 * s2, u[1], c1, c2, ah, aa)
                 if g != 0.0:
                     sgn = 1.0 if g > 0.0 else -1.0
-                _rhs_at_event(u, kend, (c1, c2, ah, aa, sgn))
+                _rhs(u, kend, (c1, c2, ah, aa, sgn))
                 for i in range(_NSTATE):
                     k1[i] = kend[i]
                 continue
