@@ -238,11 +238,11 @@ class EngineError(SolverError):
 
 # --------------------------------------------------------------------------- compiled core
 # The helpers called at every step (the right-hand side, the law, the stepper's error norm and step
-# control in .dopri) are inlined by numba (``inline="always"``): as plain calls the engine ran 12-18 %
-# slower. Those called once per impact or only in rare regimes (the set-up, the inertia-free limit
-# and its tests, the undamped mirror) are compiled as calls, which LLVM may still inline: numba's
-# inlining copies and re-types a helper at every call site, which cost 3-4 s of _integrate's compile
-# and gained no speed (README, "Compiled kernels").
+# control in .dopri) are inlined by numba (``inline="always"``): with every helper a plain call the
+# engine ran 12-18 % slower. Those called once per impact or only in rare regimes (the set-up, the
+# inertia-free limit and its tests, the undamped mirror) are compiled as calls, which LLVM may still
+# inline: numba's inlining copies and re-types a helper at every call site, which lengthened
+# _integrate's compile and gained no speed (README, "Compiled kernels").
 @njit(cache=True, inline="always")
 def _derivatives(s, y, c1, c2, ah, aa, sgn):
     """d/dsigma of the state (s, y, tau, D, J_a) at (s, y) (see the module docstring)."""
