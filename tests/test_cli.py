@@ -145,6 +145,26 @@ def test_benchmark_stops_at_its_time_budget_and_writes_nothing(tmp_path, capsys)
     assert not out.exists() or not any(out.iterdir())
 
 
+def test_a_budget_spent_inside_a_numba_compile_still_ends_in_its_own_line(tmp_path, monkeypatch, capsys):
+    """numba re-raises an exception from inside a compile pass as the same type with the pass on a
+    line before the message (seen in CI: "Failed in nopython mode pipeline (step: parfor
+    prelowering)"); the command must still end with the budget's one line and status 3."""
+    from microimpact.solvers import TimeBudgetExceeded
+    from microimpact.studies import benchmark
+
+    def compiling_when_the_budget_ran_out(**kwargs):
+        raise TimeBudgetExceeded("Failed in nopython mode pipeline (step: parfor prelowering)\n"
+                                 "benchmark: time budget of 3 s exceeded")
+
+    monkeypatch.setattr(benchmark, "run_benchmark", compiling_when_the_budget_ran_out)
+    out = tmp_path / "bench"
+    assert cli.main(["benchmark", "--quick", "--time-budget", "3", "--out", str(out)]) == 3
+    err = capsys.readouterr().err
+    assert err == ("microimpact: error: benchmark: time budget of 3 s exceeded; give a larger --time-budget, "
+                   "or none for no limit\n"), err
+    assert not out.exists() or not any(out.iterdir())
+
+
 #: one impact of each solver family that `simulate` runs interpreted: ring law rebound and capture,
 #: the hysteretic tangential law (coupled solver), JKR oblique, LAMMPS's Mindlin law
 INTERPRETED_CASES = [
