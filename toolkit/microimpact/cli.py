@@ -1322,10 +1322,7 @@ def _main(argv, written) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit
         return EXIT_BROKEN_PIPE
     except TimeBudgetExceeded as exc:  # a RuntimeError, but not a failure: its own status
-        # a budget that ran out while numba compiled comes back re-raised by numba with its compile
-        # pass on a line before the budget's own one-line message: print that line only
-        message = (str(exc).splitlines() or [""])[-1]
-        print(f"microimpact: error: {message}; give a larger --time-budget, or none for no limit", file=sys.stderr)
+        print(f"microimpact: error: {exc}; give a larger --time-budget, or none for no limit", file=sys.stderr)
         return EXIT_TIME_BUDGET
     except (UsageError, ValueError, RuntimeError) as exc:  # RuntimeError: solver failures
         print(f"microimpact: error: {exc}", file=sys.stderr)

@@ -76,7 +76,21 @@ class TimeBudgetExceeded(RuntimeError):
     """A computation ran past the time budget [s] its caller gave it (``time_budget=`` of
     :func:`microimpact.solvers.reference.simulate_reference`, the fits, the posterior, the flags,
     the sweeps and the reproduction table; ``case_time_limit`` of the stress sweep). The message
-    says which computation, the budget and how far it got. No partial result is returned."""
+    says which computation, the budget and how far it got. No partial result is returned.
+
+    The message is one line. A budget that runs out while numba compiles comes back re-raised by
+    numba as the same type with its compile pass on a line before the message; ``str()`` gives the
+    budget's own line only, so every caller that prints it prints one line.
+
+    Examples
+    --------
+    >>> str(TimeBudgetExceeded("Failed in nopython mode pipeline (step: parfor prelowering)\\n"
+    ...                        "benchmark: time budget of 3 s exceeded"))
+    'benchmark: time budget of 3 s exceeded'
+    """
+
+    def __str__(self) -> str:
+        return (super().__str__().splitlines() or [""])[-1]
 
 
 def check_time_budget(time_budget, name: str = "time_budget") -> float | None:
