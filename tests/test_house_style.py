@@ -137,7 +137,6 @@ def test_the_readme_holds_no_measurements_dates_or_history():
     assert not found, f"README.md: {found} (measurements: docs/studies.md and the JSON files; history: git)"
 
 
-@pytest.mark.xfail(strict=True, reason="the scrub of the docstrings follows in the next commit")
 def test_no_docstring_holds_measurements_dates_or_history():
     modules = sorted(PACKAGE.rglob("*.py"))
     assert len(modules) > 20
