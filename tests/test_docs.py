@@ -265,8 +265,8 @@ def test_documented_snakemake_command_dry_run(scratch, command):
 
 @pytest.mark.slow
 def test_python_examples_run(tmp_path):
-    """The ``python`` blocks of README.md and data/README.md; the data/README.md snippet reads the
-    example CSV of the same document (saved as the my_impacts.csv it names)."""
+    """The ``python`` blocks of README.md, data/README.md and the docs pages; the data/README.md
+    snippet reads the example CSV of the same document (saved as the my_impacts.csv it names)."""
     data_readme = (REPO / "data" / "README.md").read_text()
     (csv_example,) = re.findall(r"^```csv\n(.*?)^```", data_readme, flags=re.M | re.S)
     (tmp_path / "my_impacts.csv").write_text(csv_example)
