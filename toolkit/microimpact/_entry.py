@@ -2,7 +2,7 @@
 
 What only a process of its own may do lives here, not in :mod:`microimpact.cli`, which a test or
 a program imports and calls: install signal handlers. A Ctrl-C while the command imports numpy
-(0.1-0.5 s, longer on a loaded machine) ends in the same one line as one during the work, not in a
+ends in the same one line as one during the work, not in a
 traceback from inside numpy; and a signal that lands in a finaliser still stops the command
 (:func:`microimpact.io.joblog.redeliver_swallowed_signals`). Where SIGINT is ignored (a
 background job) it stays ignored. After the one line of a Ctrl-C the process ends at once
@@ -59,9 +59,9 @@ def _too_slow(signum, frame):
 def _interpreted(argv) -> bool:
     """Whether this process solves ``simulate``'s impact interpreted.
 
-    One impact takes milliseconds compiled but numba compiles the solvers first (15-20 s after an
-    install on 2 cores) or loads them from its cache (1-2 s); the same Python code run by the
-    interpreter takes 0.1-1 s for an impact of ordinary difficulty, and its numbers are the compiled
+    Compiled, one impact is quick, but numba compiles the solvers first (after an install) or loads
+    them from its cache, which takes far longer than the impact; the same Python code run by the
+    interpreter takes less for an impact of ordinary difficulty, and its numbers are the compiled
     code's, bit for bit, since no kernel uses fastmath (tests/test_cli.py compares them). An
     impact that needs more than :data:`INTERPRETED_SECONDS` (millions of steps) is started again
     compiled, as is one whose interpreted run fails in a way the compiled one might not. Not where
@@ -94,8 +94,7 @@ def _interrupted_while_starting(signum, frame):
 def main() -> int:
     """Run the command line of ``sys.argv``; the exit status."""
     # a crash of compiled code (SIGSEGV, SIGBUS, SIGFPE, SIGABRT) prints where it happened before the
-    # process dies as before: one CI run (2026-11-27, two test workers) saw a fit end in SIGSEGV when
-    # Ctrl-C came 1.5 s in, printing nothing; 80 tries here did not repeat it
+    # process dies as before, instead of nothing (a fit stopped by Ctrl-C has been seen to end so)
     faulthandler.enable()
     starting = signal.getsignal(signal.SIGINT) is signal.default_int_handler
     if starting:
@@ -127,8 +126,8 @@ def main() -> int:
     if status == EXIT_INTERRUPTED:
         # The one line is printed and nothing was written; skip the interpreter's finalisation.
         # A Ctrl-C that stops numba in the middle of a compile leaves llvmlite objects whose
-        # finalisers print "Exception ignored in: ObjectRef.__del__" at exit (CI, 2026-11-27),
-        # a second message after the one line.
+        # finalisers print "Exception ignored in: ObjectRef.__del__" at exit, a second message
+        # after the one line.
         sys.stdout.flush()
         sys.stderr.flush()
         os._exit(status)

@@ -981,9 +981,6 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
     :func:`fit_dem_law`, then mu by :func:`~microimpact.analysis.oblique.fit_dem_friction` at the
     fitted normal law, its uncertainty propagated or not.
 
-    Length: the docstring, and one loop that draws a design, fits it and records the row, each
-    step of which reads the draws before it.
-
     Parameters
     ----------
     trials : int

@@ -2,7 +2,7 @@
 
 Kept apart from the fitting procedure (:mod:`microimpact.analysis.fitting`, which needs lmfit) so that
 everything that only reads a fit -- the fitted material's simulations, the flags, the CLI -- starts
-without importing lmfit (about 1.8 s) or the compiled engine.
+without importing lmfit (slow to import) or the compiled engine.
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ damping forms of Eqs. (14)-(15). Here the fit is done with lmfit and
   w_A through Eq. (7), f0 = (9/(2 pi) K r w_A^2)^(1/3) (a fit per size would fit f0, which is not a
   material property; see notes/model-notes.md section 1);
 * with the model e_n(v_n) from :func:`microimpact.solvers.engine.solve_normal_many`, one call per distinct
-  radius per evaluation (about 1 ms for 25 speeds), so a 100-point fit takes about a second;
+  radius per evaluation;
 * from a coarse global start: chi-square on a log-spaced (zeta_H, zeta_A) grid, then
   Levenberg-Marquardt (``leastsq``) from the best grid point, with bounds zeta >= 0 (w_A > 0).
 
@@ -316,8 +316,6 @@ def fit_damping(
 ) -> DampingFit:
     """Fit zeta_H, zeta_A (and optionally w_A) to measured e_n(v_n), jointly over particle sizes.
 
-    Length: the docstring of an entry point (parameters, notes, an example); the body is short.
-
     Parameters
     ----------
     table : pandas.DataFrame
@@ -347,8 +345,7 @@ def fit_damping(
         Engine threads during the fit (restored afterwards); None keeps the current setting.
         Default 1: a fit makes hundreds of small engine calls (one per radius, ~25 speeds each),
         for which thread start-up and, on a busy machine, waiting for the second thread cost more
-        than the second core gains (measured: 0.6 ms per call on one thread versus up to 40 ms on
-        two threads under load).
+        than the second core gains.
     progress : bool
         A progress bar on stderr (a terminal only; :func:`microimpact.io.progress.progress_bar`):
         the start grid, then each least-squares round.

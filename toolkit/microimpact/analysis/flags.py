@@ -224,8 +224,6 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
                       n_draws: int = 8, explain: bool = True, time_budget: float | None = None) -> xr.Dataset:
     """Spread of the impact coefficients over unmeasured spin and angle error, and flags.
 
-    Length: the docstring (parameters, examples); the body is 36 lines.
-
     Parameters
     ----------
     table : pandas.DataFrame

@@ -186,8 +186,6 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
                       fit_friction: bool = True, curve_incidence_deg=None, contact_models=None) -> xr.Dataset:
     """Compare the model's tangential restitution, rebound spin and rebound angle with Kharaz (2001).
 
-    Length: the docstring (parameters, examples); the body is 46 lines.
-
     Parameters
     ----------
     path : str or os.PathLike, optional

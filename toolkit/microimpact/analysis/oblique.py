@@ -598,8 +598,6 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
                  propagate_damping: bool = True, progress: bool = False, time_budget: float | None = None) -> FrictionFit:
     """Fit the tangential parameters (friction f) to the oblique columns, after the damping fit.
 
-    Length: the docstring of an entry point (parameters, notes, examples); the body is short.
-
     Parameters
     ----------
     table : pandas.DataFrame
@@ -859,8 +857,6 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
     The rest of the contact (normal law, damping, tangential stiffness and damping) is given, e.g.
     by :func:`microimpact.analysis.dem_fit.fit_dem_law` for the normal law and the material's G*.
 
-    Length: the docstring (parameters, notes, example); the body is about 40 lines.
-
     Parameters
     ----------
     table : pandas.DataFrame
@@ -906,7 +902,7 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
     Notes
     -----
     The law has no closed-form map, so every trial mu solves every entry
-    (:func:`microimpact.solvers.dem_tangential.solve_dem_tangential`, ~10 ms each): the profile has
+    (:func:`microimpact.solvers.dem_tangential.solve_dem_tangential`): the profile has
     :data:`DEM_PROFILE_POINTS` log-spaced points over ``PARAMETER_BOUNDS["friction"]``, refined and
     polished as in :func:`fit_friction`; the interval is the profile-likelihood interval. With
     stated speed or angle uncertainties the effective variance is evaluated once, at a first fit

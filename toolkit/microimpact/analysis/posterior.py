@@ -362,8 +362,6 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
                      time_budget: float | None = None, require_convergence: bool = True) -> Posterior:
     """Sample the posterior of the fitted parameters with emcee until it converges (seeded).
 
-    Length: the docstring (parameters, examples); the body is 34 lines.
-
     Parameters
     ----------
     table : pandas.DataFrame or None
@@ -427,7 +425,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     --------
     Six synthetic impacts. A chain whose budget is too small is refused, saying why, rather than
     returned as a result; ``require_convergence=False`` returns it marked as not converged (the
-    default chain, 16 walkers until converged, takes about 20 s here and converges):
+    default chain, 16 walkers until converged, converges):
 
     >>> from microimpact.analysis.fitting import fit_damping
     >>> from microimpact.analysis.synthetic import write_synthetic_impacts

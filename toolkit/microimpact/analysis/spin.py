@@ -122,8 +122,6 @@ def spin_explanation(table, fit, *, posterior=None, friction: float | None = Non
                      progress: bool = False, time_budget: float | None = None) -> xr.Dataset:
     """Posterior flags that explain, and the spin range consistent with each row (module docstring).
 
-    Length: the docstring (parameters, examples); the body is 48 lines.
-
     Parameters
     ----------
     table : pandas.DataFrame

@@ -42,7 +42,7 @@ def deferred_signals(signums=(signal.SIGINT, signal.SIGTERM)) -> Iterator[None]:
 
     A KeyboardInterrupt raised inside netCDF4/xarray's writer is raised while xarray holds its
     file lock, and the writer's own cleanup then waits for that lock for ever (a pipeline job
-    hung 24 minutes after Ctrl-C). The block therefore runs to its end, and a signal that came
+    hung after Ctrl-C). The block therefore runs to its end, and a signal that came
     during it is re-raised afterwards, with the handlers that were in place before. Outside the
     main thread, where Python cannot install handlers, the block runs unchanged.
 
@@ -261,7 +261,7 @@ def recorded_outputs():
 def _commit(moves) -> None:
     """Move finished temporary files into place, with SIGINT and SIGTERM held until all are moved:
     a signal between two moves would leave the first output written and the second's temporary
-    file behind (CI, 2026-11-27: Ctrl-C of ``flags`` during its commit left ``x.csv`` and
+    file behind (a Ctrl-C of ``flags`` during its commit would leave ``x.csv`` and
     ``.x.nc.*.tmp``). The held signal is raised once every file is in place."""
     with deferred_signals():
         for tmp, path, mode, directory in moves:

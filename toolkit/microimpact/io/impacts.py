@@ -612,8 +612,6 @@ def _refuse_binary(source: str) -> None:
 def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     """Read and validate a CSV of measured impacts; return it in canonical columns and units.
 
-    Length: the docstring of an entry point (parameters, errors, an example); the body is short.
-
     Parameters
     ----------
     path : str or os.PathLike

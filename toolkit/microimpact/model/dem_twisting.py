@@ -17,7 +17,7 @@ and only changes Omega: I dOmega/dt = M. The spin about the normal enters neithe
 rolling velocity of a sphere on a flat wall, so the twist is a problem of its own, driven by the
 normal motion (:mod:`microimpact.solvers.dem_tangential` integrates it with the normal law).
 
-Two details of LAMMPS's code (``gran_sub_mod_twisting.cpp``, 22 Jul 2025) that differ from a
+Two details of LAMMPS's code (``gran_sub_mod_twisting.cpp``, version 22 Jul 2025) that differ from a
 spring-slider written from the physics, followed here so that an exported input reproduces:
 
 * The sliding torque opposes the twist rate (sgn(Omega)), not the trial torque: where the spring

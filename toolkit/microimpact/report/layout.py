@@ -343,8 +343,8 @@ def _core_fonts_suffice(pages) -> bool:
 @contextlib.contextmanager
 def _pdf_fonts(pages):
     """Write the text with the PDF core fonts (Helvetica, Courier; not embedded) where they can
-    show every character. Embedding DejaVu instead, glyph by glyph, was about 3.5 s of a 10 s
-    report (some 100,000 glyphs of tables and captions); text with a character outside cp1252
+    show every character. Embedding DejaVu instead, glyph by glyph, was a large part of the
+    report's time (some 100,000 glyphs of tables and captions); text with a character outside cp1252
     (a user's title, a file name) keeps the embedded fonts, so nothing is replaced by "?"."""
     core = _core_fonts_suffice(pages)
     quiet = logging.getLogger("matplotlib.font_manager")
@@ -399,7 +399,7 @@ def fork_map(func, items: list, workers: int = 1) -> list:
 def render_figures(figures: list, workers: int = 1) -> list:
     """RGBA images of ``figures``, drawn by ``workers`` processes (:func:`fork_map`).
 
-    Drawing the figures is most of the report's time (about 0.4 s each); they are independent, so
+    Drawing the figures is most of the report's time; they are independent, so
     forked workers draw them side by side.
 
     Examples

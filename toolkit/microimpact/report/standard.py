@@ -282,8 +282,8 @@ def save_standard_figure(file: FigureFile, dpi: float = 150.0) -> str:
 
 def save_standard_figures(files, *, workers: int = 1, dpi: float = 150.0) -> list[str]:
     """:func:`save_standard_figure` for each of ``files``, by ``workers`` forked processes (one
-    process start and one import for a whole set of figures: the HTML report's figures cost about
-    0.3 s each this way, against 1.5-2 s as one job each). Returns the captions in order.
+    process start and one import for a whole set of figures, rather than one job, process and
+    import per figure). Returns the captions in order.
 
     Examples
     --------

@@ -544,14 +544,6 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
 
     Returns (status, outcome, state at the end (12,), largest xi, tau at capture, tau at which J
     reached j_stop, n_steps, turning points of the hysteretic law, rolling stops after the capture).
-
-    Length: set-up, step control, separation, capture, the hysteretic turning points
-    and restarts, the recorded instants (largest penetration, first zero of the energy) and the
-    settle test share the loop's state (z, k1, the branch history) and may end or continue
-    the loop; they stay in one compiled loop, as in the engine, where moving the per-step work
-    into helpers was measured 1.5x slower (here not measured separately). What runs only at an
-    event (the re-step to a root, the end of a step at a zero of the Coulomb limit, at a rolling
-    stop or at a change of gross slip, the restart of the branch) is in helpers.
     """
     z = np.zeros(_N)
     z[_Y], z[_VT], z[_VTP], z[_WT], z[_WTP] = y0, vt0, vtp0, wt0, wtp0
@@ -1064,8 +1056,6 @@ def _tangential_si(contact, mindlin, states, info, f, v_in, w_in, slip, jl, jal,
 def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _DEFAULT_MAX_STEPS,
                   check_held_rolling: bool = True) -> dict:
     """Impacts of a contact that selects tangential compliance or adhesion-aware friction.
-
-    Length: the docstring (parameters, returns); the body is 62 lines.
 
     Parameters
     ----------

@@ -95,7 +95,7 @@ from microimpact.solvers import SolverError
 __all__ = ["DemTangentialError", "solve_dem_tangential", "uses_dem_tangential", "TANGENTIAL_RTOL"]
 
 _STICK, _SLIDE = 0, 1
-#: largest relative tolerance of the tangential integration (DOP853 is cheap at it: ~10 ms an impact)
+#: largest relative tolerance of the tangential integration (DOP853 is cheap at it)
 TANGENTIAL_RTOL = 1e-10
 #: largest number of stick-slip events (switches and grazes) of one impact before it is reported as a failure
 _MAX_EVENTS = 1000
@@ -718,7 +718,7 @@ def _with_rolling(contact, normal, velocity_in, omega_in, rtol):
         if w0[1] != 0.0:
             # rolling across the slip: the directions of both forces turn, at rates |G'| / (mu F_n0) that
             # made DOP853 take millions of steps where a limit is small; Radau (implicit) follows them
-            # (mu_roll >= 1e-4 at 5 deg in about 1 s; below that, at 1e-6, it fails: DemTangentialError)
+            # (mu_roll >= 1e-4 at 5 deg; below that, at 1e-6, it fails: DemTangentialError)
             law.method = "Radau"
         end, slide_end, switches, slip_ended = _integrate(law, tuple(u0), tol, tau_scale, z_scale, w0=tuple(w0))
         du_f, dw_f = (end[4:6] - u0) * unit, (end[9:11] - w0) * unit

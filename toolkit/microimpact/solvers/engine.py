@@ -90,7 +90,7 @@ _NSTATE = 5  # s, y, tau, D, J_a
 # Events located within a step (:func:`_locate`): s = 0, y = target, dy/dsigma = 0 (an extremum of y),
 # energy = target; and of the inertia-free path (:func:`_slow_event_time`): energy or y = target.
 # numpy integers, not int literals: numba compiles one specialization of a callee per literal
-# argument (the four codes cost four compiles of _locate, 2 s).
+# argument (the four codes would cost four compiles of _locate).
 _EV_S, _EV_Y, _EV_DY, _EV_ENERGY = np.int64(0), np.int64(1), np.int64(2), np.int64(3)
 _SLOW_ENERGY, _SLOW_Y = np.int64(0), np.int64(1)
 _MAX_STEPS_DEFAULT = 2_000_000
@@ -239,10 +239,10 @@ class EngineError(SolverError):
 # --------------------------------------------------------------------------- compiled core
 # The helpers called at every step (the right-hand side, the law, the stepper's error norm and step
 # control in .dopri) are inlined by numba (``inline="always"``): with every helper a plain call the
-# engine ran 12-18 % slower. Those called once per impact or only in rare regimes (the set-up, the
+# engine ran markedly slower. Those called once per impact or only in rare regimes (the set-up, the
 # inertia-free limit and its tests, the undamped mirror) are compiled as calls, which LLVM may still
 # inline: numba's inlining copies and re-types a helper at every call site, which lengthened
-# _integrate's compile and gained no speed (README, "Compiled kernels").
+# _integrate's compile and gained no speed (docs/model.md, "How it is computed").
 @njit(cache=True, inline="always")
 def _derivatives(s, y, c1, c2, ah, aa, sgn):
     """d/dsigma of the state (s, y, tau, D, J_a) at (s, y) (see the module docstring)."""
@@ -771,14 +771,6 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
     Events that only record something (largest penetration, capture, end of sliding) are located
     inside the step without changing it, so the trajectory, and e_n, do not depend on which of
     them a caller asked for.
-
-    Length: the set-up, the undamped mirror and the decision to stop a captured sphere are
-    compiled helpers (above). The work done at every step -- error norm, the events that shorten
-    the step, the advance -- stays in this loop, because as compiled helpers (numba
-    ``inline="always"`` or not) they made the engine markedly slower (``python -m
-    microimpact.studies.benchmark`` compares such variants side by side). The inertia-free jump and
-    the averaged tail of a weakly damped capture rewrite the loop's own state (u, J, sgn, k1, the
-    recorded events) and may continue the loop, so they stay in it too; their tests are helpers.
     """
     u = np.zeros(_NSTATE)
     u[1] = y0
@@ -1104,8 +1096,6 @@ def solve_normal(
 ) -> NormalSolution:
     """Solve the normal contact, Eq. (27), of one impact.
 
-    Length: the docstring (parameters, returns, references, examples); the body is short.
-
     Parameters
     ----------
     contact : Contact
@@ -1326,7 +1316,7 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     _check_resolvable(y0, np.any(np.asarray(sc.a_adhesion) > 0.0), v)
     u = sc.speed
     # writable copies, whatever the shapes: a read-only view (what broadcasting gives) would make
-    # numba compile the parallel kernel a second time (6 s on first use)
+    # numba compile the parallel kernel a second time
     u, c1, c2, y0 = (np.array(np.broadcast_to(a, v.shape), dtype=float) for a in (u, c1, c2, y0))
     length, time = sc.length, sc.time
     ah, aa = (np.array(np.broadcast_to(a, v.shape), dtype=float) for a in (sc.a_hertz, sc.a_adhesion))

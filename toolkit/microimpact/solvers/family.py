@@ -135,7 +135,7 @@ def _clenshaw(c, t):
 def _clenshaw6(c, t):
     """:func:`_clenshaw` of the six series c[0..5] at once. The recurrence is a chain of dependent
     multiply-adds, so one series at a time waits on each step's latency; six interleaved chains
-    keep the floating-point units busy (about 4x faster per impact on this machine)."""
+    keep the floating-point units busy."""
     a0 = a1 = a2 = a3 = a4 = a5 = 0.0
     b0 = b1 = b2 = b3 = b4 = b5 = 0.0
     t2 = 2.0 * t
@@ -230,8 +230,8 @@ def _fresh_array(shape) -> np.ndarray:
 
     numpy asks Linux for transparent huge pages on large arrays (madvise); where the kernel then
     compacts memory on the first touch of each page (THP defrag "madvise", the common default),
-    writing a fresh 100 MB output took 0.15-0.25 s on a 2-core test machine, against 0.1 s in plain
-    pages. The map is released with the last array that views it."""
+    writing a fresh output of hundreds of megabytes is markedly slower than in plain pages. The
+    map is released with the last array that views it."""
     n = int(np.prod(shape))
     if n * 8 < (1 << 24):  # below 16 MB: numpy's allocator, no huge pages involved
         return np.empty(shape)
@@ -243,7 +243,7 @@ def _node_values(contact, speed, captured_branch: bool, rtol: float) -> tuple[np
     and where the outcome is not the branch's (a second outcome change the scan missed)."""
     # the batch is split between the threads in contiguous blocks, and the costly solves (near a
     # capture speed, long captured tails) cluster in speed: dealt out in turn, each thread gets
-    # its share of them (build 20 % faster on 2 threads)
+    # its share of them (a faster build on 2 threads)
     order = np.argsort(np.arange(speed.size) % numba.get_num_threads(), kind="stable")
     dealt = engine.solve_normal_many(contact, speed[order], np.full(speed.shape, captured_branch), rtol=rtol,
                                      tail_tolerance=rtol)

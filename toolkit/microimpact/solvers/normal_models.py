@@ -88,9 +88,9 @@ _MAX_STEPS_DEFAULT = 2_000_000
 
 # The helpers of this solver are compiled as calls, not inlined by numba (``inline="always"``):
 # numba's inlining copies and re-types a helper at every call site (the right-hand side sits in the
-# seven stages of the unrolled step), which made the first JKR impact compile in 21 s instead of 8 s;
+# seven stages of the unrolled step), which made the first JKR impact compile several times longer;
 # LLVM still inlines them when it links the kernel, so the compiled code runs as fast and gives the
-# same numbers bit for bit (README, "Compiled kernels").
+# same numbers bit for bit (docs/model.md, "How it is computed").
 _jkr_force = njit(cache=True)(am.jkr_nondimensional_force)
 _jkr_potential = njit(cache=True)(am.jkr_nondimensional_potential)
 _jkr_dissipation = njit(cache=True)(am.jkr_nondimensional_dissipation_rate)
@@ -467,9 +467,6 @@ def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j
 
     Returns the floats (status, outcome, y_end, tau_end, D, J, J_a, z_max, tau_capture,
     tau_slip_end, energy_end, n_steps, n_rejected).
-
-    Length: one adaptive loop whose steps, events (separation, turning point, slip end, capture and
-    the settled tail) share the step's local state; split up it would pass a dozen arrays around.
     """
     args = (model, c1, c2, c3, p3)
     k = np.zeros((7, _N))
@@ -898,8 +895,6 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
                            friction_impulse_stop: float = math.inf, twist_impulse_stop: float = math.inf,
                            max_time: float = 1e5) -> NormalSolution:
     """Independent check of :func:`solve_normal`: the JKR or DMT law in the approach delta and time.
-
-    Length: the docstring (parameters, returns, references, examples); the body is short.
 
     :func:`scipy.integrate.solve_ivp` (DOP853) integrates delta/L, its rate and J, J_a, D in
     nondimensional time (no Sundman change), the JKR contact radius from delta by Newton's method

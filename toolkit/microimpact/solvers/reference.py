@@ -75,8 +75,8 @@ Events and switching
 * sign changes of F_n (terminal, restart; see above).
 * turning points y = 0 (non-terminal) give the maximum penetration.
 
-Cost: ~10-30 ms per rebound, ~0.1-0.3 s for a captured impact whose sliding or twisting outlasts
-capture (one restart per sign change of F_n in the tail).
+Cost: a captured impact whose sliding or twisting outlasts capture costs several times a rebound
+(one restart per sign change of F_n in the tail).
 
 Everything at the interface is SI; everything inside is nondimensional.
 """
@@ -366,8 +366,6 @@ def simulate_reference(
     time_budget: float | None = None,
 ) -> ImpactResult:
     """Integrate one impact with the full 3-D equations (reference solution).
-
-    Length: the docstring of a main entry point (parameters and examples); the body is short.
 
     Parameters
     ----------

@@ -18,7 +18,7 @@ class TimeLimitExceeded(TimeBudgetExceeded):
 
     Examples
     --------
-    A busy loop stopped after 0.2 s (SIGALRM, main thread):
+    A busy loop stopped by its limit (SIGALRM, main thread):
 
     >>> try:
     ...     with time_limit(0.2, "the loop"):
@@ -37,7 +37,7 @@ def time_limit(seconds: float | None, what: str | None = None):
     Uses SIGALRM, so the limit applies only in the main thread on POSIX; elsewhere, and with
     ``seconds`` None, the block runs without a limit. The previous SIGALRM handler is restored.
     Limits nest: a block inside another runs for at most what is left of the outer one, and a
-    limit that has passed raises again every 0.1 s until its block has ended, so a per-case limit
+    limit that has passed raises again at short intervals until its block has ended, so a per-case limit
     inside a whole-run budget (``microimpact benchmark --time-budget``), whose caller catches the
     case's TimeLimitExceeded and goes on, does not cancel the budget; a block that ends past its
     limit raises too.

@@ -18,7 +18,7 @@ From the command line: ``microimpact lammps verify contact.lmp``.
 
 References
 ----------
-LAMMPS documentation, ``fix wall/gran`` and ``pair_style granular`` (22 Jul 2025),
+LAMMPS documentation, ``fix wall/gran`` and ``pair_style granular`` (version 22 Jul 2025),
 https://docs.lammps.org/fix_wall_gran.html.
 
 Thompson, A. P. et al. (2022), LAMMPS - a flexible simulation tool for particle-based materials

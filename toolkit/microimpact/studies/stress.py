@@ -179,8 +179,8 @@ NOTE_KINDS = ("reference_timeout", "reference_failed", "slow_convergence", "not_
 
 #: Time budget of one reference solve [s] (at most ``case_time_limit``). The pure-Python reference
 #: needs minutes on the strongly damped cases of the extended domain, where the engine takes its
-#: inertia-free limit; 5 s compares every case it can do in reasonable time (measured: 71 of 100
-#: sampled cases, the others time out even at 10 s) and keeps the README's 3000-case run short.
+#: inertia-free limit; this budget lets it compare most cases (the others time out even at twice
+#: the budget) and keeps the documented 3000-case run short.
 REFERENCE_BUDGET = 5.0
 
 #: Error reduction that makes a case above the convergence tolerance converge "slowly" rather than
@@ -670,7 +670,7 @@ def stress_sweep(n_cases: int = 1000, seed: int = 0, *, reference_every: int = 2
     t0 = time.perf_counter()
     cases = draw_cases(n_cases, seed)
     # compile (or load) the engine before the first case's clock starts: a first-run numba
-    # compilation takes ~20 s, more on a loaded machine, and is no property of any case
+    # compilation takes far longer than a case and is no property of any case
     if cases:
         with _model_warnings_ignored(), contextlib.suppress(Exception):  # (a case's failure is found by the case)
             simulate_impact(contact_of({**cases[0], "friction": 0.5}, law), 1.0, 30.0, 0.0, (1.0, 1.0, 1.0))

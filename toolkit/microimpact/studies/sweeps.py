@@ -279,8 +279,6 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
               time_budget: float | None = None) -> xr.Dataset:
     """Simulate every impact of a sweep grid with :func:`microimpact.solvers.impact.simulate_many`.
 
-    Length: the docstring (parameters, examples); the body is 53 lines.
-
     Parameters
     ----------
     contact : Contact
@@ -296,7 +294,7 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
     capture_speed : bool
         Also compute the normal capture velocity of the contact (bisection on the outcome with
         the same solver tolerance, :func:`microimpact.dynamics.nonlinear.capture_velocity`) and store it as
-        the 0-d variable ``capture_normal_speed``; the figures mark it. About 1 s.
+        the 0-d variable ``capture_normal_speed``; the figures mark it.
     progress : bool, optional
         Draw a progress bar on stderr (:func:`microimpact.io.progress.progress_bar`) when stderr is
         a terminal; the speeds are then solved in blocks to advance it (same values as one batch).

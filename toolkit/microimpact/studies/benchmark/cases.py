@@ -150,13 +150,13 @@ class BenchmarkConfig:
 
     @classmethod
     def quick_(cls) -> "BenchmarkConfig":
-        """A small benchmark (< 60 s) for CI and the workflow."""
+        """A small benchmark for CI and the workflow."""
         return cls(
             quick=True, n_speeds=6, max_speed=100.0, capture_margin=1.02,
             engine_levels=(0, 2, 4, 6, 8), scipy_levels=(0, 2, 4), rkg_levels=(0, 2, 4, 6),
             oblique=_OBLIQUE_QUICK, repeats_single=5, repeats_scipy=1, repeats_batch=3, batch_size=1000,
             throughput_impacts=20_000, throughput_repeats=1, memory_sizes=(2_000, 20_000), time_limit=1.0,
-            oblique_time_limit=0.25,  # RK45 settles a captured case in 2.4 s: quick marks it timed out
+            oblique_time_limit=0.25,  # RK45 takes far longer to settle a captured case: quick marks it timed out
             reference_rtols=(1e-11, 1e-12), family_size=20_000, family_impacts=100_000, family_check=3_000,
             family_memory_sizes=(20_000, 200_000), fit_rows=10_000, family_oblique=False,
         )

@@ -278,12 +278,10 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
                   time_budget: float | None = None) -> xr.Dataset:
     """Run the work-precision benchmark and return its results.
 
-    Length: the docstring (parameters, examples); the body is 61 lines.
-
     Parameters
     ----------
     quick : bool
-        Smaller test set, fewer settings and repeats (< 60 s; for CI and the workflow).
+        Smaller test set, fewer settings and repeats (for CI and the workflow).
     contact : Contact
         Contact parameters (default WALL_1990, Table 1 row 2).
     config : BenchmarkConfig, optional

@@ -65,7 +65,7 @@ def accuracy_targets(tpi, err, cfg: BenchmarkConfig, reference_bound: float) -> 
     --------
     A made-up work-precision table (nine settings, the error ten times smaller at each, the time 1.5
     times larger): DOP853 and the batch engine reach the target error 1e-8 at the same setting, the
-    engine 500 times faster, which meets the target ratio; an engine whose error rises tenfold at one
+    engine's time 1/500 of DOP853's, which meets the target ratio; an engine whose error rises tenfold at one
     tightening does not converge:
 
     >>> import numpy as np
