@@ -562,7 +562,8 @@ class FrictionFit(ReportHTML, FitResult):
         return lines
 
     def to_dataset(self) -> xr.Dataset:
-        """CF form: scalar ``friction`` (+ ``friction_stderr``) and the entries along ``entry``."""
+        """CF form: scalar ``friction`` (+ ``friction_stderr``) and the entries along ``entry``; the
+        whole ``info`` record (nested entries included) as the JSON text attribute ``fit_info``."""
         d = self.data
         ds = xr.Dataset(coords={"entry": ("entry", np.arange(len(d)), {"long_name": "index of the fitted oblique entry"})})
         from microimpact.analysis.identifiability import status_variables
