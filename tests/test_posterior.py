@@ -13,9 +13,8 @@ import numpy as np
 import pytest
 
 from microimpact.analysis.fitting import FitProblem, fit_damping, model_restitution
-from microimpact.analysis.posterior import (GAUSS_HERMITE_NODES, _Likelihood, capture_velocity_interval,
-                                            load_posterior, posterior_dataset, restitution_bands, sample_posterior,
-                                            sweep_bands)
+from microimpact.analysis.posterior import (GAUSS_HERMITE_NODES, Posterior, _Likelihood, capture_velocity_interval,
+                                            restitution_bands, sample_posterior, sweep_bands)
 from microimpact.analysis.synthetic import make_synthetic_impacts
 from microimpact.io import default_materials_path, read_impacts, read_materials
 from microimpact.io.files import write_csv, write_netcdf
@@ -71,13 +70,13 @@ def test_posterior_agrees_with_least_squares(small):
 
 def test_dataset_is_cf_clean_and_round_trips(small, tmp_path):
     _, fit, post = small
-    ds = posterior_dataset(post, restitution_bands(post, fit, n_draws=8), capture_velocity_interval(post, fit, n_draws=6),
-                           sweep_bands(post, fit, cases=["2.1", "2.2"], n_draws=4, n_speeds=5))
+    ds = post.to_dataset(restitution_bands(post, fit, n_draws=8), capture_velocity_interval(post, fit, n_draws=6),
+                         sweep_bands(post, fit, cases=["2.1", "2.2"], n_draws=4, n_speeds=5))
     for name, var in ds.variables.items():
         if var.dtype.kind in "fiu" and name not in ("step", "walker", "point", "case"):
             assert "units" in var.attrs and "long_name" in var.attrs, name
     path = write_netcdf(ds, tmp_path / "posterior.nc")
-    back = load_posterior(path)
+    back = Posterior.load(path)
     np.testing.assert_array_equal(back.chain, post.chain)
     assert back.interval("zeta_adhesion") == post.interval("zeta_adhesion")
 

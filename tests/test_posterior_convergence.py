@@ -15,12 +15,11 @@ import pytest
 from microimpact.analysis.diagnostics import ess_bulk, split_rhat
 from microimpact.analysis.fitting import fit_damping
 from microimpact.analysis.oblique import fit_friction
-from microimpact.analysis.posterior import (MIN_ACCEPTANCE, PosteriorError, _raise_if_collapsed, load_posterior,
-                                            posterior_dataset, sample_posterior)
+from microimpact.analysis.posterior import MIN_ACCEPTANCE, Posterior, PosteriorError, _raise_if_collapsed, sample_posterior
 from microimpact.analysis.synthetic import make_synthetic_impacts, make_synthetic_oblique
 from microimpact.cli import main
 from microimpact.io import default_materials_path, read_impacts, read_materials
-from microimpact.io.files import write_csv, write_netcdf
+from microimpact.io.files import write_csv
 
 PAIR = "ammonium_fluorescein_on_silicon"
 
@@ -81,7 +80,7 @@ def test_default_chain_converges_and_says_so(small):
     for name in post.names:
         lo, hi = post.interval(name)
         assert lo < fit.values[name] < hi, name
-    back = posterior_dataset(post)
+    back = post.to_dataset()
     assert back["chain_zeta_hertz"].attrs["prior_max"] == 1e3
     assert back["chain_zeta_hertz"].attrs["rhat"] == pytest.approx(post.info["rhat"]["zeta_hertz"], abs=0)
 
@@ -137,5 +136,5 @@ def test_a_parameter_the_data_only_bound_is_reported_by_its_bound(tmp_path, pair
     assert post.bound("friction").startswith(f">= {st.lower:.4g}") and st.lower <= 0.6
     line = next(x for x in post.report().splitlines() if x.strip().startswith("friction"))
     assert "profile-likelihood bound" in line and "95 % [" not in line
-    back = load_posterior(write_netcdf(posterior_dataset(post), tmp_path / "p.nc"))
+    back = Posterior.load(post.save(tmp_path / "p.nc"))
     assert back.bound("friction") == post.bound("friction")

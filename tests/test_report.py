@@ -107,11 +107,11 @@ def results(tmp_path_factory):
                           "parameter_source": source})
     write_csv(flags, tmp / "flags.csv")
     from microimpact.analysis.analyst_fit import AnalystFit
-    from microimpact.analysis.posterior import capture_velocity_interval, posterior_dataset, restitution_bands, sample_posterior
+    from microimpact.analysis.posterior import capture_velocity_interval, restitution_bands, sample_posterior
 
     post = sample_posterior(table, fit, walkers=6, steps=10, seed=1, require_convergence=False)  # the form of the file, not its numbers
-    AnalystFit(fit, posterior_dataset=posterior_dataset(post, restitution_bands(post, fit, n_draws=4),
-                                                        capture_velocity_interval(post, fit, n_draws=3))).save(
+    AnalystFit(fit, posterior_dataset=post.to_dataset(restitution_bands(post, fit, n_draws=4),
+                                                      capture_velocity_interval(post, fit, n_draws=3))).save(
         tmp / "fit_again.nc", tmp / "posterior.nc", tmp / "oblique.nc")
     lammps = pd.DataFrame({"speed": [0.1, 0.1, 2.0, 2.0], "incidence_deg": [0.0, 80.0, 0.0, 80.0],
                            "outcome_lammps": ["capture", "capture", "rebound", "rebound"],

@@ -500,11 +500,11 @@ def _load_posterior(path):
     """The Posterior of a ``microimpact fit --posterior`` file, or None."""
     if path is None:
         return None
-    from microimpact.analysis.posterior import load_posterior
+    from microimpact.analysis.posterior import Posterior
 
     check_input_file("--posterior", path)
     try:
-        return load_posterior(path)
+        return Posterior.load_optional(path)
     except (KeyError, ValueError, OSError) as exc:
         raise UsageError(f"--posterior {exc}") from None
 

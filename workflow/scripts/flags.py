@@ -16,7 +16,7 @@ import xarray as xr  # noqa: E402
 
 from microimpact.analysis.fit_result import DampingFit  # noqa: E402
 from microimpact.analysis.flags import flag_measurements, write_flags  # noqa: E402
-from microimpact.analysis.posterior import load_posterior  # noqa: E402
+from microimpact.analysis.posterior import Posterior  # noqa: E402
 from microimpact.io import read_impacts, select_material_pair  # noqa: E402
 from microimpact.studies.material import stamp_fitted  # noqa: E402
 
@@ -26,7 +26,7 @@ table = select_material_pair(read_impacts(snakemake.input.data, materials=snakem
                                           material_pair=snakemake.params.material_pair),  # noqa: F821
                              pair, default=snakemake.params.material_pair)  # noqa: F821
 ds = flag_measurements(table, DampingFit.from_dataset(fit_ds), rtol=snakemake.params.rtol,  # noqa: F821
-                       posterior=load_posterior(snakemake.input.posterior),  # noqa: F821
+                       posterior=Posterior.load_optional(snakemake.input.posterior),  # noqa: F821
                        **({} if snakemake.params.n_draws is None else {"n_draws": snakemake.params.n_draws}))  # noqa: F821
 ds = stamp_fitted(ds, fit_ds)
 write_flags(ds, snakemake.output.csv, snakemake.output.nc)  # noqa: F821

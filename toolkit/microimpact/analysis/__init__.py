@@ -1,8 +1,9 @@
 """Analysis: what is learned from measurements.
 
 - :mod:`.fitting`: zeta_H, zeta_A (and optionally w_A) fitted to measured e_n(v_n) with lmfit.
-- :mod:`.fit_result`: the fit's result record (:class:`DampingFit`), its NetCDF form and its
-  formatter; reading a fit needs no lmfit.
+- :mod:`.fit_result`: the one save/load protocol of every fit result (:class:`FitResult`), and the
+  damping fit's result record (:class:`DampingFit`), its NetCDF form and its formatter; reading a
+  fit needs no lmfit.
 - :mod:`.flags`: which measurements unmeasured spin, angle error or closeness to capture make
   unreliable.
 - :mod:`.kharaz`: the model against the Kharaz et al. (2001) oblique-impact measurements.
@@ -17,7 +18,7 @@ from microimpact._lazy import lazy_exports as _lazy_exports
 _HOMES = {
     **dict.fromkeys(("AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS"), "analyst_fit"),
     **dict.fromkeys(("split_rhat", "ess_bulk", "RHAT_MAX", "ESS_MIN"), "diagnostics"),
-    **dict.fromkeys(("DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
+    **dict.fromkeys(("FitResult", "DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
                      "PARAMETER_TABLE_COLUMNS"), "fit_result"),
     **dict.fromkeys(("FitProblem", "fit_damping", "damping_residual", "model_restitution", "DEFAULT_START_GRID"),
                     "fitting"),
@@ -32,8 +33,7 @@ _HOMES = {
     **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "rank_dem_tangential_laws", "oblique_model", "rebound_state",
                      "effective_sigma", "TANGENTIAL_PARAMETERS", "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"), "oblique"),
     **dict.fromkeys(("Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "posterior_contacts",
-                     "restitution_bands", "capture_velocity_interval", "sweep_bands", "posterior_dataset",
-                     "posterior_from_dataset", "load_posterior", "save_posterior", "summary_table",
+                     "restitution_bands", "capture_velocity_interval", "sweep_bands", "summary_table",
                      "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"), "posterior"),
     **dict.fromkeys(("DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS", "MAX_SEED"),
                     "sampling_defaults"),

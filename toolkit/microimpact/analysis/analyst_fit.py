@@ -8,6 +8,11 @@
    the returned :class:`DampingFit` (so flags and simulations of the fitted material use it);
 3. optionally the posterior (:func:`~microimpact.analysis.posterior.sample_posterior`), with the
    e_n bands, the capture velocity interval and the sweep bands of the analyst's material.
+
+Its result, :class:`AnalystFit`, saves and loads through the protocol of every fit result
+(:class:`~microimpact.analysis.fit_result.FitResult`): its main result, the damping fit, at
+``path``, and each part it holds at a path of its own (the pipeline's ``fit.nc``, ``posterior.nc``,
+``oblique.nc``).
 """
 
 from __future__ import annotations
@@ -17,8 +22,11 @@ from dataclasses import dataclass
 
 import xarray as xr
 
+from microimpact.analysis.fit_result import DampingFit, FitResult
+from microimpact.analysis.oblique import FrictionFit
+from microimpact.analysis.posterior import Posterior
 from microimpact.io.formatting import ReportHTML
-from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.files import all_or_nothing, write_netcdf
 from microimpact.io.provenance import stamp_parameters
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
@@ -37,7 +45,7 @@ POSTERIOR_DEFAULTS = _posterior_defaults()
 
 
 @dataclass(frozen=True, eq=False)
-class AnalystFit(ReportHTML):
+class AnalystFit(ReportHTML, FitResult):
     """Result of :func:`analyse_impacts`.
 
     Attributes
@@ -47,7 +55,20 @@ class AnalystFit(ReportHTML):
     friction : FrictionFit or None
     posterior : Posterior or None
     posterior_dataset : xarray.Dataset or None
-        Chain, summary, diagnostics and bands (:func:`~microimpact.analysis.posterior.posterior_dataset`).
+        Chain, summary, diagnostics and bands (:meth:`Posterior.to_dataset
+        <microimpact.analysis.posterior.Posterior.to_dataset>` with the band Datasets).
+
+    Notes
+    -----
+    The protocol of :class:`~microimpact.analysis.fit_result.FitResult`, for a result of three
+    parts. Its main result is the damping fit: :meth:`to_dataset` and :meth:`from_dataset` are the
+    damping fit's, and ``save(path)`` / ``load(path)`` write and read it alone. The other parts
+    have files of their own, given as ``posterior_path`` and ``oblique_path`` (the mapping of
+    :meth:`datasets`): the posterior file holds ``posterior_dataset`` and the oblique file the
+    :class:`~microimpact.analysis.oblique.FrictionFit`'s Dataset, each stamped with the fitted
+    contacts (:func:`microimpact.io.provenance.stamp_parameters`); a part that was not computed is
+    written as its kind's :meth:`~microimpact.analysis.fit_result.FitResult.placeholder` saying why,
+    and loaded as None.
 
     Examples
     --------
@@ -60,11 +81,21 @@ class AnalystFit(ReportHTML):
     >>> result = analyse_impacts(table, material)
     >>> result.friction is None, result.posterior is None
     (True, True)
-    >>> result.oblique_dataset().attrs["comment"]
+    >>> result.datasets()["oblique"].attrs["comment"]
     'the impact table has no oblique columns: no friction fit'
     >>> [p.name for p in result.save("fit.nc", oblique_path="oblique.nc")]
     ['fit.nc', 'oblique.nc']
+    >>> back = AnalystFit.load("fit.nc", oblique_path="oblique.nc")
+    >>> back.damping.values == result.damping.values, back.friction
+    (True, None)
     """
+
+    TITLE = DampingFit.TITLE
+    KIND = DampingFit.KIND
+    WRITTEN_BY = DampingFit.WRITTEN_BY
+    #: why a part was not computed: the comment of its placeholder file
+    NO_POSTERIOR = "posterior not computed"
+    NO_FRICTION = "the impact table has no oblique columns: no friction fit"
 
     damping: object
     friction: object = None
@@ -84,28 +115,44 @@ class AnalystFit(ReportHTML):
             parts.append(self.posterior.report())
         return "\n".join(parts)
 
-    def oblique_dataset(self) -> xr.Dataset:
-        """The friction fit's Dataset, or an empty one that says there were no oblique columns."""
-        if self.friction is not None:
-            return self.friction.to_dataset()
-        return xr.Dataset(attrs={"title": "friction fit from oblique impacts", "Conventions": CONVENTIONS,
-                                 "comment": "the impact table has no oblique columns: no friction fit"})
+    def to_dataset(self) -> xr.Dataset:
+        """The main result's Dataset: the damping fit's (:meth:`DampingFit.to_dataset`)."""
+        return self.damping.to_dataset()
 
-    def save(self, fit_path, posterior_path=None, oblique_path=None) -> tuple:
-        """Write the fit, and where given the posterior and the oblique fit, as NetCDF: all of them
-        or, if one cannot be written, none (:func:`microimpact.io.files.all_or_nothing`)."""
-        from microimpact.analysis.posterior import POSTERIOR_TITLE
-        from microimpact.io.files import all_or_nothing
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset) -> "AnalystFit":
+        """An AnalystFit of the damping fit ``ds`` alone (no friction, no posterior)."""
+        return cls(DampingFit.from_dataset(ds))
 
+    def datasets(self) -> dict:
+        """``{"fit": ..., "posterior": ..., "oblique": ...}``: the Dataset of each file, the parts
+        stamped with the fitted contacts, a part not computed as its placeholder."""
+        post = self.posterior_dataset if self.posterior_dataset is not None else Posterior.placeholder(self.NO_POSTERIOR)
+        oblique = self.friction.to_dataset() if self.friction is not None else FrictionFit.placeholder(self.NO_FRICTION)
+        return {"fit": self.to_dataset(), "posterior": self._stamped(post), "oblique": self._stamped(oblique)}
+
+    def save(self, path, posterior_path=None, oblique_path=None) -> tuple:
+        """Write the damping fit to ``path`` and, where given, the posterior and the oblique fit
+        (:meth:`datasets`) as NetCDF: all of them or, if one cannot be written, none
+        (:func:`microimpact.io.files.all_or_nothing`). Returns the paths written."""
+        paths = {"fit": path, "posterior": posterior_path, "oblique": oblique_path}
+        datasets = self.datasets()
         with all_or_nothing():
-            written = [self.damping.save(fit_path)]
-            if posterior_path is not None:
-                ds = self.posterior_dataset if self.posterior_dataset is not None else xr.Dataset(attrs={
-                    "title": POSTERIOR_TITLE, "Conventions": CONVENTIONS, "comment": "posterior not computed"})
-                written.append(write_netcdf(self._stamped(ds), posterior_path))
-            if oblique_path is not None:
-                written.append(write_netcdf(self._stamped(self.oblique_dataset()), oblique_path))
-        return tuple(written)
+            return tuple(write_netcdf(datasets[k], p) for k, p in paths.items() if p is not None)
+
+    @classmethod
+    def load(cls, path, posterior_path=None, oblique_path=None) -> "AnalystFit":
+        """Read what :meth:`save` wrote: the damping fit at ``path`` and, where given, the parts (a
+        placeholder file as None).
+
+        Raises
+        ------
+        FileNotFoundError, ValueError
+            As :meth:`FitResult.load <microimpact.analysis.fit_result.FitResult.load>`, for each file.
+        """
+        posterior, posterior_ds = (None, None) if posterior_path is None else Posterior._read_part(posterior_path)
+        friction = None if oblique_path is None else FrictionFit.load_optional(oblique_path)
+        return cls(DampingFit.load(path), friction, posterior, posterior_ds)
 
     def _stamped(self, ds: xr.Dataset) -> xr.Dataset:
         """``ds`` with the fit's ``parameter_source`` and the fitted contact of every measured size
@@ -196,16 +243,15 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     if not posterior:
         return AnalystFit(damping, ff)
     opts = _posterior_options(posterior)
-    from microimpact.analysis.posterior import (capture_velocity_interval, posterior_dataset, restitution_bands,
-                                                sample_posterior, sweep_bands)
+    from microimpact.analysis.posterior import capture_velocity_interval, restitution_bands, sample_posterior, sweep_bands
 
     post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], max_steps=opts["max_steps"],
                             burn=opts["burn"], seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol,
                             progress=progress, time_budget=deadline)
     nd = opts["n_draws"]
-    ds = posterior_dataset(post, restitution_bands(post, damping, n_draws=nd, rtol=rtol, time_budget=deadline),
-                           capture_velocity_interval(post, damping, n_draws=nd, time_budget=deadline),
-                           sweep_bands(post, damping, n_draws=max(nd // 2, 4), rtol=rtol, time_budget=deadline))
+    ds = post.to_dataset(restitution_bands(post, damping, n_draws=nd, rtol=rtol, time_budget=deadline),
+                         capture_velocity_interval(post, damping, n_draws=nd, time_budget=deadline),
+                         sweep_bands(post, damping, n_draws=max(nd // 2, 4), rtol=rtol, time_budget=deadline))
     return AnalystFit(damping, ff, post, ds)
 
 

@@ -50,7 +50,10 @@ from dataclasses import dataclass, field
 from types import SimpleNamespace
 
 import numpy as np
+import xarray as xr
 
+from microimpact.analysis.fit_result import FitResult
+from microimpact.io.files import CONVENTIONS
 from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
 from microimpact.solvers import DEFAULT_RTOL
@@ -89,8 +92,12 @@ REGION_RAYS = 12
 _HESSIAN_STEP = 0.25
 
 
+#: units of the damping coefficient of each LAMMPS damping law (e of coeff_restitution and tsuji, eta_n0 else)
+_COEFFICIENT_UNITS = {"viscoelastic": "m-1 s-1", "mass_velocity": "s-1"}
+
+
 @dataclass(frozen=True)
-class DemLawFit:
+class DemLawFit(FitResult):
     """A DEM law fitted to measured normal restitution.
 
     Attributes
@@ -139,7 +146,17 @@ class DemLawFit:
     ('upper limit', False)
     >>> g.describe()
     'hertz+coeff_restitution: consistent with no damping; the data give only e >= 0.99256 (68%)'
+
+    The fit and its data survive the file, so the loaded fit still gives its confidence region:
+
+    >>> back = DemLawFit.load(f.save("dem_law.nc"))
+    >>> back.describe() == f.describe(), back.confidence_region() == f.confidence_region()
+    (True, True)
     """
+
+    TITLE = "DEM contact law fitted to measured normal restitution"
+    KIND = "DEM law fit"
+    WRITTEN_BY = "DemLawFit.save"
 
     normal_model: str
     damping_model: str
@@ -225,6 +242,59 @@ class DemLawFit:
         if self.adhesion_fitted:
             ends["work_of_adhesion"] = tuple(map(float, self.work_of_adhesion_interval))
         return ends
+
+    def to_dataset(self) -> xr.Dataset:
+        """CF form: the damping coefficient (``damping_coefficient`` with ``_lower``, ``_upper`` of
+        its 68.27 % interval and ``_best``, the chi^2 minimiser), the work of adhesion likewise,
+        the fitted impacts along ``point`` (``radius``, ``normal_speed``, ``e_n_measured``,
+        ``sigma``) and the law, status, statistics and material as attributes."""
+        unit = _COEFFICIENT_UNITS.get(self.damping_model, "1")
+        ds = xr.Dataset()
+        for suffix, v, what in (("", self.value, "fitted damping coefficient (NaN unless determined)"),
+                                ("_lower", self.interval[0], "lower end of the 68.27 % interval of the damping coefficient"),
+                                ("_upper", self.interval[1], "upper end of the 68.27 % interval of the damping coefficient"),
+                                ("_best", self.best, "damping coefficient at the least chi-square")):
+            ds[f"damping_coefficient{suffix}"] = xr.DataArray(float(v), attrs={"units": unit, "long_name": what})
+        for suffix, v, what in (("", self.work_of_adhesion, "fitted work of adhesion (NaN unless fitted and determined)"),
+                                ("_lower", self.work_of_adhesion_interval[0], "lower end of the 68.27 % interval of w_A"),
+                                ("_upper", self.work_of_adhesion_interval[1], "upper end of the 68.27 % interval of w_A")):
+            ds[f"work_of_adhesion{suffix}"] = xr.DataArray(float(v), attrs={"units": "J m-2", "long_name": what})
+        if self._data:
+            model, e_meas, sig = self._data
+            point = {"dims": ("point",)}
+            ds = ds.assign_coords(point=("point", np.arange(e_meas.size), {"long_name": "index of the fitted impact"}))
+            ds["radius"] = xr.DataArray(model.radii[model.index], **point, attrs={"units": "m", "long_name": "sphere radius"})
+            ds["normal_speed"] = xr.DataArray(model.speed, **point, attrs={"units": "m s-1", "long_name": "incident normal speed"})
+            ds["e_n_measured"] = xr.DataArray(e_meas, **point, attrs={
+                "units": "1", "long_name": "measured normal coefficient of restitution"})
+            ds["sigma"] = xr.DataArray(sig, **point, attrs={
+                "units": "1", "long_name": "e_n uncertainty the chi-square is weighted by (1 where none was stated)"})
+            ds.attrs["rtol"] = float(model.rtol)
+        ds.attrs.update({
+            "title": self.TITLE, "Conventions": CONVENTIONS, "normal_model": self.normal_model,
+            "damping_model": self.damping_model, "status": self.status, "chisqr": float(self.chisqr), "n": int(self.n),
+            "sigma_known": int(self.sigma_known), "aic": float(self.aic), "bic": float(self.bic), "source": str(self.source),
+            "adhesion_fitted": int(self.adhesion_fitted), "adhesion_status": self.adhesion_status,
+            **{f"material_{k}": float(v) for k, v in self.material.items()}})
+        return ds
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset) -> "DemLawFit":
+        """Inverse of :meth:`to_dataset` (also of the Dataset read back from its file)."""
+        a = ds.attrs
+        material = {k.removeprefix("material_"): float(v) for k, v in a.items() if k.startswith("material_")}
+        data = ()
+        if "e_n_measured" in ds:
+            model = _Model(material, ds["radius"].values, ds["normal_speed"].values, str(a["normal_model"]),
+                           str(a["damping_model"]), float(a["rtol"]))
+            data = (model, ds["e_n_measured"].values, ds["sigma"].values)
+        return cls(str(a["normal_model"]), str(a["damping_model"]), float(ds["damping_coefficient"]),
+                   (float(ds["damping_coefficient_lower"]), float(ds["damping_coefficient_upper"])), str(a["status"]),
+                   float(a["chisqr"]), int(a["n"]), bool(int(a["sigma_known"])), float(a["aic"]), float(a["bic"]),
+                   float(ds["damping_coefficient_best"]), material, str(a["source"]),
+                   adhesion_fitted=bool(int(a["adhesion_fitted"])), work_of_adhesion=float(ds["work_of_adhesion"]),
+                   work_of_adhesion_interval=(float(ds["work_of_adhesion_lower"]), float(ds["work_of_adhesion_upper"])),
+                   adhesion_status=str(a["adhesion_status"]), _data=data)
 
     def confidence_region(self, level: float = 0.95, rays: int = REGION_RAYS) -> list[dict]:
         """Points on the boundary of the fitted parameters' joint confidence region, as

@@ -1,4 +1,12 @@
-"""The result of a damping fit: :class:`DampingFit`, its NetCDF form and its one formatter.
+"""The one save/load protocol of every fit result (:class:`FitResult`), and the result of a
+damping fit: :class:`DampingFit`, its NetCDF form and its one formatter.
+
+Every fit result -- :class:`DampingFit`, :class:`~microimpact.analysis.oblique.FrictionFit`,
+:class:`~microimpact.analysis.dem_fit.DemLawFit`, :class:`~microimpact.analysis.posterior.Posterior`,
+:class:`~microimpact.analysis.target.DampingTarget` and the composite
+:class:`~microimpact.analysis.analyst_fit.AnalystFit` -- is a frozen dataclass with ``to_dataset()``,
+``from_dataset(ds)``, ``save(path)`` and ``load(path)`` of :class:`FitResult`: one way to write a
+result and one to read it back, and one message for a file of another kind.
 
 Kept apart from the fitting procedure (:mod:`microimpact.analysis.fitting`, which needs lmfit) so that
 everything that only reads a fit -- the fitted material's simulations, the flags, the CLI -- starts
@@ -10,6 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 import pandas as pd
@@ -18,14 +27,16 @@ import xarray as xr
 from microimpact.io.formatting import ReportHTML
 from microimpact.analysis.identifiability import status_from_variables, status_variables
 from microimpact.io.statuses import stderr_is_meaningful
-from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.files import CONVENTIONS, restore_label_coordinates, write_netcdf
+from microimpact.io.formatting import estimates_repr
 from microimpact.io.impacts import insert_row_labels, label_variables, labels_from_dataset
+from microimpact.io.kinds import file_kind
 from microimpact.io.materials import material_contact
 from microimpact.io.provenance import fit_parameter_source, stamp_parameters
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
 
-__all__ = ["DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
+__all__ = ["FitResult", "DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
            "PARAMETER_TABLE_COLUMNS"]
 
 #: names of the fitted parameters, in the order of the correlation matrix
@@ -36,9 +47,146 @@ SIGMA_LEVELS = (-2, -1, 1, 2)
 _POINT_COLUMNS = ("row", "radius", "normal_speed", "e_n", "sigma", "model", "residual")
 
 
+# --------------------------------------------------------------------------- the protocol
+class FitResult:
+    """Mixin of every fit result: its NetCDF form, and the one way to save and load it.
+
+    A subclass (a frozen dataclass) gives :meth:`to_dataset` and :meth:`from_dataset`, and names
+    its kind in three class attributes: :attr:`TITLE`, the ``title`` attribute its Dataset carries
+    (what :meth:`load` recognises the file by), :attr:`KIND`, the words for it in a message, and
+    :attr:`WRITTEN_BY`, what writes such a file. :meth:`save` writes the Dataset through
+    :func:`microimpact.io.write_netcdf` (atomic, CF-1.10, a ``history`` line); :meth:`load` reads
+    it back, and refuses a file of another kind with a message naming the file and what it is.
+
+    A file of the right kind may hold no result: :meth:`placeholder` is the Dataset that says why
+    (a posterior that was not sampled, a table without oblique columns), which a pipeline writes in
+    place of a result so that its outputs always exist; :meth:`load` refuses it, and
+    :meth:`load_optional` reads it as None.
+
+    Examples
+    --------
+    A damping target round-trips through its file; a damping fit refuses it, naming it:
+
+    >>> from microimpact.analysis.target import DampingTarget, damping_from_target
+    >>> from microimpact.presets import WALL_1990
+    >>> path = damping_from_target(0.5, 3.0, WALL_1990, n_points=5).save("target.nc")
+    >>> DampingTarget.load(path).curves.sizes["curve_point"]
+    5
+    >>> DampingFit.load(path)
+    Traceback (most recent call last):
+    ...
+    ValueError: target.nc: not a damping fit (the file that 'microimpact fit --out' writes): it is a NetCDF file titled 'damping coefficients that reproduce measured e_n ...'
+    """
+
+    #: the ``title`` attribute of the kind's Dataset: a file whose title begins with it is of this kind
+    TITLE: ClassVar[str] = ""
+    #: what the result is, in words (``"damping fit"``)
+    KIND: ClassVar[str] = ""
+    #: what writes its file (``"microimpact fit --out"``), for the message that refuses another file
+    WRITTEN_BY: ClassVar[str] = ""
+
+    def to_dataset(self) -> xr.Dataset:
+        """The result as an xarray Dataset with CF attributes (``units``, ``long_name``)."""
+        raise NotImplementedError
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset):
+        """Inverse of :meth:`to_dataset` (also of the Dataset read back from its file).
+
+        Raises
+        ------
+        KeyError
+            A variable or attribute of the kind is missing.
+        """
+        raise NotImplementedError
+
+    def save(self, path) -> Path:
+        """Write :meth:`to_dataset` to the NetCDF file ``path`` atomically
+        (:func:`microimpact.io.write_netcdf`); return ``path``."""
+        return write_netcdf(self.to_dataset(), path)
+
+    @classmethod
+    def load(cls, path):
+        """Read a result written by :meth:`save`.
+
+        Raises
+        ------
+        FileNotFoundError
+            There is no file at ``path``.
+        ValueError
+            The file is not of this kind (another result, not NetCDF, a :meth:`placeholder`): the
+            message names the file and says what it is.
+        """
+        return cls._from_file(cls.read_dataset(path), path)
+
+    @classmethod
+    def read_dataset(cls, path) -> xr.Dataset:
+        """The Dataset of a file of this kind, read into memory (the file closed).
+
+        Raises
+        ------
+        FileNotFoundError, ValueError
+            As :meth:`load`.
+        """
+        try:
+            with xr.open_dataset(path, engine="netcdf4") as ds:
+                ds = ds.load()
+        except FileNotFoundError:
+            raise
+        except Exception:  # noqa: BLE001 - netCDF4 raises OSError/ValueError variously
+            raise ValueError(cls._not_this_kind(path)) from None
+        if not str(ds.attrs.get("title", "")).startswith(cls.TITLE):
+            raise ValueError(cls._not_this_kind(path))
+        return restore_label_coordinates(ds)
+
+    @classmethod
+    def load_optional(cls, path):
+        """:meth:`load`, but None where the file is the kind's :meth:`placeholder` (a part a
+        pipeline did not compute, e.g. the posterior file of a fit without ``--posterior``).
+
+        Raises
+        ------
+        FileNotFoundError, ValueError
+            As :meth:`load`: a file of another kind is an error, not "no result".
+        """
+        return cls._read_part(path)[0]
+
+    @classmethod
+    def _read_part(cls, path) -> tuple:
+        """(result, Dataset) of the file ``path``; (None, None) for a placeholder."""
+        ds = cls.read_dataset(path)
+        if is_placeholder(ds):
+            return None, None
+        return cls._from_file(ds, path), ds
+
+    @classmethod
+    def _from_file(cls, ds: xr.Dataset, path):
+        """:meth:`from_dataset` of the Dataset :meth:`read_dataset` read from ``path``."""
+        if is_placeholder(ds):
+            raise ValueError(f"{path}: holds no {cls.KIND} ({ds.attrs.get('comment', 'no result')})")
+        try:
+            return cls.from_dataset(ds)
+        except KeyError:
+            raise ValueError(cls._not_this_kind(path)) from None
+
+    @classmethod
+    def placeholder(cls, comment: str) -> xr.Dataset:
+        """A Dataset of this kind that holds no result, and says why in ``comment``."""
+        return xr.Dataset(attrs={"title": cls.TITLE, "Conventions": CONVENTIONS, "comment": comment})
+
+    @classmethod
+    def _not_this_kind(cls, path) -> str:
+        return f"{path}: not a {cls.KIND} (the file that '{cls.WRITTEN_BY}' writes): it is {file_kind(path)}"
+
+
+def is_placeholder(ds: xr.Dataset) -> bool:
+    """Whether ``ds`` is a :meth:`FitResult.placeholder`: a result's file without a result (no variables)."""
+    return not ds.data_vars
+
+
 # --------------------------------------------------------------------------- result
 @dataclass(frozen=True, eq=False)
-class DampingFit(ReportHTML):
+class DampingFit(ReportHTML, FitResult):
     """Result of :func:`fit_damping`.
 
     Attributes
@@ -97,6 +245,10 @@ class DampingFit(ReportHTML):
     >>> DampingFit.from_dataset(fit.to_dataset()).values == fit.values
     True
     """
+
+    TITLE = "damping fit of the microsphere impact model (Cheng, Brach & Dunn 2002)"
+    KIND = "damping fit"
+    WRITTEN_BY = "microimpact fit --out"
 
     values: dict
     stderr: dict
@@ -182,8 +334,6 @@ class DampingFit(ReportHTML):
         return self.report()
 
     def __repr__(self) -> str:
-        from microimpact.io.formatting import estimates_repr
-
         return estimates_repr("DampingFit", self.values, self.stderr, self.varied, redchi=float(self.redchi),
                               n_points=int(self.n_points))
 
@@ -224,7 +374,7 @@ class DampingFit(ReportHTML):
             name = {"e_n": "e_n_measured", "model": "e_n_model"}.get(col, col)
             ds[name] = xr.DataArray(values, dims=("point",), attrs=attributes(name))
         ds.attrs.update({
-            "title": "damping fit of the microsphere impact model (Cheng, Brach & Dunn 2002)",
+            "title": self.TITLE,
             "Conventions": CONVENTIONS,
             "chisqr": float(self.chisqr), "redchi": float(self.redchi), "aic": float(self.aic),
             "bic": float(self.bic), "n_points": int(self.n_points),
@@ -240,15 +390,9 @@ class DampingFit(ReportHTML):
             ds.attrs[f"fit_{k}"] = int(v) if isinstance(v, (bool, np.bool_)) else (v if isinstance(v, (int, float, str)) else str(v))
         return stamp_parameters(ds, [self.contact(r) for r in self.radii], self.parameter_source)
 
-    def save(self, path) -> Path:
-        """Write :meth:`to_dataset` to NetCDF atomically (:func:`microimpact.io.write_netcdf`)."""
-        return write_netcdf(self.to_dataset(), path)
-
     @classmethod
     def from_dataset(cls, ds: xr.Dataset) -> "DampingFit":
         """Inverse of :meth:`to_dataset` (also of the Dataset read back from its file)."""
-        from microimpact.io.files import restore_label_coordinates
-
         ds = restore_label_coordinates(ds)
         a = ds.attrs
         varied = tuple(a["varied"].split()) if a.get("varied") else ()
@@ -257,7 +401,8 @@ class DampingFit(ReportHTML):
         cis = {}
         for n in varied:
             lim = ds[f"{n}_confidence_limit"].values
-            cis[n] = {int(s): float(x) for s, x in zip(ds["sigma_level"].values, lim)}
+            if np.any(np.isfinite(lim)):  # all NaN: not computed (to_dataset's fill of a missing entry)
+                cis[n] = {int(s): float(x) for s, x in zip(ds["sigma_level"].values, lim)}
         data = pd.DataFrame({
             "row": ds["row"].values.astype(np.int64), "radius": ds["radius"].values,
             "normal_speed": ds["normal_speed"].values, "e_n": ds["e_n_measured"].values,
@@ -274,35 +419,6 @@ class DampingFit(ReportHTML):
                    damping_reference_speed=None if isinstance(ref, str) else float(ref),
                    weighting=str(a["weighting"]), scale_covar=bool(int(a["scale_covar"])), info=info,
                    identifiability={n: st for n, st in statuses.items() if st is not None})
-
-    @classmethod
-    def load(cls, path) -> "DampingFit":
-        """Read a fit written by :meth:`save`.
-
-        Raises
-        ------
-        ValueError
-            If the file is not a damping-fit NetCDF (names the file and the missing variable).
-        """
-        path = Path(path)
-        try:
-            with xr.open_dataset(path, engine="netcdf4") as ds:
-                ds = ds.load()
-        except FileNotFoundError:
-            raise
-        except Exception:  # noqa: BLE001 - netCDF4 raises OSError/ValueError variously
-            raise ValueError(cls._not_a_fit(path)) from None
-        try:
-            return cls.from_dataset(ds)
-        except KeyError:
-            raise ValueError(cls._not_a_fit(path)) from None
-
-    @staticmethod
-    def _not_a_fit(path) -> str:
-        from microimpact.io.kinds import file_kind
-
-        return (f"{path}: not a damping fit (the file that 'microimpact fit --out' writes): it is "
-                f"{file_kind(path)}")
 
 
 # --------------------------------------------------------------------------- the one formatter

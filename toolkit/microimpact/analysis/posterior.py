@@ -53,18 +53,17 @@ import pandas as pd
 import xarray as xr
 
 from microimpact.io.formatting import ReportHTML
-from microimpact.analysis.fit_result import PARAMETER_NAMES
+from microimpact.analysis.fit_result import PARAMETER_NAMES, FitResult
 from microimpact.analysis.sampling_defaults import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS,
                                                     MAX_SEED)
-from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.files import CONVENTIONS, restore_label_coordinates
 from microimpact.io.materials import material_contact
 from microimpact.io.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "DEFAULT_WALKERS", "DEFAULT_MAX_STEPS",
            "DEFAULT_SEED", "DEFAULT_N_DRAWS", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
-           "sweep_bands", "posterior_dataset", "posterior_from_dataset", "load_posterior", "save_posterior",
-           "summary_table", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"]
+           "sweep_bands", "summary_table", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"]
 
 #: the title of every posterior file (a sampled one adds how it was sampled)
 POSTERIOR_TITLE = "posterior of the fitted parameters"
@@ -80,7 +79,7 @@ QUANTILES = (0.025, 0.16, 0.5, 0.84, 0.975)
 
 
 @dataclass(frozen=True, eq=False)
-class Posterior(ReportHTML):
+class Posterior(ReportHTML, FitResult):
     """An MCMC sample of the fitted parameters.
 
     Attributes
@@ -115,7 +114,20 @@ class Posterior(ReportHTML):
     >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
     >>> post.names, post.converged
     (('zeta_hertz', 'zeta_adhesion'), False)
+
+    The chain survives its file; a file of another kind is refused, naming it:
+
+    >>> Posterior.load(post.save("posterior.nc"))
+    Posterior(zeta_hertz, zeta_adhesion; 8 walkers x 60 steps, burn-in 20, seed 2002, converged=False)
+    >>> Posterior.load(fit.save("fit.nc"))
+    Traceback (most recent call last):
+    ...
+    ValueError: fit.nc: not a posterior (the file that 'microimpact fit --posterior' writes): it is a NetCDF file titled 'damping fit ...'
     """
+
+    TITLE = POSTERIOR_TITLE
+    KIND = "posterior"
+    WRITTEN_BY = "microimpact fit --posterior"
 
     names: tuple
     chain: np.ndarray
@@ -204,6 +216,107 @@ class Posterior(ReportHTML):
         lines.append(f"  speed errors: {self.info.get('errors_in_variables', '')}")
         return "\n".join(lines)
 
+
+    # ------------------------------------------------------------------ NetCDF
+    def to_dataset(self, *extra: xr.Dataset) -> xr.Dataset:
+        """The chain, its summary and diagnostics (and any band Datasets ``extra``) as one CF Dataset.
+
+        Variables: ``chain_<name>(step, walker)``, ``log_probability(step, walker)``,
+        ``<name>_quantile(quantile)``, ``<name>_autocorr_time``, ``acceptance_fraction(walker)``;
+        attributes ``burn_in``, ``seed``, ``converged``, ``convergence``, ``errors_in_variables``,
+        ``fixed_<name>``. ``extra``: e.g. :func:`restitution_bands`, :func:`capture_velocity_interval`,
+        :func:`sweep_bands` (the posterior file of ``microimpact fit --posterior`` holds them).
+
+        Examples
+        --------
+        >>> from microimpact.analysis.fitting import fit_damping
+        >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+        >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+        >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+        >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+        >>> fit = fit_damping(table, material, confidence_intervals=False)
+        >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+        >>> ds = post.to_dataset()
+        >>> [v for v in ds.data_vars if v.startswith("chain_")]
+        ['chain_zeta_hertz', 'chain_zeta_adhesion']
+        """
+        steps, walkers, _ = self.chain.shape
+        ds = xr.Dataset(coords={
+            "step": ("step", np.arange(steps), {"long_name": "MCMC step"}),
+            "walker": ("walker", np.arange(walkers), {"long_name": "emcee walker"}),
+            "quantile": ("quantile", np.array(QUANTILES), {"units": "1", "long_name": "posterior quantile"})})
+        s = self.samples
+        info = self.info
+        for i, n in enumerate(self.names):
+            u = PARAMETER_UNITS[n]
+            prior = info.get("priors", {}).get(n, (math.nan, math.nan))
+            bounds = info.get("bounds", {}).get(n, (math.nan, math.nan))
+            ds[f"chain_{n}"] = (("step", "walker"), self.chain[:, :, i], {
+                "units": u, "long_name": f"MCMC chain of {n}", "prior": "flat", "prior_min": float(prior[0]),
+                "prior_max": float(prior[1]), "status": info.get("status", {}).get(n, "determined"),
+                "fit_bound_lower": float(bounds[0]), "fit_bound_upper": float(bounds[1]),
+                "rhat": float(info.get("rhat", {}).get(n, math.nan)),
+                "ess_bulk": float(info.get("ess_bulk", {}).get(n, math.nan)),
+                "statement": self.bound(n) or "determined by the data"})
+            ds[f"{n}_quantile"] = ("quantile", np.quantile(s[:, i], QUANTILES), {
+                "units": u, "long_name": f"posterior quantiles of {n} (after burn-in)"})
+            ds[f"{n}_autocorr_time"] = ((), self.autocorr_time[n], {
+                "units": "1", "long_name": f"integrated autocorrelation time of {n} in steps"})
+        ds["log_probability"] = (("step", "walker"), self.log_probability, {
+            "units": "1", "long_name": "log posterior probability (up to a constant)"})
+        ds["acceptance_fraction"] = ("walker", self.acceptance_fraction, {
+            "units": "1", "long_name": "fraction of accepted proposals per walker"})
+        for e in extra:
+            ds = ds.merge(e, combine_attrs="drop_conflicts")
+        ds.attrs.update({
+            "title": f"{POSTERIOR_TITLE} (emcee, run until converged)", "Conventions": CONVENTIONS,
+            "sampled": " ".join(self.names), "burn_in": int(self.burn), "seed": int(self.seed),
+            "converged": int(self.converged), "convergence": str(info.get("convergence", "")),
+            "errors_in_variables": str(info.get("errors_in_variables", "")),
+            "latent_speed_rows": " ".join(map(str, info.get("latent_rows", ()))),
+            "source": str(info.get("source", "")),
+            **({"moves": str(info["moves"])} if "moves" in info else {}),
+            **({"elapsed_s": float(info["elapsed_s"])} if "elapsed_s" in info else {}),
+            **{f"fixed_{k}": float(v) for k, v in self.fixed.items()}})
+        return ds
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset) -> "Posterior":
+        """Inverse of :meth:`to_dataset` (the chain part; also of the Dataset read back from its file).
+
+        Examples
+        --------
+        >>> from microimpact.analysis.fitting import fit_damping
+        >>> from microimpact.analysis.synthetic import write_synthetic_impacts
+        >>> from microimpact.io import default_materials_path, read_impacts, read_materials
+        >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+        >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
+        >>> fit = fit_damping(table, material, confidence_intervals=False)
+        >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
+        >>> Posterior.from_dataset(post.to_dataset())
+        Posterior(zeta_hertz, zeta_adhesion; 8 walkers x 60 steps, burn-in 20, seed 2002, converged=False)
+        """
+        ds = restore_label_coordinates(ds)
+        a = ds.attrs
+        names = tuple(str(a["sampled"]).split())
+        chain = np.stack([ds[f"chain_{n}"].values for n in names], axis=-1)
+        fixed = {k.removeprefix("fixed_"): float(v) for k, v in a.items() if k.startswith("fixed_")}
+        per = {n: ds[f"chain_{n}"].attrs for n in names}
+        extra = {}
+        if all("prior_min" in v for v in per.values()):
+            extra = {"priors": {n: (float(v["prior_min"]), float(v["prior_max"])) for n, v in per.items()},
+                     "status": {n: str(v["status"]) for n, v in per.items()},
+                     "bounds": {n: (float(v["fit_bound_lower"]), float(v["fit_bound_upper"])) for n, v in per.items()},
+                     "rhat": {n: float(v["rhat"]) for n, v in per.items()},
+                     "ess_bulk": {n: float(v["ess_bulk"]) for n, v in per.items()}}
+        recorded = {"latent_rows": tuple(int(r) for r in str(a.get("latent_speed_rows", "")).split()),
+                    "source": str(a.get("source", ""))}
+        recorded |= {k: f(a[k]) for k, f in (("moves", str), ("elapsed_s", float)) if k in a}
+        return cls(names=names, chain=chain, log_probability=ds["log_probability"].values, burn=int(a["burn_in"]),
+                   fixed=fixed, autocorr_time={n: float(ds[f"{n}_autocorr_time"]) for n in names},
+                   acceptance_fraction=ds["acceptance_fraction"].values, seed=int(a["seed"]),
+                   info={"converged": bool(int(a["converged"])), "convergence": str(a.get("convergence", "")),
+                         "errors_in_variables": str(a.get("errors_in_variables", ""))} | recorded | extra)
 
 # =============================================================================== likelihood
 class _Likelihood:
@@ -857,103 +970,6 @@ def _coords(radii, quantiles) -> dict:
             "quantile": ("quantile", np.array(quantiles), {"units": "1", "long_name": "posterior quantile"})}
 
 
-# =============================================================================== NetCDF
-def posterior_dataset(posterior: Posterior, *extra: xr.Dataset) -> xr.Dataset:
-    """The chain, its summary and diagnostics (and any band Datasets) as one CF Dataset.
-
-    Variables: ``chain_<name>(step, walker)``, ``log_probability(step, walker)``,
-    ``<name>_quantile(quantile)``, ``<name>_autocorr_time``, ``acceptance_fraction(walker)``;
-    attributes ``burn_in``, ``seed``, ``converged``, ``convergence``, ``errors_in_variables``,
-    ``fixed_<name>``.
-
-    Examples
-    --------
-    >>> from microimpact.analysis.fitting import fit_damping
-    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
-    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
-    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
-    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
-    >>> fit = fit_damping(table, material, confidence_intervals=False)
-    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
-    >>> ds = posterior_dataset(post)
-    >>> [v for v in ds.data_vars if v.startswith("chain_")]
-    ['chain_zeta_hertz', 'chain_zeta_adhesion']
-    """
-    steps, walkers, _ = posterior.chain.shape
-    ds = xr.Dataset(coords={
-        "step": ("step", np.arange(steps), {"long_name": "MCMC step"}),
-        "walker": ("walker", np.arange(walkers), {"long_name": "emcee walker"}),
-        "quantile": ("quantile", np.array(QUANTILES), {"units": "1", "long_name": "posterior quantile"})})
-    s = posterior.samples
-    for i, n in enumerate(posterior.names):
-        u = PARAMETER_UNITS[n]
-        info = posterior.info
-        prior = info.get("priors", {}).get(n, (math.nan, math.nan))
-        bounds = info.get("bounds", {}).get(n, (math.nan, math.nan))
-        ds[f"chain_{n}"] = (("step", "walker"), posterior.chain[:, :, i], {
-            "units": u, "long_name": f"MCMC chain of {n}", "prior": "flat", "prior_min": float(prior[0]),
-            "prior_max": float(prior[1]), "status": info.get("status", {}).get(n, "determined"),
-            "fit_bound_lower": float(bounds[0]), "fit_bound_upper": float(bounds[1]),
-            "rhat": float(info.get("rhat", {}).get(n, math.nan)),
-            "ess_bulk": float(info.get("ess_bulk", {}).get(n, math.nan)),
-            "statement": posterior.bound(n) or "determined by the data"})
-        ds[f"{n}_quantile"] = ("quantile", np.quantile(s[:, i], QUANTILES), {
-            "units": u, "long_name": f"posterior quantiles of {n} (after burn-in)"})
-        ds[f"{n}_autocorr_time"] = ((), posterior.autocorr_time[n], {
-            "units": "1", "long_name": f"integrated autocorrelation time of {n} in steps"})
-    ds["log_probability"] = (("step", "walker"), posterior.log_probability, {
-        "units": "1", "long_name": "log posterior probability (up to a constant)"})
-    ds["acceptance_fraction"] = ("walker", posterior.acceptance_fraction, {
-        "units": "1", "long_name": "fraction of accepted proposals per walker"})
-    for e in extra:
-        ds = ds.merge(e, combine_attrs="drop_conflicts")
-    ds.attrs.update({
-        "title": f"{POSTERIOR_TITLE} (emcee, run until converged)", "Conventions": CONVENTIONS,
-        "sampled": " ".join(posterior.names), "burn_in": int(posterior.burn), "seed": int(posterior.seed),
-        "converged": int(posterior.converged), "convergence": str(posterior.info.get("convergence", "")),
-        "errors_in_variables": str(posterior.info.get("errors_in_variables", "")),
-        "latent_speed_rows": " ".join(map(str, posterior.info.get("latent_rows", ()))),
-        "source": str(posterior.info.get("source", "")),
-        **{f"fixed_{k}": float(v) for k, v in posterior.fixed.items()}})
-    return ds
-
-
-def posterior_from_dataset(ds: xr.Dataset) -> Posterior:
-    """Inverse of :func:`posterior_dataset` (the chain part; also of the Dataset read back from its file).
-
-    Examples
-    --------
-    >>> from microimpact.analysis.fitting import fit_damping
-    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
-    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
-    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
-    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
-    >>> fit = fit_damping(table, material, confidence_intervals=False)
-    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
-    >>> posterior_from_dataset(posterior_dataset(post))
-    Posterior(zeta_hertz, zeta_adhesion; 8 walkers x 60 steps, burn-in 20, seed 2002, converged=False)
-    """
-    from microimpact.io.files import restore_label_coordinates
-
-    ds = restore_label_coordinates(ds)
-    names = tuple(str(ds.attrs["sampled"]).split())
-    chain = np.stack([ds[f"chain_{n}"].values for n in names], axis=-1)
-    fixed = {k.removeprefix("fixed_"): float(v) for k, v in ds.attrs.items() if k.startswith("fixed_")}
-    per = {n: ds[f"chain_{n}"].attrs for n in names}
-    extra = {}
-    if all("prior_min" in a for a in per.values()):
-        extra = {"priors": {n: (float(a["prior_min"]), float(a["prior_max"])) for n, a in per.items()},
-                 "status": {n: str(a["status"]) for n, a in per.items()},
-                 "bounds": {n: (float(a["fit_bound_lower"]), float(a["fit_bound_upper"])) for n, a in per.items()},
-                 "rhat": {n: float(a["rhat"]) for n, a in per.items()},
-                 "ess_bulk": {n: float(a["ess_bulk"]) for n, a in per.items()}}
-    return Posterior(names=names, chain=chain, log_probability=ds["log_probability"].values, burn=int(ds.attrs["burn_in"]),
-                     fixed=fixed, autocorr_time={n: float(ds[f"{n}_autocorr_time"]) for n in names},
-                     acceptance_fraction=ds["acceptance_fraction"].values, seed=int(ds.attrs["seed"]),
-                     info={"converged": bool(int(ds.attrs["converged"])), "convergence": ds.attrs.get("convergence", ""),
-                           "errors_in_variables": ds.attrs.get("errors_in_variables", "")} | extra)
-
-
 def posterior_memory(walkers: int, steps: int, n_parameters: int) -> float:
     """Bytes a chain of ``walkers`` x ``steps`` over ``n_parameters`` holds at its largest: emcee's
     chain and log-probabilities (float64) and the posterior's own copy of the kept part.
@@ -973,66 +989,6 @@ def check_posterior_memory(walkers: int, steps: int, n_parameters: int) -> None:
 
     check_memory(f"a chain of {walkers} walkers x {steps} steps (walkers, steps / max_steps) over {n_parameters} "
                  "parameters", posterior_memory(walkers, steps, n_parameters))
-
-
-def load_posterior(path) -> Posterior | None:
-    """The :class:`Posterior` of a posterior NetCDF, or None when the file holds none (posterior disabled).
-
-    Raises
-    ------
-    ValueError
-        If the file is not a posterior file at all (a fit, a sweep, ...): it is not taken for "no
-        posterior" in silence.
-
-    Examples
-    --------
-    See :func:`save_posterior`.
-
-    A file that is not there is an error, not "no posterior":
-
-    >>> load_posterior("no_such_file.nc")
-    Traceback (most recent call last):
-    ...
-    FileNotFoundError: ...
-    """
-    from microimpact.io.kinds import file_kind
-
-    def not_a_posterior() -> ValueError:
-        return ValueError(f"{path}: not a posterior (the file that 'microimpact fit --posterior' writes): it is "
-                          f"{file_kind(path)}")
-
-    try:
-        ds = xr.open_dataset(path, engine="netcdf4")
-    except FileNotFoundError:
-        raise
-    except Exception:  # noqa: BLE001 - netCDF4 raises OSError/ValueError variously
-        raise not_a_posterior() from None
-    with ds:
-        if "sampled" not in ds.attrs:
-            if str(ds.attrs.get("title", "")).startswith(POSTERIOR_TITLE):
-                return None
-            raise not_a_posterior()
-        return posterior_from_dataset(ds.load())
-
-
-def save_posterior(ds: xr.Dataset, path):
-    """Write a :func:`posterior_dataset` atomically.
-
-    Examples
-    --------
-    >>> from microimpact.analysis.fitting import fit_damping
-    >>> from microimpact.analysis.synthetic import write_synthetic_impacts
-    >>> from microimpact.io import default_materials_path, read_impacts, read_materials
-    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
-    >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
-    >>> fit = fit_damping(table, material, confidence_intervals=False)
-    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
-    >>> save_posterior(posterior_dataset(post), "posterior.nc").name
-    'posterior.nc'
-    >>> load_posterior("posterior.nc").converged
-    False
-    """
-    return write_netcdf(ds, path)
 
 
 def summary_table(posterior: Posterior) -> pd.DataFrame:

@@ -23,7 +23,9 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from microimpact.io.files import CONVENTIONS, write_csv, write_netcdf
+from microimpact.analysis.fit_result import FitResult
+from microimpact.io.files import CONVENTIONS, write_csv
+from microimpact.io.formatting import estimates_repr
 from microimpact.solvers import DEFAULT_RTOL
 
 __all__ = ["DampingTarget", "damping_from_target"]
@@ -31,8 +33,17 @@ __all__ = ["DampingTarget", "damping_from_target"]
 _ZETA_CAP = 1e6  # [-] no physical damping is larger; the bracket search stops here
 
 
+#: the DampingTarget.info entries its file keeps (as global attributes)
+_INFO_KEYS = ("rtol", "material", "chisqr")
+#: the target columns and their (units, long_name) in the file (as ``target_<column>``)
+_TARGET_COLUMNS = {"speed": ("m s-1", "target incident normal speed"),
+                   "e_n": ("1", "target normal coefficient of restitution"),
+                   "e_n_uncertainty": ("1", "standard uncertainty of the target e_n"),
+                   "radius": ("m", "sphere radius")}
+
+
 @dataclass(frozen=True, eq=False)
-class DampingTarget:
+class DampingTarget(FitResult):
     """Result of :func:`damping_from_target`.
 
     Attributes
@@ -60,6 +71,10 @@ class DampingTarget:
     (True, 5)
     """
 
+    TITLE = "damping coefficients that reproduce measured e_n (Cheng, Brach & Dunn 2002, Eq. (27))"
+    KIND = "damping target"
+    WRITTEN_BY = "microimpact target --out"
+
     targets: pd.DataFrame
     curves: xr.Dataset
     best: dict | None = None
@@ -67,8 +82,6 @@ class DampingTarget:
     info: dict = field(default_factory=dict)
 
     def __repr__(self) -> str:
-        from microimpact.io.formatting import estimates_repr
-
         if self.best is None:
             best = "no least-squares point"
         elif len(self.targets) <= len(self.best):  # as many targets as parameters: solved, no error estimate
@@ -82,17 +95,28 @@ class DampingTarget:
         """The curves, the targets and the best point as one CF Dataset."""
         ds = self.curves.copy()
         t = self.targets
-        for c, (u, ln) in {"speed": ("m s-1", "target incident normal speed"), "e_n": ("1", "target normal coefficient "
-                           "of restitution"), "e_n_uncertainty": ("1", "standard uncertainty of the target e_n"),
-                           "radius": ("m", "sphere radius")}.items():
+        for c, (u, ln) in _TARGET_COLUMNS.items():
             ds[f"target_{c}"] = ("target", t[c].to_numpy(dtype=float), {"units": u, "long_name": ln})
         if self.best is not None:
             for k, v in self.best.items():
                 ds[f"best_{k}"] = ((), v, {"units": "1", "long_name": f"least-squares {k} over all targets"})
                 ds[f"best_{k}_stderr"] = ((), self.stderr[k], {"units": "1", "long_name": f"standard error of best {k}"})
-        ds.attrs.update({"title": "damping coefficients that reproduce measured e_n (Cheng, Brach & Dunn 2002, Eq. (27))",
-                         "Conventions": CONVENTIONS, **{k: v for k, v in self.info.items() if isinstance(v, (int, float, str))}})
+        ds.attrs.update({"title": self.TITLE, "Conventions": CONVENTIONS,
+                         **{k: v for k, v in self.info.items() if isinstance(v, (int, float, str))}})
         return ds
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset) -> "DampingTarget":
+        """Inverse of :meth:`to_dataset` (also of the Dataset read back from its file)."""
+        targets = pd.DataFrame({c: ds[f"target_{c}"].values.astype(float) for c in _TARGET_COLUMNS})
+        names = [str(v).removeprefix("best_") for v in ds.data_vars
+                 if str(v).startswith("best_") and not str(v).endswith("_stderr")]
+        best = {k: float(ds[f"best_{k}"]) for k in names} or None
+        stderr = {k: float(ds[f"best_{k}_stderr"]) for k in names} or None
+        curves = ds[["zeta_hertz", "zeta_adhesion"]]
+        curves.attrs = {}
+        info = {k: (v.item() if hasattr(v, "item") else v) for k, v in ds.attrs.items() if k in _INFO_KEYS}
+        return cls(targets=targets, curves=curves, best=best, stderr=stderr, info=info)
 
     def to_frame(self) -> pd.DataFrame:
         """One row per curve point: ``target``, ``speed`` [m/s], ``e_n`` [1], ``zeta_hertz``, ``zeta_adhesion`` [1]."""
@@ -106,12 +130,12 @@ class DampingTarget:
         return pd.DataFrame(rows)
 
     def save(self, path):
-        """Write the curves to ``path``: ``.csv`` (one row per curve point) or ``.nc`` (NetCDF)."""
-        path = str(path)
-        if path.endswith(".csv"):
+        """Write the result to ``path``: ``.nc`` through :meth:`FitResult.save` (what :meth:`load`
+        reads), or ``.csv``, the curves alone as a table of :meth:`to_frame` (one row per curve point)."""
+        if str(path).endswith(".csv"):
             return write_csv(self.to_frame(), path, float_format="%.8g")
-        if path.endswith(".nc"):
-            return write_netcdf(self.to_dataset(), path)
+        if str(path).endswith(".nc"):
+            return super().save(path)
         raise ValueError(f"{path}: the output must end in .csv or .nc")
 
 

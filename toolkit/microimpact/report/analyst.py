@@ -156,7 +156,7 @@ def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset) -> None:
     file that was not computed gives one line instead:
 
     >>> from microimpact.analysis.fitting import fit_damping
-    >>> from microimpact.analysis.posterior import posterior_dataset, restitution_bands, sample_posterior
+    >>> from microimpact.analysis.posterior import restitution_bands, sample_posterior
     >>> from microimpact.analysis.synthetic import write_synthetic_impacts
     >>> from microimpact.io import default_materials_path, read_impacts, read_materials
     >>> from microimpact.report.layout import Layout
@@ -165,7 +165,7 @@ def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset) -> None:
     >>> fit = fit_damping(table, material, confidence_intervals=False)
     >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
     >>> lay = Layout("Report")
-    >>> posterior_section(lay, fit.to_dataset(), posterior_dataset(post, restitution_bands(post, fit, [1.0, 2.0], n_draws=8)))
+    >>> posterior_section(lay, fit.to_dataset(), post.to_dataset(restitution_bands(post, fit, [1.0, 2.0], n_draws=8)))
     >>> text = " ".join(" ".join(t.get_text() for t in p.figure.texts) for p in lay.pages)
     >>> [name in text for name in ("zeta_hertz", "zeta_adhesion", "NOT converged")]
     [True, True, True]

@@ -28,14 +28,14 @@ def posterior_names(post: xr.Dataset) -> list[str]:
     Examples
     --------
     >>> from microimpact.analysis.fitting import fit_damping
-    >>> from microimpact.analysis.posterior import posterior_dataset, restitution_bands, sample_posterior
+    >>> from microimpact.analysis.posterior import restitution_bands, sample_posterior
     >>> from microimpact.analysis.synthetic import write_synthetic_impacts
     >>> from microimpact.io import default_materials_path, read_impacts, read_materials
     >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
     >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
     >>> fit = fit_damping(table, material, confidence_intervals=False)
     >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
-    >>> ds = posterior_dataset(post, restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8))
+    >>> ds = post.to_dataset(restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8))
     >>> posterior_names(ds)
     ['zeta_hertz', 'zeta_adhesion']
     """
@@ -58,14 +58,14 @@ def plot_fit_bands(fit: xr.Dataset, post: xr.Dataset) -> Plot:
     Examples
     --------
     >>> from microimpact.analysis.fitting import fit_damping
-    >>> from microimpact.analysis.posterior import posterior_dataset, restitution_bands, sample_posterior
+    >>> from microimpact.analysis.posterior import restitution_bands, sample_posterior
     >>> from microimpact.analysis.synthetic import write_synthetic_impacts
     >>> from microimpact.io import default_materials_path, read_impacts, read_materials
     >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
     >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
     >>> fit = fit_damping(table, material, confidence_intervals=False)
     >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
-    >>> ds = posterior_dataset(post, restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8))
+    >>> ds = post.to_dataset(restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8))
     >>> plot = plot_fit_bands(fit.to_dataset(), ds)
     >>> len(plot.figure.axes), plot.caption.startswith("Measured e_n (1-sigma error bars)")
     (1, True)
@@ -109,14 +109,14 @@ def plot_corner(post: xr.Dataset) -> Plot:
     Two parameters: two histograms and one scatter panel (and an empty corner):
 
     >>> from microimpact.analysis.fitting import fit_damping
-    >>> from microimpact.analysis.posterior import posterior_dataset, restitution_bands, sample_posterior
+    >>> from microimpact.analysis.posterior import restitution_bands, sample_posterior
     >>> from microimpact.analysis.synthetic import write_synthetic_impacts
     >>> from microimpact.io import default_materials_path, read_impacts, read_materials
     >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
     >>> table = read_impacts(write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3))
     >>> fit = fit_damping(table, material, confidence_intervals=False)
     >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
-    >>> ds = posterior_dataset(post, restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8))
+    >>> ds = post.to_dataset(restitution_bands(post, fit, [1.0, 2.0, 5.0], n_draws=8))
     >>> plot = plot_corner(ds)
     >>> len(plot.figure.axes), plot.caption.split(" (")[0]
     (4, 'Corner plot of the posterior')
