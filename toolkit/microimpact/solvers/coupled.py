@@ -93,7 +93,7 @@ from microimpact.model import law as _law
 from microimpact.model import tangential_compliance as _tc
 from microimpact.model.kinematics import flat_broadcast
 from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form maps
-from microimpact.solvers import SolverError, dopri
+from microimpact.solvers import SolverError, UndeterminedOutcomeWarning, dopri
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _linear_tail_variation, _slow_twist
 
@@ -1000,8 +1000,6 @@ def _held_rolling_error(contact, v_in, w_in, f, out, held, info, tail_bound, rto
     Ai, J., Chen, J.-F., Rotter, J. M., Ooi, J. Y. (2011). Assessment of rolling resistance models
     in discrete element simulations. Powder Technology 206, 269-282.
     """
-    from microimpact.solvers import UndeterminedOutcomeWarning
-
     reversed_ = info[:, 7] > 0
     # without reversals the torque stays against the mean rolling: it can at most stop it
     error = np.where(reversed_, tail_bound, np.minimum(tail_bound, np.hypot(out["v_t"], out["v_tp"])))

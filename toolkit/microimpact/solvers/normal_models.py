@@ -71,7 +71,7 @@ from microimpact._numba import njit, njit_batch
 from microimpact.model import adhesion_models as am
 from microimpact.model import dem_damping as dd
 from microimpact.model.contact import check_positive
-from microimpact.solvers import DEFAULT_RTOL, dopri
+from microimpact.solvers import DEFAULT_RTOL, dopri, engine
 from microimpact.solvers.engine import (CAPTURE, INERTIA_FREE_ENTER, _linear_tail_variation, INERTIA_FREE_RESUME, OUTCOME_NAMES, REBOUND,
                                        RELAXATION_ENTER, RELAXATION_RESUME, EngineError, NormalSolution)
 
@@ -801,8 +801,6 @@ def solve_normal(contact, normal_speed: float, *, rtol: float = DEFAULT_RTOL, ne
     >>> s.outcome, round(s.friction_impulse / (c.mass * 0.05), 9), s.n_steps < 1000
     ('capture', 1.0, True)
     """
-    from microimpact.solvers import engine
-
     v = check_positive("normal_speed", normal_speed)
     if _paper_hertz(contact):
         return engine.solve_normal(contact.with_(normal_model="ring"), v, rtol=rtol, need_tail=need_tail,
@@ -868,8 +866,6 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     >>> round(float(r["e_n"][0]), 8) == round(3**0.5 / 2, 8)
     True
     """
-    from microimpact.solvers import engine
-
     if _paper_hertz(contact):
         return engine.solve_normal_many(contact.with_(normal_model="ring"), normal_speed, need_tail, rtol=rtol,
                                         tail_tolerance=tail_tolerance, max_steps=max_steps,
@@ -977,6 +973,8 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
     >>> bool(round(solve_normal_reference(c, 2.0 * jkr_sticking_velocity(c), rtol=1e-12).e_n, 8) == round(3**0.5 / 2, 8))
     True
     """
+    # imported here, not at the module's top: scipy.integrate would add to the start-up of every
+    # JKR/DMT solve, and only this reference check uses it
     from scipy.integrate import solve_ivp
 
     v = check_positive("normal_speed", normal_speed)
