@@ -351,3 +351,15 @@ def test_one_core_against_the_three_steppers(integrators_base, selection):
             moved = np.abs(new[rows, j] - old[rows, j])
             assert np.all(moved <= allowed), (
                 f"{selection} {name} rtol {rtol:g}: moved by {np.max(moved / (rtol * scale)):.3g} rtol of the scale")
+
+
+# --------------------------------------------------------------------------- the compiled solvers, bit for bit
+def test_compiled_solvers_bit_for_bit():
+    """The engine, the JKR/DMT/Hertz solver and the coupled solver give the numbers of
+    tests/regression/baseline/kernels.json exactly, step counts included (tests/regression/kernel_cases.py:
+    impacts over the extended domain, each solver's options and sub-models). Exact equality holds on
+    the machine that wrote the baseline (its CPU, numba and LLVM); a change elsewhere shows first in the
+    tolerance-based tests above, which this one does not replace."""
+    cases = _cases_module("kernel_cases")
+    moved = cases.differences(cases.fingerprint(), json.loads(cases.BASELINE.read_text()))
+    assert not moved, f"{len(moved)} outputs moved, first: {moved[:5]}"

@@ -93,7 +93,7 @@ from microimpact.model import law as _law
 from microimpact.model import tangential_compliance as _tc
 from microimpact.model.kinematics import flat_broadcast
 from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form maps
-from microimpact.solvers import SolverError, dopri
+from microimpact.solvers import SolverError, UndeterminedOutcomeWarning, dopri
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _linear_tail_variation, _slow_twist
 
@@ -532,25 +532,13 @@ def _impulse_time(z, z1, j_stop, tau_j, h, k1, p, hist):
 
 
 @njit(cache=True)
-def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max_steps):
-    """Integrate one impact of the coupled model (nondimensional; see the module docstring).
-
-    Parameters (all nondimensional): y0 incident normal rate; vt0, vtp0 tangential velocity;
-    wt0, wtp0 rim speeds r omega_t, r omega_t'; p the law's parameters (see :func:`_rhs`); j_stop,
-    ja_stop the impulses after which a captured sphere's sliding and twist are over (rigid
-    contact); settle the oscillation amplitude (relative to the equilibrium) at which a captured
-    sphere's integration stops (its tangential rest follows in closed form: see the module
-    docstring).
-
-    Returns (status, outcome, state at the end (12,), largest xi, tau at capture, tau at which J
-    reached j_stop, n_steps, turning points of the hysteretic law, rolling stops after the capture).
-    """
+def _start(y0, vt0, vtp0, wt0, wtp0, p, rtol):
+    """The state at first contact and the constants of one impact: returns (z, k1, hist, atol,
+    sref, lim_ref, ecap, h): the state and its derivative, the branch of the hysteretic law
+    (:func:`_initial_branch`), the absolute tolerances, the scale of s, the order of the largest
+    Coulomb limit, the capture margin of the energy (the engine's) and the first step."""
     z = np.zeros(_N)
     z[_Y], z[_VT], z[_VTP], z[_WT], z[_WTP] = y0, vt0, vtp0, wt0, wtp0
-    k = np.zeros((7, _N))
-    tmp = np.zeros(_N)
-    z1 = np.zeros(_N)
-    err = np.zeros(_N)
     k1 = np.zeros(_N)
     hist = _initial_branch(z, p)
     _rhs(z, k1, (p, hist))
@@ -568,6 +556,140 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     for i in range(_VT, _FT):
         atol[i] = rtol * vref
     atol[_FT] = atol[_FTP] = rtol * (1.0 if p[9] > 1.5 else sref)
+    lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
+    ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
+    h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
+    if y0 < 1.0:
+        h = min(1e-3 * (12.0 / y0) ** (1.0 / 3.0), 1e-2)
+    return z, k1, hist, atol, sref, lim_ref, ecap, h
+
+
+@njit(cache=True)
+def _end_at_events(en, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, lim_ref, slipping, load_side, elastic,
+                   rolling, hysteretic):
+    """A trial step z -> z1 of length h (error sum ``en``), ended at the earliest of a change of
+    gross slip (:func:`_end_at_slip_change`), a rolling stop (:func:`_end_at_rolling_stop`) and a
+    zero of the Coulomb limit (:func:`_end_at_limit_zero`). Returns (the error sum that decides
+    the step, restart the branch, at rest, the step's length, slip change, load_side)."""
+    restart = False
+    at_rest = False
+    h_end = h  # the step's length, shorter where it ends at an event
+    slip_change = False
+    if elastic and z[_S] > 0.0 and z1[_S] > 0.0:
+        en, slip_change, h_end = _end_at_slip_change(slipping, h, en, z, z1, k1, err, atol, rtol, p, hist, k,
+                                                     tmp, lim_ref)
+    if rolling and z[_S] > 0.0 and z1[_S] > 0.0 and z[_WT] * z1[_WT] + z[_WTP] * z1[_WTP] < 0.0:
+        en, at_rest, h_end = _end_at_rolling_stop(h_end, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hysteretic,
+                                                  lim_ref)
+        slip_change = slip_change and not at_rest  # the rolling stop comes first
+    if hysteretic and z[_S] > 0.0 and z1[_S] > 0.0:
+        # the Coulomb limit passes through zero within the step, seen from the side the branch
+        # was started on (a root found a rounding error short of the zero is not found again)
+        gb = _load_argument(z1, p)
+        if gb * load_side < 0.0:
+            en, restart = _end_at_limit_zero(en, gb, h_end, z, z1, k1, err, atol, rtol, p, hist, k, tmp)
+            if restart:  # the step now ends at that zero, before the rolling stop if any
+                load_side = 1.0 if gb > 0.0 else -1.0
+                at_rest = False
+    return en, restart, at_rest, h_end, slip_change, load_side
+
+
+@njit(cache=True)
+def _separate(z, z1, k1, h_end, p, hist, k, tmp, err, sref, conservative, y0, j_stop, tau_j):
+    """Separation within the accepted step z -> z1: its root on the step length; z becomes the
+    state there (out of contact, nothing stored). Returns tau at which J reached j_stop."""
+    _restep_to_root(_EV_SEPARATION, 0.0, z[_S], z1[_S], 1e-14 * sref, h_end, z, k1, p, hist, k, tmp, z1, err)
+    z1[_S] = 0.0
+    if conservative:  # leaves with its energy: U(0) = 0
+        z1[_Y] = -y0
+    tau_j = _impulse_time(z, z1, j_stop, tau_j, h_end, k1, p, hist)
+    for i in range(_N):
+        z[i] = z1[i]
+    z[_FT] = z[_FTP] = 0.0  # out of contact: nothing stored
+    return tau_j
+
+
+@njit(cache=True)
+def _tangential_update(z, k1, k, p, hist, turned, restart, load_side, slipping, slip_change, hysteretic, elastic,
+                       refresh):
+    """The tangential state after an accepted step (z its end): a new branch of the hysteretic law
+    at a turning point or a zero of the Coulomb limit, the branch coordinate kept in [0, 1], the
+    displacement held at delta* in gross slip, and the derivative at z into k1 (evaluated anew
+    where the state changed, else the last stage of the step). Returns (load_side, slipping)."""
+    if turned:  # new branch: s -> -s, c from the force ratio, p = 0 (force continuous)
+        ratio = _md_ratio(z[_FT], hist[0], hist[1])
+        hist[0] = -hist[0]
+        hist[1] = _md_span(ratio, hist[0])
+        z[_FT] = 0.0
+    if restart:
+        _restart_branch(z, p, hist)
+    if hysteretic:
+        if load_side == 0.0 and z[_S] > 0.0:
+            g = _load_argument(z, p)
+            load_side = 0.0 if g == 0.0 else (1.0 if g > 0.0 else -1.0)
+        z[_FT] = min(max(z[_FT], 0.0), 1.0)
+        _rhs(z, k1, (p, hist))
+    elif elastic:
+        projected = _project(z, p)
+        slipping = (not slipping) if slip_change else projected
+        _rhs(z, k1, (p, hist))
+    elif refresh:
+        _rhs(z, k1, (p, hist))
+    else:
+        for i in range(_N):
+            k1[i] = k[6, i]
+    return load_side, slipping
+
+
+@njit(cache=True)
+def _captured_stop(z, k1, atol, settle, peaked, conserved, j_stop, ja_stop, tail_closed, p, xe, omega0, ceq,
+                   long_tail):
+    """The outcome code at which the integration of a captured sphere stops (1, _CREEPING or
+    _LONG_TAIL), or 0 while it goes on; ``long_tail``: a twentieth of the step budget is spent."""
+    dx = z[_S] * z[_S] - xe
+    amp = math.sqrt(dx * dx + (z[_Y] / omega0) ** 2) / xe
+    # settled normal motion (the tangential rest is taken in closed form afterwards), or
+    # the rigid contact's sliding and twist over
+    if amp < settle or peaked and (conserved or z[_J] >= j_stop and z[_JA] >= ja_stop):
+        return 1
+    # strongly overdamped: it creeps into the equilibrium on the slow manifold, which an
+    # explicit solver follows in ~C^2 steps (the step limit at zeta ~ 1e4); the engine's
+    # creeping test, and the rest of the normal motion in closed form (_tail_impulses)
+    # (with rolling resistance only under the pulloff friction: the tail's rolling resistance
+    # is then taken in closed form for f = 0 and left out for a held sphere, _rolling_tail;
+    # under the paper's friction the sphere slides as well, and no closed form is written)
+    if tail_closed and ceq > 2.0 * omega0 and (peaked or z[_S] * z[_S] < xe) and _is_creeping(
+            z, k1, atol[_Y], np.bool_(True), p[0], p[1], p[2], p[3], xe, omega0, ceq):
+        return _CREEPING
+    if tail_closed and peaked and long_tail:
+        return _LONG_TAIL
+    return 0
+
+
+@njit(cache=True)
+def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max_steps):
+    """Integrate one impact of the coupled model (nondimensional; see the module docstring).
+
+    Parameters (all nondimensional): y0 incident normal rate; vt0, vtp0 tangential velocity;
+    wt0, wtp0 rim speeds r omega_t, r omega_t'; p the law's parameters (see :func:`_rhs`); j_stop,
+    ja_stop the impulses after which a captured sphere's sliding and twist are over (rigid
+    contact); settle the oscillation amplitude (relative to the equilibrium) at which a captured
+    sphere's integration stops (its tangential rest follows in closed form: see the module
+    docstring).
+
+    Returns (status, outcome, state at the end (12,), largest xi, tau at capture, tau at which J
+    reached j_stop, n_steps, turning points of the hysteretic law, rolling stops after the capture).
+
+    The loop steps and locates the events within a step; the set-up, the ends of a step at an
+    event, the separation, the update of the tangential state and the stop of a captured sphere
+    are compiled helpers.
+    """
+    z, k1, hist, atol, sref, lim_ref, ecap, h = _start(y0, vt0, vtp0, wt0, wtp0, p, rtol)
+    k = np.zeros((7, _N))
+    tmp = np.zeros(_N)
+    z1 = np.zeros(_N)
+    err = np.zeros(_N)
+    ah, aa = p[2], p[3]
     n_turn = 0
     n_restart = 0
     n_held_stops = 0  # rolling stops after the capture (_held_rolling_error)
@@ -579,15 +701,10 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     # that _end_at_slip_change is compiled once, not also for the literal False
     slipping = np.bool_(False)
     load_side = 0.0  # sign of the Coulomb limit's load argument since the last restart (0: not yet known)
-    lim_ref = p[4] * max(1.0, p[3], y0 ** 1.2) if p[4] > 0.0 else 1.0  # order of the largest F_lim
     damped = p[0] > 0.0 or p[1] > 0.0
     conservative = not damped and aa > 0.0
     e0 = 0.5 * y0 * y0  # the normal energy (U = 0 at first contact)
     xe, omega0, ceq = _equilibrium(p[0], p[1], ah, aa)
-    ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
-    h = 1e-3 * min(1.0, 2.0 / max(y0, 1e-300) ** 0.6)
-    if y0 < 1.0:
-        h = min(1e-3 * (12.0 / y0) ** (1.0 / 3.0), 1e-2)
     captured = False
     peaked = False  # the largest penetration located
     # a captured sphere with friction limited at rest and no rolling resistance ends rolling at its
@@ -608,26 +725,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
         _step(z, k1, h, (p, hist), k, tmp, z1, err)
         en = _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref)
         n += 1
-        restart = False
-        at_rest = False
-        h_end = h  # the step's length, shorter where it ends at an event
-        slip_change = False
-        if elastic and z[_S] > 0.0 and z1[_S] > 0.0:
-            en, slip_change, h_end = _end_at_slip_change(slipping, h, en, z, z1, k1, err, atol, rtol, p, hist, k,
-                                                         tmp, lim_ref)
-        if rolling and z[_S] > 0.0 and z1[_S] > 0.0 and z[_WT] * z1[_WT] + z[_WTP] * z1[_WTP] < 0.0:
-            en, at_rest, h_end = _end_at_rolling_stop(h_end, z, z1, k1, err, atol, rtol, p, hist, k, tmp, hysteretic,
-                                                      lim_ref)
-            slip_change = slip_change and not at_rest  # the rolling stop comes first
-        if hysteretic and z[_S] > 0.0 and z1[_S] > 0.0:
-            # the Coulomb limit passes through zero within the step, seen from the side the branch
-            # was started on (a root found a rounding error short of the zero is not found again)
-            gb = _load_argument(z1, p)
-            if gb * load_side < 0.0:
-                en, restart = _end_at_limit_zero(en, gb, h_end, z, z1, k1, err, atol, rtol, p, hist, k, tmp)
-                if restart:  # the step now ends at that zero, before the rolling stop if any
-                    load_side = 1.0 if gb > 0.0 else -1.0
-                    at_rest = False
+        en, restart, at_rest, h_end, slip_change, load_side = _end_at_events(
+            en, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, lim_ref, slipping, load_side, elastic, rolling,
+            hysteretic)
         en = math.sqrt(en / _N)
         if en > 1.0:
             h = dopri.shrunk_step(h, en)
@@ -639,15 +739,8 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             smax = max(smax, _root_state(_EV_DEPTH, 0.0, h_end, z, z1, k1, p, hist)[_S])
             peaked = True
         if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: its root on the step length
-            _restep_to_root(_EV_SEPARATION, 0.0, z[_S], z1[_S], 1e-14 * sref, h_end, z, k1, p, hist, k, tmp, z1, err)
-            z1[_S] = 0.0
-            if conservative:  # leaves with its energy: U(0) = 0
-                z1[_Y] = -y0
+            tau_j = _separate(z, z1, k1, h_end, p, hist, k, tmp, err, sref, conservative, y0, j_stop, tau_j)
             outcome = 0
-            tau_j = _impulse_time(z, z1, j_stop, tau_j, h_end, k1, p, hist)
-            for i in range(_N):
-                z[i] = z1[i]
-            z[_FT] = z[_FTP] = 0.0  # out of contact: nothing stored
             break
         turned = False
         if not restart and hysteretic and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
@@ -680,54 +773,18 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
             z[_WT] = z[_WTP] = 0.0
             if captured:
                 n_held_stops += 1
-        if turned:  # new branch: s -> -s, c from the force ratio, p = 0 (force continuous)
-            ratio = _md_ratio(z[_FT], hist[0], hist[1])
-            hist[0] = -hist[0]
-            hist[1] = _md_span(ratio, hist[0])
-            z[_FT] = 0.0
-            n_turn += 1
-        if restart:
-            _restart_branch(z, p, hist)
-            n_restart += 1
-        if hysteretic:
-            if load_side == 0.0 and z[_S] > 0.0:
-                g = _load_argument(z, p)
-                load_side = 0.0 if g == 0.0 else (1.0 if g > 0.0 else -1.0)
-            z[_FT] = min(max(z[_FT], 0.0), 1.0)
-            _rhs(z, k1, (p, hist))
-        elif elastic:
-            projected = _project(z, p)
-            slipping = (not slipping) if slip_change else projected
-            _rhs(z, k1, (p, hist))
-        elif refresh:
-            _rhs(z, k1, (p, hist))
-        else:
-            for i in range(_N):
-                k1[i] = k[6, i]
+        n_turn += 1 if turned else 0
+        n_restart += 1 if restart else 0
+        load_side, slipping = _tangential_update(z, k1, k, p, hist, turned, restart, load_side, slipping, slip_change,
+                                                 hysteretic, elastic, refresh)
         if rolling and z[_S] > 0.0:
             _hold_rolling(z, k1, atol[_WT] * min(max(1.0, h_end * _rolling_approach(z, k1) / atol[_WT]), _HOLD_SPAN),
                           p, hist)
         smax = max(smax, z[_S])
         if captured:
-            dx = z[_S] * z[_S] - xe
-            amp = math.sqrt(dx * dx + (z[_Y] / omega0) ** 2) / xe
-            # settled normal motion (the tangential rest is taken in closed form afterwards), or
-            # the rigid contact's sliding and twist over
-            if amp < settle or peaked and (conserved or z[_J] >= j_stop and z[_JA] >= ja_stop):
-                outcome = 1
-                break
-            # strongly overdamped: it creeps into the equilibrium on the slow manifold, which an
-            # explicit solver follows in ~C^2 steps (the step limit at zeta ~ 1e4); the engine's
-            # creeping test, and the rest of the normal motion in closed form (_tail_impulses)
-            # (with rolling resistance only under the pulloff friction: the tail's rolling resistance
-            # is then taken in closed form for f = 0 and left out for a held sphere, _rolling_tail;
-            # under the paper's friction the sphere slides as well, and no closed form is written)
-            if tail_closed and ceq > 2.0 * omega0 and (peaked or z[_S] * z[_S] < xe) and _is_creeping(
-                    z, k1, atol[_Y], np.bool_(True), p[0], p[1], ah, aa, xe, omega0, ceq):
-                outcome = _CREEPING
-                break
-            if tail_closed and peaked and 20 * n >= max_steps:
-                outcome = _LONG_TAIL
+            outcome = _captured_stop(z, k1, atol, settle, peaked, conserved, j_stop, ja_stop, tail_closed, p, xe,
+                                     omega0, ceq, 20 * n >= max_steps)
+            if outcome > 0:
                 break
         h = dopri.grown_step(h, en)
     if outcome >= 1 and not peaked:  # crept into the equilibrium without turning: its supremum
@@ -943,8 +1000,6 @@ def _held_rolling_error(contact, v_in, w_in, f, out, held, info, tail_bound, rto
     Ai, J., Chen, J.-F., Rotter, J. M., Ooi, J. Y. (2011). Assessment of rolling resistance models
     in discrete element simulations. Powder Technology 206, 269-282.
     """
-    from microimpact.solvers import UndeterminedOutcomeWarning
-
     reversed_ = info[:, 7] > 0
     # without reversals the torque stays against the mean rolling: it can at most stop it
     error = np.where(reversed_, tail_bound, np.minimum(tail_bound, np.hypot(out["v_t"], out["v_tp"])))

@@ -761,6 +761,186 @@ def _capture_finished(u, kend, J, turned, follow, need_tail, settle_amp, tail_to
 
 
 @njit(cache=True)
+def _start(y0, c1, c2, ah, aa, rtol):
+    """The state at first contact and the constants of one impact: returns (u, k1, sgn, atol,
+    noise, damped, ecap, xe, omega0, ceq, h), the state and its derivative, the expected sign of
+    dy/dsigma, the absolute tolerances, the amplitude below which a captured oscillation is
+    integration noise, whether the impact is damped, the capture margin of the energy, the
+    equilibrium (:func:`_equilibrium`) and the first step."""
+    u = np.zeros(_NSTATE)
+    u[1] = y0
+    k1 = np.zeros(_NSTATE)
+    sgn = _first_sign(y0, c1, c2, ah, aa)
+    _rhs(u, k1, (c1, c2, ah, aa, sgn))
+    atol = _absolute_tolerances(y0, rtol)
+    noise = 10.0 * (atol[0] + atol[1])
+    damped = c1 > 0.0 or (c2 > 0.0 and aa > 0.0)  # adhesion damping needs adhesion
+    ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
+    xe, omega0, ceq = _equilibrium(c1, c2, ah, aa)
+    return u, k1, sgn, atol, noise, damped, ecap, xe, omega0, ceq, _initial_step(y0)
+
+
+@njit(cache=True)
+def _capture_events(e0, e1, ecap, tau_zero, tau_capture, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
+    """The capture events within the step u -> u1 (energy e0 -> e1) of an adhesive damped impact not
+    yet captured: where E first falls below zero, and the capture (E below the margin ecap).
+    Returns (captured, tau_zero, tau_capture, recorded); ``recorded``: u1 was moved to an event.
+
+    Capture is E below zero by more than the integration can drift (without damping E is conserved,
+    so a negative E could only be integration error); a true capture keeps losing energy and crosses
+    the margin a little later. The capture time is where E first fell below zero (the margin's
+    crossing, reported before, was up to 1e-6 later at rtol 1e-9, where E falls slowly: near the
+    capture speed)."""
+    recorded = False
+    captured = False
+    if math.isnan(tau_zero) and e0 >= 0.0 and e1 < 0.0:
+        _energy_crossing(_EV_ENERGY, 0.0, e0, e1, 0.0, hev, u, k1, (c1, c2, ah, aa, sgn), (ah, aa), k, tmp, u1, err)
+        tau_zero = u1[2]
+        recorded = True
+    if e0 >= ecap and e1 < ecap:
+        captured = True
+        if math.isnan(tau_zero):  # (E below zero with no crossing seen: the margin's)
+            _locate(_EV_ENERGY, ecap, u, k1, hev, e0 - ecap, e1 - ecap, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            tau_zero = u1[2]
+            recorded = True
+        tau_capture = tau_zero
+    return captured, tau_zero, tau_capture, recorded
+
+
+@njit(cache=True)
+def _slip_end(J, j_target, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
+    """tau where J reaches j_target within the step u -> u1 (J at its start; y is monotone within
+    the step), with u1 moved there."""
+    yt = u[1] + (j_target - J) * (1.0 if u1[1] > u[1] else -1.0)
+    _locate(_EV_Y, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+    return u1[2]
+
+
+@njit(cache=True, inline="always")
+def _record(rec, n_rec, rec_cap, u):
+    """Append (tau, s, y) of the state u to the trajectory ``rec`` while it has room; returns the
+    new number of rows."""
+    if rec_cap > 0 and n_rec < rec_cap:
+        rec[n_rec, 0], rec[n_rec, 1], rec[n_rec, 2] = u[2], u[0], u[1]
+        n_rec += 1
+    return n_rec
+
+
+@njit(cache=True)
+def _inertia_free_jump(u, k1, kend, xi_t, J, j_target, tau_jtarget, captured, tau_zero, tau_capture, smax, rec,
+                       rec_cap, n_rec, sgn, c1, c2, ah, aa, xe, ecap):
+    """The jump along the inertia-free path from the state u to xi_t (:func:`_inertia_free`), in
+    closed form: the events on the way, the friction and twist impulses, the time and the energy
+    the jump skips (booked as dissipated). u becomes the state at xi_t.
+
+    Returns (outcome, J, tau_jtarget, captured, tau_zero, tau_capture, smax, n_rec, sgn): outcome
+    REBOUND (the invariant line without adhesion) or CAPTURE (the equilibrium) where the impact
+    ends, -1 where the explicit integration resumes at xi_t (k1 and kend then hold the derivative
+    there, sgn the sign of dy/dsigma)."""
+    xi0 = u[0] * u[0]
+    e_now = law.nondimensional_energy(u[0], u[1], ah, aa)
+    if aa > 0.0 and xi_t == xe:
+        y_t = 0.0
+    elif aa == 0.0:
+        y_t = -1.0 / c1
+    else:  # the slow path and its first inertia correction, y_m - y_m' y_m / damping
+        y_t = _slow_speed(xi_t, c1, c2, ah, aa)
+        dd = ah * c1 * xi_t + aa * c2
+        y_t += ah * aa * (c1 + c2) / (dd * dd) * y_t / (math.sqrt(xi_t) * dd)
+    dj = abs(u[1] - y_t)
+    if math.isnan(tau_jtarget) and j_target > 0.0 and J < j_target <= J + dj:
+        tau_jtarget = _slow_event_time(u, xi_t, u[1] + (j_target - J) * (1.0 if y_t > u[1] else -1.0),
+                                       _SLOW_Y, c1, c2, ah, aa)
+    if not captured and aa > 0.0:
+        if math.isnan(tau_zero):
+            tau_zero = _slow_event_time(u, xi_t, 0.0, _SLOW_ENERGY, c1, c2, ah, aa)
+        tc = _slow_event_time(u, xi_t, ecap, _SLOW_ENERGY, c1, c2, ah, aa)
+        if not math.isnan(tc):
+            captured = True
+            tau_capture = tc if math.isnan(tau_zero) else tau_zero
+    J += dj
+    if aa == 0.0:
+        u[4] += u[0] * dj
+        u[2] += c1 * xi0
+    else:
+        u[4] += _slow_twist(xi0, xi_t, c1, c2, ah, aa)
+        if xi_t != xe:
+            u[2] += _slow_time(xi0, xi_t, c1, c2, ah, aa)
+    u[0] = math.sqrt(xi_t)
+    u[1] = y_t
+    u[3] += e_now - law.nondimensional_energy(u[0], u[1], ah, aa)
+    smax = max(smax, u[0])
+    if not (aa > 0.0 and xi_t == xe):
+        n_rec = _record(rec, n_rec, rec_cap, u)
+    outcome = -1
+    if aa == 0.0:
+        outcome = REBOUND
+    elif xi_t == xe:
+        outcome = CAPTURE
+    else:  # resume the explicit integration where inertia matters again
+        s2 = xi_t
+        g = law.nondimensional_acceleration(s2, s2 * s2, u[1], c1, c2, ah, aa)
+        if g != 0.0:
+            sgn = 1.0 if g > 0.0 else -1.0
+        _rhs(u, kend, (c1, c2, ah, aa, sgn))
+        for i in range(_NSTATE):
+            k1[i] = kend[i]
+    return outcome, J, tau_jtarget, captured, tau_zero, tau_capture, smax, n_rec, sgn
+
+
+@njit(cache=True, inline="always")
+def _shortened(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err):
+    """The accepted step u -> u1 of length h, shortened to the earliest event that ends a piece of
+    the solution: separation (code 0) or an extremum of y, where the sign of |F_n| flips (code 2).
+    Returns (the step's length, code; -1: no event); u1 and k then hold the step taken."""
+    hev = h
+    code = -1
+    g0 = k1[1]
+    g1 = k[6, 1]
+    if u[0] > 0.0 and u1[0] <= 0.0:
+        hev = _locate(_EV_S, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        code = 0
+        _step(u, k1, h, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+    # an extremum of y: dy/dsigma leaves its expected sign (comparing with the expected sign,
+    # not with g0, keeps the root just found at the start of this step from being found again)
+    if u[0] > 0.0 and g1 * sgn < 0.0:
+        if g0 * sgn <= 0.0:
+            g0 = sgn * 1e-300
+        hh = _locate(_EV_DY, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        if code < 0 or hh < hev:
+            hev, code = hh, 2
+    if code >= 0:
+        _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+        # dy/dsigma ~ s^2 vanishes at the surface too, so an extremum found at the end of
+        # contact is the separation itself
+        if code == 2 and u1[0] <= 0.0 and u1[1] < 0.0:
+            code = 0
+    return hev, code
+
+
+@njit(cache=True, inline="always")
+def _advance(code, u, u1, k, k1, kend, c1, c2, ah, aa, sgn):
+    """Move the state to the end u1 of the step that ended at event ``code`` (:func:`_shortened`);
+    returns the sign of dy/dsigma expected from there. After an event the derivative is evaluated
+    anew (k1, kend), otherwise it is the last stage of the step (first same as last)."""
+    for i in range(_NSTATE):
+        u[i] = u1[i]
+    if code == 0:
+        u[0] = 0.0  # exactly at the surface
+    if code == 2 or code == 0:
+        if code == 2:
+            sgn = -sgn
+        _rhs(u, kend, (c1, c2, ah, aa, sgn))
+        for i in range(_NSTATE):
+            k1[i] = kend[i]
+    else:
+        for i in range(_NSTATE):
+            k1[i] = k[6, i]
+            kend[i] = k1[i]
+    return sgn
+
+
+@njit(cache=True)
 def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, settle_amp,
                max_steps, rec, rec_cap, j_stop, ja_stop):
     """Integrate one normal impact (Dormand-Prince 5(4) in sigma, see the module docstring).
@@ -770,24 +950,16 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
 
     Events that only record something (largest penetration, capture, end of sliding) are located
     inside the step without changing it, so the trajectory, and e_n, do not depend on which of
-    them a caller asked for.
+    them a caller asked for. The tests done at every step stay in this loop; what runs once per
+    impact or at an event (the set-up, the located events, the undamped mirror, the inertia-free
+    jump, the decision to stop a captured sphere) is in compiled helpers (above).
     """
-    u = np.zeros(_NSTATE)
-    u[1] = y0
+    u, k1, sgn, atol, noise, damped, ecap, xe, omega0, ceq, h = _start(y0, c1, c2, ah, aa, rtol)
     k = np.zeros((7, _NSTATE))
     tmp = np.zeros(_NSTATE)
     u1 = np.zeros(_NSTATE)
     err = np.zeros(_NSTATE)
-    k1 = np.zeros(_NSTATE)
     kend = np.zeros(_NSTATE)
-    sgn = _first_sign(y0, c1, c2, ah, aa)
-    _rhs(u, k1, (c1, c2, ah, aa, sgn))
-    atol = _absolute_tolerances(y0, rtol)
-    noise = 10.0 * (atol[0] + atol[1])
-    damped = c1 > 0.0 or (c2 > 0.0 and aa > 0.0)  # adhesion damping needs adhesion
-    ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
-    xe, omega0, ceq = _equilibrium(c1, c2, ah, aa)
-    h = _initial_step(y0)
     J = smax = 0.0
     tau_capture = tau_jtarget = tau_zero = math.nan  # tau_zero: where E first fell below zero
     captured = turned = False
@@ -808,30 +980,7 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 status = _STEP_UNDERFLOW
                 break
             continue
-        # accepted. Events that end a piece of the solution (separation; an extremum of y, where
-        # the sign of |F_n| flips) shorten the step to the earliest of them.
-        hev = h
-        code = -1
-        g0 = k1[1]
-        g1 = k[6, 1]
-        if u[0] > 0.0 and u1[0] <= 0.0:
-            hev = _locate(_EV_S, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
-            code = 0
-            _step(u, k1, h, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-        # an extremum of y: dy/dsigma leaves its expected sign (comparing with the expected sign,
-        # not with g0, keeps the root just found at the start of this step from being found again)
-        if u[0] > 0.0 and g1 * sgn < 0.0:
-            if g0 * sgn <= 0.0:
-                g0 = sgn * 1e-300
-            hh = _locate(_EV_DY, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-            if code < 0 or hh < hev:
-                hev, code = hh, 2
-        if code >= 0:
-            _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-            # dy/dsigma ~ s^2 vanishes at the surface too, so an extremum found at the end of
-            # contact is the separation itself
-            if code == 2 and u1[0] <= 0.0 and u1[1] < 0.0:
-                code = 0
+        hev, code = _shortened(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         recorded = False  # u1 was moved to a recorded event: take the step again before using it
         if not turned and u[1] > 0.0 and u1[1] <= 0.0:  # largest penetration
             _locate(_EV_Y, 0.0, u, k1, hev, u[1], u1[1], c1, c2, ah, aa, sgn, k, tmp, u1, err)
@@ -843,122 +992,44 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                                                   sgn, k, tmp, err)
                 outcome = REBOUND
                 break
-        # capture: E below zero by more than the integration can drift (without damping E is
-        # conserved, so a negative E could only be integration error); a true capture keeps
-        # losing energy and crosses the margin a little later. The capture time is where E first
-        # fell below zero (the margin's crossing, reported before, was up to 1e-6 later at rtol
-        # 1e-9, where E falls slowly: near the capture speed)
         if not captured and damped and aa > 0.0:
             if recorded:
                 _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
                 recorded = False
             e0 = law.nondimensional_energy(u[0], u[1], ah, aa)
             e1 = law.nondimensional_energy(u1[0], u1[1], ah, aa)
-            if math.isnan(tau_zero) and e0 >= 0.0 and e1 < 0.0:
-                _energy_crossing(_EV_ENERGY, 0.0, e0, e1, 0.0, hev, u, k1, (c1, c2, ah, aa, sgn), (ah, aa), k, tmp, u1,
-                                 err)
-                tau_zero = u1[2]
-                recorded = True
-            if e0 >= ecap and e1 < ecap:
-                captured = True
-                if math.isnan(tau_zero):  # (E below zero with no crossing seen: the margin's)
-                    _locate(_EV_ENERGY, ecap, u, k1, hev, e0 - ecap, e1 - ecap, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-                    tau_zero = u1[2]
-                    recorded = True
-                tau_capture = tau_zero
+            if (math.isnan(tau_zero) and e0 >= 0.0 and e1 < 0.0) or (e0 >= ecap and e1 < ecap):
+                captured, tau_zero, tau_capture, recorded = _capture_events(
+                    e0, e1, ecap, tau_zero, tau_capture, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         if math.isnan(tau_jtarget) and j_target > 0.0:  # end of sliding
             if recorded:
                 _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
                 recorded = False
             dj = abs(u1[1] - u[1])  # y is monotone within the (possibly shortened) step
             if J < j_target and J + dj >= j_target:
-                yt = u[1] + (j_target - J) * (1.0 if u1[1] > u[1] else -1.0)
-                _locate(_EV_Y, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-                tau_jtarget = u1[2]
+                tau_jtarget = _slip_end(J, j_target, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
                 recorded = True
         if recorded:
             _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
         # |dy| rather than sgn * dy: robust to an extremum that falls between two steps unnoticed
         # (a signed sum would then subtract; measured: more convergence failures in the stress sweep)
         J += abs(u1[1] - u[1])
-        # advance; after an event the derivative is evaluated anew, otherwise it is the last
-        # stage of the step (first same as last)
-        for i in range(_NSTATE):
-            u[i] = u1[i]
-        if code == 0:
-            u[0] = 0.0  # exactly at the surface
-        if code == 2 or code == 0:
-            if code == 2:
-                sgn = -sgn
-            _rhs(u, kend, (c1, c2, ah, aa, sgn))
-            for i in range(_NSTATE):
-                k1[i] = kend[i]
-        else:
-            for i in range(_NSTATE):
-                k1[i] = k[6, i]
-                kend[i] = k1[i]
+        sgn = _advance(code, u, u1, k, k1, kend, c1, c2, ah, aa, sgn)
         n_steps += 1
         smax = max(smax, u[0])
-        if rec_cap > 0 and n_rec < rec_cap:
-            rec[n_rec, 0], rec[n_rec, 1], rec[n_rec, 2] = u[2], u[0], u[1]
-            n_rec += 1
+        n_rec = _record(rec, n_rec, rec_cap, u)
         if code == 0:
             outcome = REBOUND
             break
         if damped and u[0] > 0.0:
             slow, xi_t = _inertia_free(u, atol[1], c1, c2, ah, aa, xe)
             if slow:  # the inertia-free limit: finish (or jump) in closed form
-                xi0 = u[0] * u[0]
-                e_now = law.nondimensional_energy(u[0], u[1], ah, aa)
-                if aa > 0.0 and xi_t == xe:
-                    y_t = 0.0
-                elif aa == 0.0:
-                    y_t = -1.0 / c1
-                else:  # the slow path and its first inertia correction, y_m - y_m' y_m / damping
-                    y_t = _slow_speed(xi_t, c1, c2, ah, aa)
-                    dd = ah * c1 * xi_t + aa * c2
-                    y_t += ah * aa * (c1 + c2) / (dd * dd) * y_t / (math.sqrt(xi_t) * dd)
-                dj = abs(u[1] - y_t)
-                if math.isnan(tau_jtarget) and j_target > 0.0 and J < j_target <= J + dj:
-                    tau_jtarget = _slow_event_time(u, xi_t, u[1] + (j_target - J) * (1.0 if y_t > u[1] else -1.0),
-                                                   _SLOW_Y, c1, c2, ah, aa)
-                if not captured and aa > 0.0:
-                    if math.isnan(tau_zero):
-                        tau_zero = _slow_event_time(u, xi_t, 0.0, _SLOW_ENERGY, c1, c2, ah, aa)
-                    tc = _slow_event_time(u, xi_t, ecap, _SLOW_ENERGY, c1, c2, ah, aa)
-                    if not math.isnan(tc):
-                        captured = True
-                        tau_capture = tc if math.isnan(tau_zero) else tau_zero
-                J += dj
-                if aa == 0.0:
-                    u[4] += u[0] * dj
-                    u[2] += c1 * xi0
-                else:
-                    u[4] += _slow_twist(xi0, xi_t, c1, c2, ah, aa)
-                    if xi_t != xe:
-                        u[2] += _slow_time(xi0, xi_t, c1, c2, ah, aa)
-                u[0] = math.sqrt(xi_t)
-                u[1] = y_t
-                u[3] += e_now - law.nondimensional_energy(u[0], u[1], ah, aa)
-                smax = max(smax, u[0])
-                if rec_cap > 0 and n_rec < rec_cap and not (aa > 0.0 and xi_t == xe):
-                    rec[n_rec, 0], rec[n_rec, 1], rec[n_rec, 2] = u[2], u[0], u[1]
-                    n_rec += 1
-                if aa == 0.0:
-                    outcome = REBOUND
+                outcome, J, tau_jtarget, captured, tau_zero, tau_capture, smax, n_rec, sgn = _inertia_free_jump(
+                    u, k1, kend, xi_t, J, j_target, tau_jtarget, captured, tau_zero, tau_capture, smax, rec, rec_cap,
+                    n_rec, sgn, c1, c2, ah, aa, xe, ecap)
+                if outcome >= 0:
                     break
-                if xi_t == xe:
-                    outcome = CAPTURE
-                    break
-                # resume the explicit integration where inertia matters again
-                s2 = xi_t
-                g = law.nondimensional_acceleration(s2, s2 * s2, u[1], c1, c2, ah, aa)
-                if g != 0.0:
-                    sgn = 1.0 if g > 0.0 else -1.0
-                _rhs(u, kend, (c1, c2, ah, aa, sgn))
-                for i in range(_NSTATE):
-                    k1[i] = kend[i]
-                continue
+                continue  # resumed where inertia matters again
         if captured:
             done, dj, dja = _capture_finished(u, kend, J, turned, follow, need_tail, settle_amp, tail_tol, j_stop,
                                               ja_stop, noise, atol[1], c1, c2, ah, aa, xe, omega0, ceq,

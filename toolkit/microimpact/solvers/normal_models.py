@@ -71,7 +71,7 @@ from microimpact._numba import njit, njit_batch
 from microimpact.model import adhesion_models as am
 from microimpact.model import dem_damping as dd
 from microimpact.model.contact import check_positive
-from microimpact.solvers import DEFAULT_RTOL, dopri
+from microimpact.solvers import DEFAULT_RTOL, dopri, engine
 from microimpact.solvers.engine import (CAPTURE, INERTIA_FREE_ENTER, _linear_tail_variation, INERTIA_FREE_RESUME, OUTCOME_NAMES, REBOUND,
                                        RELAXATION_ENTER, RELAXATION_RESUME, EngineError, NormalSolution)
 
@@ -462,19 +462,14 @@ def _event_state(model, kind, target, u0, u1, k1, h, c1, c2, c3, p3):
 
 
 @njit(cache=True)
-def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j_stop, ja_stop, max_steps):
-    """One normal impact in the model's nondimensional units.
-
-    Returns the floats (status, outcome, y_end, tau_end, D, J, J_a, z_max, tau_capture,
-    tau_slip_end, energy_end, n_steps, n_rejected).
-    """
-    args = (model, c1, c2, c3, p3)
-    k = np.zeros((7, _N))
-    k1 = np.zeros(_N)
+def _start(model, y0, c1, c2, c3, p3, rtol):
+    """The state at first contact and the constants of one impact: returns (u, k1, zb, z_eq,
+    threshold, e_eq, x_eq, c_eq, omega_eq, atol, h): the state and its derivative, where contact
+    breaks, the equilibrium, the capture threshold (the energy at the break), the energy, approach,
+    damping rate and stiffness (sqrt(dE/dx)) at the equilibrium, the absolute tolerances and the
+    first step."""
     u = np.zeros(_N)
-    u1 = np.zeros(_N)
-    tmp = np.zeros(_N)
-    err = np.zeros(_N)
+    k1 = np.zeros(_N)
     if _is_jkr(model):  # breaks at q = 1 (displacement-controlled) or q^3 = 3 (force-controlled)
         zb, z_eq = (_Q_BREAK_FORCE if model == _JKR_FORCE else 1.0), 6.0 ** (1.0 / 3.0)
         u[0] = 4.0 ** (1.0 / 3.0)
@@ -496,8 +491,116 @@ def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j
     zref = max(1.0, u[0])
     # y to rtol y0: e_n = -y_end / y0 is then accurate to rtol also for slow impacts (y0 < 1)
     atol = np.array([rtol * zref, rtol * y0, rtol * zref, rtol * 0.5 * yref * yref, rtol * yref, rtol * yref * zref])
-    _rhs(u, k1, args)
+    _rhs(u, k1, (model, c1, c2, c3, p3))
     h = 1e-2 * min(1.0, 1.0 / y0)
+    return u, k1, zb, z_eq, threshold, e_eq, x_eq, c_eq, omega_eq, atol, h
+
+
+#: what :func:`_creep` tells the loop: nothing happened, the integration resumes from a new state,
+#: the impact ended at the equilibrium
+_CREEP_NONE, _CREEP_RESUME, _CREEP_END = 0, 1, 2
+
+
+@njit(cache=True)
+def _creep(model, u, k1, z_eq, c1, c2, c3, p3, atol_y, threshold, outcome, j_target, tau_slip, tau_cap, e_cap,
+           zmax, turned):
+    """The inertia-free creep along the slow manifold (:func:`_slow_jump`) from the strongly damped
+    state u, if it applies. Returns (action, outcome, tau_cap, tau_slip, e_cap, zmax): action
+    _CREEP_END where the rest of the impact is taken in closed form (a capture; u is then the
+    equilibrium), _CREEP_RESUME where a Hertz creep is handed back to the integration (u and k1
+    the state and derivative there), _CREEP_NONE otherwise."""
+    # a captured sphere creeping into the equilibrium: the engine's looser creeping test
+    # (what is left of J, J_a then carries an error of ~1e-2 of itself); else only where
+    # inertia is negligible all the way. A Hertz sphere that creeps out inertia-free all the
+    # way to s = 0 never leaves (e_n = 0 whatever the error of the test): the creeping test too
+    creep = model == _HERTZ or outcome == CAPTURE and (turned or u[0] < z_eq)
+    jumped, tc, ts, te, dd, jj, jja, _, _, _ = _slow_jump(
+        model, u, z_eq, c1, c2, c3, p3, atol_y, threshold, outcome == CAPTURE, j_target,
+        j_target > 0.0 and math.isnan(tau_slip), CREEP_RATIO if creep else INERTIA_FREE_ENTER,
+        CREEP_RATIO if creep else INERTIA_FREE_RESUME, CREEP_BAND if creep else 0.0)
+    if not jumped and model == _HERTZ:
+        # a damping that vanishes with a (viscoelastic): inertia returns before s = 0, so the
+        # creep is taken along the manifold only while it is inertia-free (the engine's
+        # thresholds, error ~ their square), then integrated again to the exit
+        moved, tc, ts, te, dd, jj, jja, z_end, y_end, whole = _slow_jump(
+            model, u, z_eq, c1, c2, c3, p3, atol_y, threshold, True, j_target,
+            j_target > 0.0 and math.isnan(tau_slip), INERTIA_FREE_ENTER, INERTIA_FREE_RESUME, 0.0, True)
+        jumped = moved and whole
+        if moved and not whole:
+            if not math.isnan(ts):
+                tau_slip = ts
+            u[0], u[1], u[2], u[3], u[4], u[5] = z_end, y_end, te, dd, jj, jja
+            _rhs(u, k1, (model, c1, c2, c3, p3))
+            return _CREEP_RESUME, outcome, tau_cap, tau_slip, e_cap, zmax
+    if not jumped:
+        return _CREEP_NONE, outcome, tau_cap, tau_slip, e_cap, zmax
+    # the inertia-free limit: the rest of the impact in closed form, a capture
+    if outcome == REBOUND:
+        outcome = CAPTURE
+        tau_cap = u[2] if math.isnan(tc) else tc
+        e_cap = threshold
+    if not math.isnan(ts):
+        tau_slip = ts
+    if u[0] < z_eq:  # crept inwards: the equilibrium is the supremum of the approach
+        zmax = max(zmax, z_eq)
+    u[0], u[1], u[2], u[3], u[4], u[5] = z_eq, 0.0, te, dd, jj, jja
+    return _CREEP_END, outcome, tau_cap, tau_slip, e_cap, zmax
+
+
+@njit(cache=True)
+def _captured_end(model, u, e_now, zmax, turned, need_tail, tail_tol, j_stop, ja_stop, long_tail, zb, z_eq, e_eq,
+                  e_cap, x_eq, c_eq, omega_eq, threshold, c1, c2, c3, p3):
+    """Whether the integration of a captured sphere (state u, energy e_now) can stop; returns
+    (done, zmax). The friction and twist impulses still to come are added to u[4], u[5] in closed
+    form where the linear or the averaged tail ends it. ``long_tail``: a twentieth of the step
+    budget is spent."""
+    # settled: oscillation amplitude below tail_tol (energy ratio floored at 1e-14, above
+    # the round-off of the energy near the bottom of the well)
+    if e_now - e_eq <= max(tail_tol * tail_tol, 1e-14) * (e_cap - e_eq):
+        if not turned:  # crept into the equilibrium without turning: its supremum
+            zmax = max(zmax, z_eq)
+        return True, zmax
+    # not before the largest penetration: a capture found on the way in (at the first
+    # step for a slow JKR impact) stopped short of it, up to 6x at rtol 1e-9
+    if turned and (not need_tail or u[4] >= j_stop and u[5] >= ja_stop):
+        return True, zmax
+    if turned and c_eq > 0.0:  # (undamped: the oscillation never ends; j_stop ends it)
+        # the linear damped tail about the equilibrium in closed form (the engine's), once its
+        # relative error (~ amplitude / x_eq) makes an error below tail_tol of J, or after a
+        # twentieth of the step budget (integration noise of 15-40 rtol can hold a weakly
+        # damped oscillation above the settle test indefinitely)
+        dxl = _approach(model, u[0]) - x_eq
+        tail = _linear_tail_variation(dxl, u[1], omega_eq, c_eq)
+        amp = math.sqrt(dxl * dxl + (u[1] / omega_eq) ** 2)
+        if long_tail and c_eq <= 1e-2 * omega_eq and e_now < threshold:  # weakly damped: averaged
+            jt, jat = _averaged_tail(model, e_now, zb, z_eq, c1, c2, c3, p3)
+            u[4] += jt
+            u[5] += jat
+            return True, zmax
+        if amp / x_eq * tail <= tail_tol * u[4] or long_tail:
+            u[4] += tail
+            u[5] += _radius(model, z_eq) * tail
+            return True, zmax
+    return False, zmax
+
+
+@njit(cache=True)
+def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j_stop, ja_stop, max_steps):
+    """One normal impact in the model's nondimensional units.
+
+    Returns the floats (status, outcome, y_end, tau_end, D, J, J_a, z_max, tau_capture,
+    tau_slip_end, energy_end, n_steps, n_rejected).
+
+    The loop steps and locates the events within a step (the kink of |F_n|, separation, the
+    largest penetration, the end of sliding, the capture); the set-up, the inertia-free creep and
+    the end of a captured sphere are compiled helpers.
+    """
+    args = (model, c1, c2, c3, p3)
+    k = np.zeros((7, _N))
+    u1 = np.zeros(_N)
+    tmp = np.zeros(_N)
+    err = np.zeros(_N)
+    u, k1, zb, z_eq, threshold, e_eq, x_eq, c_eq, omega_eq, atol, h = _start(model, y0, c1, c2, c3, p3, rtol)
     status, outcome = _OK, REBOUND
     zmax = u[0]
     turned = False  # the largest penetration passed (y fell through zero)
@@ -568,69 +671,19 @@ def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j
         # once turned; a strongly damped approach can end with y at the noise level of atol, never
         # seen to turn)
         if ((model == _HERTZ and turned) or _static_and_damping(model, u[0], c1, c2, c3, p3)[1] >= 10.0):
-            # a captured sphere creeping into the equilibrium: the engine's looser creeping test
-            # (what is left of J, J_a then carries an error of ~1e-2 of itself); else only where
-            # inertia is negligible all the way. A Hertz sphere that creeps out inertia-free all the
-            # way to s = 0 never leaves (e_n = 0 whatever the error of the test): the creeping test too
-            creep = model == _HERTZ or outcome == CAPTURE and (turned or u[0] < z_eq)
-            jumped, tc, ts, te, dd, jj, jja, _, _, _ = _slow_jump(
-                model, u, z_eq, c1, c2, c3, p3, atol[1], threshold, outcome == CAPTURE, j_target,
-                j_target > 0.0 and math.isnan(tau_slip), CREEP_RATIO if creep else INERTIA_FREE_ENTER,
-                CREEP_RATIO if creep else INERTIA_FREE_RESUME, CREEP_BAND if creep else 0.0)
-            if not jumped and model == _HERTZ:
-                # a damping that vanishes with a (viscoelastic): inertia returns before s = 0, so the
-                # creep is taken along the manifold only while it is inertia-free (the engine's
-                # thresholds, error ~ their square), then integrated again to the exit
-                moved, tc, ts, te, dd, jj, jja, z_end, y_end, whole = _slow_jump(
-                    model, u, z_eq, c1, c2, c3, p3, atol[1], threshold, True, j_target,
-                    j_target > 0.0 and math.isnan(tau_slip), INERTIA_FREE_ENTER, INERTIA_FREE_RESUME, 0.0, True)
-                jumped = moved and whole
-                if moved and not whole:
-                    if not math.isnan(ts):
-                        tau_slip = ts
-                    u[0], u[1], u[2], u[3], u[4], u[5] = z_end, y_end, te, dd, jj, jja
-                    _rhs(u, k1, args)
-                    continue
-            if jumped:  # the inertia-free limit: the rest of the impact in closed form, a capture
-                if outcome == REBOUND:
-                    outcome = CAPTURE
-                    tau_cap = u[2] if math.isnan(tc) else tc
-                    e_cap = threshold
-                if not math.isnan(ts):
-                    tau_slip = ts
-                if u[0] < z_eq:  # crept inwards: the equilibrium is the supremum of the approach
-                    zmax = max(zmax, z_eq)
-                u[0], u[1], u[2], u[3], u[4], u[5] = z_eq, 0.0, te, dd, jj, jja
+            action, outcome, tau_cap, tau_slip, e_cap, zmax = _creep(
+                model, u, k1, z_eq, c1, c2, c3, p3, atol[1], threshold, outcome, j_target, tau_slip, tau_cap, e_cap,
+                zmax, turned)
+            if action == _CREEP_RESUME:
+                continue
+            if action == _CREEP_END:
                 break
         if outcome == CAPTURE:
-            # settled: oscillation amplitude below tail_tol (energy ratio floored at 1e-14, above
-            # the round-off of the energy near the bottom of the well)
-            if e_now - e_eq <= max(tail_tol * tail_tol, 1e-14) * (e_cap - e_eq):
-                if not turned:  # crept into the equilibrium without turning: its supremum
-                    zmax = max(zmax, z_eq)
+            done, zmax = _captured_end(model, u, e_now, zmax, turned, need_tail, tail_tol, j_stop, ja_stop,
+                                       20 * (n_acc + n_rej) >= max_steps, zb, z_eq, e_eq, e_cap, x_eq, c_eq,
+                                       omega_eq, threshold, c1, c2, c3, p3)
+            if done:
                 break
-            # not before the largest penetration: a capture found on the way in (at the first
-            # step for a slow JKR impact) stopped short of it, up to 6x at rtol 1e-9
-            if turned and (not need_tail or u[4] >= j_stop and u[5] >= ja_stop):
-                break
-            if turned and c_eq > 0.0:  # (undamped: the oscillation never ends; j_stop ends it)
-                # the linear damped tail about the equilibrium in closed form (the engine's), once its
-                # relative error (~ amplitude / x_eq) makes an error below tail_tol of J, or after a
-                # twentieth of the step budget (integration noise of 15-40 rtol can hold a weakly
-                # damped oscillation above the settle test indefinitely)
-                dxl = _approach(model, u[0]) - x_eq
-                tail = _linear_tail_variation(dxl, u[1], omega_eq, c_eq)
-                amp = math.sqrt(dxl * dxl + (u[1] / omega_eq) ** 2)
-                long_tail = 20 * (n_acc + n_rej) >= max_steps
-                if long_tail and c_eq <= 1e-2 * omega_eq and e_now < threshold:  # weakly damped: averaged
-                    jt, jat = _averaged_tail(model, e_now, zb, z_eq, c1, c2, c3, p3)
-                    u[4] += jt
-                    u[5] += jat
-                    break
-                if amp / x_eq * tail <= tail_tol * u[4] or long_tail:
-                    u[4] += tail
-                    u[5] += _radius(model, z_eq) * tail
-                    break
         h = dopri.grown_step(h, norm)
     return (float(status), float(outcome), u[1], u[2], u[3], u[4], u[5], zmax, tau_cap, tau_slip,
             _energy(model, u[0], u[1]) - _energy(model, 4.0 ** (1.0 / 3.0) if _is_jkr(model) else 0.0, 0.0),
@@ -748,8 +801,6 @@ def solve_normal(contact, normal_speed: float, *, rtol: float = DEFAULT_RTOL, ne
     >>> s.outcome, round(s.friction_impulse / (c.mass * 0.05), 9), s.n_steps < 1000
     ('capture', 1.0, True)
     """
-    from microimpact.solvers import engine
-
     v = check_positive("normal_speed", normal_speed)
     if _paper_hertz(contact):
         return engine.solve_normal(contact.with_(normal_model="ring"), v, rtol=rtol, need_tail=need_tail,
@@ -815,8 +866,6 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     >>> round(float(r["e_n"][0]), 8) == round(3**0.5 / 2, 8)
     True
     """
-    from microimpact.solvers import engine
-
     if _paper_hertz(contact):
         return engine.solve_normal_many(contact.with_(normal_model="ring"), normal_speed, need_tail, rtol=rtol,
                                         tail_tolerance=tail_tolerance, max_steps=max_steps,
@@ -922,6 +971,8 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
     >>> bool(round(solve_normal_reference(c, 2.0 * jkr_sticking_velocity(c), rtol=1e-12).e_n, 8) == round(3**0.5 / 2, 8))
     True
     """
+    # imported here, not at the module's top: scipy.integrate would add to the start-up of every
+    # JKR/DMT solve, and only this reference check uses it
     from scipy.integrate import solve_ivp
 
     v = check_positive("normal_speed", normal_speed)
