@@ -761,12 +761,13 @@ def _capture_finished(u, kend, J, turned, follow, need_tail, settle_amp, tail_to
 
 
 @njit(cache=True)
-def _start(y0, c1, c2, ah, aa, rtol):
+def _start(y0, c1, c2, ah, aa, rtol, rec, rec_cap):
     """The state at first contact and the constants of one impact: returns (u, k1, sgn, atol,
-    noise, damped, ecap, xe, omega0, ceq, h), the state and its derivative, the expected sign of
+    noise, damped, ecap, xe, omega0, ceq, h, n_rec), the state and its derivative, the expected sign of
     dy/dsigma, the absolute tolerances, the amplitude below which a captured oscillation is
     integration noise, whether the impact is damped, the capture margin of the energy, the
-    equilibrium (:func:`_equilibrium`) and the first step."""
+    equilibrium (:func:`_equilibrium`), the first step and the rows of the trajectory ``rec``
+    (its first, the incident state, where it has room)."""
     u = np.zeros(_NSTATE)
     u[1] = y0
     k1 = np.zeros(_NSTATE)
@@ -777,7 +778,18 @@ def _start(y0, c1, c2, ah, aa, rtol):
     damped = c1 > 0.0 or (c2 > 0.0 and aa > 0.0)  # adhesion damping needs adhesion
     ecap = -10.0 * rtol * (4.0 / 15.0) * (aa * aa * aa / (ah * ah) if ah > 0.0 else 1.0) ** 0.5
     xe, omega0, ceq = _equilibrium(c1, c2, ah, aa)
-    return u, k1, sgn, atol, noise, damped, ecap, xe, omega0, ceq, _initial_step(y0)
+    n_rec = 0
+    if rec_cap > 0:
+        rec[0, 0], rec[0, 1], rec[0, 2] = 0.0, 0.0, y0
+        n_rec = 1
+    return u, k1, sgn, atol, noise, damped, ecap, xe, omega0, ceq, _initial_step(y0), n_rec
+
+
+@njit(cache=True)
+def _scratch():
+    """The work arrays of a step: its stages k (7, n), a trial state, the state at its end, its
+    error estimate, and the derivative at the end of the last step."""
+    return np.zeros((7, _NSTATE)), np.zeros(_NSTATE), np.zeros(_NSTATE), np.zeros(_NSTATE), np.zeros(_NSTATE)
 
 
 @njit(cache=True)
@@ -808,12 +820,33 @@ def _capture_events(e0, e1, ecap, tau_zero, tau_capture, hev, u, k1, c1, c2, ah,
 
 
 @njit(cache=True)
-def _slip_end(J, j_target, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
-    """tau where J reaches j_target within the step u -> u1 (J at its start; y is monotone within
-    the step), with u1 moved there."""
-    yt = u[1] + (j_target - J) * (1.0 if u1[1] > u[1] else -1.0)
-    _locate(_EV_Y, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-    return u1[2]
+def _slip_end(recorded, J, j_target, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
+    """The end of sliding within the step u -> u1 (J at its start; y is monotone within the step):
+    returns (tau where J reaches j_target, NaN if it does not; recorded). ``recorded``: u1 was
+    moved to an earlier event, so the step is taken again first; on return, whether u1 was moved
+    (to the end of sliding)."""
+    if recorded:
+        _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+        recorded = False
+    dj = abs(u1[1] - u[1])
+    if J < j_target and J + dj >= j_target:
+        yt = u[1] + (j_target - J) * (1.0 if u1[1] > u[1] else -1.0)
+        _locate(_EV_Y, yt, u, k1, hev, u[1] - yt, u1[1] - yt, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        return u1[2], True
+    return math.nan, recorded
+
+
+@njit(cache=True)
+def _largest_penetration(u, k1, hev, u1, smax, J, j_target, tau_jtarget, damped, y0, c1, c2, ah, aa, sgn, k, tmp,
+                         err):
+    """The largest penetration (y = 0) within the step u -> u1, with u1 moved there; an undamped
+    impact is then completed by symmetry (:func:`_mirror_undamped`). Returns (smax, J, tau_jtarget)."""
+    _locate(_EV_Y, 0.0, u, k1, hev, u[1], u1[1], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+    smax = max(smax, u1[0])
+    if not damped:
+        J, tau_jtarget = _mirror_undamped(u, u1, k1, hev, J, j_target, tau_jtarget, y0, c1, c2, ah, aa, sgn, k, tmp,
+                                          err)
+    return smax, J, tau_jtarget
 
 
 @njit(cache=True, inline="always")
@@ -888,58 +921,6 @@ def _inertia_free_jump(u, k1, kend, xi_t, J, j_target, tau_jtarget, captured, ta
     return outcome, J, tau_jtarget, captured, tau_zero, tau_capture, smax, n_rec, sgn
 
 
-@njit(cache=True, inline="always")
-def _shortened(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err):
-    """The accepted step u -> u1 of length h, shortened to the earliest event that ends a piece of
-    the solution: separation (code 0) or an extremum of y, where the sign of |F_n| flips (code 2).
-    Returns (the step's length, code; -1: no event); u1 and k then hold the step taken."""
-    hev = h
-    code = -1
-    g0 = k1[1]
-    g1 = k[6, 1]
-    if u[0] > 0.0 and u1[0] <= 0.0:
-        hev = _locate(_EV_S, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
-        code = 0
-        _step(u, k1, h, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-    # an extremum of y: dy/dsigma leaves its expected sign (comparing with the expected sign,
-    # not with g0, keeps the root just found at the start of this step from being found again)
-    if u[0] > 0.0 and g1 * sgn < 0.0:
-        if g0 * sgn <= 0.0:
-            g0 = sgn * 1e-300
-        hh = _locate(_EV_DY, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-        if code < 0 or hh < hev:
-            hev, code = hh, 2
-    if code >= 0:
-        _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-        # dy/dsigma ~ s^2 vanishes at the surface too, so an extremum found at the end of
-        # contact is the separation itself
-        if code == 2 and u1[0] <= 0.0 and u1[1] < 0.0:
-            code = 0
-    return hev, code
-
-
-@njit(cache=True, inline="always")
-def _advance(code, u, u1, k, k1, kend, c1, c2, ah, aa, sgn):
-    """Move the state to the end u1 of the step that ended at event ``code`` (:func:`_shortened`);
-    returns the sign of dy/dsigma expected from there. After an event the derivative is evaluated
-    anew (k1, kend), otherwise it is the last stage of the step (first same as last)."""
-    for i in range(_NSTATE):
-        u[i] = u1[i]
-    if code == 0:
-        u[0] = 0.0  # exactly at the surface
-    if code == 2 or code == 0:
-        if code == 2:
-            sgn = -sgn
-        _rhs(u, kend, (c1, c2, ah, aa, sgn))
-        for i in range(_NSTATE):
-            k1[i] = kend[i]
-    else:
-        for i in range(_NSTATE):
-            k1[i] = k[6, i]
-            kend[i] = k1[i]
-    return sgn
-
-
 @njit(cache=True)
 def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, settle_amp,
                max_steps, rec, rec_cap, j_stop, ja_stop):
@@ -954,19 +935,12 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
     impact or at an event (the set-up, the located events, the undamped mirror, the inertia-free
     jump, the decision to stop a captured sphere) is in compiled helpers (above).
     """
-    u, k1, sgn, atol, noise, damped, ecap, xe, omega0, ceq, h = _start(y0, c1, c2, ah, aa, rtol)
-    k = np.zeros((7, _NSTATE))
-    tmp = np.zeros(_NSTATE)
-    u1 = np.zeros(_NSTATE)
-    err = np.zeros(_NSTATE)
-    kend = np.zeros(_NSTATE)
+    u, k1, sgn, atol, noise, damped, ecap, xe, omega0, ceq, h, n_rec = _start(y0, c1, c2, ah, aa, rtol, rec, rec_cap)
+    k, tmp, u1, err, kend = _scratch()
     J = smax = 0.0
     tau_capture = tau_jtarget = tau_zero = math.nan  # tau_zero: where E first fell below zero
     captured = turned = False
-    outcome, status, n_steps, n_rej, n_rec = -1, _OK, 0, 0, 0
-    if rec_cap > 0:
-        rec[0, 0], rec[0, 1], rec[0, 2] = 0.0, 0.0, y0
-        n_rec = 1
+    outcome, status, n_steps, n_rej = -1, _OK, 0, 0
     while True:
         if n_steps + n_rej >= max_steps:
             status = _MAX_STEPS
@@ -980,16 +954,34 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 status = _STEP_UNDERFLOW
                 break
             continue
-        hev, code = _shortened(u, k1, h, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        # accepted. Events that end a piece of the solution (separation; an extremum of y, where
+        # the sign of |F_n| flips) shorten the step to the earliest of them.
+        hev, code = h, -1
+        g0, g1 = k1[1], k[6, 1]
+        if u[0] > 0.0 and u1[0] <= 0.0:
+            hev = _locate(_EV_S, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            code = 0
+            _step(u, k1, h, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+        # an extremum of y: dy/dsigma leaves its expected sign (comparing with the expected sign,
+        # not with g0, keeps the root just found at the start of this step from being found again)
+        if u[0] > 0.0 and g1 * sgn < 0.0:
+            if g0 * sgn <= 0.0:
+                g0 = sgn * 1e-300
+            hh = _locate(_EV_DY, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+            if code < 0 or hh < hev:
+                hev, code = hh, 2
+        if code >= 0:
+            _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+            # dy/dsigma ~ s^2 vanishes at the surface too, so an extremum found at the end of
+            # contact is the separation itself
+            if code == 2 and u1[0] <= 0.0 and u1[1] < 0.0:
+                code = 0
         recorded = False  # u1 was moved to a recorded event: take the step again before using it
         if not turned and u[1] > 0.0 and u1[1] <= 0.0:  # largest penetration
-            _locate(_EV_Y, 0.0, u, k1, hev, u[1], u1[1], c1, c2, ah, aa, sgn, k, tmp, u1, err)
-            turned = True
-            smax = max(smax, u1[0])
-            recorded = True
-            if not damped:
-                J, tau_jtarget = _mirror_undamped(u, u1, k1, hev, J, j_target, tau_jtarget, y0, c1, c2, ah, aa,
-                                                  sgn, k, tmp, err)
+            smax, J, tau_jtarget = _largest_penetration(u, k1, hev, u1, smax, J, j_target, tau_jtarget, damped, y0, c1,
+                                                        c2, ah, aa, sgn, k, tmp, err)
+            turned = recorded = True
+            if not damped:  # completed by symmetry
                 outcome = REBOUND
                 break
         if not captured and damped and aa > 0.0:
@@ -1002,19 +994,28 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                 captured, tau_zero, tau_capture, recorded = _capture_events(
                     e0, e1, ecap, tau_zero, tau_capture, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         if math.isnan(tau_jtarget) and j_target > 0.0:  # end of sliding
-            if recorded:
-                _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-                recorded = False
-            dj = abs(u1[1] - u[1])  # y is monotone within the (possibly shortened) step
-            if J < j_target and J + dj >= j_target:
-                tau_jtarget = _slip_end(J, j_target, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-                recorded = True
+            tau_jtarget, recorded = _slip_end(recorded, J, j_target, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
         if recorded:
             _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
         # |dy| rather than sgn * dy: robust to an extremum that falls between two steps unnoticed
         # (a signed sum would then subtract; measured: more convergence failures in the stress sweep)
         J += abs(u1[1] - u[1])
-        sgn = _advance(code, u, u1, k, k1, kend, c1, c2, ah, aa, sgn)
+        # advance; after an event the derivative is evaluated anew, otherwise it is the last
+        # stage of the step (first same as last)
+        for i in range(_NSTATE):
+            u[i] = u1[i]
+        if code == 0:
+            u[0] = 0.0  # exactly at the surface
+        if code == 2 or code == 0:
+            if code == 2:
+                sgn = -sgn
+            _rhs(u, kend, (c1, c2, ah, aa, sgn))
+            for i in range(_NSTATE):
+                k1[i] = kend[i]
+        else:
+            for i in range(_NSTATE):
+                k1[i] = k[6, i]
+                kend[i] = k1[i]
         n_steps += 1
         smax = max(smax, u[0])
         n_rec = _record(rec, n_rec, rec_cap, u)
@@ -1042,9 +1043,8 @@ def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, 
                     smax = math.sqrt(xe)  # approached the equilibrium without turning: its supremum
                 break
         h = dopri.grown_step(h, en)
-    e_end = law.nondimensional_energy(u[0], u[1], ah, aa)
-    return (status, outcome, u[1], u[2], u[3], J, u[4], smax * smax, tau_capture, tau_jtarget, e_end,
-            n_steps, n_rej, n_rec)
+    return (status, outcome, u[1], u[2], u[3], J, u[4], smax * smax, tau_capture, tau_jtarget,
+            law.nondimensional_energy(u[0], u[1], ah, aa), n_steps, n_rej, n_rec)
 
 
 @njit_batch
