@@ -112,7 +112,7 @@ def test_bad_input_flags(small_csv, fitted, tmp_path, capsys):
 
 
 def test_entry_point_exit_status(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "microimpact.cli", "fit", str(tmp_path / "missing.csv"), "--out",
+    r = subprocess.run([sys.executable, "-m", "microimpact", "fit", str(tmp_path / "missing.csv"), "--out",
                         str(tmp_path / "f.nc")], capture_output=True, text=True)
     assert r.returncode == 2
     assert r.stderr.count("\n") == 1 and "does not exist" in r.stderr

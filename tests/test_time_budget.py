@@ -290,7 +290,7 @@ def test_time_limits_nest_and_the_outer_one_still_ends_the_block():
     timer and this loop ran its 40 cases (8 s)."""
     import time
 
-    from microimpact.studies._timeout import TimeLimitExceeded, time_limit
+    from microimpact._runtime.timeout import TimeLimitExceeded, time_limit
 
     inner_timeouts = 0
     t0 = time.perf_counter()

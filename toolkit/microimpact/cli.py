@@ -24,8 +24,9 @@ from dataclasses import fields
 from pathlib import Path
 
 from microimpact import __version__
-from microimpact._entry import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_after_writing, interpreted_budget_over
-from microimpact._usage import exit_status
+from microimpact._runtime.signals import (EXIT_INTERRUPTED, INTERRUPTED_LINE, interpreted_budget_over,
+                                         interrupted_after_writing)
+from microimpact._runtime.usage import exit_status
 from microimpact.io.paths import (PathError, check_input_file, check_output_dir, check_outputs,
                                   reporting_os_errors, same_file)
 from microimpact.model.contact import SUB_MODELS, Contact
@@ -723,7 +724,7 @@ def _lammps_fit_friction(args, table, chosen):
     (with ``--tangential-model auto`` each law's, ranked by AIC, the best one written)."""
     import numpy as np
 
-    from microimpact.analysis.oblique import rank_dem_tangential_laws
+    from microimpact.analysis.dem_friction import rank_dem_tangential_laws
 
     laws = _lammps_tangential_laws(args)
     try:
@@ -758,7 +759,7 @@ def _lammps_fit_friction(args, table, chosen):
 
 def _cmd_lammps_fit(args) -> int:
     from microimpact.analysis.dem_fit import candidate_laws, rank_dem_laws
-    from microimpact.io.progress import progress_bar
+    from microimpact._runtime.progress import progress_bar
     from microimpact.io.files import atomic_write
     from microimpact.io.lammps import lammps_input
     from microimpact.io.provenance import fit_parameter_source
@@ -844,7 +845,7 @@ def _cmd_lammps_fit(args) -> int:
 def _cmd_lammps_verify(args) -> int:
     from microimpact.io.files import write_csv
     from microimpact.io.lammps import read_lammps_contact
-    from microimpact.io.progress import progress_bar
+    from microimpact._runtime.progress import progress_bar
     from microimpact.studies.lammps_check import DEFAULT_INCIDENCES, default_speeds, verify_lammps
 
     out = check_outputs({"--out": args.out}, {"input file": args.input})["--out"] if args.out else None
@@ -993,7 +994,7 @@ def _cmd_benchmark(args) -> int:
     if docs is not None and same_file(out, docs):
         raise PathError("--out and --docs", args.docs, "two outputs on one path (both write benchmark.md); "
                                                        "give --docs another directory")
-    from microimpact.io.progress import wants_progress
+    from microimpact._runtime.progress import wants_progress
 
     # on a terminal a bar of the stages; elsewhere (a pipe, a log) one line per stage
     ds = run_benchmark(quick=args.quick, verbose=not wants_progress(True), throughput=not args.no_throughput,
@@ -1139,7 +1140,7 @@ def _absolute_config_path(key_value: str) -> str:
 def _clear_stale_lock(directory: Path) -> None:
     """Remove the lock a killed run left in ``directory`` when no Snakemake process works there, and
     say so; refuse to start while one does (or when this platform cannot tell), saying what to run."""
-    from microimpact.io.locks import remove_stale_lock
+    from microimpact._runtime.locks import remove_stale_lock
 
     outcome, detail = remove_stale_lock(directory)
     if outcome == "unlocked":
@@ -1331,9 +1332,3 @@ def _main(argv, written) -> int:
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"microimpact: error: {where}{exc.strerror or exc}", file=sys.stderr)
         return 2
-
-
-if __name__ == "__main__":  # pragma: no cover
-    from microimpact._entry import main as console_main
-
-    sys.exit(console_main())

@@ -50,7 +50,7 @@ import pandas as pd
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit, fit_parameter_table, format_fit
 from microimpact.io.impacts import MEASUREMENT_TOLERANCE_SIGMAS, insert_row_labels, row_labels
 from microimpact.io.materials import material_contact
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.model.contact import Contact
 from microimpact.solvers import DEFAULT_RTOL, Deadline, TimeBudgetExceeded
 
@@ -350,7 +350,7 @@ def fit_damping(
         than the second core gains (measured: 0.6 ms per call on one thread versus up to 40 ms on
         two threads under load).
     progress : bool
-        A progress bar on stderr (a terminal only; :func:`microimpact.io.progress.progress_bar`):
+        A progress bar on stderr (a terminal only; :func:`microimpact._runtime.progress.progress_bar`):
         the start grid, then each least-squares round.
     time_budget : float or Deadline, optional
         Wall-clock budget of the fit; None: no limit. Checked after every start-grid point and

@@ -58,7 +58,7 @@ from microimpact.analysis.sampling_defaults import (DEFAULT_MAX_STEPS, DEFAULT_N
                                                     MAX_SEED)
 from microimpact.io.files import CONVENTIONS, write_netcdf
 from microimpact.io.materials import material_contact
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "DEFAULT_WALKERS", "DEFAULT_MAX_STEPS",
@@ -533,7 +533,7 @@ def _run_chain(log_probability, pos, seed, budget, fixed_length, burn, advance, 
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()  # seeded
     state = emcee.State(pos)
     done, previous_tau, diag = 0, None, None
-    from microimpact.io.files import interrupt_at_checkpoints
+    from microimpact._runtime.signals import interrupt_at_checkpoints
 
     with interrupt_at_checkpoints() as checkpoint:  # Ctrl-C acts between steps, not inside emcee
         while done < budget:

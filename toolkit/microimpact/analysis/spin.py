@@ -39,7 +39,7 @@ import xarray as xr
 
 from microimpact.analysis.oblique import OBSERVABLE_UNITS, ObliqueProblem, rebound_state
 from microimpact.solvers import engine_threads
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["spin_explanation", "SPIN_VARIABLES"]

@@ -99,16 +99,16 @@ import numpy as np
 import xarray as xr
 
 from microimpact.io.files import atomic_write, write_netcdf
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.io.variables import attributes
 from microimpact.model.contact import Contact
 from microimpact.solvers.impact import settled_contact_energy, simulate_impact
 from microimpact.solvers import TimeBudgetExceeded, check_sub_models
 from microimpact.solvers.reference import simulate_reference
-from microimpact.studies._timeout import time_limit
+from microimpact._runtime.timeout import time_limit
 from microimpact.model.adhesion_models import AdhesionRegimeWarning
 from microimpact.solvers import UndeterminedOutcomeWarning
-from microimpact._usage import parse_or_status
+from microimpact._runtime.usage import parse_or_status
 
 __all__ = ["LAWS", "POISSON", "TOLERANCES", "INPUT_RANGES", "FAILURE_KINDS", "NOTE_KINDS", "draw_cases", "contact_of", "check_case",
            "stress_sweep", "StressReport", "result_distance", "energy_scale", "energy_error", "kinetic_energy",

@@ -16,7 +16,7 @@ import numba
 import numpy as np
 import xarray as xr
 
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.io.provenance import contact_attributes, preset_parameter_source
 from microimpact.io.variables import attributes
 from microimpact.presets import WALL_1990
@@ -31,7 +31,7 @@ from microimpact.studies.benchmark.harness import (
 )
 from microimpact.studies.benchmark.reference import Reference, reference_set
 from microimpact.studies.benchmark.targets import accuracy_targets, throughput_targets
-from microimpact.studies._timeout import time_limit
+from microimpact._runtime.timeout import time_limit
 
 __all__ = ["run_benchmark"]
 
@@ -293,7 +293,7 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
     throughput : bool
         Also measure the 100,000-impact throughput and the memory scaling.
     progress : bool, optional
-        A progress bar of the stages on stderr (:func:`microimpact.io.progress.progress_bar`),
+        A progress bar of the stages on stderr (:func:`microimpact._runtime.progress.progress_bar`),
         drawn only when stderr is a terminal. Default: none.
     time_budget : float, optional
         Stop with :class:`microimpact.solvers.TimeBudgetExceeded` once the run has taken this long
