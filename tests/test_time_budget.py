@@ -16,7 +16,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-import microimpact.solvers as solvers
+import microimpact._runtime.budget as budget
 from microimpact.solvers import Deadline, TimeBudgetExceeded, check_time_budget
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -34,7 +34,7 @@ def clock(monkeypatch):
         readings[0] += 1
         return float(readings[0])
 
-    monkeypatch.setattr(solvers, "time", SimpleNamespace(perf_counter=perf_counter))
+    monkeypatch.setattr(budget, "time", SimpleNamespace(perf_counter=perf_counter))
     return lambda: readings[0]
 
 

@@ -17,16 +17,19 @@ from dataclasses import dataclass
 
 import xarray as xr
 
+from microimpact.analysis.fitting import fit_damping
+from microimpact.analysis.oblique import ObliqueProblem, fit_friction
+from microimpact.analysis.posterior import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS,
+                                            POSTERIOR_TITLE, capture_velocity_interval, posterior_dataset,
+                                            restitution_bands, sample_posterior, sweep_bands)
 from microimpact.io.formatting import ReportHTML
-from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.files import CONVENTIONS, all_or_nothing, write_netcdf
 from microimpact.io.provenance import stamp_parameters
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS"]
 
 def _posterior_defaults() -> dict:
-    from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS
-
     return dict(walkers=DEFAULT_WALKERS, max_steps=DEFAULT_MAX_STEPS, steps=None, burn=None, seed=DEFAULT_SEED,
                 n_draws=DEFAULT_N_DRAWS)
 
@@ -94,9 +97,6 @@ class AnalystFit(ReportHTML):
     def save(self, fit_path, posterior_path=None, oblique_path=None) -> tuple:
         """Write the fit, and where given the posterior and the oblique fit, as NetCDF: all of them
         or, if one cannot be written, none (:func:`microimpact.io.files.all_or_nothing`)."""
-        from microimpact.analysis.posterior import POSTERIOR_TITLE
-        from microimpact.io.files import all_or_nothing
-
         with all_or_nothing():
             written = [self.damping.save(fit_path)]
             if posterior_path is not None:
@@ -174,9 +174,6 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     ...
     ValueError: unknown posterior option(s) ['wlakers']; known: ['burn', 'max_steps', 'n_draws', 'seed', 'steps', 'walkers']
     """
-    from microimpact.analysis.fitting import fit_damping
-    from microimpact.analysis.oblique import ObliqueProblem, fit_friction
-
     deadline = Deadline.start(time_budget, "analyst fit")
     damping = fit_damping(table, base, fit_work_of_adhesion=fit_work_of_adhesion, weights=weights,
                           confidence_intervals=confidence_intervals, rtol=rtol, progress=progress,
@@ -196,8 +193,6 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     if not posterior:
         return AnalystFit(damping, ff)
     opts = _posterior_options(posterior)
-    from microimpact.analysis.posterior import (capture_velocity_interval, posterior_dataset, restitution_bands,
-                                                sample_posterior, sweep_bands)
 
     post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], max_steps=opts["max_steps"],
                             burn=opts["burn"], seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol,

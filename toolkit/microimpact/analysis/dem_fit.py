@@ -47,23 +47,23 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 from types import SimpleNamespace
 
 import numpy as np
+import pandas as pd
+from scipy import optimize, stats
 
+from microimpact.analysis.fitting import _sigma_e, _table_arrays
+from microimpact.analysis.identifiability import chi2_threshold
+from microimpact.io.materials import material_contact
 from microimpact.model.contact import Contact
-from microimpact.model.dem_damping import RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.model.dem_damping import DEM_LAWS, RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
+from microimpact.solvers import DEFAULT_RTOL, normal_models as nm
 
 __all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "ranked_by_aic", "information_criteria", "dem_fit_coverage",
            "INTERVAL_LEVEL", "ADEQUACY_P", "REGION_RAYS"]
 
-#: the (normal law, damping law) pairs a LAMMPS user chooses among; "hertz" is Hertz without
-#: adhesion, "jkr_force" LAMMPS's jkr, "dmt" LAMMPS's dmt
-DEM_LAWS: tuple[tuple[str, str], ...] = (
-    ("hertz", "coeff_restitution"), ("hertz", "tsuji"), ("hertz", "viscoelastic"), ("hertz", "mass_velocity"),
-    ("jkr_force", "viscoelastic"), ("jkr_force", "mass_velocity"), ("dmt", "viscoelastic"), ("dmt", "mass_velocity"),
-)
 #: the probability content of the reported interval (one standard deviation of a normal law)
 INTERVAL_LEVEL = math.erf(1.0 / math.sqrt(2.0))
 #: with stated uncertainties, a law whose chi^2 has a p-value below this does not describe the data
@@ -306,8 +306,6 @@ def _region_boundary(fit, model, e_meas, sig, threshold, rays, coordinate) -> li
     coordinate): rays from the best point, evenly spaced after whitening, each ended by Brent's
     method where chi^2 has risen by ``threshold`` (or at the searched range's edge); ``coordinate``
     is :func:`_coordinate` of the model."""
-    from scipy import optimize
-
     to_coef, from_coef, lo_x, hi_x = coordinate
     lo = np.array([_ADHESION_DECADES[0], lo_x])
     hi = np.array([_ADHESION_DECADES[1], hi_x])
@@ -364,8 +362,6 @@ def _profile_tips(chi, centre, lo, hi, level):
     included) crosses ``level``, or the searched range's edge if it stays below. These are the ends
     of each parameter's profile-likelihood interval; rays from the best point miss them where the
     region is curved (a banana in log10 w_A, whose upper end lies decades from the best fit)."""
-    from scipy import optimize
-
     tips = []
     for k in (0, 1):
         hint = [float(centre[1 - k])]
@@ -407,8 +403,6 @@ def dem_law_contact(material, radius: float, normal_model: str, damping_model: s
     >>> c.normal_model, c.adhesion_line_force, c.damping_model
     ('ring', 0.0, 'coeff_restitution')
     """
-    from microimpact.io.materials import material_contact
-
     if (normal_model, damping_model) not in DEM_LAWS:
         raise ValueError(f"unknown DEM law {normal_model}+{damping_model}; known: "
                          + ", ".join(f"{a}+{b}" for a, b in DEM_LAWS))
@@ -462,8 +456,6 @@ class _Model:
     def e_n(self, coefficient: float, work_of_adhesion: float | None = None) -> np.ndarray:
         """e_n of every impact [-] for the damping ``coefficient`` and, when given, a trial work of
         adhesion [J/m^2] in place of the material's."""
-        from microimpact.solvers import normal_models as nm
-
         material = self.material
         if work_of_adhesion is not None:
             material = {**vars(_material_record(material)), "work_of_adhesion": float(work_of_adhesion)}
@@ -489,8 +481,6 @@ def _chisqr(model, coefficient, e_meas, sigma, work_of_adhesion=None) -> float:
 def _restitution_interval(rise, x_best, lo_x):
     """(interval, status, best) of a restitution e: the ends where chi^2 rises by the threshold
     (``rise`` > 0), searched in [lo_x, 1]; the end at e = 1 is the side of no damping."""
-    from scipy import optimize
-
     low_damping_end = 1.0 if rise(1.0) <= 0.0 or x_best >= 1.0 else optimize.brentq(rise, x_best, 1.0, xtol=1e-12)
     if rise(lo_x) <= 0.0:
         strong_end, bounded = lo_x, False
@@ -503,8 +493,6 @@ def _restitution_interval(rise, x_best, lo_x):
 def _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x):
     """(interval, status, best) of eta_n0, searched in log10 coordinates x over [lo_x, hi_x] and
     below them in eta_n0 itself (``rise_coef``); x_best = -inf when no damping fits best."""
-    from scipy import optimize
-
     if rise_coef(0.0) <= 0.0:  # no damping is inside the interval
         weak = 0.0
     elif rise(lo_x) > 0.0:
@@ -525,10 +513,6 @@ def _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x):
 def _interval_threshold(chi_min, n, sigma_known, k=1, level=INTERVAL_LEVEL):
     """The rise of chi^2 that bounds the profile-likelihood interval of one parameter at ``level``
     (68.27 %: Delta chi^2 = 1 with stated uncertainties), s^2 t^2 (n - k degrees of freedom) without."""
-    from scipy import stats
-
-    from microimpact.analysis.identifiability import chi2_threshold
-
     if sigma_known:
         return chi2_threshold(level)
     if n > k:
@@ -539,8 +523,6 @@ def _interval_threshold(chi_min, n, sigma_known, k=1, level=INTERVAL_LEVEL):
 def _minimum(f, lo, hi, grid, hints=()):
     """(t, f(t)) with the smallest f over t = -inf (no damping, no adhesion) and [lo, hi]: a grid
     and the ``hints`` (minimisers found nearby before), then bounded Brent about the best of them."""
-    from scipy import optimize
-
     ts = np.linspace(lo, hi, grid)
     step = ts[1] - ts[0]
     candidates = [(float(t), f(float(t))) for t in ts]
@@ -568,8 +550,6 @@ def _fit_with_adhesion(model, e_meas, sig, sigma_known, to_coef, from_coef, lo_x
     intervals are searched means the minimum was missed: the fit starts again from there (at most
     three times).
     """
-    from functools import lru_cache
-
     lo_u, hi_u = _ADHESION_DECADES
     seen = {}
 
@@ -621,8 +601,6 @@ def _polish(chi, start, lo_u, hi_u, lo_x, hi_x):
     """The minimum of chi(u, x) near ``start``: Nelder-Mead in the plane (the valley of chi^2 is
     narrow and oblique: w_A and the damping both lower e_n), or along one coordinate when the other
     is -inf (no adhesion or no damping), then the best of that and the two edges at -inf."""
-    from scipy import optimize
-
     u0, x0 = start
     candidates = []
     if math.isfinite(u0) and math.isfinite(x0):
@@ -716,10 +694,6 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     >>> f.status, round(f.value, 4), [round(x, 4) for x in f.interval]
     ('determined', 0.71, [0.7042, 0.7158])
     """
-    from scipy import optimize, stats
-
-    from microimpact.analysis.fitting import _sigma_e, _table_arrays
-
     if fit_adhesion and normal_model == "hertz":
         raise ValueError(f"fit_adhesion: {normal_model}+{damping_model} has no work of adhesion to fit; "
                          "choose jkr_force or dmt")
@@ -772,8 +746,6 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
 
 def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x, src) -> DemLawFit:
     """:func:`fit_dem_law` with the work of adhesion fitted too."""
-    from scipy import stats
-
     n = e_meas.size
     chi_min, (w_interval, w_status, w_best), (interval, status, best) = _fit_with_adhesion(
         model, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x)
@@ -839,8 +811,6 @@ def rank_dem_laws(table, material, laws=None, *, fit_adhesion: bool = False, wei
     >>> list(ranked["law"])[0]
     'hertz+coeff_restitution'
     """
-    import pandas as pd
-
     laws = candidate_laws(material, fit_adhesion) if laws is None else list(laws)
     fits = {}
     for a, b in laws:
@@ -917,8 +887,6 @@ def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, s
     >>> r["trials"], r["determined"] == 5
     (5, True)
     """
-    import pandas as pd
-
     rng = np.random.default_rng(seed)
     material = {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0 if normal_model == "hertz" else 0.01}
     determined = covered = adequate = adhesion_determined = 0

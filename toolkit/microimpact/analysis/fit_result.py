@@ -15,10 +15,11 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from microimpact.io.formatting import ReportHTML
+from microimpact.io.formatting import ReportHTML, estimates_repr
 from microimpact.analysis.identifiability import status_from_variables, status_variables
+from microimpact.io.kinds import file_kind
 from microimpact.io.statuses import stderr_is_meaningful
-from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.files import CONVENTIONS, restore_label_coordinates, write_netcdf
 from microimpact.io.impacts import insert_row_labels, label_variables, labels_from_dataset
 from microimpact.io.materials import material_contact
 from microimpact.io.provenance import fit_parameter_source, stamp_parameters
@@ -182,8 +183,6 @@ class DampingFit(ReportHTML):
         return self.report()
 
     def __repr__(self) -> str:
-        from microimpact.io.formatting import estimates_repr
-
         return estimates_repr("DampingFit", self.values, self.stderr, self.varied, redchi=float(self.redchi),
                               n_points=int(self.n_points))
 
@@ -247,8 +246,6 @@ class DampingFit(ReportHTML):
     @classmethod
     def from_dataset(cls, ds: xr.Dataset) -> "DampingFit":
         """Inverse of :meth:`to_dataset` (also of the Dataset read back from its file)."""
-        from microimpact.io.files import restore_label_coordinates
-
         ds = restore_label_coordinates(ds)
         a = ds.attrs
         varied = tuple(a["varied"].split()) if a.get("varied") else ()
@@ -299,8 +296,6 @@ class DampingFit(ReportHTML):
 
     @staticmethod
     def _not_a_fit(path) -> str:
-        from microimpact.io.kinds import file_kind
-
         return (f"{path}: not a damping fit (the file that 'microimpact fit --out' writes): it is "
                 f"{file_kind(path)}")
 

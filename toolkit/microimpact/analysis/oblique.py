@@ -44,18 +44,28 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, field
 
+import lmfit
 import numpy as np
 import pandas as pd
 import xarray as xr
+from scipy import stats
+from scipy.optimize import brentq, minimize_scalar
 
-from microimpact.io.formatting import ReportHTML
+from microimpact.analysis.fit_result import PARAMETER_NAMES
+from microimpact.analysis.identifiability import (DEFAULT_LEVEL, chi2_threshold, profile_interval,
+                                                  status_from_interval, status_variables)
+from microimpact.io.formatting import ReportHTML, estimates_repr
 from microimpact.io.files import CONVENTIONS, write_netcdf
-from microimpact.io.impacts import OBLIQUE_COLUMNS, insert_row_labels, label_variables, row_labels
+from microimpact.io.impacts import ImpactDataWarning, OBLIQUE_COLUMNS, insert_row_labels, label_variables, row_labels
 from microimpact._runtime.progress import progress_bar
+from microimpact.io.materials import material_contact
+from microimpact.io.statuses import stderr_is_meaningful
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
-from microimpact.solvers import DEFAULT_RTOL, Deadline, engine_threads
+from microimpact.model.tangential import tangential_outcome
+from microimpact.solvers import DEFAULT_RTOL, Deadline, engine, engine_threads
 
 __all__ = ["FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state", "effective_sigma", "TANGENTIAL_PARAMETERS",
            "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"]
@@ -77,10 +87,6 @@ def _warn_unused(src: str, quantity: str, rows, unused, inc, e_n) -> None:
     """One ImpactDataWarning naming the rows whose measured oblique value the friction fit cannot
     use, and why: at normal incidence there is no tangential motion for friction to act on, and a
     captured impact has no rebound."""
-    import warnings
-
-    from microimpact.io.impacts import ImpactDataWarning
-
     if not np.any(unused):
         return
     with np.errstate(invalid="ignore"):
@@ -235,8 +241,6 @@ def normal_impulses(contact, speed, incidence_deg, rtol: float = DEFAULT_RTOL) -
     dict of arrays: ``captured`` (bool), ``e_n`` [-], ``velocity_in_n``, ``velocity_in_t`` [m/s],
     ``friction_impulse`` [N s], ``twist_impulse`` [N m s].
     """
-    from microimpact.solvers import engine
-
     a = np.radians(incidence_deg)
     vn, vt = speed * np.cos(a), speed * np.sin(a)
     speeds, inverse = np.unique(vn, return_inverse=True)  # one solve per distinct normal speed
@@ -262,8 +266,6 @@ def rebound_from_impulses(contact, impulses: dict, spin, friction=None) -> dict:
     -------
     dict of arrays, as :func:`rebound_state`.
     """
-    from microimpact.model.tangential import tangential_outcome
-
     vn, vt = impulses["velocity_in_n"], impulses["velocity_in_t"]
     zero = np.zeros_like(vn)
     f = contact.friction if friction is None else friction
@@ -479,8 +481,6 @@ class FrictionFit(ReportHTML):
         return all(st.determined for st in self.identifiability.values())
 
     def __repr__(self) -> str:
-        from microimpact.io.formatting import estimates_repr
-
         return estimates_repr("FrictionFit", self.values, self.stderr, tangential_model=self.tangential_model,
                               n_points=int(self.n_points))
 
@@ -502,7 +502,6 @@ class FrictionFit(ReportHTML):
             if st is not None and not st.determined:
                 lines.append(f"  {k:<17}: {st.describe()}")
                 continue
-            from microimpact.io.statuses import stderr_is_meaningful
 
             if stderr_is_meaningful(v, self.stderr[k]) and stderr_is_meaningful(v, self.stderr_conditional[k]):
                 lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr[k]:.3g}" + (" (at the normal law's values)" if held else
@@ -552,7 +551,6 @@ class FrictionFit(ReportHTML):
         """CF form: scalar ``friction`` (+ ``friction_stderr``) and the entries along ``entry``."""
         d = self.data
         ds = xr.Dataset(coords={"entry": ("entry", np.arange(len(d)), {"long_name": "index of the fitted oblique entry"})})
-        from microimpact.analysis.identifiability import status_variables
 
         for st in self.identifiability.values():
             ds.update(status_variables(st, "1"))
@@ -682,8 +680,6 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
 
     At 10-40 deg every impact ends rolling, and the data only bound f from below: no value is given.
     """
-    import lmfit  # only when fitting
-
     t0 = time.perf_counter()
     deadline = Deadline.start(time_budget, "friction fit")
     problem = ObliqueProblem.from_table(table, warn=True)
@@ -719,10 +715,6 @@ def _friction_result(problem, objective, best, var_damping, gradient, weighted, 
     ``shift``: the 95 % (down, up) widening by a normal law's region (:func:`_normal_law_shift`),
     in place of ``var_damping``; its standard error is the mean shift / 1.96."""
     if shift is not None:
-        from scipy import stats
-
-        from microimpact.analysis.identifiability import DEFAULT_LEVEL
-
         var_damping = (0.5 * sum(shift) / stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2)) ** 2
     status = _friction_status(best, objective, var_damping, shift)
     p = {"friction": float(best.value)}
@@ -875,8 +867,6 @@ def _refine_profile(objective, grid, chi2, points):
 
     Measured before the valleys were searched: 5 of 40 random designs had 95 % intervals that missed
     the true mu, two of them around a minimum of the grid while the true valley lay between grid points."""
-    from scipy.optimize import minimize_scalar
-
     n = grid.size
     found_x, found_c = [], []
     for i in range(1, n - 1):
@@ -910,10 +900,6 @@ def _threshold_crossings(objective, grid, chi2, dof) -> tuple[np.ndarray, np.nda
     search between the two grid points that bracket it (to 1e-6 of mu): the interval's ends exact,
     not interpolated (a grid of 32 points across cells 0.12 wide put the ends of a 0.01-wide
     interval where chi-square had risen by 3.3, not 3.84)."""
-    from scipy.optimize import brentq
-
-    from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold
-
     scale = _profile_scale(objective, float(chi2.min()), dof)
     level = float(chi2.min()) + chi2_threshold(DEFAULT_LEVEL) * scale
     above = chi2 > level
@@ -928,8 +914,6 @@ def _profile_fit(objective: _FrictionObjective, lmfit, deadline, points: int = P
     """Global minimum of chi-square(f) over the whole range, and the profile (see fit_friction).
 
     ``refine`` > 0: the profile refined by :func:`_refine_profile` (a coarse grid of a costly objective)."""
-    from scipy.optimize import minimize_scalar
-
     _, lo, hi = PARAMETER_BOUNDS["friction"]
     thresholds = objective.rolling_thresholds()
     finite = thresholds[np.isfinite(thresholds) & (thresholds > lo) & (thresholds < hi)]
@@ -981,10 +965,6 @@ def _profile_fit(objective: _FrictionObjective, lmfit, deadline, points: int = P
 def _friction_status(best: _ProfileFit, objective: _FrictionObjective, var_damping: float, shift=None):
     """The identifiability of f: profile interval, widened by the damping uncertainty (1.96 times
     the square root of ``var_damping`` each way, or the 95 % (down, up) ``shift``), classified."""
-    from microimpact.analysis.identifiability import (DEFAULT_LEVEL, chi2_threshold, profile_interval,
-                                                      status_from_interval)
-    from scipy import stats
-
     _, lo_lim, hi_lim = PARAMETER_BOUNDS["friction"]
     _, lo, hi, _ = profile_interval(best.grid, best.chi2, chi2_threshold(DEFAULT_LEVEL))
     if shift is None and math.isfinite(var_damping) and var_damping > 0:
@@ -1033,8 +1013,6 @@ def _damping_gradient(problem, damping_fit, f_best, weighted, rtol, lmfit, advan
 
 def _contact_fields(damping_fit, radius, values) -> dict:
     """Contact fields of one radius for damping parameters ``values`` (f0 from Eq. (7) when w_A moves)."""
-    from microimpact.io.materials import material_contact
-
     c = material_contact(damping_fit, radius, zeta_hertz=values["zeta_hertz"], zeta_adhesion=values["zeta_adhesion"],
                          work_of_adhesion=values["work_of_adhesion"])
     return {"zeta_hertz": c.zeta_hertz, "zeta_adhesion": c.zeta_adhesion, "adhesion_line_force": c.adhesion_line_force}
@@ -1042,8 +1020,6 @@ def _contact_fields(damping_fit, radius, values) -> dict:
 
 def _damping_covariance(damping_fit) -> np.ndarray:
     """Covariance of the varied damping parameters from the fit's standard errors and correlation."""
-    from microimpact.analysis.fit_result import PARAMETER_NAMES
-
     idx = [PARAMETER_NAMES.index(p) for p in damping_fit.varied]
     se = np.array([damping_fit.stderr[p] for p in damping_fit.varied])
     corr = np.nan_to_num(damping_fit.correlation[np.ix_(idx, idx)])

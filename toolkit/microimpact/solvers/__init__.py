@@ -19,6 +19,8 @@ solver evaluates the contact law of :mod:`microimpact.model.law`; the compiled o
 """
 
 import contextlib
+import math
+import numbers
 import sys
 
 from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
@@ -34,6 +36,30 @@ DEFAULT_RTOL = 1e-8
 #: The smallest relative tolerance accepted: 100 machine epsilons, as scipy's solve_ivp (below it no
 #: double-precision integration can meet the tolerance, and the engine ends at its step limit).
 MIN_RTOL = 100.0 * sys.float_info.epsilon
+
+
+def check_rtol(rtol) -> float:
+    """``rtol`` as a float if the solvers can meet it: finite, in [:data:`MIN_RTOL`, 1); else a
+    TypeError / ValueError saying what is accepted. The CLI's ``--rtol`` and the pipeline's config
+    key ``rtol`` are checked here too, so all three accept the same values.
+
+    Examples
+    --------
+    >>> check_rtol(1e-8)
+    1e-08
+    >>> check_rtol(1e-300)
+    Traceback (most recent call last):
+    ...
+    ValueError: rtol must be >= 2.22e-14 (100 machine epsilons; a smaller tolerance cannot be met in double precision), got 1e-300
+    """
+    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real):
+        raise TypeError(f"rtol must be a real number, got {type(rtol).__name__} {rtol!r}")
+    if not (math.isfinite(rtol) and 0.0 < rtol < 1.0):
+        raise ValueError(f"rtol must be finite and lie in (0, 1), got {rtol!r}")
+    if rtol < MIN_RTOL:
+        raise ValueError(f"rtol must be >= {MIN_RTOL:.3g} (100 machine epsilons; a smaller tolerance cannot be "
+                         f"met in double precision), got {rtol!r}")
+    return float(rtol)
 
 
 class SolverError(RuntimeError):

@@ -101,7 +101,9 @@ import xarray as xr
 from microimpact.io.files import atomic_write, write_netcdf
 from microimpact._runtime.progress import progress_bar
 from microimpact.io.variables import attributes
-from microimpact.model.contact import Contact
+from microimpact.model import tangential_compliance as tc
+from microimpact.model.contact import Contact, adhesion_line_force_from_work
+from microimpact.model.dem_damping import critical_damping_coefficient
 from microimpact.solvers.impact import settled_contact_energy, simulate_impact
 from microimpact.solvers import TimeBudgetExceeded, check_sub_models
 from microimpact.solvers.reference import simulate_reference
@@ -264,8 +266,6 @@ def contact_of(case: dict, law: str = "ring") -> Contact:
     >>> c.tangential_model, round(c.shear_modulus / case["stiffness"], 4)
     ('mindlin', 0.1544)
     """
-    from microimpact.model import tangential_compliance as tc
-
     fields = dict(LAWS[law])
     adhesive = fields.pop("adhesion", True)
     if fields.get("damping_model", "paper") != "paper":
@@ -284,9 +284,6 @@ def _dem_contact(case: dict, fields: dict, adhesive: bool) -> Contact:
     """A case under a DEM damping law: the drawn zeta_H (1e-3 to 1e6, or 0) sets the damping as a
     multiple of the critical damping 2 sqrt(m k) of the case's Hertz impact (k = K a at its largest
     approach), or the restitution e = 1 / (1 + zeta_H) of tsuji and coeff_restitution."""
-    from microimpact.model.contact import adhesion_line_force_from_work
-    from microimpact.model.dem_damping import critical_damping_coefficient
-
     r, rho, k = case["radius"], case["density"], case["stiffness"]
     f0 = adhesion_line_force_from_work(k, r, case["work_of_adhesion"]) if adhesive else 0.0
     zeta = case["zeta_hertz"]

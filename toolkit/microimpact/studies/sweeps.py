@@ -50,7 +50,7 @@ import xarray as xr
 from microimpact import __version__
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity
-from microimpact.io.files import CONVENTIONS, write_netcdf
+from microimpact.io.files import CONVENTIONS, restore_label_coordinates, write_netcdf
 from microimpact._runtime.progress import progress_bar, wants_progress
 from microimpact.io.variables import attributes
 from microimpact.model.contact import PAPER_REFERENCE
@@ -584,8 +584,6 @@ def load_sweep(path) -> xr.Dataset:
     ...
     FileNotFoundError: ...
     """
-    from microimpact.io.files import restore_label_coordinates
-
     with xr.open_dataset(path, decode_timedelta=False) as ds:
         return restore_label_coordinates(ds.load())
 
