@@ -1,7 +1,8 @@
 """The layout shows the architecture: imports point one way, and no function grows unreadable.
 
 Rooms of the package (toolkit/microimpact/) and what each may import from the others:
-model -> nothing; io -> model; solvers -> model, io; dynamics -> solvers; analysis -> dynamics;
+_runtime (the process's plumbing: signals, job logs, locks, progress bars, time budgets) -> nothing,
+and every room may use it; model -> nothing; io -> model; solvers -> model, io; dynamics -> solvers; analysis -> dynamics;
 studies -> analysis; report -> model, io only (it reads result files and runs no model); the CLI
 and the package's ``__init__`` may import anything, and so may the ``__main__.py`` entry points. These are the rules of the architecture notes
 (a study never imports the report; the report imports no solver), checked on the source text.
@@ -19,13 +20,14 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "toolkit" / "microimpact"
 
 ALLOWED = {
+    "_runtime": {"_runtime"},
     "model": {"model"},
-    "io": {"io", "model"},
-    "solvers": {"solvers", "model", "io"},
-    "dynamics": {"dynamics", "solvers", "model", "io"},
-    "analysis": {"analysis", "dynamics", "solvers", "model", "io"},
-    "studies": {"studies", "analysis", "dynamics", "solvers", "model", "io", "presets"},
-    "report": {"report", "model", "io"},
+    "io": {"io", "model", "_runtime"},
+    "solvers": {"solvers", "model", "io", "_runtime"},
+    "dynamics": {"dynamics", "solvers", "model", "io", "_runtime"},
+    "analysis": {"analysis", "dynamics", "solvers", "model", "io", "_runtime"},
+    "studies": {"studies", "analysis", "dynamics", "solvers", "model", "io", "presets", "_runtime"},
+    "report": {"report", "model", "io", "_runtime"},
 }
 #: no function of the package has more lines of code than this (docstrings, blank lines and
 #: comment-only lines aside; see test_no_function_has_more_than_100_lines_of_code)

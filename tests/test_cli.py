@@ -93,7 +93,7 @@ def test_good_rebound_json(capsys):
 
 
 def subprocess_run(args):
-    return subprocess.run([sys.executable, "-m", "microimpact.cli", *args], capture_output=True, text=True, timeout=120)
+    return subprocess.run([sys.executable, "-m", "microimpact", *args], capture_output=True, text=True, timeout=120)
 
 
 def test_subprocess_good_and_bad():
@@ -109,7 +109,7 @@ def test_subprocess_good_and_bad():
 def test_closed_stdout_exits_quietly():
     """`microimpact simulate ... | head` where head has gone: no error line, the SIGPIPE status.
     The read end is closed before the command writes (it still imports), so the write must fail."""
-    proc = subprocess.Popen([sys.executable, "-m", "microimpact.cli", *GOOD], stdout=subprocess.PIPE,
+    proc = subprocess.Popen([sys.executable, "-m", "microimpact", *GOOD], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     proc.stdout.close()
     _, err = proc.communicate(timeout=120)

@@ -112,7 +112,7 @@ def test_bad_input_flags(small_csv, fitted, tmp_path, capsys):
 
 
 def test_entry_point_exit_status(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "microimpact.cli", "fit", str(tmp_path / "missing.csv"), "--out",
+    r = subprocess.run([sys.executable, "-m", "microimpact", "fit", str(tmp_path / "missing.csv"), "--out",
                         str(tmp_path / "f.nc")], capture_output=True, text=True)
     assert r.returncode == 2
     assert r.stderr.count("\n") == 1 and "does not exist" in r.stderr
@@ -142,3 +142,13 @@ def test_fit_json_is_the_report_as_numbers(small_csv, tmp_path, capsys):
             assert "value" not in rec and "stderr" not in rec
     assert params["work_of_adhesion"] == {"status": "fixed", "value": pytest.approx(fit.values["work_of_adhesion"])}
     assert summary["n_points"] == len(fit.data) and summary["written"] == [str(out)]
+
+
+def test_fit_help_names_the_format_document_an_installed_package_has(capsys):
+    """``fit --help`` points at the packaged copy of data/README.md (an installed user has no
+    repository), by a path that exists and holds the CSV format's section."""
+    assert main(["fit", "--help"]) == 0
+    words = capsys.readouterr().out.split()
+    named = [Path(w.rstrip(",")) for w in words if w.rstrip(",").endswith("README.md")]
+    assert named and named[0].is_absolute() and named[0].is_file(), named
+    assert "Measured-impact CSV format" in named[0].read_text()

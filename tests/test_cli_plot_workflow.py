@@ -161,7 +161,7 @@ def _workflow_running(tmp_path, **popen):
     import time
 
     exe = shutil.which("microimpact")
-    cmd = [exe] if exe else [sys.executable, "-m", "microimpact.cli"]
+    cmd = [exe] if exe else [sys.executable, "-m", "microimpact"]
     run = tmp_path / "run"
     shutil.copytree(Path(__file__).resolve().parents[1] / "data", run / "data")
     env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")

@@ -341,7 +341,7 @@ def _oblique_table(contact, speeds, angles, noise, rng):
 def test_a_design_that_cannot_tell_mu_says_so():
     # DMT with LAMMPS's Mindlin spring at 2-6 deg: the limit 2 mu F_po at touch holds the contact
     # stuck throughout for any mu above ~0.02, so e_t does not depend on mu there: no number
-    from microimpact.analysis.oblique import fit_dem_friction
+    from microimpact.analysis.dem_friction import fit_dem_friction
 
     c = Contact.from_work_of_adhesion(**SPHERE, work_of_adhesion=W_A, normal_model="dmt", friction=0.4,
                                       tangential_model="lammps_mindlin", shear_modulus=3e8)
@@ -377,7 +377,7 @@ def test_the_normal_laws_uncertainty_reaches_mu():
     # profile fits of mu there measure it (to 1e-3: their polish tolerance); the standard error by the
     # mean of the two moves / 1.96.
     from microimpact.analysis.dem_fit import dem_law_contact, fit_dem_law
-    from microimpact.analysis.oblique import fit_dem_friction
+    from microimpact.analysis.dem_friction import fit_dem_friction
 
     mat = {**SPHERE, "work_of_adhesion": 0.0}
     tang = {"friction": 0.15, "tangential_model": "lammps_mindlin", "shear_modulus": 3e8}
@@ -420,7 +420,7 @@ def test_a_fitted_work_of_adhesion_widens_mu_by_at_least_its_profile_ends():
     # move, so each end of mu's interval lies at least that far out (in quadrature with the
     # conditional interval; 1e-3: their polish tolerance), and the report names both parameters.
     from microimpact.analysis.dem_fit import dem_law_contact, fit_dem_law
-    from microimpact.analysis.oblique import fit_dem_friction
+    from microimpact.analysis.dem_friction import fit_dem_friction
 
     from microimpact.model.dem_damping import critical_damping_coefficient
 
@@ -448,7 +448,7 @@ def test_a_fitted_work_of_adhesion_widens_mu_by_at_least_its_profile_ends():
 
 def test_a_normal_fit_of_another_law_or_without_an_interval_is_refused():
     from microimpact.analysis.dem_fit import dem_law_contact, fit_dem_law
-    from microimpact.analysis.oblique import fit_dem_friction
+    from microimpact.analysis.dem_friction import fit_dem_friction
 
     mat = {**SPHERE, "work_of_adhesion": 0.0}
     tang = {"friction": 0.15, "tangential_model": "lammps_mindlin", "shear_modulus": 3e8}
@@ -474,7 +474,7 @@ def test_the_friction_interval_covers_the_truth_over_random_designs():
     # stiffness; the 95 % profile interval must cover mu as often as it says (measured: 38 of 40
     # over designs of this kind with linear_history and mindlin, 31 determined); a 68 % interval
     # (Delta chi^2 = 1) fails this
-    from microimpact.analysis.oblique import fit_dem_friction
+    from microimpact.analysis.dem_friction import fit_dem_friction
 
     rng = np.random.default_rng(5)
     covered = []
@@ -576,7 +576,7 @@ def test_a_stated_angle_uncertainty_enters_the_dem_friction_fit_as_effective_var
     # the two slopes agree to their O(h^2) truncation, 1e-3), at the fitted mu of noise-free data
     import pandas as pd
 
-    from microimpact.analysis.oblique import fit_dem_friction
+    from microimpact.analysis.dem_friction import fit_dem_friction
 
     c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.2, tangential_model="lammps_mindlin", shear_modulus=3e8)
     angles = np.array([20.0, 35.0, 50.0])
@@ -597,7 +597,7 @@ def test_a_stated_angle_uncertainty_enters_the_dem_friction_fit_as_effective_var
 
 
 def test_the_stiffness_uncertainty_is_checked_and_the_parabola_vertex_is_exact():
-    from microimpact.analysis.oblique import _parabola_vertex, _stiffness_uncertainty
+    from microimpact.analysis.dem_friction import _parabola_vertex, _stiffness_uncertainty
 
     assert _stiffness_uncertainty(None) is None and _stiffness_uncertainty(0.0) is None  # nothing to profile
     assert _stiffness_uncertainty(0.05) == 0.05
@@ -622,7 +622,8 @@ def test_the_profiled_stiffness_finds_the_least_penalised_deviance():
     # below the deviance at the given stiffness, and its stiffness must be that search's (to 0.05)
     from scipy.optimize import minimize_scalar
 
-    from microimpact.analysis.oblique import ObliqueProblem, _DemFrictionObjective, _StiffnessProfile
+    from microimpact.analysis.dem_friction import _DemFrictionObjective, _StiffnessProfile
+    from microimpact.analysis.oblique import ObliqueProblem
 
     truth = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.3, tangential_model="lammps_mindlin", shear_modulus=3e8)
     given = truth.with_(shear_modulus=0.8 * 3e8)
@@ -648,7 +649,8 @@ def test_an_unweighted_fit_of_mu_has_the_profile_interval_of_its_scatter():
     # ends are where the raw chi-square has risen by 3.84 times it. Checked against the chi-square
     # evaluated independently at the ends (to 0.1 of 3.84: the ends are interpolated on the refined
     # grid); the refinement once used the raw threshold, and this interval came out 8 times narrow
-    from microimpact.analysis.oblique import ObliqueProblem, _DemFrictionObjective, fit_dem_friction
+    from microimpact.analysis.dem_friction import _DemFrictionObjective, fit_dem_friction
+    from microimpact.analysis.oblique import ObliqueProblem
 
     c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.25, tangential_model="lammps_mindlin", shear_modulus=3e8)
     table = _oblique_table(c, np.full(5, 1.0), np.linspace(10.0, 70.0, 5), 0.01, np.random.default_rng(0))
@@ -728,7 +730,8 @@ def test_the_held_stiffness_moves_mu_as_independent_fits_do_and_its_profile_give
     # at the fitted mu (to 0.05: the ends are interpolated on the profile's grid).
     from scipy.optimize import minimize_scalar
 
-    from microimpact.analysis.oblique import ObliqueProblem, _DemFrictionObjective, fit_dem_friction
+    from microimpact.analysis.dem_friction import _DemFrictionObjective, fit_dem_friction
+    from microimpact.analysis.oblique import ObliqueProblem
 
     c = Contact(**SPHERE, adhesion_line_force=0.0, friction=0.25, tangential_model="lammps_mindlin", shear_modulus=3e8)
     table = _oblique_table(c, np.full(4, 1.0), np.linspace(10.0, 70.0, 4), 0.01, np.random.default_rng(0))

@@ -222,7 +222,7 @@ def _argv(command: str) -> list[str]:
         for placeholder, real in PLACEHOLDERS.items():
             words[i] = words[i].replace(placeholder, real)
     if words[0] == "microimpact":  # the CLI of the package under test (not a console script elsewhere)
-        return [sys.executable, "-m", "microimpact.cli", *words[1:]]
+        return [sys.executable, "-m", "microimpact", *words[1:]]
     if words[0] == "python":
         return [sys.executable, *words[1:]]
     if words[0] == "snakemake":

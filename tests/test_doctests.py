@@ -19,7 +19,7 @@ FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 def test_every_module_is_found():
     """The walk sees the packages and their modules (a broken walk would pass every test below)."""
     assert {"microimpact.cli", "microimpact.model.law", "microimpact.solvers.engine",
-            "microimpact.analysis.fitting", "microimpact.io.joblog"} <= set(MODULES)
+            "microimpact.analysis.fitting", "microimpact._runtime.joblog"} <= set(MODULES)
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -367,7 +367,7 @@ END_TO_END = [
 def test_entry_point(argv, words, workspace):
     before = _snapshot(workspace)
     exe = shutil.which("microimpact")
-    cmd = [exe, *argv] if exe else [sys.executable, "-m", "microimpact.cli", *argv]
+    cmd = [exe, *argv] if exe else [sys.executable, "-m", "microimpact", *argv]
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert r.returncode == 2, r.stderr
     assert r.stdout == ""
@@ -392,7 +392,7 @@ def test_ctrl_c_ends_in_one_line_with_status_130_and_writes_nothing(argv, after,
 
     before = _snapshot(workspace)
     exe = shutil.which("microimpact")
-    cmd = [exe] if exe else [sys.executable, "-m", "microimpact.cli"]
+    cmd = [exe] if exe else [sys.executable, "-m", "microimpact"]
     proc = subprocess.Popen([*cmd, *argv], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, start_new_session=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
@@ -431,7 +431,7 @@ def test_a_warning_is_one_line_naming_the_input_not_the_installation(tmp_path):
                    "b,ammonium_fluorescein_on_silicon,1.29,2.0,0,1.006,0.01\n"
                    "c,ammonium_fluorescein_on_silicon,1.29,4.0,0,0.70,0.01\n")
     exe = shutil.which("microimpact")
-    cmd = [exe] if exe else [sys.executable, "-m", "microimpact.cli"]
+    cmd = [exe] if exe else [sys.executable, "-m", "microimpact"]
     r = subprocess.run([*cmd, "fit", str(csv), "--out", str(tmp_path / "fit.nc"), "--no-confidence-intervals"],
                        capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr

@@ -140,7 +140,7 @@ def test_averaged_tail_matches_the_full_integration(y0, c1, c2):
 
 
 def test_stress_timeout_is_a_time_budget():
-    from microimpact.studies._timeout import TimeLimitExceeded
+    from microimpact._runtime.timeout import TimeLimitExceeded
 
     assert issubclass(TimeLimitExceeded, TimeBudgetExceeded)
 

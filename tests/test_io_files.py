@@ -208,7 +208,7 @@ def test_deferred_signals_restores_the_handlers_and_raises_each_signal_once():
     import os
     import signal
 
-    from microimpact.io.files import deferred_signals
+    from microimpact._runtime.signals import deferred_signals
 
     seen = []
     before = signal.signal(signal.SIGTERM, lambda s, f: seen.append(s))

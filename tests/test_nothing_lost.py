@@ -152,7 +152,7 @@ def test_a_lock_is_removed_only_when_no_snakemake_process_works_there(tmp_path):
     """A process that names Snakemake and works in the directory holds its lock: nothing is removed
     while it runs; once it is gone the lock is stale and is removed. A process that does not name
     Snakemake (the analyst's shell in that directory) holds nothing."""
-    from microimpact.io.locks import remove_stale_lock, snakemake_processes_in
+    from microimpact._runtime.locks import remove_stale_lock, snakemake_processes_in
 
     locks = tmp_path / ".snakemake" / "locks"
     locks.mkdir(parents=True)

@@ -184,7 +184,7 @@ def test_a_refit_that_leaves_its_brackets_is_found_over_the_whole_range():
     """mu refitted at a point of the normal law's region can move beyond [mu / 2, 2 mu]: the refit
     then searches the whole range (minimum at 5 found to its xatol), and where the deviance still
     falls at the range's end it returns that end (mu moves at least so far) instead of failing."""
-    from microimpact.analysis.oblique import _refit
+    from microimpact.analysis.dem_friction import _refit
 
     brackets = [(0.1, 0.3), (0.1, 0.4)]
     assert _refit(lambda x: (x - 5.0) ** 2, brackets, 0.1, 0.0, 10.0) == pytest.approx(5.0, abs=1e-4)

@@ -130,7 +130,7 @@ def test_fit_time_budget_is_checked_at_start(tmp_path):
 def test_a_failing_job_says_why_in_one_line_and_leaves_no_result(tmp_path):
     """A job that fails while running (here the fit, past a tiny time budget) prints one line on the
     terminal naming the rule, the exception and its message, keeps the traceback in its log, and
-    leaves no result file behind (microimpact.io.joblog, atomic outputs)."""
+    leaves no result file behind (microimpact._runtime.joblog, atomic outputs)."""
     import yaml
 
     other = make_copy(tmp_path / "wf")

@@ -15,7 +15,7 @@ import sys
 import numpy as np
 import pytest
 
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.presets import WALL_1990
 from microimpact.studies import sweeps
 from microimpact.studies.benchmark.run import _STAGES
@@ -28,7 +28,7 @@ SWEEP = ["sweep", "--case", "2.1"]
 
 def _run_cli(args, tmp_path, *, terminal: bool) -> tuple[int, str]:
     """``microimpact ARGS`` in a subprocess; stderr to a pseudo-terminal or a pipe. (status, stderr)."""
-    cmd = [sys.executable, "-m", "microimpact.cli", *args]
+    cmd = [sys.executable, "-m", "microimpact", *args]
     env = dict(os.environ, PYTHONWARNINGS="ignore")
     if not terminal:
         proc = subprocess.run(cmd, cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,

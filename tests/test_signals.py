@@ -1,4 +1,4 @@
-"""A signal that Python delivers inside a finaliser still stops the process (microimpact.io.joblog)."""
+"""A signal that Python delivers inside a finaliser still stops the process (microimpact._runtime.joblog)."""
 
 import subprocess
 import sys
@@ -8,7 +8,7 @@ import pytest
 
 SCRIPT = textwrap.dedent("""
     import os, signal, sys, time
-    from microimpact.io.joblog import JobTerminated, redeliver_swallowed_signals
+    from microimpact._runtime.joblog import JobTerminated, redeliver_swallowed_signals
 
     if sys.argv[2] == "hook":
         redeliver_swallowed_signals()

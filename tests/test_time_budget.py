@@ -16,7 +16,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-import microimpact.solvers as solvers
+import microimpact._runtime.budget as budget
 from microimpact.solvers import Deadline, TimeBudgetExceeded, check_time_budget
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -34,7 +34,7 @@ def clock(monkeypatch):
         readings[0] += 1
         return float(readings[0])
 
-    monkeypatch.setattr(solvers, "time", SimpleNamespace(perf_counter=perf_counter))
+    monkeypatch.setattr(budget, "time", SimpleNamespace(perf_counter=perf_counter))
     return lambda: readings[0]
 
 
@@ -290,7 +290,7 @@ def test_time_limits_nest_and_the_outer_one_still_ends_the_block():
     timer and this loop ran its 40 cases (8 s)."""
     import time
 
-    from microimpact.studies._timeout import TimeLimitExceeded, time_limit
+    from microimpact._runtime.timeout import TimeLimitExceeded, time_limit
 
     inner_timeouts = 0
     t0 = time.perf_counter()

@@ -686,7 +686,7 @@ def test_microimpact_workflow_runs_the_packaged_pipeline(tmp_path):
     defaults, then one real job (the validation of the bundled data) in DIR."""
     env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
     work = tmp_path / "run here"  # a space in the path, and a directory that does not exist yet
-    cli = [sys.executable, "-m", "microimpact.cli", "workflow", "--directory", str(work)]
+    cli = [sys.executable, "-m", "microimpact", "workflow", "--directory", str(work)]
     dry = subprocess.run([*cli, "-n"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     assert dry.returncode == 0, (dry.stdout + dry.stderr)[-3000:]
     assert job_counts(dry.stdout).get("report") == 1, dry.stdout[-3000:]

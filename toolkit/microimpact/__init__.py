@@ -5,6 +5,8 @@ doi:10.1080/02786820290092221, with a fast compiled engine, a scipy reference so
 damping coefficients, sensitivity sweeps and a Snakemake report.
 """
 
+import sys
+
 
 from microimpact._lazy import lazy_exports as _lazy_exports
 
@@ -20,8 +22,6 @@ def _announce_numba_compiles() -> None:
     installing (or after a change of the compiled code), never when the compiled solvers are
     loaded from numba's cache. Other packages' numba functions are ignored.
     """
-    import sys
-
     from numba.core import event
 
     class _FirstCompileNotice(event.Listener):

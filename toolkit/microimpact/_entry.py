@@ -4,7 +4,7 @@ What only a process of its own may do lives here, not in :mod:`microimpact.cli`,
 a program imports and calls: install signal handlers. A Ctrl-C while the command imports numpy
 ends in the same one line as one during the work, not in a
 traceback from inside numpy; and a signal that lands in a finaliser still stops the command
-(:func:`microimpact.io.joblog.redeliver_swallowed_signals`). Where SIGINT is ignored (a
+(:func:`microimpact._runtime.joblog.redeliver_swallowed_signals`). Where SIGINT is ignored (a
 background job) it stays ignored. After the one line of a Ctrl-C the process ends at once
 (``os._exit``), without the finalisers of a compile the signal cut short. Warnings are printed
 as one line each, ``microimpact: warning: ...``.
@@ -18,18 +18,7 @@ import signal
 import sys
 import warnings
 
-#: the one line of a Ctrl-C, and its exit status: 128 + 2, as a shell reports a command SIGINT ended
-INTERRUPTED_LINE = ("microimpact: interrupted; nothing was written (outputs are written whole or not at all); run the "
-                    "same command again to redo it")
-EXIT_INTERRUPTED = 130
-
-
-def interrupted_after_writing(paths) -> str:
-    """The one line of a Ctrl-C that came after some outputs were complete and in place (the
-    signal is held while files are moved into place, so each named file is whole)."""
-    return (f"microimpact: interrupted after writing {', '.join(str(p) for p in paths)} "
-            "(complete; nothing else was written)")
-
+from microimpact._runtime.signals import COMPILED_ENV, EXIT_INTERRUPTED, INTERPRETED_SECONDS, INTERRUPTED_LINE
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """A warning as one line, ``microimpact: warning: MESSAGE``: Python's form names a file and a
@@ -38,13 +27,6 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
     own = category.__module__.startswith("microimpact")
     print(f"microimpact: warning: {message}" + ("" if own else f" ({category.__name__})"),
           file=sys.stderr if file is None else file)
-
-
-#: ``microimpact simulate`` runs its one impact with numba's compilation switched off
-#: (``NUMBA_DISABLE_JIT``) for at most this long [s], then starts again compiled (see
-#: :func:`_interpreted`); the environment variable ``MICROIMPACT_INTERPRETED_SECONDS`` sets another
-INTERPRETED_SECONDS = 4.0
-_COMPILED = "MICROIMPACT_COMPILED"  # set in the process started again: compiled, no second try
 
 
 class _CompileInstead(BaseException):
@@ -68,13 +50,7 @@ def _interpreted(argv) -> bool:
     numba is already imported (nothing to gain), where the user set ``NUMBA_DISABLE_JIT``, or in
     the process started again."""
     return (argv[:1] == ["simulate"] and "numba" not in sys.modules and "NUMBA_DISABLE_JIT" not in os.environ
-            and _COMPILED not in os.environ)
-
-
-def interpreted_budget_over() -> None:
-    """The impact is solved: the interpreted run's clock stops (the output is not cut short)."""
-    if os.environ.get("NUMBA_DISABLE_JIT") == "1" and _COMPILED not in os.environ and hasattr(signal, "setitimer"):
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
+            and COMPILED_ENV not in os.environ)
 
 
 def _start_compiled(argv):
@@ -82,7 +58,7 @@ def _start_compiled(argv):
     written yet)."""
     sys.stdout.flush()
     sys.stderr.flush()
-    env = {k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_JIT"} | {_COMPILED: "1"}
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_JIT"} | {COMPILED_ENV: "1"}
     os.execve(sys.executable, [sys.executable, "-m", "microimpact._entry", *argv], env)
 
 
@@ -100,7 +76,7 @@ def main() -> int:
     if starting:
         signal.signal(signal.SIGINT, _interrupted_while_starting)
     from microimpact.cli import main as cli_main
-    from microimpact.io.joblog import redeliver_swallowed_signals
+    from microimpact._runtime.joblog import redeliver_swallowed_signals
 
     if starting:
         signal.signal(signal.SIGINT, signal.default_int_handler)

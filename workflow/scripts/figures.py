@@ -7,7 +7,7 @@ the HTML report (snakemake --report report.html).
 
 import os
 
-from microimpact.io.joblog import log_job  # noqa: E402
+from microimpact._runtime.joblog import log_job  # noqa: E402
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -1,7 +1,7 @@
 """Rule fit: zeta_H, zeta_A (optionally w_A) from the measured e_n(v_n), the friction from the oblique
 columns when present, and the posterior with its bands -> results/analyst/<pair>/{fit,posterior,oblique}.nc."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -2,7 +2,7 @@
 is near capture, and the spin consistent with it (over the posterior draws), under the fitted model
 -> results/analyst/<pair>/flags.csv + results/analyst/<pair>/flags.nc."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -1,6 +1,6 @@
 """Rule gather_sweep: combine the chunks of one case into results/sweeps/case_<case>.nc."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

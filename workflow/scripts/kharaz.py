@@ -1,6 +1,6 @@
 """Rule kharaz: the model against the Kharaz et al. (2001) oblique impacts -> results/kharaz.nc."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -1,7 +1,7 @@
 """Rule lammps_check: the paper's microsphere as LAMMPS GRANULAR input, run by LAMMPS against
 microimpact -> results/lammps/contact.lmp + results/lammps/check.csv (docs/guide/lammps.md)."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -2,7 +2,7 @@
 (fit_curves.nc), the critical and capture velocity per measured size (dynamics.nc) and every
 configured Table 2 case for the fitted material (sweeps/case_<case>.nc)."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -1,6 +1,6 @@
 """Rule model_comparison: each normal model fitted to e_n(v_n), AIC/BIC -> results/analyst/<pair>/model_comparison.nc."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

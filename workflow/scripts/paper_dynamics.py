@@ -2,7 +2,7 @@
 phase portraits (phase_portraits.nc), v_c, the capture velocity, C and omega_f at those speeds
 (dynamics.nc), and the (C1, C2) plane of Fig. 4 with the Table 1 cases (bifurcation.nc)."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

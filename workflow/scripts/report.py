@@ -1,6 +1,6 @@
 """Rule report: lay out the result files on A4 pages -> reports/report.pdf (no simulation is run)."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

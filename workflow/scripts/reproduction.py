@@ -1,6 +1,6 @@
 """Rule reproduction: the paper's numbers and statements checked by computation (CSV + Markdown)."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -1,7 +1,7 @@
 """Rule stress: seeded random stress sweep of the engine -> results/stress_summary.json (summary)
 + results/stress.nc (one row per case: inputs, measures, failures)."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

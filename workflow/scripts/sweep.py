@@ -1,7 +1,7 @@
 """Rule paper_sweeps: every configured Table 2 case with the paper's contact
 -> results/paper/sweeps/case_<case>.nc."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -1,6 +1,6 @@
 """Rule paper_sweep_chunk: chunk <chunk> of <nchunks> (split along speed) of one Table 2 case."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -4,7 +4,7 @@ stderr is left on the terminal: a bad file stops the pipeline here with one Impa
 lists every problem (file, row, line, column, value, what is accepted) where the analyst sees it.
 """
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake, keep_stderr=True)  # noqa: F821  (the ImpactDataError is for the terminal)
 

@@ -1,7 +1,7 @@
 """Rule work_precision: accuracy against cost of the engine, scipy's solvers and Runge-Kutta-Gill
 -> results/benchmark/ (benchmark.nc, .json, .md, work_precision.pdf/.png)."""
 
-from microimpact.io.joblog import log_job
+from microimpact._runtime.joblog import log_job
 
 log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
 

@@ -9,6 +9,7 @@
 - :mod:`.kharaz`: the model against the Kharaz et al. (2001) oblique-impact measurements.
 - :mod:`.synthetic`: labelled synthetic measurements from stated parameters.
 - :mod:`.dem_fit`: the damping of LAMMPS GRANULAR's laws fitted to measured e_n, and the laws ranked.
+- :mod:`.dem_friction`: the friction mu of LAMMPS GRANULAR's tangential laws fitted to oblique rebounds.
 """
 
 from microimpact._lazy import lazy_exports as _lazy_exports
@@ -30,8 +31,9 @@ _HOMES = {
     **dict.fromkeys(("kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
                      "KHARAZ_CONDITIONS", "UNLOADING_READINGS"), "kharaz"),
     **dict.fromkeys(("compare_normal_models", "normal_model_restitution", "DEFAULT_MODELS"), "model_comparison"),
-    **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "fit_dem_friction", "rank_dem_tangential_laws", "oblique_model", "rebound_state",
+    **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state",
                      "effective_sigma", "TANGENTIAL_PARAMETERS", "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"), "oblique"),
+    **dict.fromkeys(("fit_dem_friction", "rank_dem_tangential_laws", "dem_friction_coverage"), "dem_friction"),
     **dict.fromkeys(("Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "posterior_contacts",
                      "restitution_bands", "capture_velocity_interval", "sweep_bands", "summary_table",
                      "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"), "posterior"),
@@ -42,7 +44,7 @@ _HOMES = {
                      "make_synthetic_oblique", "write_synthetic_impacts"), "synthetic"),
     **dict.fromkeys(("DampingTarget", "damping_from_target"), "target"),
     **dict.fromkeys(("DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws",
-                     "ranked_by_aic", "information_criteria", "dem_fit_coverage", "dem_friction_coverage", "INTERVAL_LEVEL", "ADEQUACY_P", "REGION_RAYS"), "dem_fit"),
+                     "ranked_by_aic", "information_criteria", "dem_fit_coverage", "INTERVAL_LEVEL", "ADEQUACY_P", "REGION_RAYS"), "dem_fit"),
 }
 #: the modules, importable as attributes
 _MODULES = tuple(sorted(set(_HOMES.values())))

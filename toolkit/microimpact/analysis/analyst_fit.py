@@ -27,14 +27,16 @@ from microimpact.analysis.oblique import FrictionFit
 from microimpact.analysis.posterior import Posterior
 from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import all_or_nothing, write_netcdf
+from microimpact.analysis.fitting import fit_damping
+from microimpact.analysis.oblique import ObliqueProblem, fit_friction
+from microimpact.analysis.posterior import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS,
+                                            capture_velocity_interval, restitution_bands, sample_posterior, sweep_bands)
 from microimpact.io.provenance import stamp_parameters
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS"]
 
 def _posterior_defaults() -> dict:
-    from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS
-
     return dict(walkers=DEFAULT_WALKERS, max_steps=DEFAULT_MAX_STEPS, steps=None, burn=None, seed=DEFAULT_SEED,
                 n_draws=DEFAULT_N_DRAWS)
 
@@ -221,9 +223,6 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     ...
     ValueError: unknown posterior option(s) ['wlakers']; known: ['burn', 'max_steps', 'n_draws', 'seed', 'steps', 'walkers']
     """
-    from microimpact.analysis.fitting import fit_damping
-    from microimpact.analysis.oblique import ObliqueProblem, fit_friction
-
     deadline = Deadline.start(time_budget, "analyst fit")
     damping = fit_damping(table, base, fit_work_of_adhesion=fit_work_of_adhesion, weights=weights,
                           confidence_intervals=confidence_intervals, rtol=rtol, progress=progress,
@@ -243,7 +242,6 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     if not posterior:
         return AnalystFit(damping, ff)
     opts = _posterior_options(posterior)
-    from microimpact.analysis.posterior import capture_velocity_interval, restitution_bands, sample_posterior, sweep_bands
 
     post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], max_steps=opts["max_steps"],
                             burn=opts["burn"], seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol,

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import lru_cache
 from types import SimpleNamespace
 
 import numpy as np
@@ -54,19 +55,19 @@ import xarray as xr
 
 from microimpact.analysis.fit_result import FitResult
 from microimpact.io.files import CONVENTIONS
-from microimpact.model.contact import Contact
-from microimpact.model.dem_damping import RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
-from microimpact.solvers import DEFAULT_RTOL
+import pandas as pd
+from scipy import optimize, stats
 
-__all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "ranked_by_aic", "information_criteria", "dem_fit_coverage", "dem_friction_coverage",
+from microimpact.analysis.fitting import _sigma_e, _table_arrays
+from microimpact.analysis.identifiability import chi2_threshold
+from microimpact.io.materials import material_contact
+from microimpact.model.contact import Contact
+from microimpact.model.dem_damping import DEM_LAWS, RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
+from microimpact.solvers import DEFAULT_RTOL, normal_models as nm
+
+__all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "ranked_by_aic", "information_criteria", "dem_fit_coverage",
            "INTERVAL_LEVEL", "ADEQUACY_P", "REGION_RAYS"]
 
-#: the (normal law, damping law) pairs a LAMMPS user chooses among; "hertz" is Hertz without
-#: adhesion, "jkr_force" LAMMPS's jkr, "dmt" LAMMPS's dmt
-DEM_LAWS: tuple[tuple[str, str], ...] = (
-    ("hertz", "coeff_restitution"), ("hertz", "tsuji"), ("hertz", "viscoelastic"), ("hertz", "mass_velocity"),
-    ("jkr_force", "viscoelastic"), ("jkr_force", "mass_velocity"), ("dmt", "viscoelastic"), ("dmt", "mass_velocity"),
-)
 #: the probability content of the reported interval (one standard deviation of a normal law)
 INTERVAL_LEVEL = math.erf(1.0 / math.sqrt(2.0))
 #: with stated uncertainties, a law whose chi^2 has a p-value below this does not describe the data
@@ -376,8 +377,6 @@ def _region_boundary(fit, model, e_meas, sig, threshold, rays, coordinate) -> li
     coordinate): rays from the best point, evenly spaced after whitening, each ended by Brent's
     method where chi^2 has risen by ``threshold`` (or at the searched range's edge); ``coordinate``
     is :func:`_coordinate` of the model."""
-    from scipy import optimize
-
     to_coef, from_coef, lo_x, hi_x = coordinate
     lo = np.array([_ADHESION_DECADES[0], lo_x])
     hi = np.array([_ADHESION_DECADES[1], hi_x])
@@ -434,8 +433,6 @@ def _profile_tips(chi, centre, lo, hi, level):
     included) crosses ``level``, or the searched range's edge if it stays below. These are the ends
     of each parameter's profile-likelihood interval; rays from the best point miss them where the
     region is curved (a banana in log10 w_A, whose upper end lies decades from the best fit)."""
-    from scipy import optimize
-
     tips = []
     for k in (0, 1):
         hint = [float(centre[1 - k])]
@@ -477,8 +474,6 @@ def dem_law_contact(material, radius: float, normal_model: str, damping_model: s
     >>> c.normal_model, c.adhesion_line_force, c.damping_model
     ('ring', 0.0, 'coeff_restitution')
     """
-    from microimpact.io.materials import material_contact
-
     if (normal_model, damping_model) not in DEM_LAWS:
         raise ValueError(f"unknown DEM law {normal_model}+{damping_model}; known: "
                          + ", ".join(f"{a}+{b}" for a, b in DEM_LAWS))
@@ -532,8 +527,6 @@ class _Model:
     def e_n(self, coefficient: float, work_of_adhesion: float | None = None) -> np.ndarray:
         """e_n of every impact [-] for the damping ``coefficient`` and, when given, a trial work of
         adhesion [J/m^2] in place of the material's."""
-        from microimpact.solvers import normal_models as nm
-
         material = self.material
         if work_of_adhesion is not None:
             material = {**vars(_material_record(material)), "work_of_adhesion": float(work_of_adhesion)}
@@ -559,8 +552,6 @@ def _chisqr(model, coefficient, e_meas, sigma, work_of_adhesion=None) -> float:
 def _restitution_interval(rise, x_best, lo_x):
     """(interval, status, best) of a restitution e: the ends where chi^2 rises by the threshold
     (``rise`` > 0), searched in [lo_x, 1]; the end at e = 1 is the side of no damping."""
-    from scipy import optimize
-
     low_damping_end = 1.0 if rise(1.0) <= 0.0 or x_best >= 1.0 else optimize.brentq(rise, x_best, 1.0, xtol=1e-12)
     if rise(lo_x) <= 0.0:
         strong_end, bounded = lo_x, False
@@ -573,8 +564,6 @@ def _restitution_interval(rise, x_best, lo_x):
 def _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x):
     """(interval, status, best) of eta_n0, searched in log10 coordinates x over [lo_x, hi_x] and
     below them in eta_n0 itself (``rise_coef``); x_best = -inf when no damping fits best."""
-    from scipy import optimize
-
     if rise_coef(0.0) <= 0.0:  # no damping is inside the interval
         weak = 0.0
     elif rise(lo_x) > 0.0:
@@ -595,10 +584,6 @@ def _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x):
 def _interval_threshold(chi_min, n, sigma_known, k=1, level=INTERVAL_LEVEL):
     """The rise of chi^2 that bounds the profile-likelihood interval of one parameter at ``level``
     (68.27 %: Delta chi^2 = 1 with stated uncertainties), s^2 t^2 (n - k degrees of freedom) without."""
-    from scipy import stats
-
-    from microimpact.analysis.identifiability import chi2_threshold
-
     if sigma_known:
         return chi2_threshold(level)
     if n > k:
@@ -609,8 +594,6 @@ def _interval_threshold(chi_min, n, sigma_known, k=1, level=INTERVAL_LEVEL):
 def _minimum(f, lo, hi, grid, hints=()):
     """(t, f(t)) with the smallest f over t = -inf (no damping, no adhesion) and [lo, hi]: a grid
     and the ``hints`` (minimisers found nearby before), then bounded Brent about the best of them."""
-    from scipy import optimize
-
     ts = np.linspace(lo, hi, grid)
     step = ts[1] - ts[0]
     candidates = [(float(t), f(float(t))) for t in ts]
@@ -638,8 +621,6 @@ def _fit_with_adhesion(model, e_meas, sig, sigma_known, to_coef, from_coef, lo_x
     intervals are searched means the minimum was missed: the fit starts again from there (at most
     three times).
     """
-    from functools import lru_cache
-
     lo_u, hi_u = _ADHESION_DECADES
     seen = {}
 
@@ -691,8 +672,6 @@ def _polish(chi, start, lo_u, hi_u, lo_x, hi_x):
     """The minimum of chi(u, x) near ``start``: Nelder-Mead in the plane (the valley of chi^2 is
     narrow and oblique: w_A and the damping both lower e_n), or along one coordinate when the other
     is -inf (no adhesion or no damping), then the best of that and the two edges at -inf."""
-    from scipy import optimize
-
     u0, x0 = start
     candidates = []
     if math.isfinite(u0) and math.isfinite(x0):
@@ -786,10 +765,6 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     >>> f.status, round(f.value, 4), [round(x, 4) for x in f.interval]
     ('determined', 0.71, [0.7042, 0.7158])
     """
-    from scipy import optimize, stats
-
-    from microimpact.analysis.fitting import _sigma_e, _table_arrays
-
     if fit_adhesion and normal_model == "hertz":
         raise ValueError(f"fit_adhesion: {normal_model}+{damping_model} has no work of adhesion to fit; "
                          "choose jkr_force or dmt")
@@ -842,8 +817,6 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
 
 def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x, src) -> DemLawFit:
     """:func:`fit_dem_law` with the work of adhesion fitted too."""
-    from scipy import stats
-
     n = e_meas.size
     chi_min, (w_interval, w_status, w_best), (interval, status, best) = _fit_with_adhesion(
         model, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x)
@@ -909,8 +882,6 @@ def rank_dem_laws(table, material, laws=None, *, fit_adhesion: bool = False, wei
     >>> list(ranked["law"])[0]
     'hertz+coeff_restitution'
     """
-    import pandas as pd
-
     laws = candidate_laws(material, fit_adhesion) if laws is None else list(laws)
     fits = {}
     for a, b in laws:
@@ -987,8 +958,6 @@ def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, s
     >>> r["trials"], r["determined"] == 5
     (5, True)
     """
-    import pandas as pd
-
     rng = np.random.default_rng(seed)
     material = {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0 if normal_model == "hertz" else 0.01}
     determined = covered = adequate = adhesion_determined = 0
@@ -1027,142 +996,3 @@ def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, s
     return {"trials": trials, "determined": determined, "covered": covered,
             "coverage": covered / determined if determined else math.nan, "undetermined": undetermined,
             "adequate": adequate, "interval_covered": interval_covered, "adhesion_determined": adhesion_determined}
-
-
-#: the tangential laws and the normal laws :func:`dem_friction_coverage` draws from
-_COVERAGE_TANGENTIAL = ("linear_history", "lammps_mindlin", "lammps_mindlin_rescale", "lammps_mindlin_force",
-                        "lammps_mindlin_rescale_force")
-_COVERAGE_NORMAL = (("hertz", "coeff_restitution"), ("hertz", "viscoelastic"), ("jkr_force", "viscoelastic"),
-                    ("dmt", "mass_velocity"))
-
-
-def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = True, fit_adhesion: bool = False,
-                          stiffness_uncertainty: float = 0.0, rtol: float = DEFAULT_RTOL):
-    """Coverage of the 95 % interval of mu of a LAMMPS tangential law fitted after its normal law,
-    both from the same noisy data, over random experiment designs.
-
-    Each trial draws a tangential law (any of LAMMPS's five, a random k_t 10^0.5-10^3 N/m or G*
-    10^8-10^8.8 Pa), a normal law (Hertz + ``coeff_restitution`` with e uniform 0.3-0.95; Hertz or
-    JKR + ``viscoelastic``, DMT + ``mass_velocity``, with eta_n0 log-uniform 0.01-0.2 critical
-    dampings at 1 m/s and w_A log-uniform 1e-3-3e-2 J/m^2), mu log-uniform 0.05-1 and a design of
-    4-13 impacts of a 1 um sphere (2000 kg/m^3, 1 GPa) at 0.1-10 m/s over a random angle range in
-    0-85 deg, with stated Gaussian noise 0.005-0.05 on e_n and on e_t. Captures are left out (a
-    design with fewer than three rebounds is skipped); the normal law is fitted by
-    :func:`fit_dem_law`, then mu by :func:`~microimpact.analysis.oblique.fit_dem_friction` at the
-    fitted normal law, its uncertainty propagated or not.
-
-    Parameters
-    ----------
-    trials : int
-        Designs drawn.
-    seed : int
-        Seed of the generator (the same seed draws the same designs with and without ``propagate``).
-    propagate : bool
-        Pass the normal fit as ``normal_fit`` (its uncertainty in mu's interval).
-    fit_adhesion : bool
-        Draw the adhesive normal laws only (JKR, DMT) and fit the work of adhesion with the damping
-        (two normal parameters propagated).
-    stiffness_uncertainty : float
-        > 0: the fit of mu is given the true tangential stiffness times (1 + u z), z standard normal
-        (from a generator of its own, so the designs are those of the same seed without it), and
-        ``stiffness_uncertainty=u``. 0: the true stiffness. [-]
-    rtol : float
-        Solver tolerance. [-]
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per design fitted: normal and tangential law, true and fitted damping coefficient
-        (and work of adhesion), the normal fit's status, true mu, n, the noises, mu's status, value
-        and interval, and ``covered`` (designs whose normal fit is not determined: no mu); with
-        ``stiffness_uncertainty``, ``stiffness_given``: the given stiffness over the true one.
-
-    References
-    ----------
-    LAMMPS documentation, ``pair_style granular``, https://docs.lammps.org/pair_granular.html.
-
-    Examples
-    --------
-    One design (a Hertz law with LAMMPS's ``mindlin_rescale/force``), whose rebounds bound mu from
-    below only; the bound holds the true mu:
-
-    >>> d = dem_friction_coverage(trials=1, seed=3, rtol=1e-6)
-    >>> d[["normal_law", "tangential_model", "status", "covered"]].values.tolist()
-    [['hertz+coeff_restitution', 'lammps_mindlin_rescale_force', 'lower_bound', True]]
-    """
-    import pandas as pd
-
-    from microimpact.analysis.oblique import fit_dem_friction
-    from microimpact.model.dem_damping import critical_damping_coefficient
-
-    rng = np.random.default_rng(seed)
-    errors = np.random.default_rng([seed, 1])  # the stiffness errors: the designs stay those of the seed
-    rows = []
-    normal_laws = _COVERAGE_NORMAL[2:] if fit_adhesion else _COVERAGE_NORMAL
-    for _ in range(trials):
-        law = str(rng.choice(_COVERAGE_TANGENTIAL))
-        normal, damping = normal_laws[int(rng.integers(0, len(normal_laws)))]
-        mat = {"density": 2000.0, "stiffness": 1e9,
-               "work_of_adhesion": 0.0 if normal == "hertz" else float(10 ** rng.uniform(-3, -1.5))}
-        if damping in RESTITUTION_DAMPING_MODELS:
-            coef = float(rng.uniform(0.3, 0.95))
-        else:
-            unit = critical_damping_coefficient(dem_law_contact(mat, 1e-6, normal, damping, 1.0), 1.0)
-            coef = float(10 ** rng.uniform(-2, -0.7)) * unit
-        mu = float(10 ** rng.uniform(-1.3, 0))
-        stiffness = ({"tangential_stiffness": float(10 ** rng.uniform(0.5, 3))} if law == "linear_history"
-                     else {"shear_modulus": float(1e9 * 10 ** rng.uniform(-1, -0.2))})
-        n = int(rng.integers(4, 14))
-        lo = rng.uniform(0, 70)
-        hi = min(lo + rng.uniform(5, 60), 85)
-        angles, speeds = rng.uniform(lo, hi, n), 10 ** rng.uniform(-1, 1, n)
-        noise_t, noise_n = float(10 ** rng.uniform(-2.3, -1.3)), float(10 ** rng.uniform(-2.3, -1.3))
-        tangential = {"friction": mu, "tangential_model": law, **stiffness}
-        truth = dem_law_contact(mat, 1e-6, normal, damping, coef).with_(**tangential)
-        table = _measured_rebounds(truth, speeds, angles, noise_n, noise_t, rng, rtol)
-        if len(table) < 3:
-            continue
-        n = len(table)
-        normal_fit = fit_dem_law(table, mat, normal, damping, fit_adhesion=fit_adhesion, rtol=rtol)
-        row = {"normal_law": f"{normal}+{damping}", "tangential_model": law, "coefficient": coef,
-               "coefficient_fitted": normal_fit.best, "normal_status": normal_fit.status, "mu": mu, "n": n,
-               "noise_e_n": noise_n, "noise_e_t": noise_t}
-        if fit_adhesion:
-            row |= {"work_of_adhesion": mat["work_of_adhesion"], "work_of_adhesion_fitted": normal_fit.material["work_of_adhesion"],
-                    "adhesion_status": normal_fit.adhesion_status}
-        if stiffness_uncertainty > 0:
-            given = 1.0 + stiffness_uncertainty * float(errors.standard_normal())
-            (name, value), = stiffness.items()
-            tangential = tangential | {name: given * value}
-            row["stiffness_given"] = given
-        if normal_fit.determined:
-            fit = fit_dem_friction(table, lambda r, f=normal_fit, t=tangential: f.contact(r).with_(**t),
-                                   normal_fit=normal_fit if propagate else None,
-                                   stiffness_uncertainty=stiffness_uncertainty or None, rtol=rtol)
-            st = fit.identifiability["friction"]
-            row |= {"status": st.status, "value": fit.friction, "lower": st.lower, "upper": st.upper,
-                    "covered": bool(st.lower <= mu <= st.upper)}
-        rows.append(row)
-    return pd.DataFrame(rows)
-
-
-def _measured_rebounds(truth, speeds, angles, noise_n, noise_t, rng, rtol):
-    """The rebounds of ``truth`` as an impact table with Gaussian noise of the stated sigma on e_n
-    and e_t (captures left out: nothing rebounds to be measured)."""
-    import pandas as pd
-
-    from microimpact.solvers.impact import simulate_impact
-
-    results = [simulate_impact(truth, v, a, rtol=rtol) for v, a in zip(speeds, angles)]
-    keep = np.array([r.outcome == "rebound" for r in results])
-    results = [r for r, k in zip(results, keep) if k]
-    speeds, angles, n = speeds[keep], angles[keep], int(keep.sum())
-    vn = speeds * np.cos(np.radians(angles))
-    e_n = np.array([abs(r.velocity_out[0]) for r in results]) / vn
-    e_t = np.array([r.velocity_out[1] for r in results]) / (speeds * np.sin(np.radians(angles)))
-    if n < 3:  # no noise drawn: the caller skips the design (as the study always has)
-        return pd.DataFrame({"speed": speeds})
-    return pd.DataFrame({"radius": truth.radius, "speed": speeds, "incidence_deg": angles, "normal_speed": vn,
-                         "e_n": e_n + rng.normal(0, noise_n, n), "e_n_uncertainty": noise_n,
-                         "tangential_restitution": e_t + rng.normal(0, noise_t, n),
-                         "tangential_restitution_uncertainty": noise_t})

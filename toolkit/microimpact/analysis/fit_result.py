@@ -24,13 +24,12 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from microimpact.io.formatting import ReportHTML
+from microimpact.io.formatting import ReportHTML, estimates_repr
 from microimpact.analysis.identifiability import status_from_variables, status_variables
+from microimpact.io.kinds import file_kind
 from microimpact.io.statuses import stderr_is_meaningful
 from microimpact.io.files import CONVENTIONS, restore_label_coordinates, write_netcdf
-from microimpact.io.formatting import estimates_repr
 from microimpact.io.impacts import insert_row_labels, label_variables, labels_from_dataset
-from microimpact.io.kinds import file_kind
 from microimpact.io.materials import material_contact
 from microimpact.io.provenance import fit_parameter_source, stamp_parameters
 from microimpact.io.variables import attributes

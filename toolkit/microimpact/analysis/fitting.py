@@ -44,15 +44,20 @@ import warnings
 from dataclasses import dataclass
 
 import lmfit
+import numba
 import numpy as np
 import pandas as pd
+from scipy import stats
+from scipy.optimize import brentq
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit, fit_parameter_table, format_fit
+from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold, status_from_interval
 from microimpact.io.impacts import MEASUREMENT_TOLERANCE_SIGMAS, insert_row_labels, row_labels
 from microimpact.io.materials import material_contact
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.model.contact import Contact
-from microimpact.solvers import DEFAULT_RTOL, Deadline, TimeBudgetExceeded
+from microimpact.solvers import DEFAULT_RTOL, Deadline, TimeBudgetExceeded, engine
+from microimpact.solvers.family import normal_restitution
 
 # The engine (numba) is imported inside the two functions that solve, so that importing the fit
 # costs no numba start-up. The result record, DampingFit, lives in fit_result (no lmfit import):
@@ -166,8 +171,6 @@ def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_ad
     >>> model_restitution(problem, 0.5, 29.0, 0.215834).round(4).tolist()
     [0.0, 0.049, 0.5437]
     """
-    from microimpact.solvers.family import normal_restitution  # numba start-up only when solving
-
     out = np.empty(problem.normal_speed.size)
     for r, idx in zip(problem.radii, problem.groups):
         c = problem.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion)
@@ -347,7 +350,7 @@ def fit_damping(
         for which thread start-up and, on a busy machine, waiting for the second thread cost more
         than the second core gains.
     progress : bool
-        A progress bar on stderr (a terminal only; :func:`microimpact.io.progress.progress_bar`):
+        A progress bar on stderr (a terminal only; :func:`microimpact._runtime.progress.progress_bar`):
         the start grid, then each least-squares round.
     time_budget : float or Deadline, optional
         Wall-clock budget of the fit; None: no limit. Checked after every start-grid point and
@@ -397,9 +400,6 @@ def fit_damping(
     if threads is None:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
                             scale_covar, progress, deadline)
-    import numba  # numba and the engine start only when solving (see the imports)
-
-    from microimpact.solvers import engine
 
     previous = numba.get_num_threads()
     engine.set_threads(threads)
@@ -472,8 +472,6 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
     info["elapsed_s"] = time.perf_counter() - t0
     info["success"] = bool(result.success) and all(st.determined for st in identifiability.values())
     if _implausible(result, sigma_e):
-        from scipy import stats
-
         info["success"] = False
         info["goodness_of_fit"] = (f"chi-square {result.chisqr:.4g} for {result.nfree} degrees of freedom (p = "
                                    f"{stats.chi2.sf(result.chisqr, result.nfree):.2g}): the model does not describe these "
@@ -542,8 +540,6 @@ def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, dead
     dict
         ``{name: ParameterStatus}`` for each varied parameter.
     """
-    from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold, status_from_interval
-
     out = {}
     varied = [n for n in PARAMETER_NAMES if result.params[n].vary]
     dof = max(e_n.size - len(varied), 1)
@@ -579,8 +575,6 @@ def _grid_valleys(grid, name, chisqr, lower, upper):
     twice the 95 % threshold of the grid's least, the threshold scaled by how much larger the grid's
     chi-square is than the fit's (the grid uses the stated e_n uncertainties, the fit may add the
     speed errors). Each candidate is confirmed by a re-fit before it counts."""
-    from microimpact.analysis.identifiability import chi2_threshold
-
     if grid is None or name not in ("zeta_hertz", "zeta_adhesion"):
         return []
     gh, ga, chi2 = grid
@@ -648,8 +642,6 @@ class _Profile:
 
     def crossing(self, value, limit, level, start=None) -> float:
         """Where P rises to ``level`` between ``value`` and ``limit`` (``limit`` if it never does)."""
-        from scipy.optimize import brentq
-
         if limit == value:
             return limit
         up = limit > value
@@ -688,8 +680,6 @@ IMPLAUSIBLE_P = 1e-3
 
 def _implausible(result, sigma_e) -> bool:
     """A weighted fit whose chi-square is improbable for its degrees of freedom (p < IMPLAUSIBLE_P)."""
-    from scipy import stats
-
     if sigma_e is None or result.nfree < 1:
         return False
     return bool(stats.chi2.sf(result.chisqr, result.nfree) < IMPLAUSIBLE_P)

@@ -51,8 +51,10 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from microimpact.analysis.spin import spin_explanation
 from microimpact.dynamics.nonlinear import capture_velocity
-from microimpact.io.files import CONVENTIONS, write_csv, write_netcdf
+from microimpact.io.files import CONVENTIONS, all_or_nothing, write_csv, write_netcdf
+from microimpact.io.impacts import CSV_COLUMN_ATTR, label_variables, row_labels
 from microimpact.io.materials import material_contact
 from microimpact.io.variables import attributes
 from microimpact.solvers import DEFAULT_RTOL, Deadline
@@ -337,8 +339,6 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
 def _with_ids(res: xr.Dataset, table) -> xr.Dataset:
     """The analyst's labels of each row (``id`` and the CSV's own columns) as text variables along
     ``impact`` (:func:`microimpact.io.label_variables`)."""
-    from microimpact.io.impacts import label_variables, row_labels
-
     return res.assign(label_variables(row_labels(table), "impact"))
 
 
@@ -368,8 +368,6 @@ def _thresholds(overrides) -> dict:
 
 def _with_explanation(res: xr.Dataset, table, fit, *, posterior, **options) -> xr.Dataset:
     """The flags with the explanation of :func:`microimpact.analysis.spin.spin_explanation` merged in."""
-    from microimpact.analysis.spin import spin_explanation
-
     extra = spin_explanation(table, fit, posterior=posterior, **options)
     res = res.merge(extra.drop_vars("spin_scan_bound"), combine_attrs="no_conflicts")
     res.attrs["explanation_draws"] = "posterior draws" if posterior is not None else "point estimate"
@@ -447,15 +445,12 @@ def write_flags(ds: xr.Dataset, csv_path, nc_path=None):
     >>> pd.read_csv(csv_path)["row"].tolist(), nc_path.name
     ([1, 2], 'flags.nc')
     """
-    from microimpact.io.impacts import CSV_COLUMN_ATTR
-
     table = ds.to_dataframe().reset_index(drop=True)
     # the row, then the analyst's labels (their own columns under the names of the CSV), then the flags
     labels = [n for n, v in ds.data_vars.items() if n == "id" or CSV_COLUMN_ATTR in v.attrs]
     cols = ["row", *labels] + [c for c in table.columns if c not in ("row", "impact", *labels)]
     table = table[cols].rename(columns={n: str(v.attrs[CSV_COLUMN_ATTR]) for n, v in ds.data_vars.items()
                                         if CSV_COLUMN_ATTR in v.attrs and str(v.attrs[CSV_COLUMN_ATTR]) not in cols})
-    from microimpact.io.files import all_or_nothing
 
     with all_or_nothing():  # both files or neither
         written = [write_csv(table, csv_path, float_format="%.8g")]

@@ -34,7 +34,7 @@ import xarray as xr
 from microimpact.analysis.fitting import FitProblem
 from microimpact.io.variables import attributes
 from microimpact.model.adhesion_models import AdhesionRegimeWarning, tabor_parameter
-from microimpact.solvers import DEFAULT_RTOL
+from microimpact.solvers import DEFAULT_RTOL, engine, normal_models
 
 __all__ = ["compare_normal_models", "normal_model_restitution", "DEFAULT_MODELS", "DEFAULT_START_GRID"]
 
@@ -75,8 +75,6 @@ def normal_model_restitution(problem: FitProblem, normal_model: str, zeta_hertz,
     ...  for m in ("ring", "dmt", "jkr", "jkr_force")}
     {'ring': [1.0, 1.0, 1.0], 'dmt': [1.0, 1.0, 1.0], 'jkr': [0.4277, 0.892, 0.9741], 'jkr_force': [0.7723, 0.9482, 0.9873]}
     """
-    from microimpact.solvers import engine, normal_models
-
     solver = engine if normal_model == "ring" else normal_models
     if normal_speed is None:
         radii, groups, speeds = problem.radii, problem.groups, problem.normal_speed

@@ -42,24 +42,34 @@ Every model evaluation goes through :func:`microimpact.solvers.engine.solve_norm
 
 from __future__ import annotations
 
+import logging
 import math
 import numbers
 import time
 import warnings
 from dataclasses import dataclass, field
 
+import emcee
 import numpy as np
 import pandas as pd
 import xarray as xr
 
+from microimpact._runtime.signals import interrupt_at_checkpoints
+from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX, ess_bulk, split_rhat
+from microimpact.analysis.fitting import DAMPING_RANGES, FitProblem, model_restitution
+from microimpact.analysis.oblique import ObliqueProblem, oblique_model
+from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.formatting import ReportHTML
 from microimpact.analysis.fit_result import PARAMETER_NAMES, FitResult
 from microimpact.analysis.sampling_defaults import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS,
                                                     MAX_SEED)
 from microimpact.io.files import CONVENTIONS, restore_label_coordinates
 from microimpact.io.materials import material_contact
-from microimpact.io.progress import progress_bar
-from microimpact.solvers import DEFAULT_RTOL, Deadline
+from microimpact._runtime.progress import progress_bar
+from microimpact.io.resources import check_memory
+from microimpact.model.parameters import TABLE2_CASES
+from microimpact.solvers import DEFAULT_RTOL, Deadline, engine, engine_threads
+from microimpact.solvers.impact import simulate_many
 
 __all__ = ["Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "DEFAULT_WALKERS", "DEFAULT_MAX_STEPS",
            "DEFAULT_SEED", "DEFAULT_N_DRAWS", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
@@ -325,8 +335,6 @@ class _Likelihood:
     and, with oblique data, one simulate_many call per radius."""
 
     def __init__(self, damping_fit, table, friction_fit, eiv, rtol):
-        from microimpact.analysis.fitting import FitProblem
-
         self.fit, self.rtol = damping_fit, rtol
         d = damping_fit.data
         e, v, r = (d[c].to_numpy(dtype=float) for c in ("e_n", "normal_speed", "radius"))
@@ -347,8 +355,6 @@ class _Likelihood:
         self.latent_rows = d["row"].to_numpy()[li]
         self.oblique = None
         if friction_fit is not None:
-            from microimpact.analysis.oblique import ObliqueProblem
-
             self.oblique = ObliqueProblem.from_table(table)
             self.oblique_sigma = friction_fit.data["sigma"].to_numpy(dtype=float)
 
@@ -371,8 +377,6 @@ class _Likelihood:
         has = sig_v > 0
         if eiv != "auto":
             return has & (eiv == "latent")
-        from microimpact.analysis.fitting import model_restitution
-        from microimpact.dynamics.nonlinear import capture_velocity
 
         p = self.fit.values
         ev = [model_restitution(FitProblem.from_arrays(r, np.maximum(v + k * 2 * sig_v, 1e-12), self.fit), p["zeta_hertz"],
@@ -383,8 +387,6 @@ class _Likelihood:
         return has & ((curvature > 0.25 * sig) | near)
 
     def __call__(self, p: dict) -> float:
-        from microimpact.analysis.fitting import model_restitution
-
         m = model_restitution(self.problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=self.rtol)
         plain = ~self.latent
         res = (m[: self.n_plain] - self.e[plain]) / self.sig_eff[plain]
@@ -396,8 +398,6 @@ class _Likelihood:
             like = (np.exp(-0.5 * ((ml - e) / s) ** 2) * self.weights[None, :]).sum(axis=1)
             logl += float(np.sum(np.log(np.maximum(like, 1e-300))))
         if self.oblique is not None:
-            from microimpact.analysis.oblique import oblique_model
-
             values = {n: p[n] for n in PARAMETER_NAMES}
             mo = oblique_model(self.oblique, lambda r: _contact(self.fit, r, values), {"friction": p["friction"]},
                                rtol=self.rtol)
@@ -455,8 +455,6 @@ def prior_bounds(names, best: dict) -> dict:
     >>> prior_bounds(["zeta_hertz", "friction"], {"zeta_hertz": 0.1, "friction": 0.2})
     {'zeta_hertz': (0.0, 1000.0), 'friction': (0.0, 10.0)}
     """
-    from microimpact.analysis.fitting import DAMPING_RANGES
-
     out = {}
     for n in names:
         if n == "friction":
@@ -554,9 +552,6 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     >>> post
     Posterior(zeta_hertz, zeta_adhesion; 8 walkers x 60 steps, burn-in 20, seed 2002, converged=False)
     """
-    from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX
-    from microimpact.solvers import engine_threads
-
     t0 = time.perf_counter()
     deadline = Deadline.start(time_budget, "posterior")
     like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol)
@@ -634,17 +629,12 @@ def _posterior_record(sampler, diag, names, best, bounds, like, damping_fit, fri
 def _run_chain(log_probability, pos, seed, budget, fixed_length, burn, advance, names, damping_fit, friction_fit):
     """(sampler, diagnostics, previous tau, steps done): chunks of CHECK_EVERY steps until converged,
     collapsed (PosteriorError) or out of ``budget`` steps."""
-    import emcee
-
-    from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX, ess_bulk, split_rhat
-
     rng = np.random.default_rng(seed)
     moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
     sampler = emcee.EnsembleSampler(len(pos), len(names), log_probability, moves=moves)
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()  # seeded
     state = emcee.State(pos)
     done, previous_tau, diag = 0, None, None
-    from microimpact.io.files import interrupt_at_checkpoints
 
     with interrupt_at_checkpoints() as checkpoint:  # Ctrl-C acts between steps, not inside emcee
         while done < budget:
@@ -743,10 +733,6 @@ def _start_ball(names, best: dict, stderr: dict, lower, walkers: int, seed: int)
 
 def _autocorr(chain: np.ndarray) -> np.ndarray:
     """Integrated autocorrelation time per parameter [steps] (emcee.autocorr, without its length check)."""
-    import logging
-
-    import emcee
-
     log = logging.getLogger("emcee.autocorr")
     level = log.level
     log.setLevel(logging.ERROR)  # the length warning: the caller states convergence itself
@@ -811,14 +797,11 @@ def restitution_bands(posterior: Posterior, damping_fit, speeds=None, *, n_draws
     >>> bands["e_n_band"].dims, bands["quantile"].values.tolist()
     (('radius', 'band_speed', 'quantile'), [0.025, 0.16, 0.5, 0.84, 0.975])
     """
-    from microimpact.solvers import engine
-
     lo, hi = damping_fit.speed_range
     v = np.geomspace(0.9 * lo, hi, 60) if speeds is None else np.asarray(speeds, dtype=float)
     radii = damping_fit.radii
     draws = posterior.draws(n_draws)
     e = np.empty((radii.size, len(draws), v.size))
-    from microimpact.solvers import engine_threads
 
     deadline = Deadline.start(time_budget, "restitution bands")
     with engine_threads(1):
@@ -857,11 +840,8 @@ def capture_velocity_interval(posterior: Posterior, damping_fit, *, n_draws: int
     >>> bool((q.diff("quantile") >= 0).all()), 1.3 < float(q.sel(quantile=0.5)[0]) < 1.5
     (True, True)
     """
-    from microimpact.dynamics.nonlinear import capture_velocity
-
     radii = damping_fit.radii
     draws = posterior.draws(n_draws)
-    from microimpact.solvers import engine_threads
 
     deadline = Deadline.start(time_budget, "capture velocity interval")
     v = []
@@ -910,8 +890,6 @@ def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int =
     >>> ds["sweep_e_n_band"].isel(case=0, sweep_speed=0).values.tolist()
     [0.0, 0.0, 0.0, 0.0, 0.0]
     """
-    from microimpact.model.parameters import TABLE2_CASES
-
     cases = list(TABLE2_CASES) if cases is None else list(cases)
     radii = damping_fit.radii
     r = float(radii[len(radii) // 2])
@@ -919,7 +897,6 @@ def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int =
     v = np.geomspace(lo, hi, n_speeds)
     draws = posterior.draws(n_draws)
     out = {q: np.empty((len(cases), len(draws), v.size)) for q in ("e_n", "mu_t", "K_L")}
-    from microimpact.solvers import engine_threads
 
     deadline = Deadline.start(time_budget, "sweep bands")
     with engine_threads(1):
@@ -942,9 +919,6 @@ def sweep_bands(posterior: Posterior, damping_fit, *, cases=None, n_draws: int =
 
 def _sweep_draws(cases, draws, damping_fit, r, v, out, rtol, deadline):
     """Fill ``out[q][case, draw, speed]`` by simulate_many (see :func:`sweep_bands`)."""
-    from microimpact.model.parameters import TABLE2_CASES
-    from microimpact.solvers.impact import simulate_many
-
     for i, case in enumerate(cases):
         cond = {k: _largest(val) for k, val in TABLE2_CASES[case].items()
                 if k in ("incidence_deg", "azimuth_deg", "omega_n", "omega_t", "omega_tp")}
@@ -985,8 +959,6 @@ def posterior_memory(walkers: int, steps: int, n_parameters: int) -> float:
 def check_posterior_memory(walkers: int, steps: int, n_parameters: int) -> None:
     """ValueError naming walkers and steps when :func:`posterior_memory` cannot fit in the machine
     (:func:`microimpact.io.resources.check_memory`), before anything is sampled."""
-    from microimpact.io.resources import check_memory
-
     check_memory(f"a chain of {walkers} walkers x {steps} steps (walkers, steps / max_steps) over {n_parameters} "
                  "parameters", posterior_memory(walkers, steps, n_parameters))
 

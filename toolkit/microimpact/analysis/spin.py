@@ -37,9 +37,10 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from microimpact.analysis.oblique import OBSERVABLE_UNITS, ObliqueProblem, rebound_state
+from microimpact.analysis.oblique import OBSERVABLE_UNITS, ObliqueProblem, _observables, rebound_state
+from microimpact.analysis.posterior import _contact
 from microimpact.solvers import engine_threads
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
 __all__ = ["spin_explanation", "SPIN_VARIABLES"]
@@ -107,8 +108,6 @@ def _row_quantities(table):
 
 def _predict(contact, speed, incidence_deg, spin, quantity):
     """Model value of ``quantity`` per entry (e_n or an oblique observable), NaN where captured."""
-    from microimpact.analysis.oblique import _observables
-
     st = rebound_state(contact, speed, np.clip(incidence_deg, 0.0, 89.9), spin)
     vn = speed * np.cos(np.radians(incidence_deg))
     out = _observables(st, speed, incidence_deg, quantity)
@@ -211,7 +210,6 @@ def spin_explanation(table, fit, *, posterior=None, friction: float | None = Non
             d.setdefault("friction", fit.friction if friction is None else friction)
     # per draw: predictions (impact, n_scan + 4): spins at the nominal angle, then angle -/+ sigma, speed -/+ sigma
     pred = np.empty((len(draws), n, n_scan + 4))
-    from microimpact.analysis.posterior import _contact
 
     with progress_bar(len(draws), "spin ranges", progress) as advance, engine_threads(1):
         advance = deadline.ticking(advance, len(draws), "posterior draws")

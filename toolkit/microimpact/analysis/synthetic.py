@@ -32,6 +32,7 @@ from microimpact.io.files import write_csv
 from microimpact.io.materials import material_contact
 from microimpact.model.parameters import TABLE1, TABLE1_ROW2
 from microimpact.solvers import engine
+from microimpact.solvers.impact import simulate_many
 
 __all__ = ["SYNTHETIC_DEFAULTS", "SYNTHETIC_OBLIQUE_DEFAULTS", "make_synthetic_impacts", "make_synthetic_oblique",
            "write_synthetic_impacts"]
@@ -215,8 +216,6 @@ def make_synthetic_oblique(**overrides) -> pd.DataFrame:
     >>> abs(float(e_t[0]) - 5 / 7) < 1e-6, bool(e_t[1] > 5 / 7)
     (True, True)
     """
-    from microimpact.solvers.impact import simulate_many  # the batch API (tangential map)
-
     unknown = set(overrides) - set(SYNTHETIC_OBLIQUE_DEFAULTS)
     if unknown:
         raise ValueError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(SYNTHETIC_OBLIQUE_DEFAULTS)}")

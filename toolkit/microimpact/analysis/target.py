@@ -19,14 +19,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import lmfit
 import numpy as np
 import pandas as pd
 import xarray as xr
+from scipy.optimize import brentq
 
 from microimpact.analysis.fit_result import FitResult
 from microimpact.io.files import CONVENTIONS, write_csv
 from microimpact.io.formatting import estimates_repr
 from microimpact.solvers import DEFAULT_RTOL
+from microimpact.analysis.fitting import FitProblem, damping_residual, model_restitution
+from microimpact.io.resources import check_memory
+from microimpact.solvers import Deadline, engine_threads
 
 __all__ = ["DampingTarget", "damping_from_target"]
 
@@ -140,8 +145,6 @@ class DampingTarget(FitResult):
 
 
 def _model(material, radius, rtol):
-    from microimpact.analysis.fitting import FitProblem, model_restitution
-
     def e_n(speed, zeta_hertz, zeta_adhesion):
         prob = FitProblem.from_arrays(np.atleast_1d(radius), np.atleast_1d(speed), material)
         return float(model_restitution(prob, zeta_hertz, zeta_adhesion, material.work_of_adhesion, rtol=rtol)[0])
@@ -150,8 +153,6 @@ def _model(material, radius, rtol):
 
 def _root(fun, lo: float, target: float) -> float:
     """The zeta >= lo where the decreasing ``fun`` reaches ``target`` (bracket by doubling, then Brent)."""
-    from scipy.optimize import brentq
-
     hi = max(2.0 * lo, 1.0)
     while fun(hi) > target:
         hi *= 4.0
@@ -169,8 +170,6 @@ def check_target_memory(n_points: int, n_targets: int = 1, what: str | None = No
     --------
     >>> check_target_memory(41)
     """
-    from microimpact.io.resources import check_memory
-
     check_memory(what or f"n_points = {n_points} for {n_targets} target(s)", 6 * 8.0 * n_points * n_targets)
 
 
@@ -194,7 +193,6 @@ def _curve(e_n, speed, target, n_points, deadline=None, which=1):
     za[-1] = za_max
     zh = np.empty(n_points)
     zh[0], zh[-1] = zh_max, 0.0
-    from scipy.optimize import brentq
 
     for j in range(1, n_points - 1):
         g = lambda z: e_n(speed, z, za[j]) - target  # noqa: E731 - decreasing in z
@@ -259,8 +257,6 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
     >>> target
     DampingTarget(2 target(s), 9 curve points, exact(zeta_hertz=0.5, zeta_adhesion=29))
     """
-    from microimpact.solvers import Deadline
-
     deadline = Deadline.start(time_budget, "target")
     e = np.atleast_1d(np.asarray(e_n, dtype=float))
     v = np.atleast_1d(np.asarray(speed, dtype=float))
@@ -280,7 +276,6 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
         raise ValueError("give the sphere radius (radius=..., or a Contact that has one)")
     se = (np.full(e.size, np.nan) if e_n_uncertainty is None
           else np.broadcast_to(np.asarray(e_n_uncertainty, dtype=float), e.shape).copy())
-    from microimpact.solvers import engine_threads
 
     model = _model(material, r, rtol)
     zh = np.empty((e.size, n_points))
@@ -306,10 +301,6 @@ def damping_from_target(e_n, speed, material, *, radius: float | None = None, e_
 def _least_squares(material, targets, zh, za, rtol):
     """Least-squares (zeta_H, zeta_A) over the targets, from the point of the first curve closest to
     the others; returns (values, standard errors, chi-square)."""
-    import lmfit
-
-    from microimpact.analysis.fitting import FitProblem, damping_residual
-
     prob = FitProblem.from_arrays(targets["radius"], targets["speed"], material)
     se = targets["e_n_uncertainty"].to_numpy()
     sigma = se if np.all(np.isfinite(se) & (se > 0)) else None

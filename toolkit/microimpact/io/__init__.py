@@ -33,7 +33,7 @@ __all__ = list(_HOMES)
 
 
 #: the modules, importable as attributes
-_MODULES = ("files", "formatting", "impacts", "joblog", "kinds", "lammps", "locks", "materials", "paths", "progress",
+_MODULES = ("files", "formatting", "impacts", "kinds", "lammps", "materials", "paths",
             "provenance", "resources", "statuses", "units", "variables")
 
 

@@ -16,10 +16,8 @@ import contextlib
 import contextvars
 import glob
 import os
-import signal
 import stat
 import tempfile
-import threading
 from collections.abc import Iterator, Mapping
 from datetime import datetime, timezone
 from importlib.metadata import PackageNotFoundError, version
@@ -27,101 +25,14 @@ from pathlib import Path
 
 import numpy as np
 
+from microimpact._runtime.signals import deferred_signals
 from microimpact.io.variables import VARIABLES, udunits
 
-__all__ = ["atomic_path", "atomic_write", "all_or_nothing", "recorded_outputs", "deferred_signals", "interrupt_at_checkpoints", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
+__all__ = ["atomic_path", "atomic_write", "all_or_nothing", "recorded_outputs", "write_netcdf", "write_netcdf_groups", "write_csv", "NETCDF_COMPRESSION",
            "CONVENTIONS", "read_netcdf_groups", "restore_label_coordinates", "LABEL_OF"]
 
 #: encoding added to every numeric, non-scalar NetCDF variable
 NETCDF_COMPRESSION = {"zlib": True, "complevel": 4}
-
-
-@contextlib.contextmanager
-def deferred_signals(signums=(signal.SIGINT, signal.SIGTERM)) -> Iterator[None]:
-    """Hold SIGINT and SIGTERM back for the duration of the block, then act on them.
-
-    A KeyboardInterrupt raised inside netCDF4/xarray's writer is raised while xarray holds its
-    file lock, and the writer's own cleanup then waits for that lock for ever (a pipeline job
-    hung after Ctrl-C). The block therefore runs to its end, and a signal that came
-    during it is re-raised afterwards, with the handlers that were in place before. Outside the
-    main thread, where Python cannot install handlers, the block runs unchanged.
-
-    Examples
-    --------
-    >>> with deferred_signals():
-    ...     x = 1 + 1
-    >>> x
-    2
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    received: list[int] = []
-    previous = {}
-    for s in signums:
-        try:
-            previous[s] = signal.signal(s, lambda signum, frame: received.append(signum))
-        except (ValueError, OSError):  # pragma: no cover - a signal this platform cannot catch
-            pass
-    try:
-        yield
-    finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-        for s in dict.fromkeys(received):
-            signal.raise_signal(s)
-
-
-@contextlib.contextmanager
-def interrupt_at_checkpoints() -> Iterator:
-    """Within the block Ctrl-C (SIGINT) only sets a flag; the yielded ``checkpoint()`` raises
-    KeyboardInterrupt once it is set, and so does the end of the block. SIGTERM is held the same
-    way where a Python handler turns it into an exception (a pipeline job), and that handler is
-    called at the checkpoint.
-
-    For loops whose inner calls must not be cut mid-way: emcee prints the whole traceback of a
-    KeyboardInterrupt raised inside the likelihood before passing it on (87 lines on a Ctrl-C of
-    ``fit --posterior``). Where SIGINT is ignored (a background job) or outside the main thread
-    nothing changes for it.
-
-    Examples
-    --------
-    >>> import os, signal
-    >>> try:
-    ...     with interrupt_at_checkpoints() as checkpoint:
-    ...         os.kill(os.getpid(), signal.SIGINT)  # held: the step runs on
-    ...         done = "step"
-    ...         checkpoint()
-    ... except KeyboardInterrupt:
-    ...     print("interrupted after the", done)
-    interrupted after the step
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield lambda: None
-        return
-    # SIGINT unless ignored (a background job); SIGTERM only where a handler turns it into an
-    # exception (a pipeline job, microimpact.io.joblog): at its default it ends the process at once
-    previous = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
-    held = [s for s, h in previous.items() if (callable(h) if s == signal.SIGTERM else h is not signal.SIG_IGN)]
-    flag: list[int] = []
-
-    def checkpoint() -> None:
-        if not flag:
-            return
-        signum = flag[0]
-        handler = previous[signum]
-        if callable(handler) and handler is not signal.default_int_handler:
-            handler(signum, None)
-        raise KeyboardInterrupt
-
-    for s in held:
-        signal.signal(s, lambda signum, frame: flag.append(signum))
-    try:
-        yield checkpoint
-    finally:
-        for s in held:
-            signal.signal(s, previous[s])
-    checkpoint()
 
 
 def _remove_orphans(directory: Path, name: str) -> None:

@@ -15,6 +15,7 @@ Example
 
 from __future__ import annotations
 
+import html
 import math
 
 import numpy as np
@@ -128,6 +129,4 @@ class ReportHTML:
     """
 
     def _repr_html_(self) -> str:
-        import html
-
         return f"<pre>{html.escape(self.report())}</pre>"

@@ -76,8 +76,11 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import xarray as xr
 
+from microimpact.io.kinds import file_kind, is_binary
 from microimpact.io.materials import read_materials
+from microimpact.io.paths import DATA_README
 from microimpact.io.units import INTERNAL_UNIT, UnitError, accepted_units, conversion_factor, parse_header_field
 
 __all__ = [
@@ -266,7 +269,7 @@ class ImpactDataError(ValueError):
         lines += ["  - " + p.format(name) for p in self.problems[:MAX_LISTED_PROBLEMS]]
         if n > MAX_LISTED_PROBLEMS:
             lines.append(f"  ... and {n - MAX_LISTED_PROBLEMS} more (all are in ImpactDataError.problems)")
-        lines.append("The format is described in data/README.md, section 'Measured-impact CSV format'.")
+        lines.append(f"The format is described in {DATA_README}, section 'Measured-impact CSV format'.")
         super().__init__("\n".join(lines))
 
 
@@ -601,8 +604,6 @@ def _check_contacts(cells: _Cells, columns, out: dict, materials, pairs, problem
 def _refuse_binary(source: str) -> None:
     """ImpactDataError with one problem saying what the file is, for a NetCDF file, a workbook, a
     PDF, ... (not thousands of "invalid UTF-8" problems, one per line of binary bytes)."""
-    from microimpact.io.kinds import file_kind, is_binary
-
     if is_binary(source):
         raise ImpactDataError(source, [Problem(
             f"the file is {file_kind(source)}, not a CSV of measured impacts (text, UTF-8); export or save "
@@ -1252,8 +1253,6 @@ def label_variables(labels: pd.DataFrame, dim: str) -> dict:
     >>> sorted(v), v["csv_batch_no"].attrs["csv_column"]
     (['csv_batch_no', 'id'], 'batch no.')
     """
-    import xarray as xr
-
     out = {}
     for c in labels.columns:
         values = labels[c].to_numpy(dtype=object).astype(str).astype(object)

@@ -10,7 +10,10 @@ which every file microimpact writes carries.
 
 from __future__ import annotations
 
+import zipfile
 from pathlib import Path
+
+import netCDF4
 
 __all__ = ["file_kind", "is_binary"]
 
@@ -31,8 +34,6 @@ _SIGNATURES = (
 
 def _netcdf_kind(path: Path) -> str:
     try:
-        import netCDF4
-
         with netCDF4.Dataset(path) as nc:
             title = str(getattr(nc, "title", "")).strip()
     except Exception:  # noqa: BLE001 - a damaged file is still a NetCDF file by its signature
@@ -41,8 +42,6 @@ def _netcdf_kind(path: Path) -> str:
 
 
 def _zip_kind(path: Path) -> str:
-    import zipfile
-
     try:
         with zipfile.ZipFile(path) as z:
             names = z.namelist()

@@ -70,11 +70,13 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, fields
 
+from microimpact import __version__
 from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import restitution_of_damping_factor, tsuji_damping_factor
 from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
 from microimpact.model.dem_twisting import DEM_TWISTING_MODELS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
+from microimpact.model.tangential_compliance import effective_shear_modulus, shear_modulus_from_elastic
 
 __all__ = ["LAMMPS_UNITS", "DEFAULT_POISSON", "LammpsExportError", "LammpsWallModel", "lammps_wall_model",
            "lammps_input", "lammps_expressible", "read_lammps_contact", "lammps_scales", "CONTACT_LINE",
@@ -340,8 +342,6 @@ def lammps_expressible(contact: Contact, poisson: float = DEFAULT_POISSON) -> Co
     >>> round(c.shear_modulus / (0.75 * c.stiffness), 6)  # G* / E* = (1 - nu) / (2 (2 - nu)) at nu = 0.3
     0.205882
     """
-    from microimpact.model.tangential_compliance import effective_shear_modulus, shear_modulus_from_elastic
-
     friction = {"friction": 0.0, "tangential_model": "rigid", "shear_modulus": None, "twisting_model": "none",
                 "twisting_stiffness": None, "twisting_damping": 0.0, "twisting_friction": 0.0}
     if contact.friction > 0.0:
@@ -404,8 +404,6 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
     >>> [line for line in text.splitlines() if not line.startswith("#")]
     ['fix microimpact_wall all wall/gran granular hertz/material 68250000 0 0.3 damping viscoelastic tangential linear_nohistory 0.0 0.0 zplane 0.0 NULL']
     """
-    from microimpact import __version__
-
     model = lammps_wall_model(contact, poisson)
     length, mass, _ = _check_units(units)
     lines = [

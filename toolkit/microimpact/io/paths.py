@@ -26,7 +26,12 @@ __all__ = [
     "check_outputs",
     "same_file",
     "reporting_os_errors",
+    "DATA_README",
 ]
+
+#: the data formats' documentation as installed with the package (a copy of the repository's
+#: data/README.md, which an installed user does not have): help texts and errors name this path
+DATA_README = Path(__file__).resolve().parents[1] / "data" / "README.md"
 
 #: fall-backs when the file system does not say (POSIX minimum values are lower; these are Linux's)
 _NAME_MAX = 255

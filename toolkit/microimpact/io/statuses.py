@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import xarray as xr
 
 __all__ = ["ParameterStatus", "STATUSES", "DEFAULT_LEVEL", "status_variables", "status_from_variables",
            "stderr_is_meaningful"]
@@ -163,8 +164,6 @@ def status_variables(status: ParameterStatus, units: str) -> dict:
     >>> int(v["friction_status"]), v["friction_status"].attrs["flag_meanings"].split()[1]
     (1, 'lower_bound')
     """
-    import xarray as xr
-
     n = status.name
     what = {"determined": "interval", "lower_bound": "lower bound (upper: end of the range searched)",
             "upper_bound": "upper bound (lower: start of the range searched)",

@@ -56,9 +56,18 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["DEM_DAMPING_MODELS", "RESTITUTION_DAMPING_MODELS", "tsuji_damping_factor",
+from microimpact.model.adhesion_models import hertz_scales
+
+__all__ = ["DEM_LAWS", "DEM_DAMPING_MODELS", "RESTITUTION_DAMPING_MODELS", "tsuji_damping_factor",
            "restitution_damping_factor", "restitution_of_damping_factor", "dem_damping_law",
            "critical_damping_coefficient"]
+
+#: the (normal law, damping law) pairs a LAMMPS user chooses among; "hertz" is Hertz without
+#: adhesion, "jkr_force" LAMMPS's jkr, "dmt" LAMMPS's dmt
+DEM_LAWS: tuple[tuple[str, str], ...] = (
+    ("hertz", "coeff_restitution"), ("hertz", "tsuji"), ("hertz", "viscoelastic"), ("hertz", "mass_velocity"),
+    ("jkr_force", "viscoelastic"), ("jkr_force", "mass_velocity"), ("dmt", "viscoelastic"), ("dmt", "mass_velocity"),
+)
 
 #: the DEM damping laws (Contact.damping_model other than "paper")
 DEM_DAMPING_MODELS = ("mass_velocity", "viscoelastic", "tsuji", "coeff_restitution")
@@ -212,8 +221,6 @@ def critical_damping_coefficient(contact, normal_speed: float) -> float:
     >>> f"{critical_damping_coefficient(c, 1.0):.4g}"
     '1.616e+08'
     """
-    from microimpact.model.adhesion_models import hertz_scales
-
     if contact.damping_model not in ("mass_velocity", "viscoelastic"):
         raise ValueError(f"a critical eta_n0 is defined for mass_velocity and viscoelastic, got {contact.damping_model!r}")
     a = float(hertz_scales(contact, normal_speed).radius)

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
+from microimpact.io.statuses import status_from_variables
 from microimpact.report import figures
 from microimpact.report import posterior_figures as pfig
 from microimpact.report.inputs import at_radius, parameter_source, per_radius
@@ -93,8 +94,6 @@ def _parameter_rows(fit: xr.Dataset) -> pd.DataFrame:
     """One row per fit parameter: value, standard error and 95 % interval where the data determine it,
     else the bound or 'not determined' (the fit's ``<name>_status`` variables); no standard error
     above 100 % of the value is printed as a number."""
-    from microimpact.io.statuses import status_from_variables
-
     rows = []
     for name in _fit_parameters(fit):
         units = fit[name].attrs.get("units", "")
@@ -273,8 +272,6 @@ def oblique_section(lay: Layout, obl: xr.Dataset) -> None:
 
 def _friction_statement(obl: xr.Dataset) -> str:
     """What the oblique data say of f: its value and 95 % interval, a one-sided bound, or nothing."""
-    from microimpact.io.statuses import status_from_variables
-
     st = status_from_variables(obl, "friction", float(obl["friction"]))
     if st is None:  # a file from before the identifiability
         return (f"f = {float(obl['friction']):.5g} +- {float(obl['friction_stderr']):.3g} "

@@ -40,6 +40,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import NullFormatter
 
+from microimpact.io.statuses import status_from_variables
+
 __all__ = [
     "Plot",
     "TABLE2_FIGURES",
@@ -822,8 +824,6 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
 
     def par(name, fmt):
-        from microimpact.io.statuses import status_from_variables
-
         val = float(fit[name])
         st = status_from_variables(fit, name, val)
         if st is not None and not st.determined:  # no number for what the data do not determine

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from microimpact.io.files import read_netcdf_groups
+from microimpact.io.files import read_netcdf_groups, restore_label_coordinates
 
 __all__ = [
     "INPUT_KEYS",
@@ -119,7 +119,6 @@ def read_dataset(obj) -> xr.Dataset:
     """
     if isinstance(obj, xr.Dataset):
         return obj
-    from microimpact.io.files import restore_label_coordinates
 
     with xr.open_dataset(obj, engine="netcdf4", decode_timedelta=False) as ds:
         return restore_label_coordinates(ds.load())

@@ -34,8 +34,10 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+import netCDF4
 import xarray as xr
 
+from microimpact.io.kinds import file_kind
 from microimpact.report import figures, models, posterior_figures
 from microimpact.io.files import atomic_path
 from microimpact.report.inputs import at_radius, read_dataset, read_portraits
@@ -90,8 +92,6 @@ class UnknownResultError(ValueError):
 
 
 def _unreadable(path) -> str:
-    from microimpact.io.kinds import file_kind
-
     return f"{path}: not a readable NetCDF result file: it is {file_kind(path)}"
 
 
@@ -126,8 +126,6 @@ def result_kind(path) -> str:
     >>> result_kind("bench.nc")
     'benchmark'
     """
-    import netCDF4
-
     try:
         with netCDF4.Dataset(os.fspath(path)) as nc:
             if "portraits" in nc.groups:

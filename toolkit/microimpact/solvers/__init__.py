@@ -22,12 +22,12 @@ import contextlib
 import math
 import numbers
 import sys
-import time
-from dataclasses import dataclass
 
 from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
 from microimpact.model.dem_twisting import DEM_TWISTING_MODELS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
+# the time budgets of every long computation; solvers are where most of them are spent and checked
+from microimpact._runtime.budget import Deadline, TimeBudgetExceeded, check_time_budget  # noqa: F401
 
 #: The one default relative tolerance of every entry point (API, CLI, pipeline config ``rtol``).
 #: At 1e-8 the engine's e_n and impulse ratios are within about 5e-8 of the reference solution
@@ -36,6 +36,30 @@ DEFAULT_RTOL = 1e-8
 #: The smallest relative tolerance accepted: 100 machine epsilons, as scipy's solve_ivp (below it no
 #: double-precision integration can meet the tolerance, and the engine ends at its step limit).
 MIN_RTOL = 100.0 * sys.float_info.epsilon
+
+
+def check_rtol(rtol) -> float:
+    """``rtol`` as a float if the solvers can meet it: finite, in [:data:`MIN_RTOL`, 1); else a
+    TypeError / ValueError saying what is accepted. The CLI's ``--rtol`` and the pipeline's config
+    key ``rtol`` are checked here too, so all three accept the same values.
+
+    Examples
+    --------
+    >>> check_rtol(1e-8)
+    1e-08
+    >>> check_rtol(1e-300)
+    Traceback (most recent call last):
+    ...
+    ValueError: rtol must be >= 2.22e-14 (100 machine epsilons; a smaller tolerance cannot be met in double precision), got 1e-300
+    """
+    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real):
+        raise TypeError(f"rtol must be a real number, got {type(rtol).__name__} {rtol!r}")
+    if not (math.isfinite(rtol) and 0.0 < rtol < 1.0):
+        raise ValueError(f"rtol must be finite and lie in (0, 1), got {rtol!r}")
+    if rtol < MIN_RTOL:
+        raise ValueError(f"rtol must be >= {MIN_RTOL:.3g} (100 machine epsilons; a smaller tolerance cannot be "
+                         f"met in double precision), got {rtol!r}")
+    return float(rtol)
 
 
 class SolverError(RuntimeError):
@@ -72,112 +96,6 @@ class ModelDomainError(ValueError):
     gives the penetration over the radius."""
 
 
-class TimeBudgetExceeded(RuntimeError):
-    """A computation ran past the time budget [s] its caller gave it (``time_budget=`` of
-    :func:`microimpact.solvers.reference.simulate_reference`, the fits, the posterior, the flags,
-    the sweeps and the reproduction table; ``case_time_limit`` of the stress sweep). The message
-    says which computation, the budget and how far it got. No partial result is returned.
-
-    The message is one line. A budget that runs out while numba compiles comes back re-raised by
-    numba as the same type with its compile pass on a line before the message; ``str()`` gives the
-    budget's own line only, so every caller that prints it prints one line.
-
-    Examples
-    --------
-    >>> str(TimeBudgetExceeded("Failed in nopython mode pipeline (step: parfor prelowering)\\n"
-    ...                        "benchmark: time budget of 3 s exceeded"))
-    'benchmark: time budget of 3 s exceeded'
-    """
-
-    def __str__(self) -> str:
-        return (super().__str__().splitlines() or [""])[-1]
-
-
-def check_time_budget(time_budget, name: str = "time_budget") -> float | None:
-    """``time_budget`` as seconds (float > 0; inf means no limit) or None; ValueError naming ``name`` else."""
-    if time_budget is None:
-        return None
-    if isinstance(time_budget, bool) or not isinstance(time_budget, numbers.Real) or not time_budget > 0.0:
-        raise ValueError(f"{name} must be a number of seconds > 0 (or None: no limit), got {time_budget!r}")
-    return float(time_budget)
-
-
-@dataclass(frozen=True)
-class Deadline:
-    """The wall-clock end of a time budget, checked between units of work of a long computation.
-
-    Make one with :meth:`start` from a caller's ``time_budget``; :meth:`check` raises
-    :class:`TimeBudgetExceeded` once the budget is spent. A check is one ``time.perf_counter``
-    call, so it may run after every model evaluation.
-
-    Attributes
-    ----------
-    what : str
-        The computation, first word of the message (e.g. ``"fit"``).
-    budget : float or None
-        The budget; None: no limit. [s]
-    end : float
-        ``time.perf_counter()`` at which the budget is spent (inf without a limit). [s]
-    """
-
-    what: str
-    budget: float | None
-    end: float
-
-    @classmethod
-    def start(cls, time_budget, what: str) -> "Deadline":
-        """A deadline ``time_budget`` seconds from now (None or inf: none), for computation ``what``.
-
-        ``time_budget`` may itself be a Deadline: a stage of a larger computation then shares the
-        budget of the whole, under its own name. A bad budget is a ValueError naming ``time_budget``.
-        """
-        if isinstance(time_budget, Deadline):
-            return cls(what, time_budget.budget, time_budget.end)
-        budget = check_time_budget(time_budget)
-        limited = budget is not None and math.isfinite(budget)
-        return cls(what, budget if limited else None, time.perf_counter() + budget if limited else math.inf)
-
-    @property
-    def limited(self) -> bool:
-        """Whether there is a budget to run out of."""
-        return self.budget is not None
-
-    def check(self, done: str) -> None:
-        """Raise :class:`TimeBudgetExceeded` if the budget is spent; ``done`` says how far the work got
-        (e.g. ``"312 function evaluations"``) and ends the message."""
-        if time.perf_counter() > self.end:
-            raise TimeBudgetExceeded(f"{self.what}: time budget of {self.budget:g} s exceeded after {done}")
-
-    def ticking(self, advance, total: int, unit: str):
-        """``advance(n=1)`` of a :func:`microimpact.io.progress.progress_bar` that also checks the deadline
-        after each advance, reporting ``"<done> of <total> <unit>"``; ``advance`` itself if unlimited."""
-        if not self.limited:
-            return advance
-        done = [0]
-
-        def step(n=1):
-            advance(n)
-            done[0] += n
-            self.check(f"{done[0]} of {total} {unit}")
-
-        return step
-
-    def iter_cb(self, stage: str):
-        """An lmfit ``iter_cb`` that checks the deadline after every function evaluation of ``stage``,
-        or None when unlimited (lmfit then runs exactly as without a budget).
-
-        It raises rather than returning True: lmfit's own abort would return a half-finished fit
-        as a result."""
-        if not self.limited:
-            return None
-        calls = [0]  # counted here: lmfit's own count restarts inside conf_interval
-
-        def iter_cb(params, nfev, resid, *args, **kwargs):
-            calls[0] += 1
-            self.check(f"{calls[0]} function evaluations of {stage}")
-
-        return iter_cb
-
 @contextlib.contextmanager
 def engine_threads(threads: int | None = 1):
     """Run the compiled solvers on ``threads`` threads inside the block (None: unchanged), restored after.
@@ -196,16 +114,14 @@ def engine_threads(threads: int | None = 1):
     if threads is None:
         yield
         return
-    import numba
-
-    from microimpact.solvers import engine
+    import numba  # start-up: importing the solvers' package loads no numba
 
     previous = numba.get_num_threads()
-    engine.set_threads(threads)
+    numba.set_num_threads(threads)
     try:
         yield
     finally:
-        engine.set_threads(previous)
+        numba.set_num_threads(previous)
 
 
 #: The solvers behind simulate_impact(method=...).

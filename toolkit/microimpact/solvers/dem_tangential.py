@@ -82,6 +82,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
 from microimpact.model import adhesion_models as am
 from microimpact.model.dem_rolling import DEM_ROLLING_MODELS, lammps_rolling_velocity
@@ -91,6 +93,7 @@ from microimpact.model.dem_tangential import (DEM_TANGENTIAL_MODELS, FORCE_HISTO
                                               lammps_pulloff_force, lammps_history_of_force, lammps_history_rate,
                                               lammps_tangential_stiffness)
 from microimpact.solvers import SolverError
+from microimpact.solvers.normal_models import _DMT, _JKR_FORCE, _setup, solve_normal
 
 __all__ = ["DemTangentialError", "solve_dem_tangential", "uses_dem_tangential", "TANGENTIAL_RTOL"]
 
@@ -142,8 +145,6 @@ class _Law:
     """The normal law, the tangential law and the scales of one impact, in the normal law's units."""
 
     def __init__(self, contact, normal_speed):
-        from microimpact.solvers.normal_models import _JKR_FORCE, _DMT, _setup
-
         model, sc, y0, c1, c2, c3, p3 = _setup(contact, normal_speed)
         if c1 != 0.0 or c2 != 0.0:  # Contact's checks refuse the paper's damping with these laws
             raise ValueError("the DEM tangential laws run without the paper's damping (zeta_H = zeta_A = 0)")
@@ -363,8 +364,6 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
     """(state at separation, end of the last tangential slide or NaN, switches, whether the
     tangential spring ends stuck), in the law's units; ``w0`` the rolling velocity (with a rolling
     law)."""
-    from scipy.integrate import solve_ivp
-
     peak = z_scale**6 / 6.0 + 3.0 if law.jkr else z_scale**3 + 2.0 * law.pulloff  # F_n0 at the largest approach
     # the direction's floor (_spring_rates) is a tolerance's part of the larger of the two limits: a
     # rolling limit far below the friction's (mu_roll 1e-12) moves the outcome by less than the
@@ -529,8 +528,6 @@ def _crossing_inside_a_step(sol, start, switch, sign, tops, end):
     mass_velocity mindlin, 27 m/s, 47 deg: a stick inside one slide step missed at rtol 1e-10, e_t
     6e-6 off). Each extremum and the last instant of contact are therefore checked on the dense
     output; where one lies past 0, the first crossing before it is the switch."""
-    from scipy.optimize import brentq
-
     def leaving(t):
         return sign * switch(t, sol.sol(t))
 
@@ -608,8 +605,6 @@ def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict
     >>> round((r["velocity_out"][1] - v[1]) / (r["velocity_out"][0] - v[0]), 8)
     -0.2
     """
-    from microimpact.solvers.normal_models import solve_normal
-
     normal = solve_normal(contact, -float(velocity_in[0]), rtol=rtol)
     result = _slip(contact, normal, velocity_in, omega_in, rtol)
     if contact.twisting_model in DEM_TWISTING_MODELS:
@@ -809,8 +804,6 @@ def _twist(contact, normal, v_n, omega_n, rtol):
     (docs/guide/lammps.md). microimpact takes the mean, Omega = 0 from there on (a spring at rest,
     xi = 0, Omega = 0, solves the stuck law). A captured sphere ends with Omega = 0 where the limit
     at rest is > 0 (its stuck elastic vibration averages to zero), as the slip does."""
-    from scipy.integrate import solve_ivp
-
     if omega_n == 0.0:
         return 0.0, 0
     law, unit, tau_scale, z_scale = _impact_law(contact, normal, v_n)

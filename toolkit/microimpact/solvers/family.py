@@ -57,6 +57,7 @@ from numba import prange
 
 from microimpact._numba import njit, njit_batch
 from microimpact.model.coefficients import coefficients_kernel
+from microimpact.model.law import contact_potential_energy
 from microimpact.model.tangential import tangential_kernel
 from microimpact.solvers import DEFAULT_RTOL, engine
 
@@ -399,8 +400,6 @@ class NormalFamily:
 
 def engine_settled_energy(contact) -> float:
     """Contact energy of a sphere at rest at the adhesive equilibrium (0 without adhesion). [J]"""
-    from microimpact.model.law import contact_potential_energy
-
     if contact.adhesion_line_force <= 0.0:
         return 0.0
     return float(contact_potential_energy(contact, contact.length_scale))

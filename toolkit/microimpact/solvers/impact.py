@@ -10,6 +10,7 @@ normal speed serves every angle, spin and friction coefficient that shares it.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 import sys
@@ -20,7 +21,8 @@ import numpy as np
 
 from microimpact.io.provenance import contact_attributes
 from microimpact.io.variables import attributes
-from microimpact.solvers import DEFAULT_RTOL, METHODS, MIN_RTOL, check_sub_models, engine
+from microimpact.model.adhesion_models import check_adhesion_regime, tabor_parameter
+from microimpact.solvers import DEFAULT_RTOL, METHODS, MIN_RTOL, check_rtol, check_sub_models, engine
 from microimpact.solvers.family import (FAMILY_MIN_SPEEDS, NODE_RTOL_FLOOR, FamilyBudgetExceeded, normal_family,
                                        normal_speed_range)
 from microimpact.solvers.rkg import DEFAULT_STEPS, solve_normal_rkg
@@ -84,30 +86,6 @@ def _check_call(contact, rtol) -> float:
         hint = "; for a mapping of fields use Contact(**contact)" if isinstance(contact, Mapping) else ""
         raise TypeError(f"contact must be a microimpact Contact, got {type(contact).__name__}{hint}")
     return check_rtol(rtol)
-
-
-def check_rtol(rtol) -> float:
-    """``rtol`` as a float if the solvers can meet it: finite, in [:data:`MIN_RTOL`, 1); else a
-    TypeError / ValueError saying what is accepted. The CLI's ``--rtol`` and the pipeline's config
-    key ``rtol`` are checked here too, so all three accept the same values.
-
-    Examples
-    --------
-    >>> check_rtol(1e-8)
-    1e-08
-    >>> check_rtol(1e-300)
-    Traceback (most recent call last):
-    ...
-    ValueError: rtol must be >= 2.22e-14 (100 machine epsilons; a smaller tolerance cannot be met in double precision), got 1e-300
-    """
-    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real):
-        raise TypeError(f"rtol must be a real number, got {type(rtol).__name__} {rtol!r}")
-    if not (math.isfinite(rtol) and 0.0 < rtol < 1.0):
-        raise ValueError(f"rtol must be finite and lie in (0, 1), got {rtol!r}")
-    if rtol < MIN_RTOL:
-        raise ValueError(f"rtol must be >= {MIN_RTOL:.3g} (100 machine epsilons; a smaller tolerance cannot be "
-                         f"met in double precision), got {rtol!r}")
-    return float(rtol)
 
 
 def _check_omega(omega) -> tuple:
@@ -464,7 +442,6 @@ def _normal_solver(contact):
     (:func:`microimpact.model.adhesion_models.check_adhesion_regime`, an AdhesionRegimeWarning)."""
     if contact.normal_model == "ring" and contact.damping_model == "paper":
         return engine
-    from microimpact.model.adhesion_models import check_adhesion_regime
     from microimpact.solvers import normal_models
 
     if contact.adhesion_line_force > 0.0:
@@ -559,11 +536,7 @@ def _simulate_over_contacts(contact, contact_fields: dict, **kwargs) -> xr.Datas
     """simulate_many once per combination of the varied contact fields, stacked along their
     dimensions (an index coordinate of the field's values each); the ``contact_<field>``
     attribute of a varied field holds its values."""
-    import dataclasses
-
     import xarray as xr
-
-    from microimpact.model.contact import Contact
 
     known = {f.name for f in dataclasses.fields(Contact)}
     axes = []
@@ -710,8 +683,6 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     ds.attrs.update(contact_attributes(contact))
     ds.attrs["solver"] = f"microimpact engine (Dormand-Prince 5(4), rtol={rtol:g})"
     if contact.normal_model != "ring":
-        from microimpact.model.adhesion_models import tabor_parameter
-
         ds.attrs["normal_model"] = contact.normal_model
         ds.attrs["tabor_parameter"] = float(tabor_parameter(contact.radius, contact.stiffness, contact.work_of_adhesion))
     ds.attrs["normal_solves"] = n_solves

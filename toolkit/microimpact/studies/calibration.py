@@ -55,7 +55,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from microimpact._usage import parse_or_status
+from microimpact._runtime.usage import parse_or_status
 
 __all__ = ["draw_design", "run_design", "calibration_study", "summarise", "plot_calibration", "markdown_tables", "main",
            "FITTED", "LEVEL"]

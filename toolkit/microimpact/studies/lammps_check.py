@@ -36,7 +36,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from microimpact.io.lammps import lammps_scales, read_lammps_contact
+from microimpact.io.lammps import lammps_scales, lammps_wall_model, read_lammps_contact
+from microimpact.model.adhesion_models import jkr_critical_approach, jkr_sticking_velocity
 
 __all__ = ["LammpsUnavailable", "load_lammps", "lammps_impact", "verify_lammps", "DEFAULT_TOLERANCE",
            "DEFAULT_STEPS", "default_speeds", "DEFAULT_INCIDENCES"]
@@ -191,7 +192,6 @@ def lammps_impact(lammps, text: str, contact, units: str, speed: float, incidenc
     v_n = speed * math.cos(math.radians(incidence_deg)) / scale["speed"]
     v_t = speed * math.sin(math.radians(incidence_deg)) / scale["speed"]
     dt = timestep / scale["time"]
-    from microimpact.model.adhesion_models import jkr_critical_approach
 
     # a rebounding sphere beyond this gap has left the contact: JKR holds on past touching, at most
     # to the critical approach of the displacement-controlled break; the other laws end at touching
@@ -254,8 +254,6 @@ def default_speeds(contact) -> tuple[float, ...]:
     >>> default_speeds(c)
     (0.01, 0.1, 1.0, 10.0)
     """
-    from microimpact.model.adhesion_models import jkr_sticking_velocity
-
     if contact.normal_model == "jkr_force" and contact.work_of_adhesion > 0.0:
         v_s = jkr_sticking_velocity(contact)
         return tuple(m * v_s for m in STICKING_MULTIPLES)
@@ -345,8 +343,6 @@ def _ratios(v_n_out, v_t_out, omega, speed, angle, radius):
 
 
 def _compare(lammps, text, contact, units, speed, angle, steps, simulate_impact) -> dict:
-    from microimpact.io.lammps import lammps_wall_model
-
     twisting = lammps_wall_model(contact).twisting != "none"
     twist = TWIST_SPIN * speed / contact.radius if twisting else 0.0
     result = simulate_impact(contact, speed, angle, omega=(twist, 0.0, 0.0))

@@ -99,16 +99,18 @@ import numpy as np
 import xarray as xr
 
 from microimpact.io.files import atomic_write, write_netcdf
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.io.variables import attributes
-from microimpact.model.contact import Contact
+from microimpact.model import tangential_compliance as tc
+from microimpact.model.contact import Contact, adhesion_line_force_from_work
+from microimpact.model.dem_damping import critical_damping_coefficient
 from microimpact.solvers.impact import settled_contact_energy, simulate_impact
 from microimpact.solvers import TimeBudgetExceeded, check_sub_models
 from microimpact.solvers.reference import simulate_reference
-from microimpact.studies._timeout import time_limit
+from microimpact._runtime.timeout import time_limit
 from microimpact.model.adhesion_models import AdhesionRegimeWarning
 from microimpact.solvers import UndeterminedOutcomeWarning
-from microimpact._usage import parse_or_status
+from microimpact._runtime.usage import parse_or_status
 
 __all__ = ["LAWS", "POISSON", "TOLERANCES", "INPUT_RANGES", "FAILURE_KINDS", "NOTE_KINDS", "draw_cases", "contact_of", "check_case",
            "stress_sweep", "StressReport", "result_distance", "energy_scale", "energy_error", "kinetic_energy",
@@ -264,8 +266,6 @@ def contact_of(case: dict, law: str = "ring") -> Contact:
     >>> c.tangential_model, round(c.shear_modulus / case["stiffness"], 4)
     ('mindlin', 0.1544)
     """
-    from microimpact.model import tangential_compliance as tc
-
     fields = dict(LAWS[law])
     adhesive = fields.pop("adhesion", True)
     if fields.get("damping_model", "paper") != "paper":
@@ -284,9 +284,6 @@ def _dem_contact(case: dict, fields: dict, adhesive: bool) -> Contact:
     """A case under a DEM damping law: the drawn zeta_H (1e-3 to 1e6, or 0) sets the damping as a
     multiple of the critical damping 2 sqrt(m k) of the case's Hertz impact (k = K a at its largest
     approach), or the restitution e = 1 / (1 + zeta_H) of tsuji and coeff_restitution."""
-    from microimpact.model.contact import adhesion_line_force_from_work
-    from microimpact.model.dem_damping import critical_damping_coefficient
-
     r, rho, k = case["radius"], case["density"], case["stiffness"]
     f0 = adhesion_line_force_from_work(k, r, case["work_of_adhesion"]) if adhesive else 0.0
     zeta = case["zeta_hertz"]

@@ -50,8 +50,8 @@ import xarray as xr
 from microimpact import __version__
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.dynamics.nonlinear import capture_velocity
-from microimpact.io.files import CONVENTIONS, write_netcdf
-from microimpact.io.progress import progress_bar, wants_progress
+from microimpact.io.files import CONVENTIONS, restore_label_coordinates, write_netcdf
+from microimpact._runtime.progress import progress_bar, wants_progress
 from microimpact.io.variables import attributes
 from microimpact.model.contact import PAPER_REFERENCE
 from microimpact.model.parameters import TABLE2_CASES, table2_case
@@ -296,7 +296,7 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
         the same solver tolerance, :func:`microimpact.dynamics.nonlinear.capture_velocity`) and store it as
         the 0-d variable ``capture_normal_speed``; the figures mark it.
     progress : bool, optional
-        Draw a progress bar on stderr (:func:`microimpact.io.progress.progress_bar`) when stderr is
+        Draw a progress bar on stderr (:func:`microimpact._runtime.progress.progress_bar`) when stderr is
         a terminal; the speeds are then solved in blocks to advance it (same values as one batch).
         Default: silent.
     time_budget : float or Deadline, optional
@@ -582,8 +582,6 @@ def load_sweep(path) -> xr.Dataset:
     ...
     FileNotFoundError: ...
     """
-    from microimpact.io.files import restore_label_coordinates
-
     with xr.open_dataset(path, decode_timedelta=False) as ds:
         return restore_label_coordinates(ds.load())
 

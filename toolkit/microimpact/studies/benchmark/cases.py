@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -172,8 +173,6 @@ class BenchmarkConfig:
         >>> c.n_speeds, len(c.oblique), c.n_settings
         (2, 1, 1)
         """
-        import dataclasses
-
         return dataclasses.replace(
             cls.quick_(), n_speeds=2, max_speed=10.0, engine_levels=(0,), scipy_levels=(0,), rkg_levels=(0,),
             oblique=_OBLIQUE_QUICK[:1], repeats_single=1, repeats_batch=1, batch_size=10, family_size=10,

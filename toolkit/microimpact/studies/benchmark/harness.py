@@ -2,7 +2,7 @@
 memory and the machine description.
 
 Times are ``time.perf_counter`` medians over repeats; the scipy solves run under a wall-clock
-limit (:func:`microimpact.studies._timeout.time_limit`) so a setting that would take minutes is
+limit (:func:`microimpact._runtime.timeout.time_limit`) so a setting that would take minutes is
 dropped instead of stalling the run.
 """
 
@@ -29,7 +29,7 @@ from microimpact import __version__
 from microimpact.presets import WALL_1990
 from microimpact.solvers.impact import simulate_impact, simulate_many
 from microimpact.solvers.reference import simulate_reference
-from microimpact.studies._timeout import TimeLimitExceeded, time_limit
+from microimpact._runtime.timeout import TimeLimitExceeded, time_limit
 
 __all__ = ["measure_throughput", "measure_memory", "machine_attrs", "ObliqueResults"]
 

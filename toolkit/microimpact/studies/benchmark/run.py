@@ -16,7 +16,7 @@ import numba
 import numpy as np
 import xarray as xr
 
-from microimpact.io.progress import progress_bar
+from microimpact._runtime.progress import progress_bar
 from microimpact.io.provenance import contact_attributes, preset_parameter_source
 from microimpact.io.variables import attributes
 from microimpact.presets import WALL_1990
@@ -31,7 +31,7 @@ from microimpact.studies.benchmark.harness import (
 )
 from microimpact.studies.benchmark.reference import Reference, reference_set
 from microimpact.studies.benchmark.targets import accuracy_targets, throughput_targets
-from microimpact.studies._timeout import time_limit
+from microimpact._runtime.timeout import time_limit
 
 __all__ = ["run_benchmark"]
 
@@ -207,6 +207,42 @@ def _engine_diagnostics(contact, batch_speeds, cfg: BenchmarkConfig) -> dict:
 
 
 # =============================================================================== the Dataset
+def diagnostics_lines(diag: dict) -> list[str]:
+    """The progress lines of :func:`_engine_diagnostics`: one per tolerance, times per impact in us.
+
+    Examples
+    --------
+    >>> row = {"loop_solve_normal": 2.5e-6, "batch_1_threads": 1.0e-6, "batch_2_threads": 0.6e-6, "mean_steps": 41.0,
+    ...        "n": 1000}
+    >>> print(diagnostics_lines({"0.0001": row})[0])
+    engine diagnostics, rtol 0.0001: loop of solve_normal 2.50 us, batch on 1 thread 1.00 us, on 2 threads 0.60 us per impact (41 steps, 1000 speeds)
+    """
+    lines = []
+    for rt, row in diag.items():
+        batch = [(int(k.split("_")[1]), v) for k, v in row.items() if k.startswith("batch_")]
+        on = ", on ".join(f"{n} thread{'s' if n > 1 else ''} {1e6 * t:.2f} us" for n, t in batch)
+        lines.append(f"engine diagnostics, rtol {rt}: loop of solve_normal {1e6 * row['loop_solve_normal']:.2f} us, "
+                     f"batch on {on} per impact ({row['mean_steps']:.0f} steps, {row['n']} speeds)")
+    return lines
+
+
+def sub_model_lines(costs: dict) -> list[str]:
+    """The progress lines of :func:`~microimpact.studies.benchmark.sub_models.sub_model_costs`: one
+    per selection of sub-models, its time per impact and its ratio to the paper's model.
+
+    Examples
+    --------
+    >>> costs = {"paper (rigid, net)": {"time_per_impact": 2e-6, "ratio_to_paper": 1.0},
+    ...          "mindlin": {"time_per_impact": 3.1e-5, "ratio_to_paper": 15.5}}
+    >>> for line in sub_model_lines(costs):
+    ...     print(line)
+    sub-model cost, paper (rigid, net): 2 us per impact (1.0 x the paper's model)
+    sub-model cost, mindlin: 31 us per impact (15.5 x the paper's model)
+    """
+    return [f"sub-model cost, {name}: {1e6 * c['time_per_impact']:.3g} us per impact ({c['ratio_to_paper']:.1f} x the "
+            "paper's model)" for name, c in costs.items()]
+
+
 def _timing_modes(cfg: BenchmarkConfig, batch_size: int, threads: int) -> list[str]:
     modes = {
         "engine": f"single call: simulate_impact, median over repeats ({cfg.repeats_single}) and speeds",
@@ -291,7 +327,7 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
     throughput : bool
         Also measure the 100,000-impact throughput and the memory scaling.
     progress : bool, optional
-        A progress bar of the stages on stderr (:func:`microimpact.io.progress.progress_bar`),
+        A progress bar of the stages on stderr (:func:`microimpact._runtime.progress.progress_bar`),
         drawn only when stderr is a terminal. Default: none.
     time_budget : float, optional
         Stop with :class:`microimpact.solvers.TimeBudgetExceeded` once the run has taken this long
@@ -343,11 +379,13 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
             stage()
             advance()
         diag = _engine_diagnostics(contact, batch_speeds, cfg)
-        log(f"engine diagnostics: {diag}", verbose)
+        for line in diagnostics_lines(diag):
+            log(line, verbose)
         sub_grid = (np.geomspace(speeds[0], speeds[-1], 4 if cfg.quick else 32),
                     np.linspace(0.0, 85.0, 5 if cfg.quick else 18))
         sub_costs = sub_model_costs(contact, *sub_grid, repeats=1 if cfg.quick else 3)
-        log(f"sub-model costs: {sub_costs}", verbose)
+        for line in sub_model_lines(sub_costs):
+            log(line, verbose)
         advance()
 
         targets = accuracy_targets(table.values["time_per_impact"], table.values["max_error_e_n"], cfg, b["e_n"])

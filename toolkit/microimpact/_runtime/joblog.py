@@ -43,7 +43,7 @@ class JobTerminated(Exception):
     >>> handler(signal.SIGTERM, None)
     Traceback (most recent call last):
     ...
-    microimpact.io.joblog.JobTerminated: SIGTERM
+    microimpact._runtime.joblog.JobTerminated: SIGTERM
     """
 
 

@@ -7,7 +7,7 @@ import signal
 import threading
 import time
 
-from microimpact.solvers import TimeBudgetExceeded
+from microimpact._runtime.budget import TimeBudgetExceeded
 
 __all__ = ["TimeLimitExceeded", "time_limit"]
 

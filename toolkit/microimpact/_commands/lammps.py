@@ -1,0 +1,230 @@
+"""``microimpact lammps export | fit | verify``: LAMMPS GRANULAR inputs, fits of its laws, and the check against LAMMPS."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from microimpact._commands.common import AUTO_TANGENTIAL, EXIT_DISAGREES, UsageError
+from microimpact._commands.contacts import contact_from_args
+from microimpact._commands.tables import impacts_for_pair, input_files
+from microimpact._runtime.progress import progress_bar
+from microimpact.analysis.dem_fit import candidate_laws, rank_dem_laws
+from microimpact.analysis.dem_friction import rank_dem_tangential_laws
+from microimpact.analysis.fit_result import DampingFit
+from microimpact.io.files import atomic_write, write_csv
+from microimpact.io.kinds import file_kind
+from microimpact.io.lammps import lammps_input, read_lammps_contact
+from microimpact.io.paths import check_input_file, check_outputs, reporting_os_errors
+from microimpact.io.provenance import fit_parameter_source
+from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
+from microimpact.studies.lammps_check import DEFAULT_INCIDENCES, default_speeds, verify_lammps
+
+
+def _fitted_values(path) -> dict:
+    """``{parameter: "value (stderr s)"}`` of the varied parameters of a fit file, for a header."""
+    fit = DampingFit.load(path)
+    return {name: f"{fit.values[name]:.6g} (standard error {fit.stderr.get(name, float('nan')):.3g}); "
+                  f"{fit.parameter_source}" for name in fit.varied}
+
+
+def run_export(args) -> int:
+    inputs = {"--fit": args.fit, "--config": args.config}
+    out = check_outputs({"--out": args.out}, {k: v for k, v in inputs.items() if v is not None})["--out"]
+    contact = contact_from_args(args)
+    text = lammps_input(contact, units=args.units, poisson=args.poisson, wall=args.wall, source=args.contact_note,
+                        fitted=_fitted_values(args.fit) if args.fit else None)
+    with reporting_os_errors({"--out": out}), atomic_write(out) as f:
+        f.write(text)
+    print(f"wrote {out} (LAMMPS units {args.units}); check it with: microimpact lammps verify {out}")
+    return 0
+
+
+def _lammps_tangential_fields(args, law: str) -> dict:
+    """The Contact fields of tangential law ``law`` from the options of ``lammps fit`` (UsageError if
+    one is missing, or, for a law named by --tangential-model, one of the other law's is given)."""
+    fields_ = {"tangential_model": law, "tangential_damping": args.tangential_damping}
+    if args.rolling_stiffness is not None:  # LAMMPS's rolling sds, held at the given values while mu is fitted
+        fields_ |= {"rolling_model": "lammps_sds", "rolling_stiffness": args.rolling_stiffness,
+                    "rolling_damping": args.rolling_damping, "rolling_friction": args.rolling_friction}
+    if args.twisting_model is not None:  # LAMMPS's twisting law: no effect on e_n, e_t; written with mu
+        fields_["twisting_model"] = args.twisting_model
+        if args.twisting_model == "lammps_sds":
+            fields_ |= {"twisting_stiffness": args.twisting_stiffness, "twisting_damping": args.twisting_damping,
+                        "twisting_friction": args.twisting_friction}
+    other = "--shear-modulus" if law == "linear_history" else "--tangential-stiffness"
+    if args.tangential_model != AUTO_TANGENTIAL and (args.shear_modulus if other == "--shear-modulus"
+                                                     else args.tangential_stiffness) is not None:
+        raise UsageError(f"{other} does not belong to --tangential-model {law}")
+    if law == "linear_history":
+        if args.tangential_stiffness is None:
+            raise UsageError("--tangential-model linear_history needs --tangential-stiffness (k_t [N/m])")
+        fields_["tangential_stiffness"] = args.tangential_stiffness
+    else:
+        if args.shear_modulus is None:
+            raise UsageError(f"--tangential-model {law} needs --shear-modulus (G* [Pa]; LAMMPS's k_t = 8 G*)")
+        fields_["shear_modulus"] = args.shear_modulus
+    return fields_
+
+
+def _lammps_tangential_laws(args) -> dict:
+    """{law: its Contact fields}: the one --tangential-model names, or with ``auto`` every LAMMPS
+    tangential law whose stiffness is given (linear_history with --tangential-stiffness, the four
+    mindlin laws with --shear-modulus)."""
+    if args.tangential_model != AUTO_TANGENTIAL:
+        return {args.tangential_model: _lammps_tangential_fields(args, args.tangential_model)}
+    laws = [law for law in DEM_TANGENTIAL_MODELS
+            if (args.tangential_stiffness if law == "linear_history" else args.shear_modulus) is not None]
+    if not laws:
+        raise UsageError("--tangential-model auto needs --tangential-stiffness (for linear_history) and/or "
+                         "--shear-modulus (for the mindlin laws)")
+    return {law: _lammps_tangential_fields(args, law) for law in laws}
+
+
+def _lammps_fit_friction(args, table, chosen):
+    """(contact with the fitted mu, header note), or (None, None) after one line saying why mu is not
+    determined; mu of LAMMPS's tangential law fitted to the oblique columns, the normal law fixed
+    (with ``--tangential-model auto`` each law's, ranked by AIC, the best one written)."""
+    laws = _lammps_tangential_laws(args)
+    try:
+        ranked, fits = rank_dem_tangential_laws(
+            table, {law: (lambda r, f=f: chosen.contact(r).with_(**f)) for law, f in laws.items()}, normal_fit=chosen,
+            stiffness_uncertainty=args.stiffness_uncertainty, rtol=args.rtol, progress=True)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    if len(laws) > 1:
+        print(ranked[["law", "status", "friction", "interval_low", "interval_high", "chisqr", "delta_aic",
+                      "akaike_weight"]].to_string(index=False, float_format=lambda x: f"{x:.6g}"))
+    law = str(ranked["law"].iloc[0])
+    fit = fits[law]
+    print(fit.report())
+    status = fit.identifiability["friction"]
+    if not status.determined:
+        print(f"microimpact: error: the oblique data do not determine the friction of LAMMPS's "
+              f"{law} law ({status.describe()}); no LAMMPS input written", file=sys.stderr)
+        return None, None
+    radius = float(np.median(np.asarray(table["radius"], dtype=float)))
+    others = ", ".join(f"{o} dAIC {d:.3g}" for o, d in zip(ranked["law"].iloc[1:], ranked["delta_aic"].iloc[1:]))
+    k = fit.info.get("stiffness_sensitivity")
+    held = ("" if not k else f"; the stiffness profiled with its relative uncertainty {args.stiffness_uncertainty:g} "
+            f"(best at {k['profiled_factor']:.4g} times the given)" if args.stiffness_uncertainty else
+            f"; at the given stiffness, not fitted (mu {k['friction_low']:.6g} / {k['friction_high']:.6g} with it "
+            f"{100 * k['step']:.0f}% lower / higher)")
+    note = (f"{fit.friction:.6g} ({law}{'; best by AIC: ' + others if others else ''}; 95% profile-likelihood "
+            f"interval {status.lower:.6g} to {status.upper:.6g}; the normal law's uncertainty included{held}; "
+            f"{fit.n_points} oblique entries)")
+    return chosen.contact(radius).with_(friction=fit.friction, **laws[law]), note
+
+
+def run_fit(args) -> int:
+    out = check_outputs({"--out": args.out}, input_files(args))["--out"]
+    if args.tangential_model is None:
+        given = [o for o, v in (("--tangential-stiffness", args.tangential_stiffness), ("--shear-modulus", args.shear_modulus),
+                                ("--tangential-damping", args.tangential_damping or None),
+                                ("--rolling-stiffness", args.rolling_stiffness),
+                                ("--twisting-model", args.twisting_model)) if v is not None]
+        if given:
+            raise UsageError(f"{', '.join(given)} belong to a tangential law: give --tangential-model too")
+    else:
+        _lammps_tangential_laws(args)  # a missing stiffness is refused before the fits run
+    if args.rolling_stiffness is None and (args.rolling_damping or args.rolling_friction):
+        raise UsageError("--rolling-damping and --rolling-friction belong to LAMMPS's rolling sds: give --rolling-stiffness too")
+    sds_twist = [o for o, v in (("--twisting-stiffness", args.twisting_stiffness), ("--twisting-damping", args.twisting_damping),
+                                ("--twisting-friction", args.twisting_friction)) if v]
+    if args.twisting_model == "lammps_sds" and args.twisting_stiffness is None:
+        raise UsageError("--twisting-model lammps_sds needs --twisting-stiffness (k_twist [N m/rad])")
+    if args.twisting_model != "lammps_sds" and sds_twist:
+        raise UsageError(f"{', '.join(sds_twist)} belong to --twisting-model lammps_sds")
+    if args.stiffness_uncertainty is not None and args.tangential_model is None:
+        raise UsageError("--stiffness-uncertainty belongs to a tangential law: give --tangential-model too")
+    if args.fit_adhesion and args.law and args.law[0] == "hertz":
+        raise UsageError(f"--fit-adhesion: the law {'+'.join(args.law)} has no work of adhesion to fit; give a "
+                         "jkr_force or dmt law, or no --law")
+    table, pair = impacts_for_pair(args)
+    laws = [args.law] if args.law else candidate_laws(pair, args.fit_adhesion)
+    try:
+        with progress_bar(len(laws), "LAMMPS laws fitted") as advance:
+            ranked, fits = rank_dem_laws(table, pair, laws, fit_adhesion=args.fit_adhesion, weights=args.weights,
+                                         rtol=args.rtol, progress=advance)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    columns = ["law", "status", "value", "interval_low", "interval_high"]
+    if args.fit_adhesion:
+        columns += ["adhesion_status", "work_of_adhesion", "w_low", "w_high"]
+    shown = ranked[columns + ["chisqr", "delta_aic", "akaike_weight"]]
+    print(shown.to_string(index=False, float_format=lambda x: f"{x:.6g}"))
+    chosen = fits[ranked["law"].iloc[0]]
+    print(chosen.describe())
+    if not chosen.determined:
+        statuses = {"damping coefficient": chosen.status}
+        if chosen.adhesion_fitted:
+            statuses["work of adhesion"] = chosen.adhesion_status
+        why = ("does not describe the data" if chosen.status == "inadequate" else "the data do not determine its "
+               + " or ".join(f"{name} ({st})" for name, st in statuses.items() if st != "determined"))
+        print(f"microimpact: error: {chosen.law}, the best LAMMPS law by AIC, {why}; no LAMMPS input written",
+              file=sys.stderr)
+        return EXIT_DISAGREES
+    radii = np.asarray(table["radius"], dtype=float)
+    radius = float(np.median(radii))
+    contact = chosen.contact(radius)
+    friction_note = None
+    if args.tangential_model is not None:  # the friction of LAMMPS's tangential law, from the oblique columns
+        contact, friction_note = _lammps_fit_friction(args, table, chosen)
+        if contact is None:
+            return EXIT_DISAGREES
+    source = fit_parameter_source(table.attrs.get("source", args.data), table.attrs.get("sha256"))
+    lo, hi = chosen.interval
+    others = ", ".join(f"{law} dAIC {d:.3g}" for law, d in zip(ranked["law"].iloc[1:], ranked["delta_aic"].iloc[1:]))
+    fitted = {"damping_coefficient": f"{chosen.value:.6g} (68% profile-likelihood interval {lo:.6g} to {hi:.6g}; "
+                                     f"{chosen.n} impacts, {'stated e_n uncertainties' if chosen.sigma_known else 'scatter estimated'})",
+              "law": f"{chosen.law} (best by AIC{'; ' + others if others else ''})",
+              **({"work_of_adhesion": f"{chosen.work_of_adhesion:.6g} J/m^2 (68% profile-likelihood interval "
+                                      f"{chosen.work_of_adhesion_interval[0]:.6g} to "
+                                      f"{chosen.work_of_adhesion_interval[1]:.6g}, the damping fitted jointly)"}
+                 if chosen.adhesion_fitted else {}),
+              **({"friction": friction_note} if friction_note else {}),
+              "radius": f"{radius:.6g} m, the median of the data's radii ({radii.min():.4g} to {radii.max():.4g} m)"}
+    pair_name = getattr(pair, "name", None) or args.material_pair
+    text = lammps_input(contact, units=args.units, source=f"{source}" + (f"; material pair {pair_name}" if pair_name else ""),
+                        fitted=fitted)
+    with reporting_os_errors({"--out": out}), atomic_write(out) as f:
+        f.write(text)
+    print(f"wrote {out} (LAMMPS units {args.units}); check it with: microimpact lammps verify {out}")
+    return 0
+
+
+def run_verify(args) -> int:
+    out = check_outputs({"--out": args.out}, {"input file": args.input})["--out"] if args.out else None
+    path = check_input_file("input file", args.input)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise UsageError(f"input file {path}: the file is {file_kind(path)}, not a LAMMPS input written by "
+                         "'microimpact lammps export'") from None
+    try:
+        contact, _ = read_lammps_contact(text)
+    except ValueError as exc:
+        raise UsageError(f"input file {path}: {exc}") from None
+    speeds = args.speeds or default_speeds(contact)
+    incidences = args.incidence_deg or DEFAULT_INCIDENCES
+    with progress_bar(len(speeds) * len(incidences), "LAMMPS impacts") as advance:
+        table = verify_lammps(text, speeds=speeds, incidences=incidences, steps=args.steps,
+                              tolerance=args.tolerance, progress=advance)
+    if out is not None:
+        with reporting_os_errors({"--out": out}):
+            write_csv(table, out, index=False)
+    columns = ["speed", "incidence_deg", "outcome_lammps", "e_n_microimpact", "e_n_lammps"]
+    if contact.friction > 0.0:  # the tangential restitution too (the spin ratio is in the --out table)
+        columns += ["e_t_microimpact", "e_t_lammps"]
+    shown = table[columns + ["difference", "step_error", "agrees"]]
+    print(shown.to_string(index=False, float_format=lambda v: f"{v:.7g}"))
+    worst = table["difference"].max()
+    print(f"LAMMPS {table.attrs['lammps_version']} on {path.name}: {int(table['agrees'].sum())} of {len(table)} impacts "
+          f"agree within {args.tolerance:g} (largest difference {worst:.2e}, largest LAMMPS step error "
+          f"{table['step_error'].max():.2e})" + (f"; wrote {out}" if out else ""))
+    if not table.attrs["passed"]:
+        print(f"microimpact: error: LAMMPS and microimpact disagree on {int((~table['agrees']).sum())} impacts "
+              f"of {path.name}", file=sys.stderr)
+        return EXIT_DISAGREES
+    return 0
