@@ -5,8 +5,17 @@ quantities of a microsphere are smaller than that (mass 2.3e-13 kg, energies 1e-
 3.5e-14 N m): a result of 0 would pass such a comparison. Here the default absolute tolerance is
 0, so a comparison without ``abs=`` is purely relative and can fail; a comparison with an expected
 value of 0 must state its ``abs=`` (and say why it is what it is).
+
+On a run of the whole suite over several pytest-xdist workers, each worker first fills numba's
+cache with the solvers' kernels (:func:`fill_numba_cache`), the workers taking the kernel groups in
+different orders: a kernel is then compiled once, by one worker, and loaded by the other workers
+and by every subprocess a test starts, instead of being compiled in each of them as they meet it.
 """
 
+import os
+import warnings
+
+import numpy as np
 import pytest
 
 try:  # pytest >= 9.2 keeps approx in its own module
@@ -14,8 +23,44 @@ try:  # pytest >= 9.2 keeps approx in its own module
 except ImportError:
     from _pytest.python_api import ApproxDecimal, ApproxScalar
 
+import microimpact as mi
+from microimpact.presets import WALL_1990
+
 ApproxScalar.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
 ApproxDecimal.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
 # the policy took effect (a pytest that keeps the default elsewhere fails here, not silently)
 if 1e-13 == pytest.approx(0.0):
     raise RuntimeError("tests/conftest.py could not set pytest.approx's default absolute tolerance to 0")
+
+#: one public call per group of compiled kernels (the groups of tests/study_compile_times.py)
+KERNEL_GROUPS = (
+    lambda c: mi.simulate_impact(c, 2.0, 30.0, omega=(0.0, 0.0, 1e5)),
+    lambda c: mi.simulate_many(c, speed=np.geomspace(0.5, 5.0, 8), incidence_deg=30.0, family=False),
+    lambda c: mi.simulate_many(c, speed=np.geomspace(0.5, 5.0, 8), incidence_deg=30.0, family=True),
+    lambda c: mi.simulate_impact(c.with_(tangential_model="lammps_mindlin", normal_model="jkr_force", zeta_hertz=0.0,
+                                         zeta_adhesion=0.0, friction=0.3, shear_modulus=3e8), 1.0, 40.0),
+    lambda c: mi.simulate_impact(c, 2.0, 20.0, method="rkg"),
+    lambda c: mi.simulate_impact(c.with_(normal_model="jkr"), 2.0, 30.0),
+    lambda c: mi.simulate_impact(c.with_(tangential_model="mindlin", shear_modulus=1e10), 2.0, 40.0),
+)
+#: a run of at least this many tests is "the suite" (a single test file is not worth the wait)
+SUITE_SIZE = 300
+
+
+def fill_numba_cache(worker: int, workers: int) -> None:
+    """Run every kernel group once, starting at a different group in each worker (worker k of n
+    starts at group k * groups / n and goes round), so that the workers compile different kernels
+    at the same time and later load those the others compiled."""
+    n = len(KERNEL_GROUPS)
+    start = worker * n // workers
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for k in range(n):
+            KERNEL_GROUPS[(start + k) % n](WALL_1990)
+
+
+def pytest_collection_finish(session):
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")  # "gw0", "gw1", ... in an xdist worker
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    if worker.startswith("gw") and workers > 1 and len(session.items) >= SUITE_SIZE:
+        fill_numba_cache(int(worker[2:]), workers)

@@ -132,8 +132,8 @@ def small_benchmark():
         engine_levels=(0, 2, 4), scipy_levels=(0,), rkg_levels=(0, 1),
         oblique=(ObliqueCase(5.0, 30.0, 0.0, 0.0, 0.0, 1.0, 0.5), ObliqueCase(2.0, 45.0, 0.0, 0.0, 0.0, 0.0, 0.5)),
         repeats_single=1, repeats_scipy=1, repeats_batch=1, batch_size=100,
-        throughput_impacts=2000, throughput_repeats=1, memory_sizes=(500, 2000), time_limit=5.0,
-        reference_rtols=(1e-10, 1e-11), family_size=3000, family_impacts=5000, family_check=300, fit_rows=300,
+        throughput_impacts=500, throughput_repeats=1, memory_sizes=(200, 500), time_limit=5.0,
+        reference_rtols=(1e-10, 1e-11), family_size=3000, family_impacts=1000, family_check=100, fit_rows=120,
     )
     return benchmark.run_benchmark(config=cfg)
 

@@ -1,6 +1,6 @@
 """The reported intervals and bounds hold the truth as often as they say (issue 25, part 1).
 
-A quick form of the calibration study (:mod:`microimpact.studies.calibration`) over random truths
+A quick form of the calibration study (``tests/study_calibration.py``) over random truths
 and random experiment designs, and checks of the committed full study (docs/calibration.json).
 Coverage is tested with a binomial tail: with n statements at 95 %, k holding the truth, the test
 fails when P(X <= k | n, 0.95) < 1e-3 -- a miscalibrated estimator (say 85 % over 40 statements,
@@ -9,6 +9,7 @@ P = 3e-3 at k = 34, 1e-4 at k = 32) fails it, while a calibrated one passes 999 
 
 from __future__ import annotations
 
+import doctest
 import json
 import math
 from pathlib import Path
@@ -16,7 +17,8 @@ from pathlib import Path
 import pytest
 from scipy import stats
 
-from microimpact.studies.calibration import FITTED, draw_design, markdown_tables, run_design, summarise
+import study_calibration
+from study_calibration import FITTED, draw_design, markdown_tables, run_design, summarise
 
 ROOT = Path(__file__).resolve().parents[1]
 COMMITTED = ROOT / "docs" / "calibration.json"
@@ -36,7 +38,7 @@ def test_designs_are_random_and_reproducible():
 
 @pytest.fixture(scope="module")
 def quick():
-    """12 random designs, least squares only (about 30 s)."""
+    """12 random designs, least squares only (the slow coverage test)."""
     return [run_design(draw_design(seed)) for seed in range(500, 512)]
 
 
@@ -56,8 +58,17 @@ def test_quick_study_is_calibrated(quick):
     assert _consistent_with_95(k, n), f"{k} of {n} statements hold the truth"
 
 
-def test_every_statement_is_a_value_a_bound_or_nothing(quick):
-    for rec in quick:
+@pytest.fixture(scope="module")
+def few():
+    """Three of the quick study's designs, together every kind of statement: a value, an upper bound
+    (zeta_H of 504), a lower bound (f of 507, whose w_A is fitted) and an oblique design (509)."""
+    return [run_design(draw_design(seed)) for seed in (504, 507, 509)]
+
+
+def test_every_statement_is_a_value_a_bound_or_nothing(few):
+    statuses = {rec[name]["status"] for rec in few for name in FITTED if name in rec}
+    assert {"determined", "upper_bound", "lower_bound"} <= statuses  # (the check below sees each kind)
+    for rec in few:
         for name in FITTED:
             if name not in rec:
                 continue
@@ -104,3 +115,11 @@ def test_calibration_page_shows_the_committed_study():
     # docs/calibration.md quotes the committed study's tables verbatim (made by markdown_tables)
     summary = json.loads(COMMITTED.read_text())["summary"]
     assert markdown_tables(summary) in (ROOT / "docs" / "calibration.md").read_text()
+
+
+def test_the_study_runs_as_its_examples_say(tmp_path, monkeypatch):
+    """The docstring examples of tests/study_calibration.py (one cheap design through run_design,
+    calibration_study and main, the figure); the package's doctest run does not see tests/."""
+    monkeypatch.chdir(tmp_path)  # main and plot_calibration write here
+    result = doctest.testmod(study_calibration, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    assert result.failed == 0 and result.attempted >= 10

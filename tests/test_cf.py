@@ -90,7 +90,8 @@ def result_files(tmp_path_factory):
         oblique=(ObliqueCase(5.0, 30.0, 0.0, 0.0, 0.0, 1.0, 0.5),),
         repeats_single=1, repeats_scipy=1, repeats_batch=1, batch_size=10,
         throughput_impacts=100, throughput_repeats=1, memory_sizes=(50, 100), time_limit=5.0,
-        reference_rtols=(1e-10, 1e-11),
+        reference_rtols=(1e-10, 1e-11), family_size=10, family_impacts=200, family_check=20,
+        family_memory_sizes=(10, 20), fit_rows=200,  # (the class defaults are the full run's millions)
     )
     files["benchmark"] = write_netcdf(benchmark.run_benchmark(config=cfg), out / "benchmark.nc")
     return files

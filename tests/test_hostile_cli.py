@@ -363,7 +363,25 @@ END_TO_END = [
 ]
 
 
+#: of END_TO_END, run through the console script in a process of its own (what only the process
+#: shows: the exit status and the stderr of the entry point's own handling): an argparse error, a
+#: refused value, a failure deep in the work's set-up (scipy's root finding)
+SUBPROCESS = {"simulate --sped 1", "simulate --speed 1e-300", "target --e-n 0.5 --speed 1e-8"}
+
+
 @pytest.mark.parametrize("argv,words", END_TO_END, ids=[" ".join(a) for a, _ in END_TO_END])
+def test_end_to_end_case_in_process(argv, words, workspace, capsys):
+    """Each end-to-end case through ``main``: status 2, one line on stderr naming it, nothing written."""
+    before = _snapshot(workspace)
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.count("\n") == 1 and err.startswith("microimpact: error: ") and words in err, err
+    assert _snapshot(workspace) == before
+
+
+@pytest.mark.parametrize("argv,words", [c for c in END_TO_END if " ".join(c[0]) in SUBPROCESS],
+                         ids=sorted(SUBPROCESS, key=[" ".join(a) for a, _ in END_TO_END].index))
 def test_entry_point(argv, words, workspace):
     before = _snapshot(workspace)
     exe = shutil.which("microimpact")

@@ -213,7 +213,7 @@ def test_the_profile_is_not_stopped_by_the_capture_plateau():
     gradient (chi-square 4439 against 9.1 at the minimum). A profile that stopped there reported
     zeta_A <= 4.3; from a start off the plateau the profile stays within 0.4 of its minimum up to
     zeta_A = 100, so the data bound zeta_A only far above the truth."""
-    from microimpact.studies.calibration import draw_design, run_design
+    from study_calibration import draw_design, run_design
 
     design = draw_design(1240)
     rec = run_design(design)["zeta_adhesion"]

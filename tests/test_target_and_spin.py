@@ -65,17 +65,25 @@ def test_cli_target_writes_csv_and_refuses_bad_input(tmp_path, capsys):
 
 
 # ----------------------------------------------------------------------------- flags that explain
-@pytest.fixture(scope="module")
-def oblique_run(tmp_path_factory):
-    """A synthetic oblique CSV with one row edited as if spun; fit, posterior and flags by the CLI."""
+SPUN = 8  # 0-based: a sliding row (50 deg at 30 m/s); its e_t raised as top-spin would
+
+
+def _spun_csv(d):
+    """A synthetic oblique CSV in ``d`` with one row edited as if spun."""
     from microimpact.analysis.synthetic import make_synthetic_oblique
     from microimpact.io.files import write_csv
 
-    d = tmp_path_factory.mktemp("spun")
     df = make_synthetic_oblique(radii=(3.45e-6,), seed=4)
-    spun = 8  # 0-based: a sliding row (50 deg at 30 m/s); its e_t raised as top-spin would
-    df.loc[spun, "tangential_restitution [1]"] = 1.0
+    df.loc[SPUN, "tangential_restitution [1]"] = 1.0
     write_csv(df, d / "obl.csv", float_format="%.6g")
+
+
+@pytest.fixture(scope="module")
+def oblique_run(tmp_path_factory):
+    """The spun CSV; fit, posterior and flags by the CLI."""
+    d = tmp_path_factory.mktemp("spun")
+    _spun_csv(d)
+    spun = SPUN
     fit, post, obl, flags = d / "fit.nc", d / "post.nc", d / "obl.nc", d / "flags.csv"
     assert main(["fit", str(d / "obl.csv"), "--out", str(fit), "--posterior", str(post), "--oblique-out", str(obl),
                  "--no-confidence-intervals"]) == 0  # the default chain: run until converged
@@ -116,15 +124,17 @@ def test_normal_only_rows_admit_every_spin(tmp_path):
     np.testing.assert_allclose(ds["spin_low"].values, -table["speed"] / table["radius"], rtol=1e-12)
 
 
-def test_fit_cli_wrote_friction_into_the_fit(oblique_run):
+def test_fit_cli_wrote_friction_into_the_fit(tmp_path):
     from microimpact.analysis.fit_result import DampingFit
 
-    _, _, d = oblique_run
-    fit = DampingFit.load(d / "fit.nc")
+    _spun_csv(tmp_path)  # (without --posterior: the friction fit is the same, the chain is not needed)
+    assert main(["fit", str(tmp_path / "obl.csv"), "--out", str(tmp_path / "fit.nc"), "--no-confidence-intervals"]) == 0
+    fit = DampingFit.load(tmp_path / "fit.nc")
     assert fit.friction != 0.15 and abs(fit.friction - 0.15) < 0.02  # fitted, not the config's 0.15
     assert "friction_stderr" in fit.info
 
 
+@pytest.mark.slow  # a converged chain through the CLI: tens of seconds (the CLI files' form: test_report.py)
 def test_report_shows_posterior_oblique_fit_and_spin_ranges(oblique_run):
     # the analyst section of the PDF from the CLI's files: posterior table and figures, measured vs
     # fitted per angle, and the per-row spin ranges naming the spun row

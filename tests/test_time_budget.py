@@ -209,7 +209,7 @@ def test_analyst_fit_shares_one_budget(table, pair, clock):
 
 
 def test_calibration_budget():
-    from microimpact.studies.calibration import calibration_study
+    from study_calibration import calibration_study
 
     with pytest.raises(TimeBudgetExceeded, match=r"^calibration study: time budget of 1e-09 s exceeded after 1 of 2 designs$"):
         calibration_study(2, seed=5, time_budget=TINY)

@@ -50,8 +50,8 @@ class Deadline:
     """The wall-clock end of a time budget, checked between units of work of a long computation.
 
     Make one with :meth:`start` from a caller's ``time_budget``; :meth:`check` raises
-    :class:`TimeBudgetExceeded` once the budget is spent. A check costs about 0.1 us (one
-    ``time.perf_counter``), so it may run after every model evaluation.
+    :class:`TimeBudgetExceeded` once the budget is spent. A check is one ``time.perf_counter``
+    call, so it may run after every model evaluation.
 
     Attributes
     ----------

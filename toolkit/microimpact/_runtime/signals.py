@@ -27,7 +27,7 @@ def deferred_signals(signums=(signal.SIGINT, signal.SIGTERM)) -> Iterator[None]:
 
     A KeyboardInterrupt raised inside netCDF4/xarray's writer is raised while xarray holds its
     file lock, and the writer's own cleanup then waits for that lock for ever (a pipeline job
-    hung 24 minutes after Ctrl-C). The block therefore runs to its end, and a signal that came
+    hung after Ctrl-C). The block therefore runs to its end, and a signal that came
     during it is re-raised afterwards, with the handlers that were in place before. Outside the
     main thread, where Python cannot install handlers, the block runs unchanged.
 

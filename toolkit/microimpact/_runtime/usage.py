@@ -1,8 +1,8 @@
 """argparse's exits as return values, for the ``main(argv) -> int`` of every command line.
 
 argparse ends ``--help``, ``--version`` and a usage error with :class:`SystemExit`; a ``main`` that
-documents a returned status (the CLI, ``python -m microimpact.studies.stress``,
-``python -m microimpact.studies.calibration``) turns it into that status here, once.
+documents a returned status (the CLI, ``python -m microimpact.studies.stress``, the developer
+studies under tests/) turns it into that status here, once.
 """
 
 from __future__ import annotations

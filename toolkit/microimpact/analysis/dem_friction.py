@@ -54,8 +54,6 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
     The rest of the contact (normal law, damping, tangential stiffness and damping) is given, e.g.
     by :func:`microimpact.analysis.dem_fit.fit_dem_law` for the normal law and the material's G*.
 
-    Length: the docstring (parameters, notes, example); the body is about 40 lines.
-
     Parameters
     ----------
     table : pandas.DataFrame
@@ -101,7 +99,7 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
     Notes
     -----
     The law has no closed-form map, so every trial mu solves every entry
-    (:func:`microimpact.solvers.dem_tangential.solve_dem_tangential`, ~10 ms each): the profile has
+    (:func:`microimpact.solvers.dem_tangential.solve_dem_tangential`): the profile has
     :data:`DEM_PROFILE_POINTS` log-spaced points over ``PARAMETER_BOUNDS["friction"]``, refined and
     polished as in :func:`fit_friction`; the interval is the profile-likelihood interval. With
     stated speed or angle uncertainties the effective variance is evaluated once, at a first fit
@@ -590,9 +588,6 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
     design with fewer than three rebounds is skipped); the normal law is fitted by
     :func:`fit_dem_law`, then mu by :func:`fit_dem_friction` at the
     fitted normal law, its uncertainty propagated or not.
-
-    Length: the docstring, and one loop that draws a design, fits it and records the row, each
-    step of which reads the draws before it.
 
     Parameters
     ----------

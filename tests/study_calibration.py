@@ -30,9 +30,10 @@ Kinds of design, from the truth (independently of what the fit says): for fricti
 (every oblique impact ends in rolling at the true f), ``all sliding`` or ``mixed``; for the damping
 parameters, ``one speed`` or ``speed range``.
 
-Run it: ``python -m microimpact.studies.calibration --designs 300 --posterior-designs 12 --workers 2
---seed 1000 --out docs/calibration.json --figure docs/calibration.png`` (docs/calibration.md holds
-its results).
+A developer's study, not part of the installed package: run it from the repository's root,
+``python tests/study_calibration.py --designs 300 --posterior-designs 12 --workers 2 --seed 1000
+--out docs/calibration.json --figure docs/calibration.png`` (docs/calibration.md holds its results;
+``tests/test_calibration.py`` runs a quick form and checks the committed results).
 
 References
 ----------
@@ -45,6 +46,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import multiprocessing as mp
 import re
 import sys
 import tempfile
@@ -54,8 +56,20 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
 
 from microimpact._runtime.usage import parse_or_status
+from microimpact.analysis.fitting import fit_damping
+from microimpact.analysis.oblique import ObliqueProblem, _FrictionObjective, fit_friction
+from microimpact.analysis.posterior import PosteriorError, sample_posterior
+from microimpact.analysis.synthetic import make_synthetic_impacts, make_synthetic_oblique
+from microimpact.dynamics.nonlinear import capture_velocity
+from microimpact.io import read_impacts
+from microimpact.io.files import atomic_path, atomic_write, write_csv
+from microimpact.io.materials import material_contact
+from microimpact.model.parameters import TABLE1_ROW2
+from microimpact.solvers import Deadline, TimeBudgetExceeded, engine
 
 __all__ = ["draw_design", "run_design", "calibration_study", "summarise", "plot_calibration", "markdown_tables", "main",
            "FITTED", "LEVEL"]
@@ -119,8 +133,6 @@ def draw_design(seed: int) -> dict:
 
 
 def _material(design: dict) -> dict:
-    from microimpact.model.parameters import TABLE1_ROW2
-
     t = design["truth"]
     return dict(density=TABLE1_ROW2.density, stiffness=TABLE1_ROW2.stiffness, work_of_adhesion=t["work_of_adhesion"],
                 zeta_hertz=t["zeta_hertz"], zeta_adhesion=t["zeta_adhesion"], friction=t["friction"],
@@ -129,12 +141,6 @@ def _material(design: dict) -> dict:
 
 def _simulate(design: dict, folder: Path) -> Path:
     """The design's measured-impact CSV, written to ``folder``."""
-    import pandas as pd
-
-    from microimpact.analysis.synthetic import make_synthetic_impacts, make_synthetic_oblique
-    from microimpact.dynamics.nonlinear import capture_velocity
-    from microimpact.io.files import write_csv
-    from microimpact.io.materials import material_contact
 
     mat = _material(design)
     frames = []
@@ -165,9 +171,6 @@ def _simulate(design: dict, folder: Path) -> Path:
 
 def _friction_kind(table, truth: dict, damping_fit) -> str | None:
     """'all rolling', 'all sliding' or 'mixed' at the TRUE f and damping, from the closed-form thresholds."""
-    from microimpact.analysis.oblique import ObliqueProblem, _FrictionObjective
-    from microimpact.io.materials import material_contact
-
     try:
         problem = ObliqueProblem.from_table(table)
     except ValueError:
@@ -232,10 +235,6 @@ def run_design(design: dict, *, posterior: bool = False, folder: Path | None = N
     >>> {n: (record[n]["status"], record[n]["covered"]) for n in ("zeta_hertz", "zeta_adhesion")}
     {'zeta_hertz': ('upper_bound', True), 'zeta_adhesion': ('determined', True)}
     """
-    from microimpact.analysis.fitting import fit_damping
-    from microimpact.analysis.oblique import fit_friction
-    from microimpact.io import read_impacts
-
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         path = _simulate(design, Path(folder or tmp))
@@ -246,8 +245,6 @@ def run_design(design: dict, *, posterior: bool = False, folder: Path | None = N
     base = SimpleNamespace(density=mat["density"], stiffness=mat["stiffness"],
                            work_of_adhesion=design["work_of_adhesion_start"], friction=0.5, damping_reference_speed=None)
     out = {"seed": design["seed"], "n_rows": int(len(table)), "fit_work_of_adhesion": design["fit_work_of_adhesion"]}
-    from microimpact.analysis.oblique import ObliqueProblem
-
     try:
         ObliqueProblem.from_table(table)
         oblique = True
@@ -281,8 +278,6 @@ def run_design(design: dict, *, posterior: bool = False, folder: Path | None = N
 
 def _check_posterior(out: dict, table, fit, ff, design: dict) -> None:
     """Add the posterior's 95 % statements (or its refusal) to the design's record."""
-    from microimpact.analysis.posterior import PosteriorError, sample_posterior
-
     try:
         post = sample_posterior(table, fit, ff, seed=design["seed"])
     except PosteriorError as exc:
@@ -307,8 +302,6 @@ def post_names(fit, ff) -> list:
 
 def _worker(args):
     seed, posterior = args
-    from microimpact.solvers import engine
-
     engine.set_threads(1)  # one engine thread per worker process
     return run_design(draw_design(seed), posterior=posterior)
 
@@ -345,8 +338,6 @@ def calibration_study(n_designs: int, *, seed: int = 0, posterior_designs: int =
     >>> [r["seed"] for r in records], summarise(records)["zeta_adhesion"]["least_squares"]["determined"]["coverage"]
     ([262], 1.0)
     """
-    from microimpact.solvers import Deadline
-
     deadline = Deadline.start(time_budget, "calibration study")
     jobs = [(seed + k, k < posterior_designs) for k in range(n_designs)]
     records = []
@@ -360,8 +351,6 @@ def calibration_study(n_designs: int, *, seed: int = 0, posterior_designs: int =
         deadline.check(f"{len(records)} of {n_designs} designs")
 
     if workers > 1:
-        import multiprocessing as mp
-
         with mp.get_context("spawn").Pool(workers) as pool:
             for rec in pool.imap_unordered(_worker, jobs):
                 note(rec)
@@ -482,12 +471,6 @@ def plot_calibration(summary: dict, path) -> Path:
     >>> path.name, path.read_bytes()[1:4]
     ('calibration.png', b'PNG')
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    from matplotlib.figure import Figure
-
-    from microimpact.io.files import atomic_path
 
     fig = Figure(figsize=(7.0, 3.4), layout="constrained")
     ax = fig.add_subplot()
@@ -528,7 +511,7 @@ def plot_calibration(summary: dict, path) -> Path:
 
 
 def main(argv=None) -> int:
-    """``python -m microimpact.studies.calibration``: run the study, write JSON (and the figure).
+    """``python tests/study_calibration.py``: run the study, write JSON (and the figure).
 
     Examples
     --------
@@ -559,10 +542,7 @@ def main(argv=None) -> int:
     >>> len(saved["designs"]), saved["summary"]["setup"]["seed"]
     (1, 262)
     """
-    from microimpact.io.files import atomic_write
-    from microimpact.solvers import TimeBudgetExceeded
-
-    p = argparse.ArgumentParser(prog="python -m microimpact.studies.calibration", description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(prog="python tests/study_calibration.py", description=__doc__.split("\n")[0])
     p.add_argument("--designs", type=int, default=300, help="random designs (default 300)")
     p.add_argument("--posterior-designs", type=int, default=0, help="of which also sample the posterior (default 0)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first design (default 0)")
