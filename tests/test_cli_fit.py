@@ -152,3 +152,15 @@ def test_fit_help_names_the_format_document_an_installed_package_has(capsys):
     named = [Path(w.rstrip(",")) for w in words if w.rstrip(",").endswith("README.md")]
     assert named and named[0].is_absolute() and named[0].is_file(), named
     assert "Measured-impact CSV format" in named[0].read_text()
+
+
+def test_fit_help_keeps_a_hyphenated_install_path_in_one_piece(capsys, monkeypatch):
+    """An installed package's path holds ``site-packages``; argparse's own wrapping broke it after
+    the hyphen, so the help named ``packages/microimpact/data/README.md`` (seen on the installed
+    wheel). The path is long so that it must wrap somewhere."""
+    import microimpact.cli as cli
+
+    path = Path("/opt/a-long-virtual-environment-name/lib/python3.11/site-packages/microimpact/data/README.md")
+    monkeypatch.setattr(cli, "DATA_README", path)
+    assert main(["fit", "--help"]) == 0
+    assert str(path) in [w.rstrip(",") for w in capsys.readouterr().out.split()]

@@ -24,6 +24,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import textwrap
 from pathlib import Path
 
 from microimpact import __version__
@@ -60,8 +61,23 @@ EXIT_BROKEN_PIPE = 141
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
 
 
+class _HelpFormatter(argparse.HelpFormatter):
+    """argparse's help layout, but a line is never broken at a hyphen: a path such as an installed
+    package's ``.../site-packages/microimpact/data/README.md`` stays one word a user can copy, on a line of its own if it is longer than a line."""
+
+    def _split_lines(self, text, width):
+        return textwrap.wrap(self._whitespace_matcher.sub(" ", text).strip(), width, break_on_hyphens=False,
+                             break_long_words=False)
+
+    def _fill_text(self, text, width, indent):
+        return textwrap.fill(self._whitespace_matcher.sub(" ", text).strip(), width, initial_indent=indent,
+                             subsequent_indent=indent, break_on_hyphens=False,
+                             break_long_words=False)
+
+
 class _Parser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", _HelpFormatter)
         super().__init__(*args, **kwargs)
         # the one hook argparse has for this (an attribute of every parser, used by parse_args)
         self._negative_number_matcher = NEGATIVE_NUMBER
