@@ -40,7 +40,8 @@ def time_limit(seconds: float | None, what: str | None = None):
     limit that has passed raises again at short intervals until its block has ended, so a per-case limit
     inside a whole-run budget (``microimpact benchmark --time-budget``), whose caller catches the
     case's TimeLimitExceeded and goes on, does not cancel the budget; a block that ends past its
-    limit raises too.
+    limit raises too, also when it ends in another exception (the code the alarm interrupted turned
+    it into an error of its own, which becomes the ``__cause__``).
 
     Parameters
     ----------
@@ -73,6 +74,14 @@ def time_limit(seconds: float | None, what: str | None = None):
     _arm()
     try:
         yield
+    except TimeLimitExceeded:
+        raise
+    except Exception as exc:
+        if time.perf_counter() >= min(e for e, _ in _active):
+            # the alarm landed in code that turned it into an error of its own (numba's compiler,
+            # interrupted, raises "no compiled object yet for <Library ...>"): the limit ended the block
+            raise TimeLimitExceeded(_expired_message()) from exc
+        raise
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0.0)
         _active.pop()
