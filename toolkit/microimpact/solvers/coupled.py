@@ -682,7 +682,9 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
 
     The loop steps and locates the events within a step; the set-up, the ends of a step at an
     event, the separation, the update of the tangential state and the stop of a captured sphere
-    are compiled helpers.
+    are compiled helpers. The step, its error norm and the event tests stay in the loop because
+    they share the loop's state (z, k1, the branch history) and may end or continue it; the body
+    is under the 100 lines of code tests/test_architecture.py allows.
     """
     z, k1, hist, atol, sref, lim_ref, ecap, h = _start(y0, vt0, vtp0, wt0, wtp0, p, rtol)
     k = np.zeros((7, _N))
