@@ -13,6 +13,7 @@ and by every subprocess a test starts, instead of being compiled in each of them
 """
 
 import os
+import signal
 import warnings
 
 import numpy as np
@@ -31,6 +32,13 @@ ApproxDecimal.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
 # the policy took effect (a pytest that keeps the default elsewhere fails here, not silently)
 if 1e-13 == pytest.approx(0.0):
     raise RuntimeError("tests/conftest.py could not set pytest.approx's default absolute tolerance to 0")
+
+# A suite started as a background job without job control (``nohup``, ``(pytest &)`` in a script)
+# inherits SIGINT ignored, and so does every process it starts: the tests of Ctrl-C would then see
+# nothing happen. The suite restores Python's own handler, as a start from a terminal has it (its
+# subprocesses then start with the default action, which Python turns into KeyboardInterrupt).
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 #: one public call per group of compiled kernels (the groups of tests/study_compile_times.py)
 KERNEL_GROUPS = (
