@@ -352,7 +352,8 @@ def _critical_radius(radius, e_star, work_of_adhesion):
 def jkr_curve_contact_radius(approach, radius, e_star, work_of_adhesion):
     """a(delta; R) on the stable branch of (TN1) (a >= a_c), delta >= -(3/4)(pi^2 w^2 R / E*^2)^(1/3). [m]
 
-    Without adhesion a = sqrt(R max(delta, 0)).
+    Below the break approach it returns a_c (an integrator may probe there before its event);
+    without adhesion a = sqrt(R max(delta, 0)).
 
     References
     ----------
@@ -369,7 +370,9 @@ def jkr_curve_contact_radius(approach, radius, e_star, work_of_adhesion):
     if work_of_adhesion == 0.0:
         return np.sqrt(radius * np.maximum(d, 0.0))
     a_c = _critical_radius(radius, e_star, work_of_adhesion)
-    return a_c * jkr_q_from_approach(d * radius / (a_c * a_c)) ** 2
+    ratio = d * radius / (a_c * a_c)  # delta / L_J; the break (fold) is at -3, where q = 1
+    inside = ratio > -3.0
+    return a_c * np.where(inside, jkr_q_from_approach(np.where(inside, ratio, 0.0)), 1.0) ** 2
 
 
 # =============================================================================== yield, loading (TN2), (TN3), (TN8)
