@@ -722,7 +722,8 @@ def yield_pressure(yield_velocity_: float, stiffness: float, density: float) -> 
 def adhesive_yield_velocity(pc: PlasticContact) -> float:
     """The speed at which the adhesive loading curve reaches yield: (1/2) m V^2 = W_load(delta_y), (TN8). [m/s]
 
-    Equals :func:`yield_velocity` without adhesion.
+    Equals :func:`yield_velocity` without adhesion. It is 0 where W_load(delta_y) <= 0: the contact
+    yields inside the adhesive well, so the adhesion alone pulls every impact past yield.
 
     Examples
     --------
