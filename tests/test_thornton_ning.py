@@ -145,6 +145,19 @@ def test_adhesive_hysteresis_is_the_jkr_cycle_of_the_flattened_contact():
     assert s.pull_off_force == pytest.approx(1.5 * math.pi * pc.work_of_adhesion * s.plastic_radius, rel=1e-9)
 
 
+def test_adhesive_unloading_starts_where_the_loading_ended():
+    # (TN4)-(TN5): the JKR curve with R_p passes through (delta_max, F_max) at the contact radius a_max,
+    # so the force is continuous at the turning point (PyGran's R_p = 4 E* a^3 / (3 F_max) is not)
+    pc = ADHESIVE
+    d_y = tn.yield_point(pc).approach
+    for x in (1.5, 5.0, 40.0):
+        s = tn.unloading_state(pc, x * d_y)
+        assert float(tn.unloading_force(pc, s, s.max_approach)) == pytest.approx(s.max_force, rel=1e-10)
+        a = float(tn.jkr_curve_contact_radius(s.max_approach - s.plastic_approach, s.plastic_radius, pc.e_star,
+                                              pc.work_of_adhesion))
+        assert a == pytest.approx(s.max_contact_radius, rel=1e-10)
+
+
 def test_plasticity_raises_the_capture_velocity():
     # the flattened contact adheres harder (R_p > R) and the plastic work adds to the loss
     pc = tn.PlasticContact.from_contact(TABLE1_ROW2, 4e7)
