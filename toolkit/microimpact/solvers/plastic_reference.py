@@ -91,7 +91,7 @@ def _solve(rhs, y0, events, span):
 
 
 def _first_event(sol):
-    """(index of the event that stopped sol, its state) or (None, last state)."""
+    """(index of the event that stopped sol, its state, its time) or (None, last state, last time)."""
     for i, ys in enumerate(sol.y_events):
         if len(ys):
             return i, ys[0], sol.t_events[i][0]
