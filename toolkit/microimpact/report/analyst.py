@@ -525,13 +525,21 @@ def _flags_with_fit(flags: pd.DataFrame, data: pd.DataFrame | None, fit: xr.Data
     """The flags table with the measured e_n, its uncertainty and the standardized residual of each row:
     the flags file's own columns where it has them, else the data table's and the fit's."""
     out = flags.copy()
-    points = None if fit is None or "row" not in fit else {k: fit[k].values for k in ("row", "residual", "id") if k in fit}
-    fills = {"e_n_measured": (data, "e_n"), "e_n_uncertainty": (data, "e_n_uncertainty"),
-             "standardized_residual": (points, "residual"), "id": (data, "id"),
-             "normal_speed": (data, "normal_speed"), "radius": (data, "radius")}
-    for column, (table, source) in fills.items():
+    points = None if fit is None or "row" not in fit else {
+        k: fit[k].values for k in ("row", "residual", "id", "e_n_measured", "sigma", "normal_speed", "radius") if k in fit}
+    # (column, [(table, its column), ...]): the first source that has it; the data table, then the fit's points
+    fills = {"e_n_measured": [(data, "e_n"), (points, "e_n_measured")],
+             "e_n_uncertainty": [(data, "e_n_uncertainty"), (points, "sigma")],
+             "standardized_residual": [(points, "residual")], "id": [(data, "id"), (points, "id")],
+             "normal_speed": [(data, "normal_speed"), (points, "normal_speed")],
+             "radius": [(data, "radius"), (points, "radius")]}
+    for column, sources in fills.items():
         if column not in out:
-            out[column] = _by_row(out, table, source)
+            out[column] = pd.Series(np.nan, index=out.index, dtype=object if column == "id" else float)
+            for table, source in sources:
+                missing = out[column].isna()
+                if missing.any():
+                    out.loc[missing, column] = _by_row(out, table, source)[missing]
     out["diameter_um"] = 2e6 * pd.to_numeric(out["radius"], errors="coerce")
     # the CSV's id where the file or the table has one, else the row number
     out["id"] = [i if isinstance(i, str) and i else str(int(r)) for i, r in zip(out["id"], out["row"])]

@@ -67,7 +67,7 @@ def _analyst_part(lay: Layout, inputs: Mapping, data: pd.DataFrame | None, synth
         f"Results for the data of {fit.attrs.get('fit_source', 'the analyst')}"
         + (f", the rows of material pair {pair}" if pair else "")
         + (" (SYNTHETIC)" if synthetic else "") + ". The damping coefficients zeta_H, zeta_A (and w_A when it is "
-        "fitted) come from the fit in section 1; every simulation in this part uses them, at the measured sphere "
+        "fitted) come from the damping fit (its verdict first, then the fit itself); every simulation in this part uses them, at the measured sphere "
         "sizes and over the measured speed range.")
     analyst.summary_section(lay, fit, verdict)
     analyst.fit_section(lay, fit, _optional(inputs, "fit_curves", read_dataset), data, synthetic)
