@@ -122,7 +122,10 @@ def _varied(fit: xr.Dataset, name: str) -> bool:
     """Whether the fit varied ``name``: the variable's ``varied`` attribute, else the file's ``varied`` list."""
     if name in fit and "varied" in fit[name].attrs:
         return bool(int(fit[name].attrs["varied"]))
-    return name in str(fit.attrs.get("varied", "")).split()
+    if "varied" in fit.attrs:
+        return name in str(fit.attrs["varied"]).split()
+    # a file that records neither: a fixed parameter has no standard error
+    return f"{name}_stderr" in fit and math.isfinite(float(fit[f"{name}_stderr"]))
 
 
 def _config_values(fit: xr.Dataset) -> list[str]:

@@ -834,14 +834,17 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
 
     def par(name, fmt):
         val = float(fit[name])
+        err = float(fit[f"{name}_stderr"]) if f"{name}_stderr" in fit else math.nan
         st = status_from_variables(fit, name, val)
         if st is not None and not st.determined:  # no number for what the data do not determine
             return {"lower_bound": f">= {st.lower:{fmt}}", "upper_bound": f"<= {st.upper:{fmt}}"}.get(
                 st.status, "not determined") + f" (curve drawn at {val:{fmt}})"
         varied = (bool(int(fit[name].attrs["varied"])) if "varied" in fit[name].attrs
-                  else name in str(fit.attrs.get("varied", "")).split())
-        if not varied:  # read from the file, never guessed from a missing standard error
+                  else name in str(fit.attrs["varied"]).split() if "varied" in fit.attrs else None)
+        if varied is False:  # read from the file, never guessed from a missing standard error
             return f"{val:{fmt}} (fixed, materials config)"
+        if varied is None and not math.isfinite(err):
+            return f"{val:{fmt}} (the file does not record whether it was fitted)"
         if st is not None and math.isfinite(st.lower) and math.isfinite(st.upper):
             return f"{val:{fmt}}, 95 % [{st.lower:{fmt}}, {st.upper:{fmt}}]"
         return f"{val:{fmt}} (fitted)"
