@@ -732,7 +732,7 @@ def plot_bifurcation_plane(ds: xr.Dataset, *, label_points: bool = True) -> Plot
     ok = x < 2.0
     ax.plot(x[ok], line[ok], color="k", lw=1.5)
     ax.set_xscale("log")
-    ax.text(0.03, 0.06, "C < 2: spiral sink", transform=ax.transAxes, ha="left", va="bottom", fontsize=7)
+    ax.text(0.55, 0.3, "C < 2: spiral sink", transform=ax.transAxes, ha="center", va="center", fontsize=7)
     ax.text(0.97, 0.94, "C > 2: sink (no oscillation)", transform=ax.transAxes, ha="right", va="top", fontsize=7)
     handles = []
     if "case" in ds.dims:
@@ -1067,7 +1067,7 @@ def plot_flags(ds: xr.Dataset, *, outliers=()) -> Plot:
     ([1, 0, 0, 0, 0, 0], 1.09)
     >>> plot = plot_flags(flags.assign(e_n_measured=("impact", table["e_n"].to_numpy())))
     >>> plot.caption.split("flags raised (")[1].split(";")[0]
-    '0 R rotation-sensitive, 0 A angle-sensitive, 1 N near capture'
+    '0 R rotation-sensitive, 0 A angle-sensitive, 1 N near capture, 0 S probably spun, 0 U unexplained'
     >>> "measured e_n" in plot.caption
     True
     >>> plot_flags(flags.drop_vars(["e_n_min", "near_capture"]))
