@@ -194,7 +194,7 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
     >>> fit = fit_damping(table, material, confidence_intervals=False).to_dataset()
     >>> pdf = PdfReader(build_report("report.pdf", {"fit": fit, "data_table": table}))
     >>> len(pdf.pages), pdf.metadata.title
-    (5, 'Microsphere contact/impact report')
+    (4, 'Microsphere contact/impact report')
     >>> "1. Verdict" in pdf.pages[1].extract_text(), "2. Damping fit (analogue of Fig. 3)" in pdf.pages[2].extract_text()
     (True, True)
     >>> build_report("report.pdf", {"data_table": table})
