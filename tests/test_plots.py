@@ -116,7 +116,7 @@ def fit_dataset():
             "work_of_adhesion": ((), 0.216, {"units": "J m-2"}),
             "work_of_adhesion_stderr": ((), np.nan, {"units": "J m-2"}),
         },
-        attrs={"redchi": 1.1, "fit_source": "synthetic_impacts.csv"},
+        attrs={"redchi": 1.1, "fit_source": "synthetic_impacts.csv", "varied": "zeta_hertz zeta_adhesion"},
     )
     ds["residual"] = ("point", (ds["e_n_model"].values - ds["e_n_measured"].values) / 0.02, {"units": "1"})
     return ds
@@ -124,7 +124,8 @@ def fit_dataset():
 
 def test_fit(tmp_path):
     p = check(plots.plot_fit(fit_dataset()), tmp_path, "fig3")
-    assert "SYNTHETIC" in p.caption and "(fixed)" in p.caption
+    # w_A was not varied (the file's 'varied' list): the caption says it is the materials config's
+    assert "SYNTHETIC" in p.caption and "w_A = 0.216 (fixed, materials config)" in p.caption
     assert len(p.figure.axes[0].get_legend().get_texts()) == 4  # 2 sizes + data + model
     # the residual panel under the fit (issue 25): every point's (model - measured)/sigma, as in the file
     ds = fit_dataset()

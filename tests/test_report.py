@@ -156,7 +156,7 @@ def test_report_has_both_parts_and_their_sources(results, report_text):
     # every section says which parameters made it: the fit's file and hash in part A, the preset in part B
     assert text[a:b].count(f"Parameters: {analyst_source}") >= 4  # fit, per-size dynamics, sweeps, flags
     assert "Normal contact models compared on the data" in text[a:b] and "Delta AIC" in text[a:b]
-    assert "Measurement flags" in text[a:b] and "Of 12 impacts: 0 R, 0 A, 1 C" in text[a:b]
+    assert "Measurement flags" in text[a:b] and "Of 12 impacts: 0 R, 0 A, 1 N" in text[a:b]  # the CLI letters
     assert text[b:].count(f"Parameters: {PAPER_SOURCE}") >= 3
     assert "Parameters: preset" not in text[a:b]
     assert "SYNTHETIC" in report_text[0] and "Contents" in report_text[0]

@@ -18,13 +18,125 @@ import xarray as xr
 from microimpact.io.statuses import status_from_variables
 from microimpact.report import figures
 from microimpact.report import posterior_figures as pfig
-from microimpact.report.inputs import at_radius, parameter_source, per_radius
+from microimpact.report.inputs import FLAG_LETTERS, Verdict, at_radius, parameter_source, per_radius, read_verdict
 from microimpact.report.layout import Layout
 
-__all__ = ["fit_section", "posterior_section", "oblique_section", "analyst_dynamics_section", "analyst_sweeps_section",
+__all__ = ["summary_section", "fit_section", "posterior_section", "oblique_section", "analyst_dynamics_section", "analyst_sweeps_section",
            "flags_section"]
 
 _PARAMETERS = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
+
+
+# =============================================================================== summary
+#: colour of the verdict line: rejected, not tested, adequate
+_VERDICT_COLOR = {"inadequate": "#b00000", "adequate": "#1a6e1a"}
+
+
+def summary_section(lay: Layout, fit: xr.Dataset, verdict: Verdict | None = None) -> None:
+    """The first page of the analyst's part: the verdict an analyst acts on.
+
+    The adequacy of the model (chi-square, degrees of freedom, p), each fitted value with its one
+    95 % interval or what the data leave undetermined and why, the rows named as outliers by their
+    CSV id, the structure of the misfit, and the values that come from the materials config.
+
+    Examples
+    --------
+    A fit file that records a rejection and two outliers: the page says so, names them, and lists the
+    density as a value of the materials config:
+
+    >>> import xarray as xr
+    >>> from microimpact.report.layout import Layout
+    >>> fit = xr.Dataset({"zeta_hertz": ((), 5.37, {"varied": 1}), "zeta_hertz_stderr": 0.07},
+    ...                  attrs={"verdict": "inadequate", "verdict_text": "The model does not describe these data.",
+    ...                         "chi_square": 535.1, "degrees_of_freedom": 58, "p_value": 2.2e-78,
+    ...                         "outlier_ids": "s-07,s-31", "density": 1350.0, "varied": "zeta_hertz"})
+    >>> lay = Layout("Report")
+    >>> summary_section(lay, fit)
+    >>> text = " ".join(" ".join(t.get_text() for t in p.figure.texts) for p in lay.pages)
+    >>> "Verdict: inadequate (chi-square 535.1 for 58 degrees of freedom, p = 2.2e-78)" in text
+    True
+    >>> "s-07, s-31" in text, "density" in text
+    (True, True)
+    """
+    verdict = verdict or read_verdict(fit)
+    lay.section("Verdict", new_page=False)
+    lay.paragraph(f"Verdict: {verdict.label}", size=11, color=_VERDICT_COLOR.get(verdict.verdict, "#7a5a00"))
+    lay.paragraph(verdict.text or ("The model is rejected by the data." if verdict.rejected else ""))
+    if verdict.misfit_description:
+        lay.paragraph(f"Where the model misses: {verdict.misfit_description}")
+    if verdict.rejected:
+        lay.paragraph("Every result of this part below (capture and critical velocities, sweeps, posterior bands, "
+                      "flags) is computed with the parameters of this rejected fit, and each section says so.",
+                      color=_VERDICT_COLOR["inadequate"])
+    lay.heading("Fitted values (one 95 % interval each)")
+    lay.table(_summary_rows(fit, verdict), {"parameter": 17, "units": 6, "value": 11, "ci95": 30, "from": 52},
+              headers={"ci95": "95 % interval", "from": "how it is known"}, size=7.4)
+    if verdict.interval_note:
+        lay.paragraph(f"Intervals: {verdict.interval_note}")
+    elif verdict.rejected:
+        lay.paragraph("Intervals: conditional on the rejected model; they do not include the misfit.")
+    lay.heading("Outliers")
+    if verdict.outlier_ids:
+        lay.paragraph(f"{len(verdict.outlier_ids)} row(s) named by their CSV id: {', '.join(verdict.outlier_ids)}"
+                      + (f" ({verdict.outlier_threshold_text})." if verdict.outlier_threshold_text else "."))
+    elif "residual" in fit or verdict.recorded:
+        lay.paragraph("No row's residual is improbable given the number of rows"
+                      + (f" ({verdict.outlier_threshold_text})." if verdict.outlier_threshold_text else "."))
+    else:
+        lay.paragraph("Not tested: the fit file holds no residuals.", color="0.4")
+    fixed = _config_values(fit)
+    if fixed:
+        lay.heading("Values from the materials config (not fitted)")
+        lay.paragraph("; ".join(fixed) + ".")
+
+
+def _summary_rows(fit: xr.Dataset, verdict: Verdict) -> pd.DataFrame:
+    """One row per fit parameter: the value and its one 95 % interval, the bound, or 'not determined'
+    with the data's reason, or the materials config for a parameter that was not varied."""
+    rows = []
+    conditional = " (conditional on the rejected model)" if verdict.rejected else ""
+    for name in _fit_parameters(fit):
+        units = fit[name].attrs.get("units", "")
+        v = float(fit[name])
+        if not _varied(fit, name):
+            rows.append({"parameter": name, "units": units, "value": f"{v:.4g}", "ci95": "-",
+                         "from": "materials config (not fitted)"})
+            continue
+        st = status_from_variables(fit, name, v)
+        if st is not None and not st.determined:
+            value = {"lower_bound": f">= {st.lower:.4g}", "upper_bound": f"<= {st.upper:.4g}"}.get(st.status, "-")
+            rows.append({"parameter": name, "units": units, "value": value, "ci95": "-",
+                         "from": f"not determined by these data: {st.reason or st.status}"})
+            continue
+        if st is not None:
+            lo, hi, how = st.lower, st.upper, "fitted; profile likelihood"
+        else:
+            se = float(fit[f"{name}_stderr"]) if f"{name}_stderr" in fit else math.nan
+            lo, hi, how = v - 1.96 * se, v + 1.96 * se, "fitted; covariance, value +/- 1.96 std. error"
+        ci = f"[{lo:.5g}, {hi:.5g}]" if math.isfinite(lo) and math.isfinite(hi) else "not computed"
+        rows.append({"parameter": name, "units": units, "value": f"{v:.5g}", "ci95": ci, "from": how + conditional})
+    return pd.DataFrame(rows, columns=["parameter", "units", "value", "ci95", "from"])
+
+
+def _varied(fit: xr.Dataset, name: str) -> bool:
+    """Whether the fit varied ``name``: the variable's ``varied`` attribute, else the file's ``varied`` list."""
+    if name in fit and "varied" in fit[name].attrs:
+        return bool(int(fit[name].attrs["varied"]))
+    if "varied" in fit.attrs:
+        return name in str(fit.attrs["varied"]).split()
+    # a file that records neither: a fixed parameter has no standard error
+    return f"{name}_stderr" in fit and math.isfinite(float(fit[f"{name}_stderr"]))
+
+
+def _config_values(fit: xr.Dataset) -> list[str]:
+    """The material values the fit took from the materials config, as 'name = value units'."""
+    a = fit.attrs
+    out = [f"{label} = {float(a[key]):.4g} {units}".rstrip() for key, label, units in
+           (("density", "density", "kg/m^3"), ("stiffness", "contact stiffness K", "Pa"),
+            ("friction", "friction f", "")) if key in a]
+    if a.get("damping_reference_speed"):
+        out.append(f"damping reference speed: {a['damping_reference_speed']}")
+    return out
 
 
 # =============================================================================== fit
@@ -98,7 +210,7 @@ def _parameter_rows(fit: xr.Dataset) -> pd.DataFrame:
     for name in _fit_parameters(fit):
         units = fit[name].attrs.get("units", "")
         v, se = float(fit[name]), float(fit[f"{name}_stderr"])
-        if not bool(int(fit[name].attrs.get("varied", 1))):
+        if not _varied(fit, name):
             rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": "fixed", "ci95": "",
                          "method": "fixed (materials config)"})
             continue
@@ -126,11 +238,20 @@ def _fit_statistics(fit: xr.Dataset) -> str:
         varied = str(a.get("varied", "")).split()
         pairs = [f"{p}/{q} {float(corr.sel(parameter=p, parameter_b=q)):+.3f}"
                  for i, p in enumerate(names) for q in names[i + 1:] if p in varied and q in varied]
+    pairs = [p for p in pairs if "nan" not in p]  # a correlation lmfit did not estimate is left out, not printed as nan
     num = lambda key: float(a.get(key, math.nan))  # noqa: E731
     return (f"{int(a.get('n_points', 0))} points; chi-square {num('chisqr'):.4g}, reduced chi-square "
             f"{num('redchi'):.4g}; AIC {num('aic'):.4g}, BIC {num('bic'):.4g}; correlations: {', '.join(pairs) or 'n/a'}. "
             f"Material: density {num('density'):g} kg/m^3, K = {num('stiffness'):.4g} Pa, damping reference speed: "
-            f"{a.get('damping_reference_speed', '?')}. {a.get('fit_ci_message', '')}")
+            f"{a.get('damping_reference_speed', '?')}."
+            # the message of lmfit's intervals contradicts the profile intervals printed above it
+            + ("" if any(f"{n}_status" in fit for n in _fit_parameters(fit)) else f" {a.get('fit_ci_message', '')}"))
+
+
+def _rejected(lay: Layout, note: str) -> None:
+    """The line of a section whose results come from a rejected model ("" writes nothing)."""
+    if note:
+        lay.paragraph(note, color=_VERDICT_COLOR["inadequate"])
 
 
 def _data_by_size(t: pd.DataFrame) -> pd.DataFrame:
@@ -145,7 +266,7 @@ def _data_by_size(t: pd.DataFrame) -> pd.DataFrame:
 
 
 # =============================================================================== posterior
-def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset) -> None:
+def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset, note: str = "") -> None:
     """The posterior: summary table, e_n bands, corner plot, capture velocity interval, sweep bands.
 
     Examples
@@ -176,6 +297,7 @@ def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset) -> None:
     '(No posterior: posterior not computed.)'
     """
     lay.section("Posterior of the fitted parameters", new_page=False)
+    _rejected(lay, note)
     if "sampled" not in post.attrs:
         lay.paragraph(f"(No posterior: {post.attrs.get('comment', 'not computed')}.)", color="0.4")
         return
@@ -227,7 +349,7 @@ def _posterior_rows(post: xr.Dataset) -> pd.DataFrame:
 
 
 # =============================================================================== oblique
-def oblique_section(lay: Layout, obl: xr.Dataset) -> None:
+def oblique_section(lay: Layout, obl: xr.Dataset, note: str = "") -> None:
     """The friction fit from the oblique columns: measured against fitted per angle.
 
     Examples
@@ -262,6 +384,7 @@ def oblique_section(lay: Layout, obl: xr.Dataset) -> None:
         lay.paragraph(f"Friction: {obl.attrs.get('comment', 'no friction fit')}.", color="0.4")
         return
     lay.section("Friction from the oblique columns", new_page=False)
+    _rejected(lay, note)
     lay.paragraph(
         f"Coulomb friction f fitted to the measured {', '.join(dict.fromkeys(str(q) for q in obl['quantity'].values))} "
         "with the paper's rigid tangential model (Eqs. (16)-(20)), AFTER the damping fit: the normal motion does not "
@@ -283,7 +406,7 @@ def _friction_statement(obl: xr.Dataset) -> str:
 
 
 # =============================================================================== dynamics per size
-def analyst_dynamics_section(lay: Layout, dyn: xr.Dataset) -> None:
+def analyst_dynamics_section(lay: Layout, dyn: xr.Dataset, note: str = "") -> None:
     """Capture and critical velocity and the fitted contact of each measured sphere size.
 
     Examples
@@ -302,10 +425,12 @@ def analyst_dynamics_section(lay: Layout, dyn: xr.Dataset) -> None:
     [('1. Capture and critical velocity of the measured sizes', 0)]
     """
     lay.section("Capture and critical velocity of the measured sizes", new_page=False)
+    _rejected(lay, note)
     lay.paragraph(
-        "For each measured sphere radius, the contact built from the fitted zeta_H, zeta_A and w_A (f0 from "
-        "Eq. (7)): the normal capture velocity (largest captured normal speed, by bisection) and the critical "
-        "velocity v_c of Eq. (38), at which the total damping C = C1 + C2 equals 2.")
+        "For each measured sphere size (diameter d), the contact built from the fitted zeta_H, zeta_A and w_A (f0 "
+        "from Eq. (7)): the normal capture velocity v_capture (largest captured normal speed, by bisection) and the "
+        "critical velocity v_c of Eq. (38), at which the total damping C = C1 + C2 equals 2 (a property of the "
+        "settling motion, not a speed below which spheres stick).")
     lay.source(parameter_source(dyn))
     t = pd.DataFrame({
         "d": 2e6 * dyn["radius"].values,
@@ -321,7 +446,7 @@ def analyst_dynamics_section(lay: Layout, dyn: xr.Dataset) -> None:
 
 
 # =============================================================================== sweeps at the measured sizes
-def analyst_sweeps_section(lay: Layout, sweeps: list[xr.Dataset], dyn: xr.Dataset | None) -> None:
+def analyst_sweeps_section(lay: Layout, sweeps: list[xr.Dataset], dyn: xr.Dataset | None, note: str = "") -> None:
     """The Table 2 cases with the fitted contact: all sizes in one figure, each case at the median size.
 
     Examples
@@ -349,6 +474,7 @@ def analyst_sweeps_section(lay: Layout, sweeps: list[xr.Dataset], dyn: xr.Datase
     radii = sweeps[0]["radius"].values
     k = len(radii) // 2
     lay.section("Sensitivity sweeps of the measured material (Table 2 cases)", new_page=False)
+    _rejected(lay, note)
     lay.paragraph(
         "The initial conditions of the paper's Table 2 cases, simulated with the fitted contact of each measured "
         "sphere size, over the measured speed range. The first figure compares the sizes; the figures of each "
@@ -366,12 +492,73 @@ def analyst_sweeps_section(lay: Layout, sweeps: list[xr.Dataset], dyn: xr.Datase
 
 
 # =============================================================================== flags
-def flags_section(lay: Layout, flags: pd.DataFrame, data: pd.DataFrame | None) -> None:
-    """Which measured impacts are sensitive to unmeasured spin, to the angle error, or near capture.
+#: flag column -> what its letter (FLAG_LETTERS, the letters of ``microimpact flags``) means
+_FLAG_MEANING = {
+    "rotation_sensitive": "rotation-sensitive (an unmeasured spin moves a measured quantity by more than its "
+                          "uncertainty, or changes the outcome)",
+    "angle_sensitive": "angle-sensitive (the incidence-angle error moves a measured quantity by more than its "
+                       "uncertainty, or changes the outcome)",
+    "near_capture": "near capture (normal speed below 1.5 x the capture velocity, where e_n is steep)",
+    "probably_spun": "probably spun (zero spin lies outside the spin range consistent with the measurement)",
+    "spin_unexplained": "unexplained (no spin and no angle error within the scan explains the row)",
+}
+
+
+def _letters(row) -> str:
+    return "".join(letter for name, letter in FLAG_LETTERS.items() if name in row and _raised(row[name])) or "-"
+
+
+def _raised(x) -> bool:
+    try:
+        return bool(int(float(x)))
+    except (TypeError, ValueError):
+        return False
+
+
+def _by_row(flags: pd.DataFrame, table, column: str) -> pd.Series:
+    """``column`` of ``table`` (the data table or the fit's points, keyed by ``row``) for each flags row."""
+    if table is None or "row" not in table or column not in table:
+        return pd.Series(np.nan, index=flags.index)
+    values = pd.Series(np.asarray(table[column]), index=np.asarray(table["row"]).astype(int))
+    values = values[~values.index.duplicated()]
+    return flags["row"].astype(int).map(values)
+
+
+def _flags_with_fit(flags: pd.DataFrame, data: pd.DataFrame | None, fit: xr.Dataset | None) -> pd.DataFrame:
+    """The flags table with the measured e_n, its uncertainty and the standardized residual of each row:
+    the flags file's own columns where it has them, else the data table's and the fit's."""
+    out = flags.copy()
+    points = None if fit is None or "row" not in fit else {
+        k: fit[k].values for k in ("row", "residual", "id", "e_n_measured", "sigma", "normal_speed", "radius") if k in fit}
+    # (column, [(table, its column), ...]): the first source that has it; the data table, then the fit's points
+    fills = {"e_n_measured": [(data, "e_n"), (points, "e_n_measured")],
+             "e_n_uncertainty": [(data, "e_n_uncertainty"), (points, "sigma")],
+             "standardized_residual": [(points, "residual")], "id": [(data, "id"), (points, "id")],
+             "normal_speed": [(data, "normal_speed"), (points, "normal_speed")],
+             "radius": [(data, "radius"), (points, "radius")]}
+    for column, sources in fills.items():
+        if column not in out:
+            out[column] = pd.Series(np.nan, index=out.index, dtype=object if column == "id" else float)
+            for table, source in sources:
+                missing = out[column].isna()
+                if missing.any():
+                    out.loc[missing, column] = _by_row(out, table, source)[missing]
+    out["diameter_um"] = 2e6 * pd.to_numeric(out["radius"], errors="coerce")
+    # the CSV's id where the file or the table has one, else the row number
+    out["id"] = [i if isinstance(i, str) and i else str(int(r)) for i, r in zip(out["id"], out["row"])]
+    return out
+
+
+def flags_section(lay: Layout, flags: pd.DataFrame, data: pd.DataFrame | None, *, fit: xr.Dataset | None = None,
+                  verdict: Verdict | None = None, path=None) -> None:
+    """The measurement flags: a figure of every row (measured and model e_n) and a table of the flagged rows only.
+
+    The flag letters are those of ``microimpact flags`` (:data:`~microimpact.report.inputs.FLAG_LETTERS`);
+    the full table (every row, every column) stays in the flags CSV, whose path the section names.
 
     Examples
     --------
-    An empty flags table says so:
+    An empty flags table says so; a table of two rows, one near capture, lists that row alone, by its id:
 
     >>> import pandas as pd
     >>> from microimpact.report.layout import Layout
@@ -379,92 +566,117 @@ def flags_section(lay: Layout, flags: pd.DataFrame, data: pd.DataFrame | None) -
     >>> flags_section(lay, pd.DataFrame(), None)
     >>> lay.page.figure.texts[-1].get_text()
     'No impacts in the flags table.'
+    >>> flags = pd.DataFrame({"row": [1, 2], "id": ["a-1", "a-2"], "e_n": [0.2, 0.6], "e_n_min": [0.1, 0.6],
+    ...                       "e_n_max": [0.3, 0.6], "capture_speed_ratio": [1.1, 5.0], "rotation_sensitive": 0,
+    ...                       "angle_sensitive": 0, "near_capture": [1, 0]})
+    >>> lay = Layout("Report")
+    >>> flags_section(lay, flags, None, path="results/analyst/x/flags.csv")
+    >>> table = next(t.get_text() for t in lay.page.figure.texts if t.get_text().startswith("id"))
+    >>> [line.split()[0] for line in table.splitlines() if line.startswith("a-")]
+    ['a-1']
     """
     lay.section("Measurement flags")
     if flags.empty:
         lay.paragraph("No impacts in the flags table.")
         return
-    count = {k: int(flags[k].sum()) if k in flags else 0 for k in ("rotation_sensitive", "angle_sensitive", "near_capture")}
+    verdict = verdict or (read_verdict(fit) if fit is not None else None)
+    outliers = set(verdict.outlier_ids) if verdict is not None else set()
+    t = _flags_with_fit(flags, data, fit)
+    kinds = [name for name in FLAG_LETTERS if name in t]
+    counts = ", ".join(f"{int(t[k].map(_raised).sum())} {FLAG_LETTERS[k]}" for k in kinds)
+    where = str(path) if path is not None else "the flags CSV of this material pair"
     lay.paragraph(
         "Each measured impact simulated under the fitted model with plausible unmeasured initial spin (up to the "
         "rolling spin v/r, 3-D directions) and with the incidence angle moved by its uncertainty "
-        "(microimpact.analysis.flags.flag_measurements). Flags: R = rotation-sensitive (an unmeasured spin changes "
-        "mu or K_L by more than the threshold), A = angle-sensitive (the angle error changes e_n, mu or the "
-        "outcome), C = near capture (normal speed below 1.5 x the capture velocity, where e_n is steep). "
-        f"Of {len(flags)} impacts: {count['rotation_sensitive']} R, {count['angle_sensitive']} A, "
-        f"{count['near_capture']} C. Spreads are max - min over the samples; all columns are in results/flags.csv.")
-    if "parameter_source" in flags:
-        lay.source("; ".join(dict.fromkeys(str(s) for s in flags["parameter_source"])))
+        "(microimpact.analysis.flags.flag_measurements). Flags, the letters of 'microimpact flags': "
+        + "; ".join(f"{FLAG_LETTERS[k]} = {_FLAG_MEANING[k]}" for k in kinds)
+        + f". Of {len(t)} impacts: {counts}"
+        + (f"; outliers of the fit (by id): {', '.join(sorted(outliers))}" if outliers else "")
+        + f". The table lists the flagged rows only; every row and column is in {where}.")
+    if verdict is not None:
+        _rejected(lay, verdict.rejected_note("the model e_n and the flags"))
+    if "parameter_source" in t:
+        lay.source("; ".join(dict.fromkeys(str(s) for s in t["parameter_source"])))
     else:
-        lay.source("the fit (the flags are computed from results/fit.nc)")
-    lay.table(_flags_table(flags, data), {"row": 5, "d": 9, "v_n": 9, "alpha": 9, "e_meas": 9, "e_n": 9, "ratio": 9,
-                                          "mu_spin": 9, "KL_spin": 9, "e_angle": 9, "mu_angle": 9, "flags": 5},
-              headers={"d": "d [um]", "v_n": "v_n [m/s]", "alpha": "alpha [deg]", "e_meas": "e_n meas.",
-                       "e_n": "e_n model", "ratio": "v_n/v_cap", "mu_spin": "d mu spin", "KL_spin": "d K_L spin",
-                       "e_angle": "d e_n angle", "mu_angle": "d mu angle"}, size=7.0)
-    if "spin_low" in flags:
-        _spin_ranges(lay, flags)
+        lay.source("the fit of this part (the flags are computed from its fit file)")
+    if all(k in t for k in ("e_n", "e_n_min", "e_n_max", "capture_speed_ratio")):
+        ds = xr.Dataset({k: ("impact", t[k].to_numpy()) for k in
+                         ("e_n", "e_n_min", "e_n_max", "capture_speed_ratio", "e_n_measured", "e_n_uncertainty",
+                          *kinds)})
+        ds["id"] = ("impact", t["id"].astype(str).to_numpy())
+        lay.plot(figures.plot_flags(ds, outliers=sorted(outliers)), max_height=3.4)
+    _flagged_rows(lay, t, outliers)
+    if "spin_low" in t:
+        _spin_ranges(lay, t)
+
+
+def _flagged_rows(lay: Layout, t: pd.DataFrame, outliers: set) -> None:
+    """The table of the rows with a flag raised or named as outliers: id, measured, model, standardized residual."""
+    letters = [_letters(r) for _, r in t.iterrows()]
+    show = [i for i, (letter, name) in enumerate(zip(letters, t["id"])) if letter != "-" or name in outliers]
+    if not show:
+        lay.paragraph("No row is flagged and none is an outlier of the fit.", color="0.4")
+        return
+
+    def fmt(x, spec=".3g"):
+        return "" if not np.isfinite(float(x)) else format(float(x), spec)
+
+    sub = t.iloc[show]
+    table = pd.DataFrame({
+        "id": sub["id"].astype(str),
+        "d": [fmt(x) for x in _by_row_or(sub, "diameter_um")],
+        "v_n": [fmt(x) for x in _by_row_or(sub, "normal_speed")],
+        "meas": [fmt(x, ".4f") for x in sub["e_n_measured"]],
+        "model": [fmt(x, ".4f") for x in sub["e_n"]],
+        "z": [fmt(x, "+.2f") for x in sub["standardized_residual"]],
+        "ratio": [fmt(x) for x in sub["capture_speed_ratio"]] if "capture_speed_ratio" in sub else "",
+        "flags": [letters[i] for i in show],
+        "outlier": ["yes" if name in outliers else "" for name in sub["id"]],
+    })
+    lay.heading(f"Flagged rows ({len(show)} of {len(t)})")
+    lay.table(table, {"id": 18, "d": 8, "v_n": 9, "meas": 10, "model": 10, "z": 10, "ratio": 9, "flags": 6,
+                      "outlier": 7},
+              headers={"d": "d [um]", "v_n": "v_n [m/s]", "meas": "e_n measured", "model": "e_n model",
+                       "z": "(model - meas.) / sigma", "ratio": "v_n / v_capture"}, size=7.2)
+
+
+def _by_row_or(t: pd.DataFrame, column: str) -> pd.Series:
+    """A per-row quantity of the flags table, NaN where it is not there."""
+    return t[column] if column in t else pd.Series(np.nan, index=t.index)
 
 
 def _spin_ranges(lay: Layout, flags: pd.DataFrame) -> None:
-    """Per-row spin consistent with the measurement (the inverse problem) and the flags that explain."""
+    """Per-row spin consistent with the measurement (the inverse problem), for the rows flagged S or U."""
     lay.heading("Which rows were probably spun, and by how much")
-    n = {k: int(flags[k].sum()) for k in ("spin_moves_prediction", "angle_moves_prediction", "probably_spun",
-                                          "spin_unexplained") if k in flags}
+    n = {k: int(flags[k].map(_raised).sum()) for k in ("spin_moves_prediction", "angle_moves_prediction",
+                                                      "probably_spun", "spin_unexplained") if k in flags}
     oblique = flags["predicted_quantity"].astype(str) != "e_n"
+    draws = flags["explanation_draws"].iloc[0] if "explanation_draws" in flags else "posterior draws or the point estimate"
     lay.paragraph(
         "For each row, the prediction of the quantity it measured (its oblique column, else e_n) under the "
-        f"posterior ({flags.get('explanation_draws', pd.Series(['posterior draws'])).iloc[0] if 'explanation_draws' in flags else 'posterior draws or the point estimate'}): "
-        "S = an unmeasured top-/back-spin up to the rolling spin v/r moves it by more than the measurement "
-        "uncertainty in at least half the draws, A = the angle error does; the spin range is the incident top-spin "
-        "(back-spin negative) [rad/s] whose prediction lies within 2 sigma of the measurement (measurement, speed "
-        "and angle errors and posterior spread). P = zero spin is outside that range (probably spun), U = no spin "
-        f"explains the row. Of {len(flags)} rows: {n.get('spin_moves_prediction', 0)} S, "
-        f"{n.get('angle_moves_prediction', 0)} A, {n.get('probably_spun', 0)} P, {n.get('spin_unexplained', 0)} U; "
-        f"{int(oblique.sum())} rows have an oblique measurement. e_n does not depend on spin (the normal motion "
-        "decouples), so a row that measured only e_n admits every spin scanned.")
-    show = flags[oblique | (flags["probably_spun"] == 1) | (flags["spin_unexplained"] == 1)]
+        f"posterior ({draws}); the spin range is the incident top-spin (back-spin negative) [rad/s] whose prediction "
+        "lies within 2 sigma of the measurement (measurement, speed and angle errors and posterior spread). "
+        f"{FLAG_LETTERS['probably_spun']} = zero spin is outside that range, {FLAG_LETTERS['spin_unexplained']} = no "
+        f"spin explains the row. Of {len(flags)} rows: an unmeasured spin moves the prediction by more than the "
+        f"measurement uncertainty in {n.get('spin_moves_prediction', 0)}, the angle error in "
+        f"{n.get('angle_moves_prediction', 0)}; {n.get('probably_spun', 0)} {FLAG_LETTERS['probably_spun']}, "
+        f"{n.get('spin_unexplained', 0)} {FLAG_LETTERS['spin_unexplained']}; {int(oblique.sum())} rows have an "
+        "oblique measurement. e_n does not depend on spin (the normal motion decouples), so a row that measured "
+        "only e_n admits every spin scanned.")
+    show = flags[flags["probably_spun"].map(_raised) | flags["spin_unexplained"].map(_raised)]
     if show.empty:
-        lay.paragraph("No row constrains the spin (no oblique measurements) and none is unexplained.", color="0.4")
+        lay.paragraph(f"No row is flagged {FLAG_LETTERS['probably_spun']} or {FLAG_LETTERS['spin_unexplained']}.",
+                      color="0.4")
         return
 
     def fmt(x):
         return "" if not np.isfinite(x) else f"{x:.3g}"
 
     t = pd.DataFrame({
-        "row": show["row"].astype(int).astype(str), "quantity": show["predicted_quantity"].astype(str),
+        "id": show["id"].astype(str), "quantity": show["predicted_quantity"].astype(str),
         "low": show["spin_low"].map(fmt), "high": show["spin_high"].map(fmt),
         "s_spin": show["spin_shift"].map(lambda x: f"{x:.2g}"), "s_angle": show["angle_shift"].map(lambda x: f"{x:.2g}"),
-        "flags": ["".join(c for c, k in (("S", "spin_moves_prediction"), ("A", "angle_moves_prediction"),
-                                         ("P", "probably_spun"), ("U", "spin_unexplained")) if int(r[k])) or "-"
-                  for _, r in show.iterrows()]})
-    lay.table(t, {"row": 5, "quantity": 24, "low": 12, "high": 12, "s_spin": 10, "s_angle": 10, "flags": 6},
+        "flags": [_letters(r) for _, r in show.iterrows()]})
+    lay.table(t, {"id": 18, "quantity": 24, "low": 12, "high": 12, "s_spin": 10, "s_angle": 10, "flags": 6},
               headers={"low": "spin low [rad/s]", "high": "spin high [rad/s]", "s_spin": "spin shift [sigma]",
                        "s_angle": "angle shift [sigma]"}, size=7.0)
-
-
-def _flags_table(flags: pd.DataFrame, data: pd.DataFrame | None) -> pd.DataFrame:
-    def spread(q, over):
-        lo, hi = f"{q}_min_{over}", f"{q}_max_{over}"
-        return (flags[hi] - flags[lo]) if lo in flags and hi in flags else pd.Series(np.nan, index=flags.index)
-
-    def fmt(series, spec=".3g"):
-        return series.map(lambda x: "" if not np.isfinite(x) else format(x, spec))
-
-    t = pd.DataFrame({"row": flags["row"]})
-    if data is not None and "row" in data:
-        d = data.set_index("row")
-        t["d"] = fmt(flags["row"].map(2e6 * d["radius"]))
-        t["v_n"] = fmt(flags["row"].map(d["normal_speed"]))
-        t["alpha"] = fmt(flags["row"].map(d["incidence_deg"]))
-        t["e_meas"] = fmt(flags["row"].map(d["e_n"]), ".3f")
-    nan = pd.Series(np.nan, index=flags.index)
-    t["e_n"] = fmt(flags.get("e_n", nan))
-    t["ratio"] = fmt(flags.get("capture_speed_ratio", nan))
-    t["mu_spin"] = fmt(np.fmax(spread("mu_t", "spin"), spread("mu_tp", "spin")))
-    t["KL_spin"] = fmt(spread("K_L", "spin"))
-    t["e_angle"] = fmt(spread("e_n", "angle"))
-    t["mu_angle"] = fmt(np.fmax(spread("mu_t", "angle"), spread("mu_tp", "angle")))
-    t["flags"] = ["".join(c for c, k in (("R", "rotation_sensitive"), ("A", "angle_sensitive"), ("C", "near_capture"))
-                          if k in flags and int(r[k])) or "-" for _, r in flags.iterrows()]
-    return t

@@ -34,13 +34,13 @@ import matplotlib.ticker
 import numpy as np
 import xarray as xr
 from matplotlib import colormaps
-from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import NullFormatter
 
 from microimpact.io.statuses import status_from_variables
+from microimpact.report.inputs import FLAG_LETTERS, read_verdict
 
 __all__ = [
     "Plot",
@@ -224,7 +224,7 @@ def _fixed_text(ds: xr.Dataset, hue: str | None) -> str:
 
 
 def _capture_speeds(ds: xr.Dataset, curves) -> list[float]:
-    """Incident speed below which each curve is captured: v_c / cos(alpha) from ``capture_normal_speed``
+    """Incident speed below which each curve is captured: v_capture / cos(alpha) from ``capture_normal_speed``
     if present, else the midpoint between the last captured and first rebounding grid speed."""
     out = []
     for _, _, c in curves:
@@ -312,9 +312,10 @@ def _caption_capture(ds: xr.Dataset, v_caps) -> str:
     if not finite:
         return "No impact in the sweep is captured. "
     if "capture_normal_speed" in ds:
-        txt = f"Grey: captured (normal capture speed v_c = {float(ds['capture_normal_speed']):.4g} m/s, dashed line"
+        txt = (f"Grey: captured (normal capture velocity v_capture = {float(ds['capture_normal_speed']):.4g} m/s, "
+               "dashed line")
         if len(finite) > 1:
-            txt += f"; light grey and triangles: v_c / cos(alpha) = {finite[0]:.3g}-{finite[-1]:.3g} m/s per curve"
+            txt += f"; light grey and triangles: v_capture / cos(alpha) = {finite[0]:.3g}-{finite[-1]:.3g} m/s per curve"
         return txt + "). "
     return f"Grey: captured (capture speed estimated from the grid: {finite[0]:.3g} m/s). "
 
@@ -577,7 +578,7 @@ def plot_size_dependence(sweep: xr.Dataset, dynamics: xr.Dataset | None = None) 
     fixed = ", ".join(f"{d} = {float(ds[d]):g}" for d in sweep["e_n"].dims if d not in ("radius", "speed"))
     lines = []
     if dynamics is not None:
-        lines = [(dynamics[k], label, m) for k, label, m in (("capture_velocity", "capture velocity", "o"),
+        lines = [(dynamics[k], label, m) for k, label, m in (("capture_velocity", "capture $v_{capture}$", "o"),
                                                              ("critical_velocity", "critical $v_c$, Eq. (38)", "s"))
                  if k in dynamics]
     elif "capture_normal_speed" in sweep and "radius" in sweep["capture_normal_speed"].dims:
@@ -609,7 +610,7 @@ def plot_size_dependence(sweep: xr.Dataset, dynamics: xr.Dataset | None = None) 
         "The measured material at each measured sphere size, with the contact fitted to the data. "
         f"(a) Normal restitution e_n against the incident speed v [m/s]{f' (Table 2 case {case}' if case else ' ('}"
         f"{', ' + fixed if fixed else ''}), one curve per diameter; dotted: captured (e_n = 0). "
-        "(b) Normal capture velocity [m/s] (below it the sphere adheres)"
+        "(b) Normal capture velocity v_capture [m/s] (below it the sphere adheres)"
         + (" and critical velocity v_c of Eq. (38) (C = 2)" if dynamics is not None and "critical_velocity" in dynamics
            else "") + " against the diameter [um]."
         + ("" if lines else " No capture velocity to draw: every impact rebounds." if dynamics is not None
@@ -649,7 +650,7 @@ def plot_phase_portraits(portraits) -> Plot:
     if not portraits:
         raise ValueError("plot_phase_portraits: no portraits given")
     n = len(portraits)
-    fig = _figure(min(WIDTH, 2.45 * n + 0.3), 2.6)
+    fig = _figure(min(WIDTH, 2.45 * n + 0.3), 2.9)
     axes = np.atleast_1d(fig.subplots(1, n))
     parts = []
     for k, (ax, p) in enumerate(zip(axes, portraits)):
@@ -681,7 +682,8 @@ def plot_phase_portraits(portraits) -> Plot:
         if freq is not None and float(freq) > 0 and p.attrs.get("outcome") == "capture":
             txt += f", asymptotic angular frequency {float(freq):.3g} rad/s"
         parts.append(txt)
-    axes[0].legend(loc="upper left", frameon=False, fontsize=7)
+    handles, texts = axes[0].get_legend_handles_labels()  # below the panels: inside, it covered the trajectory
+    fig.legend(handles, texts, loc="outside lower center", ncol=len(texts), frameon=False, fontsize=7)
     caption = (
         "Phase portraits of normal impacts (analogue of Fig. 5): normal velocity dn/dt against normal "
         "displacement n = -x of the sphere centre (n < 0 in contact), from first contact until the "
@@ -711,20 +713,27 @@ def plot_bifurcation_plane(ds: xr.Dataset, *, label_points: bool = True) -> Plot
     >>> plot.caption.startswith("Bifurcation on the (C1, C2) parameter plane (analogue of Fig. 4)")
     True
     """
-    c1 = ds["C1"].values
-    c2 = ds["C2"].values
-    fig = _figure(WIDTH * 0.72, 3.5)
+    c1 = np.asarray(ds["C1"].values, float)
+    c2 = np.asarray(ds["C2"].values, float)
+    fig = _figure(WIDTH * 0.8, 3.5)
     ax = fig.subplots()
-    # colour by C < 2 / C > 2 (the exact line is drawn on top; the 'critical' cells of ``region``
-    # would show as a staircase)
-    cc = ds["total_damping"].transpose("C2", "C1").values if "total_damping" in ds else c1[None, :] + c2[:, None]
-    ax.pcolormesh(c1, c2, (cc > 2.0).astype(int), cmap=ListedColormap(["#dbe9f6", "#fbe3c9"]), vmin=-0.5,
-                  vmax=1.5, shading="nearest", rasterized=True)
-    line = ds["critical_line_C2"].values if "critical_line_C2" in ds else 2.0 - c1
-    ok = line >= min(c2)
-    ax.plot(c1[ok], line[ok], color="k", lw=1.5, label="C = C1 + C2 = 2")
-    ax.text(0.85, 0.42, "C < 2\nspiral sink", ha="center", va="center", fontsize=7)
-    ax.text(0.72, 0.72, "C > 2: sink\n(no oscillation)", transform=ax.transAxes, ha="center", fontsize=8)
+    # C1 on a log axis: the paper's points sit at C1 ~ 1e-3 - 1e-1, which a linear axis to C1 = 6
+    # piles against C1 = 0. The regions follow from C = C1 + C2 alone, drawn on either side of the
+    # exact line C2 = 2 - C1 (the grid's cells would show as a staircase)
+    pts = np.asarray(ds["case_C1"].values, float) if "case_C1" in ds else np.array([])
+    positive = np.concatenate([c1[c1 > 0], pts[pts > 0]])
+    lo = 10.0 ** math.floor(math.log10(positive.min() / 2.0)) if positive.size else 1e-3
+    hi = max(float(c1.max()), 2.5)
+    x = np.geomspace(lo, hi, 400)
+    top = max(float(c2.max()), 2.5)
+    line = np.clip(2.0 - x, 0.0, top)
+    ax.fill_between(x, 0.0, line, color="#dbe9f6", lw=0, zorder=0)
+    ax.fill_between(x, line, top, color="#fbe3c9", lw=0, zorder=0)
+    ok = x < 2.0
+    ax.plot(x[ok], line[ok], color="k", lw=1.5)
+    ax.set_xscale("log")
+    ax.text(0.55, 0.3, "C < 2: spiral sink", transform=ax.transAxes, ha="center", va="center", fontsize=7)
+    ax.text(0.97, 0.94, "C > 2: sink (no oscillation)", transform=ax.transAxes, ha="right", va="top", fontsize=7)
     handles = []
     if "case" in ds.dims:
         speeds = ds["case_speed"].values if "case_speed" in ds else np.full(ds.sizes["case"], np.nan)
@@ -746,15 +755,15 @@ def plot_bifurcation_plane(ds: xr.Dataset, *, label_points: bool = True) -> Plot
                                   label=f"v_n = {_fmt_value(v)} m/s"))
     ax.set_xlabel(r"$C_1 = C_H X/T$, Eq. (31) [-]")
     ax.set_ylabel(r"$C_2 = C_A X/T$, Eq. (32) [-]")
-    pad1, pad2 = 0.02 * np.ptp(c1), 0.02 * np.ptp(c2)  # points sit near C1 = 0: keep them off the spine
-    ax.set_xlim(c1.min() - pad1, c1.max())
-    ax.set_ylim(c2.min() - pad2, c2.max())
+    ax.set_xlim(lo, hi)
+    ax.set_ylim(0.0, top)
     ax.grid(False)
     ax.legend(handles=[Line2D([], [], color="k", lw=1.5, label="C = 2")] + handles, loc="upper left",
               bbox_to_anchor=(1.02, 1.0), frameon=False, fontsize=7)
     caption = (
         "Bifurcation on the (C1, C2) parameter plane (analogue of Fig. 4). The equilibrium (1, 0) of Eq. (33) "
         "is a spiral sink for C = C1 + C2 < 2 (blue) and a sink for C > 2 (orange); the line C = 2 is critical. "
+        "C1 on a log axis (the parameter sets have C1 << C2). "
         "Points: parameter sets (marker) at normal impact speeds (colour); C1, C2 vary as v_n^(-1/5) when "
         "the damping reference speed is each impact's own normal speed, Eqs. (14)-(15)."
     )
@@ -825,14 +834,24 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
 
     def par(name, fmt):
         val = float(fit[name])
+        err = float(fit[f"{name}_stderr"]) if f"{name}_stderr" in fit else math.nan
         st = status_from_variables(fit, name, val)
         if st is not None and not st.determined:  # no number for what the data do not determine
             return {"lower_bound": f">= {st.lower:{fmt}}", "upper_bound": f"<= {st.upper:{fmt}}"}.get(
                 st.status, "not determined") + f" (curve drawn at {val:{fmt}})"
-        err = float(fit[f"{name}_stderr"]) if f"{name}_stderr" in fit else math.nan
-        return f"{val:{fmt}}" + (f" +- {err:{fmt}}" if math.isfinite(err) and err <= abs(val) else
-                                 "" if math.isfinite(err) else " (fixed)")
+        varied = (bool(int(fit[name].attrs["varied"])) if "varied" in fit[name].attrs
+                  else name in str(fit.attrs["varied"]).split() if "varied" in fit.attrs else None)
+        if varied is False:  # read from the file, never guessed from a missing standard error
+            return f"{val:{fmt}} (fixed, materials config)"
+        if varied is None and not math.isfinite(err):
+            return f"{val:{fmt}} (the file does not record whether it was fitted)"
+        if st is not None and math.isfinite(st.lower) and math.isfinite(st.upper):
+            return f"{val:{fmt}}, 95 % [{st.lower:{fmt}}, {st.upper:{fmt}}]"
+        return f"{val:{fmt}} (fitted)"
 
+    verdict = read_verdict(fit)
+    ax.set_title(f"model {verdict.label}", fontsize=7, loc="left",
+                 color="#b00000" if verdict.rejected else "0.2", wrap=True)
     source = str(fit.attrs.get("fit_source", "")) or "the data set"
     synthetic = "synthetic" in json.dumps({k: str(v) for k, v in fit.attrs.items()}).lower()
     caption = (
@@ -841,7 +860,9 @@ def plot_fit(fit: xr.Dataset, curves: xr.Dataset | None = None) -> Plot:
         "per sphere diameter, and the model at the best fit"
         f" (zeta_H = {par('zeta_hertz', '.3g')}, zeta_A = {par('zeta_adhesion', '.3g')}, "
         f"w_A = {par('work_of_adhesion', '.3g')} J/m^2; reduced chi-square {float(fit.attrs.get('redchi', math.nan)):.3g}). "
-        "Lower panel: residuals (model - measured) / sigma per point, the grey band +/- 2."
+        "Lower panel: residuals (model - measured) / sigma per point, the grey band +/- 2. "
+        f"Verdict: {verdict.label}."
+        + (f" Outliers (by id): {', '.join(verdict.outlier_ids)}." if verdict.outlier_ids else "")
     )
     return Plot(fig, caption, "3")
 
@@ -939,7 +960,7 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
     lim = float(np.max(angles))
     f = float(ds["friction"]) if "friction" in ds else None
     f_fit = float(ds["fitted_friction"]) if "fitted_friction" in ds else math.nan
-    fig = _figure(WIDTH, 2.5)
+    fig = _figure(WIDTH, 3.1)
     axes = np.atleast_1d(fig.subplots(1, len(names)))
     readings = []  # the other readings' lines, added to the legend
     for k, (ax, name) in enumerate(zip(axes, names)):
@@ -969,7 +990,9 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
         ax.set_xlim(0, lim)
     target = axes[names.index("rebound_angle") if "rebound_angle" in names else 0]
     handles, texts = target.get_legend_handles_labels()
-    target.legend(handles + readings, texts + [line.get_label() for line in readings], frameon=False, loc="upper left")
+    # one legend below the panels: inside a panel it covered the measured points
+    fig.legend(handles + readings, texts + [line.get_label() for line in readings], frameon=False,
+               loc="outside lower center", ncol=3)
     speed = ds.attrs.get("impact_speed")
     zeta = float(ds["zeta_hertz"]) if "zeta_hertz" in ds else None
     e_n = float(ds["e_n_model"]) if "e_n_model" in ds else None
@@ -995,17 +1018,20 @@ def plot_kharaz(ds: xr.Dataset) -> Plot:
 
 
 # ----------------------------------------------------------------------------- measurement flags
-#: flag variable -> (marker colour, legend text)
+#: flag variable -> (marker colour, legend text); the letters are those of ``microimpact flags``
 _FLAG_STYLE = {
     "rotation_sensitive": ("tab:red", "rotation-sensitive"),
     "angle_sensitive": ("tab:orange", "angle-sensitive"),
     "near_capture": ("tab:blue", "near capture"),
+    "probably_spun": ("tab:purple", "probably spun"),
+    "spin_unexplained": ("k", "unexplained"),
 }
+_FLAGS_REQUIRED = ("rotation_sensitive", "angle_sensitive", "near_capture")
 
 
 @_rc
-def plot_flags(ds: xr.Dataset) -> Plot:
-    """The model e_n of each measured impact with its range under unmeasured spin and angle error.
+def plot_flags(ds: xr.Dataset, *, outliers=()) -> Plot:
+    """The measured and the model e_n of each impact, with the model's range under unmeasured spin and angle error.
 
     Parameters
     ----------
@@ -1013,13 +1039,17 @@ def plot_flags(ds: xr.Dataset) -> Plot:
         From :func:`microimpact.analysis.flags.flag_measurements`: along ``impact``, ``e_n`` [1],
         ``e_n_min``, ``e_n_max`` [1] (range over spin and angle), ``capture_speed_ratio`` [1]
         (normal speed over the capture velocity) and the 0/1 flags ``rotation_sensitive``,
-        ``angle_sensitive``, ``near_capture``.
+        ``angle_sensitive``, ``near_capture`` (``probably_spun``, ``spin_unexplained`` when present);
+        the measured ``e_n_measured`` with ``e_n_uncertainty`` [1] and the row's ``id`` when present.
+    outliers : sequence of str
+        The ids of the rows the fit names as outliers, marked with a cross.
 
     Returns
     -------
     Plot
-        e_n against the speed ratio (log axis), a vertical bar for each impact's range, rings in
-        the colour of each flag raised.
+        e_n against the speed ratio (log axis): measured points with 1-sigma bars, the model's value
+        and its range (grey bar), rings in the colour of each flag raised, labelled with the
+        letters of ``microimpact flags``.
 
     Examples
     --------
@@ -1035,38 +1065,56 @@ def plot_flags(ds: xr.Dataset) -> Plot:
     >>> flags = flag_measurements(table, fit_damping(table, material, confidence_intervals=False))
     >>> flags["near_capture"].values.tolist(), round(float(flags["capture_speed_ratio"][0]), 2)
     ([1, 0, 0, 0, 0, 0], 1.09)
-    >>> plot = plot_flags(flags)
+    >>> plot = plot_flags(flags.assign(e_n_measured=("impact", table["e_n"].to_numpy())))
     >>> plot.caption.split("flags raised (")[1].split(";")[0]
-    '0 rotation-sensitive, 0 angle-sensitive, 1 near capture'
+    '0 R rotation-sensitive, 0 A angle-sensitive, 1 N near capture, 0 S probably spun, 0 U unexplained'
+    >>> "measured e_n" in plot.caption
+    True
     >>> plot_flags(flags.drop_vars(["e_n_min", "near_capture"]))
     Traceback (most recent call last):
     ...
     ValueError: plot_flags needs the variables e_n_min, near_capture of a flags file
     """
-    missing = [k for k in ("e_n", "e_n_min", "e_n_max", "capture_speed_ratio", *_FLAG_STYLE) if k not in ds]
+    missing = [k for k in ("e_n", "e_n_min", "e_n_max", "capture_speed_ratio", *_FLAGS_REQUIRED) if k not in ds]
     if missing:
         raise ValueError(f"plot_flags needs the variables {', '.join(missing)} of a flags file")
-    fig = _figure(WIDTH * 0.72, 3.0)
+    fig = _figure(WIDTH * 0.8, 3.0)
     ax = fig.subplots()
-    x = ds["capture_speed_ratio"].values
-    e = ds["e_n"].values
-    ax.vlines(x, ds["e_n_min"].values, ds["e_n_max"].values, color="0.55", lw=0.9)
-    ax.plot(x, e, "o", ms=3.0, color="0.2", label="model e_n, range over spin and angle")
+    x = np.asarray(ds["capture_speed_ratio"].values, float)
+    e = np.asarray(ds["e_n"].values, float)
+    ax.vlines(x, ds["e_n_min"].values, ds["e_n_max"].values, color="0.6", lw=0.9)
+    ax.plot(x, e, "_", ms=7.0, mew=1.3, color="0.25", label="model e_n (bar: range over\nspin and angle)")
+    measured = "e_n_measured" in ds and np.isfinite(np.asarray(ds["e_n_measured"].values, float)).any()
+    if measured:
+        sig = np.asarray(ds["e_n_uncertainty"].values, float) if "e_n_uncertainty" in ds else np.zeros_like(x)
+        ax.errorbar(x, ds["e_n_measured"].values, yerr=np.where(np.isfinite(sig), sig, 0.0), fmt="o", ms=2.8,
+                    color="C0", ecolor="C0", elinewidth=0.6, capsize=1.2, lw=0, label="measured e_n ± 1σ")
     counts = []
-    for k, (name, (color, text)) in enumerate(_FLAG_STYLE.items()):
-        raised = ds[name].values.astype(bool)
-        counts.append(f"{int(raised.sum())} {text}")
-        ax.plot(x[raised], e[raised], "o", ms=6.0 + 2.5 * k, mfc="none", mec=color, mew=1.0, label=text)
+    for k, (name, (color, text)) in enumerate((n, v) for n, v in _FLAG_STYLE.items() if n in ds):
+        raised = np.asarray(ds[name].values, float) > 0
+        letter = FLAG_LETTERS[name]
+        counts.append(f"{int(raised.sum())} {letter} {text}")
+        ax.plot(x[raised], e[raised], "o", ms=6.0 + 2.5 * k, mfc="none", mec=color, mew=1.0,
+                label=f"{letter}: {text}")
+    ids = [str(i) for i in ds["id"].values] if "id" in ds else []
+    out = np.array([i in set(outliers) for i in ids], bool) if ids else np.zeros(x.size, bool)
+    if out.any():
+        y_out = np.asarray(ds["e_n_measured"].values, float)[out] if measured else e[out]
+        ax.plot(x[out], y_out, "x", ms=7, mew=1.4, color="#b00000", label="outlier of the fit")
+        for xi, yi, name in zip(x[out], y_out, np.asarray(ids)[out]):
+            ax.annotate(name, (xi, yi), xytext=(4, 4), textcoords="offset points", fontsize=6.5, color="#b00000")
     ax.set_xscale("log")
     ax.xaxis.set_minor_formatter(NullFormatter())  # a short log range: label the decades only
-    ax.set_xlabel(r"normal speed / capture velocity [-]")
+    ax.set_xlabel(r"normal speed / capture velocity $v_n / v_{capture}$ [-]")
     ax.set_ylabel(r"$e_n$ [-]")
     ax.set_ylim(bottom=0.0)
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     caption = (
         f"Measurement flags of {ds.sizes.get('impact', len(e))} impacts ({str(ds.attrs.get('source', '')) or 'the data'}): "
-        "the model's e_n at each measured impact against its normal speed over the capture velocity, with a bar "
-        "from the lowest to the highest e_n under unmeasured spin and the incidence-angle uncertainty; rings "
-        f"mark the flags raised ({', '.join(counts)}; thresholds in the file's attributes)."
+        + ("the measured e_n (dots, 1-sigma bars) and " if measured else "")
+        + "the model's e_n at each measured impact against its normal speed over the capture velocity, with a bar "
+        "from the lowest to the highest model e_n under unmeasured spin and the incidence-angle uncertainty; rings "
+        f"mark the flags raised ({', '.join(counts)}; thresholds in the file's attributes)"
+        + (f"; crosses: the {int(out.sum())} outlier(s) of the fit, labelled by id" if out.any() else "") + "."
     )
     return Plot(fig, caption)

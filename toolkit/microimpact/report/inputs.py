@@ -9,15 +9,18 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import math
 import os
 import platform
 import subprocess
 from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import xarray as xr
+from scipy.special import chdtrc, ndtri
 
 from microimpact.io.files import read_netcdf_groups, restore_label_coordinates
 
@@ -34,6 +37,10 @@ __all__ = [
     "per_radius",
     "at_radius",
     "is_synthetic",
+    "Verdict",
+    "read_verdict",
+    "VERDICT_LEVEL",
+    "FLAG_LETTERS",
     "git_commit",
     "provenance",
 ]
@@ -250,6 +257,172 @@ def at_radius(ds: xr.Dataset, k: int) -> xr.Dataset:
     return out
 
 
+# =============================================================================== the verdict
+#: significance of the report's own adequacy test (files that record no verdict): a chi-square
+#: whose upper tail probability is below it rejects the model
+VERDICT_LEVEL = 0.05
+#: the flag letters of ``microimpact flags`` (microimpact.analysis.flags.FLAG_LETTERS; the report may
+#: not import analysis, tests/test_report_verdict.py checks that the two agree)
+FLAG_LETTERS = {"rotation_sensitive": "R", "angle_sensitive": "A", "near_capture": "N", "probably_spun": "S",
+                "spin_unexplained": "U"}
+_VERDICTS = ("adequate", "inadequate", "no stated uncertainties")
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Whether the fitted model describes the data, as the report states it.
+
+    Attributes
+    ----------
+    verdict : str
+        "adequate", "inadequate", "no stated uncertainties" or "verdict not recorded".
+    text : str
+        One sentence for the reader.
+    chi_square, degrees_of_freedom, p_value : float
+        The chi-square of the fit, its degrees of freedom and upper tail probability [-] (NaN when unknown).
+    outlier_ids : tuple of str
+        The CSV ids of the rows whose standardized residual is improbable given the number of rows.
+    outlier_threshold_text : str
+        The threshold that named them and its false-alarm rate.
+    misfit_description : str
+        The systematic structure of the residuals, in words ("" if none was recorded).
+    interval_note : str
+        How the intervals are to be read ("" if none was recorded).
+    recorded : bool
+        True when the fit file holds the verdict; False when the report computed it from the file's chi-square.
+
+    Examples
+    --------
+    >>> v = Verdict("inadequate", "rejected", 535.1, 58, 2.2e-78)
+    >>> v.rejected, v.label
+    (True, 'inadequate (chi-square 535.1 for 58 degrees of freedom, p = 2.2e-78)')
+    """
+
+    verdict: str
+    text: str
+    chi_square: float = math.nan
+    degrees_of_freedom: float = math.nan
+    p_value: float = math.nan
+    outlier_ids: tuple = ()
+    outlier_threshold_text: str = ""
+    misfit_description: str = ""
+    interval_note: str = ""
+    recorded: bool = True
+
+    @property
+    def rejected(self) -> bool:
+        """True when the data reject the model."""
+        return self.verdict == "inadequate"
+
+    @property
+    def label(self) -> str:
+        """The verdict with its chi-square, degrees of freedom and p where they are known."""
+        if not math.isfinite(self.chi_square):
+            return self.verdict
+        dof = f"{self.degrees_of_freedom:g}" if math.isfinite(self.degrees_of_freedom) else "?"
+        p = f", p = {self.p_value:.2g}" if math.isfinite(self.p_value) else ""
+        return f"{self.verdict} (chi-square {self.chi_square:.4g} for {dof} degrees of freedom{p})"
+
+    def rejected_note(self, what: str) -> str:
+        """The line a downstream result carries when the model is rejected ("" otherwise)."""
+        if not self.rejected:
+            return ""
+        return (f"FROM A REJECTED MODEL: {what} computed with the parameters of a fit the data reject "
+                f"({self.label}); read them as conditional on a model that does not describe these data.")
+
+
+def _attr_float(attrs, key) -> float:
+    try:
+        return float(attrs[key])
+    except (KeyError, TypeError, ValueError):
+        return math.nan
+
+
+def _stated_uncertainties(fit: xr.Dataset) -> bool:
+    """Whether the fit weighted its residuals by stated uncertainties (all finite and positive)."""
+    if "unweighted" in str(fit.attrs.get("weighting", "")).lower():
+        return False
+    if "sigma" not in fit:
+        return False
+    s = np.asarray(fit["sigma"].values, float)
+    return bool(s.size and np.all(np.isfinite(s) & (s > 0)))
+
+
+def _outliers(fit: xr.Dataset) -> tuple[tuple, str]:
+    """Ids of the rows whose |standardized residual| exceeds the two-sided Bonferroni threshold
+    (a 5 % chance that a clean data set of N rows has one such row), and the threshold's text."""
+    if "residual" not in fit:
+        return (), ""
+    z = np.asarray(fit["residual"].values, float)
+    n = int(np.isfinite(z).sum())
+    if not n:
+        return (), ""
+    threshold = float(ndtri(1.0 - VERDICT_LEVEL / (2 * n)))
+    ids = (fit["id"].values if "id" in fit else (fit["row"].values if "row" in fit else np.arange(1, z.size + 1)))
+    out = tuple(str(i) for i, x in zip(ids, z) if np.isfinite(x) and abs(x) > threshold)
+    return out, (f"|standardized residual| > {threshold:.3g}: a clean data set of {n} rows has such a row with "
+                 f"probability {VERDICT_LEVEL:g}")
+
+
+def read_verdict(fit: xr.Dataset) -> Verdict:
+    """The verdict of a fit file: its ``verdict`` attributes, or the report's own test where it has none.
+
+    A file that records no verdict (written before the fit stated one) is judged here: with stated
+    uncertainties, chi-square against its degrees of freedom (points minus varied parameters),
+    rejected below :data:`VERDICT_LEVEL`; outliers by the Bonferroni threshold on the standardized
+    residuals. Without stated uncertainties, or without a chi-square, the verdict is "verdict not recorded".
+
+    Parameters
+    ----------
+    fit : xarray.Dataset
+        A damping fit file (``DampingFit.to_dataset``).
+
+    Returns
+    -------
+    Verdict
+
+    Examples
+    --------
+    A file with the recorded verdict, and one without (chi-square 200 for 98 degrees of freedom, judged here):
+
+    >>> import xarray as xr
+    >>> recorded = xr.Dataset(attrs={"verdict": "adequate", "verdict_text": "the model describes the data",
+    ...                              "chi_square": 95.0, "degrees_of_freedom": 98, "p_value": 0.57, "outlier_ids": ""})
+    >>> read_verdict(recorded).label
+    'adequate (chi-square 95 for 98 degrees of freedom, p = 0.57)'
+    >>> old = xr.Dataset({"sigma": ("point", [0.01] * 100)}, attrs={"chisqr": 200.0, "n_points": 100,
+    ...                                                            "varied": "zeta_hertz zeta_adhesion"})
+    >>> v = read_verdict(old)
+    >>> v.verdict, v.recorded, f"{v.p_value:.1e}"
+    ('inadequate', False, '5.7e-09')
+    """
+    a = fit.attrs
+    if str(a.get("verdict", "")) in _VERDICTS:
+        ids = tuple(i.strip() for i in str(a.get("outlier_ids", "")).split(",") if i.strip())
+        return Verdict(str(a["verdict"]), str(a.get("verdict_text", "")), _attr_float(a, "chi_square"),
+                       _attr_float(a, "degrees_of_freedom"), _attr_float(a, "p_value"), ids,
+                       str(a.get("outlier_threshold_text", "")), str(a.get("misfit_description", "")),
+                       str(a.get("interval_note", "")), recorded=True)
+    chi2 = _attr_float(a, "chi_square") if "chi_square" in a else _attr_float(a, "chisqr")
+    n = _attr_float(a, "n_points")
+    dof = _attr_float(a, "degrees_of_freedom") if "degrees_of_freedom" in a else n - len(str(a.get("varied", "")).split())
+    if not (math.isfinite(chi2) and math.isfinite(dof) and dof > 0):
+        return Verdict("verdict not recorded", "The fit file records no verdict and no chi-square to judge it by.",
+                       recorded=False)
+    if not _stated_uncertainties(fit):
+        return Verdict("no stated uncertainties", "No stated uncertainties: the fit is judged against the scatter "
+                       f"of the data (chi-square {chi2:.4g} for {dof:g} degrees of freedom is not a test).",
+                       chi2, dof, recorded=False)
+    p = float(chdtrc(dof, chi2))
+    ids, threshold = _outliers(fit)
+    verdict = "inadequate" if p < VERDICT_LEVEL else "adequate"
+    text = ("The data reject the model: the misfit is larger than the stated uncertainties allow."
+            if verdict == "inadequate" else "The model describes the data within their stated uncertainties.")
+    return Verdict(verdict, text + " (Verdict computed by the report from the file's chi-square: the fit file "
+                   f"records none; rejected below p = {VERDICT_LEVEL:g}.)", chi2, dof, p, ids, threshold,
+                   recorded=False)
+
+
 # =============================================================================== provenance
 def is_synthetic(data_path, flag="auto") -> bool:
     """Whether a data file is synthetic: ``flag`` if it is a bool; for "auto", True when the file
@@ -292,10 +465,10 @@ def git_commit(directory=".") -> str | None:
 
 
 def _data_facts(t: pd.DataFrame) -> dict[str, str]:
-    radii = np.unique(np.round(t["radius"].to_numpy(float) * 1e6, 4))
+    diameters = np.unique(np.round(t["radius"].to_numpy(float) * 2e6, 4))
     v = t["normal_speed"].to_numpy(float)
     labels = sorted({str(p) for p in t["material_pair"].dropna().unique()}) if "material_pair" in t.columns else []
-    return {"data content": f"{len(t)} impacts, {len(radii)} radii ({', '.join(f'{r:g}' for r in radii)} um), "
+    return {"data content": f"{len(t)} impacts, {len(diameters)} sphere diameters d = {', '.join(f'{d:g}' for d in diameters)} um, "
                             f"normal speed {np.nanmin(v):.3g}-{np.nanmax(v):.3g} m/s"
                             + (f"; material pairs {', '.join(labels)}" if len(labels) > 1 else "")}
 
@@ -344,7 +517,7 @@ def provenance(config: Mapping | None = None, *, version: str = "", data_path=No
     >>> table = pd.DataFrame({"radius": [1e-6, 2e-6], "normal_speed": [1.0, 3.0]})
     >>> facts = provenance({"data": "data/synthetic_microspheres.csv"}, version="0.1.0", data_table=table)
     >>> facts["toolkit"], facts["data content"]
-    ('microimpact 0.1.0', '2 impacts, 2 radii (1, 2 um), normal speed 1-3 m/s')
+    ('microimpact 0.1.0', '2 impacts, 2 sphere diameters d = 2, 4 um, normal speed 1-3 m/s')
     >>> "SYNTHETIC" in facts["data"]
     True
     """

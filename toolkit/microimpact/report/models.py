@@ -12,10 +12,12 @@ import pandas as pd
 import xarray as xr
 
 from microimpact.report.figures import WIDTH, Plot, _colors, _figure, _rc
-from microimpact.report.inputs import parameter_source
+from scipy.special import chdtrc
+
+from microimpact.report.inputs import VERDICT_LEVEL, parameter_source
 from microimpact.report.layout import Layout
 
-__all__ = ["model_comparison_section", "plot_model_comparison"]
+__all__ = ["model_comparison_section", "plot_model_comparison", "model_verdicts"]
 
 _STYLES = {"ring": "-", "jkr": "--", "dmt": ":", "jkr_force": "-."}
 _NAMES = {"ring": "ring force (paper)", "jkr": "JKR", "dmt": "DMT", "jkr_force": "JKR, force-controlled break"}
@@ -80,7 +82,46 @@ def plot_model_comparison(ds: xr.Dataset) -> Plot:
     return Plot(fig, caption)
 
 
-def _table(ds: xr.Dataset) -> pd.DataFrame:
+def model_verdicts(ds: xr.Dataset) -> dict[str, str]:
+    """Normal model -> "adequate", "inadequate" or "not tested": the file's ``verdict`` per model where
+    it records one, else chi-square against N - k degrees of freedom (stated uncertainties only).
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> ds = xr.Dataset({"chi_square": ("normal_model", [95.0, 400.0])}, coords={"normal_model": ["ring", "jkr"]},
+    ...                 attrs={"number_of_points": 100, "varied_parameters": 3, "weighting": "stated e_n uncertainties"})
+    >>> model_verdicts(ds)
+    {'ring': 'adequate', 'jkr': 'inadequate'}
+    """
+    models = [str(m) for m in ds["normal_model"].values]
+    if "verdict" in ds:
+        return dict(zip(models, (str(v) for v in ds["verdict"].values)))
+    a = ds.attrs
+    dof = float(a.get("number_of_points", np.nan)) - float(a.get("varied_parameters", np.nan))
+    stated = "stated" in str(a.get("weighting", "")) or "uncertaint" in str(a.get("weighting", ""))
+    if not (stated and np.isfinite(dof) and dof > 0):
+        return dict.fromkeys(models, "not tested")
+    p = chdtrc(dof, np.asarray(ds["chi_square"].values, float))
+    return {m: "inadequate" if q < VERDICT_LEVEL else "adequate" for m, q in zip(models, p)}
+
+
+def _preference(ds: xr.Dataset, verdicts: dict[str, str]) -> str:
+    """What the comparison says: the preferred adequate model, or, with all rejected, the least bad one."""
+    order = sorted(verdicts, key=lambda m: float(ds["aic"].sel(normal_model=m)))
+    best = order[0]
+    if all(v == "inadequate" for v in verdicts.values()):
+        return (f" All {len(order)} models are rejected by the data (chi-square too large for the stated "
+                f"uncertainties): no model is preferred. Least bad (lowest AIC): {_NAMES.get(best, best)}; the AIC "
+                "differences rank misfits, not adequate models.")
+    adequate = [m for m in order if verdicts[m] != "inadequate"]
+    rejected = [m for m in order if verdicts[m] == "inadequate"]
+    return (f" Lowest AIC among the models the data do not reject: {_NAMES.get(adequate[0], adequate[0])}."
+            + (f" Rejected by the data: {', '.join(_NAMES.get(m, m) for m in rejected)}." if rejected else ""))
+
+
+def _table(ds: xr.Dataset, verdicts: dict[str, str] | None = None) -> pd.DataFrame:
+    verdicts = verdicts or model_verdicts(ds)
     rows = []
     for m in ds["normal_model"].values:
         d = ds.sel(normal_model=m)
@@ -89,7 +130,8 @@ def _table(ds: xr.Dataset) -> pd.DataFrame:
                      "BIC": f"{float(d['bic']):.1f}", "dAIC": f"{float(d['delta_aic']):.1f}",
                      "dBIC": f"{float(d['delta_bic']):.1f}", "chi2": f"{float(d['chi_square']):.4g}",
                      "zeta_H": f"{float(d['zeta_hertz']):.3g}", "zeta_A": f"{float(d['zeta_adhesion']):.3g}",
-                     "w_A": f"{float(d['work_of_adhesion']):.3g}", "mu_T": f"{mu.min():.3g}-{mu.max():.3g}"})
+                     "w_A": f"{float(d['work_of_adhesion']):.3g}", "mu_T": f"{mu.min():.3g}-{mu.max():.3g}",
+                     "verdict": verdicts.get(str(m), "")})
     return pd.DataFrame(rows)
 
 
@@ -120,17 +162,20 @@ def model_comparison_section(lay: Layout, ds: xr.Dataset, synthetic: bool = Fals
     """
     lay.section("Normal contact models compared on the data")
     a = ds.attrs
+    verdicts = model_verdicts(ds)
     lay.paragraph(
         "The paper's adhesion ring force and the JKR and DMT adhesion models (README, 'Contact models beyond the "
         "paper') are each fitted by weighted least squares to the same measured e_n(v_n), with the same three free "
         f"parameters (zeta_H, zeta_A, w_A) and the same residuals ({a.get('weighting', '?')}; "
         f"N = {a.get('number_of_points', '?')} points, k = {a.get('varied_parameters', '?')}). AIC = N ln(chi^2/N) "
-        "+ 2k and BIC = N ln(chi^2/N) + k ln N; a model lower by more than about 10 is strongly preferred. "
+        "+ 2k and BIC = N ln(chi^2/N) + k ln N; among models the data do not reject, one lower by more than about "
+        "10 is strongly preferred (a rejected model is never preferred). "
         "mu_T is the Tabor parameter at the measured sizes with the fitted w_A (z0 = 0.4 nm): JKR applies above "
         "about 5, DMT below about 0.1."
         + (" The data are SYNTHETIC, generated with the paper's ring model: the comparison is expected to prefer "
-           "it, and shows that the data can tell the models apart." if synthetic else ""))
+           "it, and shows that the data can tell the models apart." if synthetic else "")
+        + _preference(ds, verdicts))
     lay.source(parameter_source(ds))
-    lay.table(_table(ds), {"model": 18, "AIC": 8, "BIC": 8, "dAIC": 7, "dBIC": 7, "chi2": 9, "zeta_H": 7,
-                           "zeta_A": 7, "w_A": 7, "mu_T": 10}, size=7.0)
+    lay.table(_table(ds, verdicts), {"model": 18, "AIC": 8, "BIC": 8, "dAIC": 7, "dBIC": 7, "chi2": 9, "zeta_H": 7,
+                                     "zeta_A": 7, "w_A": 7, "mu_T": 10, "verdict": 10}, size=7.0)
     lay.plot(plot_model_comparison(ds), max_height=3.4)

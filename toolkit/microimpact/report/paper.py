@@ -126,8 +126,11 @@ def paper_sweeps_section(lay: Layout, sweeps: list[xr.Dataset]) -> None:
         lay.plot(figures.plot_restitution_and_impulse(ds), max_height=4.2)
 
 
-def reproduction_section(lay: Layout, repro: pd.DataFrame) -> None:
+def reproduction_section(lay: Layout, repro: pd.DataFrame, path=None) -> None:
     """The paper's numbers and statements against the toolkit's, with agreement.
+
+    One block per claim in the body font (the claim, the paper's value, the toolkit's, the note),
+    not a table of wrapped monospace cells; the full table is the CSV the section names.
 
     Examples
     --------
@@ -135,24 +138,35 @@ def reproduction_section(lay: Layout, repro: pd.DataFrame) -> None:
     >>> from microimpact.studies.reproduction import reproduction_table
     >>> repro = reproduction_table()
     >>> lay = Layout("Report")
-    >>> reproduction_section(lay, repro)
-    >>> f"{len(repro)} rows: {int((repro['agree'] == True).sum())} agree" in lay.pages[0].figure.texts[1].get_text()
+    >>> reproduction_section(lay, repro, path="results/paper/reproduction.csv")
+    >>> text = " ".join(" ".join(t.get_text().split()) for p in lay.pages for t in p.figure.texts)
+    >>> f"{len(repro)} rows: {int((repro['agree'] == True).sum())} agree" in text
+    True
+    >>> "results/paper/reproduction.csv" in text
     True
     """
     lay.section("Reproduction of the paper's numbers and statements", new_page=False, keep=1.5)
     agree = repro["agree"].astype(str).str.lower()
     n_yes = int(agree.isin(["true", "yes"]).sum())
-    n_no = int(agree.isin(["false", "no"]).sum())
+    no = agree.isin(["false", "no"])
+    where = str(path) if path is not None else "the reproduction CSV of the pipeline"
     lay.paragraph(
         f"Every toolkit value is computed when the pipeline runs (microimpact.studies.reproduction). {len(repro)} rows: "
-        f"{n_yes} agree, {n_no} disagree, {len(repro) - n_yes - n_no} not checkable (the paper's figures are "
-        "missing from the available text). Disagreements are reported, not tuned away; see the notes.")
+        f"{n_yes} agree, {int(no.sum())} disagree"
+        + (f" ({', '.join(str(x) for x in repro.loc[no, 'id'])})" if no.any() else "")
+        + f", {len(repro) - n_yes - int(no.sum())} not checkable (the paper's figures are missing from the available "
+        f"text). Disagreements are reported, not tuned away. The full table (appendix, every column): {where}.")
     if "parameter_source" in repro:
         lay.source("; ".join(dict.fromkeys(str(s) for s in repro["parameter_source"])))
     else:
         lay.source("the paper's Table 1 (each row of the table names the parameter set it uses)")
-    df = repro.copy()
-    df["agree"] = agree.map({"true": "yes", "false": "NO", "yes": "yes", "no": "NO"}).fillna(agree)
-    lay.table(df, {"id": 12, "claim": 28, "source": 12, "paper_value": 18, "toolkit_value": 18, "agree": 5,
-                   "note": 30},
-              headers={"paper_value": "paper", "toolkit_value": "toolkit"})
+    verdicts = agree.map({"true": "agrees", "false": "DISAGREES", "yes": "agrees", "no": "DISAGREES"})
+    for (_, row), verdict in zip(repro.iterrows(), verdicts):
+        cell = lambda key: "" if key not in row or pd.isna(row[key]) else str(row[key])  # noqa: E731
+        lay.paragraph(f"{cell('id')} ({cell('source')}): {verdict if isinstance(verdict, str) else 'not checkable'}."
+                      f" {cell('claim')}", size=8.0, gap=0.0,
+                      color="#b00000" if verdict == "DISAGREES" else "black")
+        lines = [f"paper: {cell('paper_value')}", f"toolkit: {cell('toolkit_value')}"]
+        if cell("note"):
+            lines.append(f"note: {cell('note')}")
+        lay.paragraph("\n".join(lines), size=7.4, gap=0.1, color="0.25")

@@ -32,6 +32,7 @@ Paper: Cheng, Brach & Dunn (2002), Aerosol Sci. Technol. 36:1081-1093, doi:10.10
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -42,7 +43,7 @@ from microimpact.model.contact import PAPER_REFERENCE
 from microimpact.report import analyst, checks, models, paper
 from microimpact.io.impacts import select_material_pair
 from microimpact.report.inputs import (ANALYST_KEYS, INPUT_KEYS, as_list, check_inputs, git_commit, is_synthetic, provenance,
-                                       read_dataset, read_json, read_portraits, read_table)
+                                       read_dataset, read_json, read_portraits, read_table, read_verdict)
 from microimpact.report.layout import PAGE_SIZE, Layout
 
 __all__ = ["build_report", "INPUT_KEYS", "PAGE_SIZE", "is_synthetic", "git_commit", "provenance"]
@@ -59,33 +60,36 @@ def _analyst_part(lay: Layout, inputs: Mapping, data: pd.DataFrame | None, synth
     """Part A (A1, A2, ... with several material pairs): every result made with the parameters of the
     fit to the analyst's data of one material pair."""
     fit = read_dataset(inputs["fit"])
+    verdict = read_verdict(fit)
     pair = pair or fit.attrs.get("fit_material_pair")
     lay.part(
         f"Part {label}. The analyst's material" + (f": {pair}" if pair else "") + " (parameters from the fit)",
         f"Results for the data of {fit.attrs.get('fit_source', 'the analyst')}"
         + (f", the rows of material pair {pair}" if pair else "")
         + (" (SYNTHETIC)" if synthetic else "") + ". The damping coefficients zeta_H, zeta_A (and w_A when it is "
-        "fitted) come from the fit in section 1; every simulation in this part uses them, at the measured sphere "
+        "fitted) come from the damping fit (its verdict first, then the fit itself); every simulation in this part uses them, at the measured sphere "
         "sizes and over the measured speed range.")
+    analyst.summary_section(lay, fit, verdict)
     analyst.fit_section(lay, fit, _optional(inputs, "fit_curves", read_dataset), data, synthetic)
     obl = _optional(inputs, "oblique", read_dataset)
     if obl is not None and "friction" not in obl:  # no oblique columns: one line under the fit
         analyst.oblique_section(lay, obl)
     post = _optional(inputs, "posterior", read_dataset)
     if post is not None:
-        analyst.posterior_section(lay, fit, post)
+        analyst.posterior_section(lay, fit, post, verdict.rejected_note("the posterior, its bands and capture velocities"))
     if obl is not None and "friction" in obl:
-        analyst.oblique_section(lay, obl)
+        analyst.oblique_section(lay, obl, verdict.rejected_note("the friction fit (made at the fitted damping)"))
     if "model_comparison" in inputs:
         models.model_comparison_section(lay, read_dataset(inputs["model_comparison"]), synthetic)
     dyn = _optional(inputs, "analyst_dynamics", read_dataset)
     if dyn is not None:
-        analyst.analyst_dynamics_section(lay, dyn)
+        analyst.analyst_dynamics_section(lay, dyn, verdict.rejected_note("the capture and critical velocities"))
     sweeps = [read_dataset(s) for s in as_list(inputs.get("analyst_sweeps"))]
     if sweeps:
-        analyst.analyst_sweeps_section(lay, sweeps, dyn)
+        analyst.analyst_sweeps_section(lay, sweeps, dyn, verdict.rejected_note("the sweeps"))
     if "flags" in inputs:
-        analyst.flags_section(lay, read_table(inputs["flags"]), data)
+        flags_path = inputs["flags"] if isinstance(inputs["flags"], (str, os.PathLike)) else None
+        analyst.flags_section(lay, read_table(inputs["flags"]), data, fit=fit, verdict=verdict, path=flags_path)
 
 
 def _rows_of_pair(data: pd.DataFrame | None, pair: str, default: str | None) -> pd.DataFrame | None:
@@ -117,7 +121,8 @@ def _paper_part(lay: Layout, inputs: Mapping) -> None:
     if sweeps:
         paper.paper_sweeps_section(lay, sweeps)
     if "reproduction" in inputs:
-        paper.reproduction_section(lay, read_table(inputs["reproduction"]))
+        repro = inputs["reproduction"]
+        paper.reproduction_section(lay, read_table(repro), path=repro if isinstance(repro, (str, os.PathLike)) else None)
 
 
 def _checks_part(lay: Layout, inputs: Mapping, config: Mapping) -> None:
@@ -190,8 +195,8 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
     >>> pdf = PdfReader(build_report("report.pdf", {"fit": fit, "data_table": table}))
     >>> len(pdf.pages), pdf.metadata.title
     (4, 'Microsphere contact/impact report')
-    >>> "1. Damping fit (analogue of Fig. 3)" in pdf.pages[1].extract_text()
-    True
+    >>> "1. Verdict" in pdf.pages[1].extract_text(), "2. Damping fit (analogue of Fig. 3)" in pdf.pages[2].extract_text()
+    (True, True)
     >>> build_report("report.pdf", {"data_table": table})
     Traceback (most recent call last):
     ...
