@@ -15,6 +15,7 @@ without importing lmfit (slow to import) or the compiled engine.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -338,9 +339,17 @@ class DampingFit(ReportHTML, FitResult):
         """Whether the damping law describes these data, the outliers by id and the misfit in words
         (:func:`microimpact.analysis.verdict.assess_residuals` of the standardized residuals)."""
         d = self.data
-        return assess_residuals(d["residual"].to_numpy(float), len(self.varied), stated=self.weighting != "none",
-                                ids=self.row_ids, speed=d["normal_speed"].to_numpy(float),
-                                radius=d["radius"].to_numpy(float), what="damping law")
+        v = assess_residuals(d["residual"].to_numpy(float), len(self.varied), stated=self.weighting != "none",
+                             ids=self.row_ids, speed=d["normal_speed"].to_numpy(float),
+                             radius=d["radius"].to_numpy(float), what="damping law")
+        # the outliers confirmed by the refit without them (analyse_impacts), where it ran
+        named, without = self.info.get("outlier_ids"), self.info.get("without_outliers")
+        excluded = tuple(x for x in str(self.info.get("excluded_ids") or "").split(",") if x)
+        # an adequate refit without the outliers: they are the misfit, not the law
+        misfit = "" if ": adequate:" in str(without or "") else v.misfit_description
+        return dataclasses.replace(v, outlier_ids=v.outlier_ids if named is None else
+                                   tuple(x for x in str(named).split(",") if x), misfit_description=misfit,
+                                   without_outliers=str(without or ""), excluded=excluded)
 
     def interval(self, name: str, widened: bool = False) -> tuple[float, float]:
         """The one interval of ``name``: its 95 % profile-likelihood interval (NaN where the data do

@@ -113,6 +113,10 @@ class Verdict:
     false_alarm: float = OUTLIER_FALSE_ALARM
     misfit_description: str = ""
     what: str = "model"
+    #: the verdict of the refit without the outliers, in words ("" when none were named)
+    without_outliers: str = ""
+    #: ids the analyst excluded (``--exclude``)
+    excluded: tuple = ()
 
     @property
     def rejected(self) -> bool:
@@ -157,6 +161,10 @@ class Verdict:
         out = [f"  verdict     : {self.text()}"]
         if self.outlier_ids:
             out.append(f"  outliers    : {', '.join(self.outlier_ids)} ({self.outlier_threshold_text()})")
+        if self.without_outliers:
+            out.append(f"  without them: {self.without_outliers}")
+        if self.excluded:
+            out.append(f"  excluded    : {', '.join(self.excluded)} (by the analyst: --exclude)")
         if self.misfit_description:
             out.append(f"  misfit      : {self.misfit_description}")
         out.append(f"  intervals   : {self.interval_note()}")
@@ -169,11 +177,13 @@ class Verdict:
                 "outlier_ids": ",".join(self.outlier_ids), "outlier_threshold": float(self.outlier_threshold),
                 "outlier_false_alarm": float(self.false_alarm), "outlier_threshold_text": self.outlier_threshold_text(),
                 "misfit_description": self.misfit_description, "interval_note": self.interval_note(),
-                "interval_widening": self.widening}
+                "interval_widening": self.widening, "without_outliers_text": self.without_outliers,
+                "excluded_ids": ",".join(self.excluded)}
 
     def to_record(self) -> dict:
         """The verdict for ``--json``: its attributes with the ids as a list."""
-        return self.to_attrs() | {"outlier_ids": list(self.outlier_ids), "rejected": self.rejected}
+        return self.to_attrs() | {"outlier_ids": list(self.outlier_ids), "excluded_ids": list(self.excluded),
+                                  "rejected": self.rejected}
 
 
 def assess_residuals(standardized, n_parameters: int, *, stated: bool = True, ids=None, speed=None, radius=None,
@@ -300,7 +310,7 @@ def describe_misfit(z, speed=None, radius=None, *, n_beyond: int = 0, threshold:
     n1, n2 = int(np.sum(signs > 0)), int(np.sum(signs < 0))
     expected = 2.0 * n1 * n2 / max(n1 + n2, 1) + 1
     p_runs = _runs_test(signs)
-    if p_runs < 0.01:
+    if p_runs < 0.01 and runs < expected:  # fewer runs than chance: a trend (more: alternation, not a trend)
         parts.append(f"{runs} runs of one sign in speed order where {expected:.0f} are expected (runs test p = "
                      f"{p_runs:.2g}): systematic in speed, not scatter")
     if radius is not None:
