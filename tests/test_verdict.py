@@ -199,3 +199,15 @@ def test_fit_json_carries_the_verdict(tmp_path, capsys):
     verdict = summary["damping"]["verdict"]
     assert verdict["verdict"] == INADEQUATE and len(verdict["outlier_ids"]) == 2
     assert summary["damping"]["without_outliers"]["verdict"]["verdict"] == ADEQUATE
+
+
+def test_model_comparison_never_prefers_a_rejected_model():
+    from microimpact.analysis.model_comparison import comparison_verdict
+    from microimpact.analysis.verdict import Verdict
+    rejected = [Verdict(INADEQUATE, c, 58.0, 1e-20, misfit_description="model too high above 20 m/s") for c in (700.0, 520.0, 900.0)]
+    text = comparison_verdict(["ring", "dmt", "jkr"], rejected, np.array([30.0, 18.0, 40.0]))
+    assert text.startswith("all rejected; least bad: dmt") and "prefer" not in text
+    assert "too high above 20 m/s" in text
+    mixed = [rejected[0], Verdict(ADEQUATE, 60.0, 58.0, 0.4), Verdict(ADEQUATE, 62.0, 58.0, 0.35)]
+    text = comparison_verdict(["ring", "dmt", "jkr"], mixed, np.array([1.0, 5.0, 7.0]))  # ring: lowest AIC, rejected
+    assert "lowest AIC among them: dmt" in text and "rejected: ring" in text
