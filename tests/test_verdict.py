@@ -211,3 +211,21 @@ def test_model_comparison_never_prefers_a_rejected_model():
     mixed = [rejected[0], Verdict(ADEQUATE, 60.0, 58.0, 0.4), Verdict(ADEQUATE, 62.0, 58.0, 0.35)]
     text = comparison_verdict(["ring", "dmt", "jkr"], mixed, np.array([1.0, 5.0, 7.0]))  # ring: lowest AIC, rejected
     assert "lowest AIC among them: dmt" in text and "rejected: ring" in text
+
+
+@pytest.mark.slow
+def test_flags_agree_with_the_fit_on_gross_outliers(material, tmp_path_factory):
+    """A row 20 sigma off is 'spin_unexplained' (no spin moves e_n), named by id, and its
+    standardized residual in the flags is the fit's (same model, same sigma: stated e_n only)."""
+    from microimpact.analysis.flags import flag_measurements
+    df = make_outlier_impacts(2)
+    table = _table(df, tmp_path_factory, "flags")
+    fit = analyse_impacts(table, material).without_outliers
+    flags = flag_measurements(table, fit)
+    ids = flags["id"].values.astype(str)
+    unexplained = set(ids[flags["spin_unexplained"].values == 1])
+    assert unexplained == set(df.attrs["outlier_ids"])
+    for name in ("measured_value", "model_value", "standardized_residual"):
+        assert name in flags
+    z = flags["standardized_residual"].values
+    assert np.all(np.abs(z[flags["spin_unexplained"].values == 1]) > sidak_threshold(40))
