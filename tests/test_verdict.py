@@ -229,3 +229,27 @@ def test_flags_agree_with_the_fit_on_gross_outliers(material, tmp_path_factory):
         assert name in flags
     z = flags["standardized_residual"].values
     assert np.all(np.abs(z[flags["spin_unexplained"].values == 1]) > sidak_threshold(40))
+
+
+@pytest.fixture(scope="module")
+def friction_fit(material, tmp_path_factory):
+    from microimpact.analysis.oblique import fit_friction
+    from microimpact.analysis.synthetic import make_synthetic_oblique
+    table = _table(make_synthetic_oblique(radii=(3.45e-6,), speeds=(30.0, 60.0), incidence_deg=(35.0, 60.0)),
+                   tmp_path_factory, "oblique")
+    return fit_friction(table, fit_damping(table, material, confidence_intervals=False))
+
+
+@pytest.mark.slow
+def test_friction_fit_carries_a_verdict_and_never_claims_a_nan_term(friction_fit):
+    import dataclasses
+    v = friction_fit.verdict
+    assert v.verdict in (ADEQUATE, INADEQUATE) and v.degrees_of_freedom == friction_fit.n_points - 1
+    assert "verdict     :" in friction_fit.report()
+    assert friction_fit.to_dataset().attrs["verdict"] == v.verdict
+    assert friction_fit.identifiability["friction"].determined  # else the lines below test nothing
+    nan = dataclasses.replace(friction_fit, stderr={k: math.nan for k in friction_fit.stderr})
+    text = nan.report()
+    assert "uncertainty of the damping included" not in text and "could not be propagated" in text
+    finite = dataclasses.replace(friction_fit, stderr={k: 1.2 * s for k, s in friction_fit.stderr_conditional.items()})
+    assert "uncertainty of the damping included" in finite.report()
