@@ -265,3 +265,15 @@ def test_printed_stderr_does_not_depend_on_the_solver_tolerance(material, tmp_pa
     for x, y in zip(a["stderr"], b["stderr"]):
         if x not in ("fixed", "n/a", "not determined"):
             assert float(x) == pytest.approx(float(y), rel=0.01)
+
+
+def test_dem_law_verdict_agrees_with_its_status():
+    """A DEM law the fit calls 'inadequate' has the verdict inadequate, by the same chi-square test."""
+    from microimpact.analysis.dem_fit import DemLawFit
+    bad = DemLawFit("hertz", "viscoelastic", math.nan, (math.nan, math.nan), "inadequate", 7488.0, 63, True,
+                    0.0, 0.0, 1.0)
+    good = DemLawFit("hertz", "viscoelastic", 1.0, (0.9, 1.1), "determined", 60.0, 63, True, 0.0, 0.0, 1.0)
+    assert bad.verdict.verdict == INADEQUATE and bad.verdict.degrees_of_freedom == 62
+    assert bad.verdict.p_value == pytest.approx(stats.chi2.sf(7488.0, 62))
+    assert good.verdict.verdict == ADEQUATE
+    assert bad.to_dataset().attrs["verdict"] == INADEQUATE
