@@ -60,12 +60,14 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from microimpact._runtime.usage import parse_or_status
+from microimpact.analysis.analyst_fit import analyse_impacts
+from microimpact.analysis.dirty_data import DIRTY_MATERIAL_PAIR, make_outlier_impacts, make_thornton_impacts
 from microimpact.analysis.fitting import fit_damping
 from microimpact.analysis.oblique import ObliqueProblem, _FrictionObjective, fit_friction
 from microimpact.analysis.posterior import PosteriorError, sample_posterior
 from microimpact.analysis.synthetic import make_synthetic_impacts, make_synthetic_oblique
 from microimpact.dynamics.nonlinear import capture_velocity
-from microimpact.io import read_impacts
+from microimpact.io import default_materials_path, read_impacts, read_materials
 from microimpact.io.files import atomic_path, atomic_write, write_csv
 from microimpact.io.materials import material_contact
 from microimpact.model.parameters import TABLE1_ROW2
@@ -510,6 +512,97 @@ def plot_calibration(summary: dict, path) -> Path:
     return path
 
 
+#: the dirty-data kinds of :func:`dirty_study`: name -> table maker of a seed (issue 51 item 8)
+DIRTY_KINDS = {
+    "clean": lambda seed: make_outlier_impacts(0, seed=seed),
+    "1 outlier": lambda seed: make_outlier_impacts(1, seed=seed),
+    "2 outliers": lambda seed: make_outlier_impacts(2, seed=seed),
+    "3 outliers": lambda seed: make_outlier_impacts(3, seed=seed),
+    "Thornton 1997 law": lambda seed: make_thornton_impacts(seed=seed),
+}
+
+
+def run_dirty_design(kind: str, seed: int, folder: Path) -> dict:
+    """One dirty-data design: the verdict, the outliers named, and whether the interval of the
+    fit after the handling (the refit without the named outliers) covers the generating values."""
+    df = DIRTY_KINDS[kind](seed)
+    path = write_csv(df, folder / f"{kind.replace(' ', '_')}_{seed}.csv", float_format="%.6g")
+    material = read_materials(default_materials_path())[DIRTY_MATERIAL_PAIR]
+    result = analyse_impacts(read_impacts(path), material)
+    v = result.damping.verdict
+    final = result.without_outliers or result.damping
+    truth = df.attrs.get("truth", {})
+    covered = {}
+    for name, value in truth.items():
+        lo, hi = final.interval(name)
+        covered[name] = None if lo != lo else bool(lo < value < hi)
+    planted = set(df.attrs.get("outlier_ids", []))
+    return {"kind": kind, "seed": seed, "verdict": v.verdict, "p_value": v.p_value,
+            "outliers_named": list(v.outlier_ids), "outliers_planted": sorted(planted),
+            "named_exactly": set(v.outlier_ids) == planted, "false_alarm": bool(set(v.outlier_ids) - planted),
+            "after_handling": final.verdict.verdict, "covered": covered}
+
+
+def summarise_dirty(records: list[dict]) -> dict:
+    """Per kind: how often the verdict is right, outliers named exactly, false alarms, coverage."""
+    out = {}
+    for kind in DIRTY_KINDS:
+        rs = [r for r in records if r["kind"] == kind]
+        if not rs:
+            continue
+        right = (lambda r: r["verdict"] == "adequate") if kind == "clean" else (lambda r: r["verdict"] == "inadequate")
+        entry = {"verdict_right": _binomial(sum(map(right, rs)), len(rs)),
+                 "outliers_named_exactly": _binomial(sum(r["named_exactly"] for r in rs), len(rs)),
+                 "false_alarm": _binomial(sum(r["false_alarm"] for r in rs), len(rs)),
+                 "adequate_after_handling": _binomial(sum(r["after_handling"] == "adequate" for r in rs), len(rs))}
+        for name in FITTED:
+            cov = [r["covered"][name] for r in rs if r["covered"].get(name) is not None]
+            if cov:
+                entry[f"coverage_{name}"] = _binomial(sum(cov), len(cov))
+        out[kind] = entry
+    return out
+
+
+def plot_dirty(summary: dict, path) -> Path:
+    """Bars of the dirty-data study's rates per kind, with their Monte Carlo errors."""
+    fig = Figure(figsize=(8, 3.6), layout="constrained")
+    ax = fig.subplots()
+    measures = ["verdict_right", "outliers_named_exactly", "false_alarm", "coverage_zeta_adhesion"]
+    kinds = list(summary)
+    width = 0.8 / len(measures)
+    for k, m in enumerate(measures):
+        vals = [summary[c].get(m, {}).get("coverage", np.nan) for c in kinds]
+        errs = [summary[c].get(m, {}).get("mc_error", np.nan) for c in kinds]
+        ax.bar(np.arange(len(kinds)) + (k - 1.5) * width, vals, width, yerr=errs, label=m.replace("_", " "))
+    ax.axhline(0.95, color="k", lw=0.6, ls="--")
+    ax.axhline(0.05, color="k", lw=0.6, ls=":")
+    ax.set_xticks(np.arange(len(kinds)), kinds)
+    ax.set_ylim(0, 1.05)
+    ax.set_ylabel("fraction of designs")
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.0, 0.5))
+    fig.savefig(path)
+    return Path(path)
+
+
+def dirty_main(n: int, seed: int, out, figure) -> int:
+    """``python tests/study_calibration.py --dirty N --out J [--figure F]``: N seeds of every kind."""
+    records = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for kind in DIRTY_KINDS:
+            for s in range(seed, seed + n):
+                records.append(run_dirty_design(kind, s, Path(tmp)))
+                print(json.dumps({k: records[-1][k] for k in ("kind", "seed", "verdict", "outliers_named")}),
+                      file=sys.stderr, flush=True)
+    summary = summarise_dirty(records)
+    with atomic_write(out) as f:
+        json.dump({"summary": summary, "setup": {"designs_per_kind": n, "seed": seed}, "designs": records}, f,
+                  indent=1, default=float)
+    if figure:
+        plot_dirty(summary, figure)
+    print(json.dumps(summary, indent=1))
+    return 0
+
+
 def main(argv=None) -> int:
     """``python tests/study_calibration.py``: run the study, write JSON (and the figure).
 
@@ -550,9 +643,13 @@ def main(argv=None) -> int:
     p.add_argument("--time-budget", type=float, default=None, metavar="SECONDS", help="stop past this wall-clock time")
     p.add_argument("--out", required=True, help="output JSON")
     p.add_argument("--figure", default=None, help="also draw the coverage figure here (.png or .pdf)")
+    p.add_argument("--dirty", type=int, default=0, metavar="N",
+                   help="instead: the dirty-data study, N seeds of each kind (clean, 1-3 outliers, Thornton law)")
     args, status = parse_or_status(p, argv)
     if args is None:
         return status
+    if args.dirty > 0:
+        return dirty_main(args.dirty, args.seed, args.out, args.figure)
     for name in ("designs", "workers"):
         if getattr(args, name) < 1:
             print(f"calibration: error: --{name} must be >= 1", file=sys.stderr)

@@ -81,7 +81,7 @@ def test_fit_recovers_generating_values_within_uncertainty(fit):
 
 def test_report_is_readable(fit):
     text = fit.report()
-    for word in ("zeta_hertz", "zeta_adhesion", "reduced", "AIC", "BIC", "fixed", "1-sigma CI"):
+    for word in ("zeta_hertz", "zeta_adhesion", "reduced", "AIC", "BIC", "fixed", "95 % interval", "verdict     : adequate"):
         assert word in text
     assert "synthetic_microspheres.csv" in text
 
@@ -231,7 +231,7 @@ def test_one_formatter_text_and_markdown(fit):
     assert format_fit(fit) == fit.report()
     md = format_fit(fit, "markdown")
     assert md.splitlines()[0].startswith("| parameter | units | value |")
-    assert table.loc[0, "ci1"] in md and "**chi-square**" in md
+    assert table.loc[0, "ci95"] in md and "**chi-square**" in md
     with pytest.raises(ValueError, match="style"):
         format_fit(fit, "html")
 

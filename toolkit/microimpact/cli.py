@@ -232,6 +232,9 @@ def register_fit(sub) -> None:
     p.add_argument("--fit-work-of-adhesion", action="store_true", help="also fit w_A (shared by all radii)")
     p.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto", help="weighting (default auto)")
     p.add_argument("--no-confidence-intervals", action="store_true", help="skip lmfit.conf_interval (faster)")
+    p.add_argument("--exclude", default="", metavar="ID,...",
+                   help="leave out the rows of these CSV ids (the report lists them); outliers the fit names are "
+                        "refitted without automatically, both fits shown")
     _add_rtol(p)
     p.add_argument("--out", required=True, help="output NetCDF of the fit")
     p.add_argument("--json", action="store_true", help="print the results as JSON instead of the text report")

@@ -8,7 +8,7 @@ import sys
 
 from microimpact._commands.common import UsageError
 from microimpact._commands.tables import impacts_for_pair, input_files
-from microimpact.analysis.analyst_fit import analyse_impacts
+from microimpact.analysis.analyst_fit import analyse_impacts, exclude_rows
 from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_WALKERS, check_posterior_memory
 from microimpact.io.paths import check_outputs, reporting_os_errors
 
@@ -37,7 +37,7 @@ def run(args) -> int:
     result = analyse_impacts(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
                              confidence_intervals=not args.no_confidence_intervals, posterior=posterior,
                              errors_in_variables=args.errors_in_variables, rtol=args.rtol, progress=True,
-                             time_budget=args.time_budget)
+                             time_budget=args.time_budget, exclude=_exclude_ids(args.exclude, table))
     with reporting_os_errors(outputs):
         written = result.save(out, outputs.get("--posterior"), outputs.get("--oblique-out"))
     if args.json:
@@ -46,6 +46,16 @@ def run(args) -> int:
         print(result.report())
     print("wrote " + ", ".join(map(str, written)), file=sys.stderr)
     return 0
+
+
+def _exclude_ids(text, table) -> tuple:
+    """``--exclude ID,...`` as ids, each checked against the table (a usage error naming an unknown one)."""
+    ids = tuple(i.strip() for i in (text or "").split(",") if i.strip())
+    try:
+        exclude_rows(table, ids)
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
+    return ids
 
 
 def _json_ready(obj):
@@ -75,8 +85,12 @@ def _fit_summary(result, table, pair, written) -> dict:
 
     d = result.damping
     summary = {"material_pair": pair.name, "n_points": int(len(table)),
-               "damping": {"parameters": parameters(d), "chisqr": float(d.chisqr), "redchi": float(d.redchi)},
+               "damping": {"parameters": parameters(d), "chisqr": float(d.chisqr), "redchi": float(d.redchi),
+                           "verdict": d.verdict.to_record()},
                "written": [str(p) for p in written]}
+    if result.without_outliers is not None:
+        w = result.without_outliers
+        summary["damping"]["without_outliers"] = {"parameters": parameters(w), "verdict": w.verdict.to_record()}
     if result.friction is not None:
         summary["friction"] = {"parameters": parameters(result.friction), "tangential_model": result.friction.tangential_model}
     if result.posterior is not None:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import sys
 
+import xarray as xr
+
 from microimpact._commands.common import FIGURE_FORMATS, UsageError
 from microimpact.io.paths import PathError, check_input_file, check_outputs, reporting_os_errors
 from microimpact.io.resources import check_memory
@@ -29,5 +31,21 @@ def run(args) -> int:
     with reporting_os_errors({"--out": out}):
         caption = save_standard_figure(figure, dpi=args.dpi)
     print(caption)
+    verdict = _verdict_line(inputs["RESULT"])
+    if verdict:
+        print(verdict)
     print(f"wrote {out}", file=sys.stderr)
     return 0
+
+
+def _verdict_line(path) -> str:
+    """The fit's verdict and outliers from a fit file's attributes ("" for a file that has none)."""
+    try:
+        with xr.open_dataset(path) as ds:
+            a = dict(ds.attrs)
+    except (OSError, ValueError):
+        return ""
+    if not a.get("verdict_text"):
+        return ""
+    outliers = f"; outliers: {a['outlier_ids']}" if a.get("outlier_ids") else ""
+    return f"verdict: {a['verdict_text']}{outliers}"

@@ -27,14 +27,14 @@ from microimpact.analysis.oblique import FrictionFit
 from microimpact.analysis.posterior import Posterior
 from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import all_or_nothing, write_netcdf
-from microimpact.analysis.fitting import fit_damping
+from microimpact.analysis.fitting import FitProblem, fit_damping, model_restitution
 from microimpact.analysis.oblique import ObliqueProblem, fit_friction
 from microimpact.analysis.posterior import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS,
                                             capture_velocity_interval, restitution_bands, sample_posterior, sweep_bands)
 from microimpact.io.provenance import stamp_parameters
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
-__all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS"]
+__all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS", "exclude_rows", "side_by_side"]
 
 def _posterior_defaults() -> dict:
     return dict(walkers=DEFAULT_WALKERS, max_steps=DEFAULT_MAX_STEPS, steps=None, burn=None, seed=DEFAULT_SEED,
@@ -103,6 +103,8 @@ class AnalystFit(ReportHTML, FitResult):
     friction: object = None
     posterior: object = None
     posterior_dataset: xr.Dataset | None = None
+    #: the damping fit without the outliers its verdict names (None when it names none)
+    without_outliers: object = None
 
     def __repr__(self) -> str:
         parts = [repr(self.damping)] + [repr(x) for x in (self.friction, self.posterior) if x is not None]
@@ -111,6 +113,8 @@ class AnalystFit(ReportHTML, FitResult):
     def report(self) -> str:
         """The text reports of the parts that were computed."""
         parts = [self.damping.report()]
+        if self.without_outliers is not None:
+            parts.append(side_by_side(self.damping, self.without_outliers))
         if self.friction is not None:
             parts.append(self.friction.report())
         if self.posterior is not None:
@@ -118,8 +122,18 @@ class AnalystFit(ReportHTML, FitResult):
         return "\n".join(parts)
 
     def to_dataset(self) -> xr.Dataset:
-        """The main result's Dataset: the damping fit's (:meth:`DampingFit.to_dataset`)."""
-        return self.damping.to_dataset()
+        """The main result's Dataset: the damping fit's (:meth:`DampingFit.to_dataset`), with the
+        refit without the outliers as ``without_outliers_<name>`` attributes (value, interval)."""
+        ds = self.damping.to_dataset()
+        w = self.without_outliers
+        if w is not None:
+            for name in w.varied:
+                lo, hi = w.interval(name)
+                ds.attrs.update({f"without_outliers_{name}": float(w.values[name]),
+                                 f"without_outliers_{name}_interval_low": lo,
+                                 f"without_outliers_{name}_interval_high": hi})
+            ds.attrs["without_outliers_chi_square"] = float(w.verdict.chi_square)
+        return ds
 
     @classmethod
     def from_dataset(cls, ds: xr.Dataset) -> "AnalystFit":
@@ -165,7 +179,8 @@ class AnalystFit(ReportHTML, FitResult):
 
 def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights="auto", confidence_intervals: bool = False,
                     friction: bool = True, posterior: bool | dict = False, errors_in_variables: str = "auto",
-                    rtol: float = DEFAULT_RTOL, progress: bool = False, time_budget: float | None = None) -> AnalystFit:
+                    rtol: float = DEFAULT_RTOL, progress: bool = False, time_budget: float | None = None,
+                    exclude=(), outlier_refit: bool = True) -> AnalystFit:
     """Fit the damping, the friction (if oblique columns) and optionally sample the posterior.
 
     Parameters
@@ -190,6 +205,11 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
         Progress bars on stderr (a terminal only).
     time_budget : float, optional
         Wall-clock budget of the whole analysis (all stages share it); None: no limit. [s]
+    exclude : sequence of str
+        CSV ids of rows to leave out (the fit's verdict lists them).
+    outlier_refit : bool
+        Where the verdict names outliers, refit without them and keep both fits
+        (:attr:`AnalystFit.without_outliers`); the outliers named are those the refit confirms.
 
     Returns
     -------
@@ -224,9 +244,19 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     ValueError: unknown posterior option(s) ['wlakers']; known: ['burn', 'max_steps', 'n_draws', 'seed', 'steps', 'walkers']
     """
     deadline = Deadline.start(time_budget, "analyst fit")
-    damping = fit_damping(table, base, fit_work_of_adhesion=fit_work_of_adhesion, weights=weights,
-                          confidence_intervals=confidence_intervals, rtol=rtol, progress=progress,
-                          time_budget=deadline)
+    table, excluded = exclude_rows(table, exclude)
+
+    def damping_fit(rows):
+        return fit_damping(rows, base, fit_work_of_adhesion=fit_work_of_adhesion, weights=weights,
+                           confidence_intervals=confidence_intervals, rtol=rtol, progress=progress,
+                           time_budget=deadline)
+
+    damping = damping_fit(table)
+    without = None
+    if outlier_refit and damping.verdict.outlier_ids:
+        damping, without = _refit_without_outliers(table, damping, damping_fit, rtol)
+    if excluded:
+        damping = dataclasses.replace(damping, info=damping.info | {"excluded_ids": ",".join(excluded)})
     ff = None
     if friction:
         try:
@@ -240,7 +270,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
                 "friction_stderr": ff.stderr["friction"], "friction_source": source, "friction_n_points": ff.n_points,
                 "friction_status": ff.identifiability["friction"].status})
     if not posterior:
-        return AnalystFit(damping, ff)
+        return AnalystFit(damping, ff, without_outliers=without)
     opts = _posterior_options(posterior)
 
     post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], max_steps=opts["max_steps"],
@@ -250,7 +280,86 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     ds = post.to_dataset(restitution_bands(post, damping, n_draws=nd, rtol=rtol, time_budget=deadline),
                          capture_velocity_interval(post, damping, n_draws=nd, time_budget=deadline),
                          sweep_bands(post, damping, n_draws=max(nd // 2, 4), rtol=rtol, time_budget=deadline))
-    return AnalystFit(damping, ff, post, ds)
+    return AnalystFit(damping, ff, post, ds, without)
+
+
+def _table_ids(table) -> list[str]:
+    """The CSV's id of each row of ``table`` ('row N' where the file has none), as DampingFit.row_ids."""
+    rows = table["row"].tolist() if "row" in table.columns else list(range(1, len(table) + 1))
+    if "id" in table.columns:
+        return [str(i) if str(i) not in ("", "nan") else f"row {r}" for i, r in zip(table["id"].tolist(), rows)]
+    return [f"row {r}" for r in rows]
+
+
+def exclude_rows(table, ids) -> tuple:
+    """(``table`` without the rows of the CSV ids ``ids``, the ids excluded); an id the table does not
+    hold is refused, naming it.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> t = pd.DataFrame({"id": ["a", "b", "c"], "e_n": [0.5, 0.6, 0.7]})
+    >>> kept, gone = exclude_rows(t, ["b"])
+    >>> kept["id"].tolist(), gone
+    (['a', 'c'], ('b',))
+    >>> exclude_rows(t, ["x"])
+    Traceback (most recent call last):
+    ...
+    ValueError: --exclude: id 'x' is not a row of the impact table (ids: a, b, c)
+    """
+    ids = tuple(str(i).strip() for i in (ids or ()) if str(i).strip())
+    if not ids:
+        return table, ()
+    known = _table_ids(table)
+    unknown = [i for i in ids if i not in known]
+    if unknown:
+        shown = ", ".join(known[:8]) + (", ..." if len(known) > 8 else "")
+        raise ValueError(f"--exclude: id {unknown[0]!r} is not a row of the impact table (ids: {shown})")
+    keep = [i not in ids for i in known]
+    out = table.loc[keep].reset_index(drop=True)
+    out.attrs = dict(table.attrs)
+    return out, ids
+
+
+def _refit_without_outliers(table, damping, damping_fit, rtol):
+    """(the fit with its confirmed outliers in its info, the refit without them).
+
+    The rows the first fit names are refitted without; an outlier is confirmed where its
+    standardized residual against the refit is still beyond the threshold (a row named only
+    because the outliers pulled the fit is not). Never drops a row silently: both fits are kept."""
+    verdict = damping.verdict
+    ids = _table_ids(table)
+    named = [i for i in ids if i in verdict.outlier_ids]
+    for _ in range(2):  # at most once more, without the confirmed rows only
+        kept, _gone = exclude_rows(table, named)
+        refit = damping_fit(kept)
+        at = [ids.index(i) for i in named]
+        d = damping.data.iloc[at]
+        model = model_restitution(FitProblem.from_arrays(d["radius"], d["normal_speed"], refit),
+                                  refit.zeta_hertz, refit.zeta_adhesion, refit.work_of_adhesion, rtol=rtol)
+        z = (model - d["e_n"].to_numpy(float)) / d["sigma"].to_numpy(float)
+        confirmed = [i for i, zi in zip(named, z) if not abs(zi) <= verdict.outlier_threshold]
+        if confirmed == named or not confirmed:
+            break
+        named = confirmed
+    info = damping.info | {"outlier_ids": ",".join(confirmed),
+                           "without_outliers": (f"without {', '.join(confirmed)}: {refit.verdict.text()}"
+                                                if confirmed else "")}
+    return dataclasses.replace(damping, info=info), (refit if confirmed else None)
+
+
+def side_by_side(fit, refit) -> str:
+    """The fit with and without its outliers, one line per parameter: value and 95 % interval."""
+    lines = [f"Fit with and without the outliers ({fit.verdict.outlier_ids and ', '.join(fit.verdict.outlier_ids)})",
+             f"  {'':<17}{'all ' + str(fit.n_points) + ' rows':<36}without the outliers ({refit.n_points} rows)"]
+    for name in fit.varied:
+        cells = []
+        for f in (fit, refit):
+            lo, hi = f.interval(name)
+            cells.append(f"{f.values[name]:.5g} [{lo:.5g}, {hi:.5g}]" if lo == lo else f"{f.values[name]:.5g} (bound)")
+        lines.append(f"  {name:<17}{cells[0]:<36}{cells[1]}")
+    lines.append(f"  {'verdict':<17}{fit.verdict.verdict:<36}{refit.verdict.text()}")
+    return "\n".join(lines)
 
 
 def _friction_for_simulations(ff, configured: float) -> tuple[float, str]:

@@ -60,6 +60,7 @@ from scipy import optimize, stats
 
 from microimpact.analysis.fitting import _sigma_e, _table_arrays
 from microimpact.analysis.identifiability import chi2_threshold
+from microimpact.analysis.verdict import ADEQUACY_P, ADEQUATE, INADEQUATE, NO_UNCERTAINTIES, Verdict
 from microimpact.io.materials import material_contact
 from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import DEM_LAWS, RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
@@ -72,7 +73,8 @@ __all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_la
 INTERVAL_LEVEL = math.erf(1.0 / math.sqrt(2.0))
 #: with stated uncertainties, a law whose chi^2 has a p-value below this does not describe the data
 #: (its interval would be meaningless): status "inadequate", no value
-ADEQUACY_P = 1e-3
+#: ADEQUACY_P: imported from microimpact.analysis.verdict, its one home
+
 _GRID = 41  # start grid over the physical range
 #: eta_n0 searched from 1e-4 critical dampings up to where e_n has fallen below 1e-4 at the median
 #: impact (Hertz: 3 critical dampings for viscoelastic, 1 for mass_velocity, measured); beyond it a
@@ -180,6 +182,16 @@ class DemLawFit(FitResult):
     _data: tuple = field(default=(), repr=False, compare=False)
 
     @property
+    def verdict(self) -> Verdict:
+        """Adequate or not by the chi-square test of the stated uncertainties (the same
+        :class:`~microimpact.analysis.verdict.Verdict` every fit carries)."""
+        dof = float(self.n - self.parameters)
+        if not self.sigma_known:
+            return Verdict(NO_UNCERTAINTIES, math.nan, dof, math.nan, what=f"{self.law} law")
+        p = float(stats.chi2.sf(self.chisqr, dof)) if dof > 0 else math.nan
+        return Verdict(INADEQUATE if p < ADEQUACY_P else ADEQUATE, float(self.chisqr), dof, p, what=f"{self.law} law")
+
+    @property
     def determined(self) -> bool:
         """Every fitted parameter determined (only then is the law written for an engine)."""
         return self.status == "determined" and (not self.adhesion_fitted or self.adhesion_status == "determined")
@@ -277,6 +289,7 @@ class DemLawFit(FitResult):
             "sigma_known": int(self.sigma_known), "aic": float(self.aic), "bic": float(self.bic), "source": str(self.source),
             "adhesion_fitted": int(self.adhesion_fitted), "adhesion_status": self.adhesion_status,
             **{f"material_{k}": float(v) for k, v in self.material.items()}})
+        ds.attrs.update(self.verdict.to_attrs())
         return ds
 
     @classmethod

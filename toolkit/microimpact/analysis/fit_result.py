@@ -15,6 +15,7 @@ without importing lmfit (slow to import) or the compiled engine.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +27,7 @@ import xarray as xr
 
 from microimpact.io.formatting import ReportHTML, estimates_repr
 from microimpact.analysis.identifiability import status_from_variables, status_variables
+from microimpact.analysis.verdict import Verdict, assess_residuals
 from microimpact.io.kinds import file_kind
 from microimpact.io.statuses import stderr_is_meaningful
 from microimpact.io.files import CONVENTIONS, restore_label_coordinates, write_netcdf
@@ -42,6 +44,8 @@ __all__ = ["FitResult", "DampingFit", "fit_parameter_table", "format_fit", "PARA
 PARAMETER_NAMES = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
 #: sigma levels of the lmfit confidence intervals
 SIGMA_LEVELS = (-2, -1, 1, 2)
+#: the standard normal quantile of a two-sided 95 % interval
+_Z95 = 1.959963984540054
 #: the columns of DampingFit.data that the fit computes (the others are the analyst's row labels)
 _POINT_COLUMNS = ("row", "radius", "normal_speed", "e_n", "sigma", "model", "residual")
 
@@ -321,6 +325,43 @@ class DampingFit(ReportHTML, FitResult):
         """
         return fit_parameter_source(self.info.get("source"), self.info.get("sha256"))
 
+    @property
+    def row_ids(self) -> tuple:
+        """The CSV's id of each fitted row (its row number where the file has no ``id``)."""
+        d = self.data
+        if "id" in d.columns:
+            ids = d["id"].astype(str).to_numpy()
+            return tuple(i if i else f"row {r}" for i, r in zip(ids, d["row"].to_numpy()))
+        return tuple(f"row {r}" for r in d["row"].to_numpy())
+
+    @property
+    def verdict(self) -> Verdict:
+        """Whether the damping law describes these data, the outliers by id and the misfit in words
+        (:func:`microimpact.analysis.verdict.assess_residuals` of the standardized residuals)."""
+        d = self.data
+        v = assess_residuals(d["residual"].to_numpy(float), len(self.varied), stated=self.weighting != "none",
+                             ids=self.row_ids, speed=d["normal_speed"].to_numpy(float),
+                             radius=d["radius"].to_numpy(float), what="damping law")
+        # the outliers confirmed by the refit without them (analyse_impacts), where it ran
+        named, without = self.info.get("outlier_ids"), self.info.get("without_outliers")
+        excluded = tuple(x for x in str(self.info.get("excluded_ids") or "").split(",") if x)
+        # an adequate refit without the outliers: they are the misfit, not the law
+        misfit = "" if ": adequate:" in str(without or "") else v.misfit_description
+        return dataclasses.replace(v, outlier_ids=v.outlier_ids if named is None else
+                                   tuple(x for x in str(named).split(",") if x), misfit_description=misfit,
+                                   without_outliers=str(without or ""), excluded=excluded)
+
+    def interval(self, name: str, widened: bool = False) -> tuple[float, float]:
+        """The one interval of ``name``: its 95 % profile-likelihood interval (NaN where the data do
+        not determine it); ``widened``: each side scaled by the verdict's sqrt(reduced chi-square)
+        (the interval of a rejected model with its misfit counted as noise). [units of name]"""
+        st = self.identifiability.get(name)
+        if st is None or not st.determined:
+            return math.nan, math.nan
+        w = self.verdict.widening if widened else 1.0
+        v = self.values[name]
+        return float(v - w * (v - st.lower)), float(v + w * (st.upper - v))
+
     # ------------------------------------------------------------------ report
     def report(self) -> str:
         """Readable summary: values, errors, intervals, correlations and fit statistics.
@@ -363,8 +404,15 @@ class DampingFit(ReportHTML, FitResult):
             ds[f"{name}_confidence_limit"] = xr.DataArray(
                 np.array([ci.get(s, np.nan) for s in SIGMA_LEVELS], dtype=float), dims=("sigma_level",),
                 attrs={"units": units, "long_name": f"lmfit.conf_interval limit of {name}"})
+        verdict = self.verdict
         for name, st in self.identifiability.items():
             ds.update(status_variables(st, attributes(name)["units"]))
+            lo, hi = self.interval(name)
+            wlo, whi = self.interval(name, widened=True)
+            # the one interval (95 % profile likelihood) and the standard error it implies
+            ds[name].attrs.update({"interval_low": lo, "interval_high": hi, "interval_level": 0.95,
+                                   "interval_stderr": (hi - lo) / (2 * _Z95), "widened_interval_low": wlo,
+                                   "widened_interval_high": whi})
         ds["correlation"] = xr.DataArray(self.correlation, dims=("parameter", "parameter_b"),
                                          attrs=attributes("correlation"))
         ds.update(label_variables(d[[c for c in d.columns if c not in _POINT_COLUMNS]], "point"))
@@ -383,6 +431,7 @@ class DampingFit(ReportHTML, FitResult):
                                         else float(self.damping_reference_speed)),
             "weighting": self.weighting, "scale_covar": int(self.scale_covar),
         })
+        ds.attrs.update(verdict.to_attrs())
         for k, v in self.info.items():
             if v is None:
                 continue
@@ -440,8 +489,10 @@ def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
         Columns :data:`PARAMETER_TABLE_COLUMNS`: ``parameter``, ``units`` (of
         :mod:`microimpact.io.variables`), ``value``, ``stderr`` ("fixed" for a fixed
         parameter), ``relative`` (stderr / |value| in %), ``ci1`` and ``ci2`` (1- and 2-sigma
-        intervals ``[lo, hi]``) and ``method``: profile likelihood (:func:`lmfit.conf_interval`)
-        where it was computed, else value +/- k stderr.
+        intervals ``[lo, hi]``), ``ci95`` (the one interval: 95 % profile likelihood) and ``method``:
+        profile likelihood (:func:`lmfit.conf_interval`) where it was computed, else value +/- k
+        stderr. Where the 95 % profile interval exists, ``stderr`` is the one it implies (its width
+        / 3.92), so that the printed standard error agrees with the printed interval.
 
     Examples
     --------
@@ -453,7 +504,7 @@ def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
     >>> fit = fit_damping(read_impacts(path), material, confidence_intervals=False)
     >>> table = fit_parameter_table(fit)
     >>> table[["parameter", "value", "stderr"]].values.tolist()
-    [['zeta_hertz', '0.596372', '0.195'], ['zeta_adhesion', '28.3897', '0.51'], ['work_of_adhesion', '0.215834', 'fixed']]
+    [['zeta_hertz', '0.596372', '0.196'], ['zeta_adhesion', '28.3897', '0.507'], ['work_of_adhesion', '0.215834', 'fixed']]
     """
     rows = []
     for name in PARAMETER_NAMES:
@@ -475,6 +526,11 @@ def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
         else:
             ci1 = ci2 = None
             method = "not estimated"
+        if st is not None and math.isfinite(st.lower) and math.isfinite(st.upper):
+            # the one interval is the profile's 95 %; the standard error printed is the one it implies
+            s = (st.upper - st.lower) / (2 * _Z95)
+            if not ci:
+                ci1, ci2, method = (v - s, v + s), (v - 2 * s, v + 2 * s), "profile likelihood (stderr: 95 % interval width / 3.92)"
         meaningful = stderr_is_meaningful(v, s)
         rows.append(row | {
             "stderr": f"{s:.3g}" if meaningful else "n/a", "relative": f"{100 * s / abs(v):.2g} %" if meaningful else "",
@@ -515,7 +571,9 @@ def _fit_facts(fit: "DampingFit") -> dict:
         "AIC, BIC": f"{fit.aic:.4g}, {fit.bic:.4g}",
         "evaluations": f"{fit.info.get('nfev', '?')} ({fit.info.get('elapsed_s', math.nan):.2f} s), "
                        f"{fit.info.get('message', '')}",
-        "note": fit.info.get("ci_message") or None,
+        # lmfit's sigma-level intervals: a note only where they would be printed (no 95 % interval)
+        "note": (fit.info.get("ci_message") or None) if not all(
+            (st := fit.identifiability.get(n)) is not None and st.determined for n in fit.varied) else None,
         "WARNING": fit.info.get("goodness_of_fit") or None,
         "measurements": (f"{fit.info['outside_physical_range']} measured e_n outside [0, 1] within their stated "
                          "uncertainty, fitted as measured" if fit.info.get("outside_physical_range") else None),
@@ -548,15 +606,18 @@ def format_fit(fit: "DampingFit", style: str = "text") -> str:
     >>> path = write_synthetic_impacts("six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
     >>> fit = fit_damping(read_impacts(path), material, confidence_intervals=False)
     >>> print(format_fit(fit, "markdown").splitlines()[2])
-    | zeta_hertz | 1 | 0.596372 | 0.195 | [0.40147, 0.79127] | [0.20658, 0.98617] | covariance: value +/- k stderr |
+    | zeta_hertz | 1 | 0.596372 | 0.196 | [0.22795, 0.99477] | profile likelihood (stderr: 95 % interval width / 3.92) |
     """
     table, facts = fit_parameter_table(fit), _fit_facts(fit)
     if style == "markdown":
-        head = ["parameter", "units", "value", "std. error", "1-sigma interval", "2-sigma interval", "method"]
-        cols = ["parameter", "units", "value", "stderr", "ci1", "ci2", "method"]
+        head = ["parameter", "units", "value", "std. error", "95 % interval", "method"]
+        cols = ["parameter", "units", "value", "stderr", "ci95", "method"]
         lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-        lines += ["| " + " | ".join(str(r[c]) for c in cols) + " |" for _, r in table.iterrows()]
+        lines += ["| " + " | ".join(str(r[c]) or (f"2-sigma {r['ci2']}" if c == "ci95" and r["ci2"] else "")
+                                    for c in cols) + " |" for _, r in table.iterrows()]
         lines.append("")
+        lines += [f"- **{line.split(':', 1)[0].strip()}**: {line.split(':', 1)[1].strip()}"
+                  for line in fit.verdict.lines()]
         for label, text in facts.items():
             text = "; ".join(text) or "n/a" if isinstance(text, list) else text
             lines.append(f"- **{label}**: {text}")
@@ -567,6 +628,8 @@ def format_fit(fit: "DampingFit", style: str = "text") -> str:
     for label in ("data", "points", "weighting", "material"):
         if label in facts:
             lines.append(f"  {label:<12}: {facts[label]}")
+    verdict = fit.verdict
+    lines += verdict.lines()
     lines.append("  parameters  :")
     for _, r in table.iterrows():
         if r["stderr"] == "fixed":
@@ -579,7 +642,12 @@ def format_fit(fit: "DampingFit", style: str = "text") -> str:
         rel = f" ({r['relative']})" if r["relative"] else ""
         how = "" if r["method"].startswith("profile") else f" ({r['method']})"
         ci95 = f"; 95 % interval {r['ci95']} (profile likelihood)" if r["ci95"] else ""
-        ci = f"; 1-sigma CI {r['ci1']}, 2-sigma CI {r['ci2']}{how}" if r["ci1"] else ""
+        # one interval per parameter: the sigma-level ones only where no 95 % interval exists
+        ci = f"; 1-sigma CI {r['ci1']}, 2-sigma CI {r['ci2']}{how}" if r["ci1"] and not r["ci95"] else ""
+        if r["ci95"] and verdict.rejected:
+            lo, hi = fit.interval(r["parameter"], widened=True)
+            ci95 += (f", conditional on the rejected model; widened by the misfit (x{verdict.widening:.3g}): "
+                     f"[{lo:.5g}, {hi:.5g}]")
         err = f" +/- {r['stderr']}{rel}" if r["stderr"] != "n/a" else ""
         lines.append(f"    {r['parameter']:<17}= {r['value']}{err} [{r['units']}]{ci95}{ci}")
     if facts["correlations"]:

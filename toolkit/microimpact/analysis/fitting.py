@@ -476,9 +476,11 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
         info["goodness_of_fit"] = (f"chi-square {result.chisqr:.4g} for {result.nfree} degrees of freedom (p = "
                                    f"{stats.chi2.sf(result.chisqr, result.nfree):.2g}): the model does not describe these "
                                    "data within their stated uncertainties at the best fit found")
+    undetermined = [n for n, st in identifiability.items() if not st.determined]
     if not info["success"] and result.success:
-        info["message"] = ("least squares converged, but the data do not determine "
-                           + ", ".join(n for n, st in identifiability.items() if not st.determined))
+        info["message"] = ("least squares converged, but the data do not determine " + ", ".join(undetermined)
+                           if undetermined else "least squares converged, but the model does not describe the data "
+                           "(see the verdict)")
     info["outside_physical_range"] = outside
     return DampingFit(values={n: float(result.params[n].value) for n in PARAMETER_NAMES},
                       stderr={n: _stderr(result.params[n]) for n in PARAMETER_NAMES}, varied=varied,

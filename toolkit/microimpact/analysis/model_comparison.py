@@ -31,12 +31,13 @@ import lmfit
 import numpy as np
 import xarray as xr
 
+from microimpact.analysis.verdict import ADEQUATE, NO_UNCERTAINTIES, assess_residuals
 from microimpact.analysis.fitting import FitProblem
 from microimpact.io.variables import attributes
 from microimpact.model.adhesion_models import AdhesionRegimeWarning, tabor_parameter
 from microimpact.solvers import DEFAULT_RTOL, engine, normal_models
 
-__all__ = ["compare_normal_models", "normal_model_restitution", "DEFAULT_MODELS", "DEFAULT_START_GRID"]
+__all__ = ["compare_normal_models", "comparison_verdict", "normal_model_restitution", "DEFAULT_MODELS", "DEFAULT_START_GRID"]
 
 #: the models compared by default: the paper's ring force and JKR (and DMT)
 DEFAULT_MODELS = ("ring", "jkr", "dmt")
@@ -173,10 +174,12 @@ def compare_normal_models(table, base, models=DEFAULT_MODELS, *, rtol: float = D
     curve_speed = np.geomspace(speed.min() * 0.8, speed.max() * 1.2, curve_points)
     rows = {k: [] for k in ("aic", "bic", "chi_square", "zeta_hertz", "zeta_adhesion", "work_of_adhesion",
                             "zeta_hertz_stderr", "zeta_adhesion_stderr", "work_of_adhesion_stderr")}
-    curves, tabor = [], []
+    curves, tabor, verdicts = [], [], []
     for model in models:
         res = _fit_one(problem, model, e_n, sigma, w0, rtol, start_grid)
         p = res.params
+        verdicts.append(assess_residuals(res.residual, res.nvarys, stated=weighted, speed=speed, radius=radius,
+                                         what=f"{model} law"))
         rows["aic"].append(res.aic)
         rows["bic"].append(res.bic)
         rows["chi_square"].append(res.chisqr)
@@ -187,8 +190,46 @@ def compare_normal_models(table, base, models=DEFAULT_MODELS, *, rtol: float = D
                                                 p["work_of_adhesion"].value, rtol=rtol,
                                                 normal_speed=curve_speed[None, :], radius=radii[:, None]))
         tabor.append(tabor_parameter(radii, base.stiffness, p["work_of_adhesion"].value))
-    return _comparison_dataset(models, rows, curves, tabor, radii, curve_speed, radius, speed, e_n, sig,
-                               weighted, res.ndata, res.nvarys)
+    ds = _comparison_dataset(models, rows, curves, tabor, radii, curve_speed, radius, speed, e_n, sig,
+                             weighted, res.ndata, res.nvarys)
+    ds["verdict"] = xr.DataArray(np.array([v.verdict for v in verdicts], dtype=object), dims="normal_model",
+                                 attrs={"long_name": "adequacy of each model (chi-square test of the stated uncertainties)"})
+    ds["p_value"] = xr.DataArray(np.array([v.p_value for v in verdicts]), dims="normal_model",
+                                 attrs={"units": "1", "long_name": "p-value of the chi-square test"})
+    ds.attrs["comparison_verdict"] = comparison_verdict(list(models), verdicts, ds["aic"].values)
+    return ds
+
+
+def comparison_verdict(models, verdicts, aic) -> str:
+    """The comparison in one sentence: never a rejected model "preferred".
+
+    All rejected: "all rejected; least bad: X (its verdict), largest misfit where ..."; else the
+    lowest AIC among the adequate models; without stated uncertainties, the lowest AIC against the
+    scatter (no model can be rejected).
+
+    Examples
+    --------
+    >>> from microimpact.analysis.verdict import Verdict
+    >>> bad = [Verdict("inadequate", c, 58.0, 1e-30, misfit_description="model too low at 3-8 m/s") for c in (600.0, 500.0)]
+    >>> comparison_verdict(["jkr", "dmt"], bad, np.array([20.0, 8.0]))
+    'all rejected; least bad: dmt (inadequate: chi-square 500 for 58 degrees of freedom (p = 1e-30)); largest misfit where model too low at 3-8 m/s'
+    """
+    aic = np.asarray(aic, dtype=float)
+    if all(v.verdict == NO_UNCERTAINTIES for v in verdicts):
+        k = int(np.argmin(aic))
+        return f"no stated uncertainties: no model can be rejected; lowest AIC against the scatter: {models[k]}"
+    adequate = [i for i, v in enumerate(verdicts) if v.verdict == ADEQUATE]
+    if not adequate:
+        k = int(np.argmin([v.chi_square for v in verdicts]))
+        v = verdicts[k]
+        where = f"; largest misfit where {v.misfit_description}" if v.misfit_description else ""
+        return f"all rejected; least bad: {models[k]} ({v.text()}){where}"
+    k = min(adequate, key=lambda i: aic[i])
+    others = [models[i] for i in adequate if i != k]
+    rejected = [models[i] for i in range(len(models)) if i not in adequate]
+    return (f"adequate: {', '.join(models[i] for i in adequate)}; lowest AIC among them: {models[k]}"
+            + (f" (by {min(aic[i] for i in adequate if i != k) - aic[k]:.3g} over {', '.join(others)})" if others else "")
+            + (f"; rejected: {', '.join(rejected)}" if rejected else ""))
 
 
 def _comparison_dataset(models, rows, curves, tabor, radii, curve_speed, radius, speed, e_n, sig, weighted,

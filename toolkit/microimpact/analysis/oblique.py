@@ -56,6 +56,7 @@ from scipy import stats
 from scipy.optimize import brentq, minimize_scalar
 
 from microimpact.analysis.fit_result import FitResult
+from microimpact.analysis.verdict import assess_residuals
 from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import CONVENTIONS, restore_label_coordinates
 from microimpact.io.impacts import OBLIQUE_COLUMNS, insert_row_labels, label_variables, labels_from_dataset, row_labels
@@ -520,14 +521,19 @@ class FrictionFit(ReportHTML, FitResult):
                 lines.append(f"  {k:<17}: {st.describe()}")
                 continue
 
+            propagated = held or math.isfinite(self.stderr[k])  # a NaN term is not "included"
             if stderr_is_meaningful(v, self.stderr[k]) and stderr_is_meaningful(v, self.stderr_conditional[k]):
                 lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr[k]:.3g}" + (" (at the normal law's values)" if held else
                              f" (with the uncertainty of {before}; {self.stderr_conditional[k]:.3g} at its best values)"))
+            elif not propagated and stderr_is_meaningful(v, self.stderr_conditional[k]):
+                lines.append(f"  {k:<17}= {v:.6g} +/- {self.stderr_conditional[k]:.3g} (at the best values of {before}: "
+                             "its uncertainty could not be propagated)")
             else:  # a standard error above 100 % says nothing the interval does not say better
                 lines.append(f"  {k:<17}= {v:.6g} (standard error above 100 %: see the interval)")
             if st is not None:
                 lines.append(f"  {'':<17}  95 % interval [{st.lower:.6g}, {st.upper:.6g}] ({st.method}"
-                             + (")" if held else f", uncertainty of {before} included)"))
+                             + (")" if held else f", uncertainty of {before} included)" if propagated
+                                else f", at the best values of {before})"))
         lines += self._stiffness_lines()
         if "work_of_adhesion" in self.info.get("normal_propagated", ""):
             lines.append("  note        : with the work of adhesion fitted too, this interval covered the true mu in 63 of 68 "
@@ -537,7 +543,19 @@ class FrictionFit(ReportHTML, FitResult):
         lines.append(f"  data        : {self.n_points} entries: {qs}; "
                      f"{'stated uncertainties + effective variance' if self.weighted else 'unweighted'}")
         lines.append(f"  chi-square  : {self.chisqr:.4g}, reduced {self.redchi:.4g}")
+        lines += self.verdict.lines()
         return "\n".join(lines)
+
+    @property
+    def verdict(self):
+        """Whether the tangential model describes the oblique entries, outliers by id
+        (:func:`microimpact.analysis.verdict.assess_residuals`)."""
+        d = self.data
+        z = (d["model"].to_numpy(float) - d["measured"].to_numpy(float)) / d["sigma"].to_numpy(float)
+        ids = (d["id"].astype(str).tolist() if "id" in d.columns else [f"row {r}" for r in d["row"]])
+        return assess_residuals(np.nan_to_num(z), len(self.values), stated=bool(self.weighted), ids=ids,
+                                speed=d["speed"].to_numpy(float), radius=d["radius"].to_numpy(float),
+                                what=f"{self.tangential_model} tangential model")
 
     def _stiffness_lines(self) -> list[str]:
         """The report's lines on the held tangential stiffness of a DEM law (fit_dem_friction)."""
@@ -593,6 +611,7 @@ class FrictionFit(ReportHTML, FitResult):
                 "units": "1", "long_name": f"{ln} of the entry's quantity (unit of the quantity: see quantity_units)"})
         ds["quantity_units"] = ("entry", np.array([OBSERVABLE_UNITS[q] for q in d["quantity"]], dtype=object),
                                 {"long_name": "unit of the entry's quantity"})
+        ds.attrs.update(self.verdict.to_attrs())
         ds.attrs.update({"title": self.TITLE, "Conventions": CONVENTIONS,
                          "tangential_model": self.tangential_model, "chisqr": self.chisqr, "redchi": self.redchi,
                          "n_points": self.n_points, "weighted": int(self.weighted),

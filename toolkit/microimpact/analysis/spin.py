@@ -39,6 +39,7 @@ import xarray as xr
 
 from microimpact.analysis.oblique import OBSERVABLE_UNITS, ObliqueProblem, _observables, rebound_state
 from microimpact.analysis.posterior import _contact
+from microimpact.analysis.verdict import sidak_threshold
 from microimpact.solvers import engine_threads
 from microimpact._runtime.progress import progress_bar
 from microimpact.solvers import DEFAULT_RTOL, Deadline
@@ -67,6 +68,10 @@ SPIN_VARIABLES = {
                               "median), in the unit of predicted_quantity"),
     "angle_shift_high": (None, "most positive change of the prediction at +/- one angle uncertainty (posterior "
                                "median), in the unit of predicted_quantity"),
+    "measured_value": (None, "the row's measured predicted_quantity, in its unit"),
+    "model_value": (None, "the fitted model's predicted_quantity at zero spin and the nominal angle (posterior median)"),
+    "standardized_residual": ("1", "(model_value - measured_value) / its standard uncertainty (measurement, speed "
+                                   "and angle errors, posterior spread)"),
     "closest_sigma": ("1", "smallest distance of the prediction from the measurement over the spin scan, in "
                            "standard uncertainties (measurement, speed and angle errors, posterior spread)"),
 }
@@ -78,8 +83,9 @@ _FLAGS = {
     "spin_moves_prediction": ("still moves", "spin_moves_probability >= 0.5"),
     "angle_moves_prediction": ("still moves", "angle_moves_probability >= 0.5"),
     "probably_spun": ("unspun_consistent probably_spun", "zero spin is outside the consistent spin range"),
-    "spin_unexplained": ("explained unexplained", "the measured quantity depends on spin, yet no spin in the scan is "
-                                                  "consistent with the measurement"),
+    "spin_unexplained": ("explained unexplained", "no spin in the scan and no angle error brings the prediction within "
+                                                  "the outlier threshold (Sidak over the rows, at least 3 sigma) of "
+                                                  "the measurement (also a row whose quantity does not depend on spin)"),
 }
 
 
@@ -255,7 +261,12 @@ def _explain(pred, k0, n_scan, quantity, measured, sigma_m, bound, scan, table) 
     # a row whose prediction does not move with spin (e_n, by the decoupling of the normal motion)
     # admits every spin: whether it fits the model is not a question about spin
     blind = np.nanmax(np.nan_to_num(spin_change), axis=0) <= 1e-9 * np.maximum(np.abs(np.nan_to_num(p0)).max(axis=0), 1e-300)
-    ok |= blind[:, None]
+    # the same test the fit's verdict names outliers by (Sidak over the rows, never below 3 sigma):
+    # a row that no spin and no angle error brings near the model is unexplained, whether or not
+    # its quantity depends on spin (a blind e_n row 20 sigma off is unexplained, as its residual says)
+    threshold = max(CONSISTENCY_SIGMAS, sidak_threshold(len(table)))
+    explained = (np.isfinite(distance) & (distance <= threshold)).any(axis=1)
+    ok |= blind[:, None] & explained[:, None]
     any_ok = ok.any(axis=1)
     low = np.where(any_ok, np.min(np.where(ok, spins, np.inf), axis=1), np.nan)
     high = np.where(any_ok, np.max(np.where(ok, spins, -np.inf), axis=1), np.nan)
@@ -268,12 +279,14 @@ def _explain(pred, k0, n_scan, quantity, measured, sigma_m, bound, scan, table) 
               "spin_low": low, "spin_high": high, "spin_scan_bound": bound,
               "spin_shift_low": np.nan_to_num(spin_lo), "spin_shift_high": np.nan_to_num(spin_hi),
               "angle_shift_low": np.nan_to_num(angle_lo), "angle_shift_high": np.nan_to_num(angle_hi),
-              "closest_sigma": np.nanmin(np.where(np.isfinite(distance), distance, np.inf), axis=1)}
+              "closest_sigma": np.nanmin(np.where(np.isfinite(distance), distance, np.inf), axis=1),
+              "measured_value": measured, "model_value": med[:, k0],
+              "standardized_residual": (med[:, k0] - measured) / np.sqrt(sigma_eff ** 2 + spread[:, k0] ** 2)}
     for name, v in values.items():
         units, long_name = SPIN_VARIABLES[name]
         ds[name] = ("impact", v, {"long_name": long_name} | ({"units": units} if units else {}))
     flags = {"spin_moves_prediction": spin_p >= 0.5, "angle_moves_prediction": angle_p >= 0.5,
-             "probably_spun": any_ok & ~ok[:, k0], "spin_unexplained": ~any_ok}
+             "probably_spun": any_ok & ~ok[:, k0], "spin_unexplained": ~explained}
     for name, (meanings, long_name) in _FLAGS.items():
         ds[name] = ("impact", flags[name].astype(np.int8), {"flag_values": np.array([0, 1], dtype=np.int8),
                                                             "flag_meanings": meanings, "long_name": long_name})

@@ -491,7 +491,9 @@ def _derive(v: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
     if "rebound_normal_speed" in v:
         r, sr = out["rebound_normal_speed"], out["rebound_normal_speed_uncertainty"]
         out["e_n"] = r / vn
-        out["e_n_uncertainty"] = _unc(sr / vn, (r / vn) * (svn / vn))
+        # a stated rebound uncertainty is used without an incident one (the incident speed then
+        # counts as exact: its term is zero, not unknown), so that it is never dropped silently
+        out["e_n_uncertainty"] = _unc(sr / vn, (r / vn) * np.where(np.isfinite(sr) & np.isnan(svn), 0.0, svn / vn))
     else:
         e, se = out["e_n"], out["e_n_uncertainty"]
         out["rebound_normal_speed"] = e * vn
