@@ -15,7 +15,7 @@ import pytest
 from microimpact import Contact
 from microimpact.model.dem_rolling import lammps_rolling_force, lammps_rolling_torque, lammps_rolling_velocity
 from microimpact.solvers.dem_tangential import DemTangentialError
-from microimpact.solvers.impact import simulate_impact
+from microimpact.solvers.impact import simulate_impact, simulate_many
 
 SPHERE = {"radius": 1e-6, "density": 2000.0, "stiffness": 1e9, "adhesion_line_force": 0.0}
 MINDLIN = {"tangential_model": "lammps_mindlin", "shear_modulus": 3e8}
@@ -182,3 +182,26 @@ def test_lammps_fit_holds_a_given_rolling_law_while_it_fits_mu_and_writes_both(t
     assert main(argv[:7] + ["--rolling-stiffness", "200", "--out", "c3.lmp"]) == 2  # no --tangential-model
     assert "give --tangential-model too" in capsys.readouterr().err
     assert not (tmp_path / "c2.lmp").exists() and not (tmp_path / "c3.lmp").exists()
+
+
+@pytest.mark.parametrize("omega", [(0.0, 0.0, 0.0), (0.0, 0.0, -2e6), (0.0, 2e5, -1e5)])
+def test_rolling_sds_with_its_default_mu_roll_0_is_the_law_without_rolling(omega):
+    # LAMMPS's rolling sds limits its force to mu_roll F_n0 (model.dem_rolling): with mu_roll 0, its
+    # documented default, that force is 0 at every step, so the impact is the tangential law's alone,
+    # to the bit (it crashed: TypeError in solvers.dem_tangential, issue 55)
+    plain = Contact(**SPHERE, friction=0.3, **MINDLIN)
+    sds = plain.with_(rolling_model="lammps_sds", rolling_stiffness=50.0, rolling_damping=2e-7)
+    assert sds.rolling_friction == 0.0
+    base, res = (simulate_impact(c, 2.0, 30.0, omega=omega) for c in (plain, sds))
+    assert res.velocity_out == base.velocity_out and res.omega_out == base.omega_out
+    assert base.omega_out != (0.0, 0.0, 0.0)  # the friction's torque acts, so a dropped tangential law would show
+
+
+def test_rolling_sds_with_mu_roll_0_runs_in_a_batch_and_when_captured():
+    jkr = Contact.from_work_of_adhesion(radius=1e-6, density=2000.0, stiffness=1e9, work_of_adhesion=0.02,
+                                        normal_model="jkr_force", friction=0.3, **MINDLIN)
+    sds = jkr.with_(rolling_model="lammps_sds", rolling_stiffness=50.0)
+    batch = simulate_many(sds, [0.01, 0.7], 30.0)
+    plain = simulate_many(jkr, [0.01, 0.7], 30.0)
+    assert list(batch["outcome"].values) == [1, 0]  # capture, rebound (the outcome codes of simulate_many)
+    np.testing.assert_array_equal(batch["velocity_out_t"].values, plain["velocity_out_t"].values)

@@ -23,11 +23,9 @@ import math
 import numbers
 import sys
 
-from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
-from microimpact.model.dem_twisting import DEM_TWISTING_MODELS
-from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 # the time budgets of every long computation; solvers are where most of them are spent and checked
 from microimpact._runtime.budget import Deadline, TimeBudgetExceeded, check_time_budget  # noqa: F401
+from microimpact.model import laws
 
 #: The one default relative tolerance of every entry point (API, CLI, pipeline config ``rtol``).
 #: At 1e-8 the engine's e_n and impulse ratios are within about 5e-8 of the reference solution
@@ -127,24 +125,12 @@ def engine_threads(threads: int | None = 1):
 #: The solvers behind simulate_impact(method=...).
 METHODS = ("engine", "reference", "rkg")
 
-#: What each solver path covers of the selectable sub-models (microimpact.model.contact.SUB_MODELS);
-#: a contact that selects anything else is refused by :func:`check_sub_models` with a message that
-#: says which method does cover it. Extended as sub-models are implemented.
-SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {
-    # the engine runs the paper's model (rigid, net) as one normal solve plus the closed-form map and
-    # every other tangential/friction choice with the compiled coupled solver (.coupled), which
-    # integrates the ring normal law only (check_sub_models refuses jkr/dmt with it)
-    "engine": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"),
-               "tangential_model": ("rigid", "mindlin", "mindlin_deresiewicz", *DEM_TANGENTIAL_MODELS),
-               "friction_model": ("net", "pulloff"),
-               "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
-               "rolling_model": ("torque", *DEM_ROLLING_MODELS), "twisting_model": ("none", *DEM_TWISTING_MODELS)},
-    "reference": {"normal_model": ("ring", "jkr", "dmt", "jkr_force"), "tangential_model": ("rigid",), "friction_model": ("net",),
-                  "damping_model": ("paper", "mass_velocity", "viscoelastic", "tsuji", "coeff_restitution"),
-                  "rolling_model": ("torque",), "twisting_model": ("none",)},
-    "rkg": {"normal_model": ("ring",), "tangential_model": ("rigid",), "friction_model": ("net",),
-            "damping_model": ("paper",), "rolling_model": ("torque",), "twisting_model": ("none",)},
-}
+#: What each solver path covers of the selectable sub-models (microimpact.model.contact.SUB_MODELS),
+#: derived from the laws' own declarations (microimpact.model.laws, SubModel.methods); a contact that
+#: selects anything else is refused by :func:`check_sub_models` with a message that says which
+#: method does cover it. The engine runs the paper's model (rigid, net) as one normal solve plus the
+#: closed-form map and every other tangential/friction choice with the compiled coupled solver (.coupled).
+SUPPORTED_SUB_MODELS: dict[str, dict[str, tuple[str, ...]]] = {m: laws.supported(m) for m in METHODS}
 #: solver paths that model rolling resistance (Contact.rolling_friction > 0): the engine's coupled
 #: solver (.coupled), with a compliant tangential model (ROLLING_RESISTANCE_TANGENTIAL_MODELS)
 ROLLING_RESISTANCE_METHODS: tuple[str, ...] = ("engine",)
@@ -171,14 +157,15 @@ def check_sub_models(contact, method: str) -> None:
         raise ValueError(f"rolling_friction={contact.rolling_friction!r} needs a compliant tangential model "
                          f"(tangential_model one of {', '.join(map(repr, ROLLING_RESISTANCE_TANGENTIAL_MODELS))}), "
                          f"got tangential_model={contact.tangential_model!r}")
-    if contact.tangential_model in DEM_TANGENTIAL_MODELS:  # with LAMMPS's normal laws (Contact checks)
-        return
-    if contact.damping_model != "paper" and (contact.tangential_model != "rigid" or contact.friction_model != "net"):
+    # the coupled solver's laws, as the laws declare them (model.laws.SubModel.coupled); LAMMPS's
+    # tangential laws run with their own solver and LAMMPS's normal laws (Contact checks)
+    refused = laws.coupled_refusal({f: getattr(contact, f) for f in laws.fields()})
+    if refused == "damping_model":
         raise ValueError(f"damping_model={contact.damping_model!r} runs with the paper's tangential map only "
                          "(tangential_model='rigid', friction_model='net'): the coupled solver integrates the "
                          f"paper's damping; got tangential_model={contact.tangential_model!r}, "
                          f"friction_model={contact.friction_model!r}")
-    if contact.normal_model != "ring" and (contact.tangential_model != "rigid" or contact.friction_model != "net"):
+    if refused == "normal_model":
         raise ValueError(f"normal_model={contact.normal_model!r} runs with the paper's tangential map only "
                          "(tangential_model='rigid', friction_model='net'): the coupled solver of tangential "
                          f"compliance and adhesion-aware friction integrates the ring normal law; got "

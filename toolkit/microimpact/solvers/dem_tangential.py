@@ -168,8 +168,10 @@ class _Law:
         self.mu = contact.friction
         self.spin = contact.mass * contact.radius**2 / contact.moment_of_inertia
         self.kappa = 1.0 + self.spin
-        # LAMMPS's rolling law (model.dem_rolling): k_roll in F / L, gamma_roll in F / (L / T)
-        self.rolling = contact.rolling_model in DEM_ROLLING_MODELS
+        # LAMMPS's rolling law (model.dem_rolling): k_roll in F / L, gamma_roll in F / (L / T); with
+        # mu_roll = 0 (LAMMPS's default) its limit mu_roll F_n0 is 0 and so is its force at every step:
+        # the slip is integrated without it (``_slip``), and its state (w, the spring) is not carried
+        self.rolling = contact.rolling_model in DEM_ROLLING_MODELS and contact.rolling_friction > 0.0
         self.k_r = contact.rolling_stiffness / self.k_unit if self.rolling else 0.0
         self.gamma_r = contact.rolling_damping * float(sc.speed) / force
         self.mu_r = contact.rolling_friction if self.rolling else 0.0

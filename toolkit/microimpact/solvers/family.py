@@ -59,7 +59,7 @@ from microimpact._numba import njit, njit_batch
 from microimpact.model.coefficients import coefficients_kernel
 from microimpact.model.law import contact_potential_energy
 from microimpact.model.tangential import tangential_kernel
-from microimpact.solvers import DEFAULT_RTOL, engine
+from microimpact.solvers import DEFAULT_RTOL, SolverError, engine
 
 __all__ = ["NormalFamily", "normal_family", "normal_restitution", "FamilyBudgetExceeded", "DEGREE", "GUARD", "GUARD_IMPACTS",
            "FAMILY_MIN_SPEEDS"]
@@ -92,8 +92,12 @@ _OUTPUTS = (("e_n_squared", False), ("time", True), ("max_penetration", True), (
             ("twist_impulse", True), ("dissipated_fraction", False))
 
 
-class FamilyBudgetExceeded(RuntimeError):
+class FamilyBudgetExceeded(SolverError):
     """The family would need more normal solves than the budget (solving directly is cheaper).
+
+    A budget of solves, not of time (that is :class:`microimpact.solvers.TimeBudgetExceeded`, the
+    package's one time-budget error): a :class:`~microimpact.solvers.SolverError`, so the solvers'
+    errors are one hierarchy.
 
     Examples
     --------
