@@ -2,7 +2,7 @@
 
 Thin: parse, call the library, print or write. Exit statuses: 0 success; 2 bad arguments, inputs
 or a solver failure (one line ``microimpact: error: ...`` on stderr); 3 the computation ran past
-``--time-budget SECONDS`` (``fit``, ``flags``, ``sweep``, ``target``, ``reproduce``, ``benchmark``; one
+``--time-budget SECONDS`` (``fit``, ``flags``, ``sweep``, ``target``, ``reproduce``, ``benchmark``, ``lammps``; one
 such line naming the budget); 141, quietly, when the reader of stdout went away (``| head``). Nothing is written on an
 error: outputs are written, atomically, only after the work.
 
@@ -185,7 +185,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="microimpact", description="Microsphere contact/impact with smooth, flat surfaces.",
                      epilog=f"Exit status: 0 success; 2 bad arguments or inputs, or a solver failure; "
                             f"{EXIT_TIME_BUDGET} the computation ran past --time-budget (fit, flags, sweep, "
-                            "target, reproduce, benchmark); 141 (quietly) when stdout is closed early (| head). "
+                            "target, reproduce, benchmark, lammps); 141 (quietly) when stdout is closed early (| head). "
                             "Nothing is written on an error.")
     parser.add_argument("--version", action="version", version=f"microimpact {__version__}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
@@ -384,6 +384,7 @@ def register_lammps(sub) -> None:
                    help=f"Poisson ratio written with E (default {DEFAULT_POISSON}; E follows so that the stiffness is kept)")
     e.add_argument("--wall", default="zplane 0.0 NULL", help="LAMMPS wall style and arguments (default 'zplane 0.0 NULL')")
     e.add_argument("--out", required=True, help="output LAMMPS input file")
+    _add_time_budget(e)
     e.set_defaults(func=_handler("lammps", "run_export"))
     f = lsub.add_parser("fit", help="fit the damping of LAMMPS laws (with --fit-adhesion also the work of adhesion) to "
                                     "measured impacts (CSV), rank the laws by AIC and "
@@ -434,6 +435,7 @@ def register_lammps(sub) -> None:
     f.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")
     _add_rtol(f)
     f.add_argument("--out", required=True, help="output LAMMPS input file")
+    _add_time_budget(f)
     f.set_defaults(func=_handler("lammps", "run_fit"))
     v = lsub.add_parser("verify", help="run LAMMPS on an exported file over speeds x angles and compare with microimpact "
                                        f"(exit status {EXIT_DISAGREES} if they disagree; needs microimpact[lammps])")
@@ -448,6 +450,7 @@ def register_lammps(sub) -> None:
                    help=f"largest difference accepted in e_n, e_t, the spin ratio and, with a twisting law, the twist "
                         f"ratio (default {DEFAULT_TOLERANCE:g})")
     v.add_argument("--out", default=None, help="write the whole comparison table as CSV")
+    _add_time_budget(v)
     v.set_defaults(func=_handler("lammps", "run_verify"))
 
 
