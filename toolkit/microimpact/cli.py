@@ -22,14 +22,14 @@ import os
 import re
 import shutil
 import signal
-import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
 from microimpact import __version__
 from microimpact._commands.common import AUTO_TANGENTIAL, CONTACT_FIELDS, EXIT_DISAGREES, FIGURE_FORMATS, UsageError
-from microimpact._runtime.locks import remove_stale_lock
+from microimpact._runtime.locks import remove_stale_lock, snakemake_processes_in
+from microimpact._runtime.supervise import run_supervised
 from microimpact._runtime.signals import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_after_writing
 from microimpact._runtime.usage import exit_status
 from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_SEED, DEFAULT_WALKERS, MAX_SEED
@@ -590,25 +590,30 @@ def _cmd_workflow(args) -> int:
             shutil.rmtree(directory, ignore_errors=True)
 
 
+def _refuse_unlock_while_running(directory: Path) -> None:
+    """UsageError if a Snakemake process works in ``directory``: ``--unlock`` would take the lock
+    from a live run, and a second run would then write its files beside it."""
+    holders = snakemake_processes_in(directory)
+    if holders:
+        ids = ", ".join(map(str, holders))
+        raise UsageError(f"--unlock: a Snakemake run is going on in {directory} (process {ids}); its lock is not "
+                         f"stale: wait for it to end or stop it (kill {ids})")
+
+
 def _run_workflow(command: list[str], directory: Path) -> int:
-    if "--unlock" not in command:
+    if "--unlock" in command:
+        _refuse_unlock_while_running(directory)
+    else:
         _clear_stale_lock(directory)
     print(f"microimpact: running the pipeline ({command[4]}) in {directory}", file=sys.stderr, flush=True)
-
-    # Ctrl-C reaches Snakemake from the terminal (same process group); Snakemake then stops its jobs,
-    # removes their unfinished outputs and releases its lock. The wrapper only waits for that:
-    # subprocess.call would kill Snakemake on the KeyboardInterrupt, leaving the directory locked.
-    interrupted: list[int] = []
-    proc = subprocess.Popen(command)
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: interrupted.append(signum))
-    try:
-        status = proc.wait()
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    if interrupted:
+    # Ctrl-C reaches Snakemake from the terminal (same process group); a SIGTERM to this process is
+    # passed on; Snakemake then stops its jobs, removes their unfinished outputs and releases its
+    # lock, and what it prints meanwhile is dropped (microimpact._runtime.supervise)
+    status, stopped_by = run_supervised(command)
+    if stopped_by is not None:
         print("microimpact: workflow interrupted; finished results are kept and unfinished ones removed; run the "
               "same command again to resume", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return EXIT_INTERRUPTED if stopped_by == signal.SIGINT else 128 + int(stopped_by)
     return status
 
 
@@ -645,7 +650,8 @@ def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | N
         if word == "--":
             break
         name = word.split("=", 1)[0]
-        if name.startswith("-") and not NEGATIVE_NUMBER.match(name) and name not in known:
+        # "-" alone is a value (argparse reads it as one: --out -), not an option
+        if name.startswith("-") and name != "-" and not NEGATIVE_NUMBER.match(name) and name not in known:
             close = difflib.get_close_matches(name, known, n=1)
             return f"unrecognized option {name}" + (f" (did you mean {close[0]}?)" if close else "")
     return None
