@@ -44,3 +44,28 @@ def test_fit_to_a_full_stdout_writes_no_file(small_csv, tmp_path):
     assert lines[-1].startswith("microimpact: error: stdout") and "No space left" in lines[-1], done.stderr
     assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["simulate", "--speed", "1_0"], "--speed: not a number: '1_0'"),  # float() read it as 10
+    (["simulate", "--speed", " 2"], "--speed: not a number"),
+    (["simulate", "--speed", "2", "--radius", "3_0e-6"], "--radius: not a number"),
+    (["fit", "d.csv", "--out", "f.nc", "--posterior", "p.nc", "--walkers", "3_2"], "--walkers: not a whole number"),
+    (["lammps", "verify", "f.lmp", "--steps", "2_000"], "--steps: not a whole number"),
+    (["target", "--e-n", "0.5", "--speed", "1", "--points", "1000000"], "--points: at most 10000 points"),
+    (["target", "--e-n", "0.5", "--speed", "1", "--points", "2"], "--points: must be a whole number >= 3"),
+    (["flags", "d.csv", "--fit", "f.nc", "--out", "o.csv", "--angle-uncertainty-deg", "1e6"],
+     "--angle-uncertainty-deg: an incidence-angle uncertainty is below 90 deg"),
+])
+def test_numbers_parse_strictly_and_counts_are_bounded_before_the_work(argv, named, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and named in err[0], err
+
+
+@pytest.mark.parametrize("name", ["", " "])
+def test_an_empty_preset_names_no_preset(name, capsys):
+    # --preset '' was taken as the default preset
+    assert main(["simulate", "--speed", "2", "--preset", name]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--preset" in err[0] and "wall1990" in err[0], err

@@ -86,11 +86,20 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+#: a number as a user types one: Python's float() also takes "1_0" (as 10), surrounding blanks and
+#: "infinity"; an option's value is read strictly, so a typo is refused instead of read as another number
+STRICT_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|[-+]?(inf|infinity|nan)", re.IGNORECASE)
+#: a whole number as a user types one (int() also takes "1_0" and blanks)
+STRICT_WHOLE = re.compile(r"[-+]?\d+")
+#: most points per curve of ``target`` (each point is a root solve of Eq. (27); the memory check of
+#: microimpact.analysis.target bounds the arrays, this the work, before it starts)
+MAX_TARGET_POINTS = 10_000
+
+
 def _finite_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not STRICT_NUMBER.fullmatch(text):
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}")
+    value = float(text)
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"not a finite number: {text!r}")
     return value
@@ -261,10 +270,9 @@ def _add_posterior_options(p: argparse.ArgumentParser) -> None:
 
 
 def _whole_number(text: str, smallest: int) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if not STRICT_WHOLE.fullmatch(text):
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}")
+    value = int(text)
     if value < smallest:
         raise argparse.ArgumentTypeError(f"must be a whole number >= {smallest}, got {text!r}")
     return value
@@ -286,6 +294,22 @@ def _positive_int(text: str) -> int:
     return _whole_number(text, 1)
 
 
+def _target_points(text: str) -> int:
+    value = _whole_number(text, 3)
+    if value > MAX_TARGET_POINTS:
+        raise argparse.ArgumentTypeError(f"at most {MAX_TARGET_POINTS} points per curve (each is a root solve of "
+                                         f"Eq. (27)), got {text!r}")
+    return value
+
+
+def _angle_uncertainty(text: str) -> float:
+    value = _non_negative_float(text)
+    if value >= 90.0:
+        raise argparse.ArgumentTypeError(f"an incidence-angle uncertainty is below 90 deg (incidences lie in "
+                                         f"[0, 90)), got {text!r}")
+    return value
+
+
 def register_flags(sub) -> None:
     """``microimpact flags DATA.csv --fit fit.nc --out flags.csv``: per-measurement flags."""
     p = sub.add_parser("flags", help="flag impacts sensitive to unmeasured spin, angle error, or near capture")
@@ -297,7 +321,7 @@ def register_flags(sub) -> None:
     p.add_argument("--nc", help="also write the flags as NetCDF")
     p.add_argument("--spin-bound", type=_non_negative_float, default=None, metavar="RAD_S",
                    help="largest initial spin sampled [rad/s] (default: speed / radius per impact)")
-    p.add_argument("--angle-uncertainty-deg", type=_non_negative_float, default=None, metavar="DEG",
+    p.add_argument("--angle-uncertainty-deg", type=_angle_uncertainty, default=None, metavar="DEG",
                    help="incidence-angle uncertainty [deg] (default: the file's column, else 2)")
     p.add_argument("--posterior", default=None, metavar="NC",
                    help="posterior NetCDF of 'microimpact fit --posterior': flags and spin ranges over its draws")
@@ -317,7 +341,8 @@ def register_target(sub) -> None:
     p.add_argument("--speed", type=_positive_float, nargs="+", required=True, help="normal speed of each target [m/s]")
     p.add_argument("--e-n-uncertainty", type=_positive_float, nargs="+", default=None,
                    help="standard uncertainty of each target e_n (weights of the least-squares point)")
-    p.add_argument("--points", type=_positive_int, default=41, help="points per curve (default 41, >= 3)")
+    p.add_argument("--points", type=_target_points, default=41,
+                   help=f"points per curve (default 41, 3 to {MAX_TARGET_POINTS})")
     _add_rtol(p)
     p.add_argument("--out", default=None, help="write the curve(s): .csv (one row per point) or .nc; default: print CSV")
     _add_time_budget(p)
@@ -355,10 +380,7 @@ def _dem_law(text: str) -> tuple[str, str]:
 
 
 def _steps(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    value = _whole_number(text, 10)
     if not 10 <= value <= 10**6:
         raise argparse.ArgumentTypeError(f"must lie in [10, 1000000], got {text!r}")
     return value
