@@ -69,3 +69,46 @@ def test_an_empty_preset_names_no_preset(name, capsys):
     assert main(["simulate", "--speed", "2", "--preset", name]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--preset" in err[0] and "wall1990" in err[0], err
+
+
+@pytest.fixture
+def small_tmpfs(tmp_path):
+    """A mount point and a function that mounts a tmpfs of a given size on it (root only; skipped else)."""
+    import subprocess as sp
+
+    point = tmp_path / "mnt"
+    point.mkdir()
+    mounted = []
+
+    def mount(size_bytes: int) -> Path:
+        size = max(4096, -(-size_bytes // 4096) * 4096)  # whole pages
+        done = sp.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(point)], capture_output=True)
+        if done.returncode != 0:
+            pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode(errors='replace').strip()}")
+        mounted.append(point)
+        return point
+
+    yield mount
+    for p in mounted:
+        sp.run(["umount", str(p)], check=False)
+
+
+@pytest.mark.slow  # a tiny benchmark and its figure, twice: tens of seconds on a loaded machine
+def test_benchmark_on_a_file_system_that_fills_up_writes_all_or_nothing(small_tmpfs, tmp_path, monkeypatch, capsys):
+    # benchmark --out on a disk that filled up left benchmark.nc and none of the other outputs
+    from microimpact._commands import benchmark as command
+    from microimpact.studies.benchmark import BenchmarkConfig, run_benchmark
+
+    ds = run_benchmark(config=BenchmarkConfig.tiny_(), throughput=False)
+    monkeypatch.setattr(command, "run_benchmark", lambda **kwargs: ds)
+    whole = tmp_path / "whole"
+    assert main(["benchmark", "--out", str(whole)]) == 0
+    sizes = {p.name: p.stat().st_size for p in whole.iterdir()}
+    assert len(sizes) == 5
+    capsys.readouterr()
+    # room for benchmark.nc (written first) and a little, not for the rest
+    out = small_tmpfs(sizes["benchmark.nc"] + 4096) / "out"
+    assert main(["benchmark", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "No space left" in err[0], err
+    assert not out.exists() or sorted(out.iterdir()) == []  # no file at all, no temporary file
