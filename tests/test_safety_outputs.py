@@ -112,3 +112,33 @@ def test_benchmark_on_a_file_system_that_fills_up_writes_all_or_nothing(small_tm
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "No space left" in err[0], err
     assert not out.exists() or sorted(out.iterdir()) == []  # no file at all, no temporary file
+
+
+@pytest.mark.parametrize("form", [["--configfile", "{missing}"], ["--configfile={missing}"],
+                                  ["--configfiles", "{present}", "{missing}"]])
+def test_workflow_names_a_missing_configfile_in_one_line(form, tmp_path, capsys):
+    # Snakemake answered a missing --configfile with a traceback
+    present = tmp_path / "present.yaml"
+    present.write_text("{}\n")
+    missing = tmp_path / "missing.yaml"
+    words = [w.format(missing=missing, present=present) for w in form]
+    assert main(["workflow", "--directory", str(tmp_path / "run"), "-n", *words]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--configfile" in err[0] and str(missing) in err[0], err
+    assert not (tmp_path / "run").exists()
+
+
+def test_workflow_on_a_full_file_system_is_one_line(small_tmpfs, capsys):
+    # Snakemake's first write of .snakemake/ on a full disk ended in a traceback
+    point = small_tmpfs(64 * 1024)
+    with open(point / "filler", "wb", buffering=0) as f:
+        try:
+            while True:
+                f.write(b"\0" * 4096)
+                f.flush()
+        except OSError:
+            pass
+    assert main(["workflow", "--directory", str(point / "run"), "-n"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--directory" in err[0] and "No space left" in err[0], err
+    assert not (point / "run").exists()

@@ -15,6 +15,7 @@ of each: :mod:`microimpact.model.parameters`, :data:`microimpact.solvers.DEFAULT
 from __future__ import annotations
 
 import argparse
+import contextlib
 import difflib
 import importlib
 import math
@@ -35,7 +36,7 @@ from microimpact._runtime.usage import exit_status
 from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_SEED, DEFAULT_WALKERS, MAX_SEED
 from microimpact.io.files import recorded_outputs
 from microimpact.io.lammps import DEFAULT_POISSON, LAMMPS_UNITS
-from microimpact.io.paths import DATA_README, PathError, reporting_os_errors
+from microimpact.io.paths import DATA_README, PathError, check_input_file, reporting_os_errors
 from microimpact.model.contact import SUB_MODELS
 from microimpact.model.dem_damping import DEM_LAWS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
@@ -536,6 +537,7 @@ def _snakemake_command(args) -> list[str]:
         if word.split("=", 1)[0] in _OWN_OPTIONS or (word[:2] in ("-s", "-d") and not word.startswith("--")):
             raise UsageError(f"snakemake option {word!r}: microimpact workflow sets the Snakefile and the "
                              "directory itself; give the directory as --directory DIR")
+    _check_config_files(extra)
     if importlib.util.find_spec("snakemake") is None:
         raise UsageError("the workflow needs Snakemake: pip install 'microimpact[workflow]'")
     if not any(w.split("=", 1)[0] in _CORES_OPTIONS or (w[:2] in ("-c", "-j") and not w.startswith("--"))
@@ -547,6 +549,37 @@ def _snakemake_command(args) -> list[str]:
         extra = ["--rerun-incomplete", *extra]
     return [sys.executable, "-m", "snakemake", "--snakefile", str(workflow_snakefile()),
             "--directory", str(args.directory), *_config_paths_from_here(extra)]
+
+
+def _check_config_files(words: list[str]) -> None:
+    """PathError for a ``--configfile`` (``--configfiles``) that is not a readable file: Snakemake
+    itself answers it with a traceback."""
+    taking = False
+    for word in words:
+        name, eq, value = word.partition("=")
+        if name in ("--configfile", "--configfiles"):
+            taking = not eq
+            if eq:
+                check_input_file(name, value)
+            continue
+        if word.startswith("-"):
+            taking = False
+        elif taking:
+            check_input_file("--configfile", word)
+
+
+def _check_writable(directory: Path) -> None:
+    """PathError naming --directory if a file cannot be written there (a full or read-only file
+    system): Snakemake's first write of .snakemake/ would end in a traceback."""
+    probe = directory / f".microimpact-probe-{os.getpid()}"
+    try:
+        with reporting_os_errors({"--directory": directory}), open(probe, "wb") as f:
+            f.write(b"\0" * 65536)  # room for Snakemake's metadata and lock files
+            f.flush()
+            os.fsync(f.fileno())
+    finally:
+        with contextlib.suppress(OSError):
+            probe.unlink()
 
 
 #: config keys that name files: a relative path is the user's, typed where they are
@@ -603,6 +636,7 @@ def _cmd_workflow(args) -> int:
         directory.mkdir(parents=True, exist_ok=True)
     status = None
     try:
+        _check_writable(directory)
         status = _run_workflow(command, directory)
         return status
     finally:  # a run refused at start-up leaves no empty run directory of its own making behind
