@@ -116,8 +116,11 @@ def test_the_file_records_its_contact_and_units_and_nothing_else_reads_as_one():
     assert "# parameters from: fit: impacts.csv abc123" in text and "# fitted w_A: 0.1 (0.01)" in text
     commands = [line for line in text.splitlines() if line and not line.startswith("#")]
     assert len(commands) == 1 and commands[0].startswith("fix microimpact_wall all wall/gran granular jkr ")
-    for broken, message in [(text.replace("# microimpact-contact: ", "# "), "microimpact-contact"),
-                            (text.replace("# microimpact-units: cgs", ""), "microimpact-units"),
+    # a contact line turned into a comment is a line the export does not write (issue 55)
+    contact_line = next(i for i, line in enumerate(text.splitlines(), 1) if line.startswith("# microimpact-contact: "))
+    for broken, message in [(text.replace("# microimpact-contact: ", "# "), f"^line {contact_line}: .* is not a line"),
+                            (text.replace("# microimpact-contact: ", "# microimpact-kontakt: "), "is not a line"),
+                            (text.replace("# microimpact-units: cgs\n", ""), "microimpact-units"),
                             (text.replace("# microimpact-units: cgs", "# microimpact-units: lj"), "'lj'"),
                             (text.replace('"density": 2200.0', '"density": -1'), "density")]:
         with pytest.raises(ValueError, match=message):
@@ -216,6 +219,12 @@ def test_lammps_damping_laws_agree_with_microimpact(changes, units):
     assert table["difference"].max() < 1e-3
 
 
+def text_file(folder, text):
+    path = folder / "export.lmp"
+    path.write_text(text)
+    return path
+
+
 def test_verify_fails_loudly_on_a_file_whose_law_was_edited(tmp_path, capsys):
     _lammps_or_skip()
     c = _contact(adhesion_line_force=F0, normal_model="jkr_force")
@@ -225,7 +234,14 @@ def test_verify_fails_loudly_on_a_file_whose_law_was_edited(tmp_path, capsys):
     edited = tmp_path / "edited.lmp"
     edited.write_text(text.replace(text.splitlines()[-1], " ".join(fix)))
     out = tmp_path / "check.csv"
-    assert main(["lammps", "verify", str(edited), "--speeds", "1.0", "--incidence-deg", "0", "--out", str(out)]) == 1
+    # the fix line's parameters are checked against the contact recorded in the header (issue 55):
+    # an edited law is refused, naming the word, before LAMMPS runs (status 2, nothing written)
+    assert main(["lammps", "verify", str(edited), "--speeds", "1.0", "--incidence-deg", "0", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "word 7 of the fix line" in err and not out.exists()
+    # a disagreement, here beyond a tolerance far below LAMMPS's step error, is status 1 with its table
+    assert main(["lammps", "verify", str(text_file(tmp_path, text)), "--speeds", "1.0", "--incidence-deg", "0",
+                 "--tolerance", "1e-12", "--out", str(out)]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "disagree on 1 impacts" in err
     assert out.exists()  # the table that shows the disagreement is written

@@ -184,7 +184,7 @@ def test_flags_figure_draws_the_measured_points_and_the_outliers():
     assert measured and np.allclose(measured[0].lines[0].get_ydata(), ds["e_n_measured"].values)
     assert [a.get_text() for a in ax.texts] == ["s-07", "s-31"]
     assert "N near capture" in plot.caption and "C near capture" not in plot.caption
-    from tests.test_report_figures import legend_overlaps
+    from test_report_figures import legend_overlaps
     assert legend_overlaps(plot.figure) == []
 
 

@@ -55,7 +55,13 @@ def _interpreted(argv) -> bool:
 
 def _start_compiled(argv):
     """Replace this process by the same command with numba compiling (exec: same pid, no output
-    written yet)."""
+    written yet).
+
+    The interpreted run's interval timer is cancelled first: a timer survives ``execve``, and its
+    SIGALRM, whose handler the new image no longer has, would kill the compiled command (exit 142,
+    nothing printed) a few seconds into its compile."""
+    signal.setitimer(signal.ITIMER_REAL, 0.0)
+    signal.signal(signal.SIGALRM, signal.SIG_DFL)
     sys.stdout.flush()
     sys.stderr.flush()
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_JIT"} | {COMPILED_ENV: "1"}

@@ -2,7 +2,7 @@
 
 Thin: parse, call the library, print or write. Exit statuses: 0 success; 2 bad arguments, inputs
 or a solver failure (one line ``microimpact: error: ...`` on stderr); 3 the computation ran past
-``--time-budget SECONDS`` (``fit``, ``flags``, ``sweep``, ``target``, ``reproduce``, ``benchmark``; one
+``--time-budget SECONDS`` (``fit``, ``flags``, ``sweep``, ``target``, ``reproduce``, ``benchmark``, ``lammps``; one
 such line naming the budget); 141, quietly, when the reader of stdout went away (``| head``). Nothing is written on an
 error: outputs are written, atomically, only after the work.
 
@@ -15,6 +15,7 @@ of each: :mod:`microimpact.model.parameters`, :data:`microimpact.solvers.DEFAULT
 from __future__ import annotations
 
 import argparse
+import contextlib
 import difflib
 import importlib
 import math
@@ -22,20 +23,20 @@ import os
 import re
 import shutil
 import signal
-import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
 from microimpact import __version__
 from microimpact._commands.common import AUTO_TANGENTIAL, CONTACT_FIELDS, EXIT_DISAGREES, FIGURE_FORMATS, UsageError
-from microimpact._runtime.locks import remove_stale_lock
+from microimpact._runtime.locks import remove_stale_lock, snakemake_processes_in
+from microimpact._runtime.supervise import run_supervised
 from microimpact._runtime.signals import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_after_writing
 from microimpact._runtime.usage import exit_status
 from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_SEED, DEFAULT_WALKERS, MAX_SEED
 from microimpact.io.files import recorded_outputs
 from microimpact.io.lammps import DEFAULT_POISSON, LAMMPS_UNITS
-from microimpact.io.paths import DATA_README, PathError, reporting_os_errors
+from microimpact.io.paths import DATA_README, PathError, check_input_file, reporting_os_errors
 from microimpact.model.contact import SUB_MODELS
 from microimpact.model.dem_damping import DEM_LAWS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
@@ -86,11 +87,20 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+#: a number as a user types one: Python's float() also takes "1_0" (as 10), surrounding blanks and
+#: "infinity"; an option's value is read strictly, so a typo is refused instead of read as another number
+STRICT_NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|[-+]?(inf|infinity|nan)", re.IGNORECASE)
+#: a whole number as a user types one (int() also takes "1_0" and blanks)
+STRICT_WHOLE = re.compile(r"[-+]?\d+")
+#: most points per curve of ``target`` (each point is a root solve of Eq. (27); the memory check of
+#: microimpact.analysis.target bounds the arrays, this the work, before it starts)
+MAX_TARGET_POINTS = 10_000
+
+
 def _finite_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not STRICT_NUMBER.fullmatch(text):
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}")
+    value = float(text)
     if not math.isfinite(value):
         raise argparse.ArgumentTypeError(f"not a finite number: {text!r}")
     return value
@@ -185,7 +195,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="microimpact", description="Microsphere contact/impact with smooth, flat surfaces.",
                      epilog=f"Exit status: 0 success; 2 bad arguments or inputs, or a solver failure; "
                             f"{EXIT_TIME_BUDGET} the computation ran past --time-budget (fit, flags, sweep, "
-                            "target, reproduce, benchmark); 141 (quietly) when stdout is closed early (| head). "
+                            "target, reproduce, benchmark, lammps); 141 (quietly) when stdout is closed early (| head). "
                             "Nothing is written on an error.")
     parser.add_argument("--version", action="version", version=f"microimpact {__version__}")
     sub = parser.add_subparsers(dest="command", parser_class=_Parser)
@@ -264,10 +274,9 @@ def _add_posterior_options(p: argparse.ArgumentParser) -> None:
 
 
 def _whole_number(text: str, smallest: int) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if not STRICT_WHOLE.fullmatch(text):
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}")
+    value = int(text)
     if value < smallest:
         raise argparse.ArgumentTypeError(f"must be a whole number >= {smallest}, got {text!r}")
     return value
@@ -289,6 +298,22 @@ def _positive_int(text: str) -> int:
     return _whole_number(text, 1)
 
 
+def _target_points(text: str) -> int:
+    value = _whole_number(text, 3)
+    if value > MAX_TARGET_POINTS:
+        raise argparse.ArgumentTypeError(f"at most {MAX_TARGET_POINTS} points per curve (each is a root solve of "
+                                         f"Eq. (27)), got {text!r}")
+    return value
+
+
+def _angle_uncertainty(text: str) -> float:
+    value = _non_negative_float(text)
+    if value >= 90.0:
+        raise argparse.ArgumentTypeError(f"an incidence-angle uncertainty is below 90 deg (incidences lie in "
+                                         f"[0, 90)), got {text!r}")
+    return value
+
+
 def register_flags(sub) -> None:
     """``microimpact flags DATA.csv --fit fit.nc --out flags.csv``: per-measurement flags."""
     p = sub.add_parser("flags", help="flag impacts sensitive to unmeasured spin, angle error, or near capture")
@@ -300,7 +325,7 @@ def register_flags(sub) -> None:
     p.add_argument("--nc", help="also write the flags as NetCDF")
     p.add_argument("--spin-bound", type=_non_negative_float, default=None, metavar="RAD_S",
                    help="largest initial spin sampled [rad/s] (default: speed / radius per impact)")
-    p.add_argument("--angle-uncertainty-deg", type=_non_negative_float, default=None, metavar="DEG",
+    p.add_argument("--angle-uncertainty-deg", type=_angle_uncertainty, default=None, metavar="DEG",
                    help="incidence-angle uncertainty [deg] (default: the file's column, else 2)")
     p.add_argument("--posterior", default=None, metavar="NC",
                    help="posterior NetCDF of 'microimpact fit --posterior': flags and spin ranges over its draws")
@@ -320,7 +345,8 @@ def register_target(sub) -> None:
     p.add_argument("--speed", type=_positive_float, nargs="+", required=True, help="normal speed of each target [m/s]")
     p.add_argument("--e-n-uncertainty", type=_positive_float, nargs="+", default=None,
                    help="standard uncertainty of each target e_n (weights of the least-squares point)")
-    p.add_argument("--points", type=_positive_int, default=41, help="points per curve (default 41, >= 3)")
+    p.add_argument("--points", type=_target_points, default=41,
+                   help=f"points per curve (default 41, 3 to {MAX_TARGET_POINTS})")
     _add_rtol(p)
     p.add_argument("--out", default=None, help="write the curve(s): .csv (one row per point) or .nc; default: print CSV")
     _add_time_budget(p)
@@ -358,10 +384,7 @@ def _dem_law(text: str) -> tuple[str, str]:
 
 
 def _steps(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    value = _whole_number(text, 10)
     if not 10 <= value <= 10**6:
         raise argparse.ArgumentTypeError(f"must lie in [10, 1000000], got {text!r}")
     return value
@@ -387,6 +410,7 @@ def register_lammps(sub) -> None:
                    help=f"Poisson ratio written with E (default {DEFAULT_POISSON}; E follows so that the stiffness is kept)")
     e.add_argument("--wall", default="zplane 0.0 NULL", help="LAMMPS wall style and arguments (default 'zplane 0.0 NULL')")
     e.add_argument("--out", required=True, help="output LAMMPS input file")
+    _add_time_budget(e)
     e.set_defaults(func=_handler("lammps", "run_export"))
     f = lsub.add_parser("fit", help="fit the damping of LAMMPS laws (with --fit-adhesion also the work of adhesion) to "
                                     "measured impacts (CSV), rank the laws by AIC and "
@@ -437,6 +461,7 @@ def register_lammps(sub) -> None:
     f.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")
     _add_rtol(f)
     f.add_argument("--out", required=True, help="output LAMMPS input file")
+    _add_time_budget(f)
     f.set_defaults(func=_handler("lammps", "run_fit"))
     v = lsub.add_parser("verify", help="run LAMMPS on an exported file over speeds x angles and compare with microimpact "
                                        f"(exit status {EXIT_DISAGREES} if they disagree; needs microimpact[lammps])")
@@ -451,6 +476,7 @@ def register_lammps(sub) -> None:
                    help=f"largest difference accepted in e_n, e_t, the spin ratio and, with a twisting law, the twist "
                         f"ratio (default {DEFAULT_TOLERANCE:g})")
     v.add_argument("--out", default=None, help="write the whole comparison table as CSV")
+    _add_time_budget(v)
     v.set_defaults(func=_handler("lammps", "run_verify"))
 
 
@@ -514,6 +540,7 @@ def _snakemake_command(args) -> list[str]:
         if word.split("=", 1)[0] in _OWN_OPTIONS or (word[:2] in ("-s", "-d") and not word.startswith("--")):
             raise UsageError(f"snakemake option {word!r}: microimpact workflow sets the Snakefile and the "
                              "directory itself; give the directory as --directory DIR")
+    _check_config_files(extra)
     if importlib.util.find_spec("snakemake") is None:
         raise UsageError("the workflow needs Snakemake: pip install 'microimpact[workflow]'")
     if not any(w.split("=", 1)[0] in _CORES_OPTIONS or (w[:2] in ("-c", "-j") and not w.startswith("--"))
@@ -525,6 +552,37 @@ def _snakemake_command(args) -> list[str]:
         extra = ["--rerun-incomplete", *extra]
     return [sys.executable, "-m", "snakemake", "--snakefile", str(workflow_snakefile()),
             "--directory", str(args.directory), *_config_paths_from_here(extra)]
+
+
+def _check_config_files(words: list[str]) -> None:
+    """PathError for a ``--configfile`` (``--configfiles``) that is not a readable file: Snakemake
+    itself answers it with a traceback."""
+    taking = False
+    for word in words:
+        name, eq, value = word.partition("=")
+        if name in ("--configfile", "--configfiles"):
+            taking = not eq
+            if eq:
+                check_input_file(name, value)
+            continue
+        if word.startswith("-"):
+            taking = False
+        elif taking:
+            check_input_file("--configfile", word)
+
+
+def _check_writable(directory: Path) -> None:
+    """PathError naming --directory if a file cannot be written there (a full or read-only file
+    system): Snakemake's first write of .snakemake/ would end in a traceback."""
+    probe = directory / f".microimpact-probe-{os.getpid()}"
+    try:
+        with reporting_os_errors({"--directory": directory}), open(probe, "wb") as f:
+            f.write(b"\0" * 65536)  # room for Snakemake's metadata and lock files
+            f.flush()
+            os.fsync(f.fileno())
+    finally:
+        with contextlib.suppress(OSError):
+            probe.unlink()
 
 
 #: config keys that name files: a relative path is the user's, typed where they are
@@ -581,6 +639,7 @@ def _cmd_workflow(args) -> int:
         directory.mkdir(parents=True, exist_ok=True)
     status = None
     try:
+        _check_writable(directory)
         status = _run_workflow(command, directory)
         return status
     finally:  # a run refused at start-up leaves no empty run directory of its own making behind
@@ -590,25 +649,30 @@ def _cmd_workflow(args) -> int:
             shutil.rmtree(directory, ignore_errors=True)
 
 
+def _refuse_unlock_while_running(directory: Path) -> None:
+    """UsageError if a Snakemake process works in ``directory``: ``--unlock`` would take the lock
+    from a live run, and a second run would then write its files beside it."""
+    holders = snakemake_processes_in(directory)
+    if holders:
+        ids = ", ".join(map(str, holders))
+        raise UsageError(f"--unlock: a Snakemake run is going on in {directory} (process {ids}); its lock is not "
+                         f"stale: wait for it to end or stop it (kill {ids})")
+
+
 def _run_workflow(command: list[str], directory: Path) -> int:
-    if "--unlock" not in command:
+    if "--unlock" in command:
+        _refuse_unlock_while_running(directory)
+    else:
         _clear_stale_lock(directory)
     print(f"microimpact: running the pipeline ({command[4]}) in {directory}", file=sys.stderr, flush=True)
-
-    # Ctrl-C reaches Snakemake from the terminal (same process group); Snakemake then stops its jobs,
-    # removes their unfinished outputs and releases its lock. The wrapper only waits for that:
-    # subprocess.call would kill Snakemake on the KeyboardInterrupt, leaving the directory locked.
-    interrupted: list[int] = []
-    proc = subprocess.Popen(command)
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: interrupted.append(signum))
-    try:
-        status = proc.wait()
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    if interrupted:
+    # Ctrl-C reaches Snakemake from the terminal (same process group); a SIGTERM to this process is
+    # passed on; Snakemake then stops its jobs, removes their unfinished outputs and releases its
+    # lock, and what it prints meanwhile is dropped (microimpact._runtime.supervise)
+    status, stopped_by = run_supervised(command)
+    if stopped_by is not None:
         print("microimpact: workflow interrupted; finished results are kept and unfinished ones removed; run the "
               "same command again to resume", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return EXIT_INTERRUPTED if stopped_by == signal.SIGINT else 128 + int(stopped_by)
     return status
 
 
@@ -645,7 +709,8 @@ def _unknown_option(parser: argparse.ArgumentParser, argv: list[str]) -> str | N
         if word == "--":
             break
         name = word.split("=", 1)[0]
-        if name.startswith("-") and not NEGATIVE_NUMBER.match(name) and name not in known:
+        # "-" alone is a value (argparse reads it as one: --out -), not an option
+        if name.startswith("-") and name != "-" and not NEGATIVE_NUMBER.match(name) and name not in known:
             close = difflib.get_close_matches(name, known, n=1)
             return f"unrecognized option {name}" + (f" (did you mean {close[0]}?)" if close else "")
     return None

@@ -8,7 +8,7 @@ from dataclasses import fields
 from microimpact._commands.common import CONTACT_FIELDS, UsageError
 from microimpact.io.paths import check_input_file
 from microimpact.model.contact import Contact, adhesion_line_force_from_work
-from microimpact.presets import get_preset
+from microimpact.presets import PRESETS, get_preset
 
 
 def _base_material(args):
@@ -40,7 +40,10 @@ def _base_material(args):
         if args.material_pair not in pairs:
             raise UsageError(f"--material-pair {args.material_pair!r} is not in {config}; known: {', '.join(pairs)}")
         return pairs[args.material_pair], f"material pair {args.material_pair} of {config}"
-    name = args.preset or "wall1990"
+    if args.preset is not None and not args.preset.strip():
+        raise UsageError(f"--preset {args.preset!r}: an empty name names no preset; known: {', '.join(sorted(PRESETS))} "
+                         "(or leave --preset out for wall1990)")
+    name = args.preset if args.preset is not None else "wall1990"
     return get_preset(name), f"preset {name}"
 
 

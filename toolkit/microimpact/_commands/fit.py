@@ -10,7 +10,7 @@ from microimpact._commands.common import UsageError
 from microimpact._commands.tables import impacts_for_pair, input_files
 from microimpact.analysis.analyst_fit import analyse_impacts, exclude_rows
 from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_WALKERS, check_posterior_memory
-from microimpact.io.paths import check_outputs, reporting_os_errors
+from microimpact.io.paths import check_outputs, print_before_writing, reporting_os_errors
 
 
 def run(args) -> int:
@@ -38,12 +38,13 @@ def run(args) -> int:
                              confidence_intervals=not args.no_confidence_intervals, posterior=posterior,
                              errors_in_variables=args.errors_in_variables, rtol=args.rtol, progress=True,
                              time_budget=args.time_budget, exclude=_exclude_ids(args.exclude, table))
+    paths = (out, outputs.get("--posterior"), outputs.get("--oblique-out"))
+    planned = tuple(p for p in paths if p is not None)
+    text = (json.dumps(_json_ready(_fit_summary(result, table, pair, planned)), indent=2, allow_nan=False)
+            if args.json else result.report())
+    print_before_writing(text)
     with reporting_os_errors(outputs):
-        written = result.save(out, outputs.get("--posterior"), outputs.get("--oblique-out"))
-    if args.json:
-        print(json.dumps(_json_ready(_fit_summary(result, table, pair, written)), indent=2, allow_nan=False))
-    else:
-        print(result.report())
+        written = result.save(*paths)
     print("wrote " + ", ".join(map(str, written)), file=sys.stderr)
     return 0
 

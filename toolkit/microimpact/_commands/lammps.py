@@ -10,16 +10,17 @@ from microimpact._commands.common import AUTO_TANGENTIAL, EXIT_DISAGREES, UsageE
 from microimpact._commands.contacts import contact_from_args
 from microimpact._commands.tables import impacts_for_pair, input_files
 from microimpact._runtime.progress import progress_bar
+from microimpact._runtime.timeout import time_limit
 from microimpact.analysis.dem_fit import candidate_laws, rank_dem_laws
 from microimpact.analysis.dem_friction import rank_dem_tangential_laws
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.io.files import atomic_write, write_csv
 from microimpact.io.kinds import file_kind
-from microimpact.io.lammps import lammps_input, read_lammps_contact
+from microimpact.io.lammps import LammpsExportError, lammps_input, read_lammps_export
 from microimpact.io.paths import check_input_file, check_outputs, reporting_os_errors
 from microimpact.io.provenance import fit_parameter_source
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
-from microimpact.studies.lammps_check import DEFAULT_INCIDENCES, default_speeds, verify_lammps
+from microimpact.studies.lammps_check import DEFAULT_INCIDENCES, LammpsRunError, default_speeds, verify_lammps
 
 
 def _fitted_values(path) -> dict:
@@ -32,9 +33,15 @@ def _fitted_values(path) -> dict:
 def run_export(args) -> int:
     inputs = {"--fit": args.fit, "--config": args.config}
     out = check_outputs({"--out": args.out}, {k: v for k, v in inputs.items() if v is not None})["--out"]
-    contact = contact_from_args(args)
-    text = lammps_input(contact, units=args.units, poisson=args.poisson, wall=args.wall, source=args.contact_note,
-                        fitted=_fitted_values(args.fit) if args.fit else None)
+    with time_limit(args.time_budget, "lammps export"):
+        contact = contact_from_args(args)
+        try:
+            text = lammps_input(contact, units=args.units, poisson=args.poisson, wall=args.wall,
+                                source=args.contact_note, fitted=_fitted_values(args.fit) if args.fit else None)
+        except LammpsExportError as exc:
+            if str(exc).startswith("wall"):
+                raise UsageError(f"--{exc}") from None
+            raise
     with reporting_os_errors({"--out": out}), atomic_write(out) as f:
         f.write(text)
     print(f"wrote {out} (LAMMPS units {args.units}); check it with: microimpact lammps verify {out}")
@@ -119,6 +126,11 @@ def _lammps_fit_friction(args, table, chosen):
 
 def run_fit(args) -> int:
     out = check_outputs({"--out": args.out}, input_files(args))["--out"]
+    with time_limit(args.time_budget, "lammps fit"):
+        return _run_fit(args, out)
+
+
+def _run_fit(args, out) -> int:
     if args.tangential_model is None:
         given = [o for o, v in (("--tangential-stiffness", args.tangential_stiffness), ("--shear-modulus", args.shear_modulus),
                                 ("--tangential-damping", args.tangential_damping or None),
@@ -198,19 +210,26 @@ def run_verify(args) -> int:
     out = check_outputs({"--out": args.out}, {"input file": args.input})["--out"] if args.out else None
     path = check_input_file("input file", args.input)
     try:
-        text = path.read_text(encoding="utf-8")
+        with open(path, encoding="utf-8", newline="") as f:  # a carriage return stays one, to be refused
+            text = f.read()
     except UnicodeDecodeError:
         raise UsageError(f"input file {path}: the file is {file_kind(path)}, not a LAMMPS input written by "
                          "'microimpact lammps export'") from None
     try:
-        contact, _ = read_lammps_contact(text)
+        export = read_lammps_export(text)
     except ValueError as exc:
         raise UsageError(f"input file {path}: {exc}") from None
+    contact = export.contact
     speeds = args.speeds or default_speeds(contact)
     incidences = args.incidence_deg or DEFAULT_INCIDENCES
-    with progress_bar(len(speeds) * len(incidences), "LAMMPS impacts") as advance:
-        table = verify_lammps(text, speeds=speeds, incidences=incidences, steps=args.steps,
-                              tolerance=args.tolerance, progress=advance)
+    try:
+        with time_limit(args.time_budget, "lammps verify"), \
+                progress_bar(len(speeds) * len(incidences), "LAMMPS impacts") as advance:
+            # the file's own text is never run: verify_lammps rebuilds its one command from the parsed contact
+            table = verify_lammps(text, speeds=speeds, incidences=incidences, steps=args.steps,
+                                  tolerance=args.tolerance, progress=advance)
+    except LammpsRunError as exc:
+        raise UsageError(f"input file {path}, line {export.fix_line_number} (its fix wall/gran command): {exc}") from None
     if out is not None:
         with reporting_os_errors({"--out": out}):
             write_csv(table, out, index=False)

@@ -28,7 +28,7 @@ import xarray as xr
 from microimpact.io.formatting import ReportHTML, estimates_repr
 from microimpact.analysis.identifiability import status_from_variables, status_variables
 from microimpact.analysis.verdict import Verdict, assess_residuals
-from microimpact.io.kinds import file_kind
+from microimpact.io.kinds import file_kind, unreadable_content
 from microimpact.io.statuses import stderr_is_meaningful
 from microimpact.io.files import CONVENTIONS, restore_label_coordinates, write_netcdf
 from microimpact.io.impacts import insert_row_labels, label_variables, labels_from_dataset
@@ -169,8 +169,13 @@ class FitResult:
             raise ValueError(f"{path}: holds no {cls.KIND} ({ds.attrs.get('comment', 'no result')})")
         try:
             return cls.from_dataset(ds)
-        except KeyError:
-            raise ValueError(cls._not_this_kind(path)) from None
+        except KeyError as exc:  # a variable missing: named, and the file's kind said
+            raise ValueError(f"{unreadable_content(path, ds, exc)}; {cls._not_this_kind(path).split(': ', 1)[1]}") \
+                from None
+        except (TypeError, ValueError, IndexError, AttributeError, OverflowError) as exc:
+            # a variable of another shape or type than the kind writes (a parameter that is not a
+            # scalar): one line naming the file and the variable (issue 55)
+            raise ValueError(unreadable_content(path, ds, exc)) from None
 
     @classmethod
     def placeholder(cls, comment: str) -> xr.Dataset:

@@ -10,12 +10,14 @@ which every file microimpact writes carries.
 
 from __future__ import annotations
 
+import linecache
+import re
 import zipfile
 from pathlib import Path
 
 import netCDF4
 
-__all__ = ["file_kind", "is_binary"]
+__all__ = ["file_kind", "is_binary", "unreadable_content"]
 
 #: leading bytes -> what the file is
 _SIGNATURES = (
@@ -118,3 +120,75 @@ def is_binary(path) -> bool:
     """
     kind = file_kind(path)
     return not (kind.startswith("a text file") or kind in ("an empty file", "binary data") or kind.startswith("unreadable"))
+
+
+def unreadable_content(path, ds, exc: BaseException) -> str:
+    """One line for a result file whose content a reader could not take: the file, the variable or
+    attribute it was reading, that variable's shape and type, and what went wrong.
+
+    The reader (``from_dataset`` of a result class) failed with ``exc`` on the Dataset ``ds`` read
+    from ``path``. The variable is the name it was reading when it failed: a missing one is the
+    KeyError's, else the innermost frame of the reader that holds a string naming a variable or
+    an attribute of ``ds`` (the loop variable of ``{n: float(ds[n]) for n in ...}``).
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> ds = xr.Dataset({"zeta_hertz": ("x", [0.5, 0.6])})
+    >>> try:
+    ...     {n: float(ds[n]) for n in ["zeta_hertz"]}
+    ... except TypeError as exc:
+    ...     print(unreadable_content("fit.nc", ds, exc))
+    fit.nc: variable 'zeta_hertz' (shape (2,), float64) does not read: only 0-dimensional arrays can be converted to Python scalars (TypeError)
+    """
+    names = set(map(str, ds.variables)) | set(map(str, ds.attrs))
+    name = exc.args[0] if isinstance(exc, KeyError) and exc.args and str(exc.args[0]) in names | {exc.args[0]} else None
+    tb, frames = exc.__traceback__, []
+    while tb is not None:
+        frames.append(tb.tb_frame)
+        tb = tb.tb_next
+    if name is None:
+        try:
+            name = _name_being_read(frames, ds, names)
+        except Exception:  # noqa: BLE001 - best effort: the message is then less precise, never wrong
+            name = None
+    reason = (str(exc).splitlines() or [""])[0] or type(exc).__name__
+    if name is None:
+        return f"{path}: a variable or attribute does not read: {reason} ({type(exc).__name__})"
+    if isinstance(exc, KeyError):
+        return f"{path}: no variable or attribute {name!r} (the file is incomplete or not this kind)"
+    if name in ds.variables:
+        v = ds.variables[name]
+        return (f"{path}: variable {name!r} (shape {tuple(v.shape)}, {v.dtype}) does not read: {reason} "
+                f"({type(exc).__name__})")
+    return f"{path}: attribute {name!r} = {str(ds.attrs[name])[:40]!r} does not read: {reason} ({type(exc).__name__})"
+
+
+#: ``ds[...]`` and ``a[...]`` (the attributes) in a reader's source line
+_SUBSCRIPT = re.compile(r"\b(?:ds|a|attrs)\[([^\[\]]+)\]")
+
+
+def _name_being_read(frames, ds, names) -> str | None:
+    """The variable or attribute a reader's frame was reading when it failed: the names its source
+    line subscripts (``ds[n]``, ``ds[f"{n}_stderr"]``, evaluated with the frame's own names; the
+    reader's code, never the file's), the odd one (not a numeric scalar) first; else a string
+    local of the frame that names one."""
+    for frame in reversed(frames):
+        line = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+        found = []
+        for expression in _SUBSCRIPT.findall(line):
+            try:
+                value = eval(expression, frame.f_globals, dict(frame.f_locals))  # noqa: S307 - our own source
+            except Exception:  # noqa: BLE001 - a subscript that needs names of another frame
+                continue
+            if isinstance(value, str) and value in names:
+                found.append(value)
+        # a variable held in a local (v = ds[...]; int(v.values)) names itself
+        found += [str(v.name) for v in frame.f_locals.values()
+                  if type(v).__module__.startswith("xarray") and type(v).__name__ == "DataArray" and str(v.name) in names]
+        found += [v for k, v in frame.f_locals.items() if isinstance(v, str) and v in names and k != "path"]
+        if found:
+            odd = [n for n in found if n in ds.variables and (ds.variables[n].ndim > 0
+                                                              or ds.variables[n].dtype.kind not in "biuf")]
+            return (odd or found)[0]
+    return None

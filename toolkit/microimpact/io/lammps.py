@@ -68,6 +68,8 @@ doi:10.1080/02786820290092221.
 from __future__ import annotations
 
 import json
+import math
+import re
 from dataclasses import dataclass, fields
 
 from microimpact import __version__
@@ -79,8 +81,8 @@ from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 from microimpact.model.tangential_compliance import effective_shear_modulus, shear_modulus_from_elastic
 
 __all__ = ["LAMMPS_UNITS", "DEFAULT_POISSON", "LammpsExportError", "LammpsWallModel", "lammps_wall_model",
-           "lammps_input", "lammps_expressible", "read_lammps_contact", "lammps_scales", "CONTACT_LINE",
-           "UNITS_LINE"]
+           "lammps_input", "lammps_expressible", "read_lammps_contact", "read_lammps_export", "LammpsExport",
+           "lammps_fix_line", "lammps_scales", "CONTACT_LINE", "UNITS_LINE"]
 
 #: LAMMPS unit styles: (metre, kilogram, second) per unit of length, mass and time
 #: (https://docs.lammps.org/units.html)
@@ -99,6 +101,25 @@ CONTACT_LINE = "# microimpact-contact: "
 #: prefix of the header line that names the unit style of the numbers (a comment, not a ``units``
 #: command: LAMMPS refuses ``units`` once the box exists, and the fix must come after the box)
 UNITS_LINE = "# microimpact-units: "
+#: the starts of the comment lines :func:`lammps_input` writes; :func:`read_lammps_export` refuses
+#: any other line but the contact, units and fix lines
+HEADER_PREFIXES = ("# LAMMPS GRANULAR wall contact written by microimpact ", "# law: ", "# the numbers are in LAMMPS units ",
+                   "# sphere: ", "# E = ", "# tangential ", "# rolling sds: ", "# twisting sds: ",
+                   "# twisting marshall: ", "# damping tsuji ", "# parameters from: ", "# fitted ",
+                   "# check with: microimpact lammps verify ")
+#: a control character (a newline, a carriage return, a tab, an escape, NUL, C1, a Unicode line or
+#: paragraph separator): in a LAMMPS input a newline starts a new command, so no written string
+#: may hold one
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+#: a number as the export writes it (``%.15g``) or LAMMPS's NULL of an open wall side
+_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+#: the wall styles of ``fix wall/gran`` the export writes and verify reads: a plane (its low and high
+#: side, a number or NULL) or a z cylinder (its radius), optionally moving (``wiggle``, ``shear``)
+#: (https://docs.lammps.org/fix_wall_gran.html)
+WALL = re.compile(rf"(?:[xyz]plane (?:{_NUMBER}|NULL) (?:{_NUMBER}|NULL)|zcylinder {_NUMBER})"
+                  rf"(?: wiggle [xyz] {_NUMBER} {_NUMBER}| shear [xyz] {_NUMBER})?")
+#: a LAMMPS fix ID or group name: letters, digits and underscores (https://docs.lammps.org/fix.html)
+_IDENTIFIER = re.compile(r"[A-Za-z0-9_]+")
 
 
 class LammpsExportError(ValueError):
@@ -406,6 +427,10 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
     """
     model = lammps_wall_model(contact, poisson)
     length, mass, _ = _check_units(units)
+    _check_text("source", source)
+    for name, text in (fitted or {}).items():
+        _check_text(f"fitted {name!r}", f"{name} {text}")
+    fix = lammps_fix_line(model, units, wall, group, fix_id)
     lines = [
         f"# LAMMPS GRANULAR wall contact written by microimpact {__version__} (microimpact lammps export)",
         (f"# law: {model.normal}, damping {model.damping_model} {model.damping:g}, tangential {model.tangential}"
@@ -441,18 +466,219 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
         "# check with: microimpact lammps verify THIS_FILE",
         CONTACT_LINE + _contact_json(contact),
         UNITS_LINE + units,
-        f"fix {fix_id} {group} wall/gran granular {model.granular_args(units)} {wall}",
+        fix,
     ]
     return "\n".join(lines) + "\n"
 
 
-def read_lammps_contact(text: str) -> tuple[Contact, str]:
-    """The contact and the unit style recorded in a file written by :func:`lammps_input`.
+def _check_text(name: str, value: str) -> None:
+    """LammpsExportError naming ``name`` if ``value`` holds a control character (a newline would
+    start a second LAMMPS command in the file)."""
+    found = _CONTROL.search(value)
+    if found:
+        raise LammpsExportError(f"{name}: holds the control character U+{ord(found.group()):04X} at position "
+                                f"{found.start() + 1} (a newline would start a LAMMPS command of its own)")
+
+
+def lammps_fix_line(model: LammpsWallModel, units: str, wall: str = "zplane 0.0 NULL", group: str = "all",
+                    fix_id: str = "microimpact_wall") -> str:
+    """The one ``fix wall/gran`` command of the wall law ``model``, in LAMMPS units ``units``.
+
+    Parameters
+    ----------
+    model : LammpsWallModel
+    units : {"si", "cgs", "micro", "nano"}
+    wall : str
+        Wall style and arguments (:data:`WALL`: ``xplane|yplane|zplane LO HI`` or ``zcylinder R``, a
+        side a number or NULL, optionally ``wiggle`` or ``shear``).
+    group, fix_id : str
+        Letters, digits and underscores.
+
+    Raises
+    ------
+    LammpsExportError
+        For a wall, group or ID outside that grammar (a control character, a second command).
+
+    Examples
+    --------
+    >>> from microimpact import Contact
+    >>> m = lammps_wall_model(Contact(radius=1e-6, density=2500.0, stiffness=5e10, adhesion_line_force=0.0))
+    >>> lammps_fix_line(m, "si", wall="zplane 0.0 NULL\\nshell touch X")
+    Traceback (most recent call last):
+    ...
+    microimpact.io.lammps.LammpsExportError: wall: holds the control character U+000A at position 16 (a newline would start a LAMMPS command of its own)
+    """
+    _check_text("wall", wall)
+    if not WALL.fullmatch(wall):
+        raise LammpsExportError(f"wall={wall!r}: not a wall of fix wall/gran written here (xplane, yplane or zplane "
+                                "LO HI, or zcylinder RADIUS, each a number or NULL; optionally wiggle or shear)")
+    for name, value in (("group", group), ("fix_id", fix_id)):
+        if not _IDENTIFIER.fullmatch(value):
+            raise LammpsExportError(f"{name}={value!r}: a LAMMPS name has letters, digits and underscores only")
+    return f"fix {fix_id} {group} wall/gran granular {model.granular_args(units)} {wall}"
+
+
+@dataclass(frozen=True)
+class LammpsExport:
+    """What a file written by :func:`lammps_input` holds, read back and checked line by line.
+
+    Attributes
+    ----------
+    contact : Contact
+        The contact of the header's JSON line.
+    units : str
+        The LAMMPS unit style of the numbers.
+    poisson : float
+        nu written with E. [-]
+    wall, group, fix_id : str
+        The wall of the fix line, its group and ID.
+    fix_line_number : int
+        Line of the file holding the ``fix wall/gran`` command (1-based).
+    """
+
+    contact: Contact
+    units: str
+    poisson: float
+    wall: str
+    group: str
+    fix_id: str
+    fix_line_number: int
+
+    def script(self) -> str:
+        """The one LAMMPS command of this contact, rebuilt from the parsed parameters (never the
+        file's own text): what ``microimpact lammps verify`` runs."""
+        return lammps_fix_line(lammps_wall_model(self.contact, self.poisson), self.units, self.wall, self.group,
+                               self.fix_id) + "\n"
+
+
+def _file_lines(text: str) -> list[str]:
+    """The lines of ``text`` split at newlines only (``str.splitlines`` also splits at a form feed
+    or a line separator, which LAMMPS does not), a final newline ending the last."""
+    lines = text.split("\n")
+    return lines[:-1] if lines and lines[-1] == "" else lines
+
+
+def read_lammps_export(text: str) -> LammpsExport:
+    """Parse a file written by :func:`lammps_input`; refuse any line that it does not write.
+
+    Accepted: the header comments (:data:`HEADER_PREFIXES`), one contact line (JSON of a
+    :class:`Contact`), one units line, and last one ``fix wall/gran`` command whose every parameter
+    is what the export of that contact writes (the Poisson ratio, wall, group and ID as written).
+    Everything else (``shell``, ``run``, ``include``, ``python``, a second command, a blank line, a
+    control character such as an injected newline) is refused, naming its line: a file received from
+    someone else is data, and nothing in it is run.
 
     Raises
     ------
     ValueError
-        If the text has no contact line or no ``units`` command, naming what is missing.
+        Naming the line (1-based) and what is wrong with it.
+
+    References
+    ----------
+    LAMMPS documentation, ``fix wall/gran`` (https://docs.lammps.org/fix_wall_gran.html).
+
+    Examples
+    --------
+    >>> from microimpact import Contact
+    >>> c = Contact(radius=1e-6, density=2500.0, stiffness=5e10, adhesion_line_force=0.0)
+    >>> text = lammps_input(c, units="nano")
+    >>> export = read_lammps_export(text)
+    >>> export.contact == c, export.units, export.script() == text.splitlines()[-1] + "\\n"
+    (True, 'nano', True)
+    >>> read_lammps_export(text + "shell touch X\\n")
+    Traceback (most recent call last):
+    ...
+    ValueError: line 10: 'shell touch X' after the fix line (line 9): the export writes nothing after its fix line
+    """
+    record = units = fix = None
+    for number, line in enumerate(_file_lines(text), 1):
+        found = _CONTROL.search(line)
+        if found:
+            raise ValueError(f"line {number}: the control character U+{ord(found.group()):04X} at column "
+                             f"{found.start() + 1} (an injected line?): not written by 'microimpact lammps export'")
+        if fix is not None:
+            raise ValueError(f"line {number}: {line[:60]!r} after the fix line (line {fix}): the export writes nothing "
+                             "after its fix line")
+        if line.startswith(CONTACT_LINE):
+            if record is not None:
+                raise ValueError(f"line {number}: a second contact line (the first is line {record[0]})")
+            record = (number, _contact_of_line(number, line[len(CONTACT_LINE):]))
+        elif line.startswith(UNITS_LINE):
+            if units is not None:
+                raise ValueError(f"line {number}: a second units line (the first is line {units[0]})")
+            units = (number, line[len(UNITS_LINE):].strip())
+            if units[1] not in LAMMPS_UNITS:
+                raise ValueError(f"line {number}: units {units[1]!r} is not one of {', '.join(LAMMPS_UNITS)}")
+        elif line.startswith("fix "):
+            missing = [prefix.strip() for prefix, seen in ((CONTACT_LINE, record), (UNITS_LINE, units)) if seen is None]
+            if missing:
+                raise ValueError(f"line {number}: the fix line comes before any '{missing[0]}' line: not written by "
+                                 "'microimpact lammps export'")
+            fix = number
+            fields_ = _fix_line_fields(number, line, record, units[1])
+        elif not line.startswith(HEADER_PREFIXES):
+            raise ValueError(f"line {number}: {line[:60]!r} is not a line 'microimpact lammps export' writes (only "
+                             "its header comments, the contact and units lines and one fix wall/gran command)")
+    if record is None:
+        raise ValueError(f"no '{CONTACT_LINE.strip()}' line: not written by 'microimpact lammps export'")
+    if units is None:
+        raise ValueError(f"no '{UNITS_LINE.strip()}' line: not written by 'microimpact lammps export'")
+    if fix is None:
+        raise ValueError("no fix wall/gran line after the contact and units lines: not written by "
+                         "'microimpact lammps export'")
+    return LammpsExport(record[1], units[1], fix_line_number=fix, **fields_)
+
+
+def _contact_of_line(number: int, text: str) -> Contact:
+    try:
+        record = json.loads(text)
+        if not isinstance(record, dict):
+            raise TypeError(f"a JSON object of the contact's fields, not {type(record).__name__}")
+        return Contact(**record)
+    except (ValueError, TypeError) as exc:
+        raise ValueError(f"line {number}: the contact record does not read: {exc}") from None
+
+
+def _fix_line_fields(number: int, line: str, record: tuple, units: str) -> dict:
+    """poisson, wall, group and fix_id of the fix line ``line``, which must be the export of the
+    contact ``record`` (line, Contact) in ``units``, word for word; ValueError naming what differs."""
+    words = line.split(" ")
+    if len(words) < 10 or words[3:5] != ["wall/gran", "granular"]:
+        raise ValueError(f"line {number}: {line[:60]!r} is not the export's 'fix ID GROUP wall/gran granular ...' line")
+    try:
+        poisson = float(words[8])
+    except ValueError:
+        poisson = math.nan
+    if not re.fullmatch(_NUMBER, words[8]) or not math.isfinite(poisson):
+        raise ValueError(f"line {number}: word 9 {words[8][:30]!r} of the fix line is not the Poisson ratio of its "
+                         "normal law")
+    contact_line, contact = record
+    try:
+        model = lammps_wall_model(contact, poisson)
+        args = f"{words[0]} {words[1]} {words[2]} wall/gran granular {model.granular_args(units)}"
+        wall = line[len(args) + 1:] if line.startswith(args + " ") else None
+        expected = lammps_fix_line(model, units, wall, words[2], words[1]) if wall is not None else args
+    except LammpsExportError as exc:
+        raise ValueError(f"line {number}: {exc}") from None
+    if expected != line:
+        mine, theirs = expected.split(" "), words
+        at = next((i for i, (a, b) in enumerate(zip(mine, theirs)) if a != b), min(len(mine), len(theirs)))
+        found = theirs[at] if at < len(theirs) else "(the end of the line)"
+        want = mine[at] if at < len(mine) else "(the end of the line)"
+        raise ValueError(f"line {number}: word {at + 1} of the fix line is {found[:30]!r} where the export of the "
+                         f"contact on line {contact_line} writes {want!r}: the parameters are not the contact's")
+    return {"poisson": poisson, "wall": wall, "group": words[2], "fix_id": words[1]}
+
+
+def read_lammps_contact(text: str) -> tuple[Contact, str]:
+    """The contact and the unit style recorded in a file written by :func:`lammps_input`
+    (:func:`read_lammps_export`, which checks every line).
+
+    Raises
+    ------
+    ValueError
+        If a line is not one the export writes, or the contact, units or fix line is missing,
+        naming the line or what is missing.
 
     Examples
     --------
@@ -461,23 +687,8 @@ def read_lammps_contact(text: str) -> tuple[Contact, str]:
     >>> read_lammps_contact(lammps_input(c, units="nano")) == (c, "nano")
     True
     """
-    record = units = None
-    for number, line in enumerate(text.splitlines(), 1):
-        if line.startswith(CONTACT_LINE):
-            try:
-                record = json.loads(line[len(CONTACT_LINE):])
-                contact = Contact(**record)
-            except (ValueError, TypeError) as exc:
-                raise ValueError(f"line {number}: the contact record does not read: {exc}") from None
-        elif line.startswith(UNITS_LINE):
-            units = line[len(UNITS_LINE):].strip()
-            if units not in LAMMPS_UNITS:
-                raise ValueError(f"line {number}: units {units!r} is not one of {', '.join(LAMMPS_UNITS)}")
-    if record is None:
-        raise ValueError(f"no '{CONTACT_LINE.strip()}' line: not written by 'microimpact lammps export'")
-    if units is None:
-        raise ValueError(f"no '{UNITS_LINE.strip()}' line: not written by 'microimpact lammps export'")
-    return contact, units
+    export = read_lammps_export(text)
+    return export.contact, export.units
 
 
 def lammps_scales(units: str) -> dict[str, float]:

@@ -14,12 +14,14 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import sys
 import tempfile
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 
 __all__ = [
     "PathError",
+    "print_before_writing",
     "check_input_file",
     "check_output_file",
     "check_output_dir",
@@ -334,3 +336,29 @@ def reporting_os_errors(outputs: Mapping[str, object]) -> Iterator[None]:
         option, path = _culprit(outputs, exc.filename)
         detail = f" ({os.fsdecode(exc.filename)})" if exc.filename and Path(os.fsdecode(exc.filename)).name != Path(str(path)).name else ""
         raise PathError(option, path, f"cannot write: {_reason(exc)}{detail}") from exc
+
+
+def print_before_writing(text: str) -> None:
+    """Print a command's report on stdout, and make sure it is out, before the command writes its files.
+
+    All or nothing: a report that cannot be printed (stdout on a full disk, ``> /dev/full``) is an
+    error, status 2, before any output file exists; printed after the files, the same error left
+    them in place under a status that says nothing was done. A reader that stopped reading
+    (``| head``) is no failure of the command: its files are still written and it ends with 141.
+
+    Raises
+    ------
+    PathError
+        Naming stdout and the system's reason.
+    """
+    try:
+        print(text)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        pass  # the command line's final flush raises it again, after the files: status 141
+    except OSError as exc:
+        try:  # the unprinted rest is dropped, or the interpreter's exit would fail on it again
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        raise PathError("stdout", "-", f"cannot be written ({exc.strerror or exc}); nothing written") from None

@@ -36,10 +36,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from microimpact.io.lammps import lammps_scales, lammps_wall_model, read_lammps_contact
+from microimpact.io.lammps import lammps_scales, lammps_wall_model, read_lammps_export
 from microimpact.model.adhesion_models import jkr_critical_approach, jkr_sticking_velocity
 
-__all__ = ["LammpsUnavailable", "load_lammps", "lammps_impact", "verify_lammps", "DEFAULT_TOLERANCE",
+__all__ = ["LammpsUnavailable", "LammpsRunError", "load_lammps", "lammps_impact", "verify_lammps", "DEFAULT_TOLERANCE",
            "DEFAULT_STEPS", "default_speeds", "DEFAULT_INCIDENCES"]
 
 #: agreement asked of LAMMPS with microimpact in e_n, e_t, the rebound spin ratio and the twist ratio [-]
@@ -70,6 +70,24 @@ class LammpsUnavailable(RuntimeError):
     >>> issubclass(LammpsUnavailable, RuntimeError)
     True
     """
+
+
+class LammpsRunError(RuntimeError):
+    """LAMMPS stopped with an error of its own (``ERROR: Lost atoms ...``): its message's first line,
+    with the impact it ran; the command line adds the file and line (exit status 2, not the 1 of a
+    disagreement).
+
+    Examples
+    --------
+    >>> issubclass(LammpsRunError, RuntimeError)
+    True
+    """
+
+
+def _lammps_error(exc: Exception) -> bool:
+    """Whether ``exc`` is LAMMPS's own error (its Python module raises a plain Exception whose
+    message starts ``ERROR``)."""
+    return type(exc) is Exception and str(exc).lstrip().startswith("ERROR")
 
 
 def load_lammps():
@@ -267,7 +285,9 @@ def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, step
     Parameters
     ----------
     text : str
-        A file written by ``microimpact lammps export``.
+        A file written by ``microimpact lammps export``; every line is checked
+        (:func:`microimpact.io.lammps.read_lammps_export`) and LAMMPS runs the fix command rebuilt
+        from the parsed contact, not the text.
     speeds : sequence of float, optional
         Incident speeds [m/s]; default :func:`default_speeds`.
     incidences : sequence of float
@@ -293,7 +313,9 @@ def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, step
     LammpsUnavailable
         If LAMMPS cannot be loaded.
     ValueError
-        If ``text`` was not written by the export.
+        If ``text`` was not written by the export (naming the line).
+    LammpsRunError
+        If LAMMPS stops with an error of its own (its message, the speed and angle).
 
     Examples
     --------
@@ -303,19 +325,28 @@ def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, step
     >>> verify_lammps("units si\\nfix 1 all wall/gran granular hertz/material 5e10 0.0 0.25 zplane 0.0 NULL\\n")
     Traceback (most recent call last):
     ...
-    ValueError: no '# microimpact-contact:' line: not written by 'microimpact lammps export'
+    ValueError: line 1: 'units si' is not a line 'microimpact lammps export' writes (only its header comments, the contact and units lines and one fix wall/gran command)
     """
     import pandas as pd
 
     from microimpact.solvers.impact import simulate_impact
 
-    contact, units = read_lammps_contact(text)
+    export = read_lammps_export(text)
+    contact, units = export.contact, export.units
+    text = export.script()  # LAMMPS runs the command rebuilt from the parsed parameters, never the file's text
     lammps = load_lammps()
     speeds = default_speeds(contact) if speeds is None else tuple(speeds)
     rows = []
     for speed in speeds:
         for angle in incidences:
-            rows.append(_compare(lammps, text, contact, units, float(speed), float(angle), steps, simulate_impact))
+            try:
+                rows.append(_compare(lammps, text, contact, units, float(speed), float(angle), steps, simulate_impact))
+            except Exception as exc:
+                if not _lammps_error(exc):
+                    raise
+                said = (str(exc).strip().splitlines() or ["ERROR"])[0]
+                raise LammpsRunError(f"LAMMPS stopped at speed {float(speed):g} m/s, incidence {float(angle):g} "
+                                     f"deg: {said}") from None
             if progress is not None:
                 progress()
     table = pd.DataFrame(rows)

@@ -1,0 +1,144 @@
+"""Outputs all or nothing and options that read as they were meant (issue 55, items 3, 5, 7)."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from microimpact.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "data" / "synthetic_microspheres.csv"  # SYNTHETIC data (data/README.md)
+
+
+@pytest.fixture(scope="module")
+def small_csv(tmp_path_factory):
+    """Every fifth impact of the synthetic file: 20 points over 4 radii (a fast fit)."""
+    lines = DATA.read_text().splitlines()
+    path = tmp_path_factory.mktemp("data") / "small.csv"
+    path.write_text("\n".join([lines[0]] + lines[1::5]) + "\n")
+    return path
+
+
+def test_out_dash_is_a_value_again(tmp_path, monkeypatch, capsys):
+    # "--out -" was answered "unrecognized option - (did you mean -h?)": a lone "-" is a value
+    monkeypatch.chdir(tmp_path)
+    assert main(["simulate", "--speed", "2", "--out", "-"]) == 2  # simulate has no --out: still refused
+    assert "unrecognized option --out" in capsys.readouterr().err
+    assert main(["reproduce", "--out", "-", "--time-budget", "1e-9"]) == 3  # parsed; stopped by the budget
+    err = capsys.readouterr().err
+    assert "unrecognized option" not in err and "time budget" in err
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_fit_to_a_full_stdout_writes_no_file(small_csv, tmp_path):
+    # `fit > /dev/full` exited 2 after writing its NetCDF; the report is now printed first
+    out = tmp_path / "fit.nc"
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-m", "microimpact._entry", "fit", str(small_csv), "--out", str(out),
+                               "--no-confidence-intervals"], stdout=full, stderr=subprocess.PIPE, text=True,
+                              timeout=300)
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert lines[-1].startswith("microimpact: error: stdout") and "No space left" in lines[-1], done.stderr
+    assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("argv, named", [
+    (["simulate", "--speed", "1_0"], "--speed: not a number: '1_0'"),  # float() read it as 10
+    (["simulate", "--speed", " 2"], "--speed: not a number"),
+    (["simulate", "--speed", "2", "--radius", "3_0e-6"], "--radius: not a number"),
+    (["fit", "d.csv", "--out", "f.nc", "--posterior", "p.nc", "--walkers", "3_2"], "--walkers: not a whole number"),
+    (["lammps", "verify", "f.lmp", "--steps", "2_000"], "--steps: not a whole number"),
+    (["target", "--e-n", "0.5", "--speed", "1", "--points", "1000000"], "--points: at most 10000 points"),
+    (["target", "--e-n", "0.5", "--speed", "1", "--points", "2"], "--points: must be a whole number >= 3"),
+    (["flags", "d.csv", "--fit", "f.nc", "--out", "o.csv", "--angle-uncertainty-deg", "1e6"],
+     "--angle-uncertainty-deg: an incidence-angle uncertainty is below 90 deg"),
+])
+def test_numbers_parse_strictly_and_counts_are_bounded_before_the_work(argv, named, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and named in err[0], err
+
+
+@pytest.mark.parametrize("name", ["", " "])
+def test_an_empty_preset_names_no_preset(name, capsys):
+    # --preset '' was taken as the default preset
+    assert main(["simulate", "--speed", "2", "--preset", name]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--preset" in err[0] and "wall1990" in err[0], err
+
+
+@pytest.fixture
+def small_tmpfs(tmp_path):
+    """A mount point and a function that mounts a tmpfs of a given size on it (root only; skipped else)."""
+    import subprocess as sp
+
+    point = tmp_path / "mnt"
+    point.mkdir()
+    mounted = []
+
+    def mount(size_bytes: int) -> Path:
+        size = max(4096, -(-size_bytes // 4096) * 4096)  # whole pages
+        done = sp.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(point)], capture_output=True)
+        if done.returncode != 0:
+            pytest.skip(f"cannot mount a tmpfs here: {done.stderr.decode(errors='replace').strip()}")
+        mounted.append(point)
+        return point
+
+    yield mount
+    for p in mounted:
+        sp.run(["umount", str(p)], check=False)
+
+
+@pytest.mark.slow  # a tiny benchmark and its figure, twice: tens of seconds on a loaded machine
+def test_benchmark_on_a_file_system_that_fills_up_writes_all_or_nothing(small_tmpfs, tmp_path, monkeypatch, capsys):
+    # benchmark --out on a disk that filled up left benchmark.nc and none of the other outputs
+    from microimpact._commands import benchmark as command
+    from microimpact.studies.benchmark import BenchmarkConfig, run_benchmark
+
+    ds = run_benchmark(config=BenchmarkConfig.tiny_(), throughput=False)
+    monkeypatch.setattr(command, "run_benchmark", lambda **kwargs: ds)
+    whole = tmp_path / "whole"
+    assert main(["benchmark", "--out", str(whole)]) == 0
+    sizes = {p.name: p.stat().st_size for p in whole.iterdir()}
+    assert len(sizes) == 5
+    capsys.readouterr()
+    # room for benchmark.nc (written first) and a little, not for the rest
+    out = small_tmpfs(sizes["benchmark.nc"] + 4096) / "out"
+    assert main(["benchmark", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "No space left" in err[0], err
+    assert not out.exists() or sorted(out.iterdir()) == []  # no file at all, no temporary file
+
+
+@pytest.mark.parametrize("form", [["--configfile", "{missing}"], ["--configfile={missing}"],
+                                  ["--configfiles", "{present}", "{missing}"]])
+def test_workflow_names_a_missing_configfile_in_one_line(form, tmp_path, capsys):
+    # Snakemake answered a missing --configfile with a traceback
+    present = tmp_path / "present.yaml"
+    present.write_text("{}\n")
+    missing = tmp_path / "missing.yaml"
+    words = [w.format(missing=missing, present=present) for w in form]
+    assert main(["workflow", "--directory", str(tmp_path / "run"), "-n", *words]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--configfile" in err[0] and str(missing) in err[0], err
+    assert not (tmp_path / "run").exists()
+
+
+def test_workflow_on_a_full_file_system_is_one_line(small_tmpfs, capsys):
+    # Snakemake's first write of .snakemake/ on a full disk ended in a traceback
+    point = small_tmpfs(64 * 1024)
+    with open(point / "filler", "wb", buffering=0) as f:
+        try:
+            while True:
+                f.write(b"\0" * 4096)
+                f.flush()
+        except OSError:
+            pass
+    assert main(["workflow", "--directory", str(point / "run"), "-n"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--directory" in err[0] and "No space left" in err[0], err
+    assert not (point / "run").exists()

@@ -1,0 +1,122 @@
+"""Signals in every window (issue 55, item 3): the interpreted run's timer never outlives it, and
+``microimpact workflow`` passes SIGTERM on and refuses --unlock while a run lives."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from microimpact import _entry
+
+
+class _Replaced(BaseException):
+    """os.execve, replaced: the process image would be replaced here."""
+
+
+@pytest.mark.skipif(not hasattr(signal, "setitimer"), reason="no interval timers on this platform")
+@pytest.mark.parametrize("how", ["error", "too slow"])
+def test_the_interpreted_runs_timer_is_cancelled_before_the_compiled_run_replaces_the_process(how, monkeypatch):
+    # a timer survives execve: if it still runs there, its SIGALRM kills the compiled command
+    # (exit 142, "Alarm clock", nothing printed), as every fallback on a cold cache did
+    seen = {}
+
+    def execve(path, argv, env):
+        seen["timer"] = signal.getitimer(signal.ITIMER_REAL)
+        seen["handler"] = signal.getsignal(signal.SIGALRM)
+        raise _Replaced
+
+    def failing_cli(argv):
+        if how == "too slow":
+            _entry._too_slow(signal.SIGALRM, None)
+        raise RuntimeError("the interpreted run failed")
+
+    monkeypatch.setenv("NUMBA_DISABLE_JIT", "0")  # restored afterwards; main sets it to 1
+    monkeypatch.setattr(sys, "argv", ["microimpact", "simulate", "--speed", "1"])
+    monkeypatch.setattr(_entry, "_interpreted", lambda argv: True)
+    monkeypatch.setattr("microimpact.cli.main", failing_cli)
+    monkeypatch.setattr(os, "execve", execve)
+    previous = signal.getsignal(signal.SIGALRM)
+    try:
+        with pytest.raises(_Replaced):
+            _entry.main()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
+    assert seen["timer"] == (0.0, 0.0)
+    assert seen["handler"] == signal.SIG_DFL
+
+
+# a stand-in for Snakemake: starts a job (a grandchild), says their pids, then waits; SIGINT stops
+# both (a traceback on stderr, which the wrapper must drop); with "stubborn" it ignores SIGINT
+CHILD = """
+import os, signal, subprocess, sys, time
+if sys.argv[1] == "stubborn":
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+job = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+print(os.getpid(), job.pid, flush=True)
+time.sleep(60)
+"""
+WRAPPER = """
+import sys
+from microimpact._runtime.supervise import run_supervised
+status, signum = run_supervised([sys.executable, "-c", sys.argv[1], sys.argv[2]])
+print("wrapper", status, signum, flush=True)
+"""
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return Path(f"/proc/{pid}/status").exists() and "zombie" not in Path(f"/proc/{pid}/status").read_text()
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs /proc to find the child's jobs")
+@pytest.mark.parametrize("child, signum", [("obedient", signal.SIGTERM), ("obedient", signal.SIGINT),
+                                           ("stubborn", signal.SIGTERM)])
+def test_a_stop_signal_to_the_wrapper_alone_ends_its_child_and_the_childs_jobs_quietly(child, signum):
+    # `kill PID` of microimpact workflow left Snakemake running detached (issue 55): the wrapper now
+    # passes the signal on as Ctrl-C to the child and everything it started, kills what has not
+    # ended STOP_GRACE s later, and drops what the child prints once stopped
+    proc = subprocess.Popen([sys.executable, "-c", WRAPPER, CHILD, child], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
+    try:
+        child_pid, job_pid = map(int, proc.stdout.readline().split())
+        sent = time.monotonic()
+        os.kill(proc.pid, signum)  # the wrapper's pid alone, not its group
+        out, err = proc.communicate(timeout=10)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    took = time.monotonic() - sent
+    assert took < 5.0
+    assert out.split()[:1] == ["wrapper"] and out.split()[2] == str(int(signum)), out
+    assert "Traceback" not in err and err == "", err  # the child's KeyboardInterrupt is dropped
+    time.sleep(0.1)
+    assert not _alive(child_pid) and not _alive(job_pid)
+
+
+@pytest.mark.skipif(not Path("/proc/self/cwd").exists(), reason="needs /proc to see other processes")
+def test_unlock_is_refused_while_a_snakemake_run_lives_in_the_directory(tmp_path, capsys):
+    from microimpact.cli import main
+
+    run = tmp_path / "run"
+    (run / ".snakemake" / "locks").mkdir(parents=True)
+    (run / ".snakemake" / "locks" / "0.input.lock").write_text("")
+    # a process that Snakemake's lock check counts: its command line names snakemake, its cwd is the run
+    holder = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)", "snakemake"], cwd=run)
+    try:
+        time.sleep(0.2)
+        assert main(["workflow", "--directory", str(run), "--unlock"]) == 2
+    finally:
+        holder.kill()
+        holder.wait()
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"process {holder.pid}" in err[0] and "--unlock" in err[0], err
+    assert (run / ".snakemake" / "locks" / "0.input.lock").exists()
