@@ -79,6 +79,7 @@ HOW = {
     # docs/calibration.md: the calibration study (tens of minutes; tests/test_calibration.py runs a quick form)
     "python tests/study_calibration.py --designs 300 --posterior-designs 12 --workers 2 --seed 1000 --out docs/calibration.json --figure docs/calibration.png": "study",
     "python tests/study_calibration.py": "study",
+    "python tests/study_calibration.py --dirty N --out docs/calibration_dirty.json --figure docs/calibration_dirty.png": "study",
     # README.md: signals at random moments of a pipeline run
     "python tests/study_interruptions.py --trials 20 --load 1 --seed 1 --out docs/interruptions.json": "study",
     "python tests/study_signals.py --sigint 30 --early 10 --sigterm 10 --seed 1 --out docs/signals.json": "study",

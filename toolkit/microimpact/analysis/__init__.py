@@ -17,7 +17,7 @@ from microimpact._lazy import lazy_exports as _lazy_exports
 #: public name -> the module of microimpact.analysis that defines it (tests/test_packaging.py checks
 #: that this table holds every module's ``__all__``)
 _HOMES = {
-    **dict.fromkeys(("AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS"), "analyst_fit"),
+    **dict.fromkeys(("AnalystFit", "analyse_impacts", "exclude_rows", "side_by_side", "POSTERIOR_DEFAULTS"), "analyst_fit"),
     **dict.fromkeys(("split_rhat", "ess_bulk", "RHAT_MAX", "ESS_MIN"), "diagnostics"),
     **dict.fromkeys(("FitResult", "DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
                      "PARAMETER_TABLE_COLUMNS"), "fit_result"),
@@ -30,7 +30,7 @@ _HOMES = {
                     "identifiability"),
     **dict.fromkeys(("kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
                      "KHARAZ_CONDITIONS", "UNLOADING_READINGS"), "kharaz"),
-    **dict.fromkeys(("compare_normal_models", "normal_model_restitution", "DEFAULT_MODELS"), "model_comparison"),
+    **dict.fromkeys(("compare_normal_models", "normal_model_restitution", "comparison_verdict", "DEFAULT_MODELS"), "model_comparison"),
     **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state",
                      "effective_sigma", "TANGENTIAL_PARAMETERS", "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"), "oblique"),
     **dict.fromkeys(("fit_dem_friction", "rank_dem_tangential_laws", "dem_friction_coverage"), "dem_friction"),
@@ -44,7 +44,11 @@ _HOMES = {
                      "make_synthetic_oblique", "write_synthetic_impacts"), "synthetic"),
     **dict.fromkeys(("DampingTarget", "damping_from_target"), "target"),
     **dict.fromkeys(("DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws",
-                     "ranked_by_aic", "information_criteria", "dem_fit_coverage", "INTERVAL_LEVEL", "ADEQUACY_P", "REGION_RAYS"), "dem_fit"),
+                     "ranked_by_aic", "information_criteria", "dem_fit_coverage", "INTERVAL_LEVEL", "REGION_RAYS"), "dem_fit"),
+    **dict.fromkeys(("Verdict", "assess_residuals", "ADEQUATE", "INADEQUATE", "NO_UNCERTAINTIES", "ADEQUACY_P",
+                     "OUTLIER_FALSE_ALARM", "MAX_OUTLIER_FRACTION", "sidak_threshold", "VERDICT_ATTRS"), "verdict"),
+    **dict.fromkeys(("thornton_restitution", "make_outlier_impacts", "make_thornton_impacts",
+                     "make_rebound_only_impacts", "DIRTY_MATERIAL_PAIR"), "dirty_data"),
 }
 #: the modules, importable as attributes
 _MODULES = tuple(sorted(set(_HOMES.values())))
