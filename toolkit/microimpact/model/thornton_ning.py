@@ -6,7 +6,7 @@ adhesion and p_y the limiting contact pressure (yield pressure). Forces are posi
 repulsive. Every formula below is written once, here; the equation numbers (TN1)-(TN12) are this
 module's, listed with their sources.
 
-Loading, elastic (JKR; Johnson, Kendall & Roberts 1971), with the radius of curvature R:
+Loading, elastic (JKR; Johnson, Kendall & Roberts 1971), with the radius of curvature R::
 
     (TN1)  delta(a; R) = a^2 / R - sqrt(2 pi w a / E*),   F(a; R) = 4 E* a^3 / (3 R) - sqrt(8 pi w E* a^3)
 
@@ -21,7 +21,7 @@ Yield (Thornton & Ning 1998): the JKR pressure, largest at the centre, reaches p
 the same equation (it cites it as Eq. (65) of the paper).
 
 Loading, plastic (Thornton 1997; Thornton & Ning 1998): the pressure is held at p_y over the
-growing contact, so each increment of contact area carries p_y:
+growing contact, so each increment of contact area carries p_y::
 
     (TN3)  F = F_y + pi p_y (a^2 - a_y^2),   a^2 = a_y^2 + R (delta - delta_y)   (delta > delta_y)
 
@@ -32,7 +32,7 @@ then not linear in delta. Without adhesion both are a^2 = R delta.
 
 Unloading (from the largest approach delta_max > delta_y, with a_max and F_max of (TN3)): elastic
 JKR with the plastically enlarged radius of curvature R_p, the curve shifted by the plastic
-approach delta_p so that it passes through (delta_max, F_max) with the contact radius a_max:
+approach delta_p so that it passes through (delta_max, F_max) with the contact radius a_max::
 
     (TN4)  F_max = 4 E* a_max^3 / (3 R_p) - sqrt(8 pi w E* a_max^3)
            ->  R_p = 4 E* a_max^3 / (3 (F_max + sqrt(8 pi w E* a_max^3)))
@@ -46,13 +46,13 @@ unloading curve would not pass through F_max, so (TN4) is used as written. Below
 
 Pull-off from the flattened contact (Thornton & Ning 1998): the contact breaks where
 d delta / d a = 0 on (TN6), the displacement-controlled break of an impact (Johnson & Pollock
-1994; the package's ``normal_model="jkr"``):
+1994; the package's ``normal_model="jkr"``)::
 
     (TN7)  a_cp^3 = pi w R_p^2 / (8 E*),   delta_break = delta_p - (3/4) (pi^2 w^2 R_p / E*^2)^(1/3),
            F_break = -(5/9) F_cp,   F_cp = (3/2) pi w R_p   (the pull-off force of the flattened contact)
 
 Energies. U(a; R) = 8 E* a^5 / (15 R^2) - (4/3) sqrt(2 pi w E*) a^(7/2) / R + pi w a^2 is the
-potential of (TN1), dU = F d delta along the curve (the package's JKR potential in SI form):
+potential of (TN1), dU = F d delta along the curve (the package's JKR potential in SI form)::
 
     (TN8)  W_load(delta) = U(a(delta); R) - U(a_0; R)            (delta <= delta_y)
                          = W_load(delta_y) + F_y (delta - delta_y) + pi R p_y (delta - delta_y)^2 / 2
@@ -74,7 +74,7 @@ rho): the impact speed whose Hertz (non-adhesive) loading just reaches p_y,
 slightly different speed (:func:`adhesive_yield_velocity`).
 
 Restitution without adhesion (Thornton 1997, J. Appl. Mech. 64:383, his closed form as PyGran's
-elasto-plastic example writes it), for V_i >= V_y:
+elasto-plastic example writes it), for V_i >= V_y::
 
     (TN12) e = sqrt(6 sqrt(3) / 5) sqrt(1 - (V_y/V_i)^2 / 6)
                [ (V_y/V_i) / ((V_y/V_i) + 2 sqrt(6/5 - (V_y/V_i)^2 / 5)) ]^(1/4)
