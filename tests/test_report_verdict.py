@@ -193,7 +193,7 @@ def test_a_file_without_the_verdict_is_judged_from_its_chi_square():
     z[[6, 30]] = (24.0, -24.0)  # two gross outliers among 40 rows
     v = read_verdict(_fit({}, residual=z))
     assert v.verdict == "inadequate" and not v.recorded
-    assert v.p_value == pytest.approx(chi2.sf(2 * 24.0 ** 2, N - 2), rel=1e-9)
+    assert v.p_value == pytest.approx(chi2.sf(2 * 24.0 ** 2, N - 2), rel=1e-9, abs=0)
     assert v.outlier_ids == ("s-07", "s-31")
     # the threshold has a 5 % false-alarm rate over 40 rows (Bonferroni, two-sided)
     assert f"{norm.isf(VERDICT_LEVEL / (2 * N)):.3g}" in v.outlier_threshold_text

@@ -20,12 +20,11 @@ References
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pandas as pd
 
 from microimpact.analysis.synthetic import make_synthetic_impacts
+from microimpact.model import thornton_ning
 
 __all__ = ["thornton_restitution", "make_outlier_impacts", "make_thornton_impacts", "make_rebound_only_impacts",
            "DIRTY_MATERIAL_PAIR"]
@@ -38,7 +37,8 @@ def thornton_restitution(speed, yield_speed):
     """Thornton's (1997) coefficient of restitution of an elastic-perfectly plastic sphere. [-]
 
     e = sqrt(6 sqrt(3) / 5) sqrt(1 - (V_y/V)^2 / 6) [ (V_y/V) / ((V_y/V) + 2 sqrt(6/5 - (V_y/V)^2 / 5)) ]^(1/4)
-    for V > V_y, and 1 (elastic) for V <= V_y.
+    for V > V_y, and 1 (elastic) for V <= V_y: the closed form (TN12) of
+    :func:`microimpact.model.thornton_ning.thornton_restitution`, as a function of the speed.
 
     Parameters
     ----------
@@ -66,10 +66,7 @@ def thornton_restitution(speed, yield_speed):
     2.0
     """
     v = np.asarray(speed, dtype=float)
-    x = np.minimum(yield_speed / v, 1.0)
-    e = (math.sqrt(6 * math.sqrt(3) / 5) * np.sqrt(1 - x * x / 6)
-         * (x / (x + 2 * np.sqrt(6 / 5 - x * x / 5))) ** 0.25)
-    return np.where(v <= yield_speed, 1.0, e)
+    return np.where(v <= yield_speed, 1.0, thornton_ning.thornton_restitution(yield_speed / v))
 
 
 def _table(radius, speed, e_n, sigma, prefix, seed_note) -> pd.DataFrame:
