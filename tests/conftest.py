@@ -72,3 +72,21 @@ def pytest_collection_finish(session):
     workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
     if worker.startswith("gw") and workers > 1 and len(session.items) >= SUITE_SIZE:
         fill_numba_cache(int(worker[2:]), workers)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Keep on one xdist worker the tests that share a module-scoped fixture of their own module
+    (run with ``--dist loadgroup``, pyproject.toml): xdist's default spreads a module's tests over
+    the workers, and each worker then builds the module's fixture again (a benchmark, a sweep, a set
+    of fits). The other tests are still spread one by one; so are those sharing only a
+    session-scoped fixture (each worker builds it once whatever the grouping, and grouping the 500
+    hostile-input cases would put them all on one worker)."""
+    for item in items:
+        info = getattr(item, "_fixtureinfo", None)
+        module = item.nodeid.split("::", 1)[0]
+        if info is None or item.get_closest_marker("xdist_group"):
+            continue
+        shared = any(d.scope in ("module", "package", "class") and d.baseid == module
+                     for defs in info.name2fixturedefs.values() for d in defs)
+        if shared:
+            item.add_marker(pytest.mark.xdist_group(name=module))

