@@ -74,7 +74,7 @@ does not depend on when the integration stopped:
   to 5e-2 between rtol 1e-8 and 1e-10).
 * the paper's friction ("net": F_lim = f |F_n| = 0 at the equilibrium): the rest of the
   oscillation is the linear damped tail about the equilibrium; its friction impulse (the total
-  variation of the normal rate, :func:`microimpact.solvers.engine._linear_tail_variation`) and twist
+  variation of the normal rate, :func:`microimpact.solvers.driver.linear_tail_variation`) and twist
   impulse (times a at the equilibrium) act as sliding friction, the closed-form map of the rigid
   contact (the limit is tiny, so the compliant contact is in gross slip while it slides).
 """
@@ -95,7 +95,8 @@ from microimpact.model.kinematics import flat_broadcast
 from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form maps
 from microimpact.solvers import SolverError, UndeterminedOutcomeWarning, dopri
 from microimpact.solvers.compiled_law import compiled
-from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _linear_tail_variation, _slow_twist
+from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
+from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _slow_twist
 
 __all__ = ["coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
 
