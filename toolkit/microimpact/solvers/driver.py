@@ -44,7 +44,7 @@ import numpy as np
 from microimpact._numba import njit
 from microimpact.solvers import dopri
 
-__all__ = ["Law", "Trace", "make_driver", "make_averaged_tail", "linear_tail_variation", "OK", "MAX_STEPS",
+__all__ = ["Law", "Trace", "make_driver", "make_error_norm", "make_averaged_tail", "linear_tail_variation", "OK", "MAX_STEPS",
            "STEP_UNDERFLOW", "GO_ON", "END", "END_UNCOUNTED", "CREEP_NONE", "CREEP_RESUME", "CREEP_END"]
 
 #: status of a solve: finished, step budget spent, step size below the law's floor
@@ -62,6 +62,9 @@ CREEP_NONE, CREEP_RESUME, CREEP_END = 0, 1, 2
 #: * ``args(p, w) -> tuple``: the arguments of the law's right-hand side at this step;
 #: * ``step``: the law's Dormand-Prince step (:func:`microimpact.solvers.dopri.make_step`);
 #: * ``step_too_small(h, u) -> bool``: the step-size floor;
+#: * ``norm(u, u1, k1, h, p, w, atol, rtol, k, tmp, err) -> float``: the error norm of the trial
+#:   step u -> u1, at most 1 to accept it (:func:`error_norm` for most laws; a law whose step ends
+#:   at an event, as the coupled law's at a change of slip, ends it here);
 #: * ``events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap) -> GO_ON | END | END_UNCOUNTED``: the
 #:   events within the accepted step u -> u1 located, and the state advanced (u, k1 at its end);
 #: * ``creep(u, k1, p, w, atol, rec, rec_cap) -> CREEP_NONE | CREEP_RESUME | CREEP_END``: the inertia-free limit;
@@ -69,17 +72,19 @@ CREEP_NONE, CREEP_RESUME, CREEP_END = 0, 1, 2
 #:   (``long_tail``: a twentieth of the step budget is spent);
 #: * ``finish(status, u, p, w, n_steps, n_rejected) -> Trace``;
 #: * ``n``: the number of states (a compile-time constant of the error norm).
-Law = collections.namedtuple("Law", "start args step step_too_small events creep captured_end finish n")
+Law = collections.namedtuple("Law", "start args step step_too_small norm events creep captured_end finish n")
 
 #: The nondimensional solution of one impact, in the units of its law: status (OK, MAX_STEPS,
 #: STEP_UNDERFLOW); outcome (the solver's REBOUND or CAPTURE); the rate and time at the end;
 #: the damping dissipation; the friction and twist impulses J = int |F_n| dt and int a |F_n| dt;
 #: the largest approach (xi for the ring law, the law's z for the others); the capture time and
 #: the time at which J reached its target (NaN where not); the contact energy at the end; the
-#: accepted and rejected steps and the rows of the recorded trajectory.
+#: accepted and rejected steps and the rows of the recorded trajectory; the whole state at the end;
+#: the turning points of a hysteretic tangential law and the rolling stops after a capture (0 for
+#: the normal laws).
 Trace = collections.namedtuple("Trace", "status outcome y_end tau_end dissipated friction_impulse twist_impulse "
                                         "max_approach tau_capture tau_slip_end final_energy n_steps n_rejected "
-                                        "n_recorded")
+                                        "n_recorded state turning_points held_rolling_stops")
 
 
 def make_driver(law):
@@ -130,15 +135,16 @@ def make_driver(law):
     ...     return GO_ON
     >>> @njit
     ... def finish(status, u, p, w, n, n_rej):
-    ...     return Trace(status, 0, u[1], u[2], 0.0, 0.0, 0.0, p[0], np.nan, np.nan, 0.0, n, n_rej, 0)
+    ...     return Trace(status, 0, u[1], u[2], 0.0, 0.0, 0.0, p[0], np.nan, np.nan, 0.0, n, n_rej, 0, u, 0, 0)
     >>> never = njit(lambda *a: False)
-    >>> law = Law(start, njit(lambda p, w: ()), step, njit(lambda h, u: h < 1e-300), events,
+    >>> norm = make_error_norm(3)
+    >>> law = Law(start, njit(lambda p, w: ()), step, njit(lambda h, u: h < 1e-300), norm, events,
     ...           njit(lambda u, k1, p, w, atol, rec, rec_cap: CREEP_NONE), never, finish, 3)
     >>> r = make_driver(law)((2.0,), 1e-9, 10_000, np.zeros((1, 3)), 0)
     >>> r.status == OK, round(r.tau_end, 6)  # from 2 m at 1 m/s^2: sqrt(4) s
     (True, 2.0)
     """
-    start, args_of, step, too_small = law.start, law.args, law.step, law.step_too_small
+    start, args_of, step, too_small, error_norm = law.start, law.args, law.step, law.step_too_small, law.norm
     events, creep, captured_end, finish, n = law.events, law.creep, law.captured_end, law.finish, law.n
 
     @njit(cache=True)
@@ -154,7 +160,7 @@ def make_driver(law):
                 status = MAX_STEPS
                 break
             step(u, k1, h, args_of(p, w), k, tmp, u1, err)
-            norm = dopri.error_norm(u, u1, err, atol, rtol, n)
+            norm = error_norm(u, u1, k1, h, p, w, atol, rtol, k, tmp, err)
             if not norm <= 1.0:  # (a NaN norm, from an overflowing trial step, is a rejection too)
                 n_rej += 1
                 h = dopri.shrunk_step(h, norm)
@@ -179,6 +185,26 @@ def make_driver(law):
         return finish(status, u, p, w, n_acc, n_rej)
 
     return drive
+
+
+def make_error_norm(n):
+    """The driver's ``norm`` of a law of n states that ends no step inside its norm: the
+    root-mean-square scaled error of :func:`microimpact.solvers.dopri.error_norm`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> norm = make_error_norm(2)
+    >>> u = np.ones(2)
+    >>> float(norm(u, u, u, 0.1, (), u, np.zeros(2), 1e-6, None, None, np.array([1e-6, 1e-6])))
+    1.0
+    """
+
+    @njit(cache=True, inline="always")
+    def norm(u, u1, k1, h, p, w, atol, rtol, k, tmp, err):
+        return dopri.error_norm(u, u1, err, atol, rtol, n)
+
+    return norm
 
 
 # --------------------------------------------------------------------------- the shared closed-form tails

@@ -1050,12 +1050,12 @@ def _law_finish(status, u, p, w, n_steps, n_rej):
     smax = w[_W_SMAX]
     return driver.Trace(status, int(w[_W_OUTCOME]), u[1], u[2], u[3], w[_W_J], u[4], smax * smax, w[_W_TAU_CAPTURE],
                         w[_W_TAU_JTARGET], law.nondimensional_energy(u[0], u[1], p[3], p[4]), n_steps, n_rej,
-                        int(w[_W_NREC]))
+                        int(w[_W_NREC]), u, 0, 0)
 
 
 #: the one driver (:mod:`.driver`) running the ring law
-_drive = driver.make_driver(driver.Law(_law_start, _law_args, _step, _law_too_small, _law_events, _law_creep,
-                                       _law_captured_end, _law_finish, _NSTATE))
+_drive = driver.make_driver(driver.Law(_law_start, _law_args, _step, _law_too_small, driver.make_error_norm(_NSTATE),
+                                       _law_events, _law_creep, _law_captured_end, _law_finish, _NSTATE))
 
 
 @njit(cache=True)
@@ -1313,7 +1313,8 @@ def normal_solution(contact, scales, y0, trace, *, trajectory=None) -> NormalSol
     >>> from microimpact.solvers.driver import OK, Trace
     >>> from microimpact.solvers.engine import REBOUND, engine_scales
     >>> sc, y0, c1, c2 = engine_scales(c, 2.0)
-    >>> trace = Trace(OK, REBOUND, -0.5 * y0, 3.0, 0.0, 0.0, 0.0, 1.2, math.nan, math.nan, 0.125 * y0**2, 40, 2, 0)
+    >>> trace = Trace(OK, REBOUND, -0.5 * y0, 3.0, 0.0, 0.0, 0.0, 1.2, math.nan, math.nan, 0.125 * y0**2, 40, 2, 0,
+    ...               None, 0, 0)
     >>> s = normal_solution(c, sc, y0, trace)
     >>> s.outcome, s.e_n, round(s.contact_time / sc.time, 12)
     ('rebound', 0.5, 3.0)

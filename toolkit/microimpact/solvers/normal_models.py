@@ -706,12 +706,12 @@ def _law_finish(status, u, p, w, n_steps, n_rej):
     model = p[0]
     e_free = _energy(model, 4.0 ** (1.0 / 3.0) if _is_jkr(model) else 0.0, 0.0)
     return driver.Trace(status, int(w[_W_OUTCOME]), u[1], u[2], u[3], u[4], u[5], w[_W_ZMAX], w[_W_TAU_CAP],
-                        w[_W_TAU_SLIP], _energy(model, u[0], u[1]) - e_free, n_steps, n_rej, 0)
+                        w[_W_TAU_SLIP], _energy(model, u[0], u[1]) - e_free, n_steps, n_rej, 0, u, 0, 0)
 
 
 #: the one driver (:mod:`.driver`) running the JKR, DMT and Hertz laws
-_drive = driver.make_driver(driver.Law(_law_start, _law_args, _step, _law_too_small, _law_events, _law_creep,
-                                       _law_captured_end, _law_finish, _N))
+_drive = driver.make_driver(driver.Law(_law_start, _law_args, _step, _law_too_small, driver.make_error_norm(_N),
+                                       _law_events, _law_creep, _law_captured_end, _law_finish, _N))
 _NO_RECORD = np.zeros((1, 3))
 
 

@@ -308,5 +308,5 @@ def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS
     y_out = r[_Y_OUT]  # exit speed, > 0
     dissipated = math.nan if captured else 0.5 * (y0[0] ** 2 - y_out**2)  # energy balance
     trace = Trace(OK, int(r[_OUTCOME]), -y_out, r[_TAU_END], dissipated, r[_J], r[_J_A], r[_XI_MAX],
-                  r[_TAU_END] if captured else math.nan, r[_TAU_J], r[_E_END], int(r[_N_STEPS]), 0, 0)
+                  r[_TAU_END] if captured else math.nan, r[_TAU_J], r[_E_END], int(r[_N_STEPS]), 0, 0, None, 0, 0)
     return engine.normal_solution(contact, sc, y0[0], trace)
