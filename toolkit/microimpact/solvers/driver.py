@@ -126,13 +126,17 @@ def make_driver(law):
     ... def start(p, rtol, rec, rec_cap):
     ...     return np.array([p[0], 0.0, 0.0]), np.array([0.0, -1.0, 1.0]), 1e-3, np.full(3, rtol), np.zeros(1)
     >>> @njit
+    ... def height(u, code, vargs):
+    ...     return u[0]
+    >>> ground = dopri.make_root_on_step(step, height)
+    >>> @njit
     ... def events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
-    ...     if u1[0] <= 0.0:  # linear in the step's length near the ground: good to the step's error
-    ...         u[2] += h * u[0] / (u[0] - u1[0])
-    ...         return END
+    ...     landed = u1[0] <= 0.0
+    ...     if landed:  # re-step to the ground, within this step
+    ...         ground(0, 0.0, u[0], u1[0], 1e-12, h, u, k1, (), (), k, tmp, u1, err)
     ...     u[:] = u1
     ...     k1[:] = k[6]
-    ...     return GO_ON
+    ...     return END if landed else GO_ON
     >>> @njit
     ... def finish(status, u, p, w, n, n_rej):
     ...     return Trace(status, 0, u[1], u[2], 0.0, 0.0, 0.0, p[0], np.nan, np.nan, 0.0, n, n_rej, 0, u, 0, 0)

@@ -28,7 +28,8 @@ Separation is the simple root s = 0 (with y < 0). The friction impulse J is the 
 of y, because the nondimensional normal force is -dy/dtau: it is summed exactly over the monotone
 pieces of y, whose ends (the zeros of dy/dsigma) are located as events. J_a and the damping
 dissipation D are integrated as extra states. Integration is Dormand-Prince 5(4) (the one core of the
-compiled solvers, :mod:`.dopri`) with error control
+compiled solvers, :mod:`.dopri`, run by their one driver, :mod:`.driver`, into which this law plugs its
+events, its inertia-free limit and its captured end) with error control
 on all states; events are located by re-stepping from the start of the step (Illinois method), so
 their accuracy is that of the integrator.
 
@@ -242,7 +243,7 @@ class EngineError(SolverError):
 # engine ran markedly slower. Those called once per impact or only in rare regimes (the set-up, the
 # inertia-free limit and its tests, the undamped mirror) are compiled as calls, which LLVM may still
 # inline: numba's inlining copies and re-types a helper at every call site, which lengthened
-# _integrate's compile and gained no speed (docs/model.md, "How it is computed").
+# the driver's compile and gained no speed (docs/model.md, "How it is computed").
 @njit(cache=True, inline="always")
 def _derivatives(s, y, c1, c2, ah, aa, sgn):
     """d/dsigma of the state (s, y, tau, D, J_a) at (s, y) (see the module docstring)."""
