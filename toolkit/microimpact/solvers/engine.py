@@ -61,6 +61,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,7 +75,7 @@ from microimpact.solvers import compiled_law as law
 from microimpact.solvers import dopri, driver
 from microimpact.solvers.dopri import hermite, illinois_point, illinois_update
 
-__all__ = ["NormalSolution", "EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
+__all__ = ["NormalSolution", "NormalBatch", "EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
 
 # Status codes of the compiled core
 _OK = 0
@@ -1169,6 +1170,66 @@ class NormalSolution:
     penetration_rate: np.ndarray | None = None
 
 
+#: the fields of a :class:`NormalBatch`, in order
+_BATCH_FIELDS = ("captured", "e_n", "contact_time", "capture_time", "max_penetration", "friction_impulse",
+                 "twist_impulse", "dissipated_energy", "final_energy", "n_steps")
+
+
+@dataclass(frozen=True, eq=False)
+class NormalBatch(Mapping):
+    """Result of many normal-contact solves (SI arrays, one element per speed): the fields of
+    :class:`NormalSolution` that a batch keeps, with ``captured`` for its outcome.
+
+    Read by attribute (``batch.e_n``) or, as the dicts it replaced were, by name
+    (``batch["e_n"]``, ``batch.items()``).
+
+    Attributes
+    ----------
+    captured : numpy.ndarray of bool
+    e_n : numpy.ndarray
+        Normal restitution coefficient; 0 if captured. [-]
+    contact_time, capture_time : numpy.ndarray
+        As in :class:`NormalSolution`. [s]
+    max_penetration : numpy.ndarray
+        [m]
+    friction_impulse, twist_impulse : numpy.ndarray
+        [N s], [N m s]
+    dissipated_energy, final_energy : numpy.ndarray
+        [J]
+    n_steps : numpy.ndarray of int
+        Accepted steps of each solve (0 where a family interpolated it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> b = NormalBatch(*(np.zeros(2) for _ in range(10)))
+    >>> list(b)[:3], b["e_n"] is b.e_n, len(b)
+    (['captured', 'e_n', 'contact_time'], True, 10)
+    """
+
+    captured: np.ndarray
+    e_n: np.ndarray
+    contact_time: np.ndarray
+    capture_time: np.ndarray
+    max_penetration: np.ndarray
+    friction_impulse: np.ndarray
+    twist_impulse: np.ndarray
+    dissipated_energy: np.ndarray
+    final_energy: np.ndarray
+    n_steps: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in _BATCH_FIELDS:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def __iter__(self):
+        return iter(_BATCH_FIELDS)
+
+    def __len__(self) -> int:
+        return len(_BATCH_FIELDS)
+
+
 #: The record array of a solve that records nothing (never written: its capacity is 0)
 _NO_RECORD = np.zeros((1, 3))
 
@@ -1354,8 +1415,9 @@ def normal_solution(contact, scales, y0, trace, *, trajectory=None) -> NormalSol
 
 def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DEFAULT_RTOL,
                       tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT,
-                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> dict:
-    """Solve many normal impacts in parallel (both cores); arrays in, dict of SI arrays out.
+                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> NormalBatch:
+    """Solve many normal impacts in parallel (both cores); arrays in, a :class:`NormalBatch` of SI
+    arrays out.
 
     Parameters
     ----------
@@ -1370,9 +1432,10 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
 
     Returns
     -------
-    dict with arrays ``captured`` (bool), ``e_n`` [-], ``contact_time`` [s], ``capture_time`` [s],
-    ``max_penetration`` [m], ``friction_impulse`` [N s], ``twist_impulse`` [N m s],
-    ``dissipated_energy`` [J], ``final_energy`` [J], ``n_steps``.
+    NormalBatch
+        ``captured`` (bool), ``e_n`` [-], ``contact_time`` [s], ``capture_time`` [s],
+        ``max_penetration`` [m], ``friction_impulse`` [N s], ``twist_impulse`` [N m s],
+        ``dissipated_energy`` [J], ``final_energy`` [J], ``n_steps``.
 
     References
     ----------
@@ -1424,18 +1487,18 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     eu = contact.mass * u * u
     e_n = np.where(captured, 0.0, -out[:, 2] / y0)
     _check_restitution(e_n, v, rtol)
-    result = {
-        "captured": captured,
-        "e_n": e_n,
-        "contact_time": np.where(captured, np.inf, out[:, 3] * time),
-        "capture_time": out[:, 8] * time,
-        "max_penetration": out[:, 7] * length,
-        "friction_impulse": out[:, 5] * ju,
-        "twist_impulse": out[:, 6] * ju * np.sqrt(contact.radius * length),
-        "dissipated_energy": out[:, 4] * eu,
-        "final_energy": out[:, 9] * eu,
-        "n_steps": out[:, 10].astype(np.int64),
-    }
+    result = NormalBatch(
+        captured=captured,
+        e_n=e_n,
+        contact_time=np.where(captured, np.inf, out[:, 3] * time),
+        capture_time=out[:, 8] * time,
+        max_penetration=out[:, 7] * length,
+        friction_impulse=out[:, 5] * ju,
+        twist_impulse=out[:, 6] * ju * np.sqrt(contact.radius * length),
+        dissipated_energy=out[:, 4] * eu,
+        final_energy=out[:, 9] * eu,
+        n_steps=out[:, 10].astype(np.int64),
+    )
     _check_domain(contact, result, v)
     return result
 

@@ -74,7 +74,7 @@ from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL, dopri, driver, engine
 from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
 from microimpact.solvers.engine import (CAPTURE, INERTIA_FREE_ENTER, INERTIA_FREE_RESUME, OUTCOME_NAMES, REBOUND,
-                                       RELAXATION_ENTER, RELAXATION_RESUME, EngineError, NormalSolution)
+                                       RELAXATION_ENTER, RELAXATION_RESUME, EngineError, NormalBatch, NormalSolution)
 
 __all__ = ["solve_normal", "solve_normal_many", "solve_normal_reference", "settled_contact_energy",
            "MODEL_CODES"]
@@ -880,9 +880,10 @@ def solve_normal(contact, normal_speed: float, *, rtol: float = DEFAULT_RTOL, ne
 
 def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DEFAULT_RTOL,
                       tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT,
-                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> dict:
-    """JKR or DMT normal solves of many speeds in parallel; the dict of
-    :func:`microimpact.solvers.engine.solve_normal_many` (SI arrays).
+                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> NormalBatch:
+    """JKR or DMT normal solves of many speeds in parallel; the
+    :class:`~microimpact.solvers.engine.NormalBatch` of :func:`microimpact.solvers.engine.solve_normal_many`
+    (SI arrays).
 
     Parameters as there: ``normal_speed`` [m/s] (1-D, > 0), ``need_tail`` per speed,
     ``friction_impulse_stop`` [N s] and ``twist_impulse_stop`` [N m s] per speed.
@@ -932,18 +933,18 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     captured = out[:, 1] == CAPTURE
     e_unit = sc.force * sc.length
     e_n = np.where(captured, 0.0, _restitution(model, y0, out[:, 4], out[:, 2]))
-    return {
-        "captured": captured,
-        "e_n": e_n,
-        "contact_time": np.where(captured, np.inf, out[:, 3] * sc.time),
-        "capture_time": out[:, 8] * sc.time,
-        "max_penetration": _penetration(model, sc, out[:, 7]),
-        "friction_impulse": out[:, 5] * j_unit,
-        "twist_impulse": out[:, 6] * j_unit * sc.radius,
-        "dissipated_energy": np.where(captured, out[:, 4], 0.5 * y0**2 * (1.0 - e_n**2)) * e_unit,
-        "final_energy": np.where(captured, out[:, 10], 0.5 * (e_n * y0) ** 2) * e_unit,
-        "n_steps": out[:, 11].astype(np.int64),
-    }
+    return NormalBatch(
+        captured=captured,
+        e_n=e_n,
+        contact_time=np.where(captured, np.inf, out[:, 3] * sc.time),
+        capture_time=out[:, 8] * sc.time,
+        max_penetration=_penetration(model, sc, out[:, 7]),
+        friction_impulse=out[:, 5] * j_unit,
+        twist_impulse=out[:, 6] * j_unit * sc.radius,
+        dissipated_energy=np.where(captured, out[:, 4], 0.5 * y0**2 * (1.0 - e_n**2)) * e_unit,
+        final_energy=np.where(captured, out[:, 10], 0.5 * (e_n * y0) ** 2) * e_unit,
+        n_steps=out[:, 11].astype(np.int64),
+    )
 
 
 def settled_contact_energy(contact) -> float:
