@@ -151,6 +151,27 @@ def _coupled(all_cases):
     return out
 
 
+def _batch(solution) -> list[str]:
+    """Every array of a batch solve (``solve_normal_many``), exactly."""
+    return [f"{k}:" + ",".join(_hex(x) for x in np.asarray(solution[k], dtype=float)) for k in sorted(solution)]
+
+
+def _many(case):
+    """The batch kernels of the engine and the JKR/DMT/Hertz solver (their parallel loops over
+    ``_integrate``): each case at its speed and at a tenth of it, the first without, the second with
+    the captured tail."""
+    from microimpact.solvers import engine, normal_models
+
+    v, tail = np.array([case["speed"], 0.1 * case["speed"]]), np.array([False, True])
+    out = {"ring": _guarded(lambda: _batch(engine.solve_normal_many(_contact(case), v, tail, rtol=RTOL)))}
+    for model in ("jkr", "dmt"):
+        c = _contact(case, normal_model=model)
+        out[model] = _guarded(lambda: _batch(normal_models.solve_normal_many(c, v, tail, rtol=RTOL)))
+    c = _dem_contact(case, "viscoelastic")
+    out["hertz-viscoelastic"] = _guarded(lambda: _batch(normal_models.solve_normal_many(c, v, tail, rtol=RTOL)))
+    return out
+
+
 def fingerprint() -> dict:
     """{solver: {case: [exact outputs]}} of the three solvers over :func:`cases`."""
     all_cases = cases()
@@ -158,8 +179,9 @@ def fingerprint() -> dict:
         warnings.simplefilter("ignore")  # undetermined outcomes and out-of-regime laws: solved all the same
         engine = {f"{i}:{k}": x for i, case in enumerate(all_cases) for k, x in _engine(case).items()}
         normal = {f"{i}:{k}": x for i, case in enumerate(all_cases) for k, x in _normal_models(case).items()}
+        many = {f"{i}:{k}": x for i, case in enumerate(all_cases) for k, x in _many(case).items()}
         coupled = _coupled(all_cases)
-    return {"engine": engine, "normal_models": normal, "coupled": coupled}
+    return {"engine": engine, "normal_models": normal, "many": many, "coupled": coupled}
 
 
 def differences(new: dict, old: dict) -> list[str]:

@@ -74,7 +74,7 @@ does not depend on when the integration stopped:
   to 5e-2 between rtol 1e-8 and 1e-10).
 * the paper's friction ("net": F_lim = f |F_n| = 0 at the equilibrium): the rest of the
   oscillation is the linear damped tail about the equilibrium; its friction impulse (the total
-  variation of the normal rate, :func:`microimpact.solvers.engine._linear_tail_variation`) and twist
+  variation of the normal rate, :func:`microimpact.solvers.driver.linear_tail_variation`) and twist
   impulse (times a at the equilibrium) act as sliding friction, the closed-form map of the rigid
   contact (the limit is tiny, so the compliant contact is in gross slip while it slides).
 """
@@ -93,9 +93,10 @@ from microimpact.model import law as _law
 from microimpact.model import tangential_compliance as _tc
 from microimpact.model.kinematics import flat_broadcast
 from microimpact.model.tangential import stop_impulses, tangential_outcome  # closed-form maps
-from microimpact.solvers import SolverError, UndeterminedOutcomeWarning, dopri
+from microimpact.solvers import SolverError, UndeterminedOutcomeWarning, dopri, driver
 from microimpact.solvers.compiled_law import compiled
-from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _linear_tail_variation, _slow_twist
+from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
+from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _slow_twist
 
 __all__ = ["coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
 
@@ -666,9 +667,173 @@ def _captured_stop(z, k1, atol, settle, peaked, conserved, j_stop, ja_stop, tail
     return 0
 
 
+# ------------------------------------------------------------------ the coupled law in the one driver
+# The law's parameters p = (y0, vt0, vtp0, wt0, wtp0, the parameter row (see _rhs), j_stop, ja_stop,
+# settle) and its bookkeeping w = (hist, b): the branch history of the hysteretic law
+# (:func:`_initial_branch`) and the array b (indices below; flags as 0.0 / 1.0), for the driver
+# (:mod:`.driver`), which owns the loop, the budgets and the step control.
+_B_TURNS, _B_HELD, _B_SLIPPING, _B_LOAD_SIDE, _B_CAPTURED, _B_PEAKED, _B_TAU_CAP, _B_TAU_ZERO = 0, 1, 2, 3, 4, 5, 6, 7
+_B_TAU_J, _B_SMAX, _B_OUTCOME, _B_H_END, _B_RESTART, _B_AT_REST, _B_SLIP_CHANGE = 8, 9, 10, 11, 12, 13, 14
+_B_SREF, _B_LIM_REF, _B_ECAP, _B_XE, _B_OMEGA0, _B_CEQ = 15, 16, 17, 18, 19, 20
+_B_SIZE = 21
+
+
+@njit(cache=True)
+def _law_start(p, rtol, rec, rec_cap):
+    """The driver's start (:func:`_start`): the state, its derivative, the first step, the
+    tolerances and the bookkeeping (hist, b) of one impact."""
+    row = p[5]
+    z, k1, hist, atol, sref, lim_ref, ecap, h = _start(p[0], p[1], p[2], p[3], p[4], row, rtol)
+    b = np.zeros(_B_SIZE)
+    # its gross slip (found by the projection at first contact, then by events), the sign of the
+    # Coulomb limit's load argument since the last restart (0: not yet known) and the capture time
+    # (tau_zero: where the energy first fell below zero, the capture time, as the engine's)
+    b[_B_TAU_CAP] = b[_B_TAU_ZERO] = b[_B_TAU_J] = math.nan
+    b[_B_SREF], b[_B_LIM_REF], b[_B_ECAP] = sref, lim_ref, ecap
+    b[_B_XE], b[_B_OMEGA0], b[_B_CEQ] = _equilibrium(row[0], row[1], row[2], row[3])
+    return z, k1, h, atol, (hist, b)
+
+
+@njit(cache=True, inline="always")
+def _law_args(p, w):
+    """The right-hand side's arguments: (the parameter row, the branch history)."""
+    return (p[5], w[0])
+
+
+@njit(cache=True, inline="always")
+def _law_too_small(h, z):
+    return h < 1e-300
+
+
+@njit(cache=True)
+def _law_norm(z, z1, k1, h, p, w, atol, rtol, k, tmp, err):
+    """The error norm of the trial step z -> z1 (:func:`_error_sum`), the step ended at the earliest
+    of its events first (:func:`_end_at_events`: a change of gross slip, a rolling stop, a zero of
+    the Coulomb limit), which the accepted step's events then read from b."""
+    row = p[5]
+    hist, b = w
+    hysteretic = row[9] > 1.5
+    en = _error_sum(z, z1, err, atol, rtol, row, hysteretic, b[_B_LIM_REF])
+    en, restart, at_rest, h_end, slip_change, load_side = _end_at_events(
+        en, h, z, z1, k1, err, atol, rtol, row, hist, k, tmp, b[_B_LIM_REF], b[_B_SLIPPING] != 0.0, b[_B_LOAD_SIDE],
+        0.5 < row[9] < 1.5, row[10] > 0.0, hysteretic)
+    b[_B_RESTART], b[_B_AT_REST], b[_B_H_END] = 1.0 if restart else 0.0, 1.0 if at_rest else 0.0, h_end
+    b[_B_SLIP_CHANGE], b[_B_LOAD_SIDE] = 1.0 if slip_change else 0.0, load_side
+    return math.sqrt(en / _N)
+
+
+@njit(cache=True)
+def _law_events(z, z1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
+    """The events within the accepted step z -> z1 (the largest penetration, separation, a turning
+    point of the hysteretic law, the end of sliding, the capture) and the advance to its end: the
+    normal energy kept exact where undamped, a rolling stop, the tangential state
+    (:func:`_tangential_update`) and a held rolling velocity."""
+    y0, row, j_stop = p[0], p[5], p[6]
+    hist, b = w
+    ah, aa = row[2], row[3]
+    hysteretic, rolling, elastic = row[9] > 1.5, row[10] > 0.0, 0.5 < row[9] < 1.5
+    damped = row[0] > 0.0 or row[1] > 0.0
+    conservative = not damped and aa > 0.0
+    h_end, restart, at_rest = b[_B_H_END], b[_B_RESTART] != 0.0, b[_B_AT_REST] != 0.0
+    captured, tau_j, smax = b[_B_CAPTURED] != 0.0, b[_B_TAU_J], b[_B_SMAX]
+    if b[_B_PEAKED] == 0.0 and z[_Y] > 0.0 and z1[_Y] <= 0.0:
+        smax = max(smax, _root_state(_EV_DEPTH, 0.0, h_end, z, z1, k1, row, hist)[_S])
+        b[_B_PEAKED] = 1.0
+    if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: its root on the step length
+        b[_B_TAU_J] = _separate(z, z1, k1, h_end, row, hist, k, tmp, err, b[_B_SREF], conservative, y0, j_stop, tau_j)
+        b[_B_SMAX], b[_B_OUTCOME] = smax, 0.0
+        return driver.END
+    turned = False
+    if not restart and hysteretic and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
+        # turning point of the hysteretic law within the step: its root on the step length
+        ga, gb = _branch_slip(z, hist), _branch_slip(z1, hist)
+        _restep_to_root(_EV_TURN, 0.0, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h_end, z, k1, row, hist, k, tmp, z1, err)
+        turned = True
+        at_rest = False
+    tau_j = _impulse_time(z, z1, j_stop, tau_j, h_end, k1, row, hist)
+    if not captured and damped and aa > 0.0:
+        e1 = _energy(z1[_S], z1[_Y], ah, aa)
+        if math.isnan(b[_B_TAU_ZERO]) and e1 < 0.0 <= _energy(z[_S], z[_Y], ah, aa):
+            b[_B_TAU_ZERO] = _root_state(_EV_ENERGY, 0.0, h_end, z, z1, k1, row, hist)[_TAU]
+        if e1 < b[_B_ECAP]:  # the capture test, with the engine's margin
+            captured = True
+            b[_B_TAU_CAP] = b[_B_TAU_ZERO] if not math.isnan(b[_B_TAU_ZERO]) else _root_state(
+                _EV_ENERGY, b[_B_ECAP], h_end, z, z1, k1, row, hist)[_TAU]
+    for i in range(_N):
+        z[i] = z1[i]
+    refresh = False
+    if conservative and z[_S] > 0.0:
+        # undamped with adhesion: the normal motion keeps its energy y0^2 / 2 exactly (it does
+        # not feel the tangential state), so y is put back on that energy; round-off of the
+        # order of rtol times the well's depth would otherwise trap a slow sphere in the well
+        # (y0 ~ 1e-5: the step limit, where the engine mirrors the way out)
+        v2 = 2.0 * (0.5 * y0 * y0 - _energy(z[_S], 0.0, ah, aa))
+        z[_Y] = math.copysign(math.sqrt(v2), z[_Y]) if v2 > 0.0 else 0.0
+        refresh = True
+    if at_rest:
+        z[_WT] = z[_WTP] = 0.0
+        if captured:
+            b[_B_HELD] += 1.0
+    b[_B_TURNS] += 1.0 if turned else 0.0
+    load_side, slipping = _tangential_update(z, k1, k, row, hist, turned, restart, b[_B_LOAD_SIDE],
+                                             b[_B_SLIPPING] != 0.0, b[_B_SLIP_CHANGE] != 0.0, hysteretic, elastic,
+                                             refresh)
+    if rolling and z[_S] > 0.0:
+        _hold_rolling(z, k1, atol[_WT] * min(max(1.0, h_end * _rolling_approach(z, k1) / atol[_WT]), _HOLD_SPAN),
+                      row, hist)
+    b[_B_LOAD_SIDE], b[_B_SLIPPING], b[_B_CAPTURED] = load_side, 1.0 if slipping else 0.0, 1.0 if captured else 0.0
+    b[_B_TAU_J], b[_B_SMAX] = tau_j, max(smax, z[_S])
+    return driver.GO_ON
+
+
+@njit(cache=True)
+def _law_creep(z, k1, p, w, atol, rec, rec_cap):
+    """No inertia-free jump: a creeping captured sphere ends in :func:`_captured_stop`."""
+    return driver.CREEP_NONE
+
+
+@njit(cache=True)
+def _law_captured_end(z, k1, p, w, atol, long_tail):
+    """Whether a captured sphere stops (:func:`_captured_stop`), its outcome code into b."""
+    b = w[1]
+    if b[_B_CAPTURED] == 0.0:
+        return False
+    row = p[5]
+    tail_closed = not row[10] > 0.0 or row[6] > 0.5  # a captured sphere's tail is taken in closed form
+    # a captured sphere with friction limited at rest and no rolling resistance ends rolling at its
+    # angular momentum about the contact point, which the contact force conserves (_rolling_state):
+    # nothing after the capture and the largest penetration changes the result
+    conserved = row[11] > 0.5  # stops_at_capture(contact), column 11 of the parameter rows
+    outcome = _captured_stop(z, k1, atol, p[8], b[_B_PEAKED] != 0.0, conserved, p[6], p[7], tail_closed, row,
+                             b[_B_XE], b[_B_OMEGA0], b[_B_CEQ], long_tail)
+    b[_B_OUTCOME] = outcome
+    return outcome > 0
+
+
+@njit(cache=True)
+def _law_finish(status, z, p, w, n_steps, n_rej):
+    """The driver's :class:`~microimpact.solvers.driver.Trace` of a coupled impact (its whole end
+    state in ``state``)."""
+    b = w[1]
+    row = p[5]
+    outcome, smax = int(b[_B_OUTCOME]), b[_B_SMAX]
+    if outcome >= 1 and b[_B_PEAKED] == 0.0:  # crept into the equilibrium without turning: its supremum
+        smax = max(smax, math.sqrt(b[_B_XE]))
+    return driver.Trace(status, outcome, z[_Y], z[_TAU], z[_D], z[_J], z[_JA], smax * smax, b[_B_TAU_CAP], b[_B_TAU_J],
+                        _energy(z[_S], z[_Y], row[2], row[3]), n_steps, n_rej, 0, z, int(b[_B_TURNS]),
+                        int(b[_B_HELD]))
+
+
+#: the one driver (:mod:`.driver`) running the coupled law
+_drive = driver.make_driver(driver.Law(_law_start, _law_args, _step, _law_too_small, _law_norm, _law_events,
+                                       _law_creep, _law_captured_end, _law_finish, _N))
+_NO_RECORD = np.zeros((1, 3))
+
+
 @njit(cache=True)
 def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max_steps):
-    """Integrate one impact of the coupled model (nondimensional; see the module docstring).
+    """Integrate one impact of the coupled model (nondimensional; see the module docstring) with the
+    one driver.
 
     Parameters (all nondimensional): y0 incident normal rate; vt0, vtp0 tangential velocity;
     wt0, wtp0 rim speeds r omega_t, r omega_t'; p the law's parameters (see :func:`_rhs`); j_stop,
@@ -677,121 +842,11 @@ def coupled_kernel(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, m
     sphere's integration stops (its tangential rest follows in closed form: see the module
     docstring).
 
-    Returns (status, outcome, state at the end (12,), largest xi, tau at capture, tau at which J
-    reached j_stop, n_steps, turning points of the hysteretic law, rolling stops after the capture).
-
-    The loop steps and locates the events within a step; the set-up, the ends of a step at an
-    event, the separation, the update of the tangential state and the stop of a captured sphere
-    are compiled helpers. The step, its error norm and the event tests stay in the loop because
-    they share the loop's state (z, k1, the branch history) and may end or continue it; the body
-    is under the 100 lines of code tests/test_architecture.py allows.
+    Returns the :class:`~microimpact.solvers.driver.Trace` (its ``state`` the 12 states at the end,
+    its outcome 0 for a rebound, 1, _CREEPING or _LONG_TAIL for a capture; its steps the accepted
+    and the rejected ones, whose sum is bounded by ``max_steps``).
     """
-    z, k1, hist, atol, sref, lim_ref, ecap, h = _start(y0, vt0, vtp0, wt0, wtp0, p, rtol)
-    k = np.zeros((7, _N))
-    tmp = np.zeros(_N)
-    z1 = np.zeros(_N)
-    err = np.zeros(_N)
-    ah, aa = p[2], p[3]
-    n_turn = 0
-    n_restart = 0
-    n_held_stops = 0  # rolling stops after the capture (_held_rolling_error)
-    hysteretic = p[9] > 1.5
-    rolling = p[10] > 0.0
-    tail_closed = not rolling or p[6] > 0.5  # a captured sphere's tail is taken in closed form
-    elastic = 0.5 < p[9] < 1.5  # the elastic Mindlin contact
-    # its gross slip (found by the projection at first contact, then by events); a numpy bool, so
-    # that _end_at_slip_change is compiled once, not also for the literal False
-    slipping = np.bool_(False)
-    load_side = 0.0  # sign of the Coulomb limit's load argument since the last restart (0: not yet known)
-    damped = p[0] > 0.0 or p[1] > 0.0
-    conservative = not damped and aa > 0.0
-    e0 = 0.5 * y0 * y0  # the normal energy (U = 0 at first contact)
-    xe, omega0, ceq = _equilibrium(p[0], p[1], ah, aa)
-    captured = False
-    peaked = False  # the largest penetration located
-    # a captured sphere with friction limited at rest and no rolling resistance ends rolling at its
-    # angular momentum about the contact point, which the contact force conserves (_rolling_state):
-    # nothing after the capture and the largest penetration changes the result
-    conserved = p[11] > 0.5  # stops_at_capture(contact), column 11 of the parameter rows
-    tau_cap = math.nan
-    tau_zero = math.nan  # where the energy first fell below zero (the capture time, as the engine's)
-    tau_j = math.nan
-    smax = 0.0
-    n = 0
-    status = _OK
-    outcome = 0
-    while True:
-        if n >= max_steps:
-            status = _MAX_STEPS
-            break
-        _step(z, k1, h, (p, hist), k, tmp, z1, err)
-        en = _error_sum(z, z1, err, atol, rtol, p, hysteretic, lim_ref)
-        n += 1
-        en, restart, at_rest, h_end, slip_change, load_side = _end_at_events(
-            en, h, z, z1, k1, err, atol, rtol, p, hist, k, tmp, lim_ref, slipping, load_side, elastic, rolling,
-            hysteretic)
-        en = math.sqrt(en / _N)
-        if en > 1.0:
-            h = dopri.shrunk_step(h, en)
-            if h < 1e-300:
-                status = _UNDERFLOW
-                break
-            continue
-        if not peaked and z[_Y] > 0.0 and z1[_Y] <= 0.0:
-            smax = max(smax, _root_state(_EV_DEPTH, 0.0, h_end, z, z1, k1, p, hist)[_S])
-            peaked = True
-        if z1[_S] < 0.0 and z[_S] > 0.0:  # separation within the step: its root on the step length
-            tau_j = _separate(z, z1, k1, h_end, p, hist, k, tmp, err, sref, conservative, y0, j_stop, tau_j)
-            outcome = 0
-            break
-        turned = False
-        if not restart and hysteretic and _branch_slip(z, hist) > 0.0 and _branch_slip(z1, hist) < 0.0:
-            # turning point of the hysteretic law within the step: its root on the step length
-            ga, gb = _branch_slip(z, hist), _branch_slip(z1, hist)
-            _restep_to_root(_EV_TURN, 0.0, ga, gb, 1e-13 * (abs(ga) + abs(gb)), h_end, z, k1, p, hist, k, tmp, z1, err)
-            turned = True
-            at_rest = False
-        tau_j = _impulse_time(z, z1, j_stop, tau_j, h_end, k1, p, hist)
-        if not captured and damped and aa > 0.0:
-            e1 = _energy(z1[_S], z1[_Y], ah, aa)
-            if math.isnan(tau_zero) and e1 < 0.0 <= _energy(z[_S], z[_Y], ah, aa):
-                tau_zero = _root_state(_EV_ENERGY, 0.0, h_end, z, z1, k1, p, hist)[_TAU]
-            if e1 < ecap:  # the capture test, with the engine's margin
-                captured = True
-                tau_cap = tau_zero if not math.isnan(tau_zero) else _root_state(
-                    _EV_ENERGY, ecap, h_end, z, z1, k1, p, hist)[_TAU]
-        for i in range(_N):
-            z[i] = z1[i]
-        refresh = False
-        if conservative and z[_S] > 0.0:
-            # undamped with adhesion: the normal motion keeps its energy y0^2 / 2 exactly (it does
-            # not feel the tangential state), so y is put back on that energy; round-off of the
-            # order of rtol times the well's depth would otherwise trap a slow sphere in the well
-            # (y0 ~ 1e-5: the step limit, where the engine mirrors the way out)
-            v2 = 2.0 * (e0 - _energy(z[_S], 0.0, ah, aa))
-            z[_Y] = math.copysign(math.sqrt(v2), z[_Y]) if v2 > 0.0 else 0.0
-            refresh = True
-        if at_rest:
-            z[_WT] = z[_WTP] = 0.0
-            if captured:
-                n_held_stops += 1
-        n_turn += 1 if turned else 0
-        n_restart += 1 if restart else 0
-        load_side, slipping = _tangential_update(z, k1, k, p, hist, turned, restart, load_side, slipping, slip_change,
-                                                 hysteretic, elastic, refresh)
-        if rolling and z[_S] > 0.0:
-            _hold_rolling(z, k1, atol[_WT] * min(max(1.0, h_end * _rolling_approach(z, k1) / atol[_WT]), _HOLD_SPAN),
-                          p, hist)
-        smax = max(smax, z[_S])
-        if captured:
-            outcome = _captured_stop(z, k1, atol, settle, peaked, conserved, j_stop, ja_stop, tail_closed, p, xe,
-                                     omega0, ceq, 20 * n >= max_steps)
-            if outcome > 0:
-                break
-        h = dopri.grown_step(h, en)
-    if outcome >= 1 and not peaked:  # crept into the equilibrium without turning: its supremum
-        smax = max(smax, math.sqrt(xe))
-    return status, outcome, z, smax * smax, tau_cap, tau_j, n, n_turn, n_held_stops
+    return _drive((y0, vt0, vtp0, wt0, wtp0, p, j_stop, ja_stop, settle), rtol, max_steps, _NO_RECORD, 0)
 
 
 @njit_batch
@@ -799,22 +854,22 @@ def coupled_many(y0, vt0, vtp0, wt0, wtp0, p, rtol, j_stop, ja_stop, settle, max
     """:func:`coupled_kernel` for many impacts in parallel; p has one row per impact.
 
     Writes the end states into ``out_state`` (n, 12) and (status, outcome, largest xi, tau at
-    capture, tau at slip end, n_steps, turning points of the hysteretic law, rolling stops after the
-    capture) into ``out_info`` (n, 8).
+    capture, tau at slip end, steps tried (accepted and rejected), turning points of the hysteretic
+    law, rolling stops after the capture) into ``out_info`` (n, 8).
     """
     for i in prange(y0.shape[0]):
         r = coupled_kernel(y0[i], vt0[i], vtp0[i], wt0[i], wtp0[i], p[i], rtol, j_stop[i], ja_stop[i], settle,
                            max_steps)
         for j in range(_N):
-            out_state[i, j] = r[2][j]
-        out_info[i, 0] = r[0]
-        out_info[i, 1] = r[1]
-        out_info[i, 2] = r[3]
-        out_info[i, 3] = r[4]
-        out_info[i, 4] = r[5]
-        out_info[i, 5] = r[6]
-        out_info[i, 6] = r[7]
-        out_info[i, 7] = r[8]
+            out_state[i, j] = r.state[j]
+        out_info[i, 0] = r.status
+        out_info[i, 1] = r.outcome
+        out_info[i, 2] = r.max_approach
+        out_info[i, 3] = r.tau_capture
+        out_info[i, 4] = r.tau_slip_end
+        out_info[i, 5] = r.n_steps + r.n_rejected
+        out_info[i, 6] = r.turning_points
+        out_info[i, 7] = r.held_rolling_stops
 
 
 #: amplitude of the captured normal oscillation, relative to the equilibrium penetration, at which

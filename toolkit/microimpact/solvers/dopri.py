@@ -6,8 +6,9 @@ The engine (:mod:`microimpact.solvers.engine`), the coupled tangential solver
 Runge-Kutta pair of Dormand & Prince (1980) [1]_, written here once: the tableau, the step, the error
 norm and the step-size control [2]_, the Illinois root finder [3]_ and the cubic Hermite interpolant of
 a step.
-Each solver plugs its law in as a compiled right-hand side and keeps its own events (which differ
-by law: separation, turning point, capture, the change of slip, the rolling stop).
+Each law plugs in a compiled right-hand side here, and its events (which differ by law: separation,
+turning point, capture, the change of slip, the rolling stop) into the one driver
+(:mod:`microimpact.solvers.driver`), which runs this step.
 
 A law is plugged in by :func:`make_step`, which compiles the step for one right-hand side
 ``rhs(u, out, args)`` (writes d/dsigma of the state ``u`` into ``out``; ``args``, a tuple, holds

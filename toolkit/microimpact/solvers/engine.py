@@ -28,7 +28,8 @@ Separation is the simple root s = 0 (with y < 0). The friction impulse J is the 
 of y, because the nondimensional normal force is -dy/dtau: it is summed exactly over the monotone
 pieces of y, whose ends (the zeros of dy/dsigma) are located as events. J_a and the damping
 dissipation D are integrated as extra states. Integration is Dormand-Prince 5(4) (the one core of the
-compiled solvers, :mod:`.dopri`) with error control
+compiled solvers, :mod:`.dopri`, run by their one driver, :mod:`.driver`, into which this law plugs its
+events, its inertia-free limit and its captured end) with error control
 on all states; events are located by re-stepping from the start of the step (Illinois method), so
 their accuracy is that of the integrator.
 
@@ -60,6 +61,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -70,10 +72,10 @@ from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL, ModelDomainError, SolverError
 from microimpact.model.law import Scales, hertz_impact_scales, nondimensional_impact, nondimensional_scales  # nondimensional_scales: re-exported
 from microimpact.solvers import compiled_law as law
-from microimpact.solvers import dopri
+from microimpact.solvers import dopri, driver
 from microimpact.solvers.dopri import hermite, illinois_point, illinois_update
 
-__all__ = ["NormalSolution", "EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
+__all__ = ["NormalSolution", "NormalBatch", "EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
 
 # Status codes of the compiled core
 _OK = 0
@@ -242,7 +244,7 @@ class EngineError(SolverError):
 # engine ran markedly slower. Those called once per impact or only in rare regimes (the set-up, the
 # inertia-free limit and its tests, the undamped mirror) are compiled as calls, which LLVM may still
 # inline: numba's inlining copies and re-types a helper at every call site, which lengthened
-# _integrate's compile and gained no speed (docs/model.md, "How it is computed").
+# the driver's compile and gained no speed (docs/model.md, "How it is computed").
 @njit(cache=True, inline="always")
 def _derivatives(s, y, c1, c2, ah, aa, sgn):
     """d/dsigma of the state (s, y, tau, D, J_a) at (s, y) (see the module docstring)."""
@@ -324,37 +326,8 @@ _energy_crossing = dopri.make_root_on_step(_step, _energy)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 
 
-@njit(cache=True)
-def _linear_tail_variation(dx, y, omega0, c):
-    """Total variation of y from now to rest for dx'' = -omega0^2 dx - c dx' (dx' = y)."""
-    yp = -omega0 * omega0 * dx - c * y
-    a = 0.5 * c
-    if a < omega0 * (1.0 - 1e-9):
-        wd = math.sqrt(omega0 * omega0 - a * a)
-        b = (yp + a * y) / wd
-        # y' = e^{-a tau} (P cos + Q sin), extrema of y every pi/wd from the first, theta1
-        pc = yp
-        qs = -a * b - wd * y
-        th = math.atan2(qs, pc) + 0.5 * math.pi
-        while th < 0.0:
-            th += math.pi
-        while th >= math.pi:
-            th -= math.pi
-        y1 = math.exp(-a * th / wd) * (y * math.cos(th) + b * math.sin(th))
-        q = math.exp(-a * math.pi / wd)  # ratio of successive |extrema|
-        return abs(y1 - y) + abs(y1) * (1.0 + q) / (1.0 - q)
-    disc = math.sqrt(max(a * a - omega0 * omega0, 0.0)) + 1e-9 * omega0
-    l1 = -a + disc
-    l2 = -a - disc
-    ca = (yp - l2 * y) / (l1 - l2)
-    cb = y - ca
-    if ca != 0.0:
-        ratio = -cb * l2 / (ca * l1)
-        if ratio > 1.0:  # one extremum ahead, then monotone to rest
-            t1 = math.log(ratio) / (l1 - l2)
-            y1 = ca * math.exp(l1 * t1) + cb * math.exp(l2 * t1)
-            return abs(y1 - y) + abs(y1)
-    return abs(y)
+#: the linear damped tail of a captured sphere, shared by every law (the driver's)
+_linear_tail_variation = driver.linear_tail_variation
 
 
 # ------------------------------------------------------------------ the inertia-free (overdamped) limit
@@ -582,24 +555,23 @@ def _orbit_integrals(e, c1, c2, ah, aa, xe):
 
 
 @njit(cache=True)
+def _orbit(e, oargs):
+    """:func:`_orbit_integrals` with its parameters as one tuple (the driver's averaging calls it)."""
+    c1, c2, ah, aa, xe = oargs
+    return _orbit_integrals(e, c1, c2, ah, aa, xe)
+
+
+#: the driver's method of averaging over this law's orbits
+_averaged = driver.make_averaged_tail(_orbit)
+
+
+@njit(cache=True)
 def _averaged_tail(e_now, c1, c2, ah, aa, xe):
-    """(J, J_a) still to come for a weakly damped captured sphere of energy e_now: the method of
-    averaging, int (variation per cycle) / (energy lost per cycle) de from the well's bottom to
-    e_now, in q = sqrt(e - V(xe)) (the integrand is smooth in q). Relative error of the order of the
+    """(J, J_a) still to come for a weakly damped captured sphere of energy e_now: the driver's
+    method of averaging (:func:`microimpact.solvers.driver.make_averaged_tail`) over the undamped
+    orbits of the ring law, from the well's bottom V(xe). Relative error of the order of the
     damping ratio C / omega0 (the change of the orbit within one cycle)."""
-    ve = _potential(xe, ah, aa)
-    q_now = math.sqrt(max(e_now - ve, 0.0))
-    if q_now == 0.0:
-        return 0.0, 0.0
-    jt = 0.0
-    jat = 0.0
-    for i in range(_GL16_X.shape[0]):
-        q = 0.5 * q_now * (_GL16_X[i] + 1.0)
-        loss, var, tw = _orbit_integrals(ve + q * q, c1, c2, ah, aa, xe)
-        w = 0.5 * q_now * _GL16_W[i] * 2.0 * q / loss
-        jt += w * var
-        jat += w * tw
-    return jt, jat
+    return _averaged(e_now, _potential(xe, ah, aa), (c1, c2, ah, aa, xe))
 
 
 # ------------------------------------------------------------------ pieces of one impact
@@ -786,13 +758,6 @@ def _start(y0, c1, c2, ah, aa, rtol, rec, rec_cap):
 
 
 @njit(cache=True)
-def _scratch():
-    """The work arrays of a step: its stages k (7, n), a trial state, the state at its end, its
-    error estimate, and the derivative at the end of the last step."""
-    return np.zeros((7, _NSTATE)), np.zeros(_NSTATE), np.zeros(_NSTATE), np.zeros(_NSTATE), np.zeros(_NSTATE)
-
-
-@njit(cache=True)
 def _capture_events(e0, e1, ecap, tau_zero, tau_capture, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err):
     """The capture events within the step u -> u1 (energy e0 -> e1) of an adhesive damped impact not
     yet captured: where E first falls below zero, and the capture (E below the margin ecap).
@@ -921,134 +886,189 @@ def _inertia_free_jump(u, k1, kend, xi_t, J, j_target, tau_jtarget, captured, ta
     return outcome, J, tau_jtarget, captured, tau_zero, tau_capture, smax, n_rec, sgn
 
 
+# ------------------------------------------------------------------ the ring law in the one driver
+# The law's parameters p = (y0, c1, c2, a_h, a_a, need_tail, tail_tol, j_target, follow, settle_amp,
+# j_stop, ja_stop) and its bookkeeping w (indices below; flags as 0.0 / 1.0), for the driver
+# (:mod:`.driver`), which owns the loop, the error control and the budgets.
+_W_J, _W_SMAX, _W_TAU_CAPTURE, _W_TAU_JTARGET, _W_TAU_ZERO, _W_CAPTURED, _W_TURNED, _W_OUTCOME = 0, 1, 2, 3, 4, 5, 6, 7
+_W_SGN, _W_NREC, _W_NOISE, _W_DAMPED, _W_ECAP, _W_XE, _W_OMEGA0, _W_CEQ = 8, 9, 10, 11, 12, 13, 14, 15
+_W_SIZE = 16
+
+
+@njit(cache=True)
+def _law_start(p, rtol, rec, rec_cap):
+    """The driver's start (:func:`_start`): the state, its derivative, the first step, the
+    tolerances and the bookkeeping of one impact."""
+    u, k1, sgn, atol, noise, damped, ecap, xe, omega0, ceq, h, n_rec = _start(p[0], p[1], p[2], p[3], p[4], rtol,
+                                                                              rec, rec_cap)
+    w = np.zeros(_W_SIZE)
+    w[_W_TAU_CAPTURE] = w[_W_TAU_JTARGET] = w[_W_TAU_ZERO] = math.nan  # tau_zero: where E first fell below zero
+    w[_W_OUTCOME] = -1.0
+    w[_W_SGN], w[_W_NREC], w[_W_NOISE], w[_W_DAMPED] = sgn, n_rec, noise, 1.0 if damped else 0.0
+    w[_W_ECAP], w[_W_XE], w[_W_OMEGA0], w[_W_CEQ] = ecap, xe, omega0, ceq
+    return u, k1, h, atol, w
+
+
+@njit(cache=True, inline="always")
+def _law_args(p, w):
+    """The right-hand side's arguments: (C1, C2, a_h, a_a, the expected sign of dy/dsigma)."""
+    return (p[1], p[2], p[3], p[4], w[_W_SGN])
+
+
+@njit(cache=True, inline="always")
+def _law_too_small(h, u):
+    return h < 1e-300
+
+
+@njit(cache=True, inline="always")
+def _keep(w, J, smax, tau_capture, tau_jtarget, tau_zero, captured, turned, outcome, sgn, n_rec):
+    """Write the bookkeeping of the ring law back into w."""
+    w[_W_J], w[_W_SMAX], w[_W_TAU_CAPTURE], w[_W_TAU_JTARGET], w[_W_TAU_ZERO] = J, smax, tau_capture, tau_jtarget, tau_zero
+    w[_W_CAPTURED], w[_W_TURNED] = 1.0 if captured else 0.0, 1.0 if turned else 0.0
+    w[_W_OUTCOME], w[_W_SGN], w[_W_NREC] = outcome, sgn, n_rec
+
+
+@njit(cache=True)
+def _law_events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
+    """The events of the ring law within the accepted step u -> u1, and the advance to its end.
+
+    Events that end a piece of the solution (separation; an extremum of y, where the sign of |F_n|
+    flips) shorten the step to the earliest of them. Events that only record something (largest
+    penetration, capture, end of sliding) are located inside the step without changing it, so the
+    trajectory, and e_n, do not depend on which of them a caller asked for.
+    """
+    y0, c1, c2, ah, aa, j_target = p[0], p[1], p[2], p[3], p[4], p[7]
+    J, smax, tau_capture, tau_jtarget, tau_zero = w[_W_J], w[_W_SMAX], w[_W_TAU_CAPTURE], w[_W_TAU_JTARGET], w[_W_TAU_ZERO]
+    captured, turned, damped = w[_W_CAPTURED] != 0.0, w[_W_TURNED] != 0.0, w[_W_DAMPED] != 0.0
+    outcome, sgn, n_rec, ecap = int(w[_W_OUTCOME]), w[_W_SGN], int(w[_W_NREC]), w[_W_ECAP]
+    hev, code = h, -1
+    g0, g1 = k1[1], k[6, 1]
+    if u[0] > 0.0 and u1[0] <= 0.0:
+        hev = _locate(_EV_S, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        code = 0
+        _step(u, k1, h, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+    # an extremum of y: dy/dsigma leaves its expected sign (comparing with the expected sign,
+    # not with g0, keeps the root just found at the start of this step from being found again)
+    if u[0] > 0.0 and g1 * sgn < 0.0:
+        if g0 * sgn <= 0.0:
+            g0 = sgn * 1e-300
+        hh = _locate(_EV_DY, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+        if code < 0 or hh < hev:
+            hev, code = hh, 2
+    if code >= 0:
+        _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+        # dy/dsigma ~ s^2 vanishes at the surface too, so an extremum found at the end of
+        # contact is the separation itself
+        if code == 2 and u1[0] <= 0.0 and u1[1] < 0.0:
+            code = 0
+    recorded = False  # u1 was moved to a recorded event: take the step again before using it
+    if not turned and u[1] > 0.0 and u1[1] <= 0.0:  # largest penetration
+        smax, J, tau_jtarget = _largest_penetration(u, k1, hev, u1, smax, J, j_target, tau_jtarget, damped, y0, c1,
+                                                    c2, ah, aa, sgn, k, tmp, err)
+        turned = recorded = True
+        if not damped:  # completed by symmetry, before the step counts
+            _keep(w, J, smax, tau_capture, tau_jtarget, tau_zero, captured, turned, REBOUND, sgn, n_rec)
+            return driver.END_UNCOUNTED
+    if not captured and damped and aa > 0.0:
+        if recorded:
+            _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+            recorded = False
+        e0 = law.nondimensional_energy(u[0], u[1], ah, aa)
+        e1 = law.nondimensional_energy(u1[0], u1[1], ah, aa)
+        if (math.isnan(tau_zero) and e0 >= 0.0 and e1 < 0.0) or (e0 >= ecap and e1 < ecap):
+            captured, tau_zero, tau_capture, recorded = _capture_events(
+                e0, e1, ecap, tau_zero, tau_capture, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+    if math.isnan(tau_jtarget) and j_target > 0.0:  # end of sliding
+        tau_jtarget, recorded = _slip_end(recorded, J, j_target, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
+    if recorded:
+        _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
+    # |dy| rather than sgn * dy: robust to an extremum that falls between two steps unnoticed
+    # (a signed sum would then subtract; measured: more convergence failures in the stress sweep)
+    J += abs(u1[1] - u[1])
+    # advance; after an event the derivative is evaluated anew, otherwise it is the last
+    # stage of the step (first same as last)
+    for i in range(_NSTATE):
+        u[i] = u1[i]
+    if code == 0:
+        u[0] = 0.0  # exactly at the surface
+    if code == 2 or code == 0:
+        if code == 2:
+            sgn = -sgn
+        _rhs(u, k1, (c1, c2, ah, aa, sgn))
+    else:
+        for i in range(_NSTATE):
+            k1[i] = k[6, i]
+    smax = max(smax, u[0])
+    n_rec = _record(rec, n_rec, rec_cap, u)
+    if code == 0:
+        outcome = REBOUND
+    _keep(w, J, smax, tau_capture, tau_jtarget, tau_zero, captured, turned, outcome, sgn, n_rec)
+    return driver.END if code == 0 else driver.GO_ON
+
+
+@njit(cache=True)
+def _law_creep(u, k1, p, w, atol, rec, rec_cap):
+    """The inertia-free limit of a damped impact (:func:`_inertia_free`): finish, or jump and
+    resume, in closed form."""
+    c1, c2, ah, aa = p[1], p[2], p[3], p[4]
+    xe = w[_W_XE]
+    if not (w[_W_DAMPED] != 0.0 and u[0] > 0.0):
+        return driver.CREEP_NONE
+    slow, xi_t = _inertia_free(u, atol[1], c1, c2, ah, aa, xe)
+    if not slow:
+        return driver.CREEP_NONE
+    outcome, J, tau_jtarget, captured, tau_zero, tau_capture, smax, n_rec, sgn = _inertia_free_jump(
+        u, k1, k1, xi_t, w[_W_J], p[7], w[_W_TAU_JTARGET], w[_W_CAPTURED] != 0.0, w[_W_TAU_ZERO],
+        w[_W_TAU_CAPTURE], w[_W_SMAX], rec, rec_cap, int(w[_W_NREC]), w[_W_SGN], c1, c2, ah, aa, xe, w[_W_ECAP])
+    _keep(w, J, smax, tau_capture, tau_jtarget, tau_zero, captured, w[_W_TURNED] != 0.0, outcome, sgn, n_rec)
+    return driver.CREEP_END if outcome >= 0 else driver.CREEP_RESUME
+
+
+@njit(cache=True)
+def _law_captured_end(u, k1, p, w, atol, long_tail):
+    """Whether a captured sphere may stop (:func:`_capture_finished`); the impulses still to come
+    are added in closed form."""
+    if w[_W_CAPTURED] == 0.0:
+        return False
+    c1, c2, ah, aa, need_tail, tail_tol, follow, settle_amp, j_stop, ja_stop = (
+        p[1], p[2], p[3], p[4], p[5], p[6], p[8], p[9], p[10], p[11])
+    xe = w[_W_XE]
+    turned = w[_W_TURNED] != 0.0
+    done, dj, dja = _capture_finished(u, k1, w[_W_J], turned, follow, need_tail, settle_amp, tail_tol, j_stop,
+                                      ja_stop, w[_W_NOISE], atol[1], c1, c2, ah, aa, xe, w[_W_OMEGA0], w[_W_CEQ],
+                                      long_tail)
+    if done:
+        w[_W_J] += dj
+        u[4] += dja
+        w[_W_OUTCOME] = CAPTURE
+        if not turned and xe > w[_W_SMAX] * w[_W_SMAX]:
+            w[_W_SMAX] = math.sqrt(xe)  # approached the equilibrium without turning: its supremum
+    return done
+
+
+@njit(cache=True)
+def _law_finish(status, u, p, w, n_steps, n_rej):
+    """The driver's :class:`~microimpact.solvers.driver.Trace` of a ring-law impact."""
+    smax = w[_W_SMAX]
+    return driver.Trace(status, int(w[_W_OUTCOME]), u[1], u[2], u[3], w[_W_J], u[4], smax * smax, w[_W_TAU_CAPTURE],
+                        w[_W_TAU_JTARGET], law.nondimensional_energy(u[0], u[1], p[3], p[4]), n_steps, n_rej,
+                        int(w[_W_NREC]), u, 0, 0)
+
+
+#: the one driver (:mod:`.driver`) running the ring law
+_drive = driver.make_driver(driver.Law(_law_start, _law_args, _step, _law_too_small, driver.make_error_norm(_NSTATE),
+                                       _law_events, _law_creep, _law_captured_end, _law_finish, _NSTATE))
+
+
 @njit(cache=True)
 def _integrate(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, j_target, follow, settle_amp,
                max_steps, rec, rec_cap, j_stop, ja_stop):
-    """Integrate one normal impact (Dormand-Prince 5(4) in sigma, see the module docstring).
-
-    Returns (status, outcome, y_end, tau_end, D, J, Ja, smax, tau_capture, tau_jtarget, E_end,
-    n_steps, n_rejected, n_rec). J and Ja are the nondimensional friction and twist impulses.
-
-    Events that only record something (largest penetration, capture, end of sliding) are located
-    inside the step without changing it, so the trajectory, and e_n, do not depend on which of
-    them a caller asked for. The tests done at every step stay in this loop; what runs once per
-    impact or at an event (the set-up, the located events, the undamped mirror, the inertia-free
-    jump, the decision to stop a captured sphere) is in compiled helpers (above). Why the
-    per-step work is not split further: as compiled helpers, numba-inlined or called, the error
-    norm, the step-shortening events and the advance made the engine slower in side-by-side runs
-    (the helpers of the one driver of a later issue replace this loop); its body stays at 100
-    lines of code, the limit tests/test_architecture.py enforces.
-    """
-    u, k1, sgn, atol, noise, damped, ecap, xe, omega0, ceq, h, n_rec = _start(y0, c1, c2, ah, aa, rtol, rec, rec_cap)
-    k, tmp, u1, err, kend = _scratch()
-    J = smax = 0.0
-    tau_capture = tau_jtarget = tau_zero = math.nan  # tau_zero: where E first fell below zero
-    captured = turned = False
-    outcome, status, n_steps, n_rej = -1, _OK, 0, 0
-    while True:
-        if n_steps + n_rej >= max_steps:
-            status = _MAX_STEPS
-            break
-        _step(u, k1, h, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-        en = dopri.error_norm(u, u1, err, atol, rtol, _NSTATE)
-        if not en <= 1.0:  # (a NaN error norm, from an overflowing trial step, is a rejection too)
-            n_rej += 1
-            h = dopri.shrunk_step(h, en)
-            if h < 1e-300:
-                status = _STEP_UNDERFLOW
-                break
-            continue
-        # accepted. Events that end a piece of the solution (separation; an extremum of y, where
-        # the sign of |F_n| flips) shorten the step to the earliest of them.
-        hev, code = h, -1
-        g0, g1 = k1[1], k[6, 1]
-        if u[0] > 0.0 and u1[0] <= 0.0:
-            hev = _locate(_EV_S, 0.0, u, k1, h, u[0], u1[0], c1, c2, ah, aa, sgn, k, tmp, u1, err)
-            code = 0
-            _step(u, k1, h, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-        # an extremum of y: dy/dsigma leaves its expected sign (comparing with the expected sign,
-        # not with g0, keeps the root just found at the start of this step from being found again)
-        if u[0] > 0.0 and g1 * sgn < 0.0:
-            if g0 * sgn <= 0.0:
-                g0 = sgn * 1e-300
-            hh = _locate(_EV_DY, 0.0, u, k1, h, g0, g1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-            if code < 0 or hh < hev:
-                hev, code = hh, 2
-        if code >= 0:
-            _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-            # dy/dsigma ~ s^2 vanishes at the surface too, so an extremum found at the end of
-            # contact is the separation itself
-            if code == 2 and u1[0] <= 0.0 and u1[1] < 0.0:
-                code = 0
-        recorded = False  # u1 was moved to a recorded event: take the step again before using it
-        if not turned and u[1] > 0.0 and u1[1] <= 0.0:  # largest penetration
-            smax, J, tau_jtarget = _largest_penetration(u, k1, hev, u1, smax, J, j_target, tau_jtarget, damped, y0, c1,
-                                                        c2, ah, aa, sgn, k, tmp, err)
-            turned = recorded = True
-            if not damped:  # completed by symmetry
-                outcome = REBOUND
-                break
-        if not captured and damped and aa > 0.0:
-            if recorded:
-                _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-                recorded = False
-            e0 = law.nondimensional_energy(u[0], u[1], ah, aa)
-            e1 = law.nondimensional_energy(u1[0], u1[1], ah, aa)
-            if (math.isnan(tau_zero) and e0 >= 0.0 and e1 < 0.0) or (e0 >= ecap and e1 < ecap):
-                captured, tau_zero, tau_capture, recorded = _capture_events(
-                    e0, e1, ecap, tau_zero, tau_capture, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-        if math.isnan(tau_jtarget) and j_target > 0.0:  # end of sliding
-            tau_jtarget, recorded = _slip_end(recorded, J, j_target, hev, u, k1, c1, c2, ah, aa, sgn, k, tmp, u1, err)
-        if recorded:
-            _step(u, k1, hev, (c1, c2, ah, aa, sgn), k, tmp, u1, err)
-        # |dy| rather than sgn * dy: robust to an extremum that falls between two steps unnoticed
-        # (a signed sum would then subtract; measured: more convergence failures in the stress sweep)
-        J += abs(u1[1] - u[1])
-        # advance; after an event the derivative is evaluated anew, otherwise it is the last
-        # stage of the step (first same as last)
-        for i in range(_NSTATE):
-            u[i] = u1[i]
-        if code == 0:
-            u[0] = 0.0  # exactly at the surface
-        if code == 2 or code == 0:
-            if code == 2:
-                sgn = -sgn
-            _rhs(u, kend, (c1, c2, ah, aa, sgn))
-            for i in range(_NSTATE):
-                k1[i] = kend[i]
-        else:
-            for i in range(_NSTATE):
-                k1[i] = k[6, i]
-                kend[i] = k1[i]
-        n_steps += 1
-        smax = max(smax, u[0])
-        n_rec = _record(rec, n_rec, rec_cap, u)
-        if code == 0:
-            outcome = REBOUND
-            break
-        if damped and u[0] > 0.0:
-            slow, xi_t = _inertia_free(u, atol[1], c1, c2, ah, aa, xe)
-            if slow:  # the inertia-free limit: finish (or jump) in closed form
-                outcome, J, tau_jtarget, captured, tau_zero, tau_capture, smax, n_rec, sgn = _inertia_free_jump(
-                    u, k1, kend, xi_t, J, j_target, tau_jtarget, captured, tau_zero, tau_capture, smax, rec, rec_cap,
-                    n_rec, sgn, c1, c2, ah, aa, xe, ecap)
-                if outcome >= 0:
-                    break
-                continue  # resumed where inertia matters again
-        if captured:
-            done, dj, dja = _capture_finished(u, kend, J, turned, follow, need_tail, settle_amp, tail_tol, j_stop,
-                                              ja_stop, noise, atol[1], c1, c2, ah, aa, xe, omega0, ceq,
-                                              20 * (n_steps + n_rej) >= max_steps)
-            if done:
-                J += dj
-                u[4] += dja
-                outcome = CAPTURE
-                if not turned and xe > smax * smax:
-                    smax = math.sqrt(xe)  # approached the equilibrium without turning: its supremum
-                break
-        h = dopri.grown_step(h, en)
-    return (status, outcome, u[1], u[2], u[3], J, u[4], smax * smax, tau_capture, tau_jtarget,
-            law.nondimensional_energy(u[0], u[1], ah, aa), n_steps, n_rej, n_rec)
+    """Integrate one normal impact (Dormand-Prince 5(4) in sigma, see the module docstring) with the
+    one driver; returns its :class:`~microimpact.solvers.driver.Trace` (nondimensional: y, tau, D, J,
+    J_a, the largest xi, the capture and slip-end times, e at the end, the steps and the rows
+    recorded into ``rec``)."""
+    return _drive((y0, c1, c2, ah, aa, need_tail, tail_tol, j_target, follow, settle_amp, j_stop, ja_stop), rtol,
+                  max_steps, rec, rec_cap)
 
 
 @njit_batch
@@ -1058,17 +1078,17 @@ def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_
         # numpy scalars, not literals: one compiled _integrate serves this kernel and solve_normal
         r = _integrate(y0[i], c1[i], c2[i], ah[i], aa[i], rtol, need_tail[i], tail_tol, 0.0, np.bool_(False), 0.0,
                        max_steps, dummy, np.int64(0), j_stop[i], ja_stop[i])
-        out[i, 0] = r[0]
-        out[i, 1] = r[1]
-        out[i, 2] = r[2]
-        out[i, 3] = r[3]
-        out[i, 4] = r[4]
-        out[i, 5] = r[5]
-        out[i, 6] = r[6]
-        out[i, 7] = r[7]
-        out[i, 8] = r[8]
-        out[i, 9] = r[10]
-        out[i, 10] = r[11]
+        out[i, 0] = r.status
+        out[i, 1] = r.outcome
+        out[i, 2] = r.y_end
+        out[i, 3] = r.tau_end
+        out[i, 4] = r.dissipated
+        out[i, 5] = r.friction_impulse
+        out[i, 6] = r.twist_impulse
+        out[i, 7] = r.max_approach
+        out[i, 8] = r.tau_capture
+        out[i, 9] = r.final_energy
+        out[i, 10] = r.n_steps
 
 
 # --------------------------------------------------------------------------- Python interface
@@ -1148,6 +1168,66 @@ class NormalSolution:
     time: np.ndarray | None = None
     penetration: np.ndarray | None = None
     penetration_rate: np.ndarray | None = None
+
+
+#: the fields of a :class:`NormalBatch`, in order
+_BATCH_FIELDS = ("captured", "e_n", "contact_time", "capture_time", "max_penetration", "friction_impulse",
+                 "twist_impulse", "dissipated_energy", "final_energy", "n_steps")
+
+
+@dataclass(frozen=True, eq=False)
+class NormalBatch(Mapping):
+    """Result of many normal-contact solves (SI arrays, one element per speed): the fields of
+    :class:`NormalSolution` that a batch keeps, with ``captured`` for its outcome.
+
+    Read by attribute (``batch.e_n``) or, as the dicts it replaced were, by name
+    (``batch["e_n"]``, ``batch.items()``).
+
+    Attributes
+    ----------
+    captured : numpy.ndarray of bool
+    e_n : numpy.ndarray
+        Normal restitution coefficient; 0 if captured. [-]
+    contact_time, capture_time : numpy.ndarray
+        As in :class:`NormalSolution`. [s]
+    max_penetration : numpy.ndarray
+        [m]
+    friction_impulse, twist_impulse : numpy.ndarray
+        [N s], [N m s]
+    dissipated_energy, final_energy : numpy.ndarray
+        [J]
+    n_steps : numpy.ndarray of int
+        Accepted steps of each solve (0 where a family interpolated it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> b = NormalBatch(*(np.zeros(2) for _ in range(10)))
+    >>> list(b)[:3], b["e_n"] is b.e_n, len(b)
+    (['captured', 'e_n', 'contact_time'], True, 10)
+    """
+
+    captured: np.ndarray
+    e_n: np.ndarray
+    contact_time: np.ndarray
+    capture_time: np.ndarray
+    max_penetration: np.ndarray
+    friction_impulse: np.ndarray
+    twist_impulse: np.ndarray
+    dissipated_energy: np.ndarray
+    final_energy: np.ndarray
+    n_steps: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in _BATCH_FIELDS:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def __iter__(self):
+        return iter(_BATCH_FIELDS)
+
+    def __len__(self) -> int:
+        return len(_BATCH_FIELDS)
 
 
 #: The record array of a solve that records nothing (never written: its capacity is 0)
@@ -1247,25 +1327,23 @@ def solve_normal(
                        settle_amplitude * (sc.a_adhesion / sc.a_hertz if sc.a_adhesion > 0 else 1.0),
                        max_steps, rec, cap, friction_impulse_stop / j_unit,
                        twist_impulse_stop / (j_unit * math.sqrt(contact.radius * sc.length)))
-        if cap == 0 or r[13] < cap:
+        if cap == 0 or r.n_recorded < cap:
             break
         cap *= 4
-    if c1 == 0.0 and c2 == 0.0 and jt > 0.0 and math.isnan(r[9]) and jt < r[5]:
+    if c1 == 0.0 and c2 == 0.0 and jt > 0.0 and math.isnan(r.tau_slip_end) and jt < r.friction_impulse:
         # time-reversible motion: J reaches jt on the way out when it reached J - jt on the way in
-        r_in = _integrate(y0, 0.0, 0.0, sc.a_hertz, sc.a_adhesion, rtol, False, rtol, r[5] - jt, False, 0.0,
-                          max_steps, rec, 0, math.inf, math.inf)
-        r = r[:9] + (r[3] - r_in[9],) + r[10:]
-    if r[0] != _OK:
-        raise EngineError(f"engine failed for normal speed {v!r} m/s: {_failure(r[0])} after {r[11]} steps")
-    solution = normal_solution(contact, sc, y0, *r[1:13], trajectory=rec[:r[13]] if cap else None)
+        r_in = _integrate(y0, 0.0, 0.0, sc.a_hertz, sc.a_adhesion, rtol, False, rtol, r.friction_impulse - jt, False,
+                          0.0, max_steps, rec, 0, math.inf, math.inf)
+        r = r._replace(tau_slip_end=r.tau_end - r_in.tau_slip_end)
+    if r.status != _OK:
+        raise EngineError(f"engine failed for normal speed {v!r} m/s: {_failure(r.status)} after {r.n_steps} steps")
+    solution = normal_solution(contact, sc, y0, r, trajectory=rec[:r.n_recorded] if cap else None)
     _check_restitution(solution.e_n, v, rtol)
     _check_domain(contact, vars(solution), v)
     return solution
 
 
-def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, friction_impulse, twist_impulse,
-                    max_xi, tau_capture, tau_slip_end, final_energy, n_steps, n_rejected, *,
-                    trajectory=None) -> NormalSolution:
+def normal_solution(contact, scales, y0, trace, *, trajectory=None) -> NormalSolution:
     """The :class:`NormalSolution` in SI units of a nondimensional normal solve (engine or RKG).
 
     Parameters
@@ -1275,14 +1353,10 @@ def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, fr
         L [m], T_c [s] of the solve.
     y0 : float
         Nondimensional incident normal speed. [-]
-    outcome : int
-        REBOUND or CAPTURE.
-    y_end, tau_end : float
-        y and tau at the end (separation for a rebound). [-]
-    dissipated, friction_impulse, twist_impulse, max_xi, tau_capture, tau_slip_end, final_energy : float
-        D, J, J_a, the largest xi, the capture and slip-end times and e at the end, nondimensional
-        (units m (L/T_c)^2, m L/T_c, m L/T_c sqrt(r L), L, T_c). [-]
-    n_steps, n_rejected : int
+    trace : microimpact.solvers.driver.Trace
+        The solve's nondimensional record: outcome (REBOUND or CAPTURE), y and tau at the end
+        (separation for a rebound), D, J, J_a, the largest xi, the capture and slip-end times and e
+        at the end (units m (L/T_c)^2, m L/T_c, m L/T_c sqrt(r L), L, T_c), the steps. [-]
     trajectory : ndarray, shape (n, 3), optional
         Rows (tau, s, y) at the accepted steps. [-]
 
@@ -1298,10 +1372,12 @@ def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, fr
 
     >>> import math
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> from microimpact.solvers.driver import OK, Trace
     >>> from microimpact.solvers.engine import REBOUND, engine_scales
     >>> sc, y0, c1, c2 = engine_scales(c, 2.0)
-    >>> s = normal_solution(c, sc, y0, REBOUND, -0.5 * y0, 3.0, 0.0, 0.0, 0.0, 1.2, math.nan,
-    ...                     math.nan, 0.125 * y0**2, 40, 2)
+    >>> trace = Trace(OK, REBOUND, -0.5 * y0, 3.0, 0.0, 0.0, 0.0, 1.2, math.nan, math.nan, 0.125 * y0**2, 40, 2, 0,
+    ...               None, 0, 0)
+    >>> s = normal_solution(c, sc, y0, trace)
     >>> s.outcome, s.e_n, round(s.contact_time / sc.time, 12)
     ('rebound', 0.5, 3.0)
     >>> round(s.max_penetration / sc.length, 12)
@@ -1312,25 +1388,25 @@ def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, fr
     u = scales.speed
     j_unit = contact.mass * u  # N s
     energy_unit = contact.mass * u * u  # J
-    captured = outcome == CAPTURE
+    captured = trace.outcome == CAPTURE
     time = pen = rate = None
     if trajectory is not None:
         time = trajectory[:, 0] * scales.time
         pen = trajectory[:, 1] ** 2 * scales.length
         rate = trajectory[:, 2] * u
     return NormalSolution(
-        outcome=OUTCOME_NAMES[int(outcome)],
-        e_n=0.0 if captured else -y_end / y0,
-        contact_time=math.inf if captured else tau_end * scales.time,
-        capture_time=tau_capture * scales.time,
-        max_penetration=max_xi * scales.length,
-        friction_impulse=friction_impulse * j_unit,
-        twist_impulse=twist_impulse * j_unit * math.sqrt(contact.radius * scales.length),
-        dissipated_energy=dissipated * energy_unit,
-        final_energy=final_energy * energy_unit,
-        slip_end_time=tau_slip_end * scales.time,
-        n_steps=int(n_steps),
-        n_rejected=int(n_rejected),
+        outcome=OUTCOME_NAMES[int(trace.outcome)],
+        e_n=0.0 if captured else -trace.y_end / y0,
+        contact_time=math.inf if captured else trace.tau_end * scales.time,
+        capture_time=trace.tau_capture * scales.time,
+        max_penetration=trace.max_approach * scales.length,
+        friction_impulse=trace.friction_impulse * j_unit,
+        twist_impulse=trace.twist_impulse * j_unit * math.sqrt(contact.radius * scales.length),
+        dissipated_energy=trace.dissipated * energy_unit,
+        final_energy=trace.final_energy * energy_unit,
+        slip_end_time=trace.tau_slip_end * scales.time,
+        n_steps=int(trace.n_steps),
+        n_rejected=int(trace.n_rejected),
         time=time,
         penetration=pen,
         penetration_rate=rate,
@@ -1339,8 +1415,9 @@ def normal_solution(contact, scales, y0, outcome, y_end, tau_end, dissipated, fr
 
 def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DEFAULT_RTOL,
                       tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT,
-                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> dict:
-    """Solve many normal impacts in parallel (both cores); arrays in, dict of SI arrays out.
+                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> NormalBatch:
+    """Solve many normal impacts in parallel (both cores); arrays in, a :class:`NormalBatch` of SI
+    arrays out.
 
     Parameters
     ----------
@@ -1355,9 +1432,10 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
 
     Returns
     -------
-    dict with arrays ``captured`` (bool), ``e_n`` [-], ``contact_time`` [s], ``capture_time`` [s],
-    ``max_penetration`` [m], ``friction_impulse`` [N s], ``twist_impulse`` [N m s],
-    ``dissipated_energy`` [J], ``final_energy`` [J], ``n_steps``.
+    NormalBatch
+        ``captured`` (bool), ``e_n`` [-], ``contact_time`` [s], ``capture_time`` [s],
+        ``max_penetration`` [m], ``friction_impulse`` [N s], ``twist_impulse`` [N m s],
+        ``dissipated_energy`` [J], ``final_energy`` [J], ``n_steps``.
 
     References
     ----------
@@ -1409,18 +1487,18 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     eu = contact.mass * u * u
     e_n = np.where(captured, 0.0, -out[:, 2] / y0)
     _check_restitution(e_n, v, rtol)
-    result = {
-        "captured": captured,
-        "e_n": e_n,
-        "contact_time": np.where(captured, np.inf, out[:, 3] * time),
-        "capture_time": out[:, 8] * time,
-        "max_penetration": out[:, 7] * length,
-        "friction_impulse": out[:, 5] * ju,
-        "twist_impulse": out[:, 6] * ju * np.sqrt(contact.radius * length),
-        "dissipated_energy": out[:, 4] * eu,
-        "final_energy": out[:, 9] * eu,
-        "n_steps": out[:, 10].astype(np.int64),
-    }
+    result = NormalBatch(
+        captured=captured,
+        e_n=e_n,
+        contact_time=np.where(captured, np.inf, out[:, 3] * time),
+        capture_time=out[:, 8] * time,
+        max_penetration=out[:, 7] * length,
+        friction_impulse=out[:, 5] * ju,
+        twist_impulse=out[:, 6] * ju * np.sqrt(contact.radius * length),
+        dissipated_energy=out[:, 4] * eu,
+        final_energy=out[:, 9] * eu,
+        n_steps=out[:, 10].astype(np.int64),
+    )
     _check_domain(contact, result, v)
     return result
 

@@ -60,6 +60,7 @@ from microimpact.model.coefficients import coefficients_kernel
 from microimpact.model.law import contact_potential_energy
 from microimpact.model.tangential import tangential_kernel
 from microimpact.solvers import DEFAULT_RTOL, SolverError, engine
+from microimpact.solvers.engine import NormalBatch
 
 __all__ = ["NormalFamily", "normal_family", "normal_restitution", "FamilyBudgetExceeded", "DEGREE", "GUARD", "GUARD_IMPACTS",
            "FAMILY_MIN_SPEEDS"]
@@ -336,11 +337,12 @@ class NormalFamily:
                 f"solves, tolerance {self.rtol:g} verified at non-node points (largest check error "
                 f"{self.max_check_error:.2g} of it), {int(self.direct.sum())} guard band(s) solved directly")
 
-    def evaluate(self, normal_speed) -> dict:
+    def evaluate(self, normal_speed) -> NormalBatch:
         """The outputs at ``normal_speed`` (1-D array within :attr:`speed_range`) [m/s].
 
-        Returns the dict of :func:`microimpact.solvers.engine.solve_normal_many` (``n_steps`` is 0
-        for interpolated speeds); for a captured impact J and J_a are totals over the settling.
+        Returns the :class:`~microimpact.solvers.engine.NormalBatch` of
+        :func:`microimpact.solvers.engine.solve_normal_many` (``n_steps`` is 0 for interpolated
+        speeds); for a captured impact J and J_a are totals over the settling.
         """
         v = np.ascontiguousarray(normal_speed, dtype=float).ravel()
         lo, hi = self.speed_range
@@ -369,7 +371,7 @@ class NormalFamily:
                         engine_settled_energy(c), out, solve_directly)
         return dict(zip(BATCH_VARIABLES, out)), solve_directly
 
-    def _assemble(self, v, piece, use_direct, values) -> dict:
+    def _assemble(self, v, piece, use_direct, values) -> NormalBatch:
         c = self.contact
         captured = self.captured[piece]
         kinetic = 0.5 * c.mass * v * v
@@ -399,7 +401,7 @@ class NormalFamily:
                                            tail_tolerance=NODE_RTOL_FLOOR)
             for k, val in sol.items():
                 out[k][idx] = val
-        return out
+        return NormalBatch(**out)
 
 
 def engine_settled_energy(contact) -> float:

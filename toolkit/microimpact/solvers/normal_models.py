@@ -71,9 +71,10 @@ from microimpact._numba import njit, njit_batch
 from microimpact.model import adhesion_models as am
 from microimpact.model import dem_damping as dd
 from microimpact.model.contact import check_positive
-from microimpact.solvers import DEFAULT_RTOL, dopri, engine
-from microimpact.solvers.engine import (CAPTURE, INERTIA_FREE_ENTER, _linear_tail_variation, INERTIA_FREE_RESUME, OUTCOME_NAMES, REBOUND,
-                                       RELAXATION_ENTER, RELAXATION_RESUME, EngineError, NormalSolution)
+from microimpact.solvers import DEFAULT_RTOL, dopri, driver, engine
+from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
+from microimpact.solvers.engine import (CAPTURE, INERTIA_FREE_ENTER, INERTIA_FREE_RESUME, OUTCOME_NAMES, REBOUND,
+                                       RELAXATION_ENTER, RELAXATION_RESUME, EngineError, NormalBatch, NormalSolution)
 
 __all__ = ["solve_normal", "solve_normal_many", "solve_normal_reference", "settled_contact_energy",
            "MODEL_CODES"]
@@ -391,23 +392,22 @@ def _orbit_integrals(model, e, z_lo, z_eq, c1, c2, c3, p3):
 
 
 @njit(cache=True)
+def _orbit(e, oargs):
+    """:func:`_orbit_integrals` with its parameters as one tuple (the driver's averaging calls it)."""
+    model, z_lo, z_eq, c1, c2, c3, p3 = oargs
+    return _orbit_integrals(model, e, z_lo, z_eq, c1, c2, c3, p3)
+
+
+#: the driver's method of averaging over this law's orbits
+_averaged = driver.make_averaged_tail(_orbit)
+
+
+@njit(cache=True)
 def _averaged_tail(model, e_now, z_lo, z_eq, c1, c2, c3, p3):
-    """(J, J_a) still to come for a weakly damped captured sphere of energy e_now: int (variation
-    per cycle) / (energy lost per cycle) de from the bottom of the well (the engine's method of
-    averaging, in q = sqrt(e - U_eq), where the integrand is smooth); relative error ~ C / omega0."""
-    e_eq = _energy(model, z_eq, 0.0)
-    q_now = math.sqrt(max(e_now - e_eq, 0.0))
-    jt = 0.0
-    jat = 0.0
-    if q_now == 0.0:
-        return jt, jat
-    for i in range(_GL16_X.shape[0]):
-        q = 0.5 * q_now * (_GL16_X[i] + 1.0)
-        loss, var, tw = _orbit_integrals(model, e_eq + q * q, z_lo, z_eq, c1, c2, c3, p3)
-        w = 0.5 * q_now * _GL16_W[i] * 2.0 * q / loss
-        jt += w * var
-        jat += w * tw
-    return jt, jat
+    """(J, J_a) still to come for a weakly damped captured sphere of energy e_now: the driver's
+    method of averaging (:func:`microimpact.solvers.driver.make_averaged_tail`) over the undamped
+    orbits of the model, from the bottom of the well U(z_eq); relative error ~ C / omega0."""
+    return _averaged(e_now, _energy(model, z_eq, 0.0), (model, z_lo, z_eq, c1, c2, c3, p3))
 
 
 #: what :func:`_locate` finds: z (the boundary), the contact energy, the friction impulse J, y
@@ -498,7 +498,7 @@ def _start(model, y0, c1, c2, c3, p3, rtol):
 
 #: what :func:`_creep` tells the loop: nothing happened, the integration resumes from a new state,
 #: the impact ended at the equilibrium
-_CREEP_NONE, _CREEP_RESUME, _CREEP_END = 0, 1, 2
+_CREEP_NONE, _CREEP_RESUME, _CREEP_END = driver.CREEP_NONE, driver.CREEP_RESUME, driver.CREEP_END
 
 
 @njit(cache=True)
@@ -584,110 +584,143 @@ def _captured_end(model, u, e_now, zmax, turned, need_tail, tail_tol, j_stop, ja
     return False, zmax
 
 
+# --------------------------------------------------------------------------- the laws in the one driver
+# The law's parameters p = (model, c1, c2, c3, p3, y0, need_tail, tail_tol, j_target, j_stop, ja_stop)
+# and its bookkeeping w (indices below; flags as 0.0 / 1.0) for the driver (:mod:`.driver`), which
+# owns the loop, the error control and the budgets.
+_W_OUTCOME, _W_TURNED, _W_TAU_CAP, _W_TAU_SLIP, _W_E_CAP, _W_ZMAX, _W_E_NOW = 0, 1, 2, 3, 4, 5, 6
+_W_ZB, _W_Z_EQ, _W_THRESHOLD, _W_E_EQ, _W_X_EQ, _W_C_EQ, _W_OMEGA_EQ = 7, 8, 9, 10, 11, 12, 13
+_W_SIZE = 14
+
+
+@njit(cache=True)
+def _law_start(p, rtol, rec, rec_cap):
+    """The driver's start (:func:`_start`): the state, its derivative, the first step, the
+    tolerances and the bookkeeping of one impact."""
+    u, k1, zb, z_eq, threshold, e_eq, x_eq, c_eq, omega_eq, atol, h = _start(p[0], p[5], p[1], p[2], p[3], p[4], rtol)
+    w = np.zeros(_W_SIZE)
+    w[_W_OUTCOME], w[_W_TAU_CAP], w[_W_TAU_SLIP], w[_W_E_CAP], w[_W_ZMAX] = REBOUND, math.nan, math.nan, threshold, u[0]
+    w[_W_ZB], w[_W_Z_EQ], w[_W_THRESHOLD], w[_W_E_EQ] = zb, z_eq, threshold, e_eq
+    w[_W_X_EQ], w[_W_C_EQ], w[_W_OMEGA_EQ] = x_eq, c_eq, omega_eq
+    return u, k1, h, atol, w
+
+
+@njit(cache=True, inline="always")
+def _law_args(p, w):
+    """The right-hand side's arguments: (model, C1, C2, C3, p3)."""
+    return (p[0], p[1], p[2], p[3], p[4])
+
+
+@njit(cache=True, inline="always")
+def _law_too_small(h, u):
+    return h < 1e-14 * max(1.0, abs(u[2]))
+
+
+@njit(cache=True)
+def _law_events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
+    """The events within the accepted step u -> u1 (the kink of |F_n|, separation, the largest
+    penetration, the end of sliding, the capture), and the advance to its end."""
+    model, c1, c2, c3, p3, j_target = p[0], p[1], p[2], p[3], p[4], p[8]
+    args = (model, c1, c2, c3, p3)
+    outcome, zb, zmax, turned, tau_slip = int(w[_W_OUTCOME]), w[_W_ZB], w[_W_ZMAX], w[_W_TURNED] != 0.0, w[_W_TAU_SLIP]
+    threshold = w[_W_THRESHOLD]
+    # the step ends where the net force changes sign: |F_n|, integrated into J and J_a, has a
+    # kink there, across which a step loses order (its error then hides in the norm's mean;
+    # measured: the rebound velocity 4x its tolerance at rtol 1e-8). Not where the kink cannot
+    # matter: integrating |F| instead of F across it differs by at most h |g| min(|F0|, |F1|),
+    # and below J's tolerance (a captured sphere at rest, whose F is round-off about zero:
+    # located at every step, 1.9e6 steps) the step is kept. A zero at the very start of the
+    # step (the one just located) is not located again.
+    hk = h
+    t0, t1 = _terms(u, args), _terms(u1, args)
+    f0, f1 = t0[2], t1[2]
+    if ((f0 > 0.0 and f1 < 0.0) or (f0 < 0.0 and f1 > 0.0)) and h * max(abs(t0[0]), abs(t1[0])) * min(
+            abs(f0), abs(f1)) > atol[4] + rtol * abs(u1[4]):
+        hk = _root(_EV_F, 0.0, f0, f1, 0.0, h, u, k1, args, args, k, tmp, u1, err)
+        if hk < 1e-9 * h:
+            hk = h
+            _step(u, k1, h, args, k, tmp, u1, err)
+    separated = u1[0] <= zb and u1[1] < 0.0 and u[0] > zb and outcome == REBOUND
+    if not separated and outcome == REBOUND and u[0] > zb and u[1] < 0.0 and u1[1] >= 0.0 and _event_state(
+            model, _EV_Y, 0.0, u, u1, k1, hk, c1, c2, c3, p3)[0] <= zb:
+        # the sphere crossed the break, turned beyond it and came back within one step (a slow
+        # exit just above the sticking velocity): it left at the crossing
+        hk = _locate(model, _EV_Y, 0.0, u, k1, hk, c1, c2, c3, p3, k, tmp, u1, err)
+        separated = True
+    if separated:
+        _locate(model, _EV_Z, zb, u, k1, hk, c1, c2, c3, p3, k, tmp, u1, err)
+    if u[1] > 0.0 and u1[1] <= 0.0:
+        zmax = max(zmax, _event_state(model, _EV_Y, 0.0, u, u1, k1, hk, c1, c2, c3, p3)[0])
+        turned = True
+    zmax = max(zmax, u1[0])
+    if j_target > 0.0 and math.isnan(tau_slip) and u1[4] >= j_target:
+        tau_slip = _event_state(model, _EV_J, j_target, u, u1, k1, hk, c1, c2, c3, p3)[2]
+    e_now = _energy(model, u1[0], u1[1])
+    if not separated and outcome == REBOUND and e_now < threshold and model != _HERTZ:
+        w[_W_OUTCOME] = CAPTURE
+        w[_W_E_CAP] = e_now
+        # where the energy fell below the threshold (at the start: captured from first contact)
+        w[_W_TAU_CAP] = u[2] if _energy(model, u[0], u[1]) < threshold else _event_state(
+            model, _EV_ENERGY, threshold, u, u1, k1, hk, c1, c2, c3, p3)[2]
+    for i in range(_N):
+        u[i] = u1[i]
+    for i in range(_N):
+        k1[i] = k[6, i]
+    w[_W_ZMAX], w[_W_TURNED], w[_W_TAU_SLIP], w[_W_E_NOW] = zmax, 1.0 if turned else 0.0, tau_slip, e_now
+    return driver.END if separated else driver.GO_ON
+
+
+@njit(cache=True)
+def _law_creep(u, k1, p, w, atol, rec, rec_cap):
+    """The inertia-free creep (:func:`_creep`) where the sphere is strongly damped here (Hertz, whose
+    DEM damping may vanish with a: also once turned; a strongly damped approach can end with y at
+    the noise level of atol, never seen to turn). The cheap test first."""
+    model, c1, c2, c3, p3 = p[0], p[1], p[2], p[3], p[4]
+    turned = w[_W_TURNED] != 0.0
+    if not ((model == _HERTZ and turned) or _static_and_damping(model, u[0], c1, c2, c3, p3)[1] >= 10.0):
+        return driver.CREEP_NONE
+    action, outcome, tau_cap, tau_slip, e_cap, zmax = _creep(
+        model, u, k1, w[_W_Z_EQ], c1, c2, c3, p3, atol[1], w[_W_THRESHOLD], int(w[_W_OUTCOME]), p[8], w[_W_TAU_SLIP],
+        w[_W_TAU_CAP], w[_W_E_CAP], w[_W_ZMAX], turned)
+    w[_W_OUTCOME], w[_W_TAU_CAP], w[_W_TAU_SLIP], w[_W_E_CAP], w[_W_ZMAX] = outcome, tau_cap, tau_slip, e_cap, zmax
+    return action
+
+
+@njit(cache=True)
+def _law_captured_end(u, k1, p, w, atol, long_tail):
+    """Whether a captured sphere may stop (:func:`_captured_end`)."""
+    if int(w[_W_OUTCOME]) != CAPTURE:
+        return False
+    model, c1, c2, c3, p3, need_tail, tail_tol, j_stop, ja_stop = p[0], p[1], p[2], p[3], p[4], p[6], p[7], p[9], p[10]
+    done, zmax = _captured_end(model, u, w[_W_E_NOW], w[_W_ZMAX], w[_W_TURNED] != 0.0, need_tail, tail_tol, j_stop,
+                               ja_stop, long_tail, w[_W_ZB], w[_W_Z_EQ], w[_W_E_EQ], w[_W_E_CAP], w[_W_X_EQ], w[_W_C_EQ],
+                               w[_W_OMEGA_EQ], w[_W_THRESHOLD], c1, c2, c3, p3)
+    w[_W_ZMAX] = zmax
+    return done
+
+
+@njit(cache=True)
+def _law_finish(status, u, p, w, n_steps, n_rej):
+    """The driver's :class:`~microimpact.solvers.driver.Trace` of one impact, in the model's units
+    (the final energy relative to free flight)."""
+    model = p[0]
+    e_free = _energy(model, 4.0 ** (1.0 / 3.0) if _is_jkr(model) else 0.0, 0.0)
+    return driver.Trace(status, int(w[_W_OUTCOME]), u[1], u[2], u[3], u[4], u[5], w[_W_ZMAX], w[_W_TAU_CAP],
+                        w[_W_TAU_SLIP], _energy(model, u[0], u[1]) - e_free, n_steps, n_rej, 0, u, 0, 0)
+
+
+#: the one driver (:mod:`.driver`) running the JKR, DMT and Hertz laws
+_drive = driver.make_driver(driver.Law(_law_start, _law_args, _step, _law_too_small, driver.make_error_norm(_N),
+                                       _law_events, _law_creep, _law_captured_end, _law_finish, _N))
+_NO_RECORD = np.zeros((1, 3))
+
+
 @njit(cache=True)
 def _integrate(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_target, j_stop, ja_stop, max_steps):
-    """One normal impact in the model's nondimensional units.
-
-    Returns the floats (status, outcome, y_end, tau_end, D, J, J_a, z_max, tau_capture,
-    tau_slip_end, energy_end, n_steps, n_rejected).
-
-    The loop steps and locates the events within a step (the kink of |F_n|, separation, the
-    largest penetration, the end of sliding, the capture); the set-up, the inertia-free creep and
-    the end of a captured sphere are compiled helpers.
-    """
-    args = (model, c1, c2, c3, p3)
-    k = np.zeros((7, _N))
-    u1 = np.zeros(_N)
-    tmp = np.zeros(_N)
-    err = np.zeros(_N)
-    u, k1, zb, z_eq, threshold, e_eq, x_eq, c_eq, omega_eq, atol, h = _start(model, y0, c1, c2, c3, p3, rtol)
-    status, outcome = _OK, REBOUND
-    zmax = u[0]
-    turned = False  # the largest penetration passed (y fell through zero)
-    tau_cap = math.nan
-    tau_slip = math.nan
-    e_cap = threshold
-    n_acc = 0
-    n_rej = 0
-    while True:
-        if n_acc + n_rej >= max_steps:
-            status = _MAX_STEPS
-            break
-        _step(u, k1, h, args, k, tmp, u1, err)
-        norm = dopri.error_norm(u, u1, err, atol, rtol, _N)
-        if not norm <= 1.0:  # also NaN
-            n_rej += 1
-            h = dopri.shrunk_step(h, norm)
-            if h < 1e-14 * max(1.0, abs(u[2])):
-                status = _STEP_UNDERFLOW
-                break
-            continue
-        n_acc += 1
-        # the step ends where the net force changes sign: |F_n|, integrated into J and J_a, has a
-        # kink there, across which a step loses order (its error then hides in the norm's mean;
-        # measured: the rebound velocity 4x its tolerance at rtol 1e-8). Not where the kink cannot
-        # matter: integrating |F| instead of F across it differs by at most h |g| min(|F0|, |F1|),
-        # and below J's tolerance (a captured sphere at rest, whose F is round-off about zero:
-        # located at every step, 1.9e6 steps) the step is kept. A zero at the very start of the
-        # step (the one just located) is not located again.
-        hk = h
-        t0, t1 = _terms(u, args), _terms(u1, args)
-        f0, f1 = t0[2], t1[2]
-        if ((f0 > 0.0 and f1 < 0.0) or (f0 < 0.0 and f1 > 0.0)) and h * max(abs(t0[0]), abs(t1[0])) * min(
-                abs(f0), abs(f1)) > atol[4] + rtol * abs(u1[4]):
-            hk = _root(_EV_F, 0.0, f0, f1, 0.0, h, u, k1, args, args, k, tmp, u1, err)
-            if hk < 1e-9 * h:
-                hk = h
-                _step(u, k1, h, args, k, tmp, u1, err)
-        separated = u1[0] <= zb and u1[1] < 0.0 and u[0] > zb and outcome == REBOUND
-        if not separated and outcome == REBOUND and u[0] > zb and u[1] < 0.0 and u1[1] >= 0.0 and _event_state(
-                model, _EV_Y, 0.0, u, u1, k1, hk, c1, c2, c3, p3)[0] <= zb:
-            # the sphere crossed the break, turned beyond it and came back within one step (a slow
-            # exit just above the sticking velocity): it left at the crossing
-            hk = _locate(model, _EV_Y, 0.0, u, k1, hk, c1, c2, c3, p3, k, tmp, u1, err)
-            separated = True
-        if separated:
-            _locate(model, _EV_Z, zb, u, k1, hk, c1, c2, c3, p3, k, tmp, u1, err)
-        if u[1] > 0.0 and u1[1] <= 0.0:
-            zmax = max(zmax, _event_state(model, _EV_Y, 0.0, u, u1, k1, hk, c1, c2, c3, p3)[0])
-            turned = True
-        zmax = max(zmax, u1[0])
-        if j_target > 0.0 and math.isnan(tau_slip) and u1[4] >= j_target:
-            tau_slip = _event_state(model, _EV_J, j_target, u, u1, k1, hk, c1, c2, c3, p3)[2]
-        e_now = _energy(model, u1[0], u1[1])
-        if not separated and outcome == REBOUND and e_now < threshold and model != _HERTZ:
-            outcome = CAPTURE
-            e_cap = e_now
-            # where the energy fell below the threshold (at the start: captured from first contact)
-            tau_cap = u[2] if _energy(model, u[0], u[1]) < threshold else _event_state(
-                model, _EV_ENERGY, threshold, u, u1, k1, hk, c1, c2, c3, p3)[2]
-        for i in range(_N):
-            u[i] = u1[i]
-        for i in range(_N):
-            k1[i] = k[6, i]
-        if separated:
-            break
-        # cheap test first: strongly damped here (Hertz, whose DEM damping may vanish with a: also
-        # once turned; a strongly damped approach can end with y at the noise level of atol, never
-        # seen to turn)
-        if ((model == _HERTZ and turned) or _static_and_damping(model, u[0], c1, c2, c3, p3)[1] >= 10.0):
-            action, outcome, tau_cap, tau_slip, e_cap, zmax = _creep(
-                model, u, k1, z_eq, c1, c2, c3, p3, atol[1], threshold, outcome, j_target, tau_slip, tau_cap, e_cap,
-                zmax, turned)
-            if action == _CREEP_RESUME:
-                continue
-            if action == _CREEP_END:
-                break
-        if outcome == CAPTURE:
-            done, zmax = _captured_end(model, u, e_now, zmax, turned, need_tail, tail_tol, j_stop, ja_stop,
-                                       20 * (n_acc + n_rej) >= max_steps, zb, z_eq, e_eq, e_cap, x_eq, c_eq,
-                                       omega_eq, threshold, c1, c2, c3, p3)
-            if done:
-                break
-        h = dopri.grown_step(h, norm)
-    return (float(status), float(outcome), u[1], u[2], u[3], u[4], u[5], zmax, tau_cap, tau_slip,
-            _energy(model, u[0], u[1]) - _energy(model, 4.0 ** (1.0 / 3.0) if _is_jkr(model) else 0.0, 0.0),
-            float(n_acc), float(n_rej))
+    """One normal impact in the model's nondimensional units, by the one driver; its
+    :class:`~microimpact.solvers.driver.Trace`."""
+    return _drive((model, c1, c2, c3, p3, y0, need_tail, tail_tol, j_target, j_stop, ja_stop), rtol, max_steps,
+                  _NO_RECORD, 0)
 
 
 @njit_batch
@@ -696,8 +729,19 @@ def _integrate_many(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_stop
     for i in prange(y0.size):
         r = _integrate(model, y0[i], c1[i], c2[i], c3[i], p3, rtol, need_tail[i], tail_tol, 0.0, j_stop[i], ja_stop[i],
                        max_steps)
-        for j in range(13):
-            out[i, j] = r[j]
+        out[i, 0] = r.status
+        out[i, 1] = r.outcome
+        out[i, 2] = r.y_end
+        out[i, 3] = r.tau_end
+        out[i, 4] = r.dissipated
+        out[i, 5] = r.friction_impulse
+        out[i, 6] = r.twist_impulse
+        out[i, 7] = r.max_approach
+        out[i, 8] = r.tau_capture
+        out[i, 9] = r.tau_slip_end
+        out[i, 10] = r.final_energy
+        out[i, 11] = r.n_steps
+        out[i, 12] = r.n_rejected
 
 
 # --------------------------------------------------------------------------- Python interface
@@ -813,32 +857,33 @@ def solve_normal(contact, normal_speed: float, *, rtol: float = DEFAULT_RTOL, ne
     jt = 0.0 if friction_impulse_target is None else float(friction_impulse_target) / j_unit
     r = _integrate(model, y0, c1, c2, c3, p3, float(rtol), bool(need_tail), float(rtol if tail_tolerance is None else tail_tolerance),
                    jt, friction_impulse_stop / j_unit, twist_impulse_stop / (j_unit * sc.radius), int(max_steps))
-    if r[0] != _OK:
-        raise EngineError(f"{_law_name(contact)} solver failed for normal speed {v!r} m/s after {r[11]} steps")
-    captured = r[1] == CAPTURE
+    if r.status != _OK:
+        raise EngineError(f"{_law_name(contact)} solver failed for normal speed {v!r} m/s after {r.n_steps} steps")
+    captured = r.outcome == CAPTURE
     e_unit = sc.force * sc.length
-    e_n = 0.0 if captured else float(_restitution(model, y0, r[4], r[2]))
+    e_n = 0.0 if captured else float(_restitution(model, y0, r.dissipated, r.y_end))
     return NormalSolution(
-        outcome=OUTCOME_NAMES[int(r[1])],
+        outcome=OUTCOME_NAMES[int(r.outcome)],
         e_n=e_n,
-        contact_time=math.inf if captured else r[3] * sc.time,
-        capture_time=r[8] * sc.time,
-        max_penetration=_penetration(model, sc, r[7]),
-        friction_impulse=r[5] * j_unit,
-        twist_impulse=r[6] * j_unit * sc.radius,
-        dissipated_energy=0.5 * y0 * y0 * (1.0 - e_n * e_n) * e_unit if not captured else r[4] * e_unit,
-        final_energy=r[10] * e_unit if captured else 0.5 * (e_n * y0) ** 2 * e_unit,
-        slip_end_time=r[9] * sc.time,
-        n_steps=int(r[11]),
-        n_rejected=int(r[12]),
+        contact_time=math.inf if captured else r.tau_end * sc.time,
+        capture_time=r.tau_capture * sc.time,
+        max_penetration=_penetration(model, sc, r.max_approach),
+        friction_impulse=r.friction_impulse * j_unit,
+        twist_impulse=r.twist_impulse * j_unit * sc.radius,
+        dissipated_energy=0.5 * y0 * y0 * (1.0 - e_n * e_n) * e_unit if not captured else r.dissipated * e_unit,
+        final_energy=r.final_energy * e_unit if captured else 0.5 * (e_n * y0) ** 2 * e_unit,
+        slip_end_time=r.tau_slip_end * sc.time,
+        n_steps=int(r.n_steps),
+        n_rejected=int(r.n_rejected),
     )
 
 
 def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DEFAULT_RTOL,
                       tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT,
-                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> dict:
-    """JKR or DMT normal solves of many speeds in parallel; the dict of
-    :func:`microimpact.solvers.engine.solve_normal_many` (SI arrays).
+                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> NormalBatch:
+    """JKR or DMT normal solves of many speeds in parallel; the
+    :class:`~microimpact.solvers.engine.NormalBatch` of :func:`microimpact.solvers.engine.solve_normal_many`
+    (SI arrays).
 
     Parameters as there: ``normal_speed`` [m/s] (1-D, > 0), ``need_tail`` per speed,
     ``friction_impulse_stop`` [N s] and ``twist_impulse_stop`` [N m s] per speed.
@@ -888,18 +933,18 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     captured = out[:, 1] == CAPTURE
     e_unit = sc.force * sc.length
     e_n = np.where(captured, 0.0, _restitution(model, y0, out[:, 4], out[:, 2]))
-    return {
-        "captured": captured,
-        "e_n": e_n,
-        "contact_time": np.where(captured, np.inf, out[:, 3] * sc.time),
-        "capture_time": out[:, 8] * sc.time,
-        "max_penetration": _penetration(model, sc, out[:, 7]),
-        "friction_impulse": out[:, 5] * j_unit,
-        "twist_impulse": out[:, 6] * j_unit * sc.radius,
-        "dissipated_energy": np.where(captured, out[:, 4], 0.5 * y0**2 * (1.0 - e_n**2)) * e_unit,
-        "final_energy": np.where(captured, out[:, 10], 0.5 * (e_n * y0) ** 2) * e_unit,
-        "n_steps": out[:, 11].astype(np.int64),
-    }
+    return NormalBatch(
+        captured=captured,
+        e_n=e_n,
+        contact_time=np.where(captured, np.inf, out[:, 3] * sc.time),
+        capture_time=out[:, 8] * sc.time,
+        max_penetration=_penetration(model, sc, out[:, 7]),
+        friction_impulse=out[:, 5] * j_unit,
+        twist_impulse=out[:, 6] * j_unit * sc.radius,
+        dissipated_energy=np.where(captured, out[:, 4], 0.5 * y0**2 * (1.0 - e_n**2)) * e_unit,
+        final_energy=np.where(captured, out[:, 10], 0.5 * (e_n * y0) ** 2) * e_unit,
+        n_steps=out[:, 11].astype(np.int64),
+    )
 
 
 def settled_contact_energy(contact) -> float:

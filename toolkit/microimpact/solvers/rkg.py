@@ -28,6 +28,7 @@ from microimpact.model.contact import check_positive
 from microimpact.model.law import nondimensional_impact
 from microimpact.solvers import compiled_law as law
 from microimpact.solvers import engine
+from microimpact.solvers.driver import OK, Trace
 
 __all__ = ["rkg_setup", "rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
 
@@ -306,6 +307,6 @@ def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS
     captured = r[_OUTCOME] == engine.CAPTURE
     y_out = r[_Y_OUT]  # exit speed, > 0
     dissipated = math.nan if captured else 0.5 * (y0[0] ** 2 - y_out**2)  # energy balance
-    return engine.normal_solution(
-        contact, sc, y0[0], r[_OUTCOME], -y_out, r[_TAU_END], dissipated, r[_J], r[_J_A], r[_XI_MAX],
-        r[_TAU_END] if captured else math.nan, r[_TAU_J], r[_E_END], r[_N_STEPS], 0)
+    trace = Trace(OK, int(r[_OUTCOME]), -y_out, r[_TAU_END], dissipated, r[_J], r[_J_A], r[_XI_MAX],
+                  r[_TAU_END] if captured else math.nan, r[_TAU_J], r[_E_END], int(r[_N_STEPS]), 0, 0, None, 0, 0)
+    return engine.normal_solution(contact, sc, y0[0], trace)
