@@ -77,9 +77,10 @@ PLASTIC_PARAMETERS = ("yield_velocity", "work_of_adhesion")
 PLASTIC_UNITS = {"yield_velocity": "m s-1", "work_of_adhesion": "J m-2", "yield_pressure": "Pa",
                  "sticking_velocity": "m s-1"}
 #: the range each profile searches (log-spaced): V_y from 1 mm/s (a microsphere at 1 m/s is then
-#: far above yield) to 1 km/s (no impact of a rebound experiment yields); w_A over the works of
-#: adhesion of solids, from a thousandth of van der Waals contact to ten times a metallic bond
-PLASTIC_RANGES = {"yield_velocity": (1e-3, 1e3), "work_of_adhesion": (1e-4, 10.0)}
+#: far above yield) to 1 km/s (no impact of a rebound experiment yields); w_A from 1e-6 J/m^2 (it
+#: moves e_n of a 1-3 um sphere of the bundled material by < 1e-4 at 0.5-60 m/s, measured: no
+#: adhesion, as far as rebound data can tell) to 10 J/m^2 (ten times a metallic bond)
+PLASTIC_RANGES = {"yield_velocity": (1e-3, 1e3), "work_of_adhesion": (1e-6, 10.0)}
 #: the start grid: V_y [m/s] and w_A as multiples of the material's w_A [-]
 PLASTIC_START_GRID = (np.geomspace(0.03, 300.0, 9), np.geomspace(0.03, 30.0, 7))
 #: rays traced from the best fit to the boundary of the joint region for the sticking velocities'
@@ -388,7 +389,7 @@ def _profiles(obj, best, chi_min, scale) -> tuple[dict, list]:
         reasons = {"not_determined": f"chi-square changes by less than the 95 % threshold over {name} in [{lo:g}, {hi:g}]",
                    "lower_bound": f"the e_n data are as well explained by any larger {name}, up to {hi:g}",
                    "upper_bound": f"the e_n data are as well explained by any smaller {name}, down to {lo:g}"}
-        out[name] = status_from_interval(name, math.exp(best[k]), ends[0], ends[1], lo, hi, method="profile",
+        out[name] = status_from_interval(name, obj.values(best)[k], ends[0], ends[1], lo, hi, method="profile",
                                          reasons=reasons, atol=1e-9 * hi)
     return out, tips
 
