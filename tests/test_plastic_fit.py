@@ -230,6 +230,13 @@ def test_cli_fits_thornton_ning_and_writes_its_file(impacts_csv, capsys):
     assert fit.identifiability["yield_velocity"].contains(TRUE_YIELD_VELOCITY)
 
 
+def test_cli_excluded_rows_are_left_out_and_named(impacts_csv, capsys):
+    assert cli.main(["fit", "impacts.csv", "--law", "thornton_ning", "--out", "x.nc", "--exclude", "tn-05,tn-30"]) == 0
+    assert "excluded    : tn-05, tn-30 (by the analyst: --exclude)" in capsys.readouterr().out
+    fit = PlasticFit.load(impacts_csv / "x.nc")
+    assert fit.n_points == 10 and fit.verdict.excluded == ("tn-05", "tn-30") and "tn-05" not in fit.row_ids
+
+
 @pytest.mark.parametrize("extra,named", [(["--posterior", "p.nc"], "--posterior"), (["--rtol", "1e-9"], "--rtol"),
                                          (["--oblique-out", "o.nc"], "--oblique-out"),
                                          (["--no-confidence-intervals"], "--no-confidence-intervals"),

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import sys
 
@@ -50,9 +51,11 @@ def run_fit(args) -> int:
     _refuse_damping_options(args)
     out = check_outputs({"--out": args.out}, input_files(args))["--out"]
     table, pair = impacts_for_pair(args)
-    table, _ = exclude_rows(table, _exclude_ids(args.exclude, table))
+    table, excluded = exclude_rows(table, _exclude_ids(args.exclude, table))
     print(f"fitting the {args.law} law to {len(table)} impacts of {pair.name} ...", file=sys.stderr, flush=True)
     fit = fit_thornton_ning(table, pair, weights=args.weights, time_budget=args.time_budget)
+    if excluded:  # the verdict lists them (the file keeps them)
+        fit = dataclasses.replace(fit, info={**fit.info, "excluded_ids": ",".join(excluded)})
     text = json.dumps(_json_ready(_summary(fit, pair, [out])), indent=2, allow_nan=False) if args.json else fit.report()
     print_before_writing(text)
     with reporting_os_errors({"--out": out}):

@@ -48,6 +48,7 @@ Press, W. H. et al. (2007), Numerical Recipes, 3rd ed., Cambridge University Pre
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -430,7 +431,8 @@ class PlasticFit(FitResult):
     scale_covar : bool
         Whether the profile threshold is scaled by the reduced chi-square (unweighted fits).
     info : dict
-        nfev, method, elapsed_s, source, sha256, material_pair, outside_physical_range.
+        nfev, method, elapsed_s, source, sha256, material_pair, outside_physical_range, and
+        excluded_ids (the rows ``fit --exclude`` left out, comma-separated) where some were.
 
     Examples
     --------
@@ -499,10 +501,11 @@ class PlasticFit(FitResult):
     def verdict(self) -> Verdict:
         """Whether the law describes the data (:func:`~microimpact.analysis.verdict.assess_residuals`)."""
         d = self.data
-        return assess_residuals(d["residual"].to_numpy(float), len(PLASTIC_PARAMETERS),
-                                stated=self.weighting != "none", ids=self.row_ids,
-                                speed=d["normal_speed"].to_numpy(float), radius=d["radius"].to_numpy(float),
-                                what="Thornton-Ning law")
+        v = assess_residuals(d["residual"].to_numpy(float), len(PLASTIC_PARAMETERS), stated=self.weighting != "none",
+                             ids=self.row_ids, speed=d["normal_speed"].to_numpy(float),
+                             radius=d["radius"].to_numpy(float), what="Thornton-Ning law")
+        # the rows the analyst left out (``fit --exclude``), as the damping fit records them
+        return dataclasses.replace(v, excluded=tuple(x for x in str(self.info.get("excluded_ids") or "").split(",") if x))
 
     def contact(self, radius: float) -> tn.PlasticContact:
         """The fitted law's contact for a sphere of ``radius``. [m]"""
