@@ -269,8 +269,8 @@ def register_compare(sub) -> None:
     p.add_argument("data", help=f"measured-impact CSV (format: {DATA_README}, section 'Measured-impact CSV format')")
     p.add_argument("--config", help="materials config YAML (default: the bundled one)")
     p.add_argument("--material-pair", help="material pair to fit (default: the file's only pair)")
-    p.add_argument("--models", default="ring,jkr,dmt,thornton_ning",
-                   help="comma-separated laws (default ring,jkr,dmt,thornton_ning; also jkr_force)")
+    p.add_argument("--models", default=None,
+                   help="comma-separated laws (default: ring, jkr, dmt and thornton_ning; also jkr_force)")
     p.add_argument("--out", default=None, help="write the comparison NetCDF (the report's model-comparison file)")
     p.add_argument("--json", action="store_true", help="print the ranking as JSON instead of the table")
     p.set_defaults(func=_handler("plastic", "run_compare"))

@@ -81,7 +81,7 @@ def run_compare(args) -> int:
     """``compare``: every law fitted to the same rows, ranked by AIC with each one's verdict."""
     outputs = check_outputs({"--out": args.out}, input_files(args))
     table, pair = impacts_for_pair(args)
-    models = tuple(m.strip() for m in args.models.split(",") if m.strip())
+    models = DEFAULT_MODELS if args.models is None else tuple(m.strip() for m in args.models.split(",") if m.strip())
     unknown = [m for m in models if m not in DEFAULT_MODELS + ("jkr_force",)]
     if unknown or not models:
         raise UsageError(f"--models: {unknown[0] if unknown else 'none given'!r} is not a law of the comparison "
