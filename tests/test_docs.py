@@ -66,6 +66,9 @@ HOW = {
     # docs/guide/lammps.md: from a CSV to a verified LAMMPS input (needs LAMMPS for verify)
     "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --units micro --out contact.lmp": "test",
     "microimpact lammps verify contact.lmp": "test",
+    # docs/laws/thornton_ning.md: the elastic-plastic law's fit and the comparison of the laws
+    "microimpact fit impacts.csv --law thornton_ning --out tn_fit.nc": "test",
+    "microimpact compare impacts.csv --models ring,thornton_ning --out comparison.nc": "test",
     # README.md, Quick start, and docs/guide/cli.md: every command once
     "microimpact simulate --preset wall1990 --speed 1.0 --incidence-deg 10 --json": "run",
     "microimpact simulate --speed 3 --zeta-adhesion 10 --friction 0.3 --omega-tp 2e5": "run",
@@ -132,6 +135,10 @@ TESTED_BY = {
     "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --units micro --out contact.lmp":
         ("tests/test_dem_fit.py", "test_csv_to_running_lammps_input_in_two_commands"),
     "microimpact lammps verify contact.lmp": ("tests/test_dem_fit.py", "test_csv_to_running_lammps_input_in_two_commands"),
+    "microimpact fit impacts.csv --law thornton_ning --out tn_fit.nc":
+        ("tests/test_plastic_fit.py", "test_cli_fits_thornton_ning_and_writes_its_file"),
+    "microimpact compare impacts.csv --models ring,thornton_ning --out comparison.nc":
+        ("tests/test_plastic_fit.py", "test_cli_compare_ranks_the_laws"),
     "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --law hertz+coeff_restitution --tangential-model lammps_mindlin --shear-modulus 1e9 --out contact.lmp":
         ("tests/test_dem_tangential.py", "test_lammps_fit_writes_the_fitted_friction_of_a_tangential_law"),
 }

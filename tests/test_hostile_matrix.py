@@ -23,6 +23,8 @@ COMMANDS = {
              "--oblique-out", "{--oblique-out}"],
             {"DATA": ("data.csv", "in"), "--config": ("m.yaml", "in"), "--out": ("f.nc", "out"),
              "--posterior": ("p.nc", "out"), "--oblique-out": ("b.nc", "out")}),
+    "compare": (["compare", "{DATA}", "--config", "{--config}", "--out", "{--out}"],
+                {"DATA": ("data.csv", "in"), "--config": ("m.yaml", "in"), "--out": ("c.nc", "out")}),
     "flags": (["flags", "{DATA}", "--fit", "{--fit}", "--config", "{--config}", "--out", "{--out}", "--nc", "{--nc}"],
               {"DATA": ("data.csv", "in"), "--fit": ("fit.nc", "in"), "--config": ("m.yaml", "in"),
                "--out": ("o.csv", "out"), "--nc": ("o.nc", "out")}),
@@ -85,7 +87,8 @@ FILE_INPUTS = [("fit", "DATA", {"csv"}), ("flags", "DATA", {"csv"}), ("flags", "
                ("sweep", "--fit", {"fit"}), ("target", "--fit", {"fit"}), ("fit", "--config", {"yaml"}),
                ("flags", "--config", {"yaml"}), ("plot", "RESULT", {"fit", "sweep", "flags"}),
                ("flags-posterior", "--posterior", set()), ("lammps-export", "--fit", {"fit"}),
-               ("lammps-verify", "INPUT", set()), ("lammps-fit", "DATA", {"csv"}), ("lammps-fit", "--config", {"yaml"})]
+               ("lammps-verify", "INPUT", set()), ("lammps-fit", "DATA", {"csv"}), ("lammps-fit", "--config", {"yaml"}),
+               ("compare", "DATA", {"csv"}), ("compare", "--config", {"yaml"})]
 WRONG_KIND = [(c, o, kind) for c, o, ok in FILE_INPUTS for kind in KINDS if kind not in ok]
 
 

@@ -1,4 +1,4 @@
-"""Command line: ``microimpact simulate | sweep | fit | flags | target | reproduce | benchmark | plot | workflow | lammps``.
+"""Command line: ``microimpact simulate | sweep | fit | compare | flags | target | reproduce | benchmark | plot | workflow | lammps``.
 
 Thin: parse, call the library, print or write. Exit statuses: 0 success; 2 bad arguments, inputs
 or a solver failure (one line ``microimpact: error: ...`` on stderr); 3 the computation ran past
@@ -41,6 +41,7 @@ from microimpact.model.contact import SUB_MODELS
 from microimpact.model.dem_damping import DEM_LAWS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 from microimpact.model.dem_twisting import DEM_TWISTING_MODELS
+from microimpact.model.laws import restitution_laws
 from microimpact.model.parameters import TABLE2_CASES
 from microimpact.presets import PRESETS
 from microimpact.solvers import DEFAULT_RTOL, METHODS, TimeBudgetExceeded, check_rtol
@@ -213,7 +214,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_handler("simulate"))
 
-    for register in (register_sweep, register_fit, register_flags, register_target, register_reproduce,
+    for register in (register_sweep, register_fit, register_compare, register_flags, register_target, register_reproduce,
                      register_benchmark, register_plot, register_workflow, register_lammps):
         register(sub)
     return parser
@@ -248,9 +249,31 @@ def register_fit(sub) -> None:
     _add_rtol(p)
     p.add_argument("--out", required=True, help="output NetCDF of the fit")
     p.add_argument("--json", action="store_true", help="print the results as JSON instead of the text report")
+    p.add_argument("--law", choices=restitution_laws(), default="damping",
+                   help="the law fitted: the paper's damping law (default: zeta_H, zeta_A, w_A) or thornton_ning "
+                        "(elastic-plastic adhesive: yield velocity and w_A; no posterior, friction or --rtol)")
     _add_posterior_options(p)
     _add_time_budget(p)
-    p.set_defaults(func=_handler("fit"))
+    p.set_defaults(func=_fit_handler)
+
+
+def _fit_handler(args) -> int:
+    """``fit``: the damping law's fit (microimpact._commands.fit), or another law's (._commands.plastic)."""
+    return (_handler("fit") if args.law == "damping" else _handler("plastic", "run_fit"))(args)
+
+
+def register_compare(sub) -> None:
+    """``microimpact compare DATA.csv``: every law fitted to the same e_n(v_n), ranked by AIC with its verdict."""
+    p = sub.add_parser("compare", help="fit the normal laws (ring, JKR, DMT, Thornton-Ning) to the same e_n(v_n) "
+                                       "and rank them by AIC, each with its verdict")
+    p.add_argument("data", help=f"measured-impact CSV (format: {DATA_README}, section 'Measured-impact CSV format')")
+    p.add_argument("--config", help="materials config YAML (default: the bundled one)")
+    p.add_argument("--material-pair", help="material pair to fit (default: the file's only pair)")
+    p.add_argument("--models", default=None,
+                   help="comma-separated laws (default: ring, jkr, dmt and thornton_ning; also jkr_force)")
+    p.add_argument("--out", default=None, help="write the comparison NetCDF (the report's model-comparison file)")
+    p.add_argument("--json", action="store_true", help="print the ranking as JSON instead of the table")
+    p.set_defaults(func=_handler("plastic", "run_compare"))
 
 
 def _add_posterior_options(p: argparse.ArgumentParser) -> None:
@@ -782,7 +805,8 @@ def _main(argv, written) -> int:
         elif rest:
             raise UsageError(f"unrecognized arguments: {' '.join(rest)}")
         if not getattr(args, "command", None):
-            raise UsageError("a command is required: simulate, sweep, fit, flags, target, reproduce, benchmark, plot, workflow or lammps")
+            raise UsageError("a command is required: simulate, sweep, fit, compare, flags, target, reproduce, benchmark, plot, "
+                             "workflow or lammps")
         status = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status

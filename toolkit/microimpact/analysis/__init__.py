@@ -10,6 +10,9 @@
 - :mod:`.synthetic`: labelled synthetic measurements from stated parameters.
 - :mod:`.dem_fit`: the damping of LAMMPS GRANULAR's laws fitted to measured e_n, and the laws ranked.
 - :mod:`.dem_friction`: the friction mu of LAMMPS GRANULAR's tangential laws fitted to oblique rebounds.
+- :mod:`.plastic_fit`: the Thornton & Ning elastic-plastic adhesive law fitted to e_n(v_n) (yield
+  velocity and w_A).
+- :mod:`.model_comparison`: the normal laws fitted to the same e_n(v_n) and ranked by AIC.
 """
 
 from microimpact._lazy import lazy_exports as _lazy_exports
@@ -31,6 +34,8 @@ _HOMES = {
     **dict.fromkeys(("kharaz_comparison", "kharaz_summary", "kharaz_table", "default_kharaz_path", "read_kharaz",
                      "KHARAZ_CONDITIONS", "UNLOADING_READINGS"), "kharaz"),
     **dict.fromkeys(("compare_normal_models", "normal_model_restitution", "comparison_verdict", "DEFAULT_MODELS"), "model_comparison"),
+    **dict.fromkeys(("PlasticFit", "PlasticProblem", "fit_thornton_ning", "PLASTIC_PARAMETERS", "PLASTIC_RANGES",
+                     "PLASTIC_UNITS", "PLASTIC_START_GRID", "STICKING_RAYS"), "plastic_fit"),
     **dict.fromkeys(("FrictionFit", "ObliqueProblem", "fit_friction", "oblique_model", "rebound_state",
                      "effective_sigma", "TANGENTIAL_PARAMETERS", "PARAMETER_BOUNDS", "OBSERVABLE_UNITS"), "oblique"),
     **dict.fromkeys(("fit_dem_friction", "rank_dem_tangential_laws", "dem_friction_coverage"), "dem_friction"),

@@ -5,15 +5,23 @@ Each normal model (the paper's adhesion ring force, "ring"; JKR; DMT; see
 the residual convention of :func:`microimpact.analysis.fitting.damping_residual`:
 (model e_n - measured e_n) / sigma, sigma the stated e_n uncertainty (or 1 when a row has none),
 model e_n = 0 where the model predicts capture, jointly over the particle sizes with one work of
-adhesion (f0 or the JKR/DMT scales per radius from it). The free parameters are the same for every
-model: zeta_H, zeta_A (Eqs. (14)-(15)) and w_A, so that the information criteria compare the laws,
-not their parameter counts. Each fit starts from the best point of a log grid of the zetas at the
-material's w_A and ends with Levenberg-Marquardt (lmfit ``leastsq``).
+adhesion (f0 or the JKR/DMT scales per radius from it). Their free parameters are the same:
+zeta_H, zeta_A (Eqs. (14)-(15)) and w_A. Each fit starts from the best point of a log grid of the
+zetas at the material's w_A and ends with Levenberg-Marquardt (lmfit ``leastsq``).
+
+The elastic-plastic adhesive law of Thornton & Ning (1998), ``"thornton_ning"``
+(:mod:`microimpact.model.thornton_ning`), is rate-independent: it has no damping, and its free
+parameters are the yield velocity V_y and w_A (:func:`microimpact.analysis.plastic_fit.fit_thornton_ning`,
+with the same residuals); its row has ``yield_velocity`` where the others have the zetas (NaN
+elsewhere), and ``n_parameters`` says each model's k.
+
+Every model carries its verdict (:func:`microimpact.analysis.verdict.assess_residuals`), and the
+comparison's sentence (:func:`comparison_verdict`) never prefers a rejected model.
 
 Information criteria (lmfit's definitions, for Gaussian residuals):
-AIC = N ln(chi^2 / N) + 2 k, BIC = N ln(chi^2 / N) + k ln N, N points, k = 3 varied parameters.
-Differences matter, not values: Delta AIC > ~10 is strong support for the lower (Burnham & Anderson
-2002).
+AIC = N ln(chi^2 / N) + 2 k, BIC = N ln(chi^2 / N) + k ln N, N points, k the model's varied
+parameters. Differences matter, not values: Delta AIC > ~10 is strong support for the lower
+(Burnham & Anderson 2002).
 
 References
 ----------
@@ -33,14 +41,20 @@ import xarray as xr
 
 from microimpact.analysis.verdict import ADEQUATE, NO_UNCERTAINTIES, assess_residuals
 from microimpact.analysis.fitting import FitProblem
+from microimpact.analysis.plastic_fit import PlasticProblem, fit_thornton_ning
 from microimpact.io.variables import attributes
 from microimpact.model.adhesion_models import AdhesionRegimeWarning, tabor_parameter
+from microimpact.model.laws import restitution_law, restitution_laws
 from microimpact.solvers import DEFAULT_RTOL, engine, normal_models
 
 __all__ = ["compare_normal_models", "comparison_verdict", "normal_model_restitution", "DEFAULT_MODELS", "DEFAULT_START_GRID"]
 
-#: the models compared by default: the paper's ring force and JKR (and DMT)
-DEFAULT_MODELS = ("ring", "jkr", "dmt")
+#: the models compared by default: the paper's ring force, JKR, DMT and the elastic-plastic Thornton-Ning law
+DEFAULT_MODELS = ("ring", "jkr", "dmt", "thornton_ning")
+#: the models fitted by their own module rather than with the damping (the registry's rate-independent laws)
+PLASTIC_MODELS = tuple(n for n in restitution_laws() if restitution_law(n).rate_independent)
+#: the parameters of a row of the comparison (NaN where a model does not have them)
+_PARAMETERS = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion", "yield_velocity")
 #: start grid of every fit: log-spaced zeta_H and zeta_A at the material's w_A
 DEFAULT_START_GRID = (np.geomspace(0.01, 10.0, 7), np.geomspace(0.1, 1000.0, 7))
 
@@ -126,7 +140,7 @@ def compare_normal_models(table, base, models=DEFAULT_MODELS, *, rtol: float = D
         one > 0; else unweighted).
     base : MaterialPair, Contact or DampingFit
         Density [kg/m^3], stiffness [Pa], the starting w_A [J/m^2] and the damping reference speed.
-    models : sequence of {"ring", "jkr", "dmt", "jkr_force"}
+    models : sequence of {"ring", "jkr", "dmt", "jkr_force", "thornton_ning"}
     rtol : float
         Relative tolerance of the normal solves. [-]
     curve_points : int
@@ -138,10 +152,12 @@ def compare_normal_models(table, base, models=DEFAULT_MODELS, *, rtol: float = D
     -------
     xarray.Dataset
         Dimension ``normal_model``: ``aic``, ``bic``, ``chi_square``, ``delta_aic``, ``delta_bic``
-        (to the best model), the fitted ``zeta_hertz``, ``zeta_adhesion``, ``work_of_adhesion`` and
-        their standard errors, the ``tabor_parameter`` at each radius; curves ``e_n_curve``
-        (normal_model, radius, curve_speed); the data (``point``). Attributes: number of points and
-        of varied parameters, the weighting.
+        (to the best model), ``n_parameters``, the fitted ``zeta_hertz``, ``zeta_adhesion``,
+        ``work_of_adhesion``, ``yield_velocity`` (NaN where a model has no such parameter) and their
+        standard errors, ``verdict`` and ``p_value``, the ``tabor_parameter`` at each radius; curves
+        ``e_n_curve`` (normal_model, radius, curve_speed); the data (``point``). Attributes: number
+        of points, of varied parameters (one number where every model has the same), the
+        weighting, the comparison's sentence.
 
     Examples
     --------
@@ -169,35 +185,60 @@ def compare_normal_models(table, base, models=DEFAULT_MODELS, *, rtol: float = D
     weighted = bool(np.all(np.isfinite(sig) & (sig > 0)))
     sigma = sig if weighted else np.ones_like(e_n)
     problem = FitProblem.from_arrays(radius, speed, base)
-    w0 = float(base.work_of_adhesion)
     radii = np.asarray(problem.radii)
     curve_speed = np.geomspace(speed.min() * 0.8, speed.max() * 1.2, curve_points)
-    rows = {k: [] for k in ("aic", "bic", "chi_square", "zeta_hertz", "zeta_adhesion", "work_of_adhesion",
-                            "zeta_hertz_stderr", "zeta_adhesion_stderr", "work_of_adhesion_stderr")}
+    rows = {k: [] for k in ("aic", "bic", "chi_square", "n_parameters", *_PARAMETERS, *(f"{n}_stderr" for n in _PARAMETERS))}
     curves, tabor, verdicts = [], [], []
     for model in models:
-        res = _fit_one(problem, model, e_n, sigma, w0, rtol, start_grid)
-        p = res.params
-        verdicts.append(assess_residuals(res.residual, res.nvarys, stated=weighted, speed=speed, radius=radius,
-                                         what=f"{model} law"))
-        rows["aic"].append(res.aic)
-        rows["bic"].append(res.bic)
-        rows["chi_square"].append(res.chisqr)
-        for name in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion"):
-            rows[name].append(p[name].value)
-            rows[f"{name}_stderr"].append(np.nan if p[name].stderr is None else p[name].stderr)
-        curves.append(normal_model_restitution(problem, model, p["zeta_hertz"].value, p["zeta_adhesion"].value,
-                                                p["work_of_adhesion"].value, rtol=rtol,
-                                                normal_speed=curve_speed[None, :], radius=radii[:, None]))
-        tabor.append(tabor_parameter(radii, base.stiffness, p["work_of_adhesion"].value))
+        row, curve, verdict = (_plastic_row(table, base, sigma if weighted else "none", radii, curve_speed)
+                               if model in PLASTIC_MODELS else
+                               _damping_row(problem, model, e_n, sigma, weighted, rtol, start_grid, radii, curve_speed,
+                                            speed, radius))
+        for k in rows:
+            rows[k].append(row.get(k, np.nan))
+        curves.append(curve)
+        verdicts.append(verdict)
+        tabor.append(tabor_parameter(radii, base.stiffness, row["work_of_adhesion"]))
     ds = _comparison_dataset(models, rows, curves, tabor, radii, curve_speed, radius, speed, e_n, sig,
-                             weighted, res.ndata, res.nvarys)
+                             weighted, e_n.size, rows["n_parameters"])
     ds["verdict"] = xr.DataArray(np.array([v.verdict for v in verdicts], dtype=object), dims="normal_model",
                                  attrs={"long_name": "adequacy of each model (chi-square test of the stated uncertainties)"})
     ds["p_value"] = xr.DataArray(np.array([v.p_value for v in verdicts]), dims="normal_model",
                                  attrs={"units": "1", "long_name": "p-value of the chi-square test"})
     ds.attrs["comparison_verdict"] = comparison_verdict(list(models), verdicts, ds["aic"].values)
     return ds
+
+
+def _damping_row(problem, model, e_n, sigma, weighted, rtol, grid, radii, curve_speed, speed, radius):
+    """(row of the comparison, fitted curves (radius, curve_speed), verdict) of a damped normal model."""
+    res = _fit_one(problem, model, e_n, sigma, float(problem.material.work_of_adhesion), rtol, grid)
+    p = res.params
+    row = {"aic": res.aic, "bic": res.bic, "chi_square": res.chisqr, "n_parameters": res.nvarys}
+    for name in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion"):
+        row[name] = p[name].value
+        row[f"{name}_stderr"] = np.nan if p[name].stderr is None else p[name].stderr
+    curve = normal_model_restitution(problem, model, p["zeta_hertz"].value, p["zeta_adhesion"].value,
+                                     p["work_of_adhesion"].value, rtol=rtol, normal_speed=curve_speed[None, :],
+                                     radius=radii[:, None])
+    verdict = assess_residuals(res.residual, res.nvarys, stated=weighted, speed=speed, radius=radius,
+                               what=f"{model} law")
+    return row, curve, verdict
+
+
+def _plastic_row(table, base, weights, radii, curve_speed):
+    """(row, curves, verdict) of the Thornton-Ning law: :func:`~microimpact.analysis.plastic_fit.fit_thornton_ning`
+    with the comparison's sigma (the stated e_n uncertainties, or none), its stderr the one its 95 %
+    profile interval implies (width / 3.92)."""
+    fit = fit_thornton_ning(table, base, weights=weights)
+    row = {"aic": fit.aic, "bic": fit.bic, "chi_square": fit.chisqr, "n_parameters": len(fit.varied)}
+    for name in fit.varied:
+        st = fit.identifiability[name]
+        row[name] = fit.values[name]
+        row[f"{name}_stderr"] = (st.upper - st.lower) / 3.92 if st.determined else np.nan
+    problem = PlasticProblem.from_arrays(np.repeat(radii, curve_speed.size), np.tile(curve_speed, radii.size),
+                                         fit.density, fit.stiffness)
+    curve = problem.restitution(fit.values["yield_velocity"], fit.values["work_of_adhesion"])
+    return row, curve.reshape(radii.size, curve_speed.size), fit.verdict
 
 
 def comparison_verdict(models, verdicts, aic) -> str:
@@ -242,6 +283,9 @@ def _comparison_dataset(models, rows, curves, tabor, radii, curve_speed, radius,
              "zeta_hertz_stderr": ("1", "standard error of zeta_H"),
              "zeta_adhesion_stderr": ("1", "standard error of zeta_A"),
              "work_of_adhesion_stderr": ("J m-2", "standard error of w_A"),
+             "yield_velocity": ("m s-1", "yield velocity V_y of the Thornton-Ning law, (TN11)"),
+             "yield_velocity_stderr": ("m s-1", "standard error of V_y (its 95 % profile interval's width / 3.92)"),
+             "n_parameters": ("1", "number of varied parameters of the model"),
              "tabor_parameter": ("1", "Tabor parameter (R w^2 / (E*^2 z0^3))^(1/3), z0 = 0.4 nm"),
              "e_n_curve": ("1", "fitted model normal coefficient of restitution")}
 
@@ -263,8 +307,9 @@ def _comparison_dataset(models, rows, curves, tabor, radii, curve_speed, radius,
     ds["data_e_n"] = xr.DataArray(e_n, dims="point", attrs={"units": "1", "long_name": "measured normal coefficient of restitution"})
     ds["data_e_n_uncertainty"] = xr.DataArray(sig, dims="point", attrs={"units": "1", "long_name": "stated standard uncertainty of e_n"})
     ds.attrs.update(title="Normal contact models fitted to the same e_n(v_n) data",
-                    parameter_source="each normal model fitted to the analyst's data (zeta_H, zeta_A, w_A)",
-                    number_of_points=int(ndata), varied_parameters=int(nvarys),
+                    parameter_source="each normal model fitted to the analyst's data (zeta_H, zeta_A, w_A; V_y, w_A of thornton_ning)",
+                    number_of_points=int(ndata),
+                    varied_parameters=int(nvarys[0]) if len(set(nvarys)) == 1 else "per model (n_parameters)",
                     weighting="stated e_n uncertainties" if weighted else "none (sigma = 1)",
-                    free_parameters="zeta_hertz zeta_adhesion work_of_adhesion")
+                    free_parameters=" ".join(n for n in _PARAMETERS if np.any(np.isfinite(ds[n].values))))
     return ds

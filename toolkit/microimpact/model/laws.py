@@ -8,6 +8,11 @@ documents. Selecting by name is :func:`get`; :func:`names` lists a field's choic
 :class:`~microimpact.model.contact.Contact` accepts, with those defaults.
 :data:`microimpact.solvers.SUPPORTED_SUB_MODELS` (the support matrix the solvers check) is derived
 from these declarations, not written beside them.
+
+A :class:`RestitutionLaw` is a law fitted to measured e_n(v_n) (``microimpact fit --law NAME``) and
+ranked by the model comparison: the paper's damped ring force, and the rate-independent
+elastic-plastic laws that are not (yet) a Contact choice; :func:`restitution_laws` lists them,
+:func:`restitution_law` looks one up.
 """
 
 from __future__ import annotations
@@ -23,7 +28,8 @@ from microimpact.model.dem_rolling import DEM_ROLLING_MODELS
 from microimpact.model.dem_tangential import DEM_TANGENTIAL_MODELS
 from microimpact.model.dem_twisting import DEM_TWISTING_MODELS
 
-__all__ = ["Combination", "SubModel", "combinations", "coupled_refusal", "fields", "get", "names", "supported"]
+__all__ = ["Combination", "RestitutionLaw", "SubModel", "combinations", "coupled_refusal", "fields", "get", "names",
+           "restitution_law", "restitution_laws", "supported"]
 
 #: every solver path, in the order of microimpact.solvers.METHODS
 _METHODS = ("engine", "reference", "rkg")
@@ -238,3 +244,62 @@ def combinations(base: _contact.Contact | None = None) -> Iterator[Combination]:
                 continue  # the solvers refuse it on every path (microimpact.solvers.check_sub_models)
             methods = tuple(m for m in _METHODS if all(m in s.methods for s in chosen))
             yield Combination(choices, contact, methods)
+
+
+# --------------------------------------------------------------------------- laws fitted to e_n(v_n)
+@dataclass(frozen=True)
+class RestitutionLaw:
+    """A law that ``microimpact fit --law NAME`` fits to measured e_n(v_n) and the model comparison ranks.
+
+    Attributes
+    ----------
+    name : str
+        Its name on the command line (``--law``) and in the comparison (``normal_model``).
+    summary : str
+        One line: what it is and where it is written.
+    parameters : tuple of str
+        The parameters the fit varies.
+    fit : str
+        The function that fits it (module.function).
+    rate_independent : bool
+        True for a law without the paper's damping (fitted by its own module, not with zeta_H, zeta_A).
+    """
+
+    name: str
+    summary: str
+    parameters: tuple[str, ...]
+    fit: str
+    rate_independent: bool = False
+
+
+_RESTITUTION_LAWS = {law.name: law for law in (
+    RestitutionLaw("damping", "the paper's ring force with its damping, Eqs. (4)-(7), (14)-(15), (27) (model.law)",
+                   ("zeta_hertz", "zeta_adhesion", "work_of_adhesion"), "microimpact.analysis.fitting.fit_damping"),
+    RestitutionLaw("thornton_ning", "Thornton & Ning (1998) elastic-plastic adhesive law, (TN1)-(TN12) "
+                   "(model.thornton_ning)", ("yield_velocity", "work_of_adhesion"),
+                   "microimpact.analysis.plastic_fit.fit_thornton_ning", rate_independent=True),
+)}
+
+
+def restitution_laws() -> tuple[str, ...]:
+    """The names of the laws fitted to e_n(v_n), the paper's damping law first.
+
+    Examples
+    --------
+    >>> restitution_laws()
+    ('damping', 'thornton_ning')
+    """
+    return tuple(_RESTITUTION_LAWS)
+
+
+def restitution_law(name: str) -> RestitutionLaw:
+    """The declared law ``name`` of :func:`restitution_laws`; ValueError naming the choices else.
+
+    Examples
+    --------
+    >>> restitution_law("thornton_ning").parameters
+    ('yield_velocity', 'work_of_adhesion')
+    """
+    if name not in _RESTITUTION_LAWS:
+        raise ValueError(f"law must be one of {', '.join(_RESTITUTION_LAWS)}, got {name!r}")
+    return _RESTITUTION_LAWS[name]

@@ -101,10 +101,12 @@ Abi-Mansour, A., PyGran (DEM toolkit), ``simulation.models.ThorntonNing`` and
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq
 
 from microimpact.model.adhesion_models import jkr_q_from_approach
 
@@ -119,6 +121,7 @@ __all__ = [
     "jkr_curve_force",
     "jkr_curve_potential",
     "jkr_curve_contact_radius",
+    "first_contact_pressure",
     "yield_point",
     "loading_force",
     "loading_work",
@@ -376,6 +379,32 @@ def jkr_curve_contact_radius(approach, radius, e_star, work_of_adhesion):
 
 
 # =============================================================================== yield, loading (TN2), (TN3), (TN8)
+def first_contact_pressure(radius, e_star, work_of_adhesion):
+    """The JKR centre pressure (TN2) as the contact forms (delta = 0, a = a_0): E* a_0 / (pi R). [Pa]
+
+    A yield pressure at or below it would yield the contact as it forms, which (TN2)-(TN3) do not
+    describe (:func:`yield_point` refuses it); it is 0 without adhesion. Parameters: R [m], E* [Pa],
+    w [J/m^2].
+
+    References
+    ----------
+    Thornton & Ning (1998), Powder Technol. 99:154-162.
+
+    Examples
+    --------
+    It is where the centre pressure 2 E* a / (pi R) - sqrt(2 w E* / (pi a)) of (TN2) is at a = a_0:
+
+    >>> import math
+    >>> r, es, w = 1e-6, 1e9, 0.1
+    >>> a0 = 4 ** (2 / 3) * (math.pi * w * r * r / (8 * es)) ** (1 / 3)
+    >>> centre = 2 * es * a0 / (math.pi * r) - math.sqrt(2 * w * es / (math.pi * a0))
+    >>> round(first_contact_pressure(r, es, w) / centre, 12)
+    1.0
+    """
+    return e_star * _first_contact_radius(radius, e_star, work_of_adhesion) / (math.pi * radius)
+
+
+@functools.lru_cache(maxsize=1024)  # a pure function of a frozen record, asked for by every branch
 def yield_point(pc: PlasticContact) -> YieldPoint:
     """Contact radius, approach and force at which the loading yields, (TN2).
 
@@ -406,10 +435,10 @@ def yield_point(pc: PlasticContact) -> YieldPoint:
     if w == 0.0:
         a_y = math.pi * r * py / (2.0 * es)
     else:
-        a0 = _A0_OVER_AC * _critical_radius(r, es, w)
-        if py <= es * a0 / (math.pi * r):  # centre pressure at first contact (module docstring)
+        p_first = first_contact_pressure(r, es, w)
+        if py <= p_first:
             raise ValueError(f"yield_pressure={py!r} Pa is below the JKR centre pressure at first contact "
-                             f"({es * a0 / (math.pi * r):.4g} Pa): the contact would yield as it forms")
+                             f"({p_first:.4g} Pa): the contact would yield as it forms")
         c3, c1, c0 = 2.0 * es / (math.pi * r), py, math.sqrt(2.0 * w * es / math.pi)
         s = math.sqrt(c1 / c3) + (c0 / c3) ** (1.0 / 3.0)  # above the root (convex, increasing there)
         for _ in range(100):
@@ -499,10 +528,11 @@ def loading_work(pc: PlasticContact, approach):
     return np.where(d > y.approach, plastic, elastic)
 
 
-def largest_approach(pc: PlasticContact, normal_speed: float) -> float:
+def largest_approach(pc: PlasticContact, normal_speed):
     """delta_max of an undamped impact at V_i: W_load(delta_max) = (1/2) m V_i^2, (TN8). [m]
 
-    Closed form on the plastic branch (a quadratic); Newton's method on the JKR branch.
+    Closed form on the plastic branch (a quadratic); Newton's method on the JKR branch, for all
+    speeds at once. A float for a scalar ``normal_speed`` [m/s], else an array of its shape.
 
     Examples
     --------
@@ -513,28 +543,37 @@ def largest_approach(pc: PlasticContact, normal_speed: float) -> float:
     >>> round(d / (1.25 * 1e-14 * 0.01 / (4e9 / 3 * 1e-3)) ** 0.4, 12)
     1.0
     """
-    ke = 0.5 * pc.mass * normal_speed * normal_speed
+    v = np.asarray(normal_speed, dtype=float)
+    ke = 0.5 * pc.mass * v * v
     y = yield_point(pc)
     w_y = float(loading_work(pc, y.approach))
-    if ke > w_y:  # (1/2) k s^2 + F_y s = ke - w_y, k = pi R p_y
-        k = math.pi * pc.radius * pc.yield_pressure
-        rest = ke - w_y
-        return y.approach + 2.0 * rest / (y.force + math.sqrt(y.force * y.force + 2.0 * k * rest))
+    # plastic branch: (1/2) k s^2 + F_y s = ke - w_y, k = pi R p_y (the root written without cancellation)
+    k = math.pi * pc.radius * pc.yield_pressure
+    rest = np.maximum(ke - w_y, 0.0)
+    plastic = y.approach + 2.0 * rest / (y.force + np.sqrt(y.force * y.force + 2.0 * k * rest))
     r, es, w = pc.radius, pc.e_star, pc.work_of_adhesion
-    u_target = ke + float(jkr_curve_potential(_first_contact_radius(r, es, w), r, es, w))
-    # Beyond the adhesive well U(a) is increasing and convex, so Newton from a_y (above the root) converges
-    # monotonically to it; dU/da = F(a) d delta/da.
-    a = y.contact_radius
+    # JKR branch (the plastic rows aim at a_y itself, where the step is 0): beyond the adhesive well
+    # U(a) is increasing and convex, so Newton from a_y (above the root) converges monotonically to
+    # it; dU/da = F(a) d delta/da
+    u_target = np.minimum(ke, w_y) + float(jkr_curve_potential(_first_contact_radius(r, es, w), r, es, w))
+    a = np.full(v.shape, y.contact_radius)
     for _ in range(200):
-        dda = 2.0 * a / r - (0.5 * math.sqrt(2.0 * math.pi * w / (es * a)) if w > 0.0 else 0.0)
-        step = (float(jkr_curve_potential(a, r, es, w)) - u_target) / (float(jkr_curve_force(a, r, es, w)) * dda)
-        a -= step
-        if abs(step) <= 1e-15 * a:
+        dda = 2.0 * a / r - (0.5 * np.sqrt(2.0 * math.pi * w / (es * a)) if w > 0.0 else 0.0)
+        step = (jkr_curve_potential(a, r, es, w) - u_target) / (jkr_curve_force(a, r, es, w) * dda)
+        a = a - step
+        if np.all(np.abs(step) <= 1e-15 * a):
             break
-    return float(jkr_curve_approach(a, r, es, w))
+    out = np.where(ke > w_y, plastic, jkr_curve_approach(a, r, es, w))
+    return float(out) if out.ndim == 0 else out
 
 
 # =============================================================================== unloading (TN4)-(TN7)
+def _plastic_radius(pc: PlasticContact, max_contact_radius, max_force):
+    """R_p = 4 E* a_max^3 / (3 (F_max + sqrt(8 pi w E* a_max^3))), (TN4). [m]"""
+    a3 = np.asarray(max_contact_radius, dtype=float) ** 3
+    return 4.0 * pc.e_star * a3 / (3.0 * (max_force + np.sqrt(8.0 * math.pi * pc.work_of_adhesion * pc.e_star * a3)))
+
+
 def unloading_state(pc: PlasticContact, max_approach: float) -> UnloadingState:
     """R_p, delta_p and the break of the unloading curve from delta_max, (TN4)-(TN7).
 
@@ -563,7 +602,7 @@ def unloading_state(pc: PlasticContact, max_approach: float) -> UnloadingState:
     a_max = float(loading_contact_radius(pc, d_max))
     f_max = float(loading_force(pc, d_max))
     if d_max > y.approach:
-        r_p = 4.0 * es * a_max**3 / (3.0 * (f_max + math.sqrt(8.0 * math.pi * w * es * a_max**3)))  # (TN4)
+        r_p = float(_plastic_radius(pc, a_max, f_max))
         d_p = d_max - float(jkr_curve_approach(a_max, r_p, es, w))  # (TN5)
     else:
         r_p, d_p = r, 0.0
@@ -618,14 +657,28 @@ def impact_energies(pc: PlasticContact, normal_speed: float) -> ImpactEnergies:
     >>> e.plastic, e.hysteresis, round(e.rebound / e.incident, 12)
     (0.0, 0.0, 1.0)
     """
+    ke, plastic, hysteresis = _energy_account(pc, float(normal_speed))
+    return ImpactEnergies(float(ke), float(plastic), float(hysteresis), float(ke - plastic - hysteresis))
+
+
+def _energy_account(pc: PlasticContact, normal_speed):
+    """(incident energy, W_p (TN9), H (TN10)) of undamped impacts at the speeds ``normal_speed``,
+    as arrays of its shape, all speeds at once. [J]"""
     r, es, w = pc.radius, pc.e_star, pc.work_of_adhesion
-    ke = 0.5 * pc.mass * normal_speed * normal_speed
-    st = unloading_state(pc, largest_approach(pc, normal_speed))
-    a0p = _first_contact_radius(st.plastic_radius, es, w)
-    u = lambda a: float(jkr_curve_potential(a, st.plastic_radius, es, w))  # noqa: E731
-    plastic = ke - (u(st.max_contact_radius) - u(a0p)) if st.yielded else 0.0  # (TN9), W_load(delta_max) = ke
-    hysteresis = u(st.break_contact_radius) - u(a0p) if w > 0.0 else 0.0  # (TN10)
-    return ImpactEnergies(ke, plastic, hysteresis, ke - plastic - hysteresis)
+    v = np.asarray(normal_speed, dtype=float)
+    ke = 0.5 * pc.mass * v * v
+    d_max = np.asarray(largest_approach(pc, v))
+    yielded = d_max > yield_point(pc).approach
+    a_max = loading_contact_radius(pc, d_max)
+    r_p = np.where(yielded, _plastic_radius(pc, a_max, loading_force(pc, d_max)), r)  # below yield R_p = R
+    a0p = _first_contact_radius(r_p, es, w)
+
+    def u(a):
+        return jkr_curve_potential(a, r_p, es, w)
+
+    plastic = np.where(yielded, ke - (u(a_max) - u(a0p)), 0.0)  # (TN9), W_load(delta_max) = ke
+    hysteresis = u(_critical_radius(r_p, es, w)) - u(a0p) if w > 0.0 else np.zeros(v.shape)  # (TN10)
+    return ke, plastic, hysteresis
 
 
 def restitution_coefficient(pc: PlasticContact, normal_speed) -> np.ndarray:
@@ -648,17 +701,18 @@ def restitution_coefficient(pc: PlasticContact, normal_speed) -> np.ndarray:
     >>> [round(float(x), 9) for x in e], round(float(thornton_restitution(0.1)), 9)
     ([1.0, 0.658558337], 0.658558337)
     """
-    out = []
-    for v in np.atleast_1d(np.asarray(normal_speed, dtype=float)):
-        en = impact_energies(pc, float(v))
-        out.append(math.sqrt(en.rebound / en.incident) if en.rebound > 0.0 else 0.0)
-    return np.asarray(out).reshape(np.shape(normal_speed))
+    ke, plastic, hysteresis = _energy_account(pc, normal_speed)
+    rebound = ke - plastic - hysteresis
+    return np.where(rebound > 0.0, np.sqrt(np.maximum(rebound, 0.0) / np.where(ke > 0.0, ke, 1.0)), 0.0)
 
 
-def capture_velocity(pc: PlasticContact, upper: float = 1e3) -> float:
-    """The largest normal speed that is captured, (1/2) m V^2 = W_p + H, by bisection. [m/s]
+def capture_velocity(pc: PlasticContact, upper: float = 1e3, rtol: float = 1e-14, bracket=None) -> float:
+    """The largest normal speed that is captured, (1/2) m V^2 = W_p + H, by Brent's method. [m/s]
 
-    0 without adhesion. In the elastic limit (p_y large) it is the JKR sticking velocity
+    ``rtol`` is the relative tolerance of the root [-]; ``bracket`` (lo, hi) [m/s], optional, a
+    first bracket to try (the whole [0, upper] where the sign does not change over it). 0 without
+    adhesion. In the elastic limit
+    (p_y large) it is the JKR sticking velocity
     (:func:`microimpact.model.adhesion_models.jkr_sticking_velocity`, displacement-controlled break).
 
     Examples
@@ -669,18 +723,15 @@ def capture_velocity(pc: PlasticContact, upper: float = 1e3) -> float:
     """
     if pc.work_of_adhesion == 0.0:
         return 0.0
-    lo, hi = 0.0, upper
-    if impact_energies(pc, hi).captured:
+    if impact_energies(pc, upper).captured:
         raise ValueError(f"capture_velocity: an impact at {upper!r} m/s is still captured; raise upper")
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        if impact_energies(pc, mid).captured:
-            lo = mid
-        else:
-            hi = mid
-        if hi - lo <= 1e-14 * hi:
-            break
-    return 0.5 * (lo + hi)
+    def rebound(v):
+        return impact_energies(pc, v).rebound
+
+    lo, hi = 0.0, upper  # the rebound energy is -H < 0 at V = 0 and > 0 at ``upper``
+    if bracket is not None and rebound(bracket[0]) <= 0.0 < rebound(bracket[1]):
+        lo, hi = bracket
+    return float(brentq(rebound, lo, hi, xtol=1e-300, rtol=rtol, maxiter=400))
 
 
 # =============================================================================== yield velocity (TN11), (TN12)

@@ -19,8 +19,9 @@ from microimpact.report.layout import Layout
 
 __all__ = ["model_comparison_section", "plot_model_comparison", "model_verdicts"]
 
-_STYLES = {"ring": "-", "jkr": "--", "dmt": ":", "jkr_force": "-."}
-_NAMES = {"ring": "ring force (paper)", "jkr": "JKR", "dmt": "DMT", "jkr_force": "JKR, force-controlled break"}
+_STYLES = {"ring": "-", "jkr": "--", "dmt": ":", "jkr_force": "-.", "thornton_ning": (0, (5, 1, 1, 1, 1, 1))}
+_NAMES = {"ring": "ring force (paper)", "jkr": "JKR", "dmt": "DMT", "jkr_force": "JKR, force-controlled break",
+          "thornton_ning": "Thornton-Ning (elastic-plastic)"}
 
 
 @_rc
@@ -75,10 +76,12 @@ def plot_model_comparison(ds: xr.Dataset) -> Plot:
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     aic = ", ".join(f"{_NAMES.get(str(m), m)} {float(ds['delta_aic'].sel(normal_model=m)):.1f}"
                     for m in ds["normal_model"].values)
+    plastic = "thornton_ning" in [str(m) for m in ds["normal_model"].values]
     caption = ("Normal restitution e_n against incident normal speed [m/s]: the data (1-sigma error bars, colour "
                "per sphere diameter) and each normal model fitted to them with the same free parameters "
-               "(zeta_H, zeta_A, w_A); line style per model (solid: the paper's ring force, dashed: JKR, "
-               f"dotted: DMT). Delta AIC: {aic}.")
+               "(zeta_H, zeta_A, w_A" + ("; the rate-independent Thornton-Ning law: V_y, w_A" if plastic else "")
+               + "); line style per model (solid: the paper's ring force, dashed: JKR, "
+               f"dotted: DMT{', dash-dotted-dotted: Thornton-Ning' if plastic else ''}). Delta AIC: {aic}.")
     return Plot(fig, caption)
 
 
@@ -122,6 +125,7 @@ def _preference(ds: xr.Dataset, verdicts: dict[str, str]) -> str:
 
 def _table(ds: xr.Dataset, verdicts: dict[str, str] | None = None) -> pd.DataFrame:
     verdicts = verdicts or model_verdicts(ds)
+    plastic = "yield_velocity" in ds and bool(ds["yield_velocity"].notnull().any())
     rows = []
     for m in ds["normal_model"].values:
         d = ds.sel(normal_model=m)
@@ -129,10 +133,17 @@ def _table(ds: xr.Dataset, verdicts: dict[str, str] | None = None) -> pd.DataFra
         rows.append({"model": _NAMES.get(str(m), str(m)), "AIC": f"{float(d['aic']):.1f}",
                      "BIC": f"{float(d['bic']):.1f}", "dAIC": f"{float(d['delta_aic']):.1f}",
                      "dBIC": f"{float(d['delta_bic']):.1f}", "chi2": f"{float(d['chi_square']):.4g}",
-                     "zeta_H": f"{float(d['zeta_hertz']):.3g}", "zeta_A": f"{float(d['zeta_adhesion']):.3g}",
+                     "zeta_H": _cell(d, "zeta_hertz"), "zeta_A": _cell(d, "zeta_adhesion"),
                      "w_A": f"{float(d['work_of_adhesion']):.3g}", "mu_T": f"{mu.min():.3g}-{mu.max():.3g}",
-                     "verdict": verdicts.get(str(m), "")})
+                     "verdict": verdicts.get(str(m), "")} | ({"V_y": _cell(d, "yield_velocity")} if plastic else {}))
     return pd.DataFrame(rows)
+
+
+def _cell(d: xr.Dataset, name: str) -> str:
+    """A parameter's cell: its value, or "-" for a model without it (the zetas of a rate-independent law)."""
+    if name not in d or not np.isfinite(float(d[name])):
+        return "-"
+    return f"{float(d[name]):.3g}"
 
 
 def model_comparison_section(lay: Layout, ds: xr.Dataset, synthetic: bool = False) -> None:
@@ -167,7 +178,10 @@ def model_comparison_section(lay: Layout, ds: xr.Dataset, synthetic: bool = Fals
         "The paper's adhesion ring force and the JKR and DMT adhesion models (README, 'Contact models beyond the "
         "paper') are each fitted by weighted least squares to the same measured e_n(v_n), with the same three free "
         f"parameters (zeta_H, zeta_A, w_A) and the same residuals ({a.get('weighting', '?')}; "
-        f"N = {a.get('number_of_points', '?')} points, k = {a.get('varied_parameters', '?')}). AIC = N ln(chi^2/N) "
+        f"N = {a.get('number_of_points', '?')} points, k = {a.get('varied_parameters', '?')})"
+        + (". The elastic-plastic adhesive law of Thornton & Ning (1998) is rate-independent: it is fitted with its "
+           "yield velocity V_y and w_A (k = 2) and the same residuals" if "yield_velocity" in ds else "")
+        + ". AIC = N ln(chi^2/N) "
         "+ 2k and BIC = N ln(chi^2/N) + k ln N; among models the data do not reject, one lower by more than about "
         "10 is strongly preferred (a rejected model is never preferred). "
         "mu_T is the Tabor parameter at the measured sizes with the fitted w_A (z0 = 0.4 nm): JKR applies above "
@@ -177,5 +191,5 @@ def model_comparison_section(lay: Layout, ds: xr.Dataset, synthetic: bool = Fals
         + _preference(ds, verdicts))
     lay.source(parameter_source(ds))
     lay.table(_table(ds, verdicts), {"model": 18, "AIC": 8, "BIC": 8, "dAIC": 7, "dBIC": 7, "chi2": 9, "zeta_H": 7,
-                                     "zeta_A": 7, "w_A": 7, "mu_T": 10, "verdict": 10}, size=7.0)
+                                     "zeta_A": 7, "w_A": 7, "V_y": 7, "mu_T": 10, "verdict": 10}, size=7.0)
     lay.plot(plot_model_comparison(ds), max_height=3.4)
