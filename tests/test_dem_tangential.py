@@ -389,7 +389,7 @@ def test_the_normal_laws_uncertainty_reaches_mu():
     fit = fit_dem_friction(table, lambda r: normal.contact(r).with_(**tang), normal_fit=normal)
     held = fit_dem_friction(table, lambda r: normal.contact(r).with_(**tang))
     lo, hi = (p["coefficient"] for p in normal.confidence_region(0.95))
-    assert lo < normal.interval[0] < normal.interval[1] < hi  # the 95 % ends, outside the 68 % ones
+    assert (lo, hi) == pytest.approx(normal.interval, rel=1e-9, abs=0)  # the 95 % region's ends: the one interval
     ends = [fit_dem_friction(table, lambda r, e=e: normal.contact(r, coefficient=e).with_(**tang)).friction
             for e in (lo, hi)]
     gradient = fit.info["damping_gradient"]["friction"]["coefficient"]
