@@ -257,14 +257,15 @@ def test_lammps_fit_recovers_both_parameters_of_the_lammps_truth(tmp_path, capsy
     eta_n0 each within its 95 % interval, the law adequate, the material pair's own w_A (0.216) not
     used; then verify runs LAMMPS over the data's three radii and speed ranges."""
     monkeypatch.chdir(tmp_path)
-    assert main(["lammps", "fit", str(DATA), "--fit-adhesion", "--law", "jkr_force+viscoelastic", "--json",
-                 "--units", "micro", "--out", "c.lmp"]) == 0
+    Path("lammps_jkr_viscoelastic.csv").write_bytes(DATA.read_bytes())
+    assert main(["lammps", "fit", "lammps_jkr_viscoelastic.csv", "--fit-adhesion", "--law", "jkr_force+viscoelastic",
+                 "--json", "--units", "micro", "--out", "jkr.lmp"]) == 0
     law = json.loads(capsys.readouterr().out)["laws"][0]
     assert law["verdict"]["verdict"] == "adequate" and law["adhesion_status"] == "determined"
     assert _within(0.12, law["work_of_adhesion_interval"]), law
     assert _within(ETA, law["damping_coefficient_interval"]), law
     _lammps_or_skip()
-    assert main(["lammps", "verify", "c.lmp", "--points", "3"]) == 0
+    assert main(["lammps", "verify", "jkr.lmp", "--points", "3"]) == 0
     assert "9 of 9 impacts agree" in capsys.readouterr().out
 
 
