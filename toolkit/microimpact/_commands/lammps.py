@@ -12,7 +12,7 @@ from microimpact._commands.contacts import contact_from_args
 from microimpact._commands.tables import impacts_for_pair, input_files
 from microimpact._runtime.progress import progress_bar
 from microimpact._runtime.timeout import time_limit
-from microimpact.analysis.dem_fit import candidate_laws, rank_dem_laws
+from microimpact.analysis.dem_fit import _p_text, candidate_laws, rank_dem_laws
 from microimpact.analysis.dem_friction import rank_dem_tangential_laws
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.io.files import atomic_write, write_csv
@@ -91,8 +91,8 @@ def _lammps_tangential_laws(args) -> dict:
 
 
 def _lammps_fit_friction(args, table, chosen):
-    """(contact with the fitted mu, header note), or (None, None) after one line saying why mu is not
-    determined; mu of LAMMPS's tangential law fitted to the oblique columns, the normal law fixed
+    """(contact with the fitted mu, header note, the fit), or (None, None, the fit) after one line
+    saying why mu is not determined; mu of LAMMPS's tangential law fitted to the oblique columns, the normal law fixed
     (with ``--tangential-model auto`` each law's, ranked by AIC, the best one written)."""
     laws = _lammps_tangential_laws(args)
     try:
@@ -112,7 +112,7 @@ def _lammps_fit_friction(args, table, chosen):
     if not status.determined:
         print(f"microimpact: error: the oblique data do not determine the friction of LAMMPS's "
               f"{law} law ({status.describe()}); no LAMMPS input written", file=sys.stderr)
-        return None, None
+        return None, None, fit
     radius = float(np.median(np.asarray(table["radius"], dtype=float)))
     others = ", ".join(f"{o} dAIC {d:.3g}" for o, d in zip(ranked["law"].iloc[1:], ranked["delta_aic"].iloc[1:]))
     k = fit.info.get("stiffness_sensitivity")
@@ -122,8 +122,8 @@ def _lammps_fit_friction(args, table, chosen):
             f"{100 * k['step']:.0f}% lower / higher)")
     note = (f"{fit.friction:.6g} ({law}{'; best by AIC: ' + others if others else ''}; 95% profile-likelihood "
             f"interval {status.lower:.6g} to {status.upper:.6g}; the normal law's uncertainty included{held}; "
-            f"{fit.n_points} oblique entries)")
-    return chosen.contact(radius).with_(friction=fit.friction, **laws[law]), note
+            f"{fit.n_points} oblique entries; {fit.verdict.text()})")
+    return chosen.contact(radius).with_(friction=fit.friction, **laws[law]), note, fit
 
 
 def run_fit(args) -> int:
@@ -170,7 +170,7 @@ def _closest_message(closest, n_laws: int, out, written: bool) -> str:
             else "no LAMMPS input written (--closest writes the closest law)")
     return (f"microimpact: error: no LAMMPS law describes these data ({n_laws} of {n_laws} rejected by the chi-square "
             f"test); closest: {closest.law}, chi^2/dof = {closest.chisqr / v.degrees_of_freedom:.4g} "
-            f"(chi^2 = {closest.chisqr:.4g} for {v.degrees_of_freedom:.0f}, p = {v.p_value:.2g}), largest e_n error "
+            f"(chi^2 = {closest.chisqr:.4g} for {v.degrees_of_freedom:.0f}, {_p_text(v.p_value)}), largest e_n error "
             f"{worst['largest_error']:+.3g} at {worst['speed']:.3g} m/s for radius {worst['radius'] * 1e6:.4g} um; {what}")
 
 
@@ -207,7 +207,12 @@ def _run_fit(args, out) -> int:
     contact = chosen.contact(radius)
     friction_note = None
     if args.tangential_model is not None:  # the friction of LAMMPS's tangential law, from the oblique columns
-        contact, friction_note = _lammps_fit_friction(args, table, chosen)
+        contact, friction_note, friction = _lammps_fit_friction(args, table, chosen)
+        summary["friction"] = {"law": friction.tangential_model, "friction": friction.friction,
+                               "status": friction.identifiability["friction"].status,
+                               "interval": [friction.identifiability["friction"].lower,
+                                            friction.identifiability["friction"].upper],
+                               "verdict": friction.verdict.to_record()}
         if contact is None:
             _print_json(args, summary)
             return EXIT_DISAGREES

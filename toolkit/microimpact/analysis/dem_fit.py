@@ -273,7 +273,7 @@ class DemLawFit(FitResult):
         if self.status == "inadequate":
             v = self.verdict
             return (f"{self.law}: does not describe the data (chi^2 = {self.chisqr:.6g} for {v.degrees_of_freedom:.0f} "
-                    f"degrees of freedom, chi^2/dof = {self.chisqr / v.degrees_of_freedom:.4g}, p = {v.p_value:.2g}); "
+                    f"degrees of freedom, chi^2/dof = {self.chisqr / v.degrees_of_freedom:.4g}, {_p_text(v.p_value)}); "
                     "no value")
         if not self.sigma_known and self.n <= self.parameters:
             return (f"{self.law}: {self.n} impacts without stated e_n uncertainties cannot give {self.parameters} "
@@ -961,6 +961,17 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     return DemLawFit(normal_model, damping_model, best if status == "determined" else math.nan, interval, status,
                      float(chi_min), int(n), sigma_known, float(aic), float(bic), best, mat, src,
                      ids=ids, _data=(model, e_meas, sig))
+
+
+def _p_text(p: float) -> str:
+    """``p = ...`` of a chi-square test, ``p < 1e-300`` where it underflows to 0.
+
+    Examples
+    --------
+    >>> _p_text(0.0123), _p_text(0.0)
+    ('p = 0.012', 'p < 1e-300')
+    """
+    return "p < 1e-300" if p == 0.0 else f"p = {p:.2g}"
 
 
 def _row_ids(df, rows) -> tuple:
