@@ -173,7 +173,8 @@ def test_lammps_fit_holds_a_given_rolling_law_while_it_fits_mu_and_writes_both(t
     text = (tmp_path / "contact.lmp").read_text()
     # a twisting law given with it is written beside it (it changes neither e_n nor e_t: not fitted)
     assert text.splitlines()[-1].split(" twisting sds ")[1].split()[:3] == ["1e-12", "0", "3e-08"]
-    low, high = (float(x) for x in text.split("95% profile-likelihood interval ")[1].split(";")[0].split(" to "))
+    friction_line = text.split("# fitted friction: ")[1]  # the damping's line states a 95 % interval too
+    low, high = (float(x) for x in friction_line.split("95% profile-likelihood interval ")[1].split(";")[0].split(" to "))
     assert low < 0.3 < high
     assert text.splitlines()[-1].split(" rolling sds ")[1].split()[:3] == ["200", "0", "0.2"]
     capsys.readouterr()

@@ -389,7 +389,7 @@ def test_the_normal_laws_uncertainty_reaches_mu():
     fit = fit_dem_friction(table, lambda r: normal.contact(r).with_(**tang), normal_fit=normal)
     held = fit_dem_friction(table, lambda r: normal.contact(r).with_(**tang))
     lo, hi = (p["coefficient"] for p in normal.confidence_region(0.95))
-    assert lo < normal.interval[0] < normal.interval[1] < hi  # the 95 % ends, outside the 68 % ones
+    assert (lo, hi) == pytest.approx(normal.interval, rel=1e-9, abs=0)  # the 95 % region's ends: the one interval
     ends = [fit_dem_friction(table, lambda r, e=e: normal.contact(r, coefficient=e).with_(**tang)).friction
             for e in (lo, hi)]
     gradient = fit.info["damping_gradient"]["friction"]["coefficient"]
@@ -522,7 +522,8 @@ def test_lammps_fit_writes_the_fitted_friction_of_a_tangential_law(tmp_path, cap
     assert main(argv) == 0
     text = (tmp_path / "contact.lmp").read_text()
     mu = float(text.split("# fitted friction: ")[1].split()[0])
-    low, high = (float(x) for x in text.split("95% profile-likelihood interval ")[1].split(";")[0].split(" to "))
+    friction_line = text.split("# fitted friction: ")[1]  # the damping's line states a 95 % interval too
+    low, high = (float(x) for x in friction_line.split("95% profile-likelihood interval ")[1].split(";")[0].split(" to "))
     assert low < 0.3 < high and high - low < 0.1 and low < mu < high
     assert "at the given stiffness, not fitted (mu " in text and "% lower / higher)" in text  # G* not fitted
     fix = text.splitlines()[-1].split()

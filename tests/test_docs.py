@@ -63,6 +63,11 @@ HOW = {
     # docs/guide/lammps.md: LAMMPS's tangential laws (their LAMMPS runs: tests/test_lammps.py)
     "microimpact simulate --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0.3 --tangential-model lammps_mindlin --shear-modulus 3e8 --speed 1 --incidence-deg 40": "run",
     "microimpact lammps export --normal-model jkr_force --zeta-hertz 0 --zeta-adhesion 0 --friction 0.3 --tangential-model lammps_mindlin --shear-modulus 3e8 --units micro --out contact.lmp": "run",
+    # docs/guide/lammps.md: no law describes the data (--closest), and LAMMPS itself as the truth
+    "microimpact lammps fit rising.csv --law hertz+coeff_restitution --closest --out c.lmp": "test",
+    "python tests/test_lammps_calibration.py tests/data/lammps_jkr_viscoelastic.csv": "study",
+    "microimpact lammps fit lammps_jkr_viscoelastic.csv --fit-adhesion --law jkr_force+viscoelastic --units micro --out jkr.lmp": "test",
+    "microimpact lammps verify jkr.lmp --points 3": "test",
     # docs/guide/lammps.md: from a CSV to a verified LAMMPS input (needs LAMMPS for verify)
     "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --units micro --out contact.lmp": "test",
     "microimpact lammps verify contact.lmp": "test",
@@ -131,6 +136,12 @@ HOW = {
 
 #: "test" commands -> the test that runs them (file, function)
 TESTED_BY = {
+    "microimpact lammps fit rising.csv --law hertz+coeff_restitution --closest --out c.lmp":
+        ("tests/test_lammps_calibration.py", "test_closest_writes_the_rejected_law_with_its_misfit_in_a_header_verify_accepts"),
+    "microimpact lammps fit lammps_jkr_viscoelastic.csv --fit-adhesion --law jkr_force+viscoelastic --units micro --out jkr.lmp":
+        ("tests/test_lammps_calibration.py", "test_lammps_fit_recovers_both_parameters_of_the_lammps_truth"),
+    "microimpact lammps verify jkr.lmp --points 3":
+        ("tests/test_lammps_calibration.py", "test_lammps_fit_recovers_both_parameters_of_the_lammps_truth"),
     "snakemake --unlock": ("tests/test_workflow.py", "test_an_interrupted_run_resumes_as_the_readme_says"),
     "microimpact lammps fit impacts.csv --material-pair ammonium_fluorescein_on_silicon --units micro --out contact.lmp":
         ("tests/test_dem_fit.py", "test_csv_to_running_lammps_input_in_two_commands"),

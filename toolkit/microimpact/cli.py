@@ -413,6 +413,17 @@ def _steps(text: str) -> int:
     return value
 
 
+#: speeds per radius of ``lammps verify`` over a fitted data range
+VERIFY_POINTS = 5
+
+
+def _verify_points(text: str) -> int:
+    value = _whole_number(text, 1)
+    if not 1 <= value <= 1000:
+        raise argparse.ArgumentTypeError(f"must lie in [1, 1000], got {text!r}")
+    return value
+
+
 def _incidence(text: str) -> float:
     value = _finite_float(text)
     if not 0.0 <= value < 90.0:
@@ -436,9 +447,10 @@ def register_lammps(sub) -> None:
     _add_time_budget(e)
     e.set_defaults(func=_handler("lammps", "run_export"))
     f = lsub.add_parser("fit", help="fit the damping of LAMMPS laws (with --fit-adhesion also the work of adhesion) to "
-                                    "measured impacts (CSV), rank the laws by AIC and "
-                                    "write the best determined one as LAMMPS input (exit status "
-                                    f"{EXIT_DISAGREES} and nothing written when the data do not determine it)")
+                                    "measured impacts (CSV), rank the laws by AIC and write the best one that describes "
+                                    f"the data as LAMMPS input (exit status {EXIT_DISAGREES} and nothing written when "
+                                    "the data do not determine it, or when no law describes the data: then the closest "
+                                    f"is named, and written with --closest, still status {EXIT_DISAGREES})")
     f.add_argument("data", help="impact CSV (see 'microimpact fit')")
     f.add_argument("--material-pair", default=None, help="material pair of the data (density, stiffness, w_A)")
     f.add_argument("--config", default=None, help="materials config YAML (default: the bundled one)")
@@ -482,6 +494,10 @@ def register_lammps(sub) -> None:
     f.add_argument("--twisting-friction", type=_non_negative_float, default=0.0, metavar="SI",
                    help="mu_twist of twisting sds, a length [m] (default 0)")
     f.add_argument("--units", choices=tuple(LAMMPS_UNITS), default="si", help="LAMMPS unit style of the numbers (default si)")
+    f.add_argument("--closest", action="store_true",
+                   help="when every law is rejected by the chi-square test, write the closest one anyway, its misfit "
+                        f"in the header (the exit status stays {EXIT_DISAGREES}: no law describes the data)")
+    f.add_argument("--json", action="store_true", help="print the fits, their verdicts and what was written as JSON")
     _add_rtol(f)
     f.add_argument("--out", required=True, help="output LAMMPS input file")
     _add_time_budget(f)
@@ -490,7 +506,13 @@ def register_lammps(sub) -> None:
                                        f"(exit status {EXIT_DISAGREES} if they disagree; needs microimpact[lammps])")
     v.add_argument("input", help="a file written by 'microimpact lammps export'")
     v.add_argument("--speeds", type=_positive_float, nargs="+", default=None, metavar="M_PER_S",
-                   help="incident speeds (default: 0.1-10 x the sticking velocity, or 0.01-10 m/s without capture)")
+                   help="incident speeds, at every radius (default: a file written by 'lammps fit' is checked at every "
+                        "radius of its data over its measured speed range; else 0.1-10 x the sticking velocity, or "
+                        "0.01-10 m/s without capture)")
+    v.add_argument("--speed-range", type=_positive_float, nargs=2, default=None, metavar=("LO", "HI"),
+                   help="check this normal-speed range [m/s] (at every radius of the fitted data) instead of the measured one")
+    v.add_argument("--points", type=_verify_points, default=VERIFY_POINTS,
+                   help=f"speeds per radius, spaced geometrically over the range (default {VERIFY_POINTS})")
     v.add_argument("--incidence-deg", type=_incidence, nargs="+", default=None, metavar="DEG",
                    help="incidence angles (default 0 20 40 60 80)")
     v.add_argument("--steps", type=_steps, default=DEFAULT_STEPS,

@@ -9,21 +9,32 @@ its own radius and normal speed.
 
 Estimate and interval. The estimate minimises chi^2 = sum ((e_meas - e_model) / sigma)^2, started
 from a grid over the whole physical range (so a second minimum is not missed) and refined by a
-bounded Brent minimisation (scipy) about the grid's best point. The interval is the profile-likelihood interval of 68.27 %: where chi^2 rises by 1 above
-its minimum when sigma is the stated e_n uncertainty, or by s^2 t^2 (s^2 = chi^2_min / (n - 1),
-t the Student quantile with n - 1 degrees of freedom) when the data state none (weights "none").
-It is searched over the physical range [0, 1] of e or [0, inf) of eta_n0, so it may be one-sided:
+bounded Brent minimisation (scipy) about the grid's best point. The interval is the project's one
+interval of every parameter, the 95 % profile-likelihood interval: where chi^2 rises by 3.84 (the
+0.95 quantile of chi^2 with one degree of freedom) above its minimum when sigma is the stated e_n
+uncertainty, or by s^2 t^2 (s^2 = chi^2_min / (n - 1), t the two-sided 95 % Student quantile with
+n - 1 degrees of freedom) when the data state none (weights "none"). The standard error printed
+beside it is the one it implies, its width / 3.92 (as :func:`~microimpact.analysis.fit_result.fit_parameter_table`
+does for the paper's damping law), so the two never disagree. The interval is searched over the
+physical range [0, 1] of e or [0, inf) of eta_n0, so it may be one-sided:
 
 * **determined**: both ends inside the range; the value is printed with its interval;
 * **upper limit**: the data are consistent with no damping (e = 1, eta_n0 = 0): only the upper end
   (or, for e, the lower end) is given, no value;
-* **inadequate**: with stated uncertainties, the smallest chi^2 is improbable for n - 1 degrees
-  of freedom (p below :data:`ADEQUACY_P`): the law does not describe the data, and no interval of
-  its coefficient means anything (the synthetic microsphere data of this project, made with the
-  paper's adhesive model, give chi^2 = 13802 for 99 for the best LAMMPS law);
+* **inadequate**: with stated uncertainties, the smallest chi^2 is improbable for n - k degrees
+  of freedom (p below :data:`ADEQUACY_P`): the law does not describe the data, and no value is
+  printed as its fit (the synthetic microsphere data of this project, made with the paper's
+  adhesive model, give chi^2 = 13802 for 99 for the best LAMMPS law). The closest such law is
+  still described (:meth:`DemLawFit.misfit_by_size`, :meth:`DemLawFit.closest_lines`): its
+  coefficient at the least chi^2, its interval conditional on the rejected law and widened by
+  sqrt(chi^2 / dof), and where its e_n misses the data most;
 * **not determined**: the chi^2 does not rise by the threshold anywhere up to the strongest damping
   searched (e_n below 1e-4, a sphere that barely leaves): the data give at most a lower limit, and
   nothing is printed as a number.
+
+Every fit carries the :class:`~microimpact.analysis.verdict.Verdict` of its standardized residuals
+(:func:`~microimpact.analysis.verdict.assess_residuals`: adequate, or inadequate with chi-square,
+degrees of freedom and p, or judged against the scatter without stated uncertainties).
 
 The interval's coverage is checked over random experiment designs (tests/test_dem_fit.py, and
 :func:`dem_fit_coverage` as a documented study).
@@ -47,7 +58,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from types import SimpleNamespace
 
 import numpy as np
@@ -59,8 +70,8 @@ import pandas as pd
 from scipy import optimize, stats
 
 from microimpact.analysis.fitting import _sigma_e, _table_arrays
-from microimpact.analysis.identifiability import chi2_threshold
-from microimpact.analysis.verdict import ADEQUACY_P, ADEQUATE, INADEQUATE, NO_UNCERTAINTIES, Verdict
+from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold
+from microimpact.analysis.verdict import ADEQUACY_P, ADEQUATE, INADEQUATE, NO_UNCERTAINTIES, Verdict, assess_residuals
 from microimpact.io.materials import material_contact
 from microimpact.model.contact import Contact
 from microimpact.model.dem_damping import DEM_LAWS, RESTITUTION_DAMPING_MODELS, critical_damping_coefficient
@@ -69,8 +80,12 @@ from microimpact.solvers import DEFAULT_RTOL, normal_models as nm
 __all__ = ["DEM_LAWS", "DemLawFit", "candidate_laws", "dem_law_contact", "dem_law_restitution", "fit_dem_law", "rank_dem_laws", "ranked_by_aic", "information_criteria", "dem_fit_coverage",
            "INTERVAL_LEVEL", "ADEQUACY_P", "REGION_RAYS"]
 
-#: the probability content of the reported interval (one standard deviation of a normal law)
-INTERVAL_LEVEL = math.erf(1.0 / math.sqrt(2.0))
+#: the probability content of the reported interval: the project's one interval, 95 %
+#: (:data:`microimpact.analysis.identifiability.DEFAULT_LEVEL`)
+INTERVAL_LEVEL = DEFAULT_LEVEL
+#: the standard normal quantile of that two-sided interval: a standard error is the interval's
+#: width / (2 z) = width / 3.92
+_Z = float(stats.norm.ppf(0.5 + INTERVAL_LEVEL / 2.0))
 #: with stated uncertainties, a law whose chi^2 has a p-value below this does not describe the data
 #: (its interval would be meaningless): status "inadequate", no value
 #: ADEQUACY_P: imported from microimpact.analysis.verdict, its one home
@@ -91,8 +106,8 @@ _PROFILE_GRID = 21  # start grid of each inner and outer minimisation of the joi
 #: spaced boundary points is within cos(15 deg) = 0.966 of its extreme over the whole boundary
 REGION_RAYS = 12
 #: step of the finite-difference Hessian of chi^2 that whitens the region's coordinates, in units
-#: of each parameter's 68 % half-width
-_HESSIAN_STEP = 0.25
+#: of each parameter's 95 % half-width (0.125 x 1.96: a quarter of a standard error)
+_HESSIAN_STEP = 0.125
 
 
 #: units of the damping coefficient of each LAMMPS damping law (e of coeff_restitution and tsuji, eta_n0 else)
@@ -110,7 +125,7 @@ class DemLawFit(FitResult):
     value : float
         The fitted damping coefficient (e [-] or eta_n0 [1/s] or [1/(m s)]); NaN unless determined.
     interval : tuple of float
-        The 68.27 % profile-likelihood interval; an end at the physical bound (0 or 1) or inf is
+        The 95 % profile-likelihood interval; an end at the physical bound (0 or 1) or inf is
         not an end the data give.
     status : str
         ``"determined"``, ``"upper limit"`` (consistent with no damping), ``"not determined"`` or
@@ -143,12 +158,17 @@ class DemLawFit(FitResult):
     >>> f.determined, f.law, round(f.contact(3.45e-6).damping_coefficient, 4)
     (True, 'hertz+coeff_restitution', 0.71)
     >>> f.describe()
-    'hertz+coeff_restitution: damping_coefficient = 0.71 (68% interval 0.704227 to 0.715774)'
+    'hertz+coeff_restitution: damping_coefficient = 0.71 (standard error 0.00577; 95% interval 0.698684 to 0.721316)'
+
+    The standard error is the one the interval implies; here, a mean of three, 0.01 / sqrt(3):
+
+    >>> round(f.stderr, 6), f.verdict.verdict
+    (0.005774, 'adequate')
     >>> g = fit_dem_law(t.assign(e_n=[1.0, 0.995, 1.0]), material)
     >>> g.status, g.determined
     ('upper limit', False)
     >>> g.describe()
-    'hertz+coeff_restitution: consistent with no damping; the data give only e >= 0.99256 (68%)'
+    'hertz+coeff_restitution: consistent with no damping; the data give only e >= 0.987017 (95%)'
 
     The fit and its data survive the file, so the loaded fit still gives its confidence region:
 
@@ -178,18 +198,60 @@ class DemLawFit(FitResult):
     work_of_adhesion: float = math.nan
     work_of_adhesion_interval: tuple[float, float] = (math.nan, math.nan)
     adhesion_status: str = ""
+    #: the CSV's id of every fitted impact (else its row number), for the verdict's outliers
+    ids: tuple = field(default=(), repr=False, compare=False)
     #: (the e_n model, measured e_n, sigma) the fit minimised over, for :meth:`confidence_region`
     _data: tuple = field(default=(), repr=False, compare=False)
 
-    @property
+    @cached_property
+    def model_e_n(self) -> np.ndarray:
+        """e_n of the law at the least chi^2 for every fitted impact (empty without the data). [-]"""
+        if not self._data:
+            return np.array([])
+        model = self._data[0]
+        return model.e_n(self.best, self.material["work_of_adhesion"] if self.adhesion_fitted else None)
+
+    @cached_property
     def verdict(self) -> Verdict:
-        """Adequate or not by the chi-square test of the stated uncertainties (the same
-        :class:`~microimpact.analysis.verdict.Verdict` every fit carries)."""
+        """Adequate or not by the chi-square test of the stated uncertainties, the outliers by id and
+        the misfit in words: :func:`~microimpact.analysis.verdict.assess_residuals` of the
+        standardized residuals (model - measured) / sigma at the least chi^2, the
+        :class:`~microimpact.analysis.verdict.Verdict` every fit carries (the chi-square test alone
+        for a fit read back without its data)."""
+        what = f"{self.law} law"
+        if self._data:
+            model, e_meas, sig = self._data
+            z = (self.model_e_n - e_meas) / sig
+            return assess_residuals(z, self.parameters, stated=self.sigma_known, ids=self.ids or None,
+                                    speed=model.speed, radius=model.radii[model.index], what=what)
         dof = float(self.n - self.parameters)
         if not self.sigma_known:
-            return Verdict(NO_UNCERTAINTIES, math.nan, dof, math.nan, what=f"{self.law} law")
+            return Verdict(NO_UNCERTAINTIES, math.nan, dof, math.nan, what=what)
         p = float(stats.chi2.sf(self.chisqr, dof)) if dof > 0 else math.nan
-        return Verdict(INADEQUATE if p < ADEQUACY_P else ADEQUATE, float(self.chisqr), dof, p, what=f"{self.law} law")
+        return Verdict(INADEQUATE if p < ADEQUACY_P else ADEQUATE, float(self.chisqr), dof, p, what=what)
+
+    @property
+    def stderr(self) -> float:
+        """The damping coefficient's standard error implied by its 95 % interval, width / 3.92
+        (NaN unless determined). [as value]"""
+        lo, hi = self.interval
+        return float((hi - lo) / (2.0 * _Z)) if self.status == "determined" else math.nan
+
+    @property
+    def work_of_adhesion_stderr(self) -> float:
+        """The work of adhesion's standard error implied by its 95 % interval, width / 3.92 (NaN
+        unless fitted and determined). [J/m^2]"""
+        lo, hi = self.work_of_adhesion_interval
+        return float((hi - lo) / (2.0 * _Z)) if self.adhesion_status == "determined" else math.nan
+
+    def widened_interval(self, name: str = "coefficient") -> tuple[float, float]:
+        """The 95 % interval of ``name`` (``coefficient`` or ``work_of_adhesion``) about the least
+        chi^2, each side scaled by the verdict's sqrt(chi^2 / dof): the interval of a rejected law
+        with its misfit counted as noise (the interval itself where the law is adequate). [as value]"""
+        best = self.best if name == "coefficient" else self.material["work_of_adhesion"]
+        lo, hi = self.interval_ends()[name]
+        w = self.verdict.widening
+        return float(best - w * (best - lo)), float(best + w * (hi - best))
 
     @property
     def determined(self) -> bool:
@@ -206,10 +268,13 @@ class DemLawFit(FitResult):
         return f"{self.normal_model}+{self.damping_model}"
 
     def describe(self) -> str:
-        """One line: the law, the value with its interval, or what the data cannot tell."""
+        """One line: the law, the value with its standard error and 95 % interval, or what the data
+        cannot tell (the verdict's lines are :meth:`report`)."""
         if self.status == "inadequate":
-            return (f"{self.law}: does not describe the data (chi^2 = {self.chisqr:.6g} for {self.n - self.parameters} "
-                    f"degrees of freedom, p < {ADEQUACY_P:g}); no value")
+            v = self.verdict
+            return (f"{self.law}: does not describe the data (chi^2 = {self.chisqr:.6g} for {v.degrees_of_freedom:.0f} "
+                    f"degrees of freedom, chi^2/dof = {self.chisqr / v.degrees_of_freedom:.4g}, {_p_text(v.p_value)}); "
+                    "no value")
         if not self.sigma_known and self.n <= self.parameters:
             return (f"{self.law}: {self.n} impacts without stated e_n uncertainties cannot give {self.parameters} "
                     "parameter(s) and their scatter; no value (state e_n_uncertainty, or measure more impacts)")
@@ -218,11 +283,12 @@ class DemLawFit(FitResult):
             return damping
         lo, hi = self.work_of_adhesion_interval
         if self.adhesion_status == "determined":
-            adhesion = f"work_of_adhesion = {self.work_of_adhesion:.6g} J/m^2 (68% interval {lo:.6g} to {hi:.6g})"
+            adhesion = (f"work_of_adhesion = {self.work_of_adhesion:.6g} J/m^2 (standard error "
+                        f"{self.work_of_adhesion_stderr:.3g}; 95% interval {lo:.6g} to {hi:.6g})")
         elif self.adhesion_status == "upper limit":
-            adhesion = f"work_of_adhesion consistent with no adhesion; the data give only w_A <= {hi:.6g} J/m^2 (68%)"
+            adhesion = f"work_of_adhesion consistent with no adhesion; the data give only w_A <= {hi:.6g} J/m^2 (95%)"
         else:
-            adhesion = (f"work_of_adhesion not determined by these data (w_A >= {lo:.6g} J/m^2, 68%: the data cannot "
+            adhesion = (f"work_of_adhesion not determined by these data (w_A >= {lo:.6g} J/m^2, 95%: the data cannot "
                         "tell it from a stronger adhesion)")
         return f"{damping}; {adhesion}"
 
@@ -230,15 +296,79 @@ class DemLawFit(FitResult):
         unit = {"viscoelastic": " 1/(m s)", "mass_velocity": " 1/s"}.get(self.damping_model, "")
         lo, hi = self.interval
         if self.status == "determined":
-            return (f"{self.law}: damping_coefficient = {self.value:.6g}{unit} "
-                    f"(68% interval {lo:.6g} to {hi:.6g})")
+            return (f"{self.law}: damping_coefficient = {self.value:.6g}{unit} (standard error {self.stderr:.3g}; "
+                    f"95% interval {lo:.6g} to {hi:.6g})")
         if self.status == "upper limit":
             bound = f"e >= {lo:.6g}" if self.damping_model in RESTITUTION_DAMPING_MODELS else f"eta_n0 <= {hi:.6g}{unit}"
-            return f"{self.law}: consistent with no damping; the data give only {bound} (68%)"
+            return f"{self.law}: consistent with no damping; the data give only {bound} (95%)"
         if self.damping_model in RESTITUTION_DAMPING_MODELS:
-            return f"{self.law}: damping_coefficient not determined by these data (e <= {hi:.6g}, 68%)"
-        return (f"{self.law}: damping_coefficient not determined by these data (eta_n0 >= {lo:.6g}{unit}, 68%: "
+            return f"{self.law}: damping_coefficient not determined by these data (e <= {hi:.6g}, 95%)"
+        return (f"{self.law}: damping_coefficient not determined by these data (eta_n0 >= {lo:.6g}{unit}, 95%: "
                 "the data cannot tell it from a stronger damping)")
+
+    def report(self) -> str:
+        """The fit as text: :meth:`describe`, then the verdict's lines (verdict, outliers, misfit,
+        what the intervals mean) and, for a rejected law, :meth:`closest_lines`."""
+        lines = [self.describe(), *self.verdict.lines()]
+        if self.status == "inadequate":
+            lines += self.closest_lines()
+        return "\n".join(lines)
+
+    def misfit_by_size(self) -> list[dict]:
+        """Where the law misses the data, per sphere radius: ``radius`` [m], ``speed_min``,
+        ``speed_max`` [m/s] (the measured range), ``impacts``, ``largest_error`` (model - measured
+        e_n of largest magnitude, [-]) at ``speed`` [m/s], and ``rms_standardized`` (root mean
+        square of (model - measured) / sigma). Empty without the data."""
+        if not self._data:
+            return []
+        model, e_meas, sig = self._data
+        err = self.model_e_n - e_meas
+        out = []
+        for i, r in enumerate(model.radii):
+            rows = np.flatnonzero(model.index == i)
+            k = rows[int(np.argmax(np.abs(err[rows])))]
+            out.append({"radius": float(r), "speed_min": float(model.speed[rows].min()),
+                        "speed_max": float(model.speed[rows].max()), "impacts": int(rows.size),
+                        "largest_error": float(err[k]), "speed": float(model.speed[k]),
+                        "rms_standardized": float(np.sqrt(np.mean(np.square(err[rows] / sig[rows]))))})
+        return out
+
+    def closest_lines(self) -> list[str]:
+        """The text of a rejected law as the closest one: its values at the least chi^2 with their
+        intervals conditional on it and widened by sqrt(chi^2 / dof), and, per radius, the largest
+        e_n error over the measured speed range."""
+        v = self.verdict
+        unit = {"viscoelastic": " 1/(m s)", "mass_velocity": " 1/s"}.get(self.damping_model, "")
+        lo, hi = self.widened_interval("coefficient")
+        out = [f"  least chi^2 : damping_coefficient {self.best:.6g}{unit} (95% interval conditional on the rejected "
+               f"law, widened x{v.widening:.3g}: {lo:.6g} to {hi:.6g})"]
+        if self.adhesion_fitted:
+            lo, hi = self.widened_interval("work_of_adhesion")
+            out.append(f"              work_of_adhesion {self.material['work_of_adhesion']:.6g} J/m^2 (likewise "
+                       f"{lo:.6g} to {hi:.6g})")
+        for m in self.misfit_by_size():
+            out.append(f"  radius {m['radius'] * 1e6:.4g} um: {m['impacts']} impacts at {m['speed_min']:.3g}-"
+                       f"{m['speed_max']:.3g} m/s; largest e_n error {m['largest_error']:+.3g} (model - measured) at "
+                       f"{m['speed']:.3g} m/s; rms standardized residual {m['rms_standardized']:.3g}")
+        return out
+
+    def record(self) -> dict:
+        """The fit as plain data (``--json``, the exported header): law, statuses, values, standard
+        errors and 95 % intervals, chi-square, the verdict's record and the misfit per radius."""
+        rec = {"law": self.law, "status": self.status, "interval_level": INTERVAL_LEVEL, "n": int(self.n),
+               "parameters": self.parameters, "sigma_known": bool(self.sigma_known), "chisqr": float(self.chisqr),
+               "aic": float(self.aic), "damping_coefficient": float(self.value), "damping_coefficient_stderr": self.stderr,
+               "damping_coefficient_interval": [float(x) for x in self.interval],
+               "damping_coefficient_best": float(self.best),
+               "damping_coefficient_widened_interval": list(self.widened_interval()),
+               "adhesion_fitted": bool(self.adhesion_fitted)}
+        if self.adhesion_fitted:
+            rec |= {"adhesion_status": self.adhesion_status, "work_of_adhesion": float(self.work_of_adhesion),
+                    "work_of_adhesion_stderr": self.work_of_adhesion_stderr,
+                    "work_of_adhesion_interval": [float(x) for x in self.work_of_adhesion_interval],
+                    "work_of_adhesion_best": float(self.material["work_of_adhesion"]),
+                    "work_of_adhesion_widened_interval": list(self.widened_interval("work_of_adhesion"))}
+        return rec | {"verdict": self.verdict.to_record(), "misfit_by_size": self.misfit_by_size()}
 
     def contact(self, radius: float, *, coefficient: float | None = None,
                 work_of_adhesion: float | None = None) -> Contact:
@@ -249,7 +379,7 @@ class DemLawFit(FitResult):
                                self.best if coefficient is None else coefficient)
 
     def interval_ends(self) -> dict:
-        """``{parameter: (low, high)}``: the 68 % interval of every fitted parameter, keyed by the
+        """``{parameter: (low, high)}``: the 95 % interval of every fitted parameter, keyed by the
         :meth:`contact` keyword it moves (``coefficient``; ``work_of_adhesion`` when fitted)."""
         ends = {"coefficient": tuple(map(float, self.interval))}
         if self.adhesion_fitted:
@@ -258,19 +388,21 @@ class DemLawFit(FitResult):
 
     def to_dataset(self) -> xr.Dataset:
         """CF form: the damping coefficient (``damping_coefficient`` with ``_lower``, ``_upper`` of
-        its 68.27 % interval and ``_best``, the chi^2 minimiser), the work of adhesion likewise,
+        its 95 % interval, ``_stderr`` (width / 3.92) and ``_best``, the chi^2 minimiser), the work of adhesion likewise,
         the fitted impacts along ``point`` (``radius``, ``normal_speed``, ``e_n_measured``,
         ``sigma``) and the law, status, statistics and material as attributes."""
         unit = _COEFFICIENT_UNITS.get(self.damping_model, "1")
         ds = xr.Dataset()
         for suffix, v, what in (("", self.value, "fitted damping coefficient (NaN unless determined)"),
-                                ("_lower", self.interval[0], "lower end of the 68.27 % interval of the damping coefficient"),
-                                ("_upper", self.interval[1], "upper end of the 68.27 % interval of the damping coefficient"),
+                                ("_lower", self.interval[0], "lower end of the 95 % interval of the damping coefficient"),
+                                ("_upper", self.interval[1], "upper end of the 95 % interval of the damping coefficient"),
+                                ("_stderr", self.stderr, "standard error of the damping coefficient (95 % interval width / 3.92)"),
                                 ("_best", self.best, "damping coefficient at the least chi-square")):
             ds[f"damping_coefficient{suffix}"] = xr.DataArray(float(v), attrs={"units": unit, "long_name": what})
         for suffix, v, what in (("", self.work_of_adhesion, "fitted work of adhesion (NaN unless fitted and determined)"),
-                                ("_lower", self.work_of_adhesion_interval[0], "lower end of the 68.27 % interval of w_A"),
-                                ("_upper", self.work_of_adhesion_interval[1], "upper end of the 68.27 % interval of w_A")):
+                                ("_lower", self.work_of_adhesion_interval[0], "lower end of the 95 % interval of w_A"),
+                                ("_upper", self.work_of_adhesion_interval[1], "upper end of the 95 % interval of w_A"),
+                                ("_stderr", self.work_of_adhesion_stderr, "standard error of w_A (95 % interval width / 3.92)")):
             ds[f"work_of_adhesion{suffix}"] = xr.DataArray(float(v), attrs={"units": "J m-2", "long_name": what})
         if self._data:
             model, e_meas, sig = self._data
@@ -288,6 +420,7 @@ class DemLawFit(FitResult):
             "damping_model": self.damping_model, "status": self.status, "chisqr": float(self.chisqr), "n": int(self.n),
             "sigma_known": int(self.sigma_known), "aic": float(self.aic), "bic": float(self.bic), "source": str(self.source),
             "adhesion_fitted": int(self.adhesion_fitted), "adhesion_status": self.adhesion_status,
+            "interval_level": float(INTERVAL_LEVEL), "point_ids": ",".join(self.ids),
             **{f"material_{k}": float(v) for k, v in self.material.items()}})
         ds.attrs.update(self.verdict.to_attrs())
         return ds
@@ -308,7 +441,8 @@ class DemLawFit(FitResult):
                    float(ds["damping_coefficient_best"]), material, str(a["source"]),
                    adhesion_fitted=bool(int(a["adhesion_fitted"])), work_of_adhesion=float(ds["work_of_adhesion"]),
                    work_of_adhesion_interval=(float(ds["work_of_adhesion_lower"]), float(ds["work_of_adhesion_upper"])),
-                   adhesion_status=str(a["adhesion_status"]), _data=data)
+                   adhesion_status=str(a["adhesion_status"]),
+                   ids=tuple(x for x in str(a.get("point_ids", "")).split(",") if x), _data=data)
 
     def confidence_region(self, level: float = 0.95, rays: int = REGION_RAYS) -> list[dict]:
         """Points on the boundary of the fitted parameters' joint confidence region, as
@@ -354,16 +488,16 @@ class DemLawFit(FitResult):
 
         Examples
         --------
-        At 68.27 % the one-parameter region is the reported interval; at 95 % it is wider:
+        At 95 % the one-parameter region is the reported interval; at 68.27 % it is narrower:
 
         >>> import pandas as pd
         >>> t = pd.DataFrame({"radius": [3.45e-6] * 3, "normal_speed": [0.5, 1.0, 2.0], "e_n": [0.70, 0.72, 0.71],
         ...                   "e_n_uncertainty": [0.01] * 3})
         >>> f = fit_dem_law(t, {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0})
-        >>> [round(p["coefficient"], 4) for p in f.confidence_region(INTERVAL_LEVEL)]
+        >>> [round(p["coefficient"], 4) for p in f.confidence_region(INTERVAL_LEVEL)] == [round(x, 4) for x in f.interval]
+        True
+        >>> [round(p["coefficient"], 4) for p in f.confidence_region(math.erf(2**-0.5))]
         [0.7042, 0.7158]
-        >>> [round(p["coefficient"], 4) for p in f.confidence_region(0.95)]
-        [0.6987, 0.7213]
         """
         if not self._data:
             raise ValueError(f"confidence_region: this {self.law} fit carries no data (make it with fit_dem_law)")
@@ -596,7 +730,7 @@ def _damping_interval(rise, rise_coef, to_coef, x_best, lo_x, hi_x):
 
 def _interval_threshold(chi_min, n, sigma_known, k=1, level=INTERVAL_LEVEL):
     """The rise of chi^2 that bounds the profile-likelihood interval of one parameter at ``level``
-    (68.27 %: Delta chi^2 = 1 with stated uncertainties), s^2 t^2 (n - k degrees of freedom) without."""
+    (95 %: Delta chi^2 = 3.84 with stated uncertainties), s^2 t^2 (n - k degrees of freedom) without."""
     if sigma_known:
         return chi2_threshold(level)
     if n > k:
@@ -776,13 +910,14 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     ...                   "e_n_uncertainty": [0.01] * 3})
     >>> f = fit_dem_law(t, {"density": 1350.0, "stiffness": 1.776e9, "work_of_adhesion": 0.0})
     >>> f.status, round(f.value, 4), [round(x, 4) for x in f.interval]
-    ('determined', 0.71, [0.7042, 0.7158])
+    ('determined', 0.71, [0.6987, 0.7213])
     """
     if fit_adhesion and normal_model == "hertz":
         raise ValueError(f"fit_adhesion: {normal_model}+{damping_model} has no work of adhesion to fit; "
                          "choose jkr_force or dmt")
     df, rows, arrays, src = _table_arrays(table)
     sigma, _, _ = _sigma_e(weights, arrays, rows, src)
+    ids = _row_ids(df, rows)
     sigma_known = sigma is not None
     e_meas = arrays["e_n"]
     n = e_meas.size
@@ -793,7 +928,7 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
 
     to_coef, from_coef, lo_x, hi_x = _coordinate(model)
     if fit_adhesion:
-        return _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x, src)
+        return _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x, src, ids)
 
     def chi(x):
         return _chisqr(model, to_coef(x), e_meas, sig)
@@ -825,10 +960,28 @@ def fit_dem_law(table, material, normal_model: str = "hertz", damping_model: str
     aic, bic = information_criteria(chi_min, n, sigma_known)
     return DemLawFit(normal_model, damping_model, best if status == "determined" else math.nan, interval, status,
                      float(chi_min), int(n), sigma_known, float(aic), float(bic), best, mat, src,
-                     _data=(model, e_meas, sig))
+                     ids=ids, _data=(model, e_meas, sig))
 
 
-def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x, src) -> DemLawFit:
+def _p_text(p: float) -> str:
+    """``p = ...`` of a chi-square test, ``p < 1e-300`` where it underflows to 0.
+
+    Examples
+    --------
+    >>> _p_text(0.0123), _p_text(0.0)
+    ('p = 0.012', 'p < 1e-300')
+    """
+    return "p < 1e-300" if p == 0.0 else f"p = {p:.2g}"
+
+
+def _row_ids(df, rows) -> tuple:
+    """The CSV's id of each row (its row number where the table has no ``id``), as the fits name rows."""
+    if "id" in df.columns:
+        return tuple(str(i) if str(i) else f"row {r}" for i, r in zip(df["id"].astype(str), rows))
+    return tuple(f"row {r}" for r in rows)
+
+
+def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, hi_x, src, ids) -> DemLawFit:
     """:func:`fit_dem_law` with the work of adhesion fitted too."""
     n = e_meas.size
     chi_min, (w_interval, w_status, w_best), (interval, status, best) = _fit_with_adhesion(
@@ -840,7 +993,8 @@ def _joint_fit(model, mat, e_meas, sig, sigma_known, to_coef, from_coef, lo_x, h
                      status, float(chi_min), int(n), sigma_known, float(aic), float(bic), best,
                      {**mat, "work_of_adhesion": w_best}, src, adhesion_fitted=True,
                      work_of_adhesion=w_best if w_status == "determined" else math.nan,
-                     work_of_adhesion_interval=w_interval, adhesion_status=w_status, _data=(model, e_meas, sig))
+                     work_of_adhesion_interval=w_interval, adhesion_status=w_status, ids=ids,
+                     _data=(model, e_meas, sig))
 
 
 def candidate_laws(material, fit_adhesion: bool = False) -> list[tuple[str, str]]:
@@ -877,9 +1031,12 @@ def rank_dem_laws(table, material, laws=None, *, fit_adhesion: bool = False, wei
     Returns
     -------
     (pandas.DataFrame, dict)
-        One row per law, best first: law, status, value, interval ends, chi^2, AIC, BIC, dAIC and
-        the Akaike weight (with ``fit_adhesion`` also adhesion_status, work_of_adhesion and its
-        interval ends, w_low and w_high); and ``{law: DemLawFit}``.
+        One row per law, best first: law, status, value, stderr (95 % interval width / 3.92),
+        interval ends (95 %), chi^2, dof, chi^2/dof, p_value and verdict (of
+        :class:`~microimpact.analysis.verdict.Verdict`), AIC, BIC, dAIC and the Akaike weight (with
+        ``fit_adhesion`` also adhesion_status, work_of_adhesion and its interval ends, w_low and
+        w_high); and ``{law: DemLawFit}``. A rejected law's value and interval are NaN here (its
+        least-chi^2 values: :meth:`DemLawFit.closest_lines`).
 
     References
     ----------
@@ -904,14 +1061,17 @@ def rank_dem_laws(table, material, laws=None, *, fit_adhesion: bool = False, wei
             progress()
     rows = []
     for name, f in fits.items():
-        row = {"law": name, "status": f.status, "value": f.value, "interval_low": f.interval[0],
+        v = f.verdict
+        row = {"law": name, "status": f.status, "value": f.value, "stderr": f.stderr, "interval_low": f.interval[0],
                "interval_high": f.interval[1]}
         if fit_adhesion:
             row.update({"adhesion_status": f.adhesion_status or "not fitted", "work_of_adhesion": f.work_of_adhesion,
                         "w_low": f.work_of_adhesion_interval[0], "w_high": f.work_of_adhesion_interval[1]})
-        rows.append({**row, "chisqr": f.chisqr, "aic": f.aic, "bic": f.bic})
+        rows.append({**row, "chisqr": f.chisqr, "dof": v.degrees_of_freedom,
+                     "chisqr_per_dof": f.chisqr / v.degrees_of_freedom if v.degrees_of_freedom > 0 else math.nan,
+                     "p_value": v.p_value, "verdict": v.verdict, "aic": f.aic, "bic": f.bic})
     df = pd.DataFrame(rows)
-    interval_ends = [c for c in ("interval_low", "interval_high", "w_low", "w_high") if c in df]
+    interval_ends = [c for c in ("stderr", "interval_low", "interval_high", "w_low", "w_high") if c in df]
     df.loc[df["status"] == "inadequate", interval_ends] = math.nan  # no number to print
     # laws of one family (tsuji and coeff_restitution: the same e_n for every speed) tie to round-off:
     # the order of DEM_LAWS decides them
@@ -944,7 +1104,7 @@ def ranked_by_aic(table):
 
 def dem_fit_coverage(normal_model: str, damping_model: str, trials: int = 100, seed: int = 0, rtol: float = 1e-8,
                      fit_adhesion: bool = False):
-    """Coverage of :func:`fit_dem_law`'s 68.27 % interval over random experiment designs.
+    """Coverage of :func:`fit_dem_law`'s 95 % interval over random experiment designs.
 
     Each trial draws a design (4-30 impacts, normal speeds log-uniform over a random range within
     0.05-20 m/s, one or two radii within 1-10 um, noise sigma 0.003-0.05) and a true coefficient

@@ -210,7 +210,7 @@ _REFIT_EVALUATIONS = 60
 
 
 def _normal_fit_ends(normal_fit, contact_of, problem) -> dict:
-    """The 68 % interval ends of the normal fit's parameters, checked: its law must be the one
+    """The 95 % interval ends of the normal fit's parameters, checked: its law must be the one
     ``contact_of`` holds, and every end finite (ValueError naming what differs)."""
     if not isinstance(normal_fit, DemLawFit):
         raise TypeError(f"normal_fit must be the DemLawFit of fit_dem_law, not {type(normal_fit).__name__}")
@@ -229,7 +229,7 @@ def _normal_fit_ends(normal_fit, contact_of, problem) -> dict:
                              f"{normal_fit.describe()}): mu cannot carry its uncertainty; fit mu at a given normal "
                              "law (normal_fit=None) or measure what determines it")
         if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-            raise ValueError(f"normal_fit: the {normal_fit.law} fit's {name} has no finite 68 % interval "
+            raise ValueError(f"normal_fit: the {normal_fit.law} fit's {name} has no finite 95 % interval "
                              f"({lo:.6g} to {hi:.6g}, status {normal_fit.status!r}): its uncertainty cannot be propagated")
     return ends
 

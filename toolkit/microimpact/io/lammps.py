@@ -54,7 +54,12 @@ Units. The numbers are written in one of LAMMPS's unit styles ``si``, ``cgs``, `
 The header records, as comments, the toolkit version, where the parameters came from (a fit's data
 file and its sha256), the fitted values, and the whole contact as one JSON line that
 :func:`read_lammps_contact` reads back (the verification, :mod:`microimpact.studies.lammps_check`,
-runs LAMMPS on the file and compares it with microimpact's prediction for that contact).
+runs LAMMPS on the file and compares it with microimpact's prediction for that contact). A file
+written by ``microimpact lammps fit`` also carries the fit as one JSON line (:data:`FIT_LINE`,
+:data:`FIT_RECORD_KEYS`): the law, its verdict (chi-square, degrees of freedom, p), the misfit in
+words, whether it is the closest of laws that were all rejected, and every radius of the data with
+its measured speed range and largest e_n error, which ``verify`` checks LAMMPS over. Both JSON
+lines are read as data, field by field against a fixed schema; nothing in them is run.
 
 References
 ----------
@@ -82,7 +87,8 @@ from microimpact.model.tangential_compliance import effective_shear_modulus, she
 
 __all__ = ["LAMMPS_UNITS", "DEFAULT_POISSON", "LammpsExportError", "LammpsWallModel", "lammps_wall_model",
            "lammps_input", "lammps_expressible", "read_lammps_contact", "read_lammps_export", "LammpsExport",
-           "lammps_fix_line", "lammps_scales", "CONTACT_LINE", "UNITS_LINE"]
+           "lammps_fix_line", "lammps_scales", "CONTACT_LINE", "UNITS_LINE", "FIT_LINE", "FIT_RECORD_KEYS",
+           "check_fit_record"]
 
 #: LAMMPS unit styles: (metre, kilogram, second) per unit of length, mass and time
 #: (https://docs.lammps.org/units.html)
@@ -98,6 +104,19 @@ LAMMPS_UNITS: dict[str, tuple[float, float, float]] = {
 DEFAULT_POISSON = 0.3
 #: prefix of the header line that carries the contact as JSON
 CONTACT_LINE = "# microimpact-contact: "
+#: prefix of the header line that carries the fit ``lammps fit`` wrote the file from, as JSON
+FIT_LINE = "# microimpact-fit: "
+#: the fields of the fit line and the type of each (``number``: finite, or null where not
+#: applicable); any other field, or a missing one, is refused
+FIT_RECORD_KEYS = {"law": "text", "verdict": "text", "chi_square": "number", "degrees_of_freedom": "number",
+                   "p_value": "number", "misfit": "text", "closest_of_rejected": "flag", "data": "ranges"}
+#: the fields of each entry of the fit line's ``data``: one radius of the data, its measured normal
+#: speed range and where the law's e_n misses it most
+FIT_RANGE_KEYS = ("radius", "speed_min", "speed_max", "impacts", "largest_error", "speed")
+#: verdicts a fit line may state (:mod:`microimpact.analysis.verdict`)
+_FIT_VERDICTS = ("adequate", "inadequate", "no stated uncertainties")
+#: the longest text field and the most radii a fit line may hold (a record, not a payload)
+_FIT_TEXT_MAX, _FIT_RANGES_MAX = 2000, 1000
 #: prefix of the header line that names the unit style of the numbers (a comment, not a ``units``
 #: command: LAMMPS refuses ``units`` once the box exists, and the fix must come after the box)
 UNITS_LINE = "# microimpact-units: "
@@ -383,7 +402,7 @@ def _contact_json(contact: Contact) -> str:
 
 def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAULT_POISSON,
                  wall: str = "zplane 0.0 NULL", group: str = "all", fix_id: str = "microimpact_wall",
-                 source: str = "", fitted: dict | None = None) -> str:
+                 source: str = "", fitted: dict | None = None, fit_record: dict | None = None) -> str:
     """LAMMPS input of the wall contact of ``contact``: a header and one ``fix wall/gran`` line.
 
     Parameters
@@ -401,6 +420,9 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
         Where the parameters came from (a fit's data file and sha256), written in the header.
     fitted : dict, optional
         Fitted values with their intervals, ``{name: text}``, written in the header.
+    fit_record : dict, optional
+        The fit the contact comes from, :data:`FIT_RECORD_KEYS` (:func:`check_fit_record`; NaN
+        written as null), written as the JSON line :data:`FIT_LINE`.
 
     Returns
     -------
@@ -462,13 +484,94 @@ def lammps_input(contact: Contact, *, units: str = "si", poisson: float = DEFAUL
         lines.append(f"# parameters from: {source}")
     for name, text in (fitted or {}).items():
         lines.append(f"# fitted {name}: {text}")
+    lines.append("# check with: microimpact lammps verify THIS_FILE")
+    if fit_record is not None:
+        record = _json_ready(fit_record)
+        try:
+            check_fit_record(record)
+        except ValueError as exc:
+            raise LammpsExportError(f"fit_record: {exc}") from None
+        lines.append(FIT_LINE + json.dumps(record, sort_keys=True, allow_nan=False))  # ASCII: no control character
     lines += [
-        "# check with: microimpact lammps verify THIS_FILE",
         CONTACT_LINE + _contact_json(contact),
         UNITS_LINE + units,
         fix,
     ]
     return "\n".join(lines) + "\n"
+
+
+def _json_ready(obj):
+    """Non-finite numbers as null (JSON has none), numpy scalars as Python numbers, tuples as lists."""
+    if isinstance(obj, dict):
+        return {k: _json_ready(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_json_ready(v) for v in obj]
+    if isinstance(obj, (bool, str)) or obj is None:
+        return obj
+    if isinstance(obj, int) or (hasattr(obj, "dtype") and obj.dtype.kind in "iu"):
+        return int(obj)
+    value = float(obj)
+    return value if math.isfinite(value) else None
+
+
+def _check_number(where: str, value, *, positive: bool = False, null: bool = True) -> None:
+    if value is None and null and not positive:
+        return
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ValueError(f"{where} must be a finite number{' or null' if null and not positive else ''}, not {value!r}")
+    if positive and not value > 0:
+        raise ValueError(f"{where} must be > 0, not {value!r}")
+
+
+def check_fit_record(record) -> dict:
+    """The fit line's record, checked field by field (:data:`FIT_RECORD_KEYS`); ValueError naming
+    the field otherwise.
+
+    Examples
+    --------
+    >>> r = {"law": "hertz+coeff_restitution", "verdict": "adequate", "chi_square": 2.1, "degrees_of_freedom": 2,
+    ...      "p_value": 0.35, "misfit": "", "closest_of_rejected": False,
+    ...      "data": [{"radius": 3e-6, "speed_min": 0.5, "speed_max": 2.0, "impacts": 3, "largest_error": 0.01,
+    ...                "speed": 1.0}]}
+    >>> check_fit_record(r) is r
+    True
+    >>> check_fit_record(r | {"run": "shell rm"})
+    Traceback (most recent call last):
+    ...
+    ValueError: field 'run' is not one the fit line holds (law, verdict, chi_square, degrees_of_freedom, p_value, misfit, closest_of_rejected, data)
+    """
+    if not isinstance(record, dict):
+        raise ValueError(f"a JSON object of the fit's fields, not {type(record).__name__}")
+    for key in record:
+        if key not in FIT_RECORD_KEYS:
+            raise ValueError(f"field {key!r} is not one the fit line holds ({', '.join(FIT_RECORD_KEYS)})")
+    for key, kind in FIT_RECORD_KEYS.items():
+        if key not in record:
+            raise ValueError(f"field {key!r} is missing")
+        value = record[key]
+        if kind == "text" and not (isinstance(value, str) and len(value) <= _FIT_TEXT_MAX):
+            raise ValueError(f"field {key!r} must be a text of at most {_FIT_TEXT_MAX} characters")
+        if kind == "number":
+            _check_number(f"field {key!r}", value)
+        if kind == "flag" and not isinstance(value, bool):
+            raise ValueError(f"field {key!r} must be true or false, not {value!r}")
+    if record["verdict"] not in _FIT_VERDICTS:
+        raise ValueError(f"field 'verdict' is {record['verdict']!r}, not one of {', '.join(_FIT_VERDICTS)}")
+    ranges = record["data"]
+    if not isinstance(ranges, list) or not 1 <= len(ranges) <= _FIT_RANGES_MAX:
+        raise ValueError(f"field 'data' must be a list of 1 to {_FIT_RANGES_MAX} radii")
+    for i, entry in enumerate(ranges, 1):
+        if not isinstance(entry, dict) or sorted(entry) != sorted(FIT_RANGE_KEYS):
+            raise ValueError(f"field 'data', entry {i}: must have exactly the fields {', '.join(FIT_RANGE_KEYS)}")
+        for key in ("radius", "speed_min", "speed_max"):
+            _check_number(f"field 'data', entry {i}, {key!r}", entry[key], positive=True)
+        for key in ("largest_error", "speed"):
+            _check_number(f"field 'data', entry {i}, {key!r}", entry[key])
+        if entry["speed_max"] < entry["speed_min"]:
+            raise ValueError(f"field 'data', entry {i}: speed_max {entry['speed_max']!r} < speed_min {entry['speed_min']!r}")
+        if isinstance(entry["impacts"], bool) or not isinstance(entry["impacts"], int) or entry["impacts"] < 1:
+            raise ValueError(f"field 'data', entry {i}, 'impacts' must be a whole number >= 1, not {entry['impacts']!r}")
+    return record
 
 
 def _check_text(name: str, value: str) -> None:
@@ -534,6 +637,9 @@ class LammpsExport:
         The wall of the fix line, its group and ID.
     fix_line_number : int
         Line of the file holding the ``fix wall/gran`` command (1-based).
+    fit : dict or None
+        The fit line's record (:func:`check_fit_record`) of a file written by ``lammps fit``; None
+        for ``lammps export``.
     """
 
     contact: Contact
@@ -543,6 +649,15 @@ class LammpsExport:
     group: str
     fix_id: str
     fix_line_number: int
+    fit: dict | None = None
+
+    @property
+    def data_ranges(self) -> tuple:
+        """((radius [m], lowest, highest measured normal speed [m/s]), ...) of the fitted data, one
+        per radius; empty without a fit line."""
+        if not self.fit:
+            return ()
+        return tuple((e["radius"], e["speed_min"], e["speed_max"]) for e in self.fit["data"])
 
     def script(self) -> str:
         """The one LAMMPS command of this contact, rebuilt from the parsed parameters (never the
@@ -562,7 +677,8 @@ def read_lammps_export(text: str) -> LammpsExport:
     """Parse a file written by :func:`lammps_input`; refuse any line that it does not write.
 
     Accepted: the header comments (:data:`HEADER_PREFIXES`), one contact line (JSON of a
-    :class:`Contact`), one units line, and last one ``fix wall/gran`` command whose every parameter
+    :class:`Contact`), at most one fit line (:data:`FIT_LINE`, checked by :func:`check_fit_record`),
+    one units line, and last one ``fix wall/gran`` command whose every parameter
     is what the export of that contact writes (the Poisson ratio, wall, group and ID as written).
     Everything else (``shell``, ``run``, ``include``, ``python``, a second command, a blank line, a
     control character such as an injected newline) is refused, naming its line: a file received from
@@ -590,7 +706,7 @@ def read_lammps_export(text: str) -> LammpsExport:
     ...
     ValueError: line 10: 'shell touch X' after the fix line (line 9): the export writes nothing after its fix line
     """
-    record = units = fix = None
+    record = units = fix = fit = None
     for number, line in enumerate(_file_lines(text), 1):
         found = _CONTROL.search(line)
         if found:
@@ -603,6 +719,10 @@ def read_lammps_export(text: str) -> LammpsExport:
             if record is not None:
                 raise ValueError(f"line {number}: a second contact line (the first is line {record[0]})")
             record = (number, _contact_of_line(number, line[len(CONTACT_LINE):]))
+        elif line.startswith(FIT_LINE):
+            if fit is not None:
+                raise ValueError(f"line {number}: a second fit line (the first is line {fit[0]})")
+            fit = (number, _fit_of_line(number, line[len(FIT_LINE):]))
         elif line.startswith(UNITS_LINE):
             if units is not None:
                 raise ValueError(f"line {number}: a second units line (the first is line {units[0]})")
@@ -626,7 +746,17 @@ def read_lammps_export(text: str) -> LammpsExport:
     if fix is None:
         raise ValueError("no fix wall/gran line after the contact and units lines: not written by "
                          "'microimpact lammps export'")
-    return LammpsExport(record[1], units[1], fix_line_number=fix, **fields_)
+    return LammpsExport(record[1], units[1], fix_line_number=fix, fit=None if fit is None else fit[1], **fields_)
+
+
+def _fit_of_line(number: int, text: str) -> dict:
+    def constant(name):  # NaN and Infinity are not JSON; the export writes null
+        raise ValueError(f"{name} is not a JSON number")
+
+    try:
+        return check_fit_record(json.loads(text, parse_constant=constant))
+    except ValueError as exc:
+        raise ValueError(f"line {number}: the fit record does not read: {exc}") from None
 
 
 def _contact_of_line(number: int, text: str) -> Contact:

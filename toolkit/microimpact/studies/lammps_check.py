@@ -279,7 +279,7 @@ def default_speeds(contact) -> tuple[float, ...]:
 
 
 def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, steps: int = DEFAULT_STEPS,
-                  tolerance: float = DEFAULT_TOLERANCE, progress=None):
+                  tolerance: float = DEFAULT_TOLERANCE, progress=None, radii=None):
     """LAMMPS against microimpact on the exported input ``text``, over speeds x incidences.
 
     Parameters
@@ -288,8 +288,9 @@ def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, step
         A file written by ``microimpact lammps export``; every line is checked
         (:func:`microimpact.io.lammps.read_lammps_export`) and LAMMPS runs the fix command rebuilt
         from the parsed contact, not the text.
-    speeds : sequence of float, optional
-        Incident speeds [m/s]; default :func:`default_speeds`.
+    speeds : sequence of float or mapping, optional
+        Incident speeds [m/s], or ``{radius: speeds}`` for each of ``radii``; default
+        :func:`default_speeds`.
     incidences : sequence of float
         Incidence angles [deg].
     steps : int
@@ -298,11 +299,14 @@ def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, step
         Largest disagreement, and largest LAMMPS step error, accepted. [-]
     progress : callable, optional
         Called with no argument after each impact.
+    radii : sequence of float, optional
+        Sphere radii [m] to run, each with the file's law (w_A and the damping kept, f0 following
+        the radius: :meth:`~microimpact.Contact.at_radius`); default the file's radius.
 
     Returns
     -------
     pandas.DataFrame
-        One row per impact: speed, incidence, outcomes, e_n, e_t, the spin ratio omega r / v_t and,
+        One row per impact: radius, speed, incidence, outcomes, e_n, e_t, the spin ratio omega r / v_t and,
         with a twisting law, the twist ratio omega_n after / before (given ``TWIST_SPIN`` speed / r)
         of both, LAMMPS's step error (coarse minus fine run), the disagreement and
         whether it is within ``tolerance``. ``attrs`` hold the tolerance, the steps, the LAMMPS
@@ -335,20 +339,23 @@ def verify_lammps(text: str, *, speeds=None, incidences=DEFAULT_INCIDENCES, step
     contact, units = export.contact, export.units
     text = export.script()  # LAMMPS runs the command rebuilt from the parsed parameters, never the file's text
     lammps = load_lammps()
-    speeds = default_speeds(contact) if speeds is None else tuple(speeds)
     rows = []
-    for speed in speeds:
-        for angle in incidences:
-            try:
-                rows.append(_compare(lammps, text, contact, units, float(speed), float(angle), steps, simulate_impact))
-            except Exception as exc:
-                if not _lammps_error(exc):
-                    raise
-                said = (str(exc).strip().splitlines() or ["ERROR"])[0]
-                raise LammpsRunError(f"LAMMPS stopped at speed {float(speed):g} m/s, incidence {float(angle):g} "
-                                     f"deg: {said}") from None
-            if progress is not None:
-                progress()
+    for radius in (contact.radius,) if radii is None else tuple(radii):
+        sphere = contact if radius == contact.radius else contact.at_radius(float(radius))
+        grid = (speeds.get(radius) if isinstance(speeds, dict) else speeds)
+        for speed in default_speeds(sphere) if grid is None else tuple(grid):
+            for angle in incidences:
+                try:
+                    row = _compare(lammps, text, sphere, units, float(speed), float(angle), steps, simulate_impact)
+                except Exception as exc:
+                    if not _lammps_error(exc):
+                        raise
+                    said = (str(exc).strip().splitlines() or ["ERROR"])[0]
+                    raise LammpsRunError(f"LAMMPS stopped at radius {float(radius):g} m, speed {float(speed):g} m/s, "
+                                         f"incidence {float(angle):g} deg: {said}") from None
+                rows.append({"radius": float(radius), **row})
+                if progress is not None:
+                    progress()
     table = pd.DataFrame(rows)
     quantities = ("e_n", "e_t", "spin", "twist")
     table["difference"] = np.nanmax(np.abs(np.stack([table[f"{q}_lammps"] - table[f"{q}_microimpact"]
