@@ -15,6 +15,7 @@ from microimpact.model import reduction as rd
 from microimpact.model.parameters import TABLE1_ROW2
 from microimpact.solvers import emulator as em, engine_threads
 from microimpact.solvers.family import normal_restitution
+from microimpact.studies import emulator_benchmark as bench
 
 #: one cell: C1 over a factor 2, C2 over a factor 2 (TABLE1_ROW2 at 1 m/s: C1 = 4e-3, C2 = 0.23)
 SMALL = {"hertz_damping": (3e-3, 6e-3), "adhesion_damping": (0.15, 0.3), "incident_speed": (1e-2, 1e2)}
@@ -49,7 +50,7 @@ def _judge(y0, c1, c2):
 
 
 def test_the_table_meets_its_tolerance_at_random_points(table):
-    g = _random_groups(np.random.default_rng(3), 200)
+    g = _random_groups(np.random.default_rng(3), 100)
     e, captured, solve = table.evaluate(g["incident_speed"], g["hertz_damping"], g["adhesion_damping"])
     assert solve.mean() < 0.05  # only the guard band and failing pieces: a few percent at most
     want = np.array([_judge(*p) for p in zip(*(g[k][~solve] for k in ("incident_speed", "hertz_damping",
@@ -157,3 +158,19 @@ def test_the_canonical_contact_has_the_groups_it_is_given():
     g = rd.groups(c, 3.0 * u)
     assert [round(x, 12) for x in g.values] == [3.0, 2e-3, 0.4]
     assert isinstance(c, Contact)
+
+
+def test_the_benchmark_measures_both_side_by_side(table):
+    out = bench.run_emulator_benchmark(contacts=4, impacts=3, tol=TOL, seed=2, repeats=1, domain=SMALL)
+    assert out["impacts"] == 12 and out["tol"] == TOL
+    assert set(out["time_per_impact_s"]) == {"emulator", "table_kernel", "solver"}
+    assert out["max_error_e_n"]["emulator"] <= TOL  # the table where it decides, the solver elsewhere
+    assert out["outcome_disagreements"]["emulator"] == 0
+    assert out["speed_ratio_solver_over_emulator"] > 0.0
+
+
+@pytest.mark.parametrize("args, message", [(["--contacts", "0"], "must be >= 1"), (["--tol", "2"], "--tol must lie")])
+def test_the_benchmark_command_refuses_bad_options(args, message, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        bench.main(args)
+    assert exit_.value.code == 2 and message in capsys.readouterr().err

@@ -216,3 +216,15 @@ def test_the_inverse_gives_back_the_groups(law):
 def test_bad_groups_are_refused_by_name(law, values, message):
     with pytest.raises(ValueError, match=message):
         rd.contact_with_groups(law, **values)
+
+
+def test_ring_groups_of_many_contacts_are_those_of_groups():
+    rng = np.random.default_rng(9)
+    contacts = [TABLE1_ROW2.with_(radius=10 ** rng.uniform(-7, -4), zeta_hertz=rng.uniform(0, 2),
+                                  damping_reference_speed=None if k % 2 else 0.7) for k in range(6)]
+    v = 10 ** rng.uniform(-1, 2, (6, 4))
+    many = rd.ring_groups(contacts, v)
+    for i, c in enumerate(contacts):
+        one = rd.groups(c, v[i])
+        for got, want in zip(many, one.values):
+            assert np.allclose(got[i], want, rtol=1e-14, atol=0)

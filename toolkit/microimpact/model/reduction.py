@@ -78,7 +78,7 @@ from microimpact.model import dem_damping as dd
 from microimpact.model.contact import Contact, adhesion_line_force_from_work, check_positive
 from microimpact.model.law import nondimensional_impact
 
-__all__ = ["LAW_GROUPS", "NormalGroups", "law_of", "groups", "paper_damping_groups", "contact_with_groups"]
+__all__ = ["LAW_GROUPS", "NormalGroups", "law_of", "groups", "ring_groups", "paper_damping_groups", "contact_with_groups"]
 
 _THREE = ("incident_speed", "hertz_damping", "adhesion_damping")
 _DEM_ADHESIVE = ("incident_speed", "dem_damping")
@@ -207,6 +207,42 @@ def groups(contact: Contact, speed) -> NormalGroups:
     plain = (lambda x: x) if isinstance(v, np.ndarray) else float  # scalar speed: scalar groups
     y0, c3, length, time = (plain(x) for x in (v / sc.speed, c3 + 0.0 * v, sc.length, sc.time))
     return NormalGroups(law, y0, 0.0 * v, 0.0 * v, c3, length, time)
+
+
+def ring_groups(contacts, speeds) -> tuple:
+    """(y0, C1, C2) of many ring-law contacts at once: row i of ``speeds`` [m/s] belongs to contact i. [-]
+
+    The numbers of :func:`groups` (tests/test_reduction.py compares them), computed for all rows
+    together from each contact's X, T (Eqs. (29)-(30)) and the damping speed scale of Eqs. (14)-(15):
+    C = zeta / ((r^3 K / m)^(2/5) v_ref^(1/5)) X / T, v_ref the impact's speed or the contact's fixed
+    ``damping_reference_speed``. A batch over many contacts pays one array operation instead of a
+    :func:`groups` call per contact.
+
+    Parameters
+    ----------
+    contacts : sequence of Contact
+        Ring-law contacts with adhesion (:func:`law_of` "ring"), N of them.
+    speeds : array_like, shape (N,) or (N, M)
+        Incident normal speeds. [m/s]
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> y0, c1, c2 = ring_groups([c, c.with_(radius=1e-5)], [[1.0], [1.0]])
+    >>> [round(float(x), 6) for x in (y0[0, 0], c1[0, 0], c2[0, 0])] == [round(x, 6) for x in groups(c, 1.0).values]
+    True
+    """
+    contacts = list(contacts)
+    v = np.asarray(speeds, dtype=float).reshape(len(contacts), -1)
+    x = np.array([c.length_scale for c in contacts])[:, None]
+    t = np.array([c.time_scale for c in contacts])[:, None]
+    d = np.array([c.damping_speed_scale for c in contacts])[:, None]
+    z_h = np.array([c.zeta_hertz for c in contacts])[:, None]
+    z_a = np.array([c.zeta_adhesion for c in contacts])[:, None]
+    fixed = np.array([np.nan if c.damping_reference_speed is None else c.damping_reference_speed for c in contacts])[:, None]
+    u = x / t
+    per_speed = u / (d * np.where(np.isnan(fixed), v, fixed) ** 0.2)  # X / T over (r^3 K sqrt(v_ref) / m)^(2/5)
+    return v / u, z_h * per_speed, z_a * per_speed
 
 
 def paper_damping_groups(contact: Contact, speed) -> tuple:
