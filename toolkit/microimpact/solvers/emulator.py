@@ -95,7 +95,8 @@ SAFETY = 2.0
 #: tolerance of the node solves (rtol) relative to the table's, its floor, and its ceiling (a node
 #: just above y_c must have the outcome right)
 NODE_RTOL, NODE_RTOL_FLOOR, NODE_RTOL_CEILING = 1e-2, 1e-12, 1e-10
-#: tolerance of the outcome solves of the capture multisection
+#: tolerance of the outcome solves of the capture multisection (at most; finer for a table finer than
+#: 1e-6: 1e-3 of :func:`surface_tolerance`), and CAPTURE_WIDTH at most 1e-2 of it
 CAPTURE_RTOL = 1e-11
 #: cell and piece states
 _OK, _CAPTURED, _SOLVE = 0, 1, 2
@@ -132,12 +133,15 @@ def _solve(c1, c2, y0, rtol):
                               family=False)
 
 
-def _capture_speed(c1, c2, y_range):
+def _capture_speed(c1, c2, y_range, width=None, rtol=None):
     """(y_c, state, solves): the capture speed of (C1, C2) in y_range and _OK; or (inf, _CAPTURED) if
     every scanned speed is captured; (nan, _SOLVE) if the scan sees more than one outcome change or
-    a rebound at its lowest speed."""
+    a rebound at its lowest speed. ``width`` and ``rtol``: the multisection's relative width and its
+    solves' tolerance (default CAPTURE_WIDTH, CAPTURE_RTOL)."""
+    width = CAPTURE_WIDTH if width is None else width
+    rtol = CAPTURE_RTOL if rtol is None else rtol
     y = np.geomspace(*y_range, SCAN)
-    rebound = _solve(c1, c2, y, CAPTURE_RTOL) > 0.0
+    rebound = _solve(c1, c2, y, rtol) > 0.0
     n = y.size
     if not rebound.any():
         return math.inf, _CAPTURED, n
@@ -145,9 +149,9 @@ def _capture_speed(c1, c2, y_range):
         return math.nan, _SOLVE, n
     i = int(np.argmax(rebound))
     lo, hi = y[i - 1], y[i]
-    while hi / lo - 1.0 > CAPTURE_WIDTH:
+    while hi / lo - 1.0 > width:
         y = np.geomspace(lo, hi, SECTIONS + 2)[1:-1]
-        r = _solve(c1, c2, y, CAPTURE_RTOL) > 0.0
+        r = _solve(c1, c2, y, rtol) > 0.0
         n += y.size
         j = int(np.argmax(r)) if r.any() else y.size
         lo, hi = (y[j - 1] if j > 0 else lo), (y[j] if j < y.size else hi)
@@ -365,13 +369,16 @@ class _Builder:
         self.tol, self.domain = float(tol), dict(domain)
         self.y_range = tuple(float(y) for y in domain["incident_speed"])
         self.node_rtol = min(max(NODE_RTOL * self.tol, NODE_RTOL_FLOOR), NODE_RTOL_CEILING)
+        # the multisection finer than the surface tolerance, its solves' outcomes finer still
+        self.capture_width = min(CAPTURE_WIDTH, 1e-2 * surface_tolerance(self.tol))
+        self.capture_rtol = min(CAPTURE_RTOL, max(1e-3 * surface_tolerance(self.tol), MIN_RTOL * 1.01))
         self.rng = np.random.default_rng(seed)
         self.n_solves, self.max_check_error = 0, 0.0
         self.cells, self.children, self.leaf, self.failures = [], [], [], []
         self.x_ab, self.x_t = _lobatto(DEGREE_AB), _lobatto(DEGREE_T)
 
     def capture_speed(self, a, b):
-        yc, state, n = _capture_speed(math.exp(a), math.exp(b), self.y_range)
+        yc, state, n = _capture_speed(math.exp(a), math.exp(b), self.y_range, self.capture_width, self.capture_rtol)
         self.n_solves += n
         return yc, state
 
@@ -419,7 +426,7 @@ class _Builder:
                   for (x, y), (yc, _) in zip(local, exact))
         if eps > surface_tolerance(self.tol):
             return self.failed(bounds, f"capture surface error {eps:.3g}")
-        self.guard = max(SAFETY * eps, (SAFETY * eps / self.tol) ** 2, SAFETY * CAPTURE_WIDTH)
+        self.guard = max(SAFETY * eps, (SAFETY * eps / self.tol) ** 2, SAFETY * self.capture_width)
         guard = self.guard
         # the e_n nodes and their capture speeds, from the surface as the evaluation takes them
         self._nodes = (_map(self.x_ab, a0, a1), _map(self.x_ab, b0, b1))
