@@ -20,7 +20,8 @@ FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 #: docstrings (by the function's name, wherever its module is) whose examples take tens of seconds:
 #: each ranks or fits several laws or runs a coverage study; their functions have tests of their own
 SLOW_EXAMPLES = ("rank_dem_tangential_laws", "dem_friction_coverage", "plot_model_comparison",
-                 "model_comparison_section", "compare_normal_models")
+                 "model_comparison_section", "compare_normal_models",
+                 "build_ring_emulator", "ring_emulator", "restitution")  # each builds a small emulator table
 
 
 def _doctests(name: str) -> list[doctest.DocTest]:

@@ -7,6 +7,8 @@
 - :mod:`.parameters`: the paper's parameter sets (Table 1 rows, Table 2 cases), defined once.
 - :mod:`.kinematics`: incident velocity, slip velocity and the impact coefficients, Eqs. (21)-(25).
 - :mod:`.tangential`: the closed-form tangential and rotational map of a homogeneous sphere.
+- :mod:`.reduction`: the nondimensional groups of the normal impact of each law, and a contact with
+  given groups.
 
 Nothing here integrates anything; the solvers do.
 """

@@ -1,0 +1,176 @@
+"""The emulator of the ring law's e_n over its groups (microimpact.solvers.emulator), judged by the solver.
+
+A small table (one cell of the groups' box, a coarse tolerance: a few seconds to build) is built into
+a temporary cache; its values are compared with engine solves at rtol 1e-12 of dimensional contacts
+whose groups fall at random points of the box, and of contacts outside it, which must be solved.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from microimpact import Contact, simulate_impact
+from microimpact.model import reduction as rd
+from microimpact.model.parameters import TABLE1_ROW2
+from microimpact.solvers import emulator as em, engine_threads
+from microimpact.solvers.family import normal_restitution
+from microimpact.studies import emulator_benchmark as bench
+
+#: one cell: C1 over a factor 2, C2 over a factor 2 (TABLE1_ROW2 at 1 m/s: C1 = 4e-3, C2 = 0.23)
+SMALL = {"hertz_damping": (3e-3, 6e-3), "adhesion_damping": (0.15, 0.3), "incident_speed": (1e-2, 1e2)}
+TOL = 1e-4
+#: the judge: engine solves at rtol 1e-12 have e_n errors ~1e-11, far below TOL
+JUDGE_RTOL = 1e-12
+
+
+@pytest.fixture(scope="module")
+def table(tmp_path_factory):
+    mp = pytest.MonkeyPatch()
+    mp.setenv("MICROIMPACT_CACHE", str(tmp_path_factory.mktemp("cache")))
+    em._LOADED.clear()
+    yield em.ring_emulator(TOL, SMALL)
+    em._LOADED.clear()
+    mp.undo()
+
+
+def _random_groups(rng, n, box=SMALL):
+    """n points of the box, log-uniform in each group."""
+    return {k: np.exp(rng.uniform(*np.log(box[k]), n)) for k in ("incident_speed", "hertz_damping", "adhesion_damping")}
+
+
+def _judge(y0, c1, c2):
+    """e_n of a dimensional contact with these groups (radius, density, stiffness, w_A drawn at random)."""
+    rng = np.random.default_rng(abs(hash((y0, c1, c2))) % 2**32)
+    contact, v = rd.contact_with_groups("ring", radius=10 ** rng.uniform(-7, -4), density=10 ** rng.uniform(3, 4),
+                                        stiffness=10 ** rng.uniform(8, 11), work_of_adhesion=10 ** rng.uniform(-2, 0),
+                                        incident_speed=y0, hertz_damping=c1, adhesion_damping=c2)
+    with engine_threads(1):  # one small solve: a second thread only waits
+        return float(normal_restitution(contact, [v], rtol=JUDGE_RTOL, family=False)[0])
+
+
+def test_the_table_meets_its_tolerance_at_random_points(table):
+    g = _random_groups(np.random.default_rng(3), 100)
+    e, captured, solve = table.evaluate(g["incident_speed"], g["hertz_damping"], g["adhesion_damping"])
+    assert solve.mean() < 0.05  # only the guard band and failing pieces: a few percent at most
+    want = np.array([_judge(*p) for p in zip(*(g[k][~solve] for k in ("incident_speed", "hertz_damping",
+                                                                       "adhesion_damping")))])
+    assert np.array_equal(captured[~solve], want == 0.0)
+    assert np.max(np.abs(e[~solve] - want)) <= TOL
+    assert 0.0 < table.max_check_error <= TOL
+
+
+def test_just_above_the_capture_speed_the_root_is_resolved(table):
+    """e_n rises like sqrt(y0 - y_c): points within a factor 1.001 above y_c, outside the guard band."""
+    c1, c2 = 4e-3, 0.2
+    contact, u = em._canonical(c1, c2)
+    with engine_threads(1):
+        yc, state, _ = em._capture_speed(c1, c2, SMALL["incident_speed"])
+        y0 = yc * (1.0 + np.geomspace(1e-3, 1e-1, 20))
+        want = normal_restitution(contact, y0 * u, rtol=JUDGE_RTOL, family=False)
+    assert state == em._OK
+    e, captured, solve = table.evaluate(y0, c1, c2)
+    assert not captured.any() and not solve.any()
+    assert np.max(np.abs(e - want)) <= TOL
+    below, _, _ = table.evaluate(yc * 0.99, c1, c2)
+    assert table.evaluate(yc * 0.99, c1, c2)[1] and below == 0.0
+
+
+def test_a_tolerance_below_the_estimates_sends_everything_to_the_solver(table):
+    g = _random_groups(np.random.default_rng(4), 50)
+    e, captured, solve = table.evaluate(g["incident_speed"], g["hertz_damping"], g["adhesion_damping"], tol=1e-14)
+    assert solve[~captured].all()  # a captured point needs no estimate: below the band it is captured
+
+
+def test_restitution_of_many_contacts_against_simulate_impact(table):
+    rng = np.random.default_rng(5)
+    contacts, speeds, inside = [], [], []
+    for k in range(12):
+        g = {n: float(x[0]) for n, x in _random_groups(rng, 1).items()}
+        if k % 4 == 3:
+            g["hertz_damping"] = 0.5  # outside the box: solved
+        c, v = rd.contact_with_groups("ring", radius=10 ** rng.uniform(-6, -5), density=2000.0, stiffness=1e10,
+                                      work_of_adhesion=0.1, **g)
+        contacts.append(c)
+        speeds.append([v, 1.7 * v])  # row i: contact i; the second speed changes C1, C2 (per-impact v_ref)
+        inside.append(k % 4 != 3)
+    r = em.restitution(contacts, np.array(speeds), tol=TOL, domain=SMALL)
+    assert r.e_n.shape == (12, 2)
+    assert r.solved[~np.array(inside)].all()
+    for i, c in enumerate(contacts):
+        for j, v in enumerate(speeds[i]):
+            want = simulate_impact(c, v, rtol=JUDGE_RTOL)
+            assert r.captured[i, j] == (want.outcome == "capture")
+            assert abs(r.e_n[i, j] - want.e_n) <= TOL
+
+
+def test_other_laws_are_solved(table):
+    c = TABLE1_ROW2.with_(adhesion_line_force=0.0)  # the Hertz law: one group, not the ring law's three
+    v = np.array([0.5, 3.0, 30.0])
+    r = em.restitution(c, v, tol=TOL, domain=SMALL)
+    assert r.solved.all()
+    assert np.array_equal(r.e_n, normal_restitution(c, v, rtol=TOL * 1e-2))
+
+
+def test_the_table_is_cached_outside_the_package_and_reloaded(table, tmp_path, monkeypatch):
+    path = em._cache_path(TOL, SMALL)
+    assert path.exists() and path.parent == em.cache_dir()
+    assert "site-packages" not in str(path) and em.__file__ not in str(path.parent)
+    em._LOADED.clear()
+    again = em.ring_emulator(TOL, SMALL)
+    assert again is not table
+    assert all(np.array_equal(again.arrays[k], table.arrays[k]) for k in table.arrays)
+    monkeypatch.setattr(em, "_SETTINGS", em._SETTINGS + ("changed",))
+    assert em._cache_path(TOL, SMALL) != path  # another setting or an edited law: another table
+
+
+def test_cache_dir_follows_the_environment(monkeypatch, tmp_path):
+    monkeypatch.setenv("MICROIMPACT_CACHE", str(tmp_path / "a"))
+    assert em.cache_dir() == tmp_path / "a"
+    monkeypatch.delenv("MICROIMPACT_CACHE")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "x"))
+    assert em.cache_dir() == tmp_path / "x" / "microimpact"
+
+
+@pytest.mark.parametrize("contacts, speeds, error, message", [
+    ([TABLE1_ROW2, TABLE1_ROW2], [1.0, 2.0, 3.0], ValueError, "first axis"),
+    (["not a contact"], [1.0], TypeError, "Contact"),
+    (TABLE1_ROW2, [1.0, -2.0], ValueError, "speeds must be finite numbers > 0"),
+])
+def test_bad_input_is_refused_by_name(contacts, speeds, error, message):
+    with pytest.raises(error, match=message):
+        em.restitution(contacts, speeds, tol=TOL, domain=SMALL)
+
+
+def test_bad_tolerance_is_refused():
+    with pytest.raises(ValueError, match="tol must be"):
+        em.restitution(TABLE1_ROW2, [1.0], tol=0.0)
+
+
+def test_the_table_tolerance_is_the_power_of_ten_below():
+    assert em._table_tolerance(3e-6) == pytest.approx(1e-6, rel=1e-12, abs=0)
+    assert em._table_tolerance(1e-6) == pytest.approx(1e-6, rel=1e-12, abs=0)
+    assert math.isclose(em.surface_tolerance(1e-4), 1e-6)
+
+
+def test_the_canonical_contact_has_the_groups_it_is_given():
+    c, u = em._canonical(2e-3, 0.4)
+    g = rd.groups(c, 3.0 * u)
+    assert [round(x, 12) for x in g.values] == [3.0, 2e-3, 0.4]
+    assert isinstance(c, Contact)
+
+
+def test_the_benchmark_measures_both_side_by_side(table):
+    out = bench.run_emulator_benchmark(contacts=4, impacts=3, tol=TOL, seed=2, repeats=1, domain=SMALL)
+    assert out["impacts"] == 12 and out["tol"] == TOL
+    assert set(out["time_per_impact_s"]) == {"emulator", "table_kernel", "solver"}
+    assert out["max_error_e_n"]["emulator"] <= TOL  # the table where it decides, the solver elsewhere
+    assert out["outcome_disagreements"]["emulator"] == 0
+    assert out["speed_ratio_solver_over_emulator"] > 0.0
+
+
+@pytest.mark.parametrize("args, message", [(["--contacts", "0"], "must be >= 1"), (["--tol", "2"], "--tol must lie")])
+def test_the_benchmark_command_refuses_bad_options(args, message, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        bench.main(args)
+    assert exit_.value.code == 2 and message in capsys.readouterr().err
