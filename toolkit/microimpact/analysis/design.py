@@ -151,7 +151,9 @@ class ExperimentDesign:
     parameters : tuple of str
         The parameters the design narrows.
     values : dict
-        The parameter values the sensitivities are taken at. [-], [-], [J/m^2]
+        The parameter values the sensitivities are taken at: the fit's estimates, or, for a parameter
+        the data do not determine, a point inside what they allow (:func:`_reference_value`); the
+        prior's geometric centres. [-], [-], [J/m^2]
     criterion : str
         What was optimised, in words (Fisher information, linearised).
     notes : dict
@@ -276,10 +278,7 @@ def _start(source, prior, material, parameters):
     """(material, values, all parameters modelled, prior information M_0, notes) of a fit or a prior."""
     if source is not None:
         varied = tuple(n for n in PARAMETER_NAMES if n in source.varied or n in parameters)
-        values = dict(source.values)
-        for p in varied:
-            if not values[p] > 0:
-                raise ValueError(f"the fit's {p} is {values[p]!r}: the relative sensitivities need a value > 0")
+        values = {**source.values, **{p: _reference_value(source, p) for p in varied}}
         d = source.data
         sigma = d["sigma"].to_numpy(float) if "sigma" in d.columns else np.full(len(d), np.nan)
         if not np.all(np.isfinite(sigma) & (sigma > 0)) or source.weighting == "none":
@@ -297,6 +296,24 @@ def _start(source, prior, material, parameters):
         raise ValueError(f"the prior needs a range for {', '.join(missing)}")
     varied = tuple(n for n in PARAMETER_NAMES if n in prior or n in parameters)
     return material, values, varied, None
+
+
+def _reference_value(fit, name) -> float:
+    """Where to linearise a fitted parameter: its estimate where the data determine it, else a point
+    inside what the data allow (half the upper bound, twice the lower bound): an estimate at the
+    range's end (zeta_H = 0 when the data prefer no Hertz damping) has no relative scale, and its
+    widths would say nothing."""
+    value = float(fit.values[name])
+    st = fit.identifiability.get(name)
+    if st is None or st.determined:
+        if not value > 0:
+            raise ValueError(f"the fit's {name} is {value!r}: the relative sensitivities need a value > 0")
+        return value
+    if st.status == "upper_bound" and st.upper > 0 and math.isfinite(st.upper):
+        return 0.5 * float(st.upper)
+    if st.status == "lower_bound" and st.lower > 0 and math.isfinite(st.lower):
+        return 2.0 * float(st.lower)
+    return value if value > 0 else 1.0
 
 
 def _prior_information(varied, prior, values, z):
