@@ -367,7 +367,8 @@ def register_design(sub) -> None:
     p.add_argument("--angles", default="0", help="comma-separated incidence angles [deg] (default 0)")
     p.add_argument("--e-n-sigma", type=_positive_float, default=None,
                    help="standard uncertainty of a new e_n (default: the fit's median)")
-    p.add_argument("--speed-sigma", type=_relative_uncertainty, default=0.0, help="relative speed uncertainty (default 0)")
+    p.add_argument("--speed-sigma", type=_relative_uncertainty, default=None,
+                   help="relative standard uncertainty of a set speed (default 0.01)")
     p.add_argument("--n-speeds", type=lambda t: _whole_number(t, 2), default=60, help="candidate speeds (default 60)")
     p.add_argument("--criterion", choices=("A", "D"), default="A", help="A- or D-optimal (default A)")
     _add_rtol(p)

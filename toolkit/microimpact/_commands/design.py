@@ -47,8 +47,9 @@ def _space(args, fit) -> DesignSpace:
     if not (math.isfinite(sigma) and 0 < sigma < 1):
         raise UsageError(f"--e-n-sigma {sigma!r}: a standard uncertainty of e_n in (0, 1)")
     try:
+        given = {} if args.speed_sigma is None else {"speed_sigma": args.speed_sigma}
         return DesignSpace(radii=radii, speed_range=(lo, hi), incidence_deg=angles, e_n_sigma=sigma,
-                           speed_sigma=args.speed_sigma, n_speeds=args.n_speeds)
+                           n_speeds=args.n_speeds, **given)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
 
