@@ -46,7 +46,8 @@ def start_fit(material):
     return _fit(material, r, v, _simulate(material, r, v, rng))
 
 
-SPACE = DesignSpace(radii=(RADIUS,), speed_range=(0.5, 20.0), e_n_sigma=SIGMA, n_speeds=25)
+#: the simulated speeds are exact (speed_sigma 0), so the new points weigh 1 / SIGMA^2
+SPACE = DesignSpace(radii=(RADIUS,), speed_range=(0.5, 20.0), e_n_sigma=SIGMA, speed_sigma=0.0, n_speeds=25)
 
 
 def test_fisher_widths_match_the_gauss_markov_variance_of_a_straight_line():

@@ -9,7 +9,8 @@ import sys
 import numpy as np
 
 from microimpact._commands.common import UsageError
-from microimpact.analysis.design import DESIGN_CRITERIA, DesignSpace, design_impacts, design_template
+from microimpact.analysis.design import (DESIGN_CRITERIA, MAX_CANDIDATE_SPEEDS, MAX_NEW_IMPACTS, DesignSpace,
+                                         design_impacts, design_template)
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit
 from microimpact.io.files import write_csv
 from microimpact.io.paths import check_input_file, check_outputs, print_before_writing, reporting_os_errors
@@ -59,6 +60,9 @@ def run(args) -> int:
     out = check_outputs({"--out": args.out}, {"fit file": fit_path})["--out"] if args.out else None
     if out is not None and not str(out).endswith(".csv"):
         raise UsageError(f"--out {args.out!r}: the template is a CSV file (end it in .csv)")
+    for option, value, most in (("--n", args.n, MAX_NEW_IMPACTS), ("--n-speeds", args.n_speeds, MAX_CANDIDATE_SPEEDS)):
+        if value > most:
+            raise UsageError(f"{option} {value}: at most {most}")
     parameters = tuple(p.strip() for p in args.parameters.split(",") if p.strip())
     bad = [p for p in parameters if p not in PARAMETER_NAMES + ("friction",)]
     if bad or not parameters:

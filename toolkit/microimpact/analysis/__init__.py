@@ -21,7 +21,7 @@ _HOMES = {
     **dict.fromkeys(("AnalystFit", "analyse_impacts", "exclude_rows", "side_by_side", "POSTERIOR_DEFAULTS"), "analyst_fit"),
     **dict.fromkeys(("DesignSpace", "ExperimentDesign", "design_impacts", "fisher_widths", "uniform_design",
                      "restitution_sensitivities", "design_template", "DESIGN_CRITERIA", "SENSITIVITY_FLOOR",
-                     "TEMPLATE_COLUMNS"), "design"),
+                     "TEMPLATE_COLUMNS", "MAX_NEW_IMPACTS", "MAX_CANDIDATE_SPEEDS"), "design"),
     **dict.fromkeys(("split_rhat", "ess_bulk", "RHAT_MAX", "ESS_MIN"), "diagnostics"),
     **dict.fromkeys(("FitResult", "DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
                      "PARAMETER_TABLE_COLUMNS"), "fit_result"),

@@ -64,13 +64,17 @@ from microimpact.solvers import DEFAULT_RTOL
 
 __all__ = ["DesignSpace", "ExperimentDesign", "design_impacts", "fisher_widths", "uniform_design",
            "restitution_sensitivities", "design_template", "DESIGN_CRITERIA", "SENSITIVITY_FLOOR",
-           "TEMPLATE_COLUMNS"]
+           "TEMPLATE_COLUMNS", "MAX_NEW_IMPACTS", "MAX_CANDIDATE_SPEEDS"]
 
 #: the design criteria of :func:`design_impacts`
 DESIGN_CRITERIA = ("A", "D")
 #: a candidate whose |d e_n / d ln theta| / sigma is below this fraction of the largest over the grid
 #: has "no effect" on theta and is never recommended for it (captured impacts have exactly 0)
 SENSITIVITY_FLOOR = 1e-2
+#: most new impacts of one design (a measurement campaign, not a simulation study)
+MAX_NEW_IMPACTS = 1000
+#: most candidate speeds of a design space (the greedy step costs candidates x parameters^3)
+MAX_CANDIDATE_SPEEDS = 2000
 #: prior standard deviation, relative to the estimate, of a parameter the data leave free: a weak
 #: regulariser that keeps the information matrix invertible (its widths then say "not determined")
 WEAK_PRIOR_RELATIVE_SD = 10.0
@@ -126,8 +130,8 @@ class DesignSpace:
             raise ValueError(f"e_n_sigma must be a finite standard uncertainty > 0, got {self.e_n_sigma!r}")
         if not (math.isfinite(self.speed_sigma) and 0 <= self.speed_sigma < 0.5):
             raise ValueError(f"speed_sigma must be a relative uncertainty in [0, 0.5), got {self.speed_sigma!r}")
-        if int(self.n_speeds) < 2:
-            raise ValueError(f"n_speeds must be >= 2, got {self.n_speeds!r}")
+        if not 2 <= int(self.n_speeds) <= MAX_CANDIDATE_SPEEDS:
+            raise ValueError(f"n_speeds must be in [2, {MAX_CANDIDATE_SPEEDS}], got {self.n_speeds!r}")
 
     def candidates(self) -> pd.DataFrame:
         """The candidate grid: radius [m], speed [m/s], incidence_deg [deg], normal_speed [m/s]."""
@@ -244,10 +248,29 @@ def restitution_sensitivities(material, radius, normal_speed, values: dict, para
 def fisher_widths(information, values: dict, parameters, level: float = DEFAULT_LEVEL) -> dict:
     """Expected ``level`` interval widths 2 z sqrt(C_jj) theta_j from a relative information matrix.
 
+    Parameters
+    ----------
+    information : numpy.ndarray
+        Fisher information of the relative parameters ln theta (inverse of their covariance). [-]
+    values : dict
+        theta_j, the scale of each relative parameter. [unit of each parameter]
+    parameters : sequence of str
+        The rows and columns of ``information``, in order.
+    level : float
+        Confidence level; z is the normal quantile of (1 + level) / 2. [-]
+
+    Returns
+    -------
+    dict
+        ``{name: width}``. [unit of each parameter]
+
     Examples
     --------
-    >>> fisher_widths(np.diag([100.0]), {"zeta_hertz": 0.5}, ("zeta_hertz",))["zeta_hertz"].round(4)
-    np.float64(0.196)
+    Information 100 in ln theta is a relative standard error of 0.1: at theta = 0.5 the 95 % width
+    is 2 x 1.96 x 0.05:
+
+    >>> round(fisher_widths(np.diag([100.0]), {"zeta_hertz": 0.5}, ("zeta_hertz",))["zeta_hertz"], 4)
+    0.196
     """
     cov = np.linalg.inv(information)
     z = float(stats.norm.ppf(0.5 + level / 2))
@@ -255,9 +278,10 @@ def fisher_widths(information, values: dict, parameters, level: float = DEFAULT_
 
 
 def _criterion(information, named, kind):
-    """The scalar to minimise: A (sum of relative variances) or D (log det) of the named block."""
-    cov = np.linalg.inv(information)[np.ix_(named, named)]
-    return float(np.trace(cov)) if kind == "A" else float(np.linalg.slogdet(cov)[1])
+    """The scalars to minimise, one per matrix of the stack ``information`` (k, p, p): A (sum of the
+    named relative variances) or D (log det of their covariance block)."""
+    cov = np.linalg.inv(information)[:, named][:, :, named]
+    return np.trace(cov, axis1=1, axis2=2) if kind == "A" else np.linalg.slogdet(cov)[1]
 
 
 def uniform_design(space: DesignSpace, n: int) -> pd.DataFrame:
@@ -377,8 +401,8 @@ def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, p
         raise ValueError("give the design space (DesignSpace)")
     if criterion not in DESIGN_CRITERIA:
         raise ValueError(f"criterion must be one of {DESIGN_CRITERIA}, got {criterion!r}")
-    if int(n) < 1:
-        raise ValueError(f"the number of new impacts must be >= 1, got {n!r}")
+    if not 1 <= int(n) <= MAX_NEW_IMPACTS:
+        raise ValueError(f"the number of new impacts must be in [1, {MAX_NEW_IMPACTS}], got {n!r}")
     wanted = tuple(parameters)
     unknown = [p for p in wanted if p not in PARAMETER_NAMES + ("friction",)]
     if unknown or not wanted:
@@ -429,11 +453,9 @@ def _greedy(info0, gw, named, admissible, n, kind, cand, e, varied, values):
                          "(all captured, or below the sensitivity floor): widen the speed range or the sizes")
     info, chosen, reasons, path = info0.copy(), [], [], []
     for _ in range(int(n)):
-        best, best_value = -1, math.inf
-        for i in np.flatnonzero(admissible):
-            value = _criterion(info + np.outer(gw[i], gw[i]), named, kind)
-            if value < best_value:
-                best, best_value = int(i), value
+        options = np.flatnonzero(admissible)
+        scores = _criterion(info[None] + gw[options, :, None] * gw[options, None, :], named, kind)
+        best = int(options[np.argmin(scores)])
         before = fisher_widths(info, values, varied)
         info = info + np.outer(gw[best], gw[best])
         after = fisher_widths(info, values, varied)
@@ -520,8 +542,9 @@ def design_template(design: ExperimentDesign, e_n_sigma: float) -> pd.DataFrame:
     >>> rows = pd.DataFrame({"id": ["design-001"], "radius": [3.45e-6], "speed": [2.0], "incidence_deg": [0.0],
     ...                      "normal_speed": [2.0], "e_n_expected": [0.5], "reason": ["why"]})
     >>> d = ExperimentDesign(rows, pd.DataFrame(), ("zeta_hertz",), {}, "Fisher")
-    >>> design_template(d, 0.02).iloc[0].tolist()
-    ['design-001', 3.45, 2.0, 0.0, '', 0.02, 'why']
+    >>> t = design_template(d, 0.02)
+    >>> list(t.columns) == list(TEMPLATE_COLUMNS), round(float(t["radius [um]"].iloc[0]), 6), t["e_n [1]"].iloc[0]
+    (True, 3.45, '')
     """
     r = design.rows
     return pd.DataFrame({TEMPLATE_COLUMNS[0]: r["id"], TEMPLATE_COLUMNS[1]: r["radius"] * 1e6,
