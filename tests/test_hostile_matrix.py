@@ -39,13 +39,15 @@ COMMANDS = {
                       {"INPUT": ("contact.lmp", "in"), "--out": ("v.csv", "out")}),
     "lammps-fit": (["lammps", "fit", "{DATA}", "--config", "{--config}", "--out", "{--out}"],
                    {"DATA": ("data.csv", "in"), "--config": ("m.yaml", "in"), "--out": ("c.lmp", "out")}),
+    "design": (["design", "{FIT}", "--n", "2", "--n-speeds", "5", "--out", "{--out}"],
+               {"FIT": ("fit.nc", "in"), "--out": ("d.csv", "out")}),
     # flags reading a posterior: for the wrong kinds only (a posterior's collisions: test_hostile_cli.py)
     "flags-posterior": (["flags", "data.csv", "--fit", "fit.nc", "--posterior", "{--posterior}", "--out", "o.csv"],
                         {"--posterior": ("notfit.nc", "in")}),
 }
 
 #: how the error names each option (the positional inputs have no option name)
-NAMES = {"DATA": "data file", "RESULT": "RESULT", "INPUT": "input file"}
+NAMES = {"DATA": "data file", "RESULT": "RESULT", "INPUT": "input file", "FIT": "fit file"}
 
 
 def _argv(command: str, values: dict) -> list[str]:
@@ -88,7 +90,8 @@ FILE_INPUTS = [("fit", "DATA", {"csv"}), ("flags", "DATA", {"csv"}), ("flags", "
                ("flags", "--config", {"yaml"}), ("plot", "RESULT", {"fit", "sweep", "flags"}),
                ("flags-posterior", "--posterior", set()), ("lammps-export", "--fit", {"fit"}),
                ("lammps-verify", "INPUT", set()), ("lammps-fit", "DATA", {"csv"}), ("lammps-fit", "--config", {"yaml"}),
-               ("compare", "DATA", {"csv"}), ("compare", "--config", {"yaml"})]
+               ("compare", "DATA", {"csv"}), ("compare", "--config", {"yaml"}),
+               ("design", "FIT", {"fit"})]
 WRONG_KIND = [(c, o, kind) for c, o, ok in FILE_INPUTS for kind in KINDS if kind not in ok]
 
 
@@ -137,6 +140,8 @@ HUGE += [(["fit", "data.csv", "--out", "f.nc", "--posterior", "p.nc", option, n]
 HUGE += [(["fit", "data.csv", "--out", "f.nc", "--posterior", "p.nc", "--seed", n], "--seed")
          for n in ("2147483648", "9" * 40)]
 HUGE += [(["target", "--e-n", "0.5", "--speed", "2", "--points", n, "--out", "t.csv"], "--points")
+         for n in ("1000000000000", "9" * 30)]
+HUGE += [(["design", "fit.nc", option, n, "--out", "d.csv"], option) for option in ("--n", "--n-speeds")
          for n in ("1000000000000", "9" * 30)]
 HUGE += [(["plot", "fit.nc", "--out", "p.png", "--dpi", n], "--dpi") for n in ("1e7", "1e300")]
 HUGE += [(["fit", "data.csv", "--out", "f.nc", option, "5"], option)  # sampler counts without a sampler

@@ -1,4 +1,4 @@
-"""Command line: ``microimpact simulate | sweep | fit | compare | flags | target | reproduce | benchmark | plot | workflow | lammps``.
+"""Command line: ``microimpact simulate | sweep | fit | compare | flags | target | design | reproduce | benchmark | plot | workflow | lammps``.
 
 Thin: parse, call the library, print or write. Exit statuses: 0 success; 2 bad arguments, inputs
 or a solver failure (one line ``microimpact: error: ...`` on stderr); 3 the computation ran past
@@ -214,7 +214,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_handler("simulate"))
 
-    for register in (register_sweep, register_fit, register_compare, register_flags, register_target, register_reproduce,
+    for register in (register_sweep, register_fit, register_compare, register_flags, register_target, register_design,
+                     register_reproduce,
                      register_benchmark, register_plot, register_workflow, register_lammps):
         register(sub)
     return parser
@@ -374,6 +375,29 @@ def register_target(sub) -> None:
     p.add_argument("--out", default=None, help="write the curve(s): .csv (one row per point) or .nc; default: print CSV")
     _add_time_budget(p)
     p.set_defaults(func=_handler("target"))
+
+
+def register_design(sub) -> None:
+    """``microimpact design FIT.nc --n 20 --out design.csv``: the next impacts to measure (microimpact.analysis.design)."""
+    p = sub.add_parser("design", help="the next impacts to measure to narrow the fitted damping (Fisher information); "
+                                      "a measured-impact CSV template")
+    p.add_argument("fit", help="fit NetCDF written by 'microimpact fit --out'")
+    p.add_argument("--n", type=lambda t: _whole_number(t, 1), default=20, help="number of new impacts (default 20)")
+    p.add_argument("--parameters", default="zeta_hertz",
+                   help="comma-separated parameters to narrow: zeta_hertz, zeta_adhesion, work_of_adhesion, friction "
+                        "(a note only: e_n does not depend on it); default zeta_hertz")
+    p.add_argument("--speeds", default=None, metavar="MIN:MAX", help="incident speeds that can be set [m/s] (default: the fit's range)")
+    p.add_argument("--radii", default=None, help="comma-separated sphere radii [m] (default: the fit's)")
+    p.add_argument("--angles", default="0", help="comma-separated incidence angles [deg] (default 0)")
+    p.add_argument("--e-n-sigma", type=_positive_float, default=None,
+                   help="standard uncertainty of a new e_n (default: the fit's median)")
+    p.add_argument("--speed-sigma", type=_relative_uncertainty, default=None,
+                   help="relative standard uncertainty of a set speed (default 0.01)")
+    p.add_argument("--n-speeds", type=lambda t: _whole_number(t, 2), default=60, help="candidate speeds (default 60)")
+    p.add_argument("--criterion", choices=("A", "D"), default="A", help="A- or D-optimal (default A)")
+    _add_rtol(p)
+    p.add_argument("--out", default=None, help="write the CSV template of the recommended impacts (e_n empty)")
+    p.set_defaults(func=_handler("design"))
 
 
 def register_sweep(sub) -> None:

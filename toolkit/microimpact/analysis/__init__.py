@@ -4,6 +4,7 @@
 - :mod:`.fit_result`: the one save/load protocol of every fit result (:class:`FitResult`), and the
   damping fit's result record (:class:`DampingFit`), its NetCDF form and its formatter; reading a
   fit needs no lmfit.
+- :mod:`.design`: the next impacts to measure to narrow named parameters (Fisher information).
 - :mod:`.flags`: which measurements unmeasured spin, angle error or closeness to capture make
   unreliable.
 - :mod:`.kharaz`: the model against the Kharaz et al. (2001) oblique-impact measurements.
@@ -21,6 +22,9 @@ from microimpact._lazy import lazy_exports as _lazy_exports
 #: that this table holds every module's ``__all__``)
 _HOMES = {
     **dict.fromkeys(("AnalystFit", "analyse_impacts", "exclude_rows", "side_by_side", "POSTERIOR_DEFAULTS"), "analyst_fit"),
+    **dict.fromkeys(("DesignSpace", "ExperimentDesign", "design_impacts", "fisher_widths", "uniform_design",
+                     "restitution_sensitivities", "design_template", "DESIGN_CRITERIA", "SENSITIVITY_FLOOR",
+                     "TEMPLATE_COLUMNS", "MAX_NEW_IMPACTS", "MAX_CANDIDATE_SPEEDS"), "design"),
     **dict.fromkeys(("split_rhat", "ess_bulk", "RHAT_MAX", "ESS_MIN"), "diagnostics"),
     **dict.fromkeys(("FitResult", "DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
                      "PARAMETER_TABLE_COLUMNS"), "fit_result"),

@@ -1,0 +1,553 @@
+"""What to measure next: the impacts that most narrow the intervals of named damping parameters.
+
+From a damping fit (:class:`~microimpact.analysis.fit_result.DampingFit`, the ``fit.nc`` of
+``microimpact fit --out``) or from prior ranges with a material, and the space a laboratory can
+measure (a speed range, incidence angles, size classes, the noise of e_n), :func:`design_impacts`
+picks the next N impacts one at a time (greedy sequential design over a candidate grid).
+
+Criterion: Fisher information (linearised, nearly linear problem)
+----------------------------------------------------------------
+The expected covariance of the parameters theta after adding impacts c_1 ... c_k is the inverse of
+the Fisher information
+
+    M = M_0 + sum_k g(c_k) g(c_k)^T / sigma_eff(c_k)^2,    g(c) = d e_n(c) / d theta,
+
+with M_0 the information of the data already fitted (at the fit's estimate) or of the prior, and
+sigma_eff^2 = sigma_e^2 + (d e_n / d v_n)^2 sigma_vn^2 the effective variance of the fit (Orear
+1982). This is the linearised (Gauss-Newton) covariance: it is the expected posterior covariance
+only where e_n is nearly linear in theta over the interval, which the profile intervals of the fit
+may contradict near capture; the output says so (``criterion``). Each step adds the candidate that
+most reduces the A-criterion (sum of the named parameters' relative variances) or the D-criterion
+(log-determinant of their block of the covariance); the expected 95 % interval width of a
+parameter is 2 z_0.975 sqrt(C_jj).
+
+The sensitivities g are central differences of the solver's e_n (:func:`model_restitution`) with
+relative step h = rtol^(1/3): the truncation error of a central difference is O(h^2), the solver's
+error O(rtol / h), and h = rtol^(1/3) balances them (Press et al. 2007, Numerical Recipes 3rd ed.,
+section 5.7).
+
+Identifiability first
+---------------------
+A parameter that the current data do not determine (the fit's
+:mod:`~microimpact.analysis.identifiability` status) gets a sentence saying where e_n responds to
+it. A candidate whose e_n does not respond to a named parameter (sensitivity below
+:data:`SENSITIVITY_FLOOR` of the largest over the grid, e.g. every captured impact, where e_n = 0
+whatever the damping) is never recommended. Friction: e_n does not depend on it (the normal motion
+is decoupled from the tangential, Cheng, Brach & Dunn 2002, Eqs. (16)-(20)); the output names the
+impacts of the grid that slide throughout the contact (f < f* = 2 m |u_0| / (7 J), J the friction
+impulse of the normal solve), where a rebound angle or tangential restitution measures f.
+
+References
+----------
+* Fedorov, V. V. (1972). Theory of Optimal Experiments. Academic Press (A- and D-optimal designs).
+* Atkinson, A. C., Donev, A. N. & Tobias, R. D. (2007). Optimum Experimental Designs, with SAS.
+  Oxford University Press, ch. 10-11 (sequential construction, D_s-optimality).
+* Orear, J. (1982). Least squares when both variables have uncertainties. Am. J. Phys. 50, 912.
+  doi:10.1119/1.12972
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from microimpact.analysis.fit_result import PARAMETER_NAMES
+from microimpact.analysis.fitting import FitProblem, model_restitution
+from microimpact.analysis.oblique import normal_impulses
+from microimpact.io.materials import material_contact
+from microimpact.io.statuses import DEFAULT_LEVEL
+from microimpact.solvers import DEFAULT_RTOL
+
+__all__ = ["DesignSpace", "ExperimentDesign", "design_impacts", "fisher_widths", "uniform_design",
+           "restitution_sensitivities", "design_template", "DESIGN_CRITERIA", "SENSITIVITY_FLOOR",
+           "TEMPLATE_COLUMNS", "MAX_NEW_IMPACTS", "MAX_CANDIDATE_SPEEDS"]
+
+#: the design criteria of :func:`design_impacts`
+DESIGN_CRITERIA = ("A", "D")
+#: a candidate whose |d e_n / d ln theta| / sigma is below this fraction of the largest over the grid
+#: has "no effect" on theta and is never recommended for it (captured impacts have exactly 0)
+SENSITIVITY_FLOOR = 1e-2
+#: most new impacts of one design (a measurement campaign, not a simulation study)
+MAX_NEW_IMPACTS = 1000
+#: most candidate speeds of a design space (the greedy step costs candidates x parameters^3)
+MAX_CANDIDATE_SPEEDS = 2000
+#: prior standard deviation, relative to the estimate, of a parameter the data leave free: a weak
+#: regulariser that keeps the information matrix invertible (its widths then say "not determined")
+WEAK_PRIOR_RELATIVE_SD = 10.0
+#: columns of the CSV template (the measured-impact format, data/README.md); e_n and its
+#: uncertainty are left empty for the laboratory to fill in
+TEMPLATE_COLUMNS = ("id", "radius [um]", "speed [m/s]", "incidence_angle [deg]", "e_n [1]", "e_n_uncertainty [1]",
+                    "reason")
+
+
+@dataclass(frozen=True)
+class DesignSpace:
+    """What the laboratory can measure.
+
+    Attributes
+    ----------
+    radii : tuple of float
+        Size classes (sphere radii). [m]
+    speed_range : (float, float)
+        Incident speeds that can be set. [m/s]
+    incidence_deg : tuple of float
+        Incidence angles from the normal that can be set. [deg]
+    e_n_sigma : float
+        Standard uncertainty of a measured e_n. [-]
+    speed_sigma : float
+        Relative standard uncertainty of the incident speed (0: none). [-] The default, 1 %, is
+        that of the bundled synthetic data; it matters near capture, where e_n rises steeply with
+        v_n and a point would otherwise look far more informative than a measurement there is.
+    n_speeds : int
+        Log-spaced candidate speeds over ``speed_range``.
+
+    Examples
+    --------
+    >>> DesignSpace(radii=(3.45e-6,), speed_range=(0.5, 20.0)).candidates().shape
+    (60, 4)
+    """
+
+    radii: tuple
+    speed_range: tuple = (0.5, 20.0)
+    incidence_deg: tuple = (0.0,)
+    e_n_sigma: float = 0.02
+    speed_sigma: float = 0.01
+    n_speeds: int = 60
+
+    def __post_init__(self):
+        lo, hi = (float(x) for x in self.speed_range)
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
+            raise ValueError(f"speed_range must be two speeds 0 < min < max [m/s], got {self.speed_range!r}")
+        if not self.radii or not all(math.isfinite(r) and r > 0 for r in self.radii):
+            raise ValueError(f"radii must be one or more finite radii > 0 [m], got {self.radii!r}")
+        if not self.incidence_deg or not all(0 <= a < 90 for a in self.incidence_deg):
+            raise ValueError(f"incidence angles must lie in [0, 90) deg, got {self.incidence_deg!r}")
+        if not (math.isfinite(self.e_n_sigma) and self.e_n_sigma > 0):
+            raise ValueError(f"e_n_sigma must be a finite standard uncertainty > 0, got {self.e_n_sigma!r}")
+        if not (math.isfinite(self.speed_sigma) and 0 <= self.speed_sigma < 0.5):
+            raise ValueError(f"speed_sigma must be a relative uncertainty in [0, 0.5), got {self.speed_sigma!r}")
+        if not 2 <= int(self.n_speeds) <= MAX_CANDIDATE_SPEEDS:
+            raise ValueError(f"n_speeds must be in [2, {MAX_CANDIDATE_SPEEDS}], got {self.n_speeds!r}")
+
+    def candidates(self) -> pd.DataFrame:
+        """The candidate grid: radius [m], speed [m/s], incidence_deg [deg], normal_speed [m/s]."""
+        speeds = np.geomspace(self.speed_range[0], self.speed_range[1], int(self.n_speeds))
+        r, v, a = (x.ravel() for x in np.meshgrid(np.asarray(self.radii, float), speeds,
+                                                  np.asarray(self.incidence_deg, float), indexing="ij"))
+        return pd.DataFrame({"radius": r, "speed": v, "incidence_deg": a, "normal_speed": v * np.cos(np.radians(a))})
+
+
+@dataclass(frozen=True)
+class ExperimentDesign:
+    """Result of :func:`design_impacts`.
+
+    Attributes
+    ----------
+    rows : pandas.DataFrame
+        The recommended impacts in the order chosen: ``id``, ``radius`` [m], ``speed`` [m/s],
+        ``incidence_deg`` [deg], ``normal_speed`` [m/s], ``e_n_expected`` [-], ``reason`` (one line).
+    widths : pandas.DataFrame
+        Expected 95 % interval width of each named parameter after 0 ... N new impacts, for the
+        recommended design (``design``) and for N impacts spread uniformly over the same space
+        (``uniform``): columns ``n_new``, ``parameter``, ``design``, ``uniform`` [unit of the parameter].
+    parameters : tuple of str
+        The parameters the design narrows.
+    values : dict
+        The parameter values the sensitivities are taken at: the fit's estimates, or, for a parameter
+        the data do not determine, a point inside what they allow (:func:`_reference_value`); the
+        prior's geometric centres. [-], [-], [J/m^2]
+    criterion : str
+        What was optimised, in words (Fisher information, linearised).
+    notes : dict
+        ``{parameter: sentence}``: identifiability of each named parameter (and friction) and what
+        would determine it.
+    """
+
+    rows: pd.DataFrame
+    widths: pd.DataFrame
+    parameters: tuple
+    values: dict
+    criterion: str
+    notes: dict = field(default_factory=dict)
+
+    def width(self, parameter: str, n_new: int | None = None, which: str = "design") -> float:
+        """Expected 95 % width of ``parameter`` after ``n_new`` (default all) new impacts."""
+        w = self.widths[self.widths["parameter"] == parameter]
+        n = int(w["n_new"].max()) if n_new is None else n_new
+        return float(w.loc[w["n_new"] == n, which].iloc[0])
+
+    def summary(self) -> str:
+        """Lines for a terminal: the criterion, the notes, the widths before and after."""
+        lines = [f"criterion: {self.criterion}"]
+        lines += [f"{k}: {v}" for k, v in self.notes.items()]
+        for p in self.parameters:
+            lines.append(f"{p}: expected 95 % width {self.width(p, 0):.4g} now, {self.width(p):.4g} after "
+                         f"{len(self.rows)} recommended impacts ({self.width(p, which='uniform'):.4g} if uniform)")
+        return "\n".join(lines)
+
+
+def restitution_sensitivities(material, radius, normal_speed, values: dict, parameters, *, rtol=DEFAULT_RTOL):
+    """e_n and its derivatives by the relative parameters and by the normal speed.
+
+    Parameters
+    ----------
+    material : MaterialPair, Contact or DampingFit
+    radius, normal_speed : array_like
+        Of each impact. [m], [m/s]
+    values : dict
+        ``zeta_hertz`` [-], ``zeta_adhesion`` [-], ``work_of_adhesion`` [J/m^2].
+    parameters : sequence of str
+        Names among :data:`PARAMETER_NAMES` to differentiate by.
+    rtol : float
+        Relative tolerance of the normal solves; the relative step is rtol^(1/3). [-]
+
+    Returns
+    -------
+    (e_n, gradient, slope)
+        e_n [-]; gradient[i, j] = d e_n,i / d ln theta_j (a change of e_n per 100 % change of
+        theta_j) [-]; slope = d e_n / d v_n [s/m].
+
+    Examples
+    --------
+    A captured impact (1 m/s at 2 um, Table 1) does not respond to the damping:
+
+    >>> from microimpact.io import default_materials_path, read_materials
+    >>> m = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> vals = {"zeta_hertz": 0.5, "zeta_adhesion": 29.0, "work_of_adhesion": 0.215834}
+    >>> e, g, s = restitution_sensitivities(m, [2e-6, 2e-6], [1.0, 10.0], vals, ("zeta_hertz",))
+    >>> float(e[0]), float(g[0, 0]), bool(g[1, 0] < 0)
+    (0.0, 0.0, True)
+    """
+    problem = FitProblem.from_arrays(radius, normal_speed, material)
+    h = float(rtol) ** (1.0 / 3.0)
+    base = {k: float(values[k]) for k in PARAMETER_NAMES}
+
+    def e_at(**changes):
+        p = {**base, **changes}
+        return model_restitution(problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=rtol)
+
+    e = e_at()
+    grad = np.empty((e.size, len(parameters)))
+    for j, name in enumerate(parameters):
+        x = base[name]
+        step = h * x if x > 0 else h
+        up, dn = e_at(**{name: x + step}), e_at(**{name: max(x - step, 0.0)})
+        grad[:, j] = (up - dn) / ((x + step) - max(x - step, 0.0)) * (x if x > 0 else 1.0)
+    up = model_restitution(problem, base["zeta_hertz"], base["zeta_adhesion"], base["work_of_adhesion"], rtol=rtol,
+                           speed_factor=1 + h)
+    dn = model_restitution(problem, base["zeta_hertz"], base["zeta_adhesion"], base["work_of_adhesion"], rtol=rtol,
+                           speed_factor=1 - h)
+    slope = (up - dn) / (2 * h * problem.normal_speed)
+    return e, grad, slope
+
+
+def fisher_widths(information, values: dict, parameters, level: float = DEFAULT_LEVEL) -> dict:
+    """Expected ``level`` interval widths 2 z sqrt(C_jj) theta_j from a relative information matrix.
+
+    Parameters
+    ----------
+    information : numpy.ndarray
+        Fisher information of the relative parameters ln theta (inverse of their covariance). [-]
+    values : dict
+        theta_j, the scale of each relative parameter. [unit of each parameter]
+    parameters : sequence of str
+        The rows and columns of ``information``, in order.
+    level : float
+        Confidence level; z is the normal quantile of (1 + level) / 2. [-]
+
+    Returns
+    -------
+    dict
+        ``{name: width}``. [unit of each parameter]
+
+    Examples
+    --------
+    Information 100 in ln theta is a relative standard error of 0.1: at theta = 0.5 the 95 % width
+    is 2 x 1.96 x 0.05:
+
+    >>> round(fisher_widths(np.diag([100.0]), {"zeta_hertz": 0.5}, ("zeta_hertz",))["zeta_hertz"], 4)
+    0.196
+    """
+    cov = np.linalg.inv(information)
+    z = float(stats.norm.ppf(0.5 + level / 2))
+    return {p: 2 * z * math.sqrt(max(cov[j, j], 0.0)) * abs(values[p]) for j, p in enumerate(parameters)}
+
+
+def _criterion(information, named, kind):
+    """The scalars to minimise, one per matrix of the stack ``information`` (k, p, p): A (sum of the
+    named relative variances) or D (log det of their covariance block)."""
+    cov = np.linalg.inv(information)[:, named][:, :, named]
+    return np.trace(cov, axis1=1, axis2=2) if kind == "A" else np.linalg.slogdet(cov)[1]
+
+
+def uniform_design(space: DesignSpace, n: int) -> pd.DataFrame:
+    """``n`` impacts spread evenly: log-spaced speeds over the range, size classes and angles cycled.
+
+    Examples
+    --------
+    >>> uniform_design(DesignSpace(radii=(1e-6, 2e-6)), 4)["radius"].tolist()
+    [1e-06, 2e-06, 1e-06, 2e-06]
+    """
+    k = np.arange(n)
+    speeds = np.geomspace(space.speed_range[0], space.speed_range[1], max(n, 1))[:n]
+    radii = np.asarray(space.radii, float)[k % len(space.radii)]
+    angles = np.asarray(space.incidence_deg, float)[(k // len(space.radii)) % len(space.incidence_deg)]
+    return pd.DataFrame({"radius": radii, "speed": speeds, "incidence_deg": angles,
+                         "normal_speed": speeds * np.cos(np.radians(angles))})
+
+
+def _start(source, prior, material, parameters):
+    """(material, values, all parameters modelled, prior information M_0, notes) of a fit or a prior."""
+    if source is not None:
+        varied = tuple(n for n in PARAMETER_NAMES if n in source.varied or n in parameters)
+        values = {**source.values, **{p: _reference_value(source, p) for p in varied}}
+        d = source.data
+        sigma = d["sigma"].to_numpy(float) if "sigma" in d.columns else np.full(len(d), np.nan)
+        if not np.all(np.isfinite(sigma) & (sigma > 0)) or source.weighting == "none":
+            sigma = np.full(len(d), math.sqrt(max(source.redchi, 1e-12)))  # unweighted: the scatter estimates sigma
+        return source, values, varied, (d["radius"].to_numpy(float), d["normal_speed"].to_numpy(float), sigma)
+    if material is None or not prior:
+        raise ValueError("give a fit, or prior ranges with a material")
+    values = {"zeta_hertz": math.nan, "zeta_adhesion": math.nan, "work_of_adhesion": float(material.work_of_adhesion)}
+    for name, (lo, hi) in prior.items():
+        if name not in PARAMETER_NAMES or not (0 < lo < hi and math.isfinite(hi)):
+            raise ValueError(f"prior range of {name!r}: give a parameter of {PARAMETER_NAMES} and 0 < min < max")
+        values[name] = math.sqrt(lo * hi)  # the range's geometric centre
+    missing = [n for n in ("zeta_hertz", "zeta_adhesion") if not math.isfinite(values[n])]
+    if missing:
+        raise ValueError(f"the prior needs a range for {', '.join(missing)}")
+    varied = tuple(n for n in PARAMETER_NAMES if n in prior or n in parameters)
+    return material, values, varied, None
+
+
+def _reference_value(fit, name) -> float:
+    """Where to linearise a fitted parameter: its estimate where the data determine it, else a point
+    inside what the data allow (half the upper bound, twice the lower bound): an estimate at the
+    range's end (zeta_H = 0 when the data prefer no Hertz damping) has no relative scale, and its
+    widths would say nothing."""
+    value = float(fit.values[name])
+    st = fit.identifiability.get(name)
+    if st is None or st.determined:
+        if not value > 0:
+            raise ValueError(f"the fit's {name} is {value!r}: the relative sensitivities need a value > 0")
+        return value
+    if st.status == "upper_bound" and st.upper > 0 and math.isfinite(st.upper):
+        return 0.5 * float(st.upper)
+    if st.status == "lower_bound" and st.lower > 0 and math.isfinite(st.lower):
+        return 2.0 * float(st.lower)
+    return value if value > 0 else 1.0
+
+
+def _prior_information(varied, prior, values, z):
+    """Information of the prior: a range [lo, hi] is a +/- z interval in ln theta; a weak prior elsewhere."""
+    sd = []
+    for p in varied:
+        if prior and p in prior:
+            lo, hi = prior[p]
+            sd.append(math.log(hi / lo) / (2 * z))
+        else:
+            sd.append(WEAK_PRIOR_RELATIVE_SD)
+    return np.diag(1.0 / np.square(sd))
+
+
+def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, parameters=("zeta_hertz",),
+                   prior: dict | None = None, material=None, criterion: str = "A", rtol: float = DEFAULT_RTOL,
+                   friction_range: tuple = (0.05, 1.0)) -> ExperimentDesign:
+    """The next ``n`` impacts that most reduce the expected 95 % intervals of ``parameters``.
+
+    Parameters
+    ----------
+    fit : DampingFit, optional
+        The current fit (:meth:`DampingFit.load` of a ``fit.nc``); its data's information is M_0.
+    space : DesignSpace
+        What can be measured.
+    n : int
+        Number of new impacts.
+    parameters : sequence of str
+        The parameters to narrow, among :data:`PARAMETER_NAMES`; ``"friction"`` gets a note only
+        (e_n does not depend on it).
+    prior : dict, optional
+        ``{name: (min, max)}`` without a fit: each range is read as a 95 % interval of ln theta.
+    material : MaterialPair, optional
+        The material, without a fit (density, stiffness, w_A).
+    criterion : {"A", "D"}
+        A-optimal (sum of relative variances) or D_s-optimal (log det of their covariance block).
+    rtol : float
+        Relative tolerance of the normal solves (and of the finite-difference step). [-]
+    friction_range : (float, float)
+        Coulomb coefficients for the friction note. [-]
+
+    Returns
+    -------
+    ExperimentDesign
+
+    Examples
+    --------
+    From a prior on the damping of Table 1's material, 4 impacts that narrow zeta_H: none is captured:
+
+    >>> from microimpact.io import default_materials_path, read_materials
+    >>> m = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> space = DesignSpace(radii=(3.45e-6,), speed_range=(0.5, 20.0), n_speeds=20)
+    >>> d = design_impacts(None, space, 4, prior={"zeta_hertz": (0.1, 2.0), "zeta_adhesion": (10.0, 80.0)},
+    ...                    material=m)
+    >>> bool((d.rows["e_n_expected"] > 0).all()), d.width("zeta_hertz") < d.width("zeta_hertz", which="uniform")
+    (True, True)
+    """
+    if space is None:
+        raise ValueError("give the design space (DesignSpace)")
+    if criterion not in DESIGN_CRITERIA:
+        raise ValueError(f"criterion must be one of {DESIGN_CRITERIA}, got {criterion!r}")
+    if not 1 <= int(n) <= MAX_NEW_IMPACTS:
+        raise ValueError(f"the number of new impacts must be in [1, {MAX_NEW_IMPACTS}], got {n!r}")
+    wanted = tuple(parameters)
+    unknown = [p for p in wanted if p not in PARAMETER_NAMES + ("friction",)]
+    if unknown or not wanted:
+        raise ValueError(f"parameters must be among {PARAMETER_NAMES + ('friction',)}, got {list(wanted)!r}")
+    damping = tuple(p for p in wanted if p != "friction")
+    base, values, varied, existing = _start(fit, prior, material, damping)
+    z = float(stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2))
+    info0 = _prior_information(varied, prior if fit is None else None, values, z)
+    if existing is not None:
+        _, g0, s0 = restitution_sensitivities(base, existing[0], existing[1], values, varied, rtol=rtol)
+        info0 = info0 + (g0 / existing[2][:, None]).T @ (g0 / existing[2][:, None])
+    cand = space.candidates()
+    e, g, slope = restitution_sensitivities(base, cand["radius"], cand["normal_speed"], values, varied, rtol=rtol)
+    sigma = np.sqrt(space.e_n_sigma ** 2 + (slope * space.speed_sigma * cand["normal_speed"].to_numpy()) ** 2)
+    notes = _notes(fit, damping, varied, g, sigma, cand, space)
+    if "friction" in wanted:
+        notes["friction"] = _friction_note(base, values, cand, friction_range, rtol)
+    if not damping:
+        empty = pd.DataFrame(columns=["n_new", "parameter", "design", "uniform"])
+        return ExperimentDesign(_rows(cand.iloc[[]], e[:0], []), empty, wanted, values, _CRITERION_TEXT[criterion], notes)
+    named = [varied.index(p) for p in damping]
+    chosen, reasons, info_path = _greedy(info0, g / sigma[:, None], named, _admissible(g, sigma, named), n, criterion,
+                                         cand, e, varied, values)
+    uni = uniform_design(space, int(n))
+    _, gu, su = restitution_sensitivities(base, uni["radius"], uni["normal_speed"], values, varied, rtol=rtol)
+    su = np.sqrt(space.e_n_sigma ** 2 + (su * space.speed_sigma * uni["normal_speed"].to_numpy()) ** 2)
+    widths = _width_table(info0, info_path, gu / su[:, None], values, varied, damping)
+    return ExperimentDesign(_rows(cand.iloc[chosen], e[chosen], reasons), widths, damping, values,
+                            _CRITERION_TEXT[criterion], notes)
+
+
+_CRITERION_TEXT = {k: f"Fisher information (linearised covariance, valid where e_n is nearly linear in the parameters "
+                      f"over their intervals); greedy sequential {k}-optimal selection over the candidate grid"
+                   for k in DESIGN_CRITERIA}
+
+
+def _admissible(g, sigma, named):
+    """Candidates where e_n responds to every named parameter (above SENSITIVITY_FLOOR of the grid's largest)."""
+    s = np.abs(g[:, named]) / sigma[:, None]
+    top = s.max(axis=0)
+    return np.all((s > SENSITIVITY_FLOOR * top) & (top > 0), axis=1)
+
+
+def _greedy(info0, gw, named, admissible, n, kind, cand, e, varied, values):
+    """Indices chosen one at a time, each the admissible candidate of least criterion; reasons; M after each."""
+    if not admissible.any():
+        raise ValueError("no candidate impact of the design space responds to the named parameters "
+                         "(all captured, or below the sensitivity floor): widen the speed range or the sizes")
+    info, chosen, reasons, path = info0.copy(), [], [], []
+    for _ in range(int(n)):
+        options = np.flatnonzero(admissible)
+        scores = _criterion(info[None] + gw[options, :, None] * gw[options, None, :], named, kind)
+        best = int(options[np.argmin(scores)])
+        before = fisher_widths(info, values, varied)
+        info = info + np.outer(gw[best], gw[best])
+        after = fisher_widths(info, values, varied)
+        lead = max(named, key=lambda j: abs(gw[best, j]))
+        reasons.append(f"v_n = {cand['normal_speed'].iloc[best]:.3g} m/s, e_n ~ {e[best]:.3f}: "
+                       + ", ".join(f"{varied[j]} width {before[varied[j]]:.3g} -> {after[varied[j]]:.3g}" for j in named)
+                       + f"; e_n moves {abs(gw[best, lead]):.2g} sigma per 100 % of {varied[lead]}")
+        chosen.append(best)
+        path.append(info.copy())
+    return chosen, reasons, path
+
+
+def _width_table(info0, path, gu, values, varied, damping):
+    """Widths after 0 ... N new impacts, recommended and uniform (the first k of the uniform N)."""
+    rows = []
+    uni = info0.copy()
+    for k in range(len(path) + 1):
+        design = fisher_widths(info0 if k == 0 else path[k - 1], values, varied)
+        if k > 0:
+            uni = uni + np.outer(gu[k - 1], gu[k - 1])
+        uniform = fisher_widths(uni, values, varied)
+        rows += [{"n_new": k, "parameter": p, "design": design[p], "uniform": uniform[p]} for p in damping]
+    return pd.DataFrame(rows)
+
+
+def _rows(chosen, e, reasons):
+    return pd.DataFrame({"id": [f"design-{k + 1:03d}" for k in range(len(chosen))],
+                         "radius": chosen["radius"].to_numpy(), "speed": chosen["speed"].to_numpy(),
+                         "incidence_deg": chosen["incidence_deg"].to_numpy(),
+                         "normal_speed": chosen["normal_speed"].to_numpy(), "e_n_expected": np.asarray(e),
+                         "reason": list(reasons)})
+
+
+def _notes(fit, damping, varied, g, sigma, cand, space):
+    """One sentence per named parameter: its status now and the speeds where e_n responds to it most."""
+    notes = {}
+    for p in damping:
+        j = varied.index(p)
+        s = np.abs(g[:, j]) / sigma
+        where = s >= 0.5 * s.max() if s.max() > 0 else np.zeros(s.size, bool)
+        st = fit.identifiability.get(p) if fit is not None else None
+        now = ("not fitted" if st is None else st.describe() if st.determined else
+               f"{st.status.replace('_', ' ')} by the current data ({st.reason})")
+        if not where.any():
+            notes[p] = f"{now}; e_n does not respond to it anywhere in the design space: widen the speed range"
+            continue
+        vn = cand["normal_speed"].to_numpy()[where]
+        radii = sorted({float(r) for r in cand["radius"].to_numpy()[where]})
+        notes[p] = (f"{now}; e_n responds to it most (>= half the largest, up to {s.max():.2g} sigma per 100 % change) "
+                    f"at v_n {vn.min():.3g}-{vn.max():.3g} m/s, radius {', '.join(f'{r * 1e6:.3g} um' for r in radii)};"
+                    f" no impact is recommended where it has no effect (captured: e_n = 0 whatever the damping)")
+    return notes
+
+
+def _friction_note(base, values, cand, friction_range, rtol):
+    """Where the grid's impacts slide throughout the contact, f < f* = 2 m |u_0| / (7 J) (no incident spin)."""
+    fstar = np.zeros(len(cand))
+    for r in np.unique(cand["radius"]):
+        idx = np.flatnonzero(cand["radius"].to_numpy() == r)
+        c = material_contact(base, float(r), zeta_hertz=values["zeta_hertz"], zeta_adhesion=values["zeta_adhesion"],
+                             work_of_adhesion=values["work_of_adhesion"])
+        imp = normal_impulses(c, cand["speed"].to_numpy()[idx], cand["incidence_deg"].to_numpy()[idx], rtol)
+        j = imp["friction_impulse"]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            fstar[idx] = np.where(j > 0, 2.0 * c.mass * np.abs(imp["velocity_in_t"]) / (7.0 * j), 0.0)
+    text = ("e_n does not depend on friction (normal motion decoupled from the tangential, Eqs. (16)-(20)): no e_n "
+            "impact determines it; measure the rebound angle or tangential restitution of impacts that slide")
+    f_ref = float(getattr(base, "friction", 0.0) or 0.0)
+    f_ref = f_ref if friction_range[0] <= f_ref <= friction_range[1] else math.sqrt(friction_range[0] * friction_range[1])
+    slides = fstar > f_ref
+    if not slides.any():
+        return text + f"; no impact of this space slides for f = {f_ref:.2g} (add larger incidence angles)"
+    a, v = cand["incidence_deg"].to_numpy()[slides], cand["speed"].to_numpy()[slides]
+    return text + (f": for f = {f_ref:.2g}, the impacts of this space at {a.min():.3g}-{a.max():.3g} deg and "
+                   f"{v.min():.3g}-{v.max():.3g} m/s slide throughout (f < f* = 2 m |u_0| / (7 J)); the most "
+                   f"slippery of them slides for f up to {min(float(fstar[slides].max()), friction_range[1]):.2g}")
+
+
+def design_template(design: ExperimentDesign, e_n_sigma: float) -> pd.DataFrame:
+    """The recommended rows as a measured-impact CSV table (:data:`TEMPLATE_COLUMNS`), e_n left empty.
+
+    Examples
+    --------
+    >>> rows = pd.DataFrame({"id": ["design-001"], "radius": [3.45e-6], "speed": [2.0], "incidence_deg": [0.0],
+    ...                      "normal_speed": [2.0], "e_n_expected": [0.5], "reason": ["why"]})
+    >>> d = ExperimentDesign(rows, pd.DataFrame(), ("zeta_hertz",), {}, "Fisher")
+    >>> t = design_template(d, 0.02)
+    >>> list(t.columns) == list(TEMPLATE_COLUMNS), round(float(t["radius [um]"].iloc[0]), 6), t["e_n [1]"].iloc[0]
+    (True, 3.45, '')
+    """
+    r = design.rows
+    return pd.DataFrame({TEMPLATE_COLUMNS[0]: r["id"], TEMPLATE_COLUMNS[1]: r["radius"] * 1e6,
+                         TEMPLATE_COLUMNS[2]: r["speed"], TEMPLATE_COLUMNS[3]: r["incidence_deg"],
+                         TEMPLATE_COLUMNS[4]: "", TEMPLATE_COLUMNS[5]: float(e_n_sigma),
+                         TEMPLATE_COLUMNS[6]: r["reason"]})
