@@ -1,7 +1,7 @@
 """The pipeline refuses a config value that cannot work at start-up, before any job runs (issue 12,
 part 5): a dry run (``snakemake -n``) of a copy of the workflow must exit non-zero with a one-line
 reason naming the config key (and the accepted values where there is a list), and create no
-``results/`` directory. The checks live in microimpact.io.workflow_config (config_problem), called by
+``results/`` directory. The checks live in microimpact.studies.workflow_config (config_problem), called by
 workflow/rules/common.smk; one real dry run shows the wiring, the others call the check in-process.
 """
 
@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from microimpact.io.workflow_config import config_problem
+from microimpact.studies.workflow_config import config_problem
 
 REPO = Path(__file__).resolve().parents[1]
 #: the analyst's results of the bundled data (one material pair)

@@ -118,11 +118,11 @@ def materials_path():
 # ---------------------------------------------------------------- start-up checks
 # Every config value that names something outside the config (files, the materials config and its
 # pair, the paper's contact, the CLI's bounds) is checked at start-up, before any job runs, by
-# microimpact.io.workflow_config (tested there without Snakemake); a problem stops snakemake with
+# microimpact.studies.workflow_config (tested there without Snakemake); a problem stops snakemake with
 # ONE line naming the config key and what is accepted. Job subprocesses parse this file again; they
 # skip the checks (the main process made them).
 if getattr(workflow, "is_main_process", True):
-    from microimpact.io.workflow_config import config_problem
+    from microimpact.studies.workflow_config import config_problem
 
     _problem = config_problem(config, workflow.basedir)
     if _problem:

@@ -34,7 +34,7 @@ __all__ = list(_HOMES)
 
 #: the modules, importable as attributes
 _MODULES = ("files", "formatting", "impacts", "kinds", "lammps", "materials", "paths",
-            "provenance", "resources", "statuses", "units", "variables", "workflow_config")
+            "provenance", "resources", "statuses", "units", "variables")
 
 
 __getattr__, __dir__ = _lazy_exports("microimpact.io", _HOMES, _MODULES)
