@@ -31,7 +31,10 @@ the effective-variance method (Orear 1982, Am. J. Phys. 50:912, doi:10.1119/1.12
 
 with the slope d e_n / d v_n of the model at the current best fit, updated twice (fit, re-weight,
 fit again, re-weight, fit again). The speed term matters near the capture velocity, where e_n rises
-steeply with v_n: at 1.1 v_c a 1 % speed error is a ~5 % error in e_n.
+steeply with v_n: at 1.1 v_c a 1 % speed error is a ~5 % error in e_n. Where the table gave the
+rebound speed and e_n = v_r / v_n was derived from it (``attrs["measured"]``), the same speed error
+is already in sigma_e (as e_n sigma_v / v_n) and moves the model too: the two are correlated, and
+sigma_eff^2 = sigma_e^2 + (m'^2 + 2 m' e_n / v_n) sigma_vn^2 (:func:`_effective_sigma`).
 With stated uncertainties the covariance is NOT rescaled by the reduced chi-square (lmfit
 ``scale_covar=False``); unweighted fits rescale it (the residual scatter estimates sigma).
 """
@@ -331,6 +334,15 @@ def _table_arrays(table):
     return df, rows, out, src
 
 
+def _derived_ratio(df, arrays):
+    """e_n / v_n [s/m] of each row where the reader derived e_n from the rebound and incident normal
+    speeds (``attrs["measured"]``: the rebound speed and not e_n), else None."""
+    measured = set(df.attrs.get("measured", ()))
+    if "rebound_normal_speed" in measured and "e_n" not in measured:
+        return arrays["e_n"] / arrays["normal_speed"]
+    return None
+
+
 def _sigma_e(weights, arrays, rows, src):
     """(sigma_e or None, use_effective_variance, label)."""
     n = arrays["e_n"].size
@@ -357,12 +369,32 @@ def _sigma_e(weights, arrays, rows, src):
     return s, False, "given"
 
 
+@dataclass(frozen=True)
+class _SpeedErrors:
+    """The incident normal speeds' uncertainties ``sigma`` [m/s] and ``ratio``: e_n / v_n [s/m] of each
+    row where e_n was derived as v_r / v_n (its uncertainty then holds the term e_n sigma_v / v_n of
+    the same speed error that moves the model; :func:`_effective_sigma`), else None."""
+
+    sigma: np.ndarray
+    ratio: np.ndarray | None = None
+
+
 def _effective_sigma(problem, p, sigma_e, sigma_v, rtol, h=1e-4):
-    """sqrt(sigma_e^2 + (de/dv sigma_v)^2) with the model slope by central differences."""
+    """The effective sigma of each row, with the model slope m' = de/dv by central differences.
+
+    Where e_n was measured: sqrt(sigma_e^2 + (m' sigma_v)^2) (Orear 1982). Where it was derived as
+    e_n = v_r / v_n (``sigma_v.ratio`` = e_n / v_n), one speed error dv moves both the measured e_n
+    (by -e_n dv / v_n, already in sigma_e) and the model (by m' dv): the residual's variance is
+    sigma_r^2 / v_n^2 + (m' + e_n / v_n)^2 sigma_v^2 = sigma_e^2 + (m'^2 + 2 m' e_n / v_n) sigma_v^2
+    (the incident and rebound speed errors independent, :data:`microimpact.io.impacts.SPEED_CORRELATION`).
+    Near capture, where m' > 0, the cross term adds to the variance; at high speed, where m' < 0, the
+    two movements partly cancel."""
     up = model_restitution(problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=rtol, speed_factor=1 + h)
     dn = model_restitution(problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=rtol, speed_factor=1 - h)
     slope = (up - dn) / (2 * h * problem.normal_speed)
-    return np.sqrt(sigma_e**2 + (slope * sigma_v) ** 2)
+    sv, ratio = np.asarray(sigma_v.sigma, dtype=float), sigma_v.ratio
+    cross = 0.0 if ratio is None else 2 * slope * ratio * sv**2
+    return np.sqrt(np.maximum(sigma_e**2 + (slope * sv) ** 2 + cross, 0.0))
 
 
 def fit_damping(
@@ -504,7 +536,9 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
         starts, nfev = _grid_start(problem, e_n, sigma_e, w_a0, start_grid, rtol, advance, loss)
         if fit_work_of_adhesion:  # w_A too: from the best grid point with w_A halved and doubled as well
             starts += [(starts[0][0], starts[0][1], w_a0 * k) for k in (0.5, 2.0)]
-        sigma_v = arr["normal_speed_uncertainty"] if effective else None
+        sigma_v = _SpeedErrors(arr["normal_speed_uncertainty"], _derived_ratio(df, arr)) if effective else None
+        if sigma_v is not None and sigma_v.ratio is not None:
+            weighting += " (e_n = v_r / v_n: one incident-speed error moves ratio and model, counted as correlated)"
         fit_args = (problem, e_n, sigma_e, sigma_v, rtol, scale_covar, fit_work_of_adhesion, deadline, loss)
         best, n_runs = _multistart(starts, *fit_args)
         nfev += n_runs
