@@ -80,9 +80,14 @@ def _fit_summary(result, table, pair, written) -> dict:
         for name, value in fit.values.items():
             st = fit.identifiability.get(name)
             if st is not None:
-                # the one standard error every output prints (the damping fit's: its 95 % interval's)
+                # the one standard error every output prints (the damping fit's: its 95 % interval's; the
+                # friction's: with the damping's uncertainty where it was propagated, else at its best values)
                 se = fit.interval_stderr(name) if hasattr(fit, "interval_stderr") else fit.stderr.get(name, float("nan"))
-                out[name] = st.to_record(se)
+                conditional = getattr(fit, "stderr_conditional", {}).get(name, float("nan"))
+                propagated = math.isfinite(se) or not math.isfinite(conditional)
+                out[name] = st.to_record(se if propagated else conditional)
+                if hasattr(fit, "stderr_conditional") and "stderr" in out[name]:
+                    out[name]["stderr_includes_damping"] = bool(propagated)
             else:  # fixed: the given material's value
                 out[name] = {"status": "fixed", "value": float(value)}
         return out

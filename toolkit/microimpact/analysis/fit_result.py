@@ -563,6 +563,12 @@ def _bound_text(st) -> str:
     return "not determined"
 
 
+def _determined(fit, name: str) -> bool:
+    """Whether the data determine ``name`` (True for a fit file without identifiability)."""
+    st = fit.identifiability.get(name)
+    return st is None or st.determined
+
+
 def _fit_facts(fit: "DampingFit") -> dict:
     """Label -> text of everything but the parameters, in report order (correlations: a list)."""
     src, pair = fit.info.get("source"), fit.info.get("material_pair")
@@ -577,10 +583,13 @@ def _fit_facts(fit: "DampingFit") -> dict:
         "material": f"density {fit.density:g} kg/m3, K {fit.stiffness:.4g} Pa, friction {fit.friction:g}, "
                     "damping reference speed "
                     f"{'per-impact normal speed' if vref is None else f'{vref:g} m/s'}",
-        # only where a covariance exists (lmfit gives NaN without one: not a number to print)
+        # only where a covariance exists (lmfit gives NaN without one: not a number to print), and
+        # between determined parameters: at a parameter's bound the covariance is an artefact of the
+        # bound's transform, there or not with the solver's rtol
         "correlations": [f"{fit.varied[a]} / {fit.varied[b]}: {fit.correlation[idx[a], idx[b]]:+.3f}"
                          for a in range(len(idx)) for b in range(a + 1, len(idx))
-                         if np.isfinite(fit.correlation[idx[a], idx[b]])],
+                         if np.isfinite(fit.correlation[idx[a], idx[b]])
+                         and all(_determined(fit, fit.varied[k]) for k in (a, b))],
         "chi-square": f"{fit.chisqr:.4g}, reduced {fit.redchi:.4g} "
                       f"({fit.n_points - len(fit.varied)} degrees of freedom)",
         "AIC, BIC": f"{fit.aic:.4g}, {fit.bic:.4g}",

@@ -56,6 +56,7 @@ from scipy.optimize import brentq
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit, fit_parameter_table, format_fit
 from microimpact.analysis.sampling_defaults import DEFAULT_LOSS, LOSSES
+from microimpact.analysis.verdict import p_value_text
 from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold, status_from_interval
 from microimpact.io.impacts import MEASUREMENT_TOLERANCE_SIGMAS, insert_row_labels, row_labels
 from microimpact.io.materials import material_contact
@@ -553,7 +554,7 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
         mini.iter_cb = deadline.iter_cb("the confidence intervals")
         cis, ci_message = _confidence_intervals(mini, result, confidence_intervals and loss == "linear")
         if confidence_intervals and loss != "linear":
-            ci_message = f"lmfit.conf_interval not used with the {loss} loss (its test is of chi-square)"
+            ci_message = f"lmfit's 1- and 2-sigma limits (conf_interval) not used with the {loss} loss (it tests chi-square)"
         advance(1)
 
     outside = arr["outside"]
@@ -579,8 +580,8 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
     info["success"] = bool(result.success) and all(st.determined for st in identifiability.values())
     if _implausible(result, sigma_e):
         info["success"] = False
-        info["goodness_of_fit"] = (f"chi-square {result.chisqr:.4g} for {result.nfree} degrees of freedom (p = "
-                                   f"{stats.chi2.sf(result.chisqr, result.nfree):.2g}): the model does not describe these "
+        info["goodness_of_fit"] = (f"chi-square {result.chisqr:.4g} for {result.nfree} degrees of freedom ("
+                                   f"{p_value_text(stats.chi2.sf(result.chisqr, result.nfree))}): the model does not describe these "
                                    "data within their stated uncertainties at the best fit found")
     undetermined = [n for n, st in identifiability.items() if not st.determined]
     if not info["success"] and result.success:
@@ -751,7 +752,7 @@ class _Profile:
         mini = lmfit.Minimizer(damping_residual, params, fcn_args=(self.problem,),
                                fcn_kws={"e_n": self.e_n, "sigma": self.sigma, "rtol": self.rtol},
                                iter_cb=self.deadline.iter_cb(f"the profile of {self.name}"))
-        res = mini.minimize(**_method(self.loss, self.rtol), max_nfev=400)
+        res = mini.minimize(**_method(self.loss, self.rtol, profile=True), max_nfev=400)
         return _objective(res.residual, self.loss) / self.scale, res.params
 
     def crossing(self, value, limit, level, start=None) -> float:
@@ -881,13 +882,19 @@ def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, ad
     return mini, result, sigma, nfev
 
 
-def _method(loss: str, rtol: float) -> dict:
+def _method(loss: str, rtol: float, profile: bool = False) -> dict:
     """lmfit's minimize arguments of a loss: ``leastsq`` for least squares; ``least_squares`` with
     scipy's robust loss at f_scale 1 (one stated uncertainty) and a finite-difference step of
-    sqrt(rtol), the step that balances truncation against the solver's relative error rtol (a step
-    of sqrt(machine epsilon) ~ 1.5e-8 would difference noise)."""
-    if loss == "linear":
-        return {"method": "leastsq"}
+    sqrt(rtol), the step that balances truncation against the solver's relative error rtol.
+
+    The profile's re-fits (``profile``) take that step with leastsq too: MINPACK's default,
+    sqrt(machine epsilon) ~ 1.5e-8, differences noise, and a re-fit can stop short of its minimum
+    (on four oblique rows the profile of zeta_A ended at 30.7 at rtol 1e-8 and at 24.6 at rtol 1e-10;
+    with the step, at 24.55 at both). The main least-squares fit keeps MINPACK's default step: its
+    value is converged to xtol either way, and its covariance is not what is printed (the interval's
+    standard error is)."""
+    if loss == "linear":  # MINPACK's forward-difference step is sqrt(epsfcn) relative
+        return {"method": "leastsq", "epsfcn": rtol} if profile else {"method": "leastsq"}
     return {"method": "least_squares", "loss": loss, "f_scale": 1.0, "diff_step": math.sqrt(rtol)}
 
 
@@ -963,9 +970,9 @@ def _correlation(params, varied) -> np.ndarray:
 def _confidence_intervals(mini, result, wanted: bool) -> tuple[dict, str]:
     """({name: {sigma level: limit}} from lmfit.conf_interval, message why not when they are missing)."""
     if not wanted:
-        return {}, "confidence intervals not requested"
+        return {}, "lmfit's 1- and 2-sigma limits (conf_interval) not requested"
     if not result.errorbars:
-        return {}, "confidence intervals not computed: lmfit could not estimate the covariance"
+        return {}, "lmfit's 1- and 2-sigma limits (conf_interval) not computed: lmfit could not estimate the covariance"
     varied = [n for n in PARAMETER_NAMES if result.params[n].vary]
     try:
         with warnings.catch_warnings():
@@ -974,7 +981,7 @@ def _confidence_intervals(mini, result, wanted: bool) -> tuple[dict, str]:
     except TimeBudgetExceeded:  # the caller's budget, not a failure of the intervals
         raise
     except Exception as exc:  # noqa: BLE001 - report, do not fail the fit
-        return {}, f"confidence intervals not computed: {exc}"
+        return {}, f"lmfit's 1- and 2-sigma limits (conf_interval) not computed: {exc}"
     # rows are (probability, value) for -2, -1, 0, +1, +2 sigma
     return {name: dict(zip((-2, -1, 1, 2), (float(rows[k][1]) for k in (0, 1, 3, 4))))
             for name, rows in raw.items()}, ""
