@@ -31,7 +31,7 @@ N = 40
 IDS = [f"s-{k:02d}" for k in range(1, N + 1)]
 VERDICT_ATTRS = {
     "verdict": "inadequate", "verdict_text": "The model does not describe these data.", "chi_square": 1310.0,
-    "degrees_of_freedom": 38, "p_value": 3.1e-250, "outlier_ids": "s-07,s-31",
+    "degrees_of_freedom": 38, "p_value": 2.7e-250, "outlier_ids": "s-07,s-31",  # chi2.sf(1310, 38) = 2.72e-250
     "outlier_threshold_text": "|z| > 3.23 (5 % false alarms on 40 rows)",
     "misfit_description": "too low at 3-8 m/s, too high above 20 m/s",
     "interval_note": "conditional on a rejected model; widened by the misfit: [17.9, 18.9]",
@@ -114,7 +114,7 @@ def _section(pages, title):
 def test_page_one_states_the_verdict_values_outliers_and_config(rejected_report):
     _, pages = rejected_report
     first = pages[1]  # the first page after the title page
-    assert "Verdict: inadequate (chi-square 1310 for 38 degrees of freedom, p = 3.1e-250)" in first
+    assert "Verdict: inadequate (chi-square 1310 for 38 degrees of freedom, p = 2.7e-250)" in first
     assert "too low at 3-8 m/s, too high above 20 m/s" in first
     assert "s-07, s-31" in first and "|z| > 3.23" in first
     # one 95 % interval for the determined parameter, a bound and the reason for the other

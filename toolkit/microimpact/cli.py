@@ -33,7 +33,8 @@ from microimpact._runtime.locks import remove_stale_lock, snakemake_processes_in
 from microimpact._runtime.supervise import run_supervised
 from microimpact._runtime.signals import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_after_writing
 from microimpact._runtime.usage import exit_status
-from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_SEED, DEFAULT_WALKERS, MAX_SEED
+from microimpact.analysis.sampling_defaults import (DEFAULT_LOSS, DEFAULT_MAX_STEPS, DEFAULT_NU, DEFAULT_SEED,
+                                                    DEFAULT_WALKERS, LIKELIHOODS, LOSSES, MAX_SEED)
 from microimpact.io.files import recorded_outputs
 from microimpact.io.lammps import DEFAULT_POISSON, LAMMPS_UNITS
 from microimpact.io.paths import DATA_README, PathError, check_input_file, reporting_os_errors
@@ -244,6 +245,10 @@ def register_fit(sub) -> None:
     p.add_argument("--fit-work-of-adhesion", action="store_true", help="also fit w_A (shared by all radii)")
     p.add_argument("--weights", choices=("auto", "e_n", "none"), default="auto", help="weighting (default auto)")
     p.add_argument("--no-confidence-intervals", action="store_true", help="skip lmfit.conf_interval (faster)")
+    p.add_argument("--loss", choices=LOSSES, default=DEFAULT_LOSS,
+                   help="loss of the damping fit: linear (least squares, default) or a robust one, soft_l1 or huber "
+                        "(scipy least_squares at one stated uncertainty; needs stated e_n uncertainties); the "
+                        "verdict's chi-square stays the plain one")
     p.add_argument("--exclude", default="", metavar="ID,...",
                    help="leave out the rows of these CSV ids (the report lists them); outliers the fit names are "
                         "refitted without automatically, both fits shown")
@@ -293,6 +298,11 @@ def _add_posterior_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--errors-in-variables", choices=("auto", "effective", "latent"), default="auto",
                    help="speed errors in the posterior: effective variance, latent true speeds, or auto (latent near "
                         "capture)")
+    p.add_argument("--likelihood", choices=LIKELIHOODS, default="normal",
+                   help="e_n likelihood of the posterior: normal (default) or student-t (heavy tails: a gross "
+                        "outlier pulls the posterior by a bounded amount)")
+    p.add_argument("--nu", type=_positive_float, default=None,
+                   help=f"degrees of freedom of the student-t likelihood (default {DEFAULT_NU:g})")
     p.add_argument("--oblique-out", default=None, metavar="NC",
                    help="write the friction fit (oblique columns: measured vs fitted per row) to this NetCDF")
 

@@ -9,7 +9,7 @@ import sys
 from microimpact._commands.common import UsageError
 from microimpact._commands.tables import impacts_for_pair, input_files
 from microimpact.analysis.analyst_fit import analyse_impacts, exclude_rows
-from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_WALKERS, check_posterior_memory
+from microimpact.analysis.posterior import DEFAULT_MAX_STEPS, DEFAULT_NU, DEFAULT_WALKERS, check_posterior_memory
 from microimpact.io.paths import check_outputs, print_before_writing, reporting_os_errors
 
 
@@ -18,8 +18,8 @@ def run(args) -> int:
                             input_files(args))
     out = outputs["--out"]
     posterior = False
-    unused = [f"--{name.replace('_', '-')}" for name in ("walkers", "steps", "max_steps", "seed")
-              if getattr(args, name) is not None]
+    unused = [f"--{name.replace('_', '-')}" for name in ("walkers", "steps", "max_steps", "seed", "nu")
+              if getattr(args, name) is not None] + (["--likelihood"] if args.likelihood != "normal" else [])
     if outputs.get("--posterior") is None and unused:
         raise UsageError(f"{', '.join(unused)} set the posterior's sampler, which runs only with --posterior FILE")
     if outputs.get("--posterior") is not None:
@@ -37,7 +37,8 @@ def run(args) -> int:
     result = analyse_impacts(table, pair, fit_work_of_adhesion=args.fit_work_of_adhesion, weights=args.weights,
                              confidence_intervals=not args.no_confidence_intervals, posterior=posterior,
                              errors_in_variables=args.errors_in_variables, rtol=args.rtol, progress=True,
-                             time_budget=args.time_budget, exclude=_exclude_ids(args.exclude, table))
+                             time_budget=args.time_budget, exclude=_exclude_ids(args.exclude, table), loss=args.loss,
+                             likelihood=args.likelihood, nu=DEFAULT_NU if args.nu is None else args.nu)
     paths = (out, outputs.get("--posterior"), outputs.get("--oblique-out"))
     planned = tuple(p for p in paths if p is not None)
     text = (json.dumps(_json_ready(_fit_summary(result, table, pair, planned)), indent=2, allow_nan=False)
@@ -79,14 +80,22 @@ def _fit_summary(result, table, pair, written) -> dict:
         for name, value in fit.values.items():
             st = fit.identifiability.get(name)
             if st is not None:
-                out[name] = st.to_record(fit.stderr.get(name, float("nan")))
+                # the one standard error every output prints (the damping fit's: its 95 % interval's; the
+                # friction's: with the damping's uncertainty where it was propagated, else at its best values)
+                se = fit.interval_stderr(name) if hasattr(fit, "interval_stderr") else fit.stderr.get(name, float("nan"))
+                conditional = getattr(fit, "stderr_conditional", {}).get(name, float("nan"))
+                propagated = math.isfinite(se) or not math.isfinite(conditional)
+                out[name] = st.to_record(se if propagated else conditional)
+                if hasattr(fit, "stderr_conditional") and "stderr" in out[name]:
+                    out[name]["stderr_includes_damping"] = bool(propagated)
             else:  # fixed: the given material's value
                 out[name] = {"status": "fixed", "value": float(value)}
         return out
 
     d = result.damping
     summary = {"material_pair": pair.name, "n_points": int(len(table)),
-               "damping": {"parameters": parameters(d), "chisqr": float(d.chisqr), "redchi": float(d.redchi),
+               "damping": {"parameters": parameters(d), "loss": str(d.info.get("loss", "linear")),
+                           "chisqr": float(d.chisqr), "redchi": float(d.redchi),
                            "verdict": d.verdict.to_record()},
                "written": [str(p) for p in written]}
     if result.without_outliers is not None:
@@ -97,5 +106,8 @@ def _fit_summary(result, table, pair, written) -> dict:
     if result.posterior is not None:
         steps, walkers, _ = result.posterior.chain.shape
         summary["posterior"] = {"converged": result.posterior.converged, "walkers": walkers, "steps": steps,
-                                "burn": int(result.posterior.burn), "seed": int(result.posterior.seed)}
+                                "burn": int(result.posterior.burn), "seed": int(result.posterior.seed),
+                                "likelihood": str(result.posterior.info.get("likelihood", "normal")),
+                                "verdict": result.posterior.info.get("verdict", ""),
+                                "verdict_text": result.posterior.info.get("verdict_text", "")}
     return summary

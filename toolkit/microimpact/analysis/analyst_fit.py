@@ -27,9 +27,9 @@ from microimpact.analysis.oblique import FrictionFit
 from microimpact.analysis.posterior import Posterior
 from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import all_or_nothing, write_netcdf
-from microimpact.analysis.fitting import FitProblem, fit_damping, model_restitution
+from microimpact.analysis.fitting import DEFAULT_LOSS, FitProblem, fit_damping, model_restitution
 from microimpact.analysis.oblique import ObliqueProblem, fit_friction
-from microimpact.analysis.posterior import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS,
+from microimpact.analysis.posterior import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_NU, DEFAULT_SEED, DEFAULT_WALKERS,
                                             capture_velocity_interval, restitution_bands, sample_posterior, sweep_bands)
 from microimpact.io.provenance import stamp_parameters
 from microimpact.solvers import DEFAULT_RTOL, Deadline
@@ -180,7 +180,8 @@ class AnalystFit(ReportHTML, FitResult):
 def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights="auto", confidence_intervals: bool = False,
                     friction: bool = True, posterior: bool | dict = False, errors_in_variables: str = "auto",
                     rtol: float = DEFAULT_RTOL, progress: bool = False, time_budget: float | None = None,
-                    exclude=(), outlier_refit: bool = True) -> AnalystFit:
+                    exclude=(), outlier_refit: bool = True, loss: str = DEFAULT_LOSS, likelihood: str = "normal",
+                    nu: float = DEFAULT_NU) -> AnalystFit:
     """Fit the damping, the friction (if oblique columns) and optionally sample the posterior.
 
     Parameters
@@ -210,6 +211,13 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     outlier_refit : bool
         Where the verdict names outliers, refit without them and keep both fits
         (:attr:`AnalystFit.without_outliers`); the outliers named are those the refit confirms.
+    loss : {"linear", "soft_l1", "huber"}
+        Loss of the damping fit (:func:`~microimpact.analysis.fitting.fit_damping`); the refit
+        without the outliers uses it too.
+    likelihood : {"normal", "student-t"}
+        e_n likelihood of the posterior (:func:`~microimpact.analysis.posterior.sample_posterior`).
+    nu : float
+        Degrees of freedom of the Student-t likelihood. [-]
 
     Returns
     -------
@@ -249,7 +257,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     def damping_fit(rows):
         return fit_damping(rows, base, fit_work_of_adhesion=fit_work_of_adhesion, weights=weights,
                            confidence_intervals=confidence_intervals, rtol=rtol, progress=progress,
-                           time_budget=deadline)
+                           time_budget=deadline, loss=loss)
 
     damping = damping_fit(table)
     without = None
@@ -275,7 +283,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
 
     post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], max_steps=opts["max_steps"],
                             burn=opts["burn"], seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol,
-                            progress=progress, time_budget=deadline)
+                            progress=progress, time_budget=deadline, likelihood=likelihood, nu=nu)
     nd = opts["n_draws"]
     ds = post.to_dataset(restitution_bands(post, damping, n_draws=nd, rtol=rtol, time_budget=deadline),
                          capture_velocity_interval(post, damping, n_draws=nd, time_budget=deadline),

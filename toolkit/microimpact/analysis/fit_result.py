@@ -367,6 +367,15 @@ class DampingFit(ReportHTML, FitResult):
         v = self.values[name]
         return float(v - w * (v - st.lower)), float(v + w * (st.upper - v))
 
+    def interval_stderr(self, name: str) -> float:
+        """The one standard error of ``name`` that every output prints (text, ``--json``, fit.nc's
+        ``interval_stderr``, the PDF): the width of its 95 % profile interval / 3.92 where the data
+        determine it, else the covariance's (NaN for a fixed parameter). [units of name]"""
+        lo, hi = self.interval(name)
+        if math.isfinite(lo) and math.isfinite(hi):
+            return float((hi - lo) / (2 * _Z95))
+        return float(self.stderr.get(name, math.nan)) if name in self.varied else math.nan
+
     # ------------------------------------------------------------------ report
     def report(self) -> str:
         """Readable summary: values, errors, intervals, correlations and fit statistics.
@@ -416,7 +425,7 @@ class DampingFit(ReportHTML, FitResult):
             wlo, whi = self.interval(name, widened=True)
             # the one interval (95 % profile likelihood) and the standard error it implies
             ds[name].attrs.update({"interval_low": lo, "interval_high": hi, "interval_level": 0.95,
-                                   "interval_stderr": (hi - lo) / (2 * _Z95), "widened_interval_low": wlo,
+                                   "interval_stderr": self.interval_stderr(name), "widened_interval_low": wlo,
                                    "widened_interval_high": whi})
         ds["correlation"] = xr.DataArray(self.correlation, dims=("parameter", "parameter_b"),
                                          attrs=attributes("correlation"))
@@ -533,7 +542,7 @@ def fit_parameter_table(fit: "DampingFit") -> pd.DataFrame:
             method = "not estimated"
         if st is not None and math.isfinite(st.lower) and math.isfinite(st.upper):
             # the one interval is the profile's 95 %; the standard error printed is the one it implies
-            s = (st.upper - st.lower) / (2 * _Z95)
+            s = fit.interval_stderr(name)
             if not ci:
                 ci1, ci2, method = (v - s, v + s), (v - 2 * s, v + 2 * s), "profile likelihood (stderr: 95 % interval width / 3.92)"
         meaningful = stderr_is_meaningful(v, s)
@@ -554,6 +563,12 @@ def _bound_text(st) -> str:
     return "not determined"
 
 
+def _determined(fit, name: str) -> bool:
+    """Whether the data determine ``name`` (True for a fit file without identifiability)."""
+    st = fit.identifiability.get(name)
+    return st is None or st.determined
+
+
 def _fit_facts(fit: "DampingFit") -> dict:
     """Label -> text of everything but the parameters, in report order (correlations: a list)."""
     src, pair = fit.info.get("source"), fit.info.get("material_pair")
@@ -564,13 +579,17 @@ def _fit_facts(fit: "DampingFit") -> dict:
         "points": f"{fit.n_points} over {len(fit.radii)} radii ({', '.join(f'{r * 1e6:.3g}' for r in fit.radii)} um)",
         "weighting": f"{fit.weighting}; covariance {'scaled by' if fit.scale_covar else 'not scaled by'} "
                      "reduced chi-square",
+        "loss": fit.info.get("loss_description") or None,
         "material": f"density {fit.density:g} kg/m3, K {fit.stiffness:.4g} Pa, friction {fit.friction:g}, "
                     "damping reference speed "
                     f"{'per-impact normal speed' if vref is None else f'{vref:g} m/s'}",
-        # only where a covariance exists (lmfit gives NaN without one: not a number to print)
+        # only where a covariance exists (lmfit gives NaN without one: not a number to print), and
+        # between determined parameters: at a parameter's bound the covariance is an artefact of the
+        # bound's transform, there or not with the solver's rtol
         "correlations": [f"{fit.varied[a]} / {fit.varied[b]}: {fit.correlation[idx[a], idx[b]]:+.3f}"
                          for a in range(len(idx)) for b in range(a + 1, len(idx))
-                         if np.isfinite(fit.correlation[idx[a], idx[b]])],
+                         if np.isfinite(fit.correlation[idx[a], idx[b]])
+                         and all(_determined(fit, fit.varied[k]) for k in (a, b))],
         "chi-square": f"{fit.chisqr:.4g}, reduced {fit.redchi:.4g} "
                       f"({fit.n_points - len(fit.varied)} degrees of freedom)",
         "AIC, BIC": f"{fit.aic:.4g}, {fit.bic:.4g}",
@@ -630,7 +649,7 @@ def format_fit(fit: "DampingFit", style: str = "text") -> str:
     if style != "text":
         raise ValueError(f"style must be 'text' or 'markdown', got {style!r}")
     lines = ["Damping fit (Cheng, Brach & Dunn 2002, Eqs. (14)-(15), (21), (27))"]
-    for label in ("data", "points", "weighting", "material"):
+    for label in ("data", "points", "weighting", "loss", "material"):
         if label in facts:
             lines.append(f"  {label:<12}: {facts[label]}")
     verdict = fit.verdict

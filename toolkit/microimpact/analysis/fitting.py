@@ -31,13 +31,17 @@ the effective-variance method (Orear 1982, Am. J. Phys. 50:912, doi:10.1119/1.12
 
 with the slope d e_n / d v_n of the model at the current best fit, updated twice (fit, re-weight,
 fit again, re-weight, fit again). The speed term matters near the capture velocity, where e_n rises
-steeply with v_n: at 1.1 v_c a 1 % speed error is a ~5 % error in e_n.
+steeply with v_n: at 1.1 v_c a 1 % speed error is a ~5 % error in e_n. Where the table gave the
+rebound speed and e_n = v_r / v_n was derived from it (``attrs["measured"]``), the same speed error
+is already in sigma_e (as e_n sigma_v / v_n) and moves the model too: the two are correlated, and
+sigma_eff^2 = sigma_e^2 + (m'^2 + 2 m' e_n / v_n) sigma_vn^2 (:func:`_effective_sigma`).
 With stated uncertainties the covariance is NOT rescaled by the reduced chi-square (lmfit
 ``scale_covar=False``); unweighted fits rescale it (the residual scatter estimates sigma).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 import warnings
@@ -47,10 +51,12 @@ import lmfit
 import numba
 import numpy as np
 import pandas as pd
-from scipy import stats
+from scipy import integrate, stats
 from scipy.optimize import brentq
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit, fit_parameter_table, format_fit
+from microimpact.analysis.sampling_defaults import DEFAULT_LOSS, LOSSES
+from microimpact.analysis.verdict import p_value_text
 from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold, status_from_interval
 from microimpact.io.impacts import MEASUREMENT_TOLERANCE_SIGMAS, insert_row_labels, row_labels
 from microimpact.io.materials import material_contact
@@ -73,10 +79,70 @@ __all__ = [
     "format_fit",
     "PARAMETER_NAMES",
     "DEFAULT_START_GRID",
+    "LOSSES",
+    "DEFAULT_LOSS",
+    "robust_terms",
+    "loss_description",
 ]
 
 #: default start grid: log-spaced zeta_H and zeta_A values on which chi-square is evaluated
 DEFAULT_START_GRID = (np.geomspace(0.01, 10.0, 13), np.geomspace(0.1, 1000.0, 13))
+
+
+
+
+def robust_terms(z, loss: str = DEFAULT_LOSS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(rho(z^2), its first and its second derivative in z) of each standardized residual z.
+
+    The objective of the damping fit is sum_i rho(z_i^2), with scipy.optimize.least_squares's
+    losses at ``f_scale`` = 1 (one stated standard uncertainty): ``linear`` rho(s) = s (chi-square),
+    ``soft_l1`` rho(s) = 2 (sqrt(1 + s) - 1), ``huber`` rho(s) = s for s <= 1, else 2 sqrt(s) - 1.
+    A residual far beyond 1 counts as |z| (``huber``, ``soft_l1``) rather than z^2: a gross outlier
+    pulls the fit by a bounded amount.
+
+    Parameters
+    ----------
+    z : array_like
+        Standardized residuals (model - measured) / sigma. [1]
+    loss : {"linear", "soft_l1", "huber"}
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray, numpy.ndarray)
+        rho(z^2), psi = d rho(z^2) / dz, d psi / dz. [1]
+
+    References
+    ----------
+    Huber, P. J. (1964). Robust estimation of a location parameter. Ann. Math. Statist. 35(1),
+    73-101. doi:10.1214/aoms/1177703732; scipy.optimize.least_squares (its ``loss`` argument).
+
+    Examples
+    --------
+    Small residuals count as in least squares; a residual of 20 counts about 2 x 20 = 40, not 400:
+
+    >>> [round(float(robust_terms([x], "soft_l1")[0][0]), 3) for x in (0.01, 20.0)]
+    [0.0, 38.05]
+    >>> robust_terms([3.0], "huber")[0].tolist(), robust_terms([3.0], "linear")[0].tolist()
+    ([5.0], [9.0])
+    """
+    z = np.asarray(z, dtype=float)
+    s = z * z
+    if loss == "linear":
+        return s, 2 * z, np.full_like(z, 2.0)
+    if loss == "soft_l1":
+        root = np.sqrt(1 + s)
+        return 2 * (root - 1), 2 * z / root, 2 / root**3
+    if loss == "huber":
+        big = s > 1
+        a = np.abs(z)
+        return (np.where(big, 2 * a - 1, s), np.where(big, 2 * np.sign(z), 2 * z), np.where(big, 0.0, 2.0))
+    raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
+
+
+def _objective(residual, loss: str) -> float:
+    """sum rho(z^2) of standardized residuals: chi-square for the linear loss."""
+    r = np.asarray(residual, dtype=float)
+    return float(r @ r) if loss == "linear" else float(np.sum(robust_terms(r, loss)[0]))
 
 
 # --------------------------------------------------------------------------- the model
@@ -269,6 +335,15 @@ def _table_arrays(table):
     return df, rows, out, src
 
 
+def _derived_ratio(df, arrays):
+    """e_n / v_n [s/m] of each row where the reader derived e_n from the rebound and incident normal
+    speeds (``attrs["measured"]``: the rebound speed and not e_n), else None."""
+    measured = set(df.attrs.get("measured", ()))
+    if "rebound_normal_speed" in measured and "e_n" not in measured:
+        return arrays["e_n"] / arrays["normal_speed"]
+    return None
+
+
 def _sigma_e(weights, arrays, rows, src):
     """(sigma_e or None, use_effective_variance, label)."""
     n = arrays["e_n"].size
@@ -295,12 +370,32 @@ def _sigma_e(weights, arrays, rows, src):
     return s, False, "given"
 
 
+@dataclass(frozen=True)
+class _SpeedErrors:
+    """The incident normal speeds' uncertainties ``sigma`` [m/s] and ``ratio``: e_n / v_n [s/m] of each
+    row where e_n was derived as v_r / v_n (its uncertainty then holds the term e_n sigma_v / v_n of
+    the same speed error that moves the model; :func:`_effective_sigma`), else None."""
+
+    sigma: np.ndarray
+    ratio: np.ndarray | None = None
+
+
 def _effective_sigma(problem, p, sigma_e, sigma_v, rtol, h=1e-4):
-    """sqrt(sigma_e^2 + (de/dv sigma_v)^2) with the model slope by central differences."""
+    """The effective sigma of each row, with the model slope m' = de/dv by central differences.
+
+    Where e_n was measured: sqrt(sigma_e^2 + (m' sigma_v)^2) (Orear 1982). Where it was derived as
+    e_n = v_r / v_n (``sigma_v.ratio`` = e_n / v_n), one speed error dv moves both the measured e_n
+    (by -e_n dv / v_n, already in sigma_e) and the model (by m' dv): the residual's variance is
+    sigma_r^2 / v_n^2 + (m' + e_n / v_n)^2 sigma_v^2 = sigma_e^2 + (m'^2 + 2 m' e_n / v_n) sigma_v^2
+    (the incident and rebound speed errors independent, :data:`microimpact.io.impacts.SPEED_CORRELATION`).
+    Near capture, where m' > 0, the cross term adds to the variance; at high speed, where m' < 0, the
+    two movements partly cancel."""
     up = model_restitution(problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=rtol, speed_factor=1 + h)
     dn = model_restitution(problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=rtol, speed_factor=1 - h)
     slope = (up - dn) / (2 * h * problem.normal_speed)
-    return np.sqrt(sigma_e**2 + (slope * sigma_v) ** 2)
+    sv, ratio = np.asarray(sigma_v.sigma, dtype=float), sigma_v.ratio
+    cross = 0.0 if ratio is None else 2 * slope * ratio * sv**2
+    return np.sqrt(np.maximum(sigma_e**2 + (slope * sv) ** 2 + cross, 0.0))
 
 
 def fit_damping(
@@ -316,6 +411,7 @@ def fit_damping(
     threads: int | None = 1,
     progress: bool = False,
     time_budget: float | None = None,
+    loss: str = DEFAULT_LOSS,
 ) -> DampingFit:
     """Fit zeta_H, zeta_A (and optionally w_A) to measured e_n(v_n), jointly over particle sizes.
 
@@ -355,10 +451,14 @@ def fit_damping(
     time_budget : float or Deadline, optional
         Wall-clock budget of the fit; None: no limit. Checked after every start-grid point and
         every function evaluation of the least-squares rounds and the confidence intervals. [s]
-
-    Returns
-    -------
-    DampingFit
+    loss : {"linear", "soft_l1", "huber"}
+        The objective sum rho(z^2) of the standardized residuals z (:func:`robust_terms`):
+        "linear" is least squares (lmfit ``leastsq``); "soft_l1" and "huber" are robust (lmfit
+        ``least_squares``, scipy's loss at ``f_scale`` = 1 stated uncertainty), for data with gross
+        outliers. A robust loss needs stated e_n uncertainties (its scale is one of them). Its 95 %
+        intervals are the profile of the robust objective, scaled per parameter by the sandwich
+        (Huber 1967) so that they have the M-estimator's width. The verdict's chi-square stays the
+        plain sum of z^2 at the fitted values.
 
     Raises
     ------
@@ -399,24 +499,25 @@ def fit_damping(
     deadline = Deadline.start(time_budget, "fit")
     if threads is None:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
-                            scale_covar, progress, deadline)
+                            scale_covar, progress, deadline, loss)
 
     previous = numba.get_num_threads()
     engine.set_threads(threads)
     try:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
-                            scale_covar, progress, deadline)
+                            scale_covar, progress, deadline, loss)
     finally:
         engine.set_threads(previous)
 
 
 def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals, scale_covar,
-                 progress=False, deadline=Deadline.start(None, "fit")):
+                 progress=False, deadline=Deadline.start(None, "fit"), loss=DEFAULT_LOSS):
     """The fit of :func:`fit_damping`: check, start on the grid, least squares, collect the result."""
     t0 = time.perf_counter()
     density, stiffness, w_a0, friction, vref = _material(base)
     df, rows, arr, src = _table_arrays(table)
     sigma_e, effective, weighting = _sigma_e(weights, arr, rows, src)
+    _check_loss(loss, sigma_e, src)
     problem = FitProblem.from_arrays(arr["radius"], arr["normal_speed"], base)
     e_n = arr["e_n"]
     n_var = 3 if fit_work_of_adhesion else 2
@@ -433,23 +534,27 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
     with progress_bar(steps, f"fit of {e_n.size} impacts", progress) as advance:
         advance = deadline.ticking(advance, steps, f"steps ({n_grid} start-grid points, {rounds} least-squares "
                                                    f"round(s){', confidence intervals' if confidence_intervals else ''})")
-        starts, nfev = _grid_start(problem, e_n, sigma_e, w_a0, start_grid, rtol, advance)
+        starts, nfev = _grid_start(problem, e_n, sigma_e, w_a0, start_grid, rtol, advance, loss)
         if fit_work_of_adhesion:  # w_A too: from the best grid point with w_A halved and doubled as well
             starts += [(starts[0][0], starts[0][1], w_a0 * k) for k in (0.5, 2.0)]
-        sigma_v = arr["normal_speed_uncertainty"] if effective else None
-        fit_args = (problem, e_n, sigma_e, sigma_v, rtol, scale_covar, fit_work_of_adhesion, deadline)
+        sigma_v = _SpeedErrors(arr["normal_speed_uncertainty"], _derived_ratio(df, arr)) if effective else None
+        if sigma_v is not None and sigma_v.ratio is not None:
+            weighting += " (e_n = v_r / v_n: one incident-speed error moves ratio and model, counted as correlated)"
+        fit_args = (problem, e_n, sigma_e, sigma_v, rtol, scale_covar, fit_work_of_adhesion, deadline, loss)
         best, n_runs = _multistart(starts, *fit_args)
         nfev += n_runs
         if _implausible(best[1], sigma_e):  # the start grid missed the valley: a denser, wider one
-            dense, n_grid2 = _grid_start(problem, e_n, sigma_e, w_a0, DENSE_START_GRID, rtol)
+            dense, n_grid2 = _grid_start(problem, e_n, sigma_e, w_a0, DENSE_START_GRID, rtol, loss=loss)
             again, n_runs = _multistart(dense, *fit_args)
             nfev += n_grid2 + n_runs
-            if again[1].chisqr < best[1].chisqr:
+            if _objective(again[1].residual, loss) < _objective(best[1].residual, loss):
                 best, starts = again, dense
         advance(rounds)
         mini, result, sigma, n = best
         mini.iter_cb = deadline.iter_cb("the confidence intervals")
-        cis, ci_message = _confidence_intervals(mini, result, confidence_intervals)
+        cis, ci_message = _confidence_intervals(mini, result, confidence_intervals and loss == "linear")
+        if confidence_intervals and loss != "linear":
+            ci_message = f"lmfit's 1- and 2-sigma limits (conf_interval) not used with the {loss} loss (it tests chi-square)"
         advance(1)
 
     outside = arr["outside"]
@@ -462,19 +567,21 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
     data = insert_row_labels(data, row_labels(df))
     labels = df["material_pair"].dropna().unique() if "material_pair" in df.columns else ()
     info = {"nfev": int(nfev + n), "success": bool(result.success), "message": str(result.message),
-            "method": "coarse log grid + lmfit leastsq", "rtol": float(rtol),
+            "method": "coarse log grid + lmfit " + ("leastsq" if loss == "linear" else f"least_squares (loss {loss})"),
+            "rtol": float(rtol), "loss": loss, "loss_description": loss_description(loss),
             "elapsed_s": time.perf_counter() - t0, "source": df.attrs.get("source"),
             "sha256": df.attrs.get("sha256"), "material_pair": str(labels[0]) if len(labels) == 1 else None,
             "ci_message": ci_message or None}
     varied = tuple(n for n in PARAMETER_NAMES if result.params[n].vary)
     grid = starts.grid if e_n.size <= GRID_START_POINTS else None  # a subsampled grid is another chi-square
-    identifiability = damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline, w_a0, grid)
+    identifiability = damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline, w_a0, grid,
+                                              loss)
     info["elapsed_s"] = time.perf_counter() - t0
     info["success"] = bool(result.success) and all(st.determined for st in identifiability.values())
     if _implausible(result, sigma_e):
         info["success"] = False
-        info["goodness_of_fit"] = (f"chi-square {result.chisqr:.4g} for {result.nfree} degrees of freedom (p = "
-                                   f"{stats.chi2.sf(result.chisqr, result.nfree):.2g}): the model does not describe these "
+        info["goodness_of_fit"] = (f"chi-square {result.chisqr:.4g} for {result.nfree} degrees of freedom ("
+                                   f"{p_value_text(stats.chi2.sf(result.chisqr, result.nfree))}): the model does not describe these "
                                    "data within their stated uncertainties at the best fit found")
     undetermined = [n for n, st in identifiability.items() if not st.determined]
     if not info["success"] and result.success:
@@ -501,7 +608,7 @@ PROFILE_XTOL = 1e-3
 
 
 def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline=Deadline.start(None, "fit"),
-                            work_of_adhesion_start: float | None = None, grid=None) -> dict:
+                            work_of_adhesion_start: float | None = None, grid=None, loss: str = DEFAULT_LOSS) -> dict:
     """What the data determine about each varied damping parameter (:mod:`microimpact.analysis.identifiability`).
 
     The 95 % interval of every varied parameter is its profile-likelihood interval, {x : P(x) -
@@ -536,6 +643,9 @@ def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, dead
         interval whose chi-square is within the threshold marks a second valley of the profile
         (zeta_H and zeta_A can trade places over a narrow speed range); the interval then extends
         over it, to where the profile walked outward from that point crosses the threshold.
+    loss : {"linear", "soft_l1", "huber"}
+        The fit's loss: a robust one profiles its objective sum rho(z^2) (:func:`robust_terms`)
+        divided by :func:`_sandwich_scale`, so that the interval has the M-estimator's width.
 
     Returns
     -------
@@ -545,18 +655,21 @@ def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, dead
     out = {}
     varied = [n for n in PARAMETER_NAMES if result.params[n].vary]
     dof = max(e_n.size - len(varied), 1)
-    scale = max(result.chisqr / dof, 1e-300) if scale_covar else 1.0
-    level = result.chisqr / scale + chi2_threshold(DEFAULT_LEVEL)
+    scales = dict.fromkeys(varied, _sandwich_scale(loss) if loss != "linear" else
+                           max(result.chisqr / dof, 1e-300) if scale_covar else 1.0)
+    best = _objective(result.residual, loss)
     for name in varied:
+        scale = scales[name]
+        level = best / scale + chi2_threshold(DEFAULT_LEVEL)
         value = float(result.params[name].value)
         lo, hi = DAMPING_RANGES[name]
         if name == "work_of_adhesion":  # relative to the material's value the fit started from
             ref = work_of_adhesion_start or value
             lo, hi = lo * ref, hi * ref
-        profile = _Profile(problem, e_n, sigma, result.params, name, rtol, scale, deadline, level)
+        profile = _Profile(problem, e_n, sigma, result.params, name, rtol, scale, deadline, level, loss)
         lower = profile.crossing(value, lo, level)
         upper = profile.crossing(value, hi, level)
-        for x, other in _grid_valleys(grid, name, result.chisqr, lower, upper):
+        for x, other in _grid_valleys(grid, name, best, lower, upper):
             start = result.params.copy()
             for n, v in other.items():
                 start[n].set(value=v)
@@ -592,9 +705,9 @@ def _grid_valleys(grid, name, chisqr, lower, upper):
 class _Profile:
     """P(x): chi-square with one parameter held at x and the other varied ones re-fitted (continuation)."""
 
-    def __init__(self, problem, e_n, sigma, best, name, rtol, scale, deadline, level=math.inf):
+    def __init__(self, problem, e_n, sigma, best, name, rtol, scale, deadline, level=math.inf, loss=DEFAULT_LOSS):
         self.problem, self.e_n, self.sigma, self.best, self.name = problem, e_n, sigma, best, name
-        self.rtol, self.scale, self.deadline, self.level = rtol, scale, deadline, level
+        self.rtol, self.scale, self.deadline, self.level, self.loss = rtol, scale, deadline, level, loss
 
     def __call__(self, x, start=None) -> tuple[float, object]:
         """(P(x), the re-fitted parameters): the re-fit starts from the previous point's optimum and,
@@ -625,7 +738,7 @@ class _Profile:
                     p[self.name].set(value=x)
                     p[n].set(value=max(p[n].value, 1e-12) * factor)
                     r = damping_residual(p, self.problem, self.e_n, self.sigma, rtol=self.rtol)
-                    candidates.append((float(r @ r), p))
+                    candidates.append((_objective(r, self.loss), p))
         if not candidates:
             return math.inf, starts[0]
         return self._refit(x, min(candidates, key=lambda c: c[0])[1])
@@ -635,12 +748,12 @@ class _Profile:
         params[self.name].set(value=x, vary=False)
         if not any(params[n].vary for n in PARAMETER_NAMES):
             r = damping_residual(params, self.problem, self.e_n, self.sigma, rtol=self.rtol)
-            return float(r @ r) / self.scale, params
+            return _objective(r, self.loss) / self.scale, params
         mini = lmfit.Minimizer(damping_residual, params, fcn_args=(self.problem,),
                                fcn_kws={"e_n": self.e_n, "sigma": self.sigma, "rtol": self.rtol},
                                iter_cb=self.deadline.iter_cb(f"the profile of {self.name}"))
-        res = mini.minimize(method="leastsq", max_nfev=400)
-        return float(res.chisqr) / self.scale, res.params
+        res = mini.minimize(**_method(self.loss, self.rtol, profile=True), max_nfev=400)
+        return _objective(res.residual, self.loss) / self.scale, res.params
 
     def crossing(self, value, limit, level, start=None) -> float:
         """Where P rises to ``level`` between ``value`` and ``limit`` (``limit`` if it never does)."""
@@ -687,7 +800,8 @@ def _implausible(result, sigma_e) -> bool:
     return bool(stats.chi2.sf(result.chisqr, result.nfree) < IMPLAUSIBLE_P)
 
 
-def _multistart(starts, problem, e_n, sigma_e, sigma_v, rtol, scale_covar, fit_work_of_adhesion, deadline):
+def _multistart(starts, problem, e_n, sigma_e, sigma_v, rtol, scale_covar, fit_work_of_adhesion, deadline,
+                loss=DEFAULT_LOSS):
     """(the least-chi-square run of _least_squares over ``starts``, evaluations): e_n trades zeta_H
     against zeta_A along curved valleys, so one start can end in the wrong one."""
     best, nfev = None, 0
@@ -696,14 +810,16 @@ def _multistart(starts, problem, e_n, sigma_e, sigma_v, rtol, scale_covar, fit_w
         params.add("zeta_hertz", value=zh0, min=0.0)
         params.add("zeta_adhesion", value=za0, min=0.0)
         params.add("work_of_adhesion", value=wa, min=1e-12 if fit_work_of_adhesion else 0.0, vary=fit_work_of_adhesion)
-        run = _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, lambda n=1: None, deadline)
+        run = _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, lambda n=1: None, deadline,
+                             loss)
         nfev += run[3]
-        if best is None or run[1].chisqr < best[1].chisqr * (1 - 1e-9):
+        if best is None or _objective(run[1].residual, loss) < _objective(best[1].residual, loss) * (1 - 1e-9):
             best = run
     return best, nfev
 
 
-def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol, advance=lambda n=1: None):
+def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol, advance=lambda n=1: None,
+                loss=DEFAULT_LOSS):
     """([(zeta_H, zeta_A, w_A)] at the GRID_STARTS best local minima of chi-square on the start grid,
     best first; number of evaluations).
 
@@ -722,7 +838,7 @@ def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol, advance
         for j, za in enumerate(ga):
             r = damping_residual({"zeta_hertz": zh, "zeta_adhesion": za, "work_of_adhesion": work_of_adhesion},
                                  problem, e_n, sigma, rtol=rtol)
-            chi2[i, j] = float(r @ r)
+            chi2[i, j] = _objective(r, loss)
             advance(1)
     padded = np.pad(chi2, 1, constant_values=math.inf)
     neighbours = np.stack([padded[:-2, 1:-1], padded[2:, 1:-1], padded[1:-1, :-2], padded[1:-1, 2:]])
@@ -742,7 +858,7 @@ class _GridStarts(list):
 
 
 def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, advance=lambda n=1: None,
-                   deadline=Deadline.start(None, "fit")):
+                   deadline=Deadline.start(None, "fit"), loss=DEFAULT_LOSS):
     """Levenberg-Marquardt from ``params``; with speed uncertainties ``sigma_v`` [m/s] re-weighted
     twice by the effective variance. Returns (minimizer, result, sigma used, evaluations)."""
     rounds = 1 if sigma_v is None else 3
@@ -751,7 +867,7 @@ def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, ad
         mini = lmfit.Minimizer(damping_residual, params, fcn_args=(problem,),
                                fcn_kws={"e_n": e_n, "sigma": sigma, "rtol": rtol}, scale_covar=scale_covar,
                                iter_cb=deadline.iter_cb(f"least-squares round {k} of {rounds}"))
-        return mini, mini.minimize(method="leastsq")
+        return mini, mini.minimize(**_method(loss, rtol))
 
     sigma = sigma_e
     mini, result = run(params, sigma, 1)
@@ -764,6 +880,73 @@ def _least_squares(problem, e_n, params, sigma_e, sigma_v, rtol, scale_covar, ad
             advance(1)
             nfev += result.nfev + 2 * len(problem.radii)
     return mini, result, sigma, nfev
+
+
+def _method(loss: str, rtol: float, profile: bool = False) -> dict:
+    """lmfit's minimize arguments of a loss: ``leastsq`` for least squares; ``least_squares`` with
+    scipy's robust loss at f_scale 1 (one stated uncertainty) and a finite-difference step of
+    sqrt(rtol), the step that balances truncation against the solver's relative error rtol.
+
+    The profile's re-fits (``profile``) take that step with leastsq too: MINPACK's default,
+    sqrt(machine epsilon) ~ 1.5e-8, differences noise, and a re-fit can stop short of its minimum
+    (on four oblique rows the profile of zeta_A ended at 30.7 at rtol 1e-8 and at 24.6 at rtol 1e-10;
+    with the step, at 24.55 at both). The main least-squares fit keeps MINPACK's default step: its
+    value is converged to xtol either way, and its covariance is not what is printed (the interval's
+    standard error is)."""
+    if loss == "linear":  # MINPACK's forward-difference step is sqrt(epsfcn) relative
+        return {"method": "leastsq", "epsfcn": rtol} if profile else {"method": "leastsq"}
+    return {"method": "least_squares", "loss": loss, "f_scale": 1.0, "diff_step": math.sqrt(rtol)}
+
+
+def loss_description(loss: str) -> str:
+    """What a loss of the damping fit means, in words, for the report.
+
+    Examples
+    --------
+    >>> loss_description("linear")
+    'linear (least squares)'
+    >>> print(loss_description("huber"))
+    huber (robust: lmfit least_squares, scipy's loss at f_scale = 1 stated uncertainty; 95 % intervals from the profile of its objective, divided by the sandwich factor 0.756); the verdict's chi-square is the plain one, sum z^2 at the fitted values
+    """
+    if loss == "linear":
+        return "linear (least squares)"
+    return (f"{loss} (robust: lmfit least_squares, scipy's loss at f_scale = 1 stated uncertainty; 95 % intervals "
+            f"from the profile of its objective, divided by the sandwich factor {_sandwich_scale(loss):.3g}); "
+            "the verdict's chi-square is the plain one, sum z^2 at the fitted values")
+
+
+def _check_loss(loss, sigma_e, src) -> None:
+    """ValueError for an unknown loss, or a robust one without stated uncertainties (its scale)."""
+    if loss not in LOSSES:
+        raise ValueError(f"loss must be one of {', '.join(LOSSES)}, got {loss!r}")
+    if loss != "linear" and sigma_e is None:
+        raise ValueError(f"{src}: the {loss} loss needs stated e_n uncertainties (its scale is one stated standard "
+                         "uncertainty); the table has none, or weights='none' was given")
+
+
+@functools.lru_cache(maxsize=None)
+def _sandwich_scale(loss: str) -> float:
+    """c: the factor by which the profile of a robust objective sum rho(z^2) is divided so that its
+    95 % interval has the M-estimator's width where the rows other than the outliers scatter by their
+    stated uncertainties (z ~ N(0, 1)), as the least-squares profile assumes too.
+
+    Near the fit, sum rho(z^2) rises by (x - x_hat)^2 / (2 (M^-1)_jj) with M = sum rho''(z) g g^T
+    (g = dz/dtheta), while the estimator's variance is the sandwich M^-1 V M^-1 with
+    V = sum psi(z)^2 g g^T (Huber 1967). With the expectations over z ~ N(0, 1) in place of each
+    row's value, M = E[rho''] G and V = E[psi^2] G (G = sum g g^T), so for every parameter
+    c = E[psi^2] / (2 E[rho'']): 1 for least squares, 0.610 for soft_l1, 0.756 for huber.
+    A gross outlier enters neither expectation: its pull on the fit is bounded (|psi| <= 2).
+
+    References
+    ----------
+    Huber, P. J. (1967). The behavior of maximum likelihood estimates under nonstandard conditions.
+    Proc. Fifth Berkeley Symp. Math. Statist. Prob. 1, 221-233.
+    """
+    def mean(f):
+        return integrate.quad(lambda z: f(np.array([z]))[0] * stats.norm.pdf(z), -40, 40, points=[-1, 0, 1])[0]
+    psi2 = mean(lambda z: robust_terms(z, loss)[1] ** 2)
+    second = mean(lambda z: robust_terms(z, loss)[2])
+    return float(psi2 / (2 * second))
 
 
 def _stderr(param) -> float:
@@ -787,9 +970,9 @@ def _correlation(params, varied) -> np.ndarray:
 def _confidence_intervals(mini, result, wanted: bool) -> tuple[dict, str]:
     """({name: {sigma level: limit}} from lmfit.conf_interval, message why not when they are missing)."""
     if not wanted:
-        return {}, "confidence intervals not requested"
+        return {}, "lmfit's 1- and 2-sigma limits (conf_interval) not requested"
     if not result.errorbars:
-        return {}, "confidence intervals not computed: lmfit could not estimate the covariance"
+        return {}, "lmfit's 1- and 2-sigma limits (conf_interval) not computed: lmfit could not estimate the covariance"
     varied = [n for n in PARAMETER_NAMES if result.params[n].vary]
     try:
         with warnings.catch_warnings():
@@ -798,7 +981,7 @@ def _confidence_intervals(mini, result, wanted: bool) -> tuple[dict, str]:
     except TimeBudgetExceeded:  # the caller's budget, not a failure of the intervals
         raise
     except Exception as exc:  # noqa: BLE001 - report, do not fail the fit
-        return {}, f"confidence intervals not computed: {exc}"
+        return {}, f"lmfit's 1- and 2-sigma limits (conf_interval) not computed: {exc}"
     # rows are (probability, value) for -2, -1, 0, +1, +2 sigma
     return {name: dict(zip((-2, -1, 1, 2), (float(rows[k][1]) for k in (0, 1, 3, 4))))
             for name, rows in raw.items()}, ""

@@ -8,7 +8,12 @@ chain. Priors are flat within :func:`prior_bounds` (the ranges the least-squares
 Likelihood
 ----------
 Normal part: each measured e_n is Gaussian about the model e_n(v_n) of Eq. (21) with the measured
-uncertainty. The incident speed is itself measured (errors in variables), handled per row:
+uncertainty (``likelihood="normal"``), or Student-t with ``nu`` degrees of freedom and that
+uncertainty as its scale (``likelihood="student-t"``; Lange, Little & Taylor 1989,
+doi:10.1080/01621459.1989.10478852): log p = -(nu + 1)/2 log(1 + z^2/nu) per row, whose tails let a
+gross outlier pull the posterior by a bounded amount. On clean data the Student-t posterior is wider
+than the normal one by about sqrt((nu + 3)/(nu + 1)) (its Fisher information per row is
+(nu + 1)/(nu + 3) of the normal's), 1.18 at the default nu = 4. The oblique rows stay normal. The incident speed is itself measured (errors in variables), handled per row:
 
 * **effective variance** (Orear 1982, doi:10.1119/1.12972) where the model is close to linear over
   the speed uncertainty: sigma^2 = sigma_e^2 + (de/dv)^2 sigma_v^2, the slope at the best fit;
@@ -25,6 +30,10 @@ The incidence-angle uncertainty enters v_n = v cos(alpha) through the reader's p
 ``normal_speed_uncertainty`` (first order; at alpha = 0 the second-order bias, v sigma_alpha^2 / 2, is
 below 2e-4 v for sigma_alpha <= 1 deg and is neglected). Tangential part (with a friction fit): the
 oblique entries with the effective variance of :mod:`microimpact.analysis.oblique`.
+
+Verdict: the posterior carries the verdict of the least-squares fit it starts from
+(:class:`~microimpact.analysis.verdict.Verdict`: ``verdict``, ``verdict_text``, ``p_value``); where
+that fit's model is rejected, the posterior is conditional on a rejected model and says so.
 
 Convergence: the chain runs in chunks of :data:`CHECK_EVERY` steps until the post-burn-in chain is
 longer than :data:`TAU_FACTOR` integrated autocorrelation times (emcee's guidance) with a stable
@@ -61,8 +70,8 @@ from microimpact.analysis.oblique import ObliqueProblem, oblique_model
 from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.formatting import ReportHTML
 from microimpact.analysis.fit_result import PARAMETER_NAMES, FitResult
-from microimpact.analysis.sampling_defaults import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_SEED, DEFAULT_WALKERS,
-                                                    MAX_SEED)
+from microimpact.analysis.sampling_defaults import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_NU, DEFAULT_SEED,
+                                                    DEFAULT_WALKERS, LIKELIHOODS, MAX_SEED)
 from microimpact.io.files import CONVENTIONS, restore_label_coordinates
 from microimpact.io.materials import material_contact
 from microimpact._runtime.progress import progress_bar
@@ -73,7 +82,11 @@ from microimpact.solvers.impact import simulate_many
 
 __all__ = ["Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "DEFAULT_WALKERS", "DEFAULT_MAX_STEPS",
            "DEFAULT_SEED", "DEFAULT_N_DRAWS", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
-           "sweep_bands", "summary_table", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES"]
+           "sweep_bands", "summary_table", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES", "LIKELIHOODS",
+           "DEFAULT_NU", "CONDITIONAL_ON_REJECTED"]
+
+#: what a posterior of a rejected model says of itself
+CONDITIONAL_ON_REJECTED = "conditional on a rejected model"
 
 #: the title of every posterior file (a sampled one adds how it was sampled)
 POSTERIOR_TITLE = "posterior of the fitted parameters"
@@ -224,7 +237,22 @@ class Posterior(ReportHTML, FitResult):
         lines.append(f"  acceptance  : mean {af.mean():.3f} (walkers {af.min():.3f}-{af.max():.3f})")
         lines.append(f"  convergence : {self.info.get('convergence', '')}")
         lines.append(f"  speed errors: {self.info.get('errors_in_variables', '')}")
+        lines.append(f"  likelihood  : {self.info.get('likelihood', 'normal')}")
+        if self.info.get("verdict"):
+            lines.append(f"  verdict     : {self.verdict_statement()}")
         return "\n".join(lines)
+
+    @property
+    def rejected(self) -> bool:
+        """True where the least-squares fit the posterior starts from has its model rejected."""
+        return self.info.get("verdict") == "inadequate"
+
+    def verdict_statement(self) -> str:
+        """The fit's verdict as the posterior states it ("conditional on a rejected model" where rejected)."""
+        text = str(self.info.get("verdict_text", ""))
+        if self.rejected:
+            return f"the fit's model is rejected ({text}): this posterior is {CONDITIONAL_ON_REJECTED}"
+        return f"the fit's: {text}" if text else ""
 
 
     # ------------------------------------------------------------------ NetCDF
@@ -285,6 +313,10 @@ class Posterior(ReportHTML, FitResult):
             "errors_in_variables": str(info.get("errors_in_variables", "")),
             "latent_speed_rows": " ".join(map(str, info.get("latent_rows", ()))),
             "source": str(info.get("source", "")),
+            "likelihood": str(info.get("likelihood", "normal")),
+            **{k: info[k] for k in ("verdict", "verdict_text", "p_value", "student_t_nu") if k in info},
+            **({"comment": f"this posterior is {CONDITIONAL_ON_REJECTED} ({info.get('verdict_text', '')})"}
+               if self.rejected else {}),
             **({"moves": str(info["moves"])} if "moves" in info else {}),
             **({"elapsed_s": float(info["elapsed_s"])} if "elapsed_s" in info else {}),
             **{f"fixed_{k}": float(v) for k, v in self.fixed.items()}})
@@ -321,7 +353,9 @@ class Posterior(ReportHTML, FitResult):
                      "ess_bulk": {n: float(v["ess_bulk"]) for n, v in per.items()}}
         recorded = {"latent_rows": tuple(int(r) for r in str(a.get("latent_speed_rows", "")).split()),
                     "source": str(a.get("source", ""))}
-        recorded |= {k: f(a[k]) for k, f in (("moves", str), ("elapsed_s", float)) if k in a}
+        recorded |= {k: f(a[k]) for k, f in (("moves", str), ("elapsed_s", float), ("likelihood", str),
+                                             ("verdict", str), ("verdict_text", str), ("p_value", float),
+                                             ("student_t_nu", float)) if k in a}
         return cls(names=names, chain=chain, log_probability=ds["log_probability"].values, burn=int(a["burn_in"]),
                    fixed=fixed, autocorr_time={n: float(ds[f"{n}_autocorr_time"]) for n in names},
                    acceptance_fraction=ds["acceptance_fraction"].values, seed=int(a["seed"]),
@@ -334,8 +368,12 @@ class _Likelihood:
     the tangential part. Each evaluation: one model_restitution call (one engine call per radius)
     and, with oblique data, one simulate_many call per radius."""
 
-    def __init__(self, damping_fit, table, friction_fit, eiv, rtol):
-        self.fit, self.rtol = damping_fit, rtol
+    def __init__(self, damping_fit, table, friction_fit, eiv, rtol, likelihood="normal", nu=DEFAULT_NU):
+        if likelihood not in LIKELIHOODS:
+            raise ValueError(f"likelihood must be one of {', '.join(LIKELIHOODS)}, got {likelihood!r}")
+        if not (isinstance(nu, numbers.Real) and math.isfinite(nu) and nu > 0):
+            raise ValueError(f"nu (the Student-t degrees of freedom) must be a finite number > 0, got {nu!r}")
+        self.fit, self.rtol, self.student, self.nu = damping_fit, rtol, likelihood == "student-t", float(nu)
         d = damping_fit.data
         e, v, r = (d[c].to_numpy(dtype=float) for c in ("e_n", "normal_speed", "radius"))
         sig = d["sigma"].to_numpy(dtype=float)
@@ -390,12 +428,12 @@ class _Likelihood:
         m = model_restitution(self.problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=self.rtol)
         plain = ~self.latent
         res = (m[: self.n_plain] - self.e[plain]) / self.sig_eff[plain]
-        logl = -0.5 * float(res @ res)
+        logl = float(np.sum(self.log_density(res)))
         if self.latent.any():
             k = GAUSS_HERMITE_NODES
             ml = m[self.n_plain:].reshape(-1, k)
             e, s = self.e[self.latent, None], self.sig_e[self.latent, None]
-            like = (np.exp(-0.5 * ((ml - e) / s) ** 2) * self.weights[None, :]).sum(axis=1)
+            like = (np.exp(self.log_density((ml - e) / s)) * self.weights[None, :]).sum(axis=1)
             logl += float(np.sum(np.log(np.maximum(like, 1e-300))))
         if self.oblique is not None:
             values = {n: p[n] for n in PARAMETER_NAMES}
@@ -404,6 +442,21 @@ class _Likelihood:
             r2 = np.nan_to_num((mo - self.oblique.measured) / self.oblique_sigma, nan=1e3)
             logl -= 0.5 * float(r2 @ r2)
         return logl
+
+    def log_density(self, z):
+        """log of the e_n density at standardized residuals z, up to a constant: -z^2/2 (normal) or
+        -(nu + 1)/2 log(1 + z^2/nu) (Student-t)."""
+        z = np.asarray(z, dtype=float)
+        if self.student:
+            return -0.5 * (self.nu + 1) * np.log1p(z * z / self.nu)
+        return -0.5 * z * z
+
+    def description(self) -> str:
+        """The likelihood in words (the posterior's ``likelihood`` attribute)."""
+        if not self.student:
+            return "normal"
+        return (f"student-t (nu = {self.nu:g}, scale = the stated e_n uncertainty; oblique rows normal); "
+                "the fit's verdict and chi-square are those of the normal model")
 
 
 def _contact(fit, radius, values: dict):
@@ -470,7 +523,8 @@ def prior_bounds(names, best: dict) -> dict:
 def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | None = None, steps: int | None = None,
                      max_steps: int | None = None, burn: int | None = None, seed: int = DEFAULT_SEED,
                      errors_in_variables: str = "auto", rtol: float = DEFAULT_RTOL, progress: bool = False,
-                     time_budget: float | None = None, require_convergence: bool = True) -> Posterior:
+                     time_budget: float | None = None, require_convergence: bool = True, likelihood: str = "normal",
+                     nu: float = DEFAULT_NU) -> Posterior:
     """Sample the posterior of the fitted parameters with emcee until it converges (seeded).
 
     Parameters
@@ -503,6 +557,10 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     require_convergence : bool
         Raise :class:`PosteriorError` for a chain that has not converged (default). False returns it,
         marked ``converged = False`` (for studies of the sampler itself).
+    likelihood : {"normal", "student-t"}
+        e_n likelihood of each row (module docstring).
+    nu : float
+        Degrees of freedom of the Student-t likelihood (default :data:`DEFAULT_NU`). [-]
 
     Returns
     -------
@@ -554,7 +612,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     """
     t0 = time.perf_counter()
     deadline = Deadline.start(time_budget, "posterior")
-    like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol)
+    like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol, likelihood, nu)
     names = list(damping_fit.varied) + (["friction"] if friction_fit is not None else [])
     best = dict(damping_fit.values) | ({"friction": friction_fit.friction} if friction_fit is not None else {})
     stderr = dict(damping_fit.stderr) | ({"friction": friction_fit.stderr["friction"]} if friction_fit is not None else {})
@@ -623,7 +681,17 @@ def _posterior_record(sampler, diag, names, best, bounds, like, damping_fit, fri
                            "priors": {n: tuple(map(float, bounds[n])) for n in names},
                            "status": _statuses(damping_fit, friction_fit),
                            "bounds": _statuses(damping_fit, friction_fit, "bounds"),
-                           "moves": "emcee DEMove 0.8 + DESnookerMove 0.2"})
+                           "moves": "emcee DEMove 0.8 + DESnookerMove 0.2",
+                           "likelihood": like.description()} | _fit_verdict(damping_fit)
+                     | ({"student_t_nu": like.nu} if like.student else {}))
+
+
+def _fit_verdict(damping_fit) -> dict:
+    """The verdict of the least-squares fit the posterior starts from (verdict, verdict_text, p_value)."""
+    verdict = getattr(damping_fit, "verdict", None)
+    if verdict is None:
+        return {}
+    return {"verdict": verdict.verdict, "verdict_text": verdict.text(), "p_value": float(verdict.p_value)}
 
 
 def _run_chain(log_probability, pos, seed, budget, fixed_length, burn, advance, names, damping_fit, friction_fit):

@@ -12,7 +12,8 @@ Examples
 True
 """
 
-__all__ = ["DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS", "MAX_SEED"]
+__all__ = ["DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS", "MAX_SEED", "LIKELIHOODS",
+           "DEFAULT_NU", "LOSSES", "DEFAULT_LOSS"]
 
 #: walkers of the ensemble (at least 2 x the sampled parameters are needed; 16 suits 2-4)
 DEFAULT_WALKERS = 16
@@ -24,3 +25,13 @@ DEFAULT_SEED = 2002
 MAX_SEED = 2**31 - 1
 #: posterior draws pushed through the bands and the flags
 DEFAULT_N_DRAWS = 24
+#: e_n likelihoods of the posterior: normal, or Student-t (heavy tails, for gross outliers)
+LIKELIHOODS = ("normal", "student-t")
+#: degrees of freedom of the Student-t likelihood: 4, the value Lange, Little & Taylor (1989,
+#: doi:10.1080/01621459.1989.10478852) found to serve across their examples
+DEFAULT_NU = 4.0
+#: losses of the damping fit (scipy.optimize.least_squares's names; :mod:`microimpact.analysis.fitting`):
+#: "linear" is least squares, here because the command line's help names them
+LOSSES = ("linear", "soft_l1", "huber")
+#: the loss of the damping fit: plain least squares
+DEFAULT_LOSS = "linear"

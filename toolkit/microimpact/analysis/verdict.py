@@ -35,7 +35,7 @@ import numpy as np
 from scipy import stats
 
 __all__ = ["Verdict", "assess_residuals", "ADEQUATE", "INADEQUATE", "NO_UNCERTAINTIES", "ADEQUACY_P",
-           "OUTLIER_FALSE_ALARM", "MAX_OUTLIER_FRACTION", "sidak_threshold", "VERDICT_ATTRS"]
+           "OUTLIER_FALSE_ALARM", "MAX_OUTLIER_FRACTION", "sidak_threshold", "VERDICT_ATTRS", "p_value_text"]
 
 ADEQUATE = "adequate"
 INADEQUATE = "inadequate"
@@ -52,6 +52,17 @@ _MAD_SCALE = 1.4826
 #: the fit-file attributes of a verdict (the report reads these names)
 VERDICT_ATTRS = ("verdict", "verdict_text", "chi_square", "degrees_of_freedom", "p_value", "outlier_ids",
                  "outlier_threshold_text", "misfit_description", "interval_note")
+
+
+def p_value_text(p: float) -> str:
+    """'p = 0.15', or 'p < 1e-300' where p underflows to 0 (a p of exactly 0 would be a claim).
+
+    Examples
+    --------
+    >>> p_value_text(0.1533), p_value_text(0.0)
+    ('p = 0.15', 'p < 1e-300')
+    """
+    return "p < 1e-300" if p == 0 else f"p = {p:.2g}"
 
 
 def sidak_threshold(n: int, false_alarm: float = OUTLIER_FALSE_ALARM) -> float:
@@ -136,7 +147,7 @@ class Verdict:
             return (f"{NO_UNCERTAINTIES}: the {self.what} is judged against the scatter (no chi-square test; "
                     "intervals scaled by the residual scatter)")
         return (f"{self.verdict}: chi-square {self.chi_square:.4g} for {self.degrees_of_freedom:.0f} degrees of "
-                f"freedom (p = {self.p_value:.2g})")
+                f"freedom ({p_value_text(self.p_value)})")
 
     def outlier_threshold_text(self) -> str:
         """The outlier threshold and its false-alarm rate in words."""

@@ -33,8 +33,19 @@ column                                      unit     meaning
 Angles are kept in degrees in columns whose names end in ``_deg``, the convention of
 :func:`microimpact.model.kinematics.incident_velocity`; everything else is SI.
 
-Derived columns (first-order propagation of independent standard uncertainties; a derived
-uncertainty is NaN unless every input it needs has an uncertainty):
+Derived columns (first-order propagation of standard uncertainties; a derived uncertainty is NaN
+unless every input it needs has an uncertainty, except for the ratios below):
+
+* The errors of the incident and the rebound speeds are taken as independent
+  (:data:`SPEED_CORRELATION` = 0): they are measured on separate segments of a track (other frames,
+  fitted apart), whose random errors do not share a cause. An error common to both -- the
+  length scale of the camera's calibration -- is fully correlated and cancels in the ratios e_n
+  and e_t; independence then over-states their uncertainty (conservative), never under-states it.
+  :func:`ratio_uncertainty` takes a correlation for a laboratory that knows its own.
+* The ratios e_n = v_r / v_n, e_t = v_t,out / v_t,in, the rebound angle atan(v_t / v_r) and the
+  rebound tangential speed e_t v_t,in of a given e_t use every stated uncertainty: where only one of
+  their two inputs has one, the other counts as exact (its term zero, not unknown), so that a stated
+  uncertainty is never dropped.
 
 * ``normal_speed = speed cos(incidence)`` when speed and incidence angle are given;
   ``speed = normal_speed / cos(incidence)`` when normal speed and incidence angle are given;
@@ -85,6 +96,8 @@ from microimpact.io.units import INTERNAL_UNIT, UnitError, accepted_units, conve
 
 __all__ = [
     "read_impacts",
+    "ratio_uncertainty",
+    "SPEED_CORRELATION",
     "row_labels",
     "insert_row_labels",
     "label_variables",
@@ -458,6 +471,65 @@ def _required(columns: Mapping[str, _Column]) -> set[str]:
 
 
 # --------------------------------------------------------------------------- propagation
+#: correlation of the errors of a row's incident and rebound speeds: independent (module docstring)
+SPEED_CORRELATION = 0.0
+
+
+def ratio_uncertainty(numerator, numerator_uncertainty, denominator, denominator_uncertainty,
+                      correlation: float = SPEED_CORRELATION):
+    """Standard uncertainty of q = a / b from those of a and b and the correlation of their errors.
+
+    sigma_q^2 = (sigma_a / b)^2 + (a sigma_b / b^2)^2 - 2 rho (sigma_a / b)(a sigma_b / b^2)
+    (first order; the minus sign: q falls as b rises). An uncertainty given as NaN counts as zero
+    (exact) where the other is given; NaN where neither is.
+
+    Parameters
+    ----------
+    numerator, numerator_uncertainty : array_like
+        a and sigma_a (e.g. the rebound normal speed [m/s]).
+    denominator, denominator_uncertainty : array_like
+        b and sigma_b (e.g. the incident normal speed [m/s]).
+    correlation : float
+        rho, the correlation coefficient of the errors of a and b, in [-1, 1]. [-]
+
+    Returns
+    -------
+    numpy.ndarray
+        sigma_q, in the unit of a / b.
+
+    References
+    ----------
+    JCGM 100:2008 (GUM), Eq. (16): the law of propagation of uncertainty for correlated inputs.
+
+    Examples
+    --------
+    e_n = 0.6 / 1.0 with 0.02 on each speed: independent, fully correlated (the ratio's relative
+    uncertainty is then the difference of the relative ones), and the rebound alone:
+
+    >>> [round(float(ratio_uncertainty(0.6, 0.02, 1.0, 0.02, rho)), 6) for rho in (0.0, 1.0)]
+    [0.023324, 0.008]
+    >>> float(ratio_uncertainty(0.6, 0.02, 1.0, float("nan")))
+    0.02
+    """
+    if not -1.0 <= correlation <= 1.0:
+        raise ValueError(f"correlation must lie in [-1, 1], got {correlation!r}")
+    a, sa, b, sb = (np.asarray(x, dtype=float) for x in (numerator, numerator_uncertainty, denominator,
+                                                          denominator_uncertainty))
+    neither = np.isnan(sa) & np.isnan(sb)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ta, tb = np.nan_to_num(sa) / b, (a / b) * (np.nan_to_num(sb) / b)
+        # hypot where independent: squares near the float limit would overflow
+        out = np.hypot(ta, tb) if correlation == 0 else np.sqrt(np.maximum(ta * ta + tb * tb - 2 * correlation * ta * tb, 0.0))
+    return np.where(neither, np.nan, out)
+
+
+def _angle_uncertainty(t, st, r, sr):
+    """Uncertainty of atan2(t, r) [rad] from independent errors of t and r; one unstated counts as exact."""
+    h = np.hypot(r, t)  # divided before squaring: no overflow near the float limit
+    neither = np.isnan(st) & np.isnan(sr)
+    return np.where(neither, np.nan, np.hypot(r / h * np.nan_to_num(st), t / h * np.nan_to_num(sr)) / h)
+
+
 def _unc(*terms):
     """sqrt(sum of squares) of the terms; NaN if any is NaN (first-order propagation).
 
@@ -491,9 +563,9 @@ def _derive(v: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
     if "rebound_normal_speed" in v:
         r, sr = out["rebound_normal_speed"], out["rebound_normal_speed_uncertainty"]
         out["e_n"] = r / vn
-        # a stated rebound uncertainty is used without an incident one (the incident speed then
-        # counts as exact: its term is zero, not unknown), so that it is never dropped silently
-        out["e_n_uncertainty"] = _unc(sr / vn, (r / vn) * np.where(np.isfinite(sr) & np.isnan(svn), 0.0, svn / vn))
+        # every stated uncertainty used: a rebound one without an incident one (the incident speed then
+        # counts as exact: its term is zero, not unknown), and the other way round
+        out["e_n_uncertainty"] = ratio_uncertainty(r, sr, vn, svn)
     else:
         e, se = out["e_n"], out["e_n_uncertainty"]
         out["rebound_normal_speed"] = e * vn
@@ -504,8 +576,7 @@ def _derive(v: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
         t, st = out["rebound_tangential_speed"], out["rebound_tangential_speed_uncertainty"]
         with np.errstate(invalid="ignore", divide="ignore"):
             out["rebound_angle_deg"] = np.degrees(np.arctan2(t, r))
-            h = np.hypot(r, t)
-            out["rebound_angle_deg_uncertainty"] = np.degrees(_unc(r / h * st, t / h * sr) / h)
+            out["rebound_angle_deg_uncertainty"] = np.degrees(_angle_uncertainty(t, st, r, sr))
     elif "rebound_angle_deg" in v:
         b, sb = out["rebound_angle_deg"] * rad, out["rebound_angle_deg_uncertainty"] * rad
         out["rebound_tangential_speed"] = r * np.tan(b)
@@ -525,18 +596,18 @@ def _derive_tangential_restitution(v: dict, out: dict, a, sa) -> None:
             e, se = out["tangential_restitution"], out["tangential_restitution_uncertainty"]
             t = e * vt_in
             out["rebound_tangential_speed"] = t
-            out["rebound_tangential_speed_uncertainty"] = _unc(vt_in * se, e * s_vt_in)
+            # e_t's stated uncertainty used without the incident speed's (that then counts as exact)
+            out["rebound_tangential_speed_uncertainty"] = np.where(
+                np.isnan(se) & np.isnan(s_vt_in), np.nan, np.hypot(vt_in * np.nan_to_num(se), e * np.nan_to_num(s_vt_in)))
             r, sr = out["rebound_normal_speed"], out["rebound_normal_speed_uncertainty"]
             out["rebound_angle_deg"] = np.degrees(np.arctan2(t, r))
-            h = np.hypot(r, t)
             out["rebound_angle_deg_uncertainty"] = np.degrees(
-                _unc(r / h * out["rebound_tangential_speed_uncertainty"], t / h * sr) / h)
+                _angle_uncertainty(t, out["rebound_tangential_speed_uncertainty"], r, sr))
         elif np.any(np.isfinite(out["rebound_tangential_speed"])):
             t, st = out["rebound_tangential_speed"], out["rebound_tangential_speed_uncertainty"]
             ok = vt_in > 0
             out["tangential_restitution"] = np.where(ok, t / vt_in, np.nan)
-            out["tangential_restitution_uncertainty"] = np.where(
-                ok, _unc(st / vt_in, (t / vt_in) * (s_vt_in / vt_in)), np.nan)
+            out["tangential_restitution_uncertainty"] = np.where(ok, ratio_uncertainty(t, st, vt_in, s_vt_in), np.nan)
 
 
 #: inputs (canonical names) that each derived column can be computed from

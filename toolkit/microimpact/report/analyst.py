@@ -209,7 +209,8 @@ def _parameter_rows(fit: xr.Dataset) -> pd.DataFrame:
     rows = []
     for name in _fit_parameters(fit):
         units = fit[name].attrs.get("units", "")
-        v, se = float(fit[name]), float(fit[f"{name}_stderr"])
+        # the standard error the text report and --json print: the 95 % interval's (fit.nc's interval_stderr)
+        v, se = float(fit[name]), float(fit[name].attrs.get("interval_stderr", fit[f"{name}_stderr"]))
         if not _varied(fit, name):
             rows.append({"parameter": name, "units": units, "value": f"{v:.6g}", "stderr": "fixed", "ci95": "",
                          "method": "fixed (materials config)"})

@@ -320,7 +320,8 @@ class Verdict:
         if not math.isfinite(self.chi_square):
             return self.verdict
         dof = f"{self.degrees_of_freedom:g}" if math.isfinite(self.degrees_of_freedom) else "?"
-        p = f", p = {self.p_value:.2g}" if math.isfinite(self.p_value) else ""
+        # a p that underflowed to 0 is below the smallest printed, not zero
+        p = ("" if not math.isfinite(self.p_value) else ", p < 1e-300" if self.p_value == 0 else f", p = {self.p_value:.2g}")
         return f"{self.verdict} (chi-square {self.chi_square:.4g} for {dof} degrees of freedom{p})"
 
     def rejected_note(self, what: str) -> str:

@@ -16,7 +16,7 @@ import xarray as xr
 
 from microimpact.report.figures import WIDTH, Plot, _colors, _figure, _rc
 
-__all__ = ["plot_fit_bands", "plot_corner", "plot_sweep_bands", "plot_oblique", "posterior_names"]
+__all__ = ["plot_fit_bands", "plot_corner", "plot_sweep_bands", "plot_oblique", "posterior_names", "posterior_verdict_title"]
 
 _LABEL = {"zeta_hertz": r"$\zeta_H$", "zeta_adhesion": r"$\zeta_A$", "work_of_adhesion": r"$w_A$ [J/m$^2$]",
           "friction": r"$f$"}
@@ -153,7 +153,32 @@ def plot_corner(post: xr.Dataset) -> Plot:
                f"{post.attrs.get('burn_in')}, seed {post.attrs.get('seed')}): marginal histograms with median (solid) "
                f"and 95 % interval (dashed), pairwise samples below. Autocorrelation times [steps]: {tau}; acceptance "
                f"fraction {af.mean():.2f} (walkers {af.min():.2f}-{af.max():.2f}). {_convergence(post)}")
+    title = posterior_verdict_title(post)
+    if title:
+        fig.suptitle(title, fontsize=7, color="#b00000" if post.attrs.get("verdict") == "inadequate" else "0.2",
+                     wrap=True)
+        caption += f" {title[0].upper()}{title[1:]}."
     return Plot(fig, caption)
+
+
+def posterior_verdict_title(post: xr.Dataset) -> str:
+    """The title a posterior figure carries: its fit's verdict, "conditional on a rejected model"
+    where the fit's model is rejected ("" for a file that records no verdict).
+
+    Examples
+    --------
+    >>> post = xr.Dataset(attrs={"verdict": "inadequate", "verdict_text": "inadequate: chi-square 790 for 38 dof"})
+    >>> posterior_verdict_title(post)
+    'posterior conditional on a rejected model (inadequate: chi-square 790 for 38 dof)'
+    >>> posterior_verdict_title(xr.Dataset())
+    ''
+    """
+    verdict, text = str(post.attrs.get("verdict", "")), str(post.attrs.get("verdict_text", ""))
+    if not verdict:
+        return ""
+    if verdict == "inadequate":
+        return f"posterior conditional on a rejected model ({text})"
+    return f"posterior of a fit judged {text}"
 
 
 @_rc
