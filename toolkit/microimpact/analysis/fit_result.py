@@ -28,7 +28,7 @@ import xarray as xr
 from microimpact.io.formatting import ReportHTML, estimates_repr
 from microimpact.analysis.identifiability import status_from_variables, status_variables
 from microimpact.analysis.verdict import Verdict, assess_residuals
-from microimpact.io.kinds import file_kind, unreadable_content
+from microimpact.io.kinds import file_kind, layout_mismatch, unreadable_content
 from microimpact.io.statuses import stderr_is_meaningful
 from microimpact.io.files import CONVENTIONS, restore_label_coordinates, write_netcdf
 from microimpact.io.impacts import insert_row_labels, label_variables, labels_from_dataset
@@ -168,7 +168,9 @@ class FitResult:
         if is_placeholder(ds):
             raise ValueError(f"{path}: holds no {cls.KIND} ({ds.attrs.get('comment', 'no result')})")
         try:
-            return cls.from_dataset(ds)
+            result = cls.from_dataset(ds)
+            # what it took must be what it writes: text or an extra dimension fails later, far from the file
+            mismatch = layout_mismatch(path, ds, result.to_dataset(), cls.KIND)
         except KeyError as exc:  # a variable missing: named, and the file's kind said
             raise ValueError(f"{unreadable_content(path, ds, exc)}; {cls._not_this_kind(path).split(': ', 1)[1]}") \
                 from None
@@ -176,6 +178,9 @@ class FitResult:
             # a variable of another shape or type than the kind writes (a parameter that is not a
             # scalar): one line naming the file and the variable (issue 55)
             raise ValueError(unreadable_content(path, ds, exc)) from None
+        if mismatch:
+            raise ValueError(mismatch)
+        return result
 
     @classmethod
     def placeholder(cls, comment: str) -> xr.Dataset:

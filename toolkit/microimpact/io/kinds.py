@@ -10,14 +10,16 @@ which every file microimpact writes carries.
 
 from __future__ import annotations
 
+import contextlib
 import linecache
 import re
 import zipfile
 from pathlib import Path
 
 import netCDF4
+import numpy as np
 
-__all__ = ["file_kind", "is_binary", "unreadable_content"]
+__all__ = ["file_kind", "is_binary", "layout_mismatch", "unreadable_content"]
 
 #: leading bytes -> what the file is
 _SIGNATURES = (
@@ -142,20 +144,27 @@ def unreadable_content(path, ds, exc: BaseException) -> str:
     fit.nc: variable 'zeta_hertz' (shape (2,), float64) does not read: only 0-dimensional arrays can be converted to Python scalars (TypeError)
     """
     names = set(map(str, ds.variables)) | set(map(str, ds.attrs))
-    name = exc.args[0] if isinstance(exc, KeyError) and exc.args and str(exc.args[0]) in names | {exc.args[0]} else None
+    missing = isinstance(exc, KeyError) and bool(exc.args) and str(exc.args[0]) not in names
+    # a KeyError for a name the file lacks is a missing variable; one for a value the file holds
+    # (a label read as a key: 'x') is a variable that does not read
+    if missing and isinstance(exc.args[0], str):
+        missing = not any(v.dtype.kind in "OUS" and exc.args[0] in set(map(str, np.asarray(v.values).ravel()[:1000]))
+                          for v in ds.variables.values())
+    name = exc.args[0] if missing else None
     tb, frames = exc.__traceback__, []
     while tb is not None:
-        frames.append(tb.tb_frame)
+        frames.append((tb.tb_frame, tb.tb_lasti))
         tb = tb.tb_next
     if name is None:
-        try:
-            name = _name_being_read(frames, ds, names)
-        except Exception:  # noqa: BLE001 - best effort: the message is then less precise, never wrong
-            name = None
+        certain, possible = _best_effort(_misfits, ds, exc) or ([], [])
+        read = _best_effort(_names_being_read, frames, ds, names)
+        # several possible ones (a label column is text too): the one the reader was reading, if it is one
+        name = next(iter(certain), None) or next((n for n in read if n in possible), None) \
+            or next(iter(possible + read), None)
     reason = (str(exc).splitlines() or [""])[0] or type(exc).__name__
     if name is None:
         return f"{path}: a variable or attribute does not read: {reason} ({type(exc).__name__})"
-    if isinstance(exc, KeyError):
+    if isinstance(exc, KeyError) and name not in names:
         return f"{path}: no variable or attribute {name!r} (the file is incomplete or not this kind)"
     if name in ds.variables:
         v = ds.variables[name]
@@ -168,15 +177,80 @@ def unreadable_content(path, ds, exc: BaseException) -> str:
 _SUBSCRIPT = re.compile(r"\b(?:ds|a|attrs)\[([^\[\]]+)\]")
 
 
-def _name_being_read(frames, ds, names) -> str | None:
-    """The variable or attribute a reader's frame was reading when it failed: the names its source
-    line subscripts (``ds[n]``, ``ds[f"{n}_stderr"]``, evaluated with the frame's own names; the
-    reader's code, never the file's), the odd one (not a numeric scalar) first; else a string
-    local of the frame that names one."""
-    for frame in reversed(frames):
-        line = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+def _best_effort(find, *args) -> list[str]:
+    """``find(*args)``, or [] where it fails: the message is then less precise, never wrong."""
+    try:
+        return find(*args)
+    except Exception:  # noqa: BLE001 - best effort
+        return []
+
+
+#: a quoted value in an exception's message ("could not convert string to float: 'x'")
+_QUOTED = re.compile(r"""(?:np\.str_\()?'([^']*)'""")
+
+
+def _misfits(ds, exc: BaseException) -> tuple[list[str], list[str]]:
+    """Variables of ``ds`` that do not fit the file itself, whatever the reader: (certain, possible).
+    Certain: one with a dimension that no other variable and no coordinate has (a parameter given an
+    extra axis), or one that holds the text value the exception quotes (a number column holding
+    "x"). Possible: a text variable beside numbers of its dimensions, where the reader failed on text."""
+    users = {}
+    for name, v in ds.variables.items():
+        for d in v.dims:
+            users.setdefault(d, []).append(str(name))
+    lone = [u[0] for d, u in users.items() if len(u) == 1 and d not in ds.variables and u[0] in ds.data_vars]
+    quoted = set(_QUOTED.findall(str(exc)))
+    holding = [str(n) for n, v in ds.variables.items() if quoted and v.dtype.kind in "OUS"
+               and quoted & set(map(str, np.asarray(v.values).ravel()[:1000]))]
+    # a text variable beside variables of its dimensions that hold numbers (a chain made text),
+    # where the reader failed on text ("unsupported operand type(s) for -: 'str' and 'str'")
+    odd_text = []
+    if "str" in str(exc) or isinstance(exc, KeyError):  # noqa: SIM102
+        for name, v in ds.data_vars.items():
+            siblings = [w for n, w in ds.data_vars.items() if n != name and w.dims == v.dims]
+            if v.dtype.kind in "OUS" and any(w.dtype.kind in "biuf" for w in siblings):
+                odd_text.append(str(name))
+    # microimpact's own text (labels, units) reads back as fixed-width strings; variable-length
+    # ones (object arrays) first
+    odd_text.sort(key=lambda n: ds[n].dtype.kind != "O")
+    return list(dict.fromkeys(lone + holding)), odd_text
+
+
+def _statement(frame, lasti: int) -> str:
+    """The source of what ``frame`` was running at instruction ``lasti``: every line of the
+    expression (a ``pd.DataFrame({...})`` spans several), not only its first."""
+    first = last = frame.f_lineno
+    with contextlib.suppress(Exception):  # co_positions: Python 3.11+; else the one line
+        positions = list(frame.f_code.co_positions())[lasti // 2]
+        first, last = positions[0] or first, positions[1] or last
+    return "".join(linecache.getline(frame.f_code.co_filename, n) for n in range(first, last + 1))
+
+
+def _odd_ones(found: list[str], ds) -> list[str]:
+    """Of the variables ``found`` on the failing statement, those unlike the others: text where the
+    rest are numbers, else a shape that is not the most common one (the column of a table that is
+    two-dimensional, the chain of another length), else the non-scalars (a parameter read with
+    float())."""
+    found = [n for n in dict.fromkeys(found) if n in ds.variables]
+    text = [n for n in found if ds.variables[n].dtype.kind not in "biuf"]
+    if text:
+        return text
+    shapes = [ds.variables[n].shape for n in found]
+    if len(set(shapes)) > 1:
+        common = max(set(shapes), key=shapes.count)
+        if shapes.count(common) > 1:
+            return [n for n, shape in zip(found, shapes) if shape != common]
+    return [n for n in found if ds.variables[n].ndim > 0]
+
+
+def _names_being_read(frames, ds, names) -> list[str]:
+    """The variables or attributes a reader's frame was reading when it failed: the names its source
+    statement subscripts (``ds[n]``, ``ds[f"{n}_stderr"]``, evaluated with the frame's own names; the
+    reader's code, never the file's), the odd one (:func:`_odd_ones`) first; else a string or array
+    local of the frame that names one; [] when no frame names one."""
+    for frame, lasti in reversed(frames):
         found = []
-        for expression in _SUBSCRIPT.findall(line):
+        for expression in _SUBSCRIPT.findall(_statement(frame, lasti)):
             try:
                 value = eval(expression, frame.f_globals, dict(frame.f_locals))  # noqa: S307 - our own source
             except Exception:  # noqa: BLE001 - a subscript that needs names of another frame
@@ -186,9 +260,54 @@ def _name_being_read(frames, ds, names) -> str | None:
         # a variable held in a local (v = ds[...]; int(v.values)) names itself
         found += [str(v.name) for v in frame.f_locals.values()
                   if type(v).__module__.startswith("xarray") and type(v).__name__ == "DataArray" and str(v.name) in names]
+        # ... and so does its array (lim = ds[f"{n}_confidence_limit"].values; np.isfinite(lim)), which
+        # the string local n would otherwise misname
+        found += _variables_of_arrays(frame.f_locals.values(), ds)
         found += [v for k, v in frame.f_locals.items() if isinstance(v, str) and v in names and k != "path"]
         if found:
-            odd = [n for n in found if n in ds.variables and (ds.variables[n].ndim > 0
-                                                              or ds.variables[n].dtype.kind not in "biuf")]
-            return (odd or found)[0]
+            odd = _odd_ones(found, ds)
+            return list(dict.fromkeys(odd + found))
+    return []
+
+
+def _variables_of_arrays(values, ds) -> list[str]:
+    """The variables of ``ds`` whose data are one of the NumPy arrays among ``values`` (a reader's
+    locals): ``ds[name].values`` hands out the variable's own array, so identity (or shared
+    memory, for a view) names it."""
+    values = [*values]
+    values += [x for v in values if isinstance(v, (list, tuple)) for x in v]  # np.stack([...]) of a comprehension
+    arrays = [v for v in values if isinstance(v, np.ndarray) and v.size]
+    found = []
+    for name, variable in ds.variables.items():
+        data = variable.values
+        if any(a is data or (a.dtype == data.dtype and np.shares_memory(a, data)) for a in arrays):
+            found.append(str(name))
+    return found
+
+
+def layout_mismatch(path, ds, written, kind: str) -> str | None:
+    """One line naming the first variable of ``ds`` (read from ``path``) whose dimensions or type
+    (numbers or text) are not those of ``written``, the Dataset the result read from it writes
+    again; None when every shared variable matches.
+
+    A reader that takes text or an extra dimension where its kind holds numbers (a column of
+    strings read into a table) fails later, far from the file; the round trip names it at once.
+
+    Examples
+    --------
+    >>> import xarray as xr
+    >>> written = xr.Dataset({"radius": ("point", [1e-6, 2e-6])})
+    >>> layout_mismatch("fit.nc", xr.Dataset({"radius": ("point", ["x", "y"])}), written, "damping fit")
+    "fit.nc: variable 'radius' (dimensions ('point',), <U1) is not what a damping fit holds (dimensions ('point',), numbers)"
+    >>> layout_mismatch("fit.nc", written, written, "damping fit") is None
+    True
+    """
+    for name in written.variables:
+        if name not in ds.variables:
+            continue
+        have, want = ds.variables[name], written.variables[name]
+        numeric_have, numeric_want = have.dtype.kind in "biufc", want.dtype.kind in "biufc"
+        if have.dims != want.dims or numeric_have != numeric_want:
+            return (f"{path}: variable {str(name)!r} (dimensions {have.dims}, {have.dtype}) is not what a {kind} holds "
+                    f"(dimensions {want.dims}, {'numbers' if numeric_want else 'text'})")
     return None

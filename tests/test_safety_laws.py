@@ -1,0 +1,215 @@
+"""Every law on every path (issue 55, item 2): each law x sub-model combination of the registry
+(:func:`microimpact.model.laws.combinations`, with the defaults each sub-model documents) run
+through the library (``simulate_impact`` on every path the combination lists, ``simulate_many``),
+``microimpact simulate`` (every path), ``sweep``, ``lammps export``, ``lammps verify`` of what was
+exported and ``lammps fit`` where the law is one of LAMMPS's, gives a result or a one-line refusal
+(``microimpact: error: ...``, exit 2; 1 for "LAMMPS and microimpact disagree" or "the data do not
+determine it"), never a traceback.
+
+The default run takes a sample that holds every sub-model of every field, the Hertz (f0 = 0) twin
+and every solver path at least once; ``-m slow`` runs all of them (docs/studies.md)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from microimpact.cli import main
+from microimpact.io.lammps import LammpsExportError, lammps_wall_model
+from microimpact.model import laws
+from microimpact.model.parameters import TABLE2_CASES
+from microimpact.solvers.impact import simulate_impact, simulate_many
+from microimpact.studies import sweeps
+
+COMBINATIONS = list(laws.combinations())
+PAIR = "ammonium_fluorescein_on_silicon"  # Table 1 row 2's material: the registry's base contact
+#: a small Table 2 grid for the sweep path (the path, not the grid, is under test): 2 speeds x 2 angles
+TINY_CASE = {"description": "two speeds, two angles", "speed": {"start": 0.5, "stop": 2.0, "num": 2},
+             "incidence_deg": {"start": 0.0, "stop": 30.0, "step": 30.0}}
+#: the sample's impact: oblique (the tangential, rolling and twisting laws act), above capture for every law
+SPEED, ANGLE = 1.0, 30.0
+
+
+def _label(c) -> str:
+    return "+".join(c.choices.values()) + ("" if c.contact.adhesion_line_force > 0.0 else "+f0=0")
+
+
+def _sample() -> list:
+    """Combinations (greedy) until every (field, name), f0 > 0 and f0 = 0 and every path is held."""
+    def keys(c):
+        return set(c.choices.items()) | {("f0", c.contact.adhesion_line_force > 0.0)} | {("method", m) for m in c.methods}
+
+    wanted = set().union(*map(keys, COMBINATIONS))
+    chosen = []
+    while wanted:
+        best = max(COMBINATIONS, key=lambda c: len(keys(c) & wanted))
+        chosen.append(best)
+        wanted -= keys(best)
+    return chosen
+
+
+SAMPLE = _sample()
+
+
+def contact_argv(contact) -> list[str]:
+    """The command-line options of every field of ``contact`` (None fields left out)."""
+    argv = []
+    for name in (f.name for f in dataclasses.fields(contact)):
+        value = getattr(contact, name)
+        if value is not None:
+            argv += [f"--{name.replace('_', '-')}", value if isinstance(value, str) else repr(float(value))]
+    return argv
+
+
+def one_result_or_one_line(argv, capsys, allowed=(0, 2)) -> tuple[int, str]:
+    """Run ``microimpact ARGV`` in-process: (status, stdout), after checking that it is a result (0,
+    no error line) or one line ``microimpact: error: ...``; a traceback fails the test by itself."""
+    capsys.readouterr()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the regime warnings of JKR and DMT are not what is under test
+        status = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    errors = [line for line in err.splitlines() if line.startswith("microimpact: error:")]
+    assert status in allowed, (argv, status, err)
+    assert "Traceback" not in err, (argv, err)
+    assert len(errors) == (status != 0), (argv, status, err)
+    return status, out
+
+
+def check_library(c) -> None:
+    """simulate_impact on every path the combination lists, simulate_many on the engine: a result
+    (a ValueError, one line, is a refusal: rkg's captured-impact limit)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for method in c.methods:
+            try:
+                r = simulate_impact(c.contact, SPEED, ANGLE, method=method)
+            except ValueError as exc:
+                assert "\n" not in str(exc), (_label(c), method, exc)
+                continue
+            assert r.outcome in ("rebound", "capture") and math.isfinite(r.e_n), (_label(c), method, r)
+        many = simulate_many(c.contact, [SPEED, 2.0 * SPEED], ANGLE)
+    assert np.all(np.isfinite(many["e_n"])), _label(c)
+
+
+def check_simulate(c, capsys) -> None:
+    for method in c.methods:
+        status, out = one_result_or_one_line(["simulate", *contact_argv(c.contact), "--speed", SPEED,
+                                              "--incidence-deg", ANGLE, "--method", method, "--json"], capsys)
+        if status == 0 and method == "engine":  # the command's contact is the combination's, so its result too
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                expected = simulate_impact(c.contact, SPEED, ANGLE).e_n
+            assert json.loads(out)["e_n"] == expected, _label(c)
+
+
+def check_sweep(c, tmp_path, capsys, monkeypatch) -> None:
+    monkeypatch.setattr(sweeps, "TABLE2_CASES", {**TABLE2_CASES, "2.1": TINY_CASE})
+    out = tmp_path / "sweep.nc"
+    status, _ = one_result_or_one_line(["sweep", *contact_argv(c.contact), "--case", "2.1", "--out", out], capsys)
+    assert (status == 0) == out.exists()
+    out.unlink(missing_ok=True)
+
+
+def lammps_law(c) -> str | None:
+    """The ``lammps fit --law`` of the combination (NORMAL+DAMPING), or None where LAMMPS has none of
+    its laws (:func:`microimpact.io.lammps.lammps_wall_model` refuses it)."""
+    try:
+        lammps_wall_model(c.contact)
+    except LammpsExportError:
+        return None
+    return f"{'hertz' if c.contact.adhesion_line_force == 0.0 else c.contact.normal_model}+{c.contact.damping_model}"
+
+
+def impacts_csv(c, path) -> None:
+    """Noise-free impacts of the combination (4 speeds x 3 angles at its radius) as a lab CSV with
+    stated uncertainties: what ``lammps fit`` fits."""
+    speeds, angles = np.repeat([0.5, 1.0, 2.0, 4.0], 3), np.tile([20.0, 35.0, 50.0], 4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        results = [simulate_impact(c.contact, v, a) for v, a in zip(speeds, angles)]
+    pd.DataFrame({"material_pair": PAIR, "radius [um]": c.contact.radius * 1e6, "speed [m/s]": speeds,
+                  "incidence_angle [deg]": angles, "e_n [1]": [max(r.e_n, 0.0) for r in results],
+                  "e_n_uncertainty [1]": 0.01}).to_csv(path, index=False)
+
+
+def check_lammps(c, tmp_path, capsys, verify=True, fit=True) -> dict:
+    """export (0 or one line), verify what was written (0 agree, 1 disagree), ``lammps fit --law`` of
+    its normal law where it is LAMMPS's (0, 1 not determined, or one line): the statuses.
+
+    The fit is of the normal law (``--law``) only: a fit of the tangential laws' friction to the
+    oblique columns takes minutes per law (tests/test_dem_tangential.py runs those, slow)."""
+    lmp = tmp_path / "c.lmp"
+    found = {"export": one_result_or_one_line(["lammps", "export", *contact_argv(c.contact), "--out", lmp], capsys)[0]}
+    assert (found["export"] == 0) == lmp.exists()
+    if found["export"] == 0 and verify:
+        found["verify"] = one_result_or_one_line(["lammps", "verify", lmp, "--speeds", SPEED, "--incidence-deg", ANGLE],
+                                                 capsys, allowed=(0, 1, 2))[0]
+    lmp.unlink(missing_ok=True)
+    law = lammps_law(c)
+    assert (law is None) == (found["export"] != 0)  # export and fit agree on what is LAMMPS's
+    if law is not None and fit:
+        data = tmp_path / "impacts.csv"
+        impacts_csv(c, data)
+        found["fit"] = one_result_or_one_line(["lammps", "fit", data, "--material-pair", PAIR, "--law", law, "--out",
+                                               lmp], capsys, allowed=(0, 1, 2))[0]
+        assert (found["fit"] == 0) == lmp.exists()
+        lmp.unlink(missing_ok=True)
+    return found
+
+
+def test_the_sample_holds_every_sub_model_and_every_path():
+    held = {item for c in SAMPLE for item in c.choices.items()}
+    assert held == {(f, n) for f in laws.fields() for n in laws.names(f)}
+    assert {m for c in SAMPLE for m in c.methods} == {"engine", "reference", "rkg"}
+    assert {c.contact.adhesion_line_force > 0.0 for c in SAMPLE} == {True, False}
+    assert len(COMBINATIONS) == 394 and len(SAMPLE) < 20  # the registry as declared; a sample, not all
+
+
+@pytest.mark.parametrize("c", SAMPLE, ids=_label)
+def test_a_law_gives_a_result_or_one_line_in_the_library_simulate_and_sweep(c, tmp_path, capsys, monkeypatch):
+    check_library(c)
+    check_simulate(c, capsys)
+    check_sweep(c, tmp_path, capsys, monkeypatch)
+
+
+@pytest.mark.parametrize("c", SAMPLE, ids=_label)
+def test_a_law_is_exported_or_refused_in_one_line(c, tmp_path, capsys):
+    check_lammps(c, tmp_path, capsys, verify=False, fit=False)
+
+
+def test_what_lammps_expresses_is_verified_and_fitted(tmp_path, capsys):
+    lammps_laws = [c for c in SAMPLE if lammps_law(c) is not None]
+    assert lammps_laws, "the sample holds a LAMMPS law"
+    c = lammps_laws[0]
+    found = check_lammps(c, tmp_path, capsys)
+    assert found["verify"] == 0, (_label(c), found)  # LAMMPS's own law: LAMMPS agrees
+    assert found["fit"] in (0, 1), (_label(c), found)  # a fit, determined or not, not a refusal
+
+
+@pytest.mark.slow  # every combination on every path: 20-40 min (`pytest -m slow -s` prints the tally)
+def test_every_law_on_every_path(tmp_path, capsys, monkeypatch):
+    tally, fitted, failed = {}, set(), {}
+    for c in COMBINATIONS:
+        law = lammps_law(c)  # the normal fit depends on the law alone: once per law
+        try:
+            check_library(c)
+            check_simulate(c, capsys)
+            check_sweep(c, tmp_path, capsys, monkeypatch)
+            found = check_lammps(c, tmp_path, capsys, fit=law not in fitted)
+        except Exception as exc:  # noqa: BLE001 - every combination is tried; the failures are named at the end
+            failed[_label(c)] = f"{type(exc).__name__}: {str(exc)[:300]}"
+            continue
+        fitted.add(law)
+        for path, status in found.items():
+            tally[f"{path} {status}"] = tally.get(f"{path} {status}", 0) + 1
+    with capsys.disabled():
+        print(json.dumps({"combinations": len(COMBINATIONS), "passed": len(COMBINATIONS) - len(failed), **tally,
+                          "failed": failed}, indent=1))
+    assert not failed
