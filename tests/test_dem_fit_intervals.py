@@ -74,7 +74,7 @@ def test_every_dem_fit_carries_its_verdict_with_chi_square_dof_and_p():
     chi2 = float(np.sum(((rising - rising.mean()) / 0.01) ** 2))
     assert g.status == "inadequate" and g.verdict.rejected and math.isnan(g.value)
     assert g.verdict.degrees_of_freedom == 4 and g.verdict.chi_square == pytest.approx(chi2, rel=1e-6, abs=0)
-    assert f"chi^2/dof = {chi2 / 4:.4g}" in g.describe() and "p = " in g.describe()
+    assert f"chi^2/dof = {chi2 / 4:.4g}" in g.describe() and ("p = " in g.describe() or "p < 1e-300" in g.describe())
     assert g.verdict.misfit_description.startswith("systematic: 5 rows beyond the outlier threshold")  # all off
     assert g.to_dataset().attrs["verdict"] == "inadequate"
     ranked, _ = rank_dem_laws(_table(rising), HERTZ, [("hertz", "coeff_restitution")])
