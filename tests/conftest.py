@@ -74,6 +74,7 @@ def pytest_collection_finish(session):
         fill_numba_cache(int(worker[2:]), workers)
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which turns the marks into groups
 def pytest_collection_modifyitems(config, items):
     """Keep on one xdist worker the tests that share a module-scoped fixture of their own module
     (run with ``--dist loadgroup``, pyproject.toml): xdist's default spreads a module's tests over
