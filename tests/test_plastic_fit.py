@@ -114,7 +114,7 @@ def test_the_fit_recovers_thorntons_published_closed_form():
     # noise-free data, sigma 0.005: the fit trades a little V_y against a trace of adhesion (w_A <=
     # 1e-2 J/m^2 moves e_n by < 1 sigma), so V_y to 1 % and inside its 95 % interval, which is narrow
     st = fit.identifiability["yield_velocity"]
-    assert fit.values["yield_velocity"] == pytest.approx(TRUE_YIELD_VELOCITY, rel=0.01)
+    assert fit.values["yield_velocity"] == pytest.approx(TRUE_YIELD_VELOCITY, rel=0.01, abs=0)
     assert st.contains(TRUE_YIELD_VELOCITY) and (st.upper - st.lower) / TRUE_YIELD_VELOCITY < 0.05
     assert fit.chisqr < 0.1  # 24 rows: ~0.3 % of the chi-square of noise at sigma
     # without adhesion the data bound w_A only from above (its smallest value searched is 1e-6 J/m^2)
