@@ -10,13 +10,16 @@ second per reading (:func:`clock`), so "a budget of N s" means "N checks".
 from __future__ import annotations
 
 import math
+import time
 from pathlib import Path
 from types import SimpleNamespace
 
+import numba
 import numpy as np
 import pytest
 
 import microimpact._runtime.budget as budget
+from microimpact._runtime.timeout import TimeLimitExceeded, time_limit
 from microimpact.solvers import Deadline, TimeBudgetExceeded, check_time_budget
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -330,3 +333,43 @@ def test_time_limits_nest_and_the_outer_one_still_ends_the_block():
     # 0.5 s and the handler's latency; a loaded machine may add a little (0.2 s per case otherwise)
     assert 0.45 < elapsed < 1.5, elapsed
     assert inner_timeouts >= 2  # the cases after the budget are refused at once (caught here too)
+
+
+def _busy(seconds: float) -> None:
+    """Python bytecode for ``seconds`` [s] (a sleep would be a C call; the alarm runs between bytecodes)."""
+    t0 = time.perf_counter()
+    while time.perf_counter() - t0 < seconds:
+        pass
+
+
+def test_a_limit_never_interrupts_numba_s_compiler():
+    """A CI worker died of a segmentation fault in a compiled call after a budget had interrupted a
+    numba compile (the test of ``benchmark --time-budget`` on a fresh cache). The alarm is held while
+    numba's or llvmlite's Python code runs, and ends the block at the first alarm after it: here a
+    "compile pass" (a function whose module is named numba.*) of 0.3 s under a limit of 0.05 s runs
+    to its end, and the limit ends the block 0.1 s (the repeat of the timer) after it."""
+    compiler = {"__name__": "numba.core.a_pass", "_busy": _busy}
+    exec("def compile_pass():\n    _busy(0.3)\n    return 'compiled'\n", compiler)
+    done = []
+    t0 = time.perf_counter()
+    with pytest.raises(TimeLimitExceeded, match="^compile: time budget of 0.05 s exceeded$"):
+        with time_limit(0.05, "compile"):
+            done.append(compiler["compile_pass"]())
+            _busy(5.0)
+    elapsed = time.perf_counter() - t0
+    assert done == ["compiled"]
+    assert 0.3 <= elapsed < 1.5, elapsed  # 0.3 s of compile + at most one repeat; loaded machines add latency
+
+
+def test_a_real_compile_under_a_spent_limit_gives_a_working_function():
+    """The same with numba itself: a fresh function compiled under a limit of 1 ms is compiled whole
+    (the limit is raised after it) and computes what it should when called again."""
+    source = ("def triangle(n):\n    s = 0\n    for i in range(n + 1):\n        s += i\n    return s\n")
+    namespace = {}
+    exec(source, namespace)
+    triangle = numba.njit(namespace["triangle"])  # not cached: compiled here, in this process
+    with pytest.raises(TimeLimitExceeded):
+        with time_limit(1e-3, "compile"):
+            triangle(10)
+            _busy(5.0)
+    assert triangle(100) == 5050 and len(triangle.overloads) == 1
