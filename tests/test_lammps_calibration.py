@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import sys
 from pathlib import Path
 
@@ -59,17 +58,6 @@ def lammps_jkr_impacts(seed: int = SEED, steps: int = 4000) -> pd.DataFrame:
                          "radius [um]": table["radius"] * 1e6, "speed [m/s]": table["speed"],
                          "incidence_angle [deg]": 0.0, "e_n [1]": measured.round(6), "e_n_uncertainty [1]": SIGMA,
                          "e_n_lammps [1]": e, "lammps_step_error [1]": table["step_error"]})
-
-
-def _lammps_or_skip():
-    from microimpact.studies.lammps_check import LammpsUnavailable, load_lammps
-
-    try:
-        return load_lammps()
-    except LammpsUnavailable as exc:
-        if os.environ.get("MICROIMPACT_REQUIRE_LAMMPS") == "1":
-            pytest.fail(f"MICROIMPACT_REQUIRE_LAMMPS=1 but {exc}")
-        pytest.skip(str(exc))
 
 
 def _within(truth, interval) -> bool:
@@ -222,11 +210,10 @@ def test_the_fit_line_is_data_checked_field_by_field(tmp_path):
         read_lammps_export(text + fit_line)
 
 
-def test_verify_checks_every_radius_of_the_fitted_data_over_its_speed_range(tmp_path, capsys, monkeypatch):
+def test_verify_checks_every_radius_of_the_fitted_data_over_its_speed_range(needs_lammps, tmp_path, capsys, monkeypatch):
     """A file written by `lammps fit` from impacts at two radii over different speed ranges:
     verify runs LAMMPS at both radii, at the ends of each measured range (--points 2) unless
     --speed-range asks for another; each impact agrees with microimpact."""
-    _lammps_or_skip()
     monkeypatch.chdir(tmp_path)
     rng = np.random.default_rng(3)
     radius, speed = [1.0] * 4 + [3.0] * 4, [0.2, 0.5, 1.0, 2.0, 1.0, 2.0, 4.0, 8.0]
@@ -253,7 +240,7 @@ def test_verify_checks_every_radius_of_the_fitted_data_over_its_speed_range(tmp_
 
 # ------------------------------------------------------------------ slow: recovery, coverage, the data
 @pytest.mark.slow  # one joint fit of 45 impacts: minutes
-def test_lammps_fit_recovers_both_parameters_of_the_lammps_truth(tmp_path, capsys, monkeypatch):
+def test_lammps_fit_recovers_both_parameters_of_the_lammps_truth(needs_lammps, tmp_path, capsys, monkeypatch):
     """`lammps fit --fit-adhesion --law jkr_force+viscoelastic` on the LAMMPS impacts: w_A and
     eta_n0 each within its 95 % interval, the law adequate, the material pair's own w_A (0.216) not
     used; then verify runs LAMMPS over the data's three radii and speed ranges."""
@@ -265,18 +252,16 @@ def test_lammps_fit_recovers_both_parameters_of_the_lammps_truth(tmp_path, capsy
     assert law["verdict"]["verdict"] == "adequate" and law["adhesion_status"] == "determined"
     assert _within(0.12, law["work_of_adhesion_interval"]), law
     assert _within(ETA, law["damping_coefficient_interval"]), law
-    _lammps_or_skip()
     assert main(["lammps", "verify", "jkr.lmp", "--points", "3"]) == 0
     assert "9 of 9 impacts agree" in capsys.readouterr().out
 
 
 @pytest.mark.slow  # LAMMPS 45 impacts x 2 runs, then a joint fit per seed
-def test_recovery_without_bias_over_seeds():
+def test_recovery_without_bias_over_seeds(needs_lammps):
     """The same LAMMPS impacts with noise of four other seeds: each truth is inside its 95 %
     interval in most fits (4 seeds x 2 parameters: 8 intervals; a calibrated interval misses 2 or
     more of 8 with probability 0.057) and the fitted values scatter about the truth (the mean of
     the four standardized errors (fit - truth) / stderr within 2 / sqrt(4) * 1.5 of 0)."""
-    _lammps_or_skip()
     base = lammps_jkr_impacts(seed=SEED)
     e_lammps = base["e_n_lammps [1]"].to_numpy(float)
     misses, z = 0, {"w": [], "eta": []}
@@ -296,9 +281,8 @@ def test_recovery_without_bias_over_seeds():
 
 
 @pytest.mark.slow  # runs LAMMPS on 45 impacts at two step sizes
-def test_the_committed_data_are_what_lammps_gives():
+def test_the_committed_data_are_what_lammps_gives(needs_lammps):
     """The committed file is LAMMPS's output (to its 6 written digits) with the seed's noise."""
-    _lammps_or_skip()
     fresh = lammps_jkr_impacts()
     committed = pd.read_csv(DATA)
     assert (fresh["id"] == committed["id"]).all()

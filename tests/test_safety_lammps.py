@@ -5,7 +5,6 @@ no second command; LAMMPS's own errors are one line, exit 2; every lammps comman
 The parsing tests run everywhere; those that run LAMMPS are skipped without it (as in test_lammps.py).
 """
 
-import os
 
 import pytest
 
@@ -15,17 +14,6 @@ from microimpact.io.lammps import LammpsExportError, lammps_input, read_lammps_e
 
 # a JKR contact of Table 1 row 2's sphere (Cheng et al. 2002), undamped: LAMMPS can write it
 JKR = Contact(radius=3.45e-6, density=1350.0, stiffness=1.776e9, adhesion_line_force=7.422, normal_model="jkr_force")
-
-
-def _lammps_or_skip():
-    from microimpact.studies.lammps_check import LammpsUnavailable, load_lammps
-
-    try:
-        return load_lammps()
-    except LammpsUnavailable as exc:
-        if os.environ.get("MICROIMPACT_REQUIRE_LAMMPS") == "1":
-            pytest.fail(f"MICROIMPACT_REQUIRE_LAMMPS=1 but {exc}")
-        pytest.skip(str(exc))
 
 
 def _one_error_line(err: str) -> str:
@@ -81,14 +69,13 @@ def test_verify_refuses_every_line_the_export_does_not_write_naming_it(case, exp
     assert not witness.exists()
 
 
-def test_the_export_reads_back_whole_and_verify_runs_the_rebuilt_command(export, monkeypatch):
+def test_the_export_reads_back_whole_and_verify_runs_the_rebuilt_command(needs_lammps, export, monkeypatch):
     from microimpact.studies import lammps_check
 
     parsed = read_lammps_export(export.read_text())
     assert parsed.contact == JKR and parsed.units == "micro" and parsed.fix_line_number == len(
         export.read_text().splitlines())
     assert parsed.script() == export.read_text().splitlines()[-1] + "\n"
-    _lammps_or_skip()
     seen = []
     real = lammps_check.lammps_impact
 
@@ -122,12 +109,11 @@ def test_the_header_strings_hold_no_control_character(field):
         lammps_input(JKR, **kwargs)
 
 
-def test_every_lammps_command_takes_a_time_budget(export, tmp_path, capsys):
+def test_every_lammps_command_takes_a_time_budget(needs_lammps, export, tmp_path, capsys):
     from microimpact.cli import build_parser
 
     for words in (["export", "--out", "x"], ["fit", "d.csv", "--out", "x"], ["verify", "f"]):
         assert build_parser().parse_args(["lammps", *words, "--time-budget", "2"]).time_budget == 2.0
-    _lammps_or_skip()
     # a million steps per contact time runs for minutes; the budget stops it, exit 3, one line
     status = main(["lammps", "verify", str(export), "--speeds", "1", "--incidence-deg", "0", "--steps", "1000000",
                    "--time-budget", "0.5"])
@@ -135,8 +121,7 @@ def test_every_lammps_command_takes_a_time_budget(export, tmp_path, capsys):
     assert "lammps verify: time budget of 0.5 s exceeded" in _one_error_line(capsys.readouterr().err)
 
 
-def test_a_lammps_error_is_one_line_naming_file_and_line_with_status_2(export, capsys):
-    _lammps_or_skip()
+def test_a_lammps_error_is_one_line_naming_file_and_line_with_status_2(needs_lammps, export, capsys):
     # at 1e6 m/s the sphere passes through the wall within one step: LAMMPS stops with "Lost atoms"
     assert main(["lammps", "verify", str(export), "--speeds", "1e6", "--incidence-deg", "0"]) == 2
     err = _one_error_line(capsys.readouterr().err)
