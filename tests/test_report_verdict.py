@@ -35,6 +35,9 @@ VERDICT_ATTRS = {
     "outlier_threshold_text": "|z| > 3.23 (5 % false alarms on 40 rows)",
     "misfit_description": "too low at 3-8 m/s, too high above 20 m/s",
     "interval_note": "conditional on a rejected model; widened by the misfit: [17.9, 18.9]",
+    "without_outliers_text": "without s-07, s-31: adequate: chi-square 31.2 for 36 degrees of freedom (p = 0.69)",
+    "without_outliers_zeta_adhesion": 18.31, "without_outliers_zeta_adhesion_interval_low": 18.02,
+    "without_outliers_zeta_adhesion_interval_high": 18.57,
 }
 
 
@@ -123,6 +126,25 @@ def test_page_one_states_the_verdict_values_outliers_and_config(rejected_report)
     # w_A was not varied: it is the materials config's, as are the density and stiffness
     assert re.search(r"work_of_adhesion J m-2 0\.216 - materials config", first)
     assert "density = 1350 kg/m^3" in first and "contact stiffness K = 1.776e+09 Pa" in first
+
+
+def test_the_title_page_states_each_verdict_the_outliers_and_the_refit_without_them(rejected_report):
+    """Issue 51: the PDF's first page (the title page) states the verdict; the outliers are named by
+    id there and the refit without them is shown beside the fit on the verdict page."""
+    _, pages = rejected_report
+    title = pages[0]
+    assert "Verdict, Part A: inadequate (chi-square 1310 for 38 degrees of freedom, p = 2.7e-250)" in title
+    assert ("Outliers (by CSV id): s-07, s-31; refit without s-07, s-31: adequate: chi-square 31.2 for 36 "
+            "degrees of freedom (p = 0.69)") in title
+    verdict_page = pages[1]
+    assert "Refit without s-07, s-31: adequate" in verdict_page
+    assert re.search(r"zeta_adhesion 18\.31 \[18\.02, 18\.57\]", verdict_page), verdict_page
+    # the fit's own text, when it is the verdict line again (as analysis.verdict writes it), is not repeated
+    lay = Layout("Report")
+    analyst.summary_section(lay, _fit(VERDICT_ATTRS | {
+        "verdict_text": "inadequate: chi-square 1310 for 38 degrees of freedom (p = 2.7e-250)"}))
+    text = " ".join(t.get_text() for p in lay.pages for t in p.figure.texts)
+    assert text.count("chi-square 1310 for 38") == 1, text
 
 
 def test_every_downstream_section_says_it_comes_from_a_rejected_model(rejected_report):

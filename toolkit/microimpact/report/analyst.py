@@ -22,7 +22,7 @@ from microimpact.report.inputs import FLAG_LETTERS, Verdict, at_radius, paramete
 from microimpact.report.layout import Layout
 
 __all__ = ["summary_section", "fit_section", "posterior_section", "oblique_section", "analyst_dynamics_section", "analyst_sweeps_section",
-           "flags_section"]
+           "flags_section", "verdict_title_lines"]
 
 _PARAMETERS = ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")
 
@@ -61,7 +61,8 @@ def summary_section(lay: Layout, fit: xr.Dataset, verdict: Verdict | None = None
     verdict = verdict or read_verdict(fit)
     lay.section("Verdict", new_page=False)
     lay.paragraph(f"Verdict: {verdict.label}", size=11, color=_VERDICT_COLOR.get(verdict.verdict, "#7a5a00"))
-    lay.paragraph(verdict.text or ("The model is rejected by the data." if verdict.rejected else ""))
+    if not verdict.text.startswith(f"{verdict.verdict}: chi-square"):  # the fit's text is the label again
+        lay.paragraph(verdict.text or ("The model is rejected by the data." if verdict.rejected else ""))
     if verdict.misfit_description:
         lay.paragraph(f"Where the model misses: {verdict.misfit_description}")
     if verdict.rejected:
@@ -71,7 +72,10 @@ def summary_section(lay: Layout, fit: xr.Dataset, verdict: Verdict | None = None
     lay.heading("Fitted values (one 95 % interval each)")
     lay.table(_summary_rows(fit, verdict), {"parameter": 17, "units": 6, "value": 11, "ci95": 30, "from": 52},
               headers={"ci95": "95 % interval", "from": "how it is known"}, size=7.4)
-    if verdict.interval_note:
+    if verdict.rejected and math.isfinite(verdict.widening):
+        lay.paragraph("Intervals: conditional on the rejected model; they do not include the misfit (counted as "
+                      f"noise it would widen each by sqrt(reduced chi-square) = {verdict.widening:.3g}).")
+    elif verdict.interval_note:
         lay.paragraph(f"Intervals: {verdict.interval_note}")
     elif verdict.rejected:
         lay.paragraph("Intervals: conditional on the rejected model; they do not include the misfit.")
@@ -79,6 +83,13 @@ def summary_section(lay: Layout, fit: xr.Dataset, verdict: Verdict | None = None
     if verdict.outlier_ids:
         lay.paragraph(f"{len(verdict.outlier_ids)} row(s) named by their CSV id: {', '.join(verdict.outlier_ids)}"
                       + (f" ({verdict.outlier_threshold_text})." if verdict.outlier_threshold_text else "."))
+        refit = _without_outliers_rows(fit)
+        if verdict.without_outliers or len(refit):
+            lay.paragraph(f"Refit {_refit_phrase(verdict.without_outliers or 'see the table')}"
+                          + (". These values are shown for comparison; the rest of this part uses the fit above."
+                             if len(refit) else "."))
+        if len(refit):
+            lay.table(refit, {"parameter": 17, "value": 11, "ci95": 30}, headers={"ci95": "95 % interval"}, size=7.4)
     elif "residual" in fit or verdict.recorded:
         lay.paragraph("No row's residual is improbable given the number of rows"
                       + (f" ({verdict.outlier_threshold_text})." if verdict.outlier_threshold_text else "."))
@@ -88,6 +99,29 @@ def summary_section(lay: Layout, fit: xr.Dataset, verdict: Verdict | None = None
     if fixed:
         lay.heading("Values from the materials config (not fitted)")
         lay.paragraph("; ".join(fixed) + ".")
+
+
+def verdict_title_lines(verdict: Verdict, part: str) -> list[tuple[str, str]]:
+    """The title page's lines of one analyst part's verdict, as (text, colour): the verdict with its
+    chi-square, the outliers by id and the verdict of the refit without them.
+
+    Examples
+    --------
+    >>> v = Verdict("inadequate", "", 817.9, 38, 4.2e-147, ("d-12", "d-24"), without_outliers="without d-12, d-24: adequate")
+    >>> [text for text, _ in verdict_title_lines(v, "Part A")]
+    ['Verdict, Part A: inadequate (chi-square 817.9 for 38 degrees of freedom, p = 4.2e-147)', 'Outliers (by CSV id): d-12, d-24; refit without d-12, d-24: adequate']
+    """
+    color = _VERDICT_COLOR.get(verdict.verdict, "#7a5a00")
+    lines = [(f"Verdict, {part}: {verdict.label}", color)]
+    if verdict.outlier_ids:
+        lines.append((f"Outliers (by CSV id): {', '.join(verdict.outlier_ids)}"
+                      + (f"; refit {_refit_phrase(verdict.without_outliers)}" if verdict.without_outliers else ""), color))
+    return lines
+
+
+def _refit_phrase(text: str) -> str:
+    """'without A, B: adequate ...' as the fit states it, or 'without them: <text>'."""
+    return text if text.startswith("without ") else f"without them: {text}"
 
 
 def _summary_rows(fit: xr.Dataset, verdict: Verdict) -> pd.DataFrame:
@@ -116,6 +150,18 @@ def _summary_rows(fit: xr.Dataset, verdict: Verdict) -> pd.DataFrame:
         ci = f"[{lo:.5g}, {hi:.5g}]" if math.isfinite(lo) and math.isfinite(hi) else "not computed"
         rows.append({"parameter": name, "units": units, "value": f"{v:.5g}", "ci95": ci, "from": how + conditional})
     return pd.DataFrame(rows, columns=["parameter", "units", "value", "ci95", "from"])
+
+
+def _without_outliers_rows(fit: xr.Dataset) -> pd.DataFrame:
+    """The refit without the outliers (the ``without_outliers_<name>`` attributes): one row per parameter."""
+    a, rows = fit.attrs, []
+    for name in _fit_parameters(fit):
+        if f"without_outliers_{name}" not in a:
+            continue
+        lo, hi = (float(a.get(f"without_outliers_{name}_interval_{end}", math.nan)) for end in ("low", "high"))
+        ci = f"[{lo:.5g}, {hi:.5g}]" if math.isfinite(lo) and math.isfinite(hi) else "not determined"
+        rows.append({"parameter": name, "value": f"{float(a[f'without_outliers_{name}']):.5g}", "ci95": ci})
+    return pd.DataFrame(rows, columns=["parameter", "value", "ci95"])
 
 
 def _varied(fit: xr.Dataset, name: str) -> bool:

@@ -288,6 +288,11 @@ class Verdict:
         The systematic structure of the residuals, in words ("" if none was recorded).
     interval_note : str
         How the intervals are to be read ("" if none was recorded).
+    without_outliers : str
+        The verdict of the refit without the outliers ("" if there was none).
+    widening : float
+        sqrt(reduced chi-square) of a rejected fit, by which its intervals widen with the misfit
+        counted as noise [-] (NaN where not recorded).
     recorded : bool
         True when the fit file holds the verdict; False when the report computed it from the file's chi-square.
 
@@ -308,6 +313,8 @@ class Verdict:
     misfit_description: str = ""
     interval_note: str = ""
     recorded: bool = True
+    without_outliers: str = ""
+    widening: float = math.nan
 
     @property
     def rejected(self) -> bool:
@@ -403,7 +410,9 @@ def read_verdict(fit: xr.Dataset) -> Verdict:
         return Verdict(str(a["verdict"]), str(a.get("verdict_text", "")), _attr_float(a, "chi_square"),
                        _attr_float(a, "degrees_of_freedom"), _attr_float(a, "p_value"), ids,
                        str(a.get("outlier_threshold_text", "")), str(a.get("misfit_description", "")),
-                       str(a.get("interval_note", "")), recorded=True)
+                       str(a.get("interval_note", "")), recorded=True,
+                       without_outliers=str(a.get("without_outliers_text", "") or a.get("fit_without_outliers", "")),
+                       widening=_attr_float(a, "interval_widening"))
     chi2 = _attr_float(a, "chi_square") if "chi_square" in a else _attr_float(a, "chisqr")
     n = _attr_float(a, "n_points")
     dof = _attr_float(a, "degrees_of_freedom") if "degrees_of_freedom" in a else n - len(str(a.get("varied", "")).split())

@@ -12,7 +12,7 @@ import contextlib
 import logging
 import multiprocessing
 import textwrap
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import matplotlib
@@ -269,8 +269,9 @@ class Layout:
 
     # ------------------------------------------------------------------ title page and output
     def title_page(self, subtitle: str, facts: Mapping[str, str], *, warning: str | None = None,
-                   footnote: str = "") -> None:
-        """Insert the title page (title, subtitle, provenance facts, contents) in front of the pages."""
+                   footnote: str = "", verdicts: Sequence[tuple[str, str]] = ()) -> None:
+        """Insert the title page (title, subtitle, the verdicts as (text, colour) lines, provenance
+        facts, contents) in front of the pages."""
         fig = Figure(figsize=PAGE_SIZE)
         W, H = PAGE_SIZE
 
@@ -279,9 +280,15 @@ class Layout:
 
         text(MARGIN_X, 1.3, "\n".join(textwrap.wrap(self.title, 42)), fontsize=20, fontweight="bold", linespacing=1.25)
         text(MARGIN_X, 2.35, "\n".join(textwrap.wrap(subtitle, 95)), fontsize=9, linespacing=1.35)
+        y = 3.25
         if warning:
-            text(MARGIN_X, 3.25, warning, fontsize=11, fontweight="bold", color="#b00000")
-        y = 3.6
+            text(MARGIN_X, y, warning, fontsize=11, fontweight="bold", color="#b00000")
+            y += 0.3
+        for line, color in verdicts:
+            lines = wrap(line, 95)
+            text(MARGIN_X, y, "\n".join(lines), fontsize=9, fontweight="bold", color=color, linespacing=1.3)
+            y += 0.17 * len(lines) + 0.06
+        y = max(y + 0.1, 3.6)
         text(MARGIN_X, y, "Provenance", fontsize=12, fontweight="bold")
         y += 0.3
         for key, value in facts.items():
