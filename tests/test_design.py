@@ -4,17 +4,21 @@ never lie where the parameter has no effect, and come as a template that reads b
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pandas as pd
 import pytest
+from pypdf import PdfReader
 
 from microimpact.analysis.design import (FRICTION_RANGE, OBLIQUE_ANGLES_DEG, DesignSpace, design_friction,
-                                         design_impacts, fisher_widths, restitution_sensitivities,
-                                         tangential_sensitivities, uniform_design)
+                                         design_impacts, design_next_impacts, design_record, fisher_widths,
+                                         restitution_sensitivities, tangential_sensitivities, uniform_design)
 from microimpact.analysis.fitting import FitProblem, fit_damping, model_restitution
 from microimpact.analysis.oblique import fit_friction, normal_impulses, rebound_state
 from microimpact.cli import main
 from microimpact.io import default_materials_path, read_impacts, read_materials
+from microimpact.report.pdf import build_report
 
 #: the hidden truth of the simulations: Table 1 row 2 of the paper (zeta_H, zeta_A, w_A)
 TRUTH = {"zeta_hertz": 0.5, "zeta_adhesion": 29.0, "work_of_adhesion": 0.215834}
@@ -245,3 +249,15 @@ def test_cli_without_a_command_lists_design(capsys):
     assert main([]) == 2
     err = capsys.readouterr().err
     assert "design" in err and "lammps" in err
+
+
+def test_report_has_the_design_page(tmp_path, start_fit):
+    # the page the pipeline's design rule feeds (its JSON, made here in-process), in the PDF report
+    space = DesignSpace(radii=(RADIUS,), speed_range=(0.5, 20.0), e_n_sigma=SIGMA, n_speeds=12)
+    d = design_next_impacts(start_fit, space, 3, ("zeta_hertz", "friction"), n_friction=2)
+    record = json.loads(json.dumps(design_record(d, space, source="fit.nc")))  # what the rule writes and the page reads
+    pdf = PdfReader(build_report(tmp_path / "report.pdf", {"fit": start_fit.to_dataset(), "design": record}))
+    page = next(t for t in (p.extract_text() for p in pdf.pages) if "What to measure next" in t and "Criterion" in t)
+    assert "design-001" in page and "design-005" in page
+    assert "zeta_hertz" in page and "friction" in page  # the notes of both named parameters
+    assert "recommended" in page and "uniform" in page  # the width figure's caption

@@ -7,11 +7,10 @@ import re
 import sys
 
 import numpy as np
-import pandas as pd
 
 from microimpact._commands.common import UsageError
 from microimpact.analysis.design import (DESIGN_CRITERIA, MAX_CANDIDATE_SPEEDS, MAX_NEW_IMPACTS, DesignSpace,
-                                         ExperimentDesign, design_friction, design_impacts, design_template)
+                                         design_next_impacts, design_template)
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit
 from microimpact.io.files import write_csv
 from microimpact.io.paths import check_input_file, check_outputs, print_before_writing, reporting_os_errors
@@ -74,7 +73,8 @@ def run(args) -> int:
         raise UsageError(f"--n-friction {args.n_friction}: at most {MAX_NEW_IMPACTS}")
     fit = DampingFit.load(fit_path)
     space = _space(args, fit)
-    design = _design(fit, space, args, parameters)
+    design = design_next_impacts(fit, space, args.n, parameters, n_friction=args.n_friction,
+                                 criterion=args.criterion, rtol=args.rtol)
     table = design.rows[["id", "radius", "speed", "incidence_deg", "e_n_expected", "reason"]]
     print_before_writing(design.summary() + "\n" + table.to_string(index=False)
                          + "\n\nexpected 95 % interval widths against the number of new impacts:\n"
@@ -85,19 +85,3 @@ def run(args) -> int:
         print(f"wrote {out}", file=sys.stderr)
     return 0
 
-
-def _design(fit, space, args, parameters) -> ExperimentDesign:
-    """The damping design of the e_n parameters and, with friction named, the oblique design after it."""
-    damping = tuple(p for p in parameters if p != "friction")
-    parts = []
-    if damping:
-        parts.append(design_impacts(fit, space, args.n, parameters=damping, criterion=args.criterion, rtol=args.rtol))
-    if "friction" in parameters:
-        parts.append(design_friction(fit, space, args.n_friction, rtol=args.rtol))
-    if len(parts) == 1:
-        return parts[0]
-    rows = pd.concat([p.rows for p in parts], ignore_index=True)
-    rows["id"] = [f"design-{k + 1:03d}" for k in range(len(rows))]
-    return ExperimentDesign(rows, pd.concat([p.widths for p in parts], ignore_index=True),
-                            parts[0].parameters + parts[1].parameters, {**parts[0].values, **parts[1].values},
-                            "; ".join(p.criterion for p in parts), {**parts[0].notes, **parts[1].notes})

@@ -64,7 +64,8 @@ from microimpact.solvers import DEFAULT_RTOL
 
 __all__ = ["DesignSpace", "ExperimentDesign", "design_impacts", "fisher_widths", "uniform_design",
            "restitution_sensitivities", "design_template", "DESIGN_CRITERIA", "SENSITIVITY_FLOOR",
-           "TEMPLATE_COLUMNS", "MAX_NEW_IMPACTS", "MAX_CANDIDATE_SPEEDS", "design_friction", "uniform_oblique_design",
+           "TEMPLATE_COLUMNS", "MAX_NEW_IMPACTS", "MAX_CANDIDATE_SPEEDS", "design_friction", "uniform_oblique_design", "design_record", "design_next_impacts",
+           "fit_design_space",
            "tangential_sensitivities", "FRICTION_RANGE", "OBLIQUE_ANGLES_DEG"]
 
 #: the design criteria of :func:`design_impacts`
@@ -810,3 +811,117 @@ def _friction_design_note(cand, g, e_n, grid, chosen):
     covered = grid[(g[chosen] != 0).any(axis=0)]
     return text + (f"; the recommended impacts slide for f up to {covered.max():.2g} of the range "
                    f"{grid[0]:.2g}-{grid[-1]:.2g}" if covered.size else "; none of them slides")
+
+
+def design_record(design: ExperimentDesign, space: DesignSpace, source: str = "") -> dict:
+    """The design as JSON-ready data (the pipeline's ``design.json``, the report page's input).
+
+    Parameters
+    ----------
+    design : ExperimentDesign
+    space : DesignSpace
+        The space it was chosen from (recorded with it).
+    source : str
+        Where the fit came from (a file name).
+
+    Returns
+    -------
+    dict
+        ``criterion``, ``parameters``, ``values``, ``notes``, ``space`` (radii [m], speed_range
+        [m/s], incidence_deg and the friction design's oblique_deg [deg], e_n_sigma, e_t_sigma,
+        speed_sigma [-], n_speeds), ``rows``
+        (records of :attr:`ExperimentDesign.rows`), ``widths`` (records of
+        :attr:`ExperimentDesign.widths`), ``source``.
+
+    Examples
+    --------
+    >>> rows = pd.DataFrame({"id": ["design-001"], "radius": [3.45e-6], "speed": [2.0], "incidence_deg": [0.0],
+    ...                      "normal_speed": [2.0], "e_n_expected": [0.5], "reason": ["why"]})
+    >>> widths = pd.DataFrame({"n_new": [0, 1], "parameter": "zeta_hertz", "design": [1.0, 0.5], "uniform": [1.0, 0.8]})
+    >>> rec = design_record(ExperimentDesign(rows, widths, ("zeta_hertz",), {"zeta_hertz": 0.5}, "Fisher"),
+    ...                     DesignSpace(radii=(3.45e-6,)))
+    >>> rec["rows"][0]["reason"], rec["widths"][1]["uniform"], rec["space"]["speed_range"]
+    ('why', 0.8, [0.5, 20.0])
+    """
+    return {"criterion": design.criterion, "parameters": list(design.parameters),
+            "values": {k: float(v) for k, v in design.values.items()}, "notes": dict(design.notes),
+            "space": {"radii": [float(r) for r in space.radii], "speed_range": [float(x) for x in space.speed_range],
+                      "incidence_deg": [float(a) for a in space.incidence_deg], "e_n_sigma": float(space.e_n_sigma),
+                      "oblique_deg": sorted({float(a) for a in _friction_candidates(space)["incidence_deg"]}),
+                      "e_t_sigma": float(space.e_t_sigma), "speed_sigma": float(space.speed_sigma),
+                      "n_speeds": int(space.n_speeds)},
+            "rows": design.rows.to_dict("records"), "widths": design.widths.to_dict("records"), "source": str(source)}
+
+
+def fit_design_space(fit, **changes) -> DesignSpace:
+    """The design space of a fit: its radii and speed range, e_n uncertainty its median stated one
+    (the scatter, sqrt(reduced chi-square), when unweighted); ``changes`` replace any field.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> fit = SimpleNamespace(radii=[3.45e-6], speed_range=(1.0, 10.0), weighting="none", redchi=0.0004,
+    ...                       data=pd.DataFrame({"e_n": [0.5]}))
+    >>> s = fit_design_space(fit, n_speeds=10)
+    >>> s.speed_range, round(s.e_n_sigma, 6), s.n_speeds
+    ((1.0, 10.0), 0.02, 10)
+    """
+    d = fit.data
+    s = d["sigma"].to_numpy(float) if "sigma" in d.columns else np.array([np.nan])
+    sigma = float(np.nanmedian(s)) if fit.weighting != "none" and np.isfinite(s).any() else math.sqrt(fit.redchi)
+    lo, hi = fit.speed_range
+    base = {"radii": tuple(float(r) for r in fit.radii), "speed_range": (float(lo), float(hi)), "e_n_sigma": sigma}
+    return DesignSpace(**{**base, **changes})
+
+
+def design_next_impacts(fit, space: DesignSpace, n: int = 20, parameters=("zeta_hertz",), *, n_friction: int = 6,
+                        criterion: str = "A", rtol: float = DEFAULT_RTOL) -> ExperimentDesign:
+    """The e_n design of the damping parameters named and, with ``"friction"`` named, the oblique
+    design of :func:`design_friction` after it, as one :class:`ExperimentDesign` (ids renumbered).
+
+    Parameters
+    ----------
+    fit : DampingFit
+    space : DesignSpace
+    n : int
+        New e_n impacts for the damping parameters.
+    parameters : sequence of str
+        Among :data:`PARAMETER_NAMES` and ``"friction"``.
+    n_friction : int
+        New oblique impacts for friction.
+    criterion : {"A", "D"}
+        Of the damping design.
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+
+    Returns
+    -------
+    ExperimentDesign
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.io import default_materials_path, read_materials
+    >>> m = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = pd.DataFrame({"radius": 3.45e-6, "normal_speed": [2.0, 4.0, 8.0, 16.0], "e_n": [0.3, 0.55, 0.68, 0.7],
+    ...                       "e_n_uncertainty": 0.02})
+    >>> fit = fit_damping(table, m, confidence_intervals=False)
+    >>> d = design_next_impacts(fit, fit_design_space(fit, n_speeds=8), 2, ("zeta_hertz", "friction"), n_friction=2)
+    >>> d.rows["id"].tolist(), d.parameters
+    (['design-001', 'design-002', 'design-003', 'design-004'], ('zeta_hertz', 'friction'))
+    """
+    damping = tuple(p for p in parameters if p != "friction")
+    parts = []
+    if damping:
+        parts.append(design_impacts(fit, space, n, parameters=damping, criterion=criterion, rtol=rtol))
+    if "friction" in parameters:
+        parts.append(design_friction(fit, space, n_friction, rtol=rtol))
+    if not parts:
+        raise ValueError(f"parameters must be among {PARAMETER_NAMES + ('friction',)}, got {list(parameters)!r}")
+    if len(parts) == 1:
+        return parts[0]
+    rows = pd.concat([p.rows for p in parts], ignore_index=True)
+    rows["id"] = [f"design-{k + 1:03d}" for k in range(len(rows))]
+    return ExperimentDesign(rows, pd.concat([p.widths for p in parts], ignore_index=True),
+                            parts[0].parameters + parts[1].parameters, {**parts[0].values, **parts[1].values},
+                            "; ".join(p.criterion for p in parts), {**parts[0].notes, **parts[1].notes})
