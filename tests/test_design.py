@@ -16,6 +16,7 @@ from microimpact.analysis.design import (FRICTION_RANGE, OBLIQUE_ANGLES_DEG, Des
                                          restitution_sensitivities, tangential_sensitivities, uniform_design)
 from microimpact.analysis.fitting import FitProblem, fit_damping, model_restitution
 from microimpact.analysis.oblique import fit_friction, normal_impulses, rebound_state
+from microimpact.analysis.posterior import sample_posterior
 from microimpact.cli import main
 from microimpact.io import default_materials_path, read_impacts, read_materials
 from microimpact.report.pdf import build_report
@@ -261,3 +262,22 @@ def test_report_has_the_design_page(tmp_path, start_fit):
     assert "design-001" in page and "design-005" in page
     assert "zeta_hertz" in page and "friction" in page  # the notes of both named parameters
     assert "recommended" in page and "uniform" in page  # the width figure's caption
+
+
+def test_design_from_a_posterior_uses_its_covariance(tmp_path, start_fit, material, capsys):
+    # a short chain (an illustration, not converged): its sample covariance of ln zeta is M_0
+    table = pd.DataFrame({"radius": RADIUS, "normal_speed": np.array(START_SPEEDS),
+                          "e_n": start_fit.data["e_n"].to_numpy(), "e_n_uncertainty": SIGMA})
+    post = sample_posterior(table, start_fit, walkers=8, steps=60, require_convergence=False, seed=5)
+    d = design_impacts(start_fit, SPACE, 3, posterior=post)
+    assert post.names == ("zeta_hertz", "zeta_adhesion")
+    # every parameter sampled: the width now is 2 z sd(ln zeta_H) zeta_H of the samples
+    now = 2 * 1.959964 * np.std(np.log(post.samples[:, 0]), ddof=1) * d.values["zeta_hertz"]
+    assert d.width("zeta_hertz", 0) == pytest.approx(now, rel=1e-5, abs=0)  # the posterior's spread, not the fit's
+    assert d.values["zeta_hertz"] == pytest.approx(float(np.median(post.samples[:, 0])), rel=1e-12, abs=0)
+    fit, pf = tmp_path / "fit.nc", tmp_path / "post.nc"
+    start_fit.save(fit)
+    post.save(pf)
+    assert main(["design", str(fit), "--posterior", str(pf), "--n", "2", "--n-speeds", "8"]) == 0
+    assert main(["design", str(fit), "--posterior", str(fit), "--n", "2"]) == 2  # a fit is not a posterior
+    assert "not a posterior" in capsys.readouterr().err

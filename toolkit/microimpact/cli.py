@@ -397,6 +397,9 @@ def register_design(sub) -> None:
     p.add_argument("--parameters", default="zeta_hertz",
                    help="comma-separated parameters to narrow: zeta_hertz, zeta_adhesion, work_of_adhesion, friction "
                         "(oblique impacts whose tangential restitution determines f); default zeta_hertz")
+    p.add_argument("--posterior", default=None, metavar="POST.nc",
+                   help="the fit's posterior ('microimpact fit --posterior'): its covariance replaces the fit's "
+                        "linearised information")
     p.add_argument("--n-friction", type=lambda t: _whole_number(t, 1), default=6,
                    help="number of new oblique impacts for friction (default 6)")
     p.add_argument("--e-t-sigma", type=_positive_float, default=0.02,

@@ -374,6 +374,25 @@ def _reference_value(fit, name) -> float:
     return value if value > 0 else 1.0
 
 
+def _posterior_information(posterior, values, varied):
+    """(values at the posterior medians, information = inverse sample covariance of ln theta) for the
+    parameters ``varied``; a parameter the posterior did not sample gets the weak prior."""
+    names = [p for p in varied if p in posterior.names]
+    if not names:
+        raise ValueError(f"the posterior samples none of {list(varied)!r}")
+    x = posterior.samples[:, [posterior.names.index(p) for p in names]]
+    if not np.all(x > 0):
+        raise ValueError("the posterior has samples <= 0 of " + ", ".join(names) + ": the relative (ln) design "
+                         "needs positive values")
+    med = posterior.median()
+    values = {**values, **{p: float(med[p]) for p in names}}
+    cov = np.atleast_2d(np.cov(np.log(x), rowvar=False))
+    info = np.diag(np.full(len(varied), 1.0 / WEAK_PRIOR_RELATIVE_SD ** 2))
+    idx = [varied.index(p) for p in names]
+    info[np.ix_(idx, idx)] = np.linalg.inv(cov)
+    return values, info
+
+
 def _prior_information(varied, prior, values, z):
     """Information of the prior: a range [lo, hi] is a +/- z interval in ln theta; a weak prior elsewhere."""
     sd = []
@@ -388,7 +407,7 @@ def _prior_information(varied, prior, values, z):
 
 def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, parameters=("zeta_hertz",),
                    prior: dict | None = None, material=None, criterion: str = "A", rtol: float = DEFAULT_RTOL,
-                   friction_range: tuple = (0.05, 1.0)) -> ExperimentDesign:
+                   friction_range: tuple = (0.05, 1.0), posterior=None) -> ExperimentDesign:
     """The next ``n`` impacts that most reduce the expected 95 % intervals of ``parameters``.
 
     Parameters
@@ -412,6 +431,10 @@ def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, p
         Relative tolerance of the normal solves (and of the finite-difference step). [-]
     friction_range : (float, float)
         Coulomb coefficients for the friction note. [-]
+    posterior : Posterior, optional
+        An MCMC sample of the fit's parameters (``microimpact fit --posterior``): M_0 is then the
+        inverse of its sample covariance of ln theta (the data's information, without the
+        linearisation of the fit) and the sensitivities are taken at its medians.
 
     Returns
     -------
@@ -443,6 +466,11 @@ def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, p
     base, values, varied, existing = _start(fit, prior, material, damping)
     z = float(stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2))
     info0 = _prior_information(varied, prior if fit is None else None, values, z)
+    if posterior is not None:
+        if fit is None:
+            raise ValueError("a posterior needs its damping fit (the material and the data's radii)")
+        values, info0 = _posterior_information(posterior, values, varied)
+        existing = None  # the posterior already holds the data's information
     if existing is not None:
         _, g0, s0 = restitution_sensitivities(base, existing[0], existing[1], values, varied, rtol=rtol)
         info0 = info0 + (g0 / existing[2][:, None]).T @ (g0 / existing[2][:, None])
@@ -875,7 +903,7 @@ def fit_design_space(fit, **changes) -> DesignSpace:
 
 
 def design_next_impacts(fit, space: DesignSpace, n: int = 20, parameters=("zeta_hertz",), *, n_friction: int = 6,
-                        criterion: str = "A", rtol: float = DEFAULT_RTOL) -> ExperimentDesign:
+                        criterion: str = "A", rtol: float = DEFAULT_RTOL, posterior=None) -> ExperimentDesign:
     """The e_n design of the damping parameters named and, with ``"friction"`` named, the oblique
     design of :func:`design_friction` after it, as one :class:`ExperimentDesign` (ids renumbered).
 
@@ -893,6 +921,8 @@ def design_next_impacts(fit, space: DesignSpace, n: int = 20, parameters=("zeta_
         Of the damping design.
     rtol : float
         Relative tolerance of the normal solves. [-]
+    posterior : Posterior, optional
+        Of the fit: the damping design's M_0 (:func:`design_impacts`).
 
     Returns
     -------
@@ -913,7 +943,8 @@ def design_next_impacts(fit, space: DesignSpace, n: int = 20, parameters=("zeta_
     damping = tuple(p for p in parameters if p != "friction")
     parts = []
     if damping:
-        parts.append(design_impacts(fit, space, n, parameters=damping, criterion=criterion, rtol=rtol))
+        parts.append(design_impacts(fit, space, n, parameters=damping, criterion=criterion, rtol=rtol,
+                                    posterior=posterior))
     if "friction" in parameters:
         parts.append(design_friction(fit, space, n_friction, rtol=rtol))
     if not parts:
