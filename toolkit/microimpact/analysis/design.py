@@ -202,8 +202,9 @@ class ExperimentDesign:
         lines = [f"criterion: {self.criterion}"]
         lines += [f"{k}: {v}" for k, v in self.notes.items()]
         for p in self.parameters:
+            n = int(self.widths.loc[self.widths["parameter"] == p, "n_new"].max())
             lines.append(f"{p}: expected 95 % width {self.width(p, 0):.4g} now, {self.width(p):.4g} after "
-                         f"{len(self.rows)} recommended impacts ({self.width(p, which='uniform'):.4g} if uniform)")
+                         f"{n} recommended impacts ({self.width(p, which='uniform'):.4g} if uniform)")
         return "\n".join(lines)
 
 
