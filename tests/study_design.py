@@ -20,6 +20,7 @@ spread uniformly over the same angles and speeds, refits f with
 friction draws use their own random stream, so the damping rows do not depend on them.
 
     python tests/study_design.py --truths 50 --n 6 --seed 54 --out docs/design-study.json
+    python tests/study_design.py --replot docs/design-study.json --figure docs/design-study.png
 """
 
 from __future__ import annotations
@@ -170,13 +171,60 @@ def summary(rows) -> dict:
             "determined_start": int(sum(r["start_status"] == "determined" for r in rows))}
 
 
+def draw_figure(result: dict, path) -> None:
+    """Left: the refitted zeta_H width, recommended against uniform, per truth; right: the friction
+    status of each truth after its start, the recommended and the uniform oblique impacts."""
+    from matplotlib.figure import Figure  # a study's figure: matplotlib only when asked for
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
+
+    rows = result["rows"]
+    fig = Figure(figsize=(8.0, 3.4), layout="constrained")
+    ax, bx = fig.subplots(1, 2)
+    w_d = np.array([r["refit_design"]["width"] for r in rows])
+    w_u = np.array([r["refit_uniform"]["width"] for r in rows])
+    cov = np.array([r["refit_design"]["covers"] for r in rows])
+    ax.loglog(w_u[cov], w_d[cov], "o", ms=3.5, label="covers the truth")
+    ax.loglog(w_u[~cov], w_d[~cov], "x", ms=5, color="C3", label="misses it")
+    lim = [min(w_d.min(), w_u.min()) * 0.8, max(w_d.max(), w_u.max()) * 1.2]
+    ax.plot(lim, lim, "k-", lw=0.7, label="equal")
+    ax.plot(lim, np.array(lim) / 1.5, "k--", lw=0.7, label="1.5x narrower")
+    ax.set_xlabel("95 % width of zeta_H, uniform [-]")
+    ax.set_ylabel("95 % width of zeta_H, recommended [-]")
+    ax.set_title(f"median ratio {result['summary']['median_refit_width_ratio']:.2f} ({len(rows)} truths)", fontsize=9)
+    ax.legend(fontsize=7, frameon=False)
+    ticks = [t for t in (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0) if lim[0] <= t <= lim[1]]
+    for axis in (ax.xaxis, ax.yaxis):  # plain labels at 1-2-5, no crowded minor ones
+        axis.set_ticks(ticks)
+        axis.set_major_formatter(ScalarFormatter())
+        axis.set_minor_formatter(NullFormatter())
+    statuses = ["determined", "lower_bound", "upper_bound", "not_determined"]
+    fr = [r["friction"] for r in rows if "friction" in r]
+    counts = {k: [sum(r[k]["status"] == s for r in fr) for s in statuses]
+              for k in ("refit_start", "refit_design", "refit_uniform")}
+    x = np.arange(len(statuses))
+    for i, (k, label) in enumerate((("refit_start", "start (10-30 deg)"), ("refit_design", "+ recommended"),
+                                    ("refit_uniform", "+ uniform"))):
+        bx.bar(x + (i - 1) * 0.27, counts[k], 0.27, label=label)
+    bx.set_xticks(x, [s.replace("_", "\n") for s in statuses], fontsize=8)
+    bx.set_ylabel("truths")
+    bx.set_title("friction status after the refit", fontsize=9)
+    bx.legend(fontsize=7, frameon=False)
+    fig.savefig(path, dpi=120)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--truths", type=int, default=50)
     p.add_argument("--n", type=int, default=6, help="new impacts per design")
     p.add_argument("--seed", type=int, default=54)
     p.add_argument("--out", default=None, help="JSON file (default: print)")
+    p.add_argument("--figure", default=None, help="PNG of the widths and the friction statuses")
+    p.add_argument("--replot", default=None, metavar="JSON", help="draw --figure from a study's JSON, run nothing")
     args = p.parse_args(argv)
+    if args.replot:
+        with open(args.replot, encoding="utf-8") as f:
+            draw_figure(json.load(f), args.figure or "design-study.png")
+        return 0
     material = read_materials(default_materials_path())[PAIR]
     space = DesignSpace(radii=(RADIUS,), speed_range=(0.5, 20.0), e_n_sigma=SIGMA, n_speeds=25)
     rng = np.random.default_rng(args.seed)
@@ -207,6 +255,8 @@ def main(argv=None) -> int:
     else:
         print(text)
     print(json.dumps(result["summary"], indent=1), file=sys.stderr)
+    if args.figure:
+        draw_figure(result, args.figure)
     return 0
 
 
