@@ -36,6 +36,7 @@ include: "workflow/rules/dynamics.smk"
 include: "workflow/rules/sweeps.smk"
 include: "workflow/rules/validation.smk"
 include: "workflow/rules/benchmark.smk"
+include: "workflow/rules/design.smk"
 include: "workflow/rules/report.smk"
 include: "workflow/rules/figures.smk"
 

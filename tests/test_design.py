@@ -4,15 +4,22 @@ never lie where the parameter has no effect, and come as a template that reads b
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pandas as pd
 import pytest
+from pypdf import PdfReader
 
-from microimpact.analysis.design import (DesignSpace, design_impacts, fisher_widths, restitution_sensitivities,
-                                         uniform_design)
+from microimpact.analysis.design import (FRICTION_RANGE, OBLIQUE_ANGLES_DEG, DesignSpace, design_friction,
+                                         design_impacts, design_next_impacts, design_record, fisher_widths,
+                                         restitution_sensitivities, tangential_sensitivities, uniform_design)
 from microimpact.analysis.fitting import FitProblem, fit_damping, model_restitution
+from microimpact.analysis.oblique import fit_friction, normal_impulses, rebound_state
+from microimpact.analysis.posterior import sample_posterior
 from microimpact.cli import main
 from microimpact.io import default_materials_path, read_impacts, read_materials
+from microimpact.report.pdf import build_report
 
 #: the hidden truth of the simulations: Table 1 row 2 of the paper (zeta_H, zeta_A, w_A)
 TRUTH = {"zeta_hertz": 0.5, "zeta_adhesion": 29.0, "work_of_adhesion": 0.215834}
@@ -152,3 +159,125 @@ def test_cli_refuses_a_file_that_is_not_a_fit(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "notafit.nc" in err[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notafit.nc"]
+
+
+# --------------------------------------------------------------------------- friction (oblique designs)
+#: the oblique space of the friction tests: the design's default angles, 2-20 m/s
+OBLIQUE = DesignSpace(radii=(RADIUS,), speed_range=(2.0, 20.0), incidence_deg=OBLIQUE_ANGLES_DEG, n_speeds=6,
+                      e_t_sigma=SIGMA)
+
+
+def _contact(material, friction=0.3):
+    return material.contact(RADIUS).with_(zeta_hertz=TRUTH["zeta_hertz"], zeta_adhesion=TRUTH["zeta_adhesion"],
+                                          friction=friction)
+
+
+def test_tangential_sensitivity_is_the_sliding_impulse_and_zero_when_rolling(material):
+    # sliding throughout, v_t,out = v_t,in - f J / m (Cheng, Brach & Dunn 2002, Eqs. (16)-(20)), so
+    # d e_t / d ln f = -f J / (m v_t,in); once the sphere ends rolling e_t = 5/7 and does not move
+    c = _contact(material)
+    speed, angle = np.array([10.0, 10.0]), np.array([75.0, 20.0])
+    imp = normal_impulses(c, speed, angle)
+    _, e_t, g = tangential_sensitivities(c, speed, angle, [0.3])
+    expected = -0.3 * imp["friction_impulse"][0] / (c.mass * imp["velocity_in_t"][0])
+    assert g[0, 0] == pytest.approx(expected, rel=1e-6, abs=0)  # linear in f: only rounding
+    assert e_t[0, 0] == pytest.approx(1 + expected, rel=1e-9, abs=0)
+    assert e_t[1, 0] == pytest.approx(5 / 7, rel=1e-9, abs=0) and g[1, 0] == 0.0
+
+
+def test_friction_design_only_picks_impacts_that_slide_for_some_f(material):
+    d = design_friction(None, OBLIQUE, 6, material=material, values=TRUTH)
+    assert d.parameters == ("friction",) and len(d.rows) == 6
+    # checked with the solver's rebound map, not the design's sensitivities: at the range's smallest
+    # f each recommended impact rebounds and still slides (e_t above the rolling 5/7)
+    out = rebound_state(_contact(material, FRICTION_RANGE[0]), d.rows["speed"].to_numpy(),
+                        d.rows["incidence_deg"].to_numpy(), np.zeros(6))
+    e_t = out["velocity_out_t"] / (d.rows["speed"] * np.sin(np.radians(d.rows["incidence_deg"])))
+    assert not out["captured"].any() and np.all(e_t > 5 / 7 + 1e-6)
+    # and the design reaches the top of the range: some impact slides at f = 1 (steep angles)
+    top = rebound_state(_contact(material, FRICTION_RANGE[1]), d.rows["speed"].to_numpy(),
+                        d.rows["incidence_deg"].to_numpy(), np.zeros(6))
+    assert np.any(top["velocity_out_t"] / (d.rows["speed"] * np.sin(np.radians(d.rows["incidence_deg"]))) > 5 / 7 + 1e-6)
+    assert d.width("friction") < d.width("friction", 0)
+
+
+def test_friction_design_refuses_a_space_where_everything_rolls(material):
+    space = DesignSpace(radii=(RADIUS,), speed_range=(5.0, 20.0), incidence_deg=(5.0,), n_speeds=3)
+    with pytest.raises(ValueError, match="steeper incidence angles"):
+        design_friction(None, space, 2, material=material, values=TRUTH)
+
+
+def _oblique_table(material, friction, rows, rng):
+    speed, angle = rows["speed"].to_numpy(float), rows["incidence_deg"].to_numpy(float)
+    out = rebound_state(_contact(material, friction), speed, angle, np.zeros(speed.size))
+    return pd.DataFrame({"radius": RADIUS, "speed": speed, "incidence_deg": angle,
+                         "e_n": out["velocity_out_n"] / (speed * np.cos(np.radians(angle))),
+                         "tangential_restitution": out["velocity_out_t"] / (speed * np.sin(np.radians(angle)))
+                         + rng.normal(0.0, SIGMA, speed.size), "tangential_restitution_uncertainty": SIGMA})
+
+
+def test_friction_design_determines_f_where_the_start_does_not(start_fit, material):
+    rng = np.random.default_rng(3)
+    start = _oblique_table(material, 0.3, pd.DataFrame({"speed": [8.0, 12.0, 16.0], "incidence_deg": [10.0, 20.0, 30.0]}),
+                           rng)
+    before = fit_friction(start, start_fit, propagate_damping=False).identifiability["friction"]
+    assert not before.determined  # every start impact ends rolling at f = 0.3
+    d = design_friction(start_fit, OBLIQUE, 4, existing=start)
+    after = fit_friction(pd.concat([start, _oblique_table(material, 0.3, d.rows, rng)]), start_fit,
+                         propagate_damping=False).identifiability["friction"]
+    assert after.determined and after.lower <= 0.3 <= after.upper
+
+
+def test_friction_template_reads_back_once_filled_in(tmp_path, start_fit, capsys):
+    fit = tmp_path / "fit.nc"
+    start_fit.save(fit)
+    out = tmp_path / "design.csv"
+    assert main(["design", str(fit), "--parameters", "zeta_hertz,friction", "--n", "2", "--n-friction", "3",
+                 "--n-speeds", "8", "--speeds", "2:20", "--out", str(out)]) == 0
+    assert "slides throughout" in capsys.readouterr().out
+    t = pd.read_csv(out)
+    assert len(t) == 5 and (t["incidence_angle [deg]"] > 0).sum() == 3
+    t["e_n [1]"] = 0.5
+    t.loc[t["incidence_angle [deg]"] > 0, "tangential_restitution [1]"] = 0.8
+    filled = tmp_path / "filled.csv"
+    t.to_csv(filled, index=False)
+    back = read_impacts(filled)
+    assert list(back["id"]) == list(t["id"])
+    assert np.allclose(back["tangential_restitution"].to_numpy()[t["incidence_angle [deg]"].to_numpy() > 0], 0.8)
+
+
+def test_cli_without_a_command_lists_design(capsys):
+    assert main([]) == 2
+    err = capsys.readouterr().err
+    assert "design" in err and "lammps" in err
+
+
+def test_report_has_the_design_page(tmp_path, start_fit):
+    # the page the pipeline's design rule feeds (its JSON, made here in-process), in the PDF report
+    space = DesignSpace(radii=(RADIUS,), speed_range=(0.5, 20.0), e_n_sigma=SIGMA, n_speeds=12)
+    d = design_next_impacts(start_fit, space, 3, ("zeta_hertz", "friction"), n_friction=2)
+    record = json.loads(json.dumps(design_record(d, space, source="fit.nc")))  # what the rule writes and the page reads
+    pdf = PdfReader(build_report(tmp_path / "report.pdf", {"fit": start_fit.to_dataset(), "design": record}))
+    page = next(t for t in (p.extract_text() for p in pdf.pages) if "What to measure next" in t and "Criterion" in t)
+    assert "design-001" in page and "design-005" in page
+    assert "zeta_hertz" in page and "friction" in page  # the notes of both named parameters
+    assert "recommended" in page and "uniform" in page  # the width figure's caption
+
+
+def test_design_from_a_posterior_uses_its_covariance(tmp_path, start_fit, material, capsys):
+    # a short chain (an illustration, not converged): its sample covariance of ln zeta is M_0
+    table = pd.DataFrame({"radius": RADIUS, "normal_speed": np.array(START_SPEEDS),
+                          "e_n": start_fit.data["e_n"].to_numpy(), "e_n_uncertainty": SIGMA})
+    post = sample_posterior(table, start_fit, walkers=8, steps=60, require_convergence=False, seed=5)
+    d = design_impacts(start_fit, SPACE, 3, posterior=post)
+    assert post.names == ("zeta_hertz", "zeta_adhesion")
+    # every parameter sampled: the width now is 2 z sd(ln zeta_H) zeta_H of the samples
+    now = 2 * 1.959964 * np.std(np.log(post.samples[:, 0]), ddof=1) * d.values["zeta_hertz"]
+    assert d.width("zeta_hertz", 0) == pytest.approx(now, rel=1e-5, abs=0)  # the posterior's spread, not the fit's
+    assert d.values["zeta_hertz"] == pytest.approx(float(np.median(post.samples[:, 0])), rel=1e-12, abs=0)
+    fit, pf = tmp_path / "fit.nc", tmp_path / "post.nc"
+    start_fit.save(fit)
+    post.save(pf)
+    assert main(["design", str(fit), "--posterior", str(pf), "--n", "2", "--n-speeds", "8"]) == 0
+    assert main(["design", str(fit), "--posterior", str(fit), "--n", "2"]) == 2  # a fit is not a posterior
+    assert "not a posterior" in capsys.readouterr().err

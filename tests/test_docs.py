@@ -86,7 +86,8 @@ HOW = {
     "microimpact simulate --fit fit.nc --radius 2e-6 --speed 3 --json": "run",
     # docs/guide/design.md: what to measure next, and its study (minutes; tests/test_design.py runs a refit)
     "microimpact design fit.nc --n 20 --speeds 0.5:20 --out design.csv": "run",
-    "python tests/study_design.py --truths 20 --n 6 --seed 54 --out docs/design-study.json": "study",
+    "python tests/study_design.py --truths 50 --n 6 --seed 54 --out docs/design-study.json": "study",
+    "python tests/study_design.py --replot docs/design-study.json --figure docs/design-study.png": "study",
     # docs/calibration.md: the calibration study (tens of minutes; tests/test_calibration.py runs a quick form)
     "python tests/study_calibration.py --designs 300 --posterior-designs 12 --workers 2 --seed 1000 --out docs/calibration.json --figure docs/calibration.png": "study",
     "python tests/study_calibration.py": "study",

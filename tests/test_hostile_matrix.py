@@ -44,6 +44,8 @@ COMMANDS = {
     # flags reading a posterior: for the wrong kinds only (a posterior's collisions: test_hostile_cli.py)
     "flags-posterior": (["flags", "data.csv", "--fit", "fit.nc", "--posterior", "{--posterior}", "--out", "o.csv"],
                         {"--posterior": ("notfit.nc", "in")}),
+    "design-posterior": (["design", "fit.nc", "--posterior", "{--posterior}", "--n", "2", "--out", "d.csv"],
+                         {"--posterior": ("notfit.nc", "in")}),
 }
 
 #: how the error names each option (the positional inputs have no option name)
@@ -91,7 +93,7 @@ FILE_INPUTS = [("fit", "DATA", {"csv"}), ("flags", "DATA", {"csv"}), ("flags", "
                ("flags-posterior", "--posterior", set()), ("lammps-export", "--fit", {"fit"}),
                ("lammps-verify", "INPUT", set()), ("lammps-fit", "DATA", {"csv"}), ("lammps-fit", "--config", {"yaml"}),
                ("compare", "DATA", {"csv"}), ("compare", "--config", {"yaml"}),
-               ("design", "FIT", {"fit"})]
+               ("design", "FIT", {"fit"}), ("design-posterior", "--posterior", set())]
 WRONG_KIND = [(c, o, kind) for c, o, ok in FILE_INPUTS for kind in KINDS if kind not in ok]
 
 
@@ -141,7 +143,7 @@ HUGE += [(["fit", "data.csv", "--out", "f.nc", "--posterior", "p.nc", "--seed", 
          for n in ("2147483648", "9" * 40)]
 HUGE += [(["target", "--e-n", "0.5", "--speed", "2", "--points", n, "--out", "t.csv"], "--points")
          for n in ("1000000000000", "9" * 30)]
-HUGE += [(["design", "fit.nc", option, n, "--out", "d.csv"], option) for option in ("--n", "--n-speeds")
+HUGE += [(["design", "fit.nc", option, n, "--out", "d.csv"], option) for option in ("--n", "--n-speeds", "--n-friction")
          for n in ("1000000000000", "9" * 30)]
 HUGE += [(["plot", "fit.nc", "--out", "p.png", "--dpi", n], "--dpi") for n in ("1e7", "1e300")]
 HUGE += [(["fit", "data.csv", "--out", "f.nc", option, "5"], option)  # sampler counts without a sampler

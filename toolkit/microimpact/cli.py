@@ -219,6 +219,7 @@ def build_parser() -> argparse.ArgumentParser:
                      register_reproduce,
                      register_benchmark, register_plot, register_workflow, register_lammps):
         register(sub)
+    parser.set_defaults(command_names=tuple(sub.choices))  # the "a command is required" list, never stale
     return parser
 
 
@@ -395,10 +396,18 @@ def register_design(sub) -> None:
     p.add_argument("--n", type=lambda t: _whole_number(t, 1), default=20, help="number of new impacts (default 20)")
     p.add_argument("--parameters", default="zeta_hertz",
                    help="comma-separated parameters to narrow: zeta_hertz, zeta_adhesion, work_of_adhesion, friction "
-                        "(a note only: e_n does not depend on it); default zeta_hertz")
+                        "(oblique impacts whose tangential restitution determines f); default zeta_hertz")
+    p.add_argument("--posterior", default=None, metavar="POST.nc",
+                   help="the fit's posterior ('microimpact fit --posterior'): its covariance replaces the fit's "
+                        "linearised information")
+    p.add_argument("--n-friction", type=lambda t: _whole_number(t, 1), default=6,
+                   help="number of new oblique impacts for friction (default 6)")
+    p.add_argument("--e-t-sigma", type=_positive_float, default=0.02,
+                   help="standard uncertainty of a new tangential restitution (default 0.02)")
     p.add_argument("--speeds", default=None, metavar="MIN:MAX", help="incident speeds that can be set [m/s] (default: the fit's range)")
     p.add_argument("--radii", default=None, help="comma-separated sphere radii [m] (default: the fit's)")
-    p.add_argument("--angles", default="0", help="comma-separated incidence angles [deg] (default 0)")
+    p.add_argument("--angles", default="0", help="comma-separated incidence angles [deg] (default 0; for friction the "
+                                                 "nonzero ones, else 20-85 deg)")
     p.add_argument("--e-n-sigma", type=_positive_float, default=None,
                    help="standard uncertainty of a new e_n (default: the fit's median)")
     p.add_argument("--speed-sigma", type=_relative_uncertainty, default=None,
@@ -861,8 +870,8 @@ def _main(argv, written) -> int:
         elif rest:
             raise UsageError(f"unrecognized arguments: {' '.join(rest)}")
         if not getattr(args, "command", None):
-            raise UsageError("a command is required: simulate, sweep, fit, compare, flags, target, reproduce, benchmark, plot, "
-                             "workflow or lammps")
+            names = args.command_names
+            raise UsageError(f"a command is required: {', '.join(names[:-1])} or {names[-1]}")
         status = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
         return status

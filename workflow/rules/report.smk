@@ -10,6 +10,7 @@ rule report:
         unpack(stress_outputs),
         unpack(lammps_outputs),
         unpack(analyst_report_inputs),
+        unpack(design_report_inputs),
         data_table=rules.validate_data.output.table,
         phase_portraits=rules.paper_dynamics.output.phase_portraits,
         dynamics=rules.paper_dynamics.output.dynamics,

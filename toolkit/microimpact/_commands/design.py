@@ -10,8 +10,9 @@ import numpy as np
 
 from microimpact._commands.common import UsageError
 from microimpact.analysis.design import (DESIGN_CRITERIA, MAX_CANDIDATE_SPEEDS, MAX_NEW_IMPACTS, DesignSpace,
-                                         design_impacts, design_template)
+                                         design_next_impacts, design_template)
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit
+from microimpact.analysis.posterior import Posterior
 from microimpact.io.files import write_csv
 from microimpact.io.paths import check_input_file, check_outputs, print_before_writing, reporting_os_errors
 
@@ -50,14 +51,17 @@ def _space(args, fit) -> DesignSpace:
     try:
         given = {} if args.speed_sigma is None else {"speed_sigma": args.speed_sigma}
         return DesignSpace(radii=radii, speed_range=(lo, hi), incidence_deg=angles, e_n_sigma=sigma,
-                           n_speeds=args.n_speeds, **given)
+                           n_speeds=args.n_speeds, e_t_sigma=args.e_t_sigma, **given)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
 
 
 def run(args) -> int:
     fit_path = check_input_file("fit file", args.fit)
-    out = check_outputs({"--out": args.out}, {"fit file": fit_path})["--out"] if args.out else None
+    inputs = {"fit file": fit_path}
+    if args.posterior is not None:
+        inputs["--posterior"] = check_input_file("--posterior", args.posterior)
+    out = check_outputs({"--out": args.out}, inputs)["--out"] if args.out else None
     if out is not None and not str(out).endswith(".csv"):
         raise UsageError(f"--out {args.out!r}: the template is a CSV file (end it in .csv)")
     for option, value, most in (("--n", args.n, MAX_NEW_IMPACTS), ("--n-speeds", args.n_speeds, MAX_CANDIDATE_SPEEDS)):
@@ -69,15 +73,25 @@ def run(args) -> int:
         raise UsageError(f"--parameters {args.parameters!r}: choose among {', '.join(PARAMETER_NAMES + ('friction',))}")
     if args.criterion not in DESIGN_CRITERIA:
         raise UsageError(f"--criterion {args.criterion!r}: one of {', '.join(DESIGN_CRITERIA)}")
+    if args.n_friction > MAX_NEW_IMPACTS:
+        raise UsageError(f"--n-friction {args.n_friction}: at most {MAX_NEW_IMPACTS}")
     fit = DampingFit.load(fit_path)
     space = _space(args, fit)
-    design = design_impacts(fit, space, args.n, parameters=parameters, criterion=args.criterion, rtol=args.rtol)
+    post = None
+    if args.posterior is not None:
+        post = Posterior.load(inputs["--posterior"])
+    try:
+        design = design_next_impacts(fit, space, args.n, parameters, n_friction=args.n_friction,
+                                     criterion=args.criterion, rtol=args.rtol, posterior=post)
+    except ValueError as exc:
+        raise UsageError(f"{args.posterior or args.fit}: {exc}") from None
     table = design.rows[["id", "radius", "speed", "incidence_deg", "e_n_expected", "reason"]]
     print_before_writing(design.summary() + "\n" + table.to_string(index=False)
                          + "\n\nexpected 95 % interval widths against the number of new impacts:\n"
                          + design.widths.to_string(index=False))
     if out is not None:
         with reporting_os_errors({"--out": out}):
-            write_csv(design_template(design, space.e_n_sigma), out, float_format="%.6g")
+            write_csv(design_template(design, space.e_n_sigma, space.e_t_sigma), out, float_format="%.6g")
         print(f"wrote {out}", file=sys.stderr)
     return 0
+

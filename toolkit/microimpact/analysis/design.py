@@ -57,14 +57,16 @@ from scipy import stats
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES
 from microimpact.analysis.fitting import FitProblem, model_restitution
-from microimpact.analysis.oblique import normal_impulses
+from microimpact.analysis.oblique import normal_impulses, rebound_from_impulses
 from microimpact.io.materials import material_contact
 from microimpact.io.statuses import DEFAULT_LEVEL
 from microimpact.solvers import DEFAULT_RTOL
 
 __all__ = ["DesignSpace", "ExperimentDesign", "design_impacts", "fisher_widths", "uniform_design",
            "restitution_sensitivities", "design_template", "DESIGN_CRITERIA", "SENSITIVITY_FLOOR",
-           "TEMPLATE_COLUMNS", "MAX_NEW_IMPACTS", "MAX_CANDIDATE_SPEEDS"]
+           "TEMPLATE_COLUMNS", "MAX_NEW_IMPACTS", "MAX_CANDIDATE_SPEEDS", "design_friction", "uniform_oblique_design", "design_record", "design_next_impacts",
+           "fit_design_space",
+           "tangential_sensitivities", "FRICTION_RANGE", "OBLIQUE_ANGLES_DEG"]
 
 #: the design criteria of :func:`design_impacts`
 DESIGN_CRITERIA = ("A", "D")
@@ -81,7 +83,16 @@ WEAK_PRIOR_RELATIVE_SD = 10.0
 #: columns of the CSV template (the measured-impact format, data/README.md); e_n and its
 #: uncertainty are left empty for the laboratory to fill in
 TEMPLATE_COLUMNS = ("id", "radius [um]", "speed [m/s]", "incidence_angle [deg]", "e_n [1]", "e_n_uncertainty [1]",
-                    "reason")
+                    "tangential_restitution [1]", "tangential_restitution_uncertainty [1]", "reason")
+#: Coulomb coefficients a friction design must determine when nothing else is known: the prior range
+#: the design averages its criterion over (log-uniform). [-]
+FRICTION_RANGE = (0.05, 1.0)
+#: incidence angles of a friction design when the design space gives none but normal incidence:
+#: an impact slides throughout only for f < f* ~ 2 tan(alpha) / (7 (1 + e_n)), so f up to 1
+#: needs alpha near 80 deg (Cheng, Brach & Dunn 2002, Eqs. (16)-(20)). [deg]
+OBLIQUE_ANGLES_DEG = (20.0, 30.0, 40.0, 50.0, 60.0, 65.0, 70.0, 75.0, 80.0, 85.0)
+#: log-spaced friction values the friction design averages its criterion over
+FRICTION_GRID_POINTS = 25
 
 
 @dataclass(frozen=True)
@@ -104,6 +115,9 @@ class DesignSpace:
         v_n and a point would otherwise look far more informative than a measurement there is.
     n_speeds : int
         Log-spaced candidate speeds over ``speed_range``.
+    e_t_sigma : float
+        Standard uncertainty of a measured tangential restitution e_t = v_t,out / v_t,in (the
+        friction design). [-]
 
     Examples
     --------
@@ -117,6 +131,7 @@ class DesignSpace:
     e_n_sigma: float = 0.02
     speed_sigma: float = 0.01
     n_speeds: int = 60
+    e_t_sigma: float = 0.02
 
     def __post_init__(self):
         lo, hi = (float(x) for x in self.speed_range)
@@ -130,6 +145,8 @@ class DesignSpace:
             raise ValueError(f"e_n_sigma must be a finite standard uncertainty > 0, got {self.e_n_sigma!r}")
         if not (math.isfinite(self.speed_sigma) and 0 <= self.speed_sigma < 0.5):
             raise ValueError(f"speed_sigma must be a relative uncertainty in [0, 0.5), got {self.speed_sigma!r}")
+        if not (math.isfinite(self.e_t_sigma) and self.e_t_sigma > 0):
+            raise ValueError(f"e_t_sigma must be a finite standard uncertainty > 0, got {self.e_t_sigma!r}")
         if not 2 <= int(self.n_speeds) <= MAX_CANDIDATE_SPEEDS:
             raise ValueError(f"n_speeds must be in [2, {MAX_CANDIDATE_SPEEDS}], got {self.n_speeds!r}")
 
@@ -185,8 +202,9 @@ class ExperimentDesign:
         lines = [f"criterion: {self.criterion}"]
         lines += [f"{k}: {v}" for k, v in self.notes.items()]
         for p in self.parameters:
+            n = int(self.widths.loc[self.widths["parameter"] == p, "n_new"].max())
             lines.append(f"{p}: expected 95 % width {self.width(p, 0):.4g} now, {self.width(p):.4g} after "
-                         f"{len(self.rows)} recommended impacts ({self.width(p, which='uniform'):.4g} if uniform)")
+                         f"{n} recommended impacts ({self.width(p, which='uniform'):.4g} if uniform)")
         return "\n".join(lines)
 
 
@@ -300,6 +318,21 @@ def uniform_design(space: DesignSpace, n: int) -> pd.DataFrame:
                          "normal_speed": speeds * np.cos(np.radians(angles))})
 
 
+def uniform_oblique_design(space: DesignSpace, n: int) -> pd.DataFrame:
+    """``n`` oblique impacts spread evenly: angles evenly over the space's oblique range (that of
+    :data:`OBLIQUE_ANGLES_DEG` if it has none), speeds log-spaced, size classes cycled.
+
+    Examples
+    --------
+    >>> uniform_oblique_design(DesignSpace(radii=(1e-6,), incidence_deg=(0.0, 20.0, 80.0)), 4)["incidence_deg"].tolist()
+    [20.0, 40.0, 60.0, 80.0]
+    """
+    angles = tuple(a for a in space.incidence_deg if a > 0) or OBLIQUE_ANGLES_DEG
+    rows = uniform_design(space, n)
+    a = np.linspace(min(angles), max(angles), n) if n > 1 else np.array([max(angles)])
+    return rows.assign(incidence_deg=a, normal_speed=rows["speed"] * np.cos(np.radians(a)))
+
+
 def _start(source, prior, material, parameters):
     """(material, values, all parameters modelled, prior information M_0, notes) of a fit or a prior."""
     if source is not None:
@@ -342,6 +375,25 @@ def _reference_value(fit, name) -> float:
     return value if value > 0 else 1.0
 
 
+def _posterior_information(posterior, values, varied):
+    """(values at the posterior medians, information = inverse sample covariance of ln theta) for the
+    parameters ``varied``; a parameter the posterior did not sample gets the weak prior."""
+    names = [p for p in varied if p in posterior.names]
+    if not names:
+        raise ValueError(f"the posterior samples none of {list(varied)!r}")
+    x = posterior.samples[:, [posterior.names.index(p) for p in names]]
+    if not np.all(x > 0):
+        raise ValueError("the posterior has samples <= 0 of " + ", ".join(names) + ": the relative (ln) design "
+                         "needs positive values")
+    med = posterior.median()
+    values = {**values, **{p: float(med[p]) for p in names}}
+    cov = np.atleast_2d(np.cov(np.log(x), rowvar=False))
+    info = np.diag(np.full(len(varied), 1.0 / WEAK_PRIOR_RELATIVE_SD ** 2))
+    idx = [varied.index(p) for p in names]
+    info[np.ix_(idx, idx)] = np.linalg.inv(cov)
+    return values, info
+
+
 def _prior_information(varied, prior, values, z):
     """Information of the prior: a range [lo, hi] is a +/- z interval in ln theta; a weak prior elsewhere."""
     sd = []
@@ -356,7 +408,7 @@ def _prior_information(varied, prior, values, z):
 
 def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, parameters=("zeta_hertz",),
                    prior: dict | None = None, material=None, criterion: str = "A", rtol: float = DEFAULT_RTOL,
-                   friction_range: tuple = (0.05, 1.0)) -> ExperimentDesign:
+                   friction_range: tuple = (0.05, 1.0), posterior=None) -> ExperimentDesign:
     """The next ``n`` impacts that most reduce the expected 95 % intervals of ``parameters``.
 
     Parameters
@@ -380,6 +432,10 @@ def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, p
         Relative tolerance of the normal solves (and of the finite-difference step). [-]
     friction_range : (float, float)
         Coulomb coefficients for the friction note. [-]
+    posterior : Posterior, optional
+        An MCMC sample of the fit's parameters (``microimpact fit --posterior``): M_0 is then the
+        inverse of its sample covariance of ln theta (the data's information, without the
+        linearisation of the fit) and the sensitivities are taken at its medians.
 
     Returns
     -------
@@ -411,6 +467,11 @@ def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, p
     base, values, varied, existing = _start(fit, prior, material, damping)
     z = float(stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2))
     info0 = _prior_information(varied, prior if fit is None else None, values, z)
+    if posterior is not None:
+        if fit is None:
+            raise ValueError("a posterior needs its damping fit (the material and the data's radii)")
+        values, info0 = _posterior_information(posterior, values, varied)
+        existing = None  # the posterior already holds the data's information
     if existing is not None:
         _, g0, s0 = restitution_sensitivities(base, existing[0], existing[1], values, varied, rtol=rtol)
         info0 = info0 + (g0 / existing[2][:, None]).T @ (g0 / existing[2][:, None])
@@ -522,7 +583,8 @@ def _friction_note(base, values, cand, friction_range, rtol):
         with np.errstate(divide="ignore", invalid="ignore"):
             fstar[idx] = np.where(j > 0, 2.0 * c.mass * np.abs(imp["velocity_in_t"]) / (7.0 * j), 0.0)
     text = ("e_n does not depend on friction (normal motion decoupled from the tangential, Eqs. (16)-(20)): no e_n "
-            "impact determines it; measure the rebound angle or tangential restitution of impacts that slide")
+            "impact determines it; measure the rebound angle or tangential restitution of impacts that slide "
+            "(design_friction recommends them)")
     f_ref = float(getattr(base, "friction", 0.0) or 0.0)
     f_ref = f_ref if friction_range[0] <= f_ref <= friction_range[1] else math.sqrt(friction_range[0] * friction_range[1])
     slides = fstar > f_ref
@@ -534,8 +596,12 @@ def _friction_note(base, values, cand, friction_range, rtol):
                    f"slippery of them slides for f up to {min(float(fstar[slides].max()), friction_range[1]):.2g}")
 
 
-def design_template(design: ExperimentDesign, e_n_sigma: float) -> pd.DataFrame:
+def design_template(design: ExperimentDesign, e_n_sigma: float, e_t_sigma: float | None = None) -> pd.DataFrame:
     """The recommended rows as a measured-impact CSV table (:data:`TEMPLATE_COLUMNS`), e_n left empty.
+
+    The oblique rows (incidence > 0) also leave ``tangential_restitution`` empty and state
+    ``e_t_sigma`` [-] as its uncertainty (empty at normal incidence, or when ``e_t_sigma`` is None);
+    ``e_n_sigma`` [-] is the uncertainty of every row's e_n.
 
     Examples
     --------
@@ -547,7 +613,347 @@ def design_template(design: ExperimentDesign, e_n_sigma: float) -> pd.DataFrame:
     (True, 3.45, '')
     """
     r = design.rows
+    oblique = r["incidence_deg"].to_numpy(float) > 0
+    e_t = "" if e_t_sigma is None else np.where(oblique, f"{float(e_t_sigma):.6g}", "")
     return pd.DataFrame({TEMPLATE_COLUMNS[0]: r["id"], TEMPLATE_COLUMNS[1]: r["radius"] * 1e6,
                          TEMPLATE_COLUMNS[2]: r["speed"], TEMPLATE_COLUMNS[3]: r["incidence_deg"],
                          TEMPLATE_COLUMNS[4]: "", TEMPLATE_COLUMNS[5]: float(e_n_sigma),
-                         TEMPLATE_COLUMNS[6]: r["reason"]})
+                         TEMPLATE_COLUMNS[6]: "", TEMPLATE_COLUMNS[7]: e_t, TEMPLATE_COLUMNS[8]: r["reason"]})
+
+
+def tangential_sensitivities(contact, speed, incidence_deg, frictions, rtol=DEFAULT_RTOL):
+    """e_n, and the tangential restitution e_t and d e_t / d ln f of impacts at several frictions.
+
+    The normal solve does not depend on f (model-notes section 4), so each impact is solved once
+    (:func:`~microimpact.analysis.oblique.normal_impulses`) and e_t follows from the closed-form map
+    of Eqs. (16)-(20) (:func:`~microimpact.analysis.oblique.rebound_from_impulses`) at each f. The
+    derivative is a central difference in ln f with step 1e-4: e_t is linear in f while the sphere
+    slides throughout (v_t,out = v_t,in - f J / m) and constant once it ends rolling, so the only
+    error is at the kink f = f*, where the difference is a one-sided mean.
+
+    Parameters
+    ----------
+    contact : Contact
+        The normal parameters (damping, f0) at the impacts' radius.
+    speed, incidence_deg : array_like
+        Incident speed [m/s] and angle from the normal [deg] (> 0).
+    frictions : array_like
+        Coulomb coefficients. [-]
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+
+    Returns
+    -------
+    (e_n, e_t, gradient)
+        e_n [-] per impact; e_t [-] and gradient[i, k] = d e_t,i / d ln f_k [-], shape
+        (impacts, frictions); 0 where the impact is captured or ends in rolling at f_k.
+
+    Examples
+    --------
+    At 60 deg and 10 m/s the sphere slides throughout for f = 0.1 (e_t responds) and ends rolling
+    for f = 1 (e_t = 5/7 whatever f):
+
+    >>> from microimpact.io import default_materials_path, read_materials
+    >>> from microimpact.io.materials import material_contact
+    >>> m = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> c = material_contact(m, 3.45e-6, zeta_hertz=0.5, zeta_adhesion=29.0)
+    >>> e_n, e_t, g = tangential_sensitivities(c, [10.0], [60.0], [0.1, 1.0])
+    >>> bool(g[0, 0] < -0.01), round(float(e_t[0, 1]), 4), float(g[0, 1])
+    (True, 0.7143, 0.0)
+    """
+    speed, angle = np.asarray(speed, float), np.asarray(incidence_deg, float)
+    imp = normal_impulses(contact, speed, angle, rtol)
+    zero = np.zeros_like(speed)
+    h = 1e-4
+    e_t, grad = np.empty((speed.size, len(frictions))), np.empty((speed.size, len(frictions)))
+    vt_in = imp["velocity_in_t"]
+
+    def et(f):
+        vt = rebound_from_impulses(contact, imp, zero, friction=f)["velocity_out_t"]
+        return np.where(imp["captured"] | (vt_in <= 0), np.nan, vt / np.where(vt_in > 0, vt_in, 1.0))
+
+    for k, f in enumerate(np.asarray(frictions, float)):
+        e_t[:, k] = et(f)
+        d = np.nan_to_num((et(f * math.exp(h)) - et(f * math.exp(-h))) / (2 * h))
+        # a rolling impact's e_t differs only by rounding (~1e-16 / h = 1e-12): that is no response
+        grad[:, k] = np.where(np.abs(d) > 1e-8, d, 0.0)
+    return imp["e_n"], e_t, grad
+
+
+def _friction_candidates(space: DesignSpace) -> pd.DataFrame:
+    """The oblique candidates: the space's nonzero angles, else :data:`OBLIQUE_ANGLES_DEG`."""
+    angles = tuple(a for a in space.incidence_deg if a > 0) or OBLIQUE_ANGLES_DEG
+    return DesignSpace(radii=space.radii, speed_range=space.speed_range, incidence_deg=angles,
+                       e_n_sigma=space.e_n_sigma, speed_sigma=space.speed_sigma, n_speeds=space.n_speeds,
+                       e_t_sigma=space.e_t_sigma).candidates()
+
+
+def design_friction(fit=None, space: DesignSpace | None = None, n: int = 6, *, material=None, values=None,
+                    existing=None, friction_range: tuple = FRICTION_RANGE, rtol: float = DEFAULT_RTOL) -> ExperimentDesign:
+    """The next ``n`` oblique impacts (angle, speed, size) that most narrow the Coulomb coefficient f.
+
+    e_n does not depend on f; a measured tangential restitution e_t does, but only while the
+    sphere slides throughout the contact (f < f*_i = 2 m |u_0| / (7 J_i)); an impact that ends
+    rolling gives e_t = 5/7 whatever f and only bounds it (the ``lower_bound`` / ``not_determined``
+    statuses of :func:`~microimpact.analysis.oblique.fit_friction`). Because where an impact slides
+    depends on the unknown f itself, the criterion is averaged over ``friction_range``
+    (log-uniform, :data:`FRICTION_GRID_POINTS` values): each greedy step adds the candidate that
+    most reduces the mean over f of the relative variance 1 / I(f) of ln f, with
+    I(f) = I_0(f) + sum_k (d e_t,k / d ln f)^2 / sigma_t^2 (a Bayesian A-criterion; Chaloner &
+    Verdinelli 1995). A candidate that is captured or ends rolling for every f of the range is never
+    recommended.
+
+    Parameters
+    ----------
+    fit : DampingFit, optional
+        The damping fit whose contact the impacts are solved with (else ``material`` and ``values``).
+    space : DesignSpace
+        Its nonzero ``incidence_deg`` are the candidate angles (:data:`OBLIQUE_ANGLES_DEG` if none).
+    n : int
+        Number of new oblique impacts.
+    material : MaterialPair, optional
+        Without a fit.
+    values : dict, optional
+        ``zeta_hertz``, ``zeta_adhesion`` [-] (and ``work_of_adhesion`` [J/m^2]) without a fit.
+    existing : pandas.DataFrame, optional
+        Oblique impacts already measured (``radius`` [m], ``speed`` [m/s], ``incidence_deg`` [deg]):
+        their information is I_0.
+    friction_range : (float, float)
+        The range f is believed to lie in. [-]
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+
+    Returns
+    -------
+    ExperimentDesign
+        ``widths``: the expected 95 % width of f at the range's geometric centre.
+
+    References
+    ----------
+    Chaloner, K. & Verdinelli, I. (1995). Bayesian experimental design: a review. Statistical
+    Science 10(3), 273-304. doi:10.1214/ss/1177009939
+
+    Examples
+    --------
+    With candidate angles 10-80 deg, the design never picks an angle where every f of 0.05-1 rolls:
+
+    >>> from microimpact.io import default_materials_path, read_materials
+    >>> m = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> space = DesignSpace(radii=(3.45e-6,), speed_range=(2.0, 20.0), incidence_deg=(10.0, 45.0, 80.0), n_speeds=4)
+    >>> d = design_friction(None, space, 3, material=m, values={"zeta_hertz": 0.5, "zeta_adhesion": 29.0})
+    >>> sorted(set(d.rows["incidence_deg"].tolist())) != [10.0], d.parameters
+    (True, ('friction',))
+    """
+    if space is None:
+        raise ValueError("give the design space (DesignSpace)")
+    if not 1 <= int(n) <= MAX_NEW_IMPACTS:
+        raise ValueError(f"the number of new impacts must be in [1, {MAX_NEW_IMPACTS}], got {n!r}")
+    lo, hi = (float(x) for x in friction_range)
+    if not 0 < lo < hi:
+        raise ValueError(f"friction_range must be 0 < min < max, got {friction_range!r}")
+    if fit is not None:
+        base, vals = fit, dict(fit.values)
+    elif material is not None and values:
+        base = material
+        vals = {"work_of_adhesion": float(material.work_of_adhesion), **{k: float(v) for k, v in values.items()}}
+    else:
+        raise ValueError("give a damping fit, or a material with the damping values")
+    grid = np.geomspace(lo, hi, FRICTION_GRID_POINTS)
+    cand = _friction_candidates(space)
+    e_n, e_t, g = _oblique_sensitivities(base, vals, cand, grid, rtol)
+    info0 = np.full(grid.size, 1.0 / WEAK_PRIOR_RELATIVE_SD ** 2)
+    if existing is not None and len(existing):
+        _, _, g0 = _oblique_sensitivities(base, vals, existing, grid, rtol)
+        info0 = info0 + np.sum(np.square(g0 / space.e_t_sigma), axis=0)
+    gw2 = np.square(g / space.e_t_sigma)
+    admissible = (e_n > 0) & np.any(gw2 > 0, axis=1)
+    if not admissible.any():
+        raise ValueError("no oblique candidate of the design space slides for any f of the friction range (all "
+                         "captured or rolling): add steeper incidence angles or higher speeds")
+    chosen, reasons, path = _greedy_friction(info0, gw2, admissible, int(n), cand, e_n, e_t, grid)
+    uni = uniform_oblique_design(space, int(n))
+    _, _, gu = _oblique_sensitivities(base, vals, uni, grid, rtol)
+    centre = int(np.argmin(np.abs(np.log(grid) - 0.5 * math.log(lo * hi))))
+    widths = _friction_width_table(info0, path, np.square(gu / space.e_t_sigma), grid, centre)
+    rows = _rows(cand.iloc[chosen], e_n[chosen], reasons)
+    notes = {"friction": _friction_design_note(cand, g, e_n, grid, chosen)}
+    return ExperimentDesign(rows, widths, ("friction",), {**vals, "friction": float(grid[centre])},
+                            "Fisher information of e_t in ln f averaged over the friction range (Bayesian A-criterion, "
+                            "log-uniform prior); greedy sequential selection over the oblique candidates", notes)
+
+
+def _oblique_sensitivities(base, vals, table, grid, rtol):
+    """:func:`tangential_sensitivities` of the rows of ``table`` (radius, speed, incidence_deg), one contact per radius."""
+    e_n = np.zeros(len(table))
+    e_t, g = np.full((len(table), grid.size), np.nan), np.zeros((len(table), grid.size))
+    radius = np.asarray(table["radius"], float)
+    for r in np.unique(radius):
+        idx = np.flatnonzero(radius == r)
+        c = material_contact(base, float(r), zeta_hertz=vals["zeta_hertz"], zeta_adhesion=vals["zeta_adhesion"],
+                             work_of_adhesion=vals["work_of_adhesion"])
+        e_n[idx], e_t[idx], g[idx] = tangential_sensitivities(c, np.asarray(table["speed"], float)[idx],
+                                                              np.asarray(table["incidence_deg"], float)[idx], grid, rtol)
+    return e_n, e_t, g
+
+
+def _greedy_friction(info0, gw2, admissible, n, cand, e_n, e_t, grid):
+    """Candidates chosen one at a time, each of least mean relative variance of ln f over the grid."""
+    info, chosen, reasons, path = info0.copy(), [], [], []
+    options = np.flatnonzero(admissible)
+    for _ in range(n):
+        scores = np.mean(1.0 / (info[None, :] + gw2[options]), axis=1)
+        best = int(options[np.argmin(scores)])
+        info = info + gw2[best]
+        slides = grid[gw2[best] > 0]
+        reasons.append(f"{cand['incidence_deg'].iloc[best]:.3g} deg, {cand['speed'].iloc[best]:.3g} m/s, "
+                       f"e_n ~ {e_n[best]:.3f}: slides throughout for f up to {slides.max():.2g} (e_t responds to f "
+                       f"there, up to {math.sqrt(gw2[best].max()):.2g} sigma per 100 % of f)")
+        chosen.append(best)
+        path.append(info.copy())
+    return chosen, reasons, path
+
+
+def _friction_width_table(info0, path, gu2, grid, centre):
+    """Expected 95 % widths of f at the grid's centre after 0 ... N impacts, recommended and uniform."""
+    z = float(stats.norm.ppf(0.5 + DEFAULT_LEVEL / 2))
+    uni = info0.copy()
+    rows = []
+    for k in range(len(path) + 1):
+        rec = info0 if k == 0 else path[k - 1]
+        if k > 0:
+            uni = uni + gu2[k - 1]
+        rows.append({"n_new": k, "parameter": "friction", "design": 2 * z * grid[centre] / math.sqrt(rec[centre]),
+                     "uniform": 2 * z * grid[centre] / math.sqrt(uni[centre])})
+    return pd.DataFrame(rows)
+
+
+def _friction_design_note(cand, g, e_n, grid, chosen):
+    """What determines f: the angles and speeds that slide for the upper half of the range, and the design's reach."""
+    top = grid[grid >= np.sqrt(grid[0] * grid[-1])]
+    reach = (g[:, grid >= top[0]] != 0).any(axis=1) & (e_n > 0)
+    text = ("e_n does not depend on friction (Eqs. (16)-(20)); a measured tangential restitution (or rebound angle) "
+            "determines f only from impacts that slide throughout (f < f* = 2 m |u_0| / (7 J))")
+    if reach.any():
+        a, v = cand["incidence_deg"].to_numpy()[reach], cand["speed"].to_numpy()[reach]
+        text += (f"; impacts at {a.min():.3g}-{a.max():.3g} deg and {v.min():.3g}-{v.max():.3g} m/s slide for "
+                 f"f >= {top[0]:.2g}")
+    covered = grid[(g[chosen] != 0).any(axis=0)]
+    return text + (f"; the recommended impacts slide for f up to {covered.max():.2g} of the range "
+                   f"{grid[0]:.2g}-{grid[-1]:.2g}" if covered.size else "; none of them slides")
+
+
+def design_record(design: ExperimentDesign, space: DesignSpace, source: str = "") -> dict:
+    """The design as JSON-ready data (the pipeline's ``design.json``, the report page's input).
+
+    Parameters
+    ----------
+    design : ExperimentDesign
+    space : DesignSpace
+        The space it was chosen from (recorded with it).
+    source : str
+        Where the fit came from (a file name).
+
+    Returns
+    -------
+    dict
+        ``criterion``, ``parameters``, ``values``, ``notes``, ``space`` (radii [m], speed_range
+        [m/s], incidence_deg and the friction design's oblique_deg [deg], e_n_sigma, e_t_sigma,
+        speed_sigma [-], n_speeds), ``rows``
+        (records of :attr:`ExperimentDesign.rows`), ``widths`` (records of
+        :attr:`ExperimentDesign.widths`), ``source``.
+
+    Examples
+    --------
+    >>> rows = pd.DataFrame({"id": ["design-001"], "radius": [3.45e-6], "speed": [2.0], "incidence_deg": [0.0],
+    ...                      "normal_speed": [2.0], "e_n_expected": [0.5], "reason": ["why"]})
+    >>> widths = pd.DataFrame({"n_new": [0, 1], "parameter": "zeta_hertz", "design": [1.0, 0.5], "uniform": [1.0, 0.8]})
+    >>> rec = design_record(ExperimentDesign(rows, widths, ("zeta_hertz",), {"zeta_hertz": 0.5}, "Fisher"),
+    ...                     DesignSpace(radii=(3.45e-6,)))
+    >>> rec["rows"][0]["reason"], rec["widths"][1]["uniform"], rec["space"]["speed_range"]
+    ('why', 0.8, [0.5, 20.0])
+    """
+    return {"criterion": design.criterion, "parameters": list(design.parameters),
+            "values": {k: float(v) for k, v in design.values.items()}, "notes": dict(design.notes),
+            "space": {"radii": [float(r) for r in space.radii], "speed_range": [float(x) for x in space.speed_range],
+                      "incidence_deg": [float(a) for a in space.incidence_deg], "e_n_sigma": float(space.e_n_sigma),
+                      "oblique_deg": sorted({float(a) for a in _friction_candidates(space)["incidence_deg"]}),
+                      "e_t_sigma": float(space.e_t_sigma), "speed_sigma": float(space.speed_sigma),
+                      "n_speeds": int(space.n_speeds)},
+            "rows": design.rows.to_dict("records"), "widths": design.widths.to_dict("records"), "source": str(source)}
+
+
+def fit_design_space(fit, **changes) -> DesignSpace:
+    """The design space of a fit: its radii and speed range, e_n uncertainty its median stated one
+    (the scatter, sqrt(reduced chi-square), when unweighted); ``changes`` replace any field.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> fit = SimpleNamespace(radii=[3.45e-6], speed_range=(1.0, 10.0), weighting="none", redchi=0.0004,
+    ...                       data=pd.DataFrame({"e_n": [0.5]}))
+    >>> s = fit_design_space(fit, n_speeds=10)
+    >>> s.speed_range, round(s.e_n_sigma, 6), s.n_speeds
+    ((1.0, 10.0), 0.02, 10)
+    """
+    d = fit.data
+    s = d["sigma"].to_numpy(float) if "sigma" in d.columns else np.array([np.nan])
+    sigma = float(np.nanmedian(s)) if fit.weighting != "none" and np.isfinite(s).any() else math.sqrt(fit.redchi)
+    lo, hi = fit.speed_range
+    base = {"radii": tuple(float(r) for r in fit.radii), "speed_range": (float(lo), float(hi)), "e_n_sigma": sigma}
+    return DesignSpace(**{**base, **changes})
+
+
+def design_next_impacts(fit, space: DesignSpace, n: int = 20, parameters=("zeta_hertz",), *, n_friction: int = 6,
+                        criterion: str = "A", rtol: float = DEFAULT_RTOL, posterior=None) -> ExperimentDesign:
+    """The e_n design of the damping parameters named and, with ``"friction"`` named, the oblique
+    design of :func:`design_friction` after it, as one :class:`ExperimentDesign` (ids renumbered).
+
+    Parameters
+    ----------
+    fit : DampingFit
+    space : DesignSpace
+    n : int
+        New e_n impacts for the damping parameters.
+    parameters : sequence of str
+        Among :data:`PARAMETER_NAMES` and ``"friction"``.
+    n_friction : int
+        New oblique impacts for friction.
+    criterion : {"A", "D"}
+        Of the damping design.
+    rtol : float
+        Relative tolerance of the normal solves. [-]
+    posterior : Posterior, optional
+        Of the fit: the damping design's M_0 (:func:`design_impacts`).
+
+    Returns
+    -------
+    ExperimentDesign
+
+    Examples
+    --------
+    >>> from microimpact.analysis.fitting import fit_damping
+    >>> from microimpact.io import default_materials_path, read_materials
+    >>> m = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> table = pd.DataFrame({"radius": 3.45e-6, "normal_speed": [2.0, 4.0, 8.0, 16.0], "e_n": [0.3, 0.55, 0.68, 0.7],
+    ...                       "e_n_uncertainty": 0.02})
+    >>> fit = fit_damping(table, m, confidence_intervals=False)
+    >>> d = design_next_impacts(fit, fit_design_space(fit, n_speeds=8), 2, ("zeta_hertz", "friction"), n_friction=2)
+    >>> d.rows["id"].tolist(), d.parameters
+    (['design-001', 'design-002', 'design-003', 'design-004'], ('zeta_hertz', 'friction'))
+    """
+    damping = tuple(p for p in parameters if p != "friction")
+    parts = []
+    if damping:
+        parts.append(design_impacts(fit, space, n, parameters=damping, criterion=criterion, rtol=rtol,
+                                    posterior=posterior))
+    if "friction" in parameters:
+        parts.append(design_friction(fit, space, n_friction, rtol=rtol))
+    if not parts:
+        raise ValueError(f"parameters must be among {PARAMETER_NAMES + ('friction',)}, got {list(parameters)!r}")
+    if len(parts) == 1:
+        return parts[0]
+    rows = pd.concat([p.rows for p in parts], ignore_index=True)
+    rows["id"] = [f"design-{k + 1:03d}" for k in range(len(rows))]
+    return ExperimentDesign(rows, pd.concat([p.widths for p in parts], ignore_index=True),
+                            parts[0].parameters + parts[1].parameters, {**parts[0].values, **parts[1].values},
+                            "; ".join(p.criterion for p in parts), {**parts[0].notes, **parts[1].notes})

@@ -57,6 +57,8 @@ INPUT_KEYS = {
     "analyst_dynamics": (False, "critical and capture velocity per measured radius, NetCDF"),
     "analyst_sweeps": (False, "Table 2 sweeps at the measured radii (leading dimension radius), NetCDF files"),
     "model_comparison": (False, "normal models (ring, JKR, DMT) fitted to the data with AIC/BIC, NetCDF"),
+    "design": (False, "what to measure next: the experiment design of the fit, JSON "
+                      "(microimpact.analysis.design.design_record)"),
     # the paper's parameters (Table 1 row 2)
     "phase_portraits": (False, "grouped NetCDF of phase portraits"),
     "dynamics": (False, "dynamics summary NetCDF"),
@@ -74,7 +76,7 @@ INPUT_KEYS = {
 
 #: the keys of the analyst's part (one set per material pair in ``build_report(pairs=...)``)
 ANALYST_KEYS = ("fit", "fit_curves", "flags", "posterior", "oblique", "analyst_dynamics", "analyst_sweeps",
-                "model_comparison")
+                "model_comparison", "design")
 
 
 def check_inputs(inputs: Mapping, *, keys=None, required=None) -> dict:

@@ -5,8 +5,8 @@ Snakemake workflow (keys in :data:`microimpact.report.inputs.INPUT_KEYS`) in thr
 
 A. the analyst's material, with the parameters of the fit (one part per material pair of the data): the damping fit (Fig. 3 analogue),
    the normal contact models compared on the data (:mod:`.models`), capture and critical velocity
-   per measured size, the Table 2 sweeps at the measured sizes and the measurement flags
-   (:mod:`.analyst`);
+   per measured size, the Table 2 sweeps at the measured sizes, the measurement flags
+   (:mod:`.analyst`) and what to measure next (:mod:`.design`);
 B. the reproduction of the paper with the paper's parameters (Table 1 row 2): the nonlinear
    dynamics (Figs. 4, 5), the Table 2 sweeps (Figs. 7-14) and the table of the paper's claims
    (:mod:`.paper`);
@@ -40,7 +40,7 @@ import pandas as pd
 
 from microimpact import __version__
 from microimpact.model.contact import PAPER_REFERENCE
-from microimpact.report import analyst, checks, models, paper
+from microimpact.report import analyst, checks, design, models, paper
 from microimpact.io.impacts import select_material_pair
 from microimpact.report.inputs import (ANALYST_KEYS, INPUT_KEYS, as_list, check_inputs, git_commit, is_synthetic, provenance,
                                        read_dataset, read_json, read_portraits, read_table, read_verdict)
@@ -90,6 +90,8 @@ def _analyst_part(lay: Layout, inputs: Mapping, data: pd.DataFrame | None, synth
     if "flags" in inputs:
         flags_path = inputs["flags"] if isinstance(inputs["flags"], (str, os.PathLike)) else None
         analyst.flags_section(lay, read_table(inputs["flags"]), data, fit=fit, verdict=verdict, path=flags_path)
+    if "design" in inputs:
+        design.design_section(lay, read_json(inputs["design"]))
     return analyst.verdict_title_lines(verdict, f"Part {label}" + (f" ({pair})" if pair else ""))
 
 
@@ -153,7 +155,7 @@ def build_report(path, inputs: Mapping, config: Mapping | None = None, title: st
         Result files by key; ``fit`` is required, every other key may be missing (its section is
         left out or says why it is empty). Keys (see :data:`microimpact.report.inputs.INPUT_KEYS`):
         analyst part ``data_table`` (CSV), ``fit``, ``fit_curves``, ``posterior``, ``oblique``, ``flags`` (CSV),
-        ``analyst_dynamics``, ``analyst_sweeps`` (list), ``model_comparison``; paper part ``phase_portraits``,
+        ``analyst_dynamics``, ``analyst_sweeps`` (list), ``model_comparison``, ``design`` (JSON); paper part ``phase_portraits``,
         ``dynamics``, ``bifurcation``, ``reproduction`` (CSV), ``paper_sweeps`` (list); checks
         ``kharaz``, ``work_precision``, ``stress`` (JSON). NetCDF unless stated. In-memory
         objects (Dataset, DataFrame, dict, list of Datasets) are accepted in place of files.

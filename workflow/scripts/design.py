@@ -1,0 +1,27 @@
+"""Rule design: what to measure next, from the damping fit -> results/analyst/<pair>/design.json
+(the report page) + design.csv (the measured-impact template, e_n empty)."""
+
+from microimpact._runtime.joblog import log_job
+
+log_job(snakemake)  # noqa: F821  (output to the log; a failure also as one line on the terminal)
+
+from microimpact.solvers.engine import set_threads  # noqa: E402
+
+set_threads(snakemake.threads)  # noqa: F821  (the rule's threads: numba uses no more)
+
+import json  # noqa: E402
+
+from microimpact.analysis.design import (design_next_impacts, design_record, design_template,  # noqa: E402
+                                         fit_design_space)
+from microimpact.analysis.fit_result import DampingFit  # noqa: E402
+from microimpact.io.files import atomic_write, write_csv  # noqa: E402
+
+fit = DampingFit.load(snakemake.input.fit)  # noqa: F821
+space = fit_design_space(fit)
+design = design_next_impacts(fit, space, snakemake.params.n, tuple(snakemake.params.parameters),  # noqa: F821
+                             n_friction=snakemake.params.n_friction, rtol=snakemake.params.rtol)  # noqa: F821
+write_csv(design_template(design, space.e_n_sigma, space.e_t_sigma), snakemake.output.csv,  # noqa: F821
+          float_format="%.6g")
+with atomic_write(snakemake.output.json) as f:  # noqa: F821
+    json.dump(design_record(design, space, source=str(snakemake.input.fit)), f, indent=1)  # noqa: F821
+print(design.summary())
