@@ -99,3 +99,20 @@ def test_the_result_converges_with_rtol_over_decades_of_speed():
 def test_bad_speed_is_refused(bad):
     with pytest.raises(ValueError, match="normal_speed"):
         solve_thornton_ning(NON_ADHESIVE, bad)
+
+
+def test_just_above_yield_with_adhesion_the_law_as_stated_returns_energy():
+    """A property of the law as model/thornton_ning.py states it, not of the driver: with adhesion
+    the plastic line (TN3) starts stiffer than the JKR curve at yield (its slope pi R p_y exceeds the
+    JKR stiffness there by O(w)), so just above yield R_p < R and W_p (TN9) < 0: e > 1. Case 18200
+    of the stress sweep (seed 0), the one of 20,000 where it shows: the driver, the energy account
+    and the scipy reference agree on e - 1 = 1.39e-7 to 1e-10."""
+    pc = tn.PlasticContact(1.0099451674932637e-05, 4.384095460632637e-12, 101450023.19994327,
+                           0.0023101526979935477, 21298000.459309913)
+    v = 17.74393547173183
+    r = solve_thornton_ning(pc, v, rtol=RTOL)
+    assert r.yielded and r.plastic_radius < pc.radius
+    assert tn.impact_energies(pc, v).plastic < 0.0
+    assert r.restitution - 1.0 == pytest.approx(float(tn.restitution_coefficient(pc, v)) - 1.0, abs=1e-10)
+    assert r.restitution - 1.0 == pytest.approx(plastic_impact(pc, v).restitution - 1.0, abs=1e-10)
+    assert r.restitution - 1.0 == pytest.approx(1.39e-7, rel=0.01)
