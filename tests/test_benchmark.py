@@ -85,8 +85,8 @@ def test_rkg_restitution_converges_on_hertz_elastic_impact():
     errors = []
     for n in (25, 50, 100):
         r = rkg_restitution(HERTZ, [1.0, 10.0], n)
-        assert not r["captured"].any()
-        errors.append(float(np.max(np.abs(r["e_n"] - 1.0))))
+        assert not r.captured.any()
+        errors.append(float(np.max(np.abs(r.e_n - 1.0))))
     assert np.all(observed_orders(errors) >= 3.9)
     assert errors[-1] < 1e-8
 
@@ -96,8 +96,8 @@ def test_rkg_matches_engine_on_adhesive_impact():
     to 1e-5 (measured error 1.1e-6 at 3 m/s)."""
     ref = engine.solve_normal(WALL_1990, 3.0, rtol=1e-12).e_n
     r = rkg_restitution(WALL_1990, [3.0], 1600)
-    assert abs(r["e_n"][0] - ref) < 1e-5
-    assert r["n_steps"][0] == pytest.approx(1600, rel=0.01)  # the duration estimate is accurate
+    assert abs(r.e_n[0] - ref) < 1e-5
+    assert r.n_steps[0] == pytest.approx(1600, rel=0.01)  # the duration estimate is accurate
 
 
 def test_test_set_starts_just_above_the_capture_speed():

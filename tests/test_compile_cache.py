@@ -87,7 +87,7 @@ parts = [mi.simulate_many(C, speed=v, incidence_deg=30.0, omega=(0.0, 0.0, 1e5),
          mi.simulate_many(C.with_(normal_model="jkr"), speed=v, family=False),
          mi.simulate_many(C.with_(tangential_model="mindlin", shear_modulus=1e10), speed=v[::10], incidence_deg=40.0)]
 values = [np.nan_to_num(ds[k].values.ravel()) for ds in parts for k in ("e_n", "mu_t", "K_L")]
-values.append(rkg.rkg_restitution(C, v[::20], 200)["e_n"])
+values.append(rkg.rkg_restitution(C, v[::20], 200).e_n)
 np.save(sys.argv[1], np.concatenate(values))
 kernels = [engine._integrate_many, normal_models._integrate_many, coupled.coupled_many, rkg._rkg_many,
            family._evaluate, family._impacts_kernel, family.normal_speed_range]

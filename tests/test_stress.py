@@ -223,3 +223,32 @@ def test_compliant_law_gets_the_shear_modulus_of_its_stiffness():
     nu = 0.3
     assert c.shear_modulus / case["stiffness"] == pytest.approx(3 * (1 - nu) / (8 * (2 - nu)), rel=1e-12, abs=0.0)
     assert c.tangential_model == "mindlin" and stress.contact_of(case).tangential_model == "rigid"
+
+
+# ------------------------------------------------------------------ the plastic law
+def test_plastic_law_sweep_against_its_closed_form():
+    """The Thornton & Ning law over 60 cases of seed 0 of the extended domain, each compared with
+    the law's closed-form energy account (reference_every=1): every check passes, captures and
+    rebounds both occur, and the driver meets the closed form to 1e-7 of the energy scale (measured
+    worst 3.6e-9 over 200 cases; TOLERANCES["reference"] is 1e-5)."""
+    s = stress.stress_sweep(60, seed=0, reference_every=1, law="thornton_ning").summary
+    assert s["cases_failed"] == 0, s["failed_cases"]
+    assert s["reference_cases"] == 60 and 0 < s["captures"] < 60
+    assert s["worst_reference_error"]["value"] < 1e-7
+    assert s["worst_energy_error"]["value"] < 1e-8
+
+
+def test_plastic_law_case_yields_over_its_drawn_decades():
+    """The drawn yield velocity spans V_y / v_n from 1e-3 to 1e2 (above 1: no yield), and a
+    mis-scaled p_y would show as a wrong V_y by (TN11)."""
+    cases = stress.draw_cases(200, seed=0)
+    ratios = []
+    for case in cases:
+        pc = stress.plastic_contact_of(case)
+        v_n = case["speed"] * math.cos(math.radians(case["incidence_deg"]))
+        ratios.append(math.log10(stress.tn.yield_velocity(pc) / v_n))
+        if case["work_of_adhesion"] == 0.0:  # no first-contact floor: V_y exactly as drawn
+            assert ratios[-1] == pytest.approx(-3.0 + 5.0 * case["azimuth_deg"] / 360.0, abs=1e-9)
+    assert min(ratios) < -2.5 and max(ratios) > 1.5
+    with pytest.raises(ValueError, match="not a Contact choice"):
+        stress.contact_of(cases[0], "thornton_ning")

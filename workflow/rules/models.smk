@@ -1,4 +1,5 @@
-# Contact models beyond the paper: the normal models (the paper's adhesion ring force, JKR, DMT)
+# Contact models beyond the paper: the normal models (the paper's adhesion ring force, JKR, DMT) and the
+# Thornton & Ning (1998) elastic-plastic adhesive law
 # fitted to the same e_n(v_n) data, with AIC and BIC side by side
 # (microimpact.analysis.model_comparison.compare_normal_models).
 
@@ -19,7 +20,7 @@ rule model_comparison:
     threads: 1
     params:
         material_pair=config["material_pair"],
-        models=["ring", "jkr", "dmt"],
+        models=["ring", "jkr", "dmt", "thornton_ning"],
         rtol=RTOL,
     script:
         "../scripts/model_comparison.py"

@@ -84,6 +84,8 @@ from __future__ import annotations
 import contextlib
 import math
 import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numba import prange
@@ -98,7 +100,7 @@ from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
 from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _slow_twist
 
-__all__ = ["coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
+__all__ = ["CoupledBatch", "coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
 
 _acc = compiled(_law.nondimensional_acceleration)
 _energy = compiled(_law.nondimensional_energy)
@@ -1011,7 +1013,7 @@ def _second_solve_difference(contact, v_in, w_in, f, out, rows, rtol, max_steps)
     def difference(res, sel):
         d = np.zeros(len(sel))
         for key, scale in (("v_t", 1.0), ("v_tp", 1.0), ("omega_t", contact.radius), ("omega_tp", contact.radius)):
-            d = np.maximum(d, scale * np.abs(out[key][sel] - res[key]))
+            d = np.maximum(d, scale * np.abs(out[key][sel] - getattr(res, key)))
         return d
 
     try:
@@ -1165,8 +1167,81 @@ def _tangential_si(contact, mindlin, states, info, f, v_in, w_in, slip, jl, jal,
             np.where(tan["slip_ended"], slip_end_time, np.nan))
 
 
+@dataclass(frozen=True, eq=False)
+class CoupledBatch(Mapping):
+    """Result of :func:`solve_coupled`: one element per impact (SI arrays), as a
+    :class:`~microimpact.solvers.engine.NormalBatch` is for the normal solver.
+
+    Read by attribute (``batch.e_n``) or, as the dict it replaced was, by name (``batch["e_n"]``,
+    ``batch.items()``, in the order of the attributes).
+
+    Attributes
+    ----------
+    captured : numpy.ndarray of bool
+    e_n : numpy.ndarray
+        Normal restitution coefficient; 0 if captured. [-]
+    v_t, v_tp : numpy.ndarray
+        Tangential velocities after the impact. [m/s]
+    omega_n, omega_t, omega_tp : numpy.ndarray
+        Angular velocities after the impact. [rad/s]
+    contact_time, capture_time, slip_end_time : numpy.ndarray
+        [s] (contact_time inf if captured; capture_time, slip_end_time NaN where not reached).
+    max_penetration : numpy.ndarray
+        [m]
+    friction_impulse : numpy.ndarray
+        Integral of the friction load, |F_n| or |F_n + 2 F_po|. [N s]
+    slip_ended : numpy.ndarray of bool
+    n_steps, turning_points : numpy.ndarray of int
+        Accepted steps; turning points of a hysteretic tangential law.
+    tangential_error : numpy.ndarray
+        Error estimate of the final tangential velocity and rim speed of a captured sphere held by
+        friction with rolling resistance, else 0. [m/s]
+    not_determined : numpy.ndarray of bool
+        That estimate exceeds :data:`HELD_ROLLING_TOLERANCE` of the speed scale.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> b = CoupledBatch(*(np.zeros(1) for _ in range(17)))
+    >>> list(b)[:3], b["e_n"] is b.e_n, len(b)
+    (['captured', 'e_n', 'v_t'], True, 17)
+    """
+
+    captured: np.ndarray
+    e_n: np.ndarray
+    v_t: np.ndarray
+    v_tp: np.ndarray
+    omega_n: np.ndarray
+    omega_t: np.ndarray
+    omega_tp: np.ndarray
+    contact_time: np.ndarray
+    capture_time: np.ndarray
+    slip_end_time: np.ndarray
+    max_penetration: np.ndarray
+    friction_impulse: np.ndarray
+    slip_ended: np.ndarray
+    n_steps: np.ndarray
+    turning_points: np.ndarray
+    tangential_error: np.ndarray
+    not_determined: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in _COUPLED_FIELDS:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def __iter__(self):
+        return iter(_COUPLED_FIELDS)
+
+    def __len__(self) -> int:
+        return len(_COUPLED_FIELDS)
+
+
+_COUPLED_FIELDS = tuple(f.name for f in fields(CoupledBatch))
+
+
 def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _DEFAULT_MAX_STEPS,
-                  check_held_rolling: bool = True) -> dict:
+                  check_held_rolling: bool = True) -> CoupledBatch:
     """Impacts of a contact that selects tangential compliance or adhesion-aware friction.
 
     Parameters
@@ -1190,7 +1265,8 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
 
     Returns
     -------
-    dict of 1-D arrays (SI): ``captured``, ``e_n``, ``v_t``, ``v_tp`` [m/s], ``omega_n``,
+    CoupledBatch
+        1-D arrays (SI): ``captured``, ``e_n``, ``v_t``, ``v_tp`` [m/s], ``omega_n``,
     ``omega_t``, ``omega_tp`` [rad/s], ``contact_time``, ``capture_time``, ``slip_end_time`` [s],
     ``max_penetration`` [m], ``turning_points`` (hysteretic law), ``friction_impulse`` (int of the
     friction load, |F_n| or |F_n + 2 F_po|; for a captured sphere over the part followed, as
@@ -1253,18 +1329,18 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
                                                     (w_n, w_t, w_tp), slip, j_map, ja_map, u, time)
     error, undetermined = _held_rolling_error(contact, (v_n, v_t, v_tp), (w_n, w_t, w_tp), f, out, held, info,
                                               tail_bound, rtol, max_steps, check_held_rolling)
-    return {
-        "captured": captured,
-        "e_n": np.where(captured, 0.0, -states[:, _Y] / y0),
+    return CoupledBatch(
+        captured=captured,
+        e_n=np.where(captured, 0.0, -states[:, _Y] / y0),
         **out,
-        "contact_time": np.where(captured, np.inf, states[:, _TAU] * time),
-        "capture_time": info[:, 3] * time,
-        "slip_end_time": slip_end_time,
-        "max_penetration": info[:, 2] * length,
-        "friction_impulse": jl,
-        "slip_ended": np.asarray(slip_ended, dtype=bool),
-        "n_steps": info[:, 5].astype(np.int64),
-        "turning_points": info[:, 6].astype(np.int64),
-        "tangential_error": error,
-        "not_determined": undetermined,
-    }
+        contact_time=np.where(captured, np.inf, states[:, _TAU] * time),
+        capture_time=info[:, 3] * time,
+        slip_end_time=slip_end_time,
+        max_penetration=info[:, 2] * length,
+        friction_impulse=jl,
+        slip_ended=np.asarray(slip_ended, dtype=bool),
+        n_steps=info[:, 5].astype(np.int64),
+        turning_points=info[:, 6].astype(np.int64),
+        tangential_error=error,
+        not_determined=undetermined,
+    )

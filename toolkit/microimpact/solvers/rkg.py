@@ -19,6 +19,8 @@ the global order drops from 4 to 2.5 or lower; with adhesion N = 1600 gives e_n 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numba import prange
@@ -30,7 +32,7 @@ from microimpact.solvers import compiled_law as law
 from microimpact.solvers import engine
 from microimpact.solvers.driver import OK, Trace
 
-__all__ = ["rkg_setup", "rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
+__all__ = ["RkgBatch", "rkg_setup", "rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
 
 #: Default steps per estimated contact duration of :func:`solve_normal_rkg` (e_n to ~1e-6 with
 #: adhesion, tests/test_benchmark.py).
@@ -45,6 +47,51 @@ _G2 = 1.0 + 1.0 / math.sqrt(2.0)
 # Columns of the compiled impact result
 _Y_OUT, _TAU_END, _N_STEPS, _OUTCOME, _J, _J_A, _XI_MAX, _TAU_J, _E_END = range(9)
 _NCOL = 9
+
+
+@dataclass(frozen=True, eq=False)
+class RkgBatch(Mapping):
+    """Result of :func:`rkg_restitution`: one element per speed, as a
+    :class:`~microimpact.solvers.engine.NormalBatch` is for the engine.
+
+    Read by attribute (``batch.e_n``) or, as the dict it replaced was, by name (``batch["e_n"]``).
+
+    Attributes
+    ----------
+    e_n : numpy.ndarray
+        Normal restitution coefficient; 0 if captured, NaN if no outcome within the step limit. [-]
+    captured : numpy.ndarray of bool
+    n_steps : numpy.ndarray of int
+        Fixed steps taken.
+    tau : numpy.ndarray
+        Nondimensional separation time t / T_c; NaN unless it rebounded. [-]
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> b = RkgBatch(np.ones(2), np.zeros(2, bool), np.zeros(2, int), np.ones(2))
+    >>> list(b), b["e_n"] is b.e_n, len(b)
+    (['e_n', 'captured', 'n_steps', 'tau'], True, 4)
+    """
+
+    e_n: np.ndarray
+    captured: np.ndarray
+    n_steps: np.ndarray
+    tau: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in _RKG_FIELDS:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def __iter__(self):
+        return iter(_RKG_FIELDS)
+
+    def __len__(self) -> int:
+        return len(_RKG_FIELDS)
+
+
+_RKG_FIELDS = tuple(f.name for f in fields(RkgBatch))
 
 
 @njit(cache=True)
@@ -199,7 +246,7 @@ def rkg_setup(contact, speeds):
     return y0, c1, c2, sc.a_hertz, sc.a_adhesion, dur
 
 
-def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> dict:
+def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> RkgBatch:
     """e_n by the fixed-step Runge-Kutta-Gill method, dtau = (estimated contact duration) / N.
 
     Parameters
@@ -214,8 +261,9 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> d
 
     Returns
     -------
-    dict with ``e_n`` [-] (0 if captured, NaN if no outcome in 20 N steps), ``captured`` (bool),
-    ``n_steps`` (int) and ``tau`` (nondimensional separation time; NaN if captured) [-].
+    RkgBatch
+        ``e_n`` [-] (0 if captured, NaN if no outcome in 20 N steps), ``captured`` (bool),
+        ``n_steps`` (int) and ``tau`` (nondimensional separation time; NaN if captured) [-].
 
     References
     ----------
@@ -231,7 +279,7 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> d
     >>> from microimpact import simulate_impact
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
     >>> rkg = rkg_restitution(c, [2.0], 400)
-    >>> abs(float(rkg["e_n"][0]) - simulate_impact(c, 2.0).e_n) < 1e-4
+    >>> abs(float(rkg.e_n[0]) - simulate_impact(c, 2.0).e_n) < 1e-4
     True
     """
     y0, c1, c2, ah, aa, dur = setup if setup is not None else rkg_setup(contact, speeds)
@@ -240,12 +288,12 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> d
     out = np.empty((y0.size, _NCOL))
     _rkg_many(y0, c1, c2, ah, aa, h, max_steps, out)
     outcome = out[:, _OUTCOME]
-    return {
-        "e_n": np.where(outcome == 1, 0.0, np.where(outcome < 0, np.nan, out[:, _Y_OUT] / y0)),
-        "captured": outcome == 1,
-        "n_steps": out[:, _N_STEPS].astype(np.int64),
-        "tau": np.where(outcome == 0, out[:, _TAU_END], np.nan),
-    }
+    return RkgBatch(
+        e_n=np.where(outcome == 1, 0.0, np.where(outcome < 0, np.nan, out[:, _Y_OUT] / y0)),
+        captured=outcome == 1,
+        n_steps=out[:, _N_STEPS].astype(np.int64),
+        tau=np.where(outcome == 0, out[:, _TAU_END], np.nan),
+    )
 
 
 def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS,

@@ -104,6 +104,8 @@ from microimpact.io.variables import attributes
 from microimpact.model import tangential_compliance as tc
 from microimpact.model.contact import Contact, adhesion_line_force_from_work
 from microimpact.model.dem_damping import critical_damping_coefficient
+from microimpact.model import thornton_ning as tn
+from microimpact.solvers.thornton_ning_law import solve_thornton_ning
 from microimpact.solvers.impact import settled_contact_energy, simulate_impact
 from microimpact.solvers import TimeBudgetExceeded, check_sub_models
 from microimpact.solvers.reference import simulate_reference
@@ -112,7 +114,7 @@ from microimpact.model.adhesion_models import AdhesionRegimeWarning
 from microimpact.solvers import UndeterminedOutcomeWarning
 from microimpact._runtime.usage import parse_or_status
 
-__all__ = ["LAWS", "POISSON", "TOLERANCES", "INPUT_RANGES", "FAILURE_KINDS", "NOTE_KINDS", "draw_cases", "contact_of", "check_case",
+__all__ = ["LAWS", "POISSON", "TOLERANCES", "INPUT_RANGES", "FAILURE_KINDS", "NOTE_KINDS", "draw_cases", "contact_of", "plastic_contact_of", "check_case",
            "stress_sweep", "StressReport", "result_distance", "energy_scale", "energy_error", "kinetic_energy",
            "summary_line", "write_stress_summary", "main", "REFERENCE_BUDGET"]
 
@@ -153,7 +155,17 @@ LAWS = {
     "hertz_coeff_restitution": {"damping_model": "coeff_restitution", "adhesion": False},
     "jkr_force_viscoelastic": {"normal_model": "jkr_force", "damping_model": "viscoelastic"},
     "dmt_mass_velocity": {"normal_model": "dmt", "damping_model": "mass_velocity"},
+    # the rate-independent elastic-plastic adhesive law of Thornton & Ning (1998), not a Contact
+    # choice: its cases are checked by :func:`_plastic_check` (see :func:`plastic_contact_of`)
+    "thornton_ning": {"plastic": True},
 }
+#: log10 of V_y / v_n of a plastic law's case, drawn from the case's azimuth (which a normal impact
+#: does not use, so the seeded cases of every other law stay as they were): -3 at 0 deg, 2 at 360 deg
+PLASTIC_YIELD_DECADES = (-3.0, 2.0)
+#: a plastic law's p_y is at least this multiple of the JKR centre pressure at first contact
+#: (:func:`microimpact.model.thornton_ning.first_contact_pressure`), below which the contact would
+#: yield as it forms, which (TN2)-(TN3) do not describe
+PLASTIC_FIRST_CONTACT_MARGIN = 1.5
 #: Poisson's ratio of both bodies of a compliant law's pair: the shear modulus G* follows from the
 #: drawn stiffness K (E = 3 K (1 - nu^2) / 2 for two equal materials, G = E / (2 (1 + nu))).
 POISSON = 0.3
@@ -267,6 +279,8 @@ def contact_of(case: dict, law: str = "ring") -> Contact:
     ('mindlin', 0.1544)
     """
     fields = dict(LAWS[law])
+    if fields.pop("plastic", False):
+        raise ValueError(f"law {law!r} is not a Contact choice: its case is plastic_contact_of(case)")
     adhesive = fields.pop("adhesion", True)
     if fields.get("damping_model", "paper") != "paper":
         return _dem_contact(case, fields, adhesive)
@@ -280,6 +294,86 @@ def contact_of(case: dict, law: str = "ring") -> Contact:
     )
 
 
+def _normal_speed(case: dict) -> float:
+    """The normal component of the drawn speed (> 0). [m/s]"""
+    return max(case["speed"] * math.cos(math.radians(case["incidence_deg"])), 1e-300)
+
+
+def plastic_contact_of(case: dict) -> tn.PlasticContact:
+    """The Thornton & Ning contact of a drawn case: its R, rho, K and w, and the yield pressure of a
+    yield velocity V_y = v_n 10^x, x uniform over :data:`PLASTIC_YIELD_DECADES` by the case's
+    azimuth, by (TN11) inverted (:func:`microimpact.model.thornton_ning.yield_pressure`), at least
+    :data:`PLASTIC_FIRST_CONTACT_MARGIN` times the first-contact pressure.
+
+    Examples
+    --------
+    >>> case = {"radius": 1e-6, "density": 2000.0, "stiffness": 4e9 / 3, "work_of_adhesion": 0.0,
+    ...         "speed": 2.0, "incidence_deg": 0.0, "azimuth_deg": 216.0}
+    >>> pc = plastic_contact_of(case)  # x = 0: V_y = v_n
+    >>> round(tn.yield_velocity(pc) / 2.0, 12)
+    1.0
+    """
+    lo, hi = PLASTIC_YIELD_DECADES
+    v_y = _normal_speed(case) * 10.0 ** (lo + (hi - lo) * case["azimuth_deg"] / 360.0)
+    r, rho, k, w = case["radius"], case["density"], case["stiffness"], case["work_of_adhesion"]
+    p_y = max(tn.yield_pressure(v_y, k, rho), PLASTIC_FIRST_CONTACT_MARGIN * tn.first_contact_pressure(r, 0.75 * k, w))
+    return tn.PlasticContact(r, rho * 4.0 / 3.0 * math.pi * r**3, k, w, p_y)
+
+
+def _plastic_energy(pc: tn.PlasticContact, res) -> tuple[float, float]:
+    """(incident energy, energy scale): max(KE_in, H) with H the adhesive hysteresis (TN10) of the
+    undamped elastic contact, the depth of the energy an impact can lose to adhesion. [J]"""
+    ke = 0.5 * pc.mass * res.normal_speed**2
+    return ke, max(ke, tn.impact_energies(pc, res.normal_speed).hysteresis)
+
+
+def _plastic_distance(pc: tn.PlasticContact, a_rebound: float, b_rebound: float, scale: float) -> float:
+    """Two rebound speeds compared as energies (module docstring, "Distance between two results"). [-]"""
+    return abs(0.5 * pc.mass * (a_rebound**2 - b_rebound**2)) / scale
+
+
+def _plastic_check(case: dict, reference: bool, tol: dict, out: dict) -> None:
+    """A plastic law's case: finite results, e in [0, 1], the energy balance (the integrated work of
+    the contact force against the kinetic energy lost), convergence in rtol and, on the reference
+    cases, the law's closed-form energy account (TN8)-(TN10); findings appended to ``out``."""
+    pc = plastic_contact_of(case)
+    v_n = _normal_speed(case)
+    try:
+        fine, coarse = (solve_thornton_ning(pc, v_n, rtol=rtol) for rtol in (_RTOL_FINE, _RTOL_COARSE))
+    except Exception as exc:  # noqa: BLE001 - any exception is a finding
+        out["failures"].append(("exception", f"{type(exc).__name__}: {exc}"))
+        return
+    out["outcome"], out["e_n"] = ("capture" if fine.captured else "rebound"), fine.restitution
+    for res, label in ((fine, f"rtol={_RTOL_FINE:g}"), (coarse, f"rtol={_RTOL_COARSE:g}")):
+        if res.status != "ok":
+            out["failures"].append(("exception", f"{label}: the driver stopped: {res.status}"))
+        bad = [n for n in ("restitution", "work", "contact_time", "max_approach") if not math.isfinite(getattr(res, n))]
+        if bad:
+            out["failures"].append(("nonfinite", f"{label}: {', '.join(bad)}"))
+        if not (0.0 <= res.restitution <= 1.0) or (res.captured and res.restitution != 0.0):
+            out["failures"].append(("restitution", f"{label}: e_n = {res.restitution!r}"))
+    ke, scale = _plastic_energy(pc, fine)
+    err = abs(ke - 0.5 * pc.mass * fine.rebound_speed**2 - fine.work) / scale
+    out["energy_error"] = err
+    if not err <= tol["energy"]:
+        out["failures"].append(("energy", f"energy balance off by {err:.3g} of the energy scale"))
+    conv = _plastic_distance(pc, fine.rebound_speed, coarse.rebound_speed, scale)
+    out["convergence_error"] = conv
+    if not conv <= tol["convergence"]:
+        out["failures"].append(("convergence", f"rtol {_RTOL_COARSE:g} vs {_RTOL_FINE:g} differ by {conv:.3g}"))
+    if reference:
+        try:
+            closed = float(tn.restitution_coefficient(pc, v_n)) * v_n
+        except Exception as exc:  # noqa: BLE001 - the yardstick could not evaluate the case
+            out["notes"].append(("reference_failed", f"closed form raised {type(exc).__name__}: {exc}"))
+            return
+        d = _plastic_distance(pc, fine.rebound_speed, closed, scale)
+        out["reference_error"] = d
+        if not d <= tol["reference"]:
+            out["failures"].append(("reference", f"driver vs closed form differ by {d:.3g} (e_n {fine.restitution:.6g} "
+                                                  f"vs {closed / v_n:.6g})"))
+
+
 def _dem_contact(case: dict, fields: dict, adhesive: bool) -> Contact:
     """A case under a DEM damping law: the drawn zeta_H (1e-3 to 1e6, or 0) sets the damping as a
     multiple of the critical damping 2 sqrt(m k) of the case's Hertz impact (k = K a at its largest
@@ -290,8 +384,7 @@ def _dem_contact(case: dict, fields: dict, adhesive: bool) -> Contact:
     if fields["damping_model"] in ("tsuji", "coeff_restitution"):
         return Contact(r, rho, k, f0, friction=case["friction"], damping_coefficient=1.0 / (1.0 + zeta), **fields)
     base = Contact(r, rho, k, f0, friction=case["friction"], **fields)
-    v_n = max(case["speed"] * math.cos(math.radians(case["incidence_deg"])), 1e-300)
-    return base.with_(damping_coefficient=zeta * critical_damping_coefficient(base, v_n))
+    return base.with_(damping_coefficient=zeta * critical_damping_coefficient(base, _normal_speed(case)))
 
 
 def _omega(case):
@@ -527,6 +620,13 @@ def check_case(case: dict, *, reference: bool = False, case_time_limit: float = 
     """
     tol = dict(TOLERANCES, **(tolerances or {}))
     out = {"outcome": "", **{k: math.nan for k in _MEASURES}, "seconds": 0.0, "failures": [], "notes": []}
+    if LAWS[law].get("plastic"):
+        t0 = time.perf_counter()
+        _plastic_check(case, reference, tol, out)
+        out["seconds"] = time.perf_counter() - t0
+        if out["seconds"] > case_time_limit:
+            out["failures"].append(("timeout", f"driver took {out['seconds']:.1f} s"))
+        return out
     contact = contact_of(case, law)
     reference = reference and _reference_covers(contact)
     args = (contact, case["speed"], case["incidence_deg"], case["azimuth_deg"], _omega(case))
@@ -670,7 +770,10 @@ def stress_sweep(n_cases: int = 1000, seed: int = 0, *, reference_every: int = 2
     # compilation takes far longer than a case and is no property of any case
     if cases:
         with _model_warnings_ignored(), contextlib.suppress(Exception):  # (a case's failure is found by the case)
-            simulate_impact(contact_of({**cases[0], "friction": 0.5}, law), 1.0, 30.0, 0.0, (1.0, 1.0, 1.0))
+            if LAWS[law].get("plastic"):
+                solve_thornton_ning(plastic_contact_of(cases[0]), 1.0)
+            else:
+                simulate_impact(contact_of({**cases[0], "friction": 0.5}, law), 1.0, 30.0, 0.0, (1.0, 1.0, 1.0))
     rows = []
     for i, case in enumerate(cases):
         ref = bool(reference_every) and i % int(reference_every) == 0

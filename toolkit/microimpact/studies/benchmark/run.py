@@ -130,8 +130,8 @@ def _run_rkg(contact, speeds, batch_speeds, cfg: BenchmarkConfig, table: _Table,
         table.set("steps_per_contact", "rkg", k, n)
         t, sol = timed(lambda: rkg_restitution(contact, batch_speeds, n, setup=setup_batch), cfg.repeats_batch)
         r = rkg_restitution(contact, speeds, n, setup=setup_set)
-        table.record("rkg", k, t / batch_speeds.size, r["e_n"], None, batch_speeds.size,
-                     steps=float(np.mean(sol["n_steps"])))
+        table.record("rkg", k, t / batch_speeds.size, r.e_n, None, batch_speeds.size,
+                     steps=float(np.mean(sol.n_steps)))
         log(f"rkg N={n}: {t / batch_speeds.size * 1e6:.2f} us/impact, err {table.get('max_error_e_n', 'rkg', k):.2e}",
             verbose)
 

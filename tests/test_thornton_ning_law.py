@@ -1,0 +1,118 @@
+"""The Thornton & Ning (1998) law run by the one compiled driver (solvers/thornton_ning_law.py).
+
+Yardsticks not written here: Thornton's (1997) published closed form e(V_y / V_i) (TN12), the JKR
+sticking velocity of Johnson & Pollock (1994) in the elastic limit, the law's energy account
+(TN8)-(TN10) of model/thornton_ning.py and the independent scipy integration
+solvers/plastic_reference.py (DOP853 at rtol 1e-12, which shares no code with the driver).
+
+Tolerances: at rtol 1e-11 the driver's global error in e is measured at 1e-12-1e-11 (the events
+are located on the step itself, so no kink of the force is stepped over); the reference agrees
+with the closed forms to 1e-8 by its own docstring. 1e-8 is then the tolerance where both are
+converged: above the sum of the two errors, far below any physics error (a wrong R_p or delta_p
+moves e by 1e-3 or more).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from microimpact.model import adhesion_models as am
+from microimpact.model import thornton_ning as tn
+from microimpact.model.parameters import TABLE1_ROW2
+from microimpact.solvers.plastic_reference import plastic_impact
+from microimpact.solvers.thornton_ning_law import solve_thornton_ning
+
+RTOL = 1e-11
+TOL = 1e-8  # module docstring
+NON_ADHESIVE = tn.PlasticContact(1e-6, 1e-14, 4e9 / 3, 0.0, 1e8)
+
+
+@pytest.mark.parametrize("ratio", [2.0, 0.999, 0.5, 0.1, 0.01])
+def test_non_adhesive_restitution_is_thorntons_closed_form(ratio):
+    """e(V_y / V_i) of (TN12), Thornton (1997); e = 1 below yield (ratio > 1)."""
+    v = tn.yield_velocity(NON_ADHESIVE) / ratio
+    r = solve_thornton_ning(NON_ADHESIVE, v, rtol=RTOL)
+    assert r.status == "ok" and not r.captured
+    assert r.yielded == (ratio < 1.0)
+    assert r.restitution == pytest.approx(float(tn.thornton_restitution(ratio)), abs=TOL)
+
+
+def test_elastic_limit_sticks_below_the_jkr_sticking_velocity():
+    """With p_y far above any contact pressure the law is JKR with the displacement-controlled
+    break: captured below v_s, e = sqrt(1 - v_s^2 / v^2) above (Johnson & Pollock 1994)."""
+    pc = tn.PlasticContact.from_contact(TABLE1_ROW2, 1e12)
+    v_s = am.jkr_sticking_velocity(TABLE1_ROW2.with_(normal_model="jkr"))
+    below = solve_thornton_ning(pc, 0.99 * v_s, rtol=RTOL)
+    assert below.captured and below.restitution == 0.0 and not below.yielded
+    for f in (1.01, 3.0):
+        r = solve_thornton_ning(pc, f * v_s, rtol=RTOL)
+        assert not r.captured
+        assert r.restitution == pytest.approx(math.sqrt(1.0 - 1.0 / f**2), abs=TOL)
+
+
+@pytest.mark.parametrize("speed", [0.3, 5.0, 20.0, 45.0])
+def test_adhesive_plastic_impact_matches_energy_account_and_scipy_reference(speed):
+    """TABLE1_ROW2 with p_y = 2e8 Pa (V_y = 13.5 m/s, v_c = 0.452 m/s): captured, elastic rebound,
+    plastic rebound; e against (TN8)-(TN10) and the DOP853 reference, the work of the contact force
+    against W_p + H (energy balance, relative to the incident energy)."""
+    pc = tn.PlasticContact.from_contact(TABLE1_ROW2, 2e8)
+    r = solve_thornton_ning(pc, speed, rtol=RTOL)
+    ref = plastic_impact(pc, speed)
+    assert r.status == "ok" and r.captured == ref.captured == (speed < 0.452)
+    assert r.yielded == (speed > tn.adhesive_yield_velocity(pc))
+    assert r.restitution == pytest.approx(float(tn.restitution_coefficient(pc, speed)), abs=TOL)
+    assert r.restitution == pytest.approx(ref.restitution, abs=TOL)
+    assert r.plastic_radius == pytest.approx(ref.state.plastic_radius, rel=1e-6)
+    energies = tn.impact_energies(pc, speed)
+    if not r.captured:
+        assert r.work / energies.incident == pytest.approx((energies.plastic + energies.hysteresis) / energies.incident,
+                                                           abs=TOL)
+    assert r.contact_time == pytest.approx(ref.contact_time, rel=1e-6)
+
+
+def test_sticking_velocity_of_the_plastic_law_brackets_the_capture():
+    """The closed-form capture velocity (1/2) m V^2 = W_p + H with a yield inside the adhesive
+    range (p_y just above the first-contact pressure): captured just below, rebound just above."""
+    p_first = tn.first_contact_pressure(TABLE1_ROW2.radius, 0.75 * TABLE1_ROW2.stiffness,
+                                        TABLE1_ROW2.work_of_adhesion)
+    pc = tn.PlasticContact.from_contact(TABLE1_ROW2, 1.5 * p_first)
+    v_c = tn.capture_velocity(pc)
+    assert v_c > am.jkr_sticking_velocity(TABLE1_ROW2.with_(normal_model="jkr"))  # plastic loss adds to H
+    assert solve_thornton_ning(pc, 0.999 * v_c, rtol=RTOL).captured
+    above = solve_thornton_ning(pc, 1.01 * v_c, rtol=RTOL)
+    assert not above.captured and above.yielded
+    assert above.restitution == pytest.approx(float(tn.restitution_coefficient(pc, 1.01 * v_c)), abs=TOL)
+
+
+def test_the_result_converges_with_rtol_over_decades_of_speed():
+    pc = tn.PlasticContact.from_contact(TABLE1_ROW2, 2e8)
+    for v in np.geomspace(0.5, 1e3, 4):
+        a, b = (solve_thornton_ning(pc, v, rtol=t) for t in (1e-8, 1e-10))
+        assert a.status == b.status == "ok"
+        assert a.restitution == pytest.approx(b.restitution, abs=1e-6)  # global error ~1e2 rtol
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, math.nan, math.inf])
+def test_bad_speed_is_refused(bad):
+    with pytest.raises(ValueError, match="normal_speed"):
+        solve_thornton_ning(NON_ADHESIVE, bad)
+
+
+def test_just_above_yield_with_adhesion_the_law_as_stated_returns_energy():
+    """A property of the law as model/thornton_ning.py states it, not of the driver: with adhesion
+    the plastic line (TN3) starts stiffer than the JKR curve at yield (its slope pi R p_y exceeds the
+    JKR stiffness there by O(w)), so just above yield R_p < R and W_p (TN9) < 0: e > 1. Case 18200
+    of the stress sweep (seed 0), the one of 20,000 where it shows: the driver, the energy account
+    and the scipy reference agree on e - 1 = 1.39e-7 to 1e-10."""
+    pc = tn.PlasticContact(1.0099451674932637e-05, 4.384095460632637e-12, 101450023.19994327,
+                           0.0023101526979935477, 21298000.459309913)
+    v = 17.74393547173183
+    r = solve_thornton_ning(pc, v, rtol=RTOL)
+    assert r.yielded and r.plastic_radius < pc.radius
+    assert tn.impact_energies(pc, v).plastic < 0.0
+    assert r.restitution - 1.0 == pytest.approx(float(tn.restitution_coefficient(pc, v)) - 1.0, abs=1e-10)
+    assert r.restitution - 1.0 == pytest.approx(plastic_impact(pc, v).restitution - 1.0, abs=1e-10)
+    assert r.restitution - 1.0 == pytest.approx(1.39e-7, rel=0.01)
