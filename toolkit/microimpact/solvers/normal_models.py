@@ -616,7 +616,7 @@ def _law_too_small(h, u):
     return h < 1e-14 * max(1.0, abs(u[2]))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _law_events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
     """The events within the accepted step u -> u1 (the kink of |F_n|, separation, the largest
     penetration, the end of sliding, the capture), and the advance to its end."""
@@ -670,7 +670,7 @@ def _law_events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
     return driver.END if separated else driver.GO_ON
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _law_creep(u, k1, p, w, atol, rec, rec_cap):
     """The inertia-free creep (:func:`_creep`) where the sphere is strongly damped here (Hertz, whose
     DEM damping may vanish with a: also once turned; a strongly damped approach can end with y at
@@ -686,7 +686,7 @@ def _law_creep(u, k1, p, w, atol, rec, rec_cap):
     return action
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _law_captured_end(u, k1, p, w, atol, long_tail):
     """Whether a captured sphere may stop (:func:`_captured_end`)."""
     if int(w[_W_OUTCOME]) != CAPTURE:
