@@ -1078,15 +1078,7 @@ def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_
         # numpy scalars, not literals: one compiled _integrate serves this kernel and solve_normal
         r = _integrate(y0[i], c1[i], c2[i], ah[i], aa[i], rtol, need_tail[i], tail_tol, 0.0, np.bool_(False), 0.0,
                        max_steps, dummy, np.int64(0), j_stop[i], ja_stop[i])
-        out[i, 0] = r.status
-        out[i, 1] = r.outcome
-        out[i, 2] = r.y_end
-        out[i, 3] = r.tau_end
-        out[i, 4] = r.dissipated
-        out[i, 5] = r.friction_impulse
-        out[i, 6] = r.twist_impulse
-        out[i, 7] = r.max_approach
-        out[i, 8] = r.tau_capture
+        driver.write_common_row(r, out, i)
         out[i, 9] = r.final_energy
         out[i, 10] = r.n_steps
 

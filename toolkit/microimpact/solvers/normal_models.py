@@ -729,15 +729,7 @@ def _integrate_many(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_stop
     for i in prange(y0.size):
         r = _integrate(model, y0[i], c1[i], c2[i], c3[i], p3, rtol, need_tail[i], tail_tol, 0.0, j_stop[i], ja_stop[i],
                        max_steps)
-        out[i, 0] = r.status
-        out[i, 1] = r.outcome
-        out[i, 2] = r.y_end
-        out[i, 3] = r.tau_end
-        out[i, 4] = r.dissipated
-        out[i, 5] = r.friction_impulse
-        out[i, 6] = r.twist_impulse
-        out[i, 7] = r.max_approach
-        out[i, 8] = r.tau_capture
+        driver.write_common_row(r, out, i)
         out[i, 9] = r.tau_slip_end
         out[i, 10] = r.final_energy
         out[i, 11] = r.n_steps
