@@ -44,7 +44,7 @@ import numpy as np
 from microimpact._numba import njit
 from microimpact.solvers import dopri
 
-__all__ = ["Law", "Trace", "make_driver", "make_error_norm", "make_averaged_tail", "linear_tail_variation", "OK", "MAX_STEPS",
+__all__ = ["Law", "Trace", "make_driver", "write_common_row", "make_error_norm", "make_averaged_tail", "linear_tail_variation", "OK", "MAX_STEPS",
            "STEP_UNDERFLOW", "GO_ON", "END", "END_UNCOUNTED", "CREEP_NONE", "CREEP_RESUME", "CREEP_END"]
 
 #: status of a solve: finished, step budget spent, step size below the law's floor
@@ -189,6 +189,32 @@ def make_driver(law):
         return finish(status, u, p, w, n_acc, n_rej)
 
     return drive
+
+
+@njit(cache=True, inline="always")
+def write_common_row(r, out, i):
+    """Write the fields every normal law's batch row starts with into ``out[i, 0:9]``: status,
+    outcome, y_end, tau_end, dissipated, friction_impulse, twist_impulse, max_approach,
+    tau_capture of the :class:`Trace` ``r`` (the columns after them differ by law).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> r = Trace(0, 1, -0.5, 2.0, 0.1, 0.3, 0.0, 1.2, np.nan, np.nan, 0.0, 10, 1, 0, np.zeros(1), 0, 0)
+    >>> out = np.zeros((1, 9))
+    >>> write_common_row(r, out, 0)
+    >>> out[0, :4].tolist()
+    [0.0, 1.0, -0.5, 2.0]
+    """
+    out[i, 0] = r.status
+    out[i, 1] = r.outcome
+    out[i, 2] = r.y_end
+    out[i, 3] = r.tau_end
+    out[i, 4] = r.dissipated
+    out[i, 5] = r.friction_impulse
+    out[i, 6] = r.twist_impulse
+    out[i, 7] = r.max_approach
+    out[i, 8] = r.tau_capture
 
 
 def make_error_norm(n):

@@ -928,7 +928,7 @@ def _keep(w, J, smax, tau_capture, tau_jtarget, tau_zero, captured, turned, outc
     w[_W_OUTCOME], w[_W_SGN], w[_W_NREC] = outcome, sgn, n_rec
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _law_events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
     """The events of the ring law within the accepted step u -> u1, and the advance to its end.
 
@@ -1006,7 +1006,7 @@ def _law_events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
     return driver.END if code == 0 else driver.GO_ON
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _law_creep(u, k1, p, w, atol, rec, rec_cap):
     """The inertia-free limit of a damped impact (:func:`_inertia_free`): finish, or jump and
     resume, in closed form."""
@@ -1024,7 +1024,7 @@ def _law_creep(u, k1, p, w, atol, rec, rec_cap):
     return driver.CREEP_END if outcome >= 0 else driver.CREEP_RESUME
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _law_captured_end(u, k1, p, w, atol, long_tail):
     """Whether a captured sphere may stop (:func:`_capture_finished`); the impulses still to come
     are added in closed form."""
@@ -1078,15 +1078,7 @@ def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_
         # numpy scalars, not literals: one compiled _integrate serves this kernel and solve_normal
         r = _integrate(y0[i], c1[i], c2[i], ah[i], aa[i], rtol, need_tail[i], tail_tol, 0.0, np.bool_(False), 0.0,
                        max_steps, dummy, np.int64(0), j_stop[i], ja_stop[i])
-        out[i, 0] = r.status
-        out[i, 1] = r.outcome
-        out[i, 2] = r.y_end
-        out[i, 3] = r.tau_end
-        out[i, 4] = r.dissipated
-        out[i, 5] = r.friction_impulse
-        out[i, 6] = r.twist_impulse
-        out[i, 7] = r.max_approach
-        out[i, 8] = r.tau_capture
+        driver.write_common_row(r, out, i)
         out[i, 9] = r.final_energy
         out[i, 10] = r.n_steps
 

@@ -616,7 +616,7 @@ def _law_too_small(h, u):
     return h < 1e-14 * max(1.0, abs(u[2]))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _law_events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
     """The events within the accepted step u -> u1 (the kink of |F_n|, separation, the largest
     penetration, the end of sliding, the capture), and the advance to its end."""
@@ -670,7 +670,7 @@ def _law_events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
     return driver.END if separated else driver.GO_ON
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _law_creep(u, k1, p, w, atol, rec, rec_cap):
     """The inertia-free creep (:func:`_creep`) where the sphere is strongly damped here (Hertz, whose
     DEM damping may vanish with a: also once turned; a strongly damped approach can end with y at
@@ -686,7 +686,7 @@ def _law_creep(u, k1, p, w, atol, rec, rec_cap):
     return action
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _law_captured_end(u, k1, p, w, atol, long_tail):
     """Whether a captured sphere may stop (:func:`_captured_end`)."""
     if int(w[_W_OUTCOME]) != CAPTURE:
@@ -729,15 +729,7 @@ def _integrate_many(model, y0, c1, c2, c3, p3, rtol, need_tail, tail_tol, j_stop
     for i in prange(y0.size):
         r = _integrate(model, y0[i], c1[i], c2[i], c3[i], p3, rtol, need_tail[i], tail_tol, 0.0, j_stop[i], ja_stop[i],
                        max_steps)
-        out[i, 0] = r.status
-        out[i, 1] = r.outcome
-        out[i, 2] = r.y_end
-        out[i, 3] = r.tau_end
-        out[i, 4] = r.dissipated
-        out[i, 5] = r.friction_impulse
-        out[i, 6] = r.twist_impulse
-        out[i, 7] = r.max_approach
-        out[i, 8] = r.tau_capture
+        driver.write_common_row(r, out, i)
         out[i, 9] = r.tau_slip_end
         out[i, 10] = r.final_energy
         out[i, 11] = r.n_steps
