@@ -6,7 +6,7 @@ measure (a speed range, incidence angles, size classes, the noise of e_n), :func
 picks the next N impacts one at a time (greedy sequential design over a candidate grid).
 
 Criterion: Fisher information (linearised, nearly linear problem)
-----------------------------------------------------------------
+-----------------------------------------------------------------
 The expected covariance of the parameters theta after adding impacts c_1 ... c_k is the inverse of
 the Fisher information
 

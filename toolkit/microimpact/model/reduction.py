@@ -7,20 +7,20 @@ own length L and time T_c (the paper's X and T of Eqs. (29)-(30), corrected, for
 without adhesion) its coefficients of the elastic and adhesive terms are pure numbers fixed by the
 law, and what is left are the groups of :data:`LAW_GROUPS`:
 
-=========================================== ======================================= ==========
-law (:func:`law_of`)                        groups                                  count
-=========================================== ======================================= ==========
-``ring`` (Eq. (27), f0 > 0)                 y0 = v T / X, C1 = C_H X / T,           3
-                                            C2 = C_A X / T (Eqs. (28), (31)-(32))
-``jkr``, ``jkr_force``, ``dmt`` (f0 > 0)    y0 = v T_J / L_J, C1 = C_H L_J / T_J,   3
-                                            C2 = C_A L_J / T_J (their own units)
-``hertz`` (f0 = 0, the paper's damping)     C1 = C_H v (x* / t* = v)                1
-``jkr+mass_velocity``, ... (f0 > 0, a DEM   y0, C3 = eta a_u^p U / F                2
+============================================= ======================================= ==========
+law (:func:`law_of`)                          groups                                  count
+============================================= ======================================= ==========
+``ring`` (Eq. (27), f0 > 0)                   y0 = v T / X, C1 = C_H X / T,           3
+                                              C2 = C_A X / T (Eqs. (28), (31)-(32))
+``jkr``, ``jkr_force``, ``dmt`` (f0 > 0)      y0 = v T_J / L_J, C1 = C_H L_J / T_J,   3
+                                              C2 = C_A L_J / T_J (their own units)
+``hertz`` (f0 = 0, the paper's damping)       C1 = C_H v (x* / t* = v)                1
+``jkr+mass_velocity``, ... (f0 > 0, a DEM     y0, C3 = eta a_u^p U / F                2
 damping law of :mod:`.dem_damping`)
-``hertz+mass_velocity``,                    C3 = eta a_u^p U / F                    1
+``hertz+mass_velocity``,                      C3 = eta a_u^p U / F                    1
 ``hertz+viscoelastic``
-``hertz+tsuji``, ``hertz+coeff_restitution`` C3 = the damping factor of e           1
-=========================================== ======================================= ==========
+``hertz+tsuji``, ``hertz+coeff_restitution``  C3 = the damping factor of e            1
+============================================= ======================================= ==========
 
 (eta = c a^p is :func:`~microimpact.model.dem_damping.dem_damping_law`, a_u the law's unit of the
 contact radius, U = L / T_c and F its force unit.) Every nondimensional normal output is a

@@ -6,7 +6,7 @@ Snakemake workflow (keys in :data:`microimpact.report.inputs.INPUT_KEYS`) in thr
 A. the analyst's material, with the parameters of the fit (one part per material pair of the data): the damping fit (Fig. 3 analogue),
    the normal contact models compared on the data (:mod:`.models`), capture and critical velocity
    per measured size, the Table 2 sweeps at the measured sizes, the measurement flags
-   (:mod:`.analyst`) and what to measure next (:mod:`.design`);
+   (:mod:`.analyst`) and what to measure next (:mod:`microimpact.report.design`);
 B. the reproduction of the paper with the paper's parameters (Table 1 row 2): the nonlinear
    dynamics (Figs. 4, 5), the Table 2 sweeps (Figs. 7-14) and the table of the paper's claims
    (:mod:`.paper`);

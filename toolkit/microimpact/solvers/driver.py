@@ -1,7 +1,7 @@
 """The one compiled driver of the adaptive normal solvers: a contact law plugs in, the driver runs it.
 
 The paper's ring law (:mod:`.engine`) and the JKR, DMT and Hertz-with-DEM-damping laws
-(:mod:`.normal_models`) are integrated by one loop, :func:`make_driver`'s ``drive``. The split
+(:mod:`microimpact.solvers.normal_models`) are integrated by one loop, :func:`make_driver`'s ``drive``. The split
 follows PyBaMM's of model, solver and solution [1]_:
 
 * **the law** (a :class:`Law` of compiled functions) states its right-hand side (through its
@@ -14,7 +14,7 @@ follows PyBaMM's of model, solver and solution [1]_:
   step-size control of :mod:`.dopri`), the step budget and the step-size floor, the order in which a
   law's events, its creep and its captured end are asked for at each accepted step, the budget
   after which a long captured tail is closed, and the closed-form tails every law shares: the
-  linear damped tail (:func:`linear_tail_variation`) and the method of averaging
+  linear damped tail (:func:`linear_tail_variation`) and the method of averaging [2]_
   (:func:`make_averaged_tail`), which a law plugs its per-cycle orbit integrals into;
 * **the solution** is one record, :class:`Trace`, nondimensional, which each solver turns into
   its SI :class:`~microimpact.solvers.engine.NormalSolution` at its Python boundary.
@@ -286,7 +286,7 @@ _GL16_X, _GL16_W = np.polynomial.legendre.leggauss(16)
 
 
 def make_averaged_tail(orbit_integrals):
-    """The method of averaging [2]_ for the captured tail of a law, from its per-cycle orbit integrals.
+    """The method of averaging (Sanders, Verhulst & Murdock 2007) for the captured tail of a law, from its per-cycle orbit integrals.
 
     Parameters
     ----------
