@@ -10,7 +10,10 @@ import argparse
 
 import pytest
 
+import microimpact.solvers.reference as reference
 from microimpact import cli
+from microimpact._commands import simulate as command
+from microimpact._commands.contacts import contact_from_args
 from microimpact.cli import main
 
 #: the parsers of numeric options (cli.py); an option with another type is not numeric
@@ -83,3 +86,32 @@ def test_negative_zero_and_huge_contact_values_give_a_result_or_one_line(option,
             assert len(err) == 1 and err[0].startswith("microimpact: error:"), (option, value, err)
             assert not out.exists(), (option, value)
         out.unlink(missing_ok=True)
+
+
+def test_an_impossibly_long_reference_run_is_refused_before_the_work(monkeypatch, capsys):
+    # simulate --method reference at zeta_H 1e6 ran for hours without a word
+    def never(*args, **kwargs):
+        raise AssertionError("the reference run started")
+
+    monkeypatch.setattr(command, "simulate_impact", never)
+    assert main(["simulate", "--speed", "2", "--method", "reference", "--zeta-hertz", "1e6"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--method reference" in err[0] and "--method engine" in err[0], err
+
+
+@pytest.mark.parametrize("zeta", ["1e3", "3e3"])  # overdamped (C1 = 6.9, 20.8), a second or two each
+def test_the_reference_work_estimate_follows_the_solver(zeta, monkeypatch):
+    # the estimate against the evaluations solve_ivp reports for the same impact
+    counted = []
+    solve = reference.solve_ivp
+
+    def counting(*args, **kwargs):
+        sol = solve(*args, **kwargs)
+        counted.append(sol.nfev)
+        return sol
+
+    monkeypatch.setattr(reference, "solve_ivp", counting)
+    contact = contact_from_args(PARSER.parse_args(["simulate", "--speed", "2", "--zeta-hertz", zeta]))
+    command.simulate_impact(contact, 2.0, 0.0, method="reference")
+    # within a factor 2: an estimate for a bound (refused above ~1e7, where a factor 2 is minutes)
+    assert 0.5 < command.reference_evaluations(contact, 2.0) / sum(counted) < 2.0, sum(counted)
