@@ -1,13 +1,15 @@
 """Stop signals at random moments of ``microimpact workflow``, each followed by a plain rerun.
 
 Issue 55, item 3: SIGINTs (Ctrl-C: to the wrapper's process group) at moments drawn uniformly from
-an uninterrupted run's duration, ``--early`` of them in its first 10 s (Snakemake's start-up and
-first job launch), and SIGTERMs, half to the process group and half to the wrapper's pid alone
-(``kill PID``). Each trial checks:
+the duration of an uninterrupted run on a warm numba cache (a first run fills the cache and is the
+reference; a second, timed run on a fresh copy gives the duration: a cold run is several times
+longer, and moments drawn over it mostly fall after a trial's warm run has ended), ``--early`` of
+them in its first 10 s (Snakemake's start-up and first job launch), and SIGTERMs, half to the
+process group and half to the wrapper's pid alone (``kill PID``). Each trial checks:
 
 - the wrapper ends within ``--max-stop`` seconds of the signal (default 5);
-- what it printed after the signal is one line (the wrapper's), and nothing it printed holds a
-  traceback;
+- what it printed after the signal is one line (the wrapper's; or, for a signal before Snakemake
+  started, the command line's own interrupted line), and nothing it printed holds a traceback;
 - no process is left: nothing in the wrapper's process group, no Snakemake process in the
   directory;
 - the same command again completes, and every NetCDF result then holds the values of the
@@ -17,6 +19,9 @@ The run is the tiny configuration of tests/test_workflow.py (``make_copy``) thro
 ``microimpact workflow --configfile``::
 
     python tests/study_signals.py --sigint 30 --early 10 --sigterm 10 --seed 1 --out signals.json
+
+The trials run in a shuffled order and ``--out`` is rewritten after each one, so a study stopped
+early leaves a representative subset (``trials`` says how many ran of ``planned``).
 
 Exit status 0 when every trial passed, 1 otherwise.
 """
@@ -42,7 +47,8 @@ from test_workflow import make_copy  # noqa: E402
 from microimpact._runtime.locks import snakemake_processes_in  # noqa: E402
 
 ENV = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
-INTERRUPTED = "microimpact: workflow interrupted"
+# the wrapper's line, and the command line's own (a signal before the wrapper started Snakemake)
+INTERRUPTED = ("microimpact: workflow interrupted", "microimpact: interrupted")
 
 
 def _command(run: Path, config: Path) -> list[str]:
@@ -161,25 +167,36 @@ def main() -> int:
     t0 = time.monotonic()
     done = subprocess.run(_command(ref_run, config), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=ENV,
                           text=True, timeout=3600)
-    duration = time.monotonic() - t0
+    cold = time.monotonic() - t0
     if done.returncode != 0:
         print(done.stdout[-3000:])
         return 1
     reference = _results(ref_run)
+    warm_run = _fresh(root, template, "warm")
+    t0 = time.monotonic()
+    done = subprocess.run(_command(warm_run, config), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=ENV,
+                          text=True, timeout=3600)
+    duration = time.monotonic() - t0
+    warm_differs = _same(reference, _results(warm_run))
+    if done.returncode != 0 or warm_differs:
+        print(done.stdout[-3000:], warm_differs)
+        return 1
+    print(json.dumps({"cold_seconds": round(cold, 1), "warm_seconds": round(duration, 1)}), flush=True)
     plan = [(signal.SIGINT, True, rng.uniform(0.0, 10.0)) for _ in range(args.early)]
     plan += [(signal.SIGINT, True, rng.uniform(0.0, duration)) for _ in range(args.sigint - args.early)]
     plan += [(signal.SIGTERM, i % 2 == 0, rng.uniform(0.0, duration)) for i in range(args.sigterm)]
+    rng.shuffle(plan)  # any prefix of the trials is a sample of all kinds
     rows = []
     for number, (signum, to_group, moment) in enumerate(plan, 1):
         row = trial(root, template, config, reference, number, signum, to_group, moment, args.max_stop)
         rows.append(row)
         print(json.dumps(row), flush=True)
-    summary = {"uninterrupted_seconds": round(duration, 1), "trials": len(rows),
-               "passed": sum(r["passed"] for r in rows),
-               "signalled": sum(not r["finished_before_the_signal"] for r in rows), "rows": rows}
+        summary = {"cold_seconds": round(cold, 1), "uninterrupted_seconds": round(duration, 1),
+                   "planned": len(plan), "trials": len(rows), "passed": sum(r["passed"] for r in rows),
+                   "signalled": sum(not r["finished_before_the_signal"] for r in rows), "rows": rows}
+        if args.out:
+            Path(args.out).write_text(json.dumps(summary, indent=1) + "\n")
     print(json.dumps({k: v for k, v in summary.items() if k != "rows"}))
-    if args.out:
-        Path(args.out).write_text(json.dumps(summary, indent=1) + "\n")
     shutil.rmtree(root, ignore_errors=True)
     return 0 if summary["passed"] == len(rows) else 1
 

@@ -46,6 +46,45 @@ def test_fit_to_a_full_stdout_writes_no_file(small_csv, tmp_path):
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
+@pytest.fixture(scope="module")
+def small_fit(small_csv, tmp_path_factory):
+    """A fit file of ``small_csv`` (no intervals: fast)."""
+    out = tmp_path_factory.mktemp("fit") / "fit.nc"
+    assert main(["fit", str(small_csv), "--out", str(out), "--no-confidence-intervals"]) == 0
+    return out
+
+
+def _to_full_stdout(argv, monkeypatch, capsys) -> list[str]:
+    """``main(argv)`` with stdout on /dev/full (``> /dev/full``): its status 2 and stderr's last line."""
+    capsys.readouterr()
+    with open("/dev/full", "w") as full:
+        monkeypatch.setattr(sys, "stdout", full)
+        status = main(argv)
+        monkeypatch.undo()
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2, err
+    return err
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_flags_to_a_full_stdout_writes_no_file(small_csv, small_fit, tmp_path, monkeypatch, capsys):
+    # `flags > /dev/full` wrote its CSV and NetCDF, then failed on the summary
+    out, nc = tmp_path / "flags.csv", tmp_path / "flags.nc"
+    err = _to_full_stdout(["flags", str(small_csv), "--fit", str(small_fit), "--out", str(out), "--nc", str(nc)],
+                          monkeypatch, capsys)
+    assert err[-1].startswith("microimpact: error: stdout") and "No space left" in err[-1], err
+    assert not out.exists() and not nc.exists() and list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_sweep_to_a_full_stdout_writes_no_file(tmp_path, monkeypatch, capsys):
+    # `sweep > /dev/full` wrote its NetCDF, then failed on the report
+    out = tmp_path / "sweep.nc"
+    err = _to_full_stdout(["sweep", "--case", "2.2", "--out", str(out)], monkeypatch, capsys)
+    assert err[-1].startswith("microimpact: error: stdout") and "No space left" in err[-1], err
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("argv, named", [
     (["simulate", "--speed", "1_0"], "--speed: not a number: '1_0'"),  # float() read it as 10
     (["simulate", "--speed", " 2"], "--speed: not a number"),

@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from microimpact import _entry
+from microimpact._runtime import timeout
 
 
 class _Replaced(BaseException):
@@ -120,3 +121,21 @@ def test_unlock_is_refused_while_a_snakemake_run_lives_in_the_directory(tmp_path
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and f"process {holder.pid}" in err[0] and "--unlock" in err[0], err
     assert (run / ".snakemake" / "locks" / "0.input.lock").exists()
+
+
+def test_a_time_limit_shorter_than_its_own_set_up_leaves_no_timer_behind():
+    # --time-budget 5e-324: the alarm fired as the timer was armed, before the block's try, and the
+    # limit stayed in force: the timer went on firing every 0.1 s and raised in later, unrelated code
+    before = signal.getsignal(signal.SIGALRM)
+    raised = 0
+    for _ in range(50):
+        try:
+            with timeout.time_limit(5e-324, "tiny"):
+                time.sleep(1e-4)
+        except timeout.TimeLimitExceeded:
+            raised += 1
+    assert raised == 50
+    assert timeout._active == [] and signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
+    assert signal.getsignal(signal.SIGALRM) == before
+    with timeout.time_limit(5.0, "after"):  # a later limit is not already expired
+        time.sleep(0.01)

@@ -889,6 +889,10 @@ def _main(argv, written) -> int:
     except (UsageError, ValueError, RuntimeError) as exc:  # RuntimeError: solver failures
         print(f"microimpact: error: {exc}", file=sys.stderr)
         return 2
+    except OverflowError as exc:  # a finite but huge option value (--work-of-adhesion 1e300) squared: no traceback
+        print(f"microimpact: error: a number overflowed ({exc}): an option's value is far outside its physical "
+              "range", file=sys.stderr)
+        return 2
     except OSError as exc:  # reading or writing a file: name it, no traceback
         where = f"{exc.filename}: " if exc.filename else ""
         print(f"microimpact: error: {where}{exc.strerror or exc}", file=sys.stderr)

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import sys
+
 from microimpact._commands.common import UsageError
 from microimpact._commands.tables import impacts_for_pair, input_files
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.analysis.flags import flag_measurements, flag_summary, write_flags
 from microimpact.analysis.posterior import Posterior
-from microimpact.io.paths import check_input_file, check_outputs, reporting_os_errors
+from microimpact.io.paths import check_input_file, check_outputs, print_before_writing, reporting_os_errors
 
 
 def run(args) -> int:
@@ -22,10 +24,11 @@ def run(args) -> int:
     table, _ = impacts_for_pair(args)
     ds = flag_measurements(table, fit, spin_bound=args.spin_bound, angle_uncertainty_deg=args.angle_uncertainty_deg,
                            rtol=args.rtol, progress=True, posterior=posterior, time_budget=args.time_budget)
+    # the summary first: a stdout that cannot take it (> /dev/full) is an error before any file exists
+    print_before_writing(flag_summary(ds) + f"; writing {out}" + (f" and {nc}" if nc else ""))
     with reporting_os_errors(outputs):
         write_flags(ds, out, nc)
-
-    print(flag_summary(ds) + f"; wrote {out}" + (f" and {nc}" if nc else ""))
+    print(f"wrote {out}" + (f" and {nc}" if nc else ""), file=sys.stderr)
     return 0
 
 

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import math
+import sys
 
 from microimpact._commands.common import UsageError
 from microimpact._commands.contacts import contact_from_args
 from microimpact._commands.tables import input_files
 from microimpact.io.files import write_netcdf
-from microimpact.io.paths import check_outputs, reporting_os_errors
+from microimpact.io.paths import check_outputs, print_before_writing, reporting_os_errors
 from microimpact.model.parameters import TABLE2_CASES
 from microimpact.studies.sweeps import run_sweep
 
@@ -20,10 +21,11 @@ def run(args) -> int:
     contact = contact_from_args(args)
     ds = run_sweep(contact, case=args.case, rtol=args.rtol, progress=True, time_budget=args.time_budget)
     ds.attrs["contact_source"] = args.contact_note
+    grid = " x ".join(f"{n} {dim}" for dim, n in ds.sizes.items())
+    # the report first: a stdout that cannot take it (> /dev/full) is an error before the file exists
+    print_before_writing(f"case {args.case}: {math.prod(ds.sizes.values())} impacts ({grid}), "
+                         f"{int(ds['outcome'].sum())} captured; writing {out}\nmaterial: {args.contact_note}")
     with reporting_os_errors({"--out": out}):
         write_netcdf(ds, out)
-    grid = " x ".join(f"{n} {dim}" for dim, n in ds.sizes.items())
-    print(f"case {args.case}: {math.prod(ds.sizes.values())} impacts ({grid}), {int(ds['outcome'].sum())} captured; "
-          f"wrote {out}")
-    print(f"material: {args.contact_note}")
+    print(f"wrote {out}", file=sys.stderr)
     return 0

@@ -57,9 +57,12 @@ def time_limit(seconds: float | None, what: str | None = None):
         raise TimeLimitExceeded(_expired_message())  # an enclosing limit has passed (its signal was caught)
     previous = signal.signal(signal.SIGALRM, _on_alarm) if not _active else None
     end = time.perf_counter() + seconds
-    _active.append((end, message))
-    _arm()
+    entry = (end, message)
     try:
+        # inside the try: a limit shorter than these two calls (--time-budget 5e-324) fires as _arm
+        # returns, and raised before the try, it left the timer repeating and the handler installed
+        _active.append(entry)
+        _arm()
         yield
     except TimeLimitExceeded:
         raise
@@ -70,18 +73,27 @@ def time_limit(seconds: float | None, what: str | None = None):
             raise TimeLimitExceeded(_expired_message()) from exc
         raise
     finally:
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
-        _active.pop()
-        if _active:
-            _arm()
-        else:
-            signal.signal(signal.SIGALRM, previous)
+        # no alarm raises while the limit is taken down (a subscript store runs no signal handler,
+        # so nothing can raise before it): raised here, it left the same timer and handler behind
+        _closing[0] += 1
+        try:
+            signal.setitimer(signal.ITIMER_REAL, 0.0)
+            if entry in _active:
+                del _active[len(_active) - 1 - _active[::-1].index(entry)]
+            if _active:
+                _arm()
+            else:
+                signal.signal(signal.SIGALRM, previous)
+        finally:
+            _closing[0] -= 1
     if time.perf_counter() >= end:  # ran past the limit, and the block's callees caught the signal
         raise TimeLimitExceeded(message)
 
 
 #: (end as time.perf_counter(), message) of the time_limit blocks in force, outermost first
 _active: list[tuple[float, str]] = []
+#: how many time_limit blocks are being taken down (their alarms are then ignored)
+_closing = [0]
 #: after a limit has passed its timer fires again this often [s] until its block has ended: a
 #: TimeLimitExceeded caught by an inner block's caller (a per-case limit) does not end the outer one
 _REPEAT = 0.1
@@ -111,7 +123,7 @@ def _on_alarm(signum, frame):
     # finalised ("no compiled object yet for <Library ...>"), and a later call that links to it
     # crashed a CI worker with a segmentation fault. The timer repeats every _REPEAT s after the
     # limit, so the block ends at the first alarm after the compile (one uninterruptible step).
-    if _in_compiler(frame):
+    if _in_compiler(frame) or _closing[0]:
         return
     raise TimeLimitExceeded(_expired_message())
 

@@ -58,7 +58,9 @@ unless every input it needs has an uncertainty, except for the ratios below):
   the rebound angle.
 
 Possible but implausible values warn (:class:`ImpactDataWarning`, naming the rows): a tangential
-restitution above 1 without a stated ``spin``. ``df.attrs["measured"]`` lists the canonical
+restitution above 1 without a stated ``spin``; |e_t| above 1 by more than
+:data:`MEASUREMENT_TOLERANCE_SIGMAS` stated uncertainties without a stated ``spin`` is impossible
+and refused. ``df.attrs["measured"]`` lists the canonical
 columns the file gave (not derived), so a fit uses what was measured.
 
 Columns that are not part of the format (an operator, a batch, a note) are the analyst's own:
@@ -776,6 +778,7 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     _check_overflow(cells, columns, values, out, problems)
     if "rebound_normal_speed" in values:
         _check_rebound(cells, columns["rebound_normal_speed"], out, problems)
+    _check_tangential_bound(cells, columns, out, problems)
     if materials is not None:
         pairs = labels.get("material_pair", np.full(cells.n, None, dtype=object))
         pairs = np.array([p if p is not None else material_pair for p in pairs], dtype=object)
@@ -1179,6 +1182,31 @@ def _check_rebound(cells: _Cells, col: _Column, out: dict, problems: list[Proble
             f"{r[i] / vn[i]:.4g} > 1; e_n must be in [0, 1], or above 1 by no more than "
             f"{MEASUREMENT_TOLERANCE_SIGMAS:g} stated standard uncertainties",
             int(cells.rows[i]), int(cells.lines[i]), col.field, cells.text["rebound_normal_speed"][i]))
+
+
+def _check_tangential_bound(cells: _Cells, columns, out: dict, problems: list[Problem]) -> None:
+    """Append a problem for every row without a stated ``spin`` whose |e_t| exceeds 1 by more than
+    :data:`MEASUREMENT_TOLERANCE_SIGMAS` of its stated uncertainty.
+
+    Without incident spin the friction and tangential-compliance impulses only take tangential and
+    rotational kinetic energy, m (v_t'^2 + k r^2 omega'^2) / 2 <= m v_t^2 / 2 (Maw, Barber & Fawcett
+    1976, Wear 38:101-114: the tangential work is dissipated or stored and returned), so |v_t,out| <= v_t,in: |e_t| <= 1. A row above it within its errors
+    is a measurement (kept, warned by :func:`_warn_implausible`); without a stated uncertainty the
+    row is kept and warned as before (it may have had an unstated top-spin); with one, an excess
+    the errors cannot explain is refused: every fit reads the table, so each refuses it alike."""
+    e, se = out["tangential_restitution"], out["tangential_restitution_uncertainty"]
+    with np.errstate(invalid="ignore"):
+        impossible = (np.abs(e) > 1.0) & ~np.isfinite(out["spin"]) & np.isfinite(se) \
+            & (np.abs(e) - 1.0 > MEASUREMENT_TOLERANCE_SIGMAS * se)
+    name = next((n for n in ("tangential_restitution", "rebound_tangential_speed", "rebound_angle") if n in columns), None)
+    if name is None:
+        return
+    for i in np.flatnonzero(impossible):
+        problems.append(Problem(
+            f"gives e_t = {e[i]:.4g} +- {se[i]:.2g}, so |e_t| > 1 by more than {MEASUREMENT_TOLERANCE_SIGMAS:g} "
+            "standard uncertainties: without incident spin the rebound cannot be faster along the surface than "
+            "the incidence; correct the value or its uncertainty, or state the incident spin in a 'spin [rad/s]' column",
+            int(cells.rows[i]), int(cells.lines[i]), columns[name].field, cells.text[name][i]))
 
 
 def _sorted(problems: list[Problem]) -> list[Problem]:
