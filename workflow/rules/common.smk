@@ -274,6 +274,26 @@ def analyst_report_inputs(wildcards):
     return inputs
 
 
+# the optional design step of workflow/rules/design.smk, off unless config design: {enabled: true}
+DESIGN = {
+    "enabled": False,
+    "n": 20,
+    "parameters": ["zeta_hertz"],
+    "n_friction": 6,
+    **config.get("design", {}),
+}
+DESIGN_ENABLED = as_bool(DESIGN["enabled"])
+
+
+def design_report_inputs(wildcards):
+    """The design of every material pair for the report (KEY__I as analyst_report_inputs); none when off."""
+    if not DESIGN_ENABLED:
+        return {}
+    return {
+        f"design__{i}": f"results/analyst/{p}/design.json" for i, p in enumerate(PAIRS)
+    }
+
+
 def report_figures(wildcards=None):
     """Every figure of the HTML report: the parts' directories, and the benchmark's figure (an
     output of the work_precision rule)."""

@@ -2,16 +2,6 @@
 # impacts that most narrow the named parameters given the damping fit, as a JSON for the report's
 # page and a measured-impact CSV template. Off unless config design: {enabled: true}.
 
-DESIGN = {"enabled": False, "n": 20, "parameters": ["zeta_hertz"], "n_friction": 6, **config.get("design", {})}
-DESIGN_ENABLED = as_bool(DESIGN["enabled"])
-
-
-def design_report_inputs(wildcards):
-    """The design of every material pair for the report (KEY__I as analyst_report_inputs); none when off."""
-    if not DESIGN_ENABLED:
-        return {}
-    return {f"design__{i}": f"results/analyst/{p}/design.json" for i, p in enumerate(PAIRS)}
-
 
 rule design:
     input:
