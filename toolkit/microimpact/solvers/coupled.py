@@ -84,8 +84,7 @@ from __future__ import annotations
 import contextlib
 import math
 import warnings
-from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 from numba import prange
@@ -99,6 +98,7 @@ from microimpact.solvers import SolverError, UndeterminedOutcomeWarning, dopri, 
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
 from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _slow_twist
+from microimpact.solvers._by_name import ReadableByName
 
 __all__ = ["CoupledBatch", "coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
 
@@ -1168,7 +1168,7 @@ def _tangential_si(contact, mindlin, states, info, f, v_in, w_in, slip, jl, jal,
 
 
 @dataclass(frozen=True, eq=False)
-class CoupledBatch(Mapping):
+class CoupledBatch(ReadableByName):
     """Result of :func:`solve_coupled`: one element per impact (SI arrays), as a
     :class:`~microimpact.solvers.engine.NormalBatch` is for the normal solver.
 
@@ -1225,19 +1225,6 @@ class CoupledBatch(Mapping):
     tangential_error: np.ndarray
     not_determined: np.ndarray
 
-    def __getitem__(self, name: str) -> np.ndarray:
-        if name not in _COUPLED_FIELDS:
-            raise KeyError(name)
-        return getattr(self, name)
-
-    def __iter__(self):
-        return iter(_COUPLED_FIELDS)
-
-    def __len__(self) -> int:
-        return len(_COUPLED_FIELDS)
-
-
-_COUPLED_FIELDS = tuple(f.name for f in fields(CoupledBatch))
 
 
 def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _DEFAULT_MAX_STEPS,

@@ -61,7 +61,6 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,6 +73,7 @@ from microimpact.model.law import Scales, hertz_impact_scales, nondimensional_im
 from microimpact.solvers import compiled_law as law
 from microimpact.solvers import dopri, driver
 from microimpact.solvers.dopri import hermite, illinois_point, illinois_update
+from microimpact.solvers._by_name import ReadableByName
 
 __all__ = ["NormalSolution", "NormalBatch", "EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
 
@@ -1162,13 +1162,8 @@ class NormalSolution:
     penetration_rate: np.ndarray | None = None
 
 
-#: the fields of a :class:`NormalBatch`, in order
-_BATCH_FIELDS = ("captured", "e_n", "contact_time", "capture_time", "max_penetration", "friction_impulse",
-                 "twist_impulse", "dissipated_energy", "final_energy", "n_steps")
-
-
 @dataclass(frozen=True, eq=False)
-class NormalBatch(Mapping):
+class NormalBatch(ReadableByName):
     """Result of many normal-contact solves (SI arrays, one element per speed): the fields of
     :class:`NormalSolution` that a batch keeps, with ``captured`` for its outcome.
 
@@ -1209,17 +1204,6 @@ class NormalBatch(Mapping):
     dissipated_energy: np.ndarray
     final_energy: np.ndarray
     n_steps: np.ndarray
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        if name not in _BATCH_FIELDS:
-            raise KeyError(name)
-        return getattr(self, name)
-
-    def __iter__(self):
-        return iter(_BATCH_FIELDS)
-
-    def __len__(self) -> int:
-        return len(_BATCH_FIELDS)
 
 
 #: The record array of a solve that records nothing (never written: its capacity is 0)

@@ -19,8 +19,7 @@ the global order drops from 4 to 2.5 or lower; with adhesion N = 1600 gives e_n 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 from numba import prange
@@ -31,6 +30,7 @@ from microimpact.model.law import nondimensional_impact
 from microimpact.solvers import compiled_law as law
 from microimpact.solvers import engine
 from microimpact.solvers.driver import OK, Trace
+from microimpact.solvers._by_name import ReadableByName
 
 __all__ = ["RkgBatch", "rkg_setup", "rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
 
@@ -50,7 +50,7 @@ _NCOL = 9
 
 
 @dataclass(frozen=True, eq=False)
-class RkgBatch(Mapping):
+class RkgBatch(ReadableByName):
     """Result of :func:`rkg_restitution`: one element per speed, as a
     :class:`~microimpact.solvers.engine.NormalBatch` is for the engine.
 
@@ -79,19 +79,6 @@ class RkgBatch(Mapping):
     n_steps: np.ndarray
     tau: np.ndarray
 
-    def __getitem__(self, name: str) -> np.ndarray:
-        if name not in _RKG_FIELDS:
-            raise KeyError(name)
-        return getattr(self, name)
-
-    def __iter__(self):
-        return iter(_RKG_FIELDS)
-
-    def __len__(self) -> int:
-        return len(_RKG_FIELDS)
-
-
-_RKG_FIELDS = tuple(f.name for f in fields(RkgBatch))
 
 
 @njit(cache=True)
