@@ -184,7 +184,7 @@ def test_a_law_is_exported_or_refused_in_one_line(c, tmp_path, capsys):
     check_lammps(c, tmp_path, capsys, verify=False, fit=False)
 
 
-def test_what_lammps_expresses_is_verified_and_fitted(tmp_path, capsys):
+def test_what_lammps_expresses_is_verified_and_fitted(needs_lammps, tmp_path, capsys):
     lammps_laws = [c for c in SAMPLE if lammps_law(c) is not None]
     assert lammps_laws, "the sample holds a LAMMPS law"
     c = lammps_laws[0]
