@@ -16,6 +16,7 @@ import os
 import signal
 import warnings
 
+import numba
 import numpy as np
 import pytest
 
@@ -71,7 +72,8 @@ def fill_numba_cache(worker: int, workers: int) -> None:
 def pytest_collection_finish(session):
     worker = os.environ.get("PYTEST_XDIST_WORKER", "")  # "gw0", "gw1", ... in an xdist worker
     workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
-    if worker.startswith("gw") and workers > 1 and len(session.items) >= SUITE_SIZE:
+    # interpreted (NUMBA_DISABLE_JIT=1) there is no cache to fill, only slow Python to run
+    if worker.startswith("gw") and workers > 1 and len(session.items) >= SUITE_SIZE and not numba.config.DISABLE_JIT:
         fill_numba_cache(int(worker[2:]), workers)
 
 

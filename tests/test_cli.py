@@ -211,6 +211,41 @@ def test_the_interpreted_impact_prints_the_compiled_numbers_bit_for_bit(case, ca
     assert status == 0 and interpreted.stdout == compiled
 
 
+def test_an_alarm_due_before_the_command_starts_is_a_restart_not_a_traceback(monkeypatch):
+    # the interpreted run's alarm delivered the moment it is armed (a budget shorter than the next
+    # bytecode on a loaded machine): main must start the command again compiled, not let the
+    # alarm's exception escape (seen once in a suite run: exit 1 with an uncaught _CompileInstead)
+    import os
+    import signal
+
+    from microimpact import _entry
+
+    restarts = []
+    real_setitimer = signal.setitimer
+
+    def arm_and_fire(which, seconds, *interval):
+        real_setitimer(which, 0.0)
+        if seconds > 0:
+            os.kill(os.getpid(), signal.SIGALRM)  # Python runs the handler at the next bytecode
+
+    monkeypatch.setattr(_entry, "_interpreted", lambda argv: True)
+    def start_compiled(argv):  # the real one replaces the process (execve) and never returns
+        restarts.append(argv)
+        raise SystemExit(0)
+
+    monkeypatch.setattr(_entry, "_start_compiled", start_compiled)
+    monkeypatch.setattr(signal, "setitimer", arm_and_fire)
+    monkeypatch.setattr(sys, "argv", ["microimpact", "simulate", "--speed", "2"])
+    monkeypatch.setenv("NUMBA_DISABLE_JIT", "0")  # main sets it; monkeypatch restores it
+    previous = signal.getsignal(signal.SIGALRM)
+    try:
+        with pytest.raises(SystemExit):
+            _entry.main()
+    finally:
+        signal.signal(signal.SIGALRM, previous)
+    assert restarts == [["simulate", "--speed", "2"]]
+
+
 def test_simulate_runs_interpreted_and_starts_again_compiled_past_its_budget(capsys):
     from microimpact._entry import _interpreted
 

@@ -92,9 +92,12 @@ def main() -> int:
     interpreted = _interpreted(argv) and hasattr(signal, "setitimer")
     if interpreted:
         os.environ["NUMBA_DISABLE_JIT"] = "1"  # read by numba when it is first imported, below
-        signal.signal(signal.SIGALRM, _too_slow)
-        signal.setitimer(signal.ITIMER_REAL, float(os.environ.get("MICROIMPACT_INTERPRETED_SECONDS", INTERPRETED_SECONDS)))
     try:
+        if interpreted:
+            # armed inside the try: an alarm due before the command's first line (a short budget on
+            # a loaded machine) is a restart, not an uncaught _CompileInstead
+            signal.signal(signal.SIGALRM, _too_slow)
+            signal.setitimer(signal.ITIMER_REAL, float(os.environ.get("MICROIMPACT_INTERPRETED_SECONDS", INTERPRETED_SECONDS)))
         status = cli_main(argv)
     except _CompileInstead:
         _start_compiled(argv)
