@@ -17,7 +17,7 @@ follows PyBaMM's of model, solver and solution [1]_:
   linear damped tail (:func:`linear_tail_variation`) and the method of averaging [2]_
   (:func:`make_averaged_tail`), which a law plugs its per-cycle orbit integrals into;
 * **the solution** is one record, :class:`Trace`, nondimensional, which each solver turns into
-  its SI :class:`~microimpact.solvers.engine.NormalSolution` at its Python boundary.
+  its SI :class:`~microimpact.solvers.solution.NormalSolution` at its Python boundary.
 
 A law is plugged in by a factory (a closure over its compiled functions), as
 :func:`microimpact.solvers.dopri.make_step` plugs in a right-hand side: numba compiles one driver per
@@ -44,7 +44,7 @@ import numpy as np
 from microimpact._numba import njit
 from microimpact.solvers import dopri
 
-__all__ = ["Law", "Trace", "make_driver", "write_common_row", "make_error_norm", "make_averaged_tail", "linear_tail_variation", "OK", "MAX_STEPS",
+__all__ = ["Law", "Trace", "make_driver", "stop_reason", "write_common_row", "make_error_norm", "make_averaged_tail", "linear_tail_variation", "OK", "MAX_STEPS",
            "STEP_UNDERFLOW", "GO_ON", "END", "END_UNCOUNTED", "CREEP_NONE", "CREEP_RESUME", "CREEP_END"]
 
 #: status of a solve: finished, step budget spent, step size below the law's floor
@@ -85,6 +85,23 @@ Law = collections.namedtuple("Law", "start args step step_too_small norm events 
 Trace = collections.namedtuple("Trace", "status outcome y_end tau_end dissipated friction_impulse twist_impulse "
                                         "max_approach tau_capture tau_slip_end final_energy n_steps n_rejected "
                                         "n_recorded state turning_points held_rolling_stops")
+
+
+def stop_reason(status, captured: bool, followed: bool = False) -> str:
+    """Why a solve of the driver stopped, as :class:`~microimpact.solvers.solution.NormalSolution`
+    says it: its budget ("max_steps", "step_underflow"), else "separation", "capture" (at the
+    capture test) or "settled" (a captured sphere ``followed`` past it).
+
+    Examples
+    --------
+    >>> stop_reason(OK, False), stop_reason(OK, True), stop_reason(OK, True, True), stop_reason(MAX_STEPS, True)
+    ('separation', 'capture', 'settled', 'max_steps')
+    """
+    if int(status) != OK:
+        return "max_steps" if int(status) == MAX_STEPS else "step_underflow"
+    if not captured:
+        return "separation"
+    return "settled" if followed else "capture"
 
 
 def make_driver(law):
