@@ -99,7 +99,7 @@ from microimpact.solvers.driver import linear_tail_variation as _linear_tail_var
 from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _slow_twist
 from microimpact.solvers.solution import SolutionBatch
 
-__all__ = ["coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
+__all__ = ["solve_coupled", "coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
 
 _acc = compiled(_law.nondimensional_acceleration)
 _energy = compiled(_law.nondimensional_energy)
