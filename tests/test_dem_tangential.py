@@ -59,9 +59,10 @@ def test_jkr_and_dmt_sliding_throughout_use_the_pulloff_limit(normal_model):
     q = JKR_Q_BREAK["jkr_force"]
     delta_end = adhesion_scales(c).length * (q**4 - 4.0 * q) if normal_model == "jkr_force" else 0.0
     pulloff = (1.5 if normal_model == "jkr_force" else 2.0) * math.pi * W_A * c.radius
-    j_n = c.mass * (r["velocity_out"][0] - v_in[0]) - 1e7 * c.mass * delta_end + 2.0 * pulloff * r["normal"].contact_time
-    j_t = c.mass * (r["velocity_out"][1] - v_in[1])
-    assert r["normal"].outcome == "rebound" and r["switches"] == 0 and not r["slip_ended"]
+    v_out = r.state["velocity_out"]
+    j_n = c.mass * (v_out[0] - v_in[0]) - 1e7 * c.mass * delta_end + 2.0 * pulloff * r.contact_time
+    j_t = c.mass * (v_out[1] - v_in[1])
+    assert r.outcome == "rebound" and r.state["switches"] == 0 and not r.state["slip_ended"]
     # measured 1.7e-12 (JKR) and 1.3e-12 (DMT); a pull-off factor off by 1 % moves it ~1e-3
     assert j_t / j_n == pytest.approx(-0.2, rel=1e-10, abs=0)
 

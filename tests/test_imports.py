@@ -37,6 +37,7 @@ LAZY = {
     ("microimpact._commands.contacts", "microimpact.io.materials"): (2, f"{_SIMULATE}: only with --material-pair "
                                                                         "(jsonschema, yaml)"),
     ("microimpact.solvers", "numba"): (1, f"{_STARTUP}; the solvers' package (errors, tolerances) loads no numba"),
+    ("microimpact.solvers.solution", "xarray"): (1, f"{_SIMULATE}: xarray for SolutionBatch.to_dataset only"),
     ("microimpact.solvers.impact", "xarray"): (5, f"{_SIMULATE}: xarray and pandas for simulate_many's Dataset only"),
     ("microimpact.solvers.impact", "microimpact.solvers.reference"): (1, f"{_SIMULATE}: scipy.integrate"),
     ("microimpact.solvers.impact", "microimpact.solvers.dem_tangential"): (3, f"{_SIMULATE}: scipy.integrate"),

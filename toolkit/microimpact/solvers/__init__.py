@@ -13,7 +13,10 @@
   (:func:`.normal_models.solve_normal_reference`) plus the same tangential map;
 - ``"rkg"``: the paper's fixed-step Runge-Kutta-Gill normal solve (:mod:`.rkg`) plus the same map.
 
-:func:`microimpact.simulate_many` (a broadcast batch, :mod:`.impact`) runs the engine only. Every
+:func:`microimpact.simulate_many` (a broadcast batch, :mod:`.impact`) runs the engine only. Beneath them
+every solve of one normal impact returns one :class:`~microimpact.solvers.solution.NormalSolution`, which
+says why it stopped, and every batch of solves one :class:`~microimpact.solvers.solution.SolutionBatch`
+(:mod:`.solution`). Every
 solver evaluates the contact law of :mod:`microimpact.model.law`; the compiled ones through
 :mod:`.compiled_law`, which compiles the law's own functions instead of keeping a copy.
 """

@@ -84,7 +84,6 @@ from __future__ import annotations
 import contextlib
 import math
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 from numba import prange
@@ -98,9 +97,9 @@ from microimpact.solvers import SolverError, UndeterminedOutcomeWarning, dopri, 
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
 from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _slow_twist
-from microimpact.solvers._by_name import ReadableByName
+from microimpact.solvers.solution import SolutionBatch
 
-__all__ = ["CoupledBatch", "coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
+__all__ = ["solve_coupled", "coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
 
 _acc = compiled(_law.nondimensional_acceleration)
 _energy = compiled(_law.nondimensional_energy)
@@ -1167,68 +1166,8 @@ def _tangential_si(contact, mindlin, states, info, f, v_in, w_in, slip, jl, jal,
             np.where(tan["slip_ended"], slip_end_time, np.nan))
 
 
-@dataclass(frozen=True, eq=False)
-class CoupledBatch(ReadableByName):
-    """Result of :func:`solve_coupled`: one element per impact (SI arrays), as a
-    :class:`~microimpact.solvers.engine.NormalBatch` is for the normal solver.
-
-    Read by attribute (``batch.e_n``) or, as the dict it replaced was, by name (``batch["e_n"]``,
-    ``batch.items()``, in the order of the attributes).
-
-    Attributes
-    ----------
-    captured : numpy.ndarray of bool
-    e_n : numpy.ndarray
-        Normal restitution coefficient; 0 if captured. [-]
-    v_t, v_tp : numpy.ndarray
-        Tangential velocities after the impact. [m/s]
-    omega_n, omega_t, omega_tp : numpy.ndarray
-        Angular velocities after the impact. [rad/s]
-    contact_time, capture_time, slip_end_time : numpy.ndarray
-        [s] (contact_time inf if captured; capture_time, slip_end_time NaN where not reached).
-    max_penetration : numpy.ndarray
-        [m]
-    friction_impulse : numpy.ndarray
-        Integral of the friction load, |F_n| or |F_n + 2 F_po|. [N s]
-    slip_ended : numpy.ndarray of bool
-    n_steps, turning_points : numpy.ndarray of int
-        Accepted steps; turning points of a hysteretic tangential law.
-    tangential_error : numpy.ndarray
-        Error estimate of the final tangential velocity and rim speed of a captured sphere held by
-        friction with rolling resistance, else 0. [m/s]
-    not_determined : numpy.ndarray of bool
-        That estimate exceeds :data:`HELD_ROLLING_TOLERANCE` of the speed scale.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> b = CoupledBatch(*(np.zeros(1) for _ in range(17)))
-    >>> list(b)[:3], b["e_n"] is b.e_n, len(b)
-    (['captured', 'e_n', 'v_t'], True, 17)
-    """
-
-    captured: np.ndarray
-    e_n: np.ndarray
-    v_t: np.ndarray
-    v_tp: np.ndarray
-    omega_n: np.ndarray
-    omega_t: np.ndarray
-    omega_tp: np.ndarray
-    contact_time: np.ndarray
-    capture_time: np.ndarray
-    slip_end_time: np.ndarray
-    max_penetration: np.ndarray
-    friction_impulse: np.ndarray
-    slip_ended: np.ndarray
-    n_steps: np.ndarray
-    turning_points: np.ndarray
-    tangential_error: np.ndarray
-    not_determined: np.ndarray
-
-
-
 def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _DEFAULT_MAX_STEPS,
-                  check_held_rolling: bool = True) -> CoupledBatch:
+                  check_held_rolling: bool = True) -> SolutionBatch:
     """Impacts of a contact that selects tangential compliance or adhesion-aware friction.
 
     Parameters
@@ -1252,7 +1191,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
 
     Returns
     -------
-    CoupledBatch
+    SolutionBatch
         1-D arrays (SI): ``captured``, ``e_n``, ``v_t``, ``v_tp`` [m/s], ``omega_n``,
     ``omega_t``, ``omega_tp`` [rad/s], ``contact_time``, ``capture_time``, ``slip_end_time`` [s],
     ``max_penetration`` [m], ``turning_points`` (hysteretic law), ``friction_impulse`` (int of the
@@ -1316,7 +1255,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
                                                     (w_n, w_t, w_tp), slip, j_map, ja_map, u, time)
     error, undetermined = _held_rolling_error(contact, (v_n, v_t, v_tp), (w_n, w_t, w_tp), f, out, held, info,
                                               tail_bound, rtol, max_steps, check_held_rolling)
-    return CoupledBatch(
+    return SolutionBatch(
         captured=captured,
         e_n=np.where(captured, 0.0, -states[:, _Y] / y0),
         **out,

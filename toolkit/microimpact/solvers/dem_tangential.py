@@ -79,6 +79,7 @@ LAMMPS documentation, ``pair_style granular``, https://docs.lammps.org/pair_gran
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -94,6 +95,7 @@ from microimpact.model.dem_tangential import (DEM_TANGENTIAL_MODELS, FORCE_HISTO
                                               lammps_tangential_stiffness)
 from microimpact.solvers import SolverError
 from microimpact.solvers.normal_models import _DMT, _JKR_FORCE, _setup, solve_normal
+from microimpact.solvers.solution import NormalSolution
 
 __all__ = ["DemTangentialError", "solve_dem_tangential", "uses_dem_tangential", "TANGENTIAL_RTOL"]
 
@@ -560,7 +562,7 @@ def _crossing_inside_a_step(sol, start, switch, sign, tops, end):
     return None
 
 
-def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict:
+def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> NormalSolution:
     """One impact of a contact with a DEM tangential law.
 
     Parameters
@@ -578,12 +580,12 @@ def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict
 
     Returns
     -------
-    dict
-        ``normal`` (the :class:`~microimpact.solvers.engine.NormalSolution`), ``velocity_out``,
-        ``omega_out`` (3-tuples, SI), ``slip_ended`` (bool: the contact is stuck at separation, or
-        the captured sphere rolls), ``slip_end_time`` [s] (end of the last slide if it ends
-        stuck, else NaN),
-        ``tangential_impulse`` (2-tuple, [N s]), ``switches`` (stick-slip changes).
+    NormalSolution
+        The normal solve, with ``slip_end_time`` [s] the end of the last slide if it ends stuck
+        (else NaN) and the tangential outcome in its ``state``: ``velocity_out``, ``omega_out``
+        (3-tuples, [m/s], [rad/s]), ``slip_ended`` (bool: the contact is stuck at separation, or
+        the captured sphere rolls), ``tangential_impulse`` (2-tuple, [N s]), ``switches``
+        (stick-slip changes) and, with a twisting law, ``twist_switches``.
 
     Raises
     ------
@@ -604,8 +606,9 @@ def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict
     ...             shear_modulus=3e8)
     >>> v = (-math.cos(math.radians(70.0)), math.sin(math.radians(70.0)), 0.0)
     >>> r = solve_dem_tangential(c, v, (0.0, 0.0, 0.0), rtol=1e-10)
-    >>> round((r["velocity_out"][1] - v[1]) / (r["velocity_out"][0] - v[0]), 8)
-    -0.2
+    >>> v_out = r.state["velocity_out"]
+    >>> round((v_out[1] - v[1]) / (v_out[0] - v[0]), 8), r.stop_reason
+    (-0.2, 'separation')
     """
     normal = solve_normal(contact, -float(velocity_in[0]), rtol=rtol)
     result = _slip(contact, normal, velocity_in, omega_in, rtol)
@@ -613,7 +616,8 @@ def solve_dem_tangential(contact, velocity_in, omega_in, *, rtol: float) -> dict
         twist, twist_switches = _twist(contact, normal, float(velocity_in[0]), float(omega_in[0]), rtol)
         result["omega_out"] = (twist, *result["omega_out"][1:])
         result["twist_switches"] = twist_switches
-    return result
+    del result["normal"]
+    return dataclasses.replace(normal, slip_end_time=result.pop("slip_end_time"), state=result)
 
 
 def _slip(contact, normal, velocity_in, omega_in, rtol):

@@ -17,7 +17,7 @@ follows PyBaMM's of model, solver and solution [1]_:
   linear damped tail (:func:`linear_tail_variation`) and the method of averaging [2]_
   (:func:`make_averaged_tail`), which a law plugs its per-cycle orbit integrals into;
 * **the solution** is one record, :class:`Trace`, nondimensional, which each solver turns into
-  its SI :class:`~microimpact.solvers.engine.NormalSolution` at its Python boundary.
+  its SI :class:`~microimpact.solvers.solution.NormalSolution` at its Python boundary.
 
 A law is plugged in by a factory (a closure over its compiled functions), as
 :func:`microimpact.solvers.dopri.make_step` plugs in a right-hand side: numba compiles one driver per
@@ -44,7 +44,7 @@ import numpy as np
 from microimpact._numba import njit
 from microimpact.solvers import dopri
 
-__all__ = ["Law", "Trace", "make_driver", "write_common_row", "make_error_norm", "make_averaged_tail", "linear_tail_variation", "OK", "MAX_STEPS",
+__all__ = ["Law", "Trace", "make_driver", "stop_reason", "write_common_row", "make_error_norm", "make_averaged_tail", "linear_tail_variation", "OK", "MAX_STEPS",
            "STEP_UNDERFLOW", "GO_ON", "END", "END_UNCOUNTED", "CREEP_NONE", "CREEP_RESUME", "CREEP_END"]
 
 #: status of a solve: finished, step budget spent, step size below the law's floor
@@ -87,6 +87,23 @@ Trace = collections.namedtuple("Trace", "status outcome y_end tau_end dissipated
                                         "n_recorded state turning_points held_rolling_stops")
 
 
+def stop_reason(status, captured: bool, followed: bool = False) -> str:
+    """Why a solve of the driver stopped, as :class:`~microimpact.solvers.solution.NormalSolution`
+    says it: its budget ("max_steps", "step_underflow"), else "separation", "capture" (at the
+    capture test) or "settled" (a captured sphere ``followed`` past it).
+
+    Examples
+    --------
+    >>> stop_reason(OK, False), stop_reason(OK, True), stop_reason(OK, True, True), stop_reason(MAX_STEPS, True)
+    ('separation', 'capture', 'settled', 'max_steps')
+    """
+    if int(status) != OK:
+        return "max_steps" if int(status) == MAX_STEPS else "step_underflow"
+    if not captured:
+        return "separation"
+    return "settled" if followed else "capture"
+
+
 def make_driver(law):
     """The compiled driver of one contact law.
 
@@ -112,41 +129,25 @@ def make_driver(law):
 
     Examples
     --------
-    A free fall that stops at the ground: the law's events end the solve where the height
-    crosses zero, and its finish reports the time there:
+    The Thornton & Ning law (:mod:`microimpact.solvers.thornton_ning_law`) plugs in as a
+    :class:`Law` of its compiled functions and the driver's error norm of its 4 states:
 
-    >>> import numpy as np
-    >>> from microimpact._numba import njit
-    >>> from microimpact.solvers import dopri
-    >>> @njit
-    ... def fall(u, out, args):
-    ...     out[0], out[1], out[2] = u[1], -1.0, 1.0
-    >>> step = dopri.make_step(fall, 3)
-    >>> @njit
-    ... def start(p, rtol, rec, rec_cap):
-    ...     return np.array([p[0], 0.0, 0.0]), np.array([0.0, -1.0, 1.0]), 1e-3, np.full(3, rtol), np.zeros(1)
-    >>> @njit
-    ... def height(u, code, vargs):
-    ...     return u[0]
-    >>> ground = dopri.make_root_on_step(step, height)
-    >>> @njit
-    ... def events(u, u1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
-    ...     landed = u1[0] <= 0.0
-    ...     if landed:  # re-step to the ground, within this step
-    ...         ground(0, 0.0, u[0], u1[0], 1e-12, h, u, k1, (), (), k, tmp, u1, err)
-    ...     u[:] = u1
-    ...     k1[:] = k[6]
-    ...     return END if landed else GO_ON
-    >>> @njit
-    ... def finish(status, u, p, w, n, n_rej):
-    ...     return Trace(status, 0, u[1], u[2], 0.0, 0.0, 0.0, p[0], np.nan, np.nan, 0.0, n, n_rej, 0, u, 0, 0)
-    >>> never = njit(lambda *a: False)
-    >>> norm = make_error_norm(3)
-    >>> law = Law(start, njit(lambda p, w: ()), step, njit(lambda h, u: h < 1e-300), norm, events,
-    ...           njit(lambda u, k1, p, w, atol, rec, rec_cap: CREEP_NONE), never, finish, 3)
-    >>> r = make_driver(law)((2.0,), 1e-9, 10_000, np.zeros((1, 3)), 0)
-    >>> r.status == OK, round(r.tau_end, 6)  # from 2 m at 1 m/s^2: sqrt(4) s
-    (True, 2.0)
+    >>> from microimpact.model import thornton_ning as tn
+    >>> from microimpact.solvers import thornton_ning_law as tnl
+    >>> law = Law(tnl._law_start, tnl._law_args, tnl._step, tnl._law_too_small, make_error_norm(4), tnl._law_events,
+    ...           tnl._law_creep, tnl._law_captured_end, tnl._law_finish, 4)
+    >>> law.n, tnl._drive.py_func.__qualname__
+    (4, 'make_driver.<locals>.drive')
+
+    Its module runs ``make_driver(law)`` once, through a cached module-level function (a driver
+    compiled in a doctest could not be cached, so this example runs the module's). Without adhesion
+    its rebound is Thornton's (1997) closed form, at V_i = 4 V_y:
+
+    >>> pc = tn.PlasticContact(1e-6, 1e-14, 4e9 / 3, 0.0, 1e8)
+    >>> p, length = tnl.law_parameters(pc, 4 * tn.yield_velocity(pc))
+    >>> r = tnl._integrate(p, 1e-11, 100_000)
+    >>> r.status == OK, r.outcome == tnl.REBOUND, round(-r.y_end, 8), round(float(tn.thornton_restitution(0.25)), 8)
+    (True, True, 0.81227887, 0.81227887)
     """
     start, args_of, step, too_small, error_norm = law.start, law.args, law.step, law.step_too_small, law.norm
     events, creep, captured_end, finish, n = law.events, law.creep, law.captured_end, law.finish, law.n

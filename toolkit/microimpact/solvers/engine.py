@@ -61,7 +61,6 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
 
 import numpy as np
 from numba import prange, set_num_threads
@@ -73,9 +72,9 @@ from microimpact.model.law import Scales, hertz_impact_scales, nondimensional_im
 from microimpact.solvers import compiled_law as law
 from microimpact.solvers import dopri, driver
 from microimpact.solvers.dopri import hermite, illinois_point, illinois_update
-from microimpact.solvers._by_name import ReadableByName
+from microimpact.solvers.solution import NormalSolution, SolutionBatch
 
-__all__ = ["NormalSolution", "NormalBatch", "EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
+__all__ = ["EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
 
 # Status codes of the compiled core
 _OK = 0
@@ -1084,128 +1083,6 @@ def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_
 
 
 # --------------------------------------------------------------------------- Python interface
-@dataclass(frozen=True)
-class NormalSolution:
-    """Result of a normal-contact solve (SI units).
-
-    Attributes
-    ----------
-    outcome : str
-        "rebound" or "capture".
-    e_n : float
-        Normal restitution coefficient, Eq. (21); 0 if captured. [-]
-    contact_time : float
-        Duration of contact; inf if captured. [s]
-    capture_time : float
-        Time at which the contact energy first fell below zero; NaN for a rebound. [s]
-    max_penetration : float
-        Largest penetration x = -n. [m]
-    friction_impulse : float
-        J = int |F_n| dt over the contact; for a captured sphere over the part integrated (the
-        settled tail is bounded by ``tail_tolerance`` relative to J). [N s]
-    twist_impulse : float
-        J_a = int a |F_n| dt, drives the twist friction torque. [N m s]
-    dissipated_energy : float
-        Energy removed by the normal damping (Eq. (27)). [J]
-    final_energy : float
-        Normal kinetic plus contact energy at the end (m v_out^2/2 for a rebound). [J]
-    slip_end_time : float
-        Time at which J reached the requested ``friction_impulse_target``; NaN if not reached or
-        not requested. [s]
-    n_steps, n_rejected : int
-        Accepted and rejected integration steps.
-    time, penetration, penetration_rate : numpy.ndarray or None
-        Trajectory at the accepted steps, when asked for. [s], [m], [m/s]
-
-    Examples
-    --------
-    The paper's microsphere at 2 m/s rebounds: of the incident kinetic energy it keeps e_n^2, and
-    that plus what the damping dissipated is all of it; the trajectory starts at the incident
-    speed and ends at the separation:
-
-    >>> from microimpact.presets import WALL_1990 as c
-    >>> from microimpact.solvers.engine import solve_normal
-    >>> s = solve_normal(c, 2.0, trajectory=True)
-    >>> kinetic = 0.5 * c.mass * 2.0**2
-    >>> s.outcome, round(s.final_energy / kinetic - s.e_n**2, 12)
-    ('rebound', 0.0)
-    >>> round((s.final_energy + s.dissipated_energy) / kinetic, 6)
-    1.0
-    >>> s.time.shape == s.penetration.shape, round(float(s.penetration_rate[0]), 12)
-    (True, 2.0)
-    >>> end, deepest = s.time[-1] / s.contact_time, s.penetration.max() / s.max_penetration
-    >>> round(float(end), 12), round(float(deepest), 4)
-    (1.0, 1.0)
-
-    At 1 cm/s it is captured: no restitution, no end of contact, and the energy left is negative
-    (bound by adhesion):
-
-    >>> s = solve_normal(c, 0.01)
-    >>> s.outcome, s.e_n, s.contact_time, s.final_energy < 0.0, s.time is None
-    ('capture', 0.0, inf, True, True)
-    """
-
-    outcome: str
-    e_n: float
-    contact_time: float
-    capture_time: float
-    max_penetration: float
-    friction_impulse: float
-    twist_impulse: float
-    dissipated_energy: float
-    final_energy: float
-    slip_end_time: float
-    n_steps: int
-    n_rejected: int
-    time: np.ndarray | None = None
-    penetration: np.ndarray | None = None
-    penetration_rate: np.ndarray | None = None
-
-
-@dataclass(frozen=True, eq=False)
-class NormalBatch(ReadableByName):
-    """Result of many normal-contact solves (SI arrays, one element per speed): the fields of
-    :class:`NormalSolution` that a batch keeps, with ``captured`` for its outcome.
-
-    Read by attribute (``batch.e_n``) or, as the dicts it replaced were, by name
-    (``batch["e_n"]``, ``batch.items()``).
-
-    Attributes
-    ----------
-    captured : numpy.ndarray of bool
-    e_n : numpy.ndarray
-        Normal restitution coefficient; 0 if captured. [-]
-    contact_time, capture_time : numpy.ndarray
-        As in :class:`NormalSolution`. [s]
-    max_penetration : numpy.ndarray
-        [m]
-    friction_impulse, twist_impulse : numpy.ndarray
-        [N s], [N m s]
-    dissipated_energy, final_energy : numpy.ndarray
-        [J]
-    n_steps : numpy.ndarray of int
-        Accepted steps of each solve (0 where a family interpolated it).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> b = NormalBatch(*(np.zeros(2) for _ in range(10)))
-    >>> list(b)[:3], b["e_n"] is b.e_n, len(b)
-    (['captured', 'e_n', 'contact_time'], True, 10)
-    """
-
-    captured: np.ndarray
-    e_n: np.ndarray
-    contact_time: np.ndarray
-    capture_time: np.ndarray
-    max_penetration: np.ndarray
-    friction_impulse: np.ndarray
-    twist_impulse: np.ndarray
-    dissipated_energy: np.ndarray
-    final_energy: np.ndarray
-    n_steps: np.ndarray
-
-
 #: The record array of a solve that records nothing (never written: its capacity is 0)
 _NO_RECORD = np.zeros((1, 3))
 
@@ -1313,13 +1190,14 @@ def solve_normal(
         r = r._replace(tau_slip_end=r.tau_end - r_in.tau_slip_end)
     if r.status != _OK:
         raise EngineError(f"engine failed for normal speed {v!r} m/s: {_failure(r.status)} after {r.n_steps} steps")
-    solution = normal_solution(contact, sc, y0, r, trajectory=rec[:r.n_recorded] if cap else None)
+    solution = normal_solution(contact, sc, y0, r, trajectory=rec[:r.n_recorded] if cap else None,
+                               followed=need_tail or follow_capture)
     _check_restitution(solution.e_n, v, rtol)
     _check_domain(contact, vars(solution), v)
     return solution
 
 
-def normal_solution(contact, scales, y0, trace, *, trajectory=None) -> NormalSolution:
+def normal_solution(contact, scales, y0, trace, *, trajectory=None, followed: bool = False) -> NormalSolution:
     """The :class:`NormalSolution` in SI units of a nondimensional normal solve (engine or RKG).
 
     Parameters
@@ -1335,6 +1213,8 @@ def normal_solution(contact, scales, y0, trace, *, trajectory=None) -> NormalSol
         at the end (units m (L/T_c)^2, m L/T_c, m L/T_c sqrt(r L), L, T_c), the steps. [-]
     trajectory : ndarray, shape (n, 3), optional
         Rows (tau, s, y) at the accepted steps. [-]
+    followed : bool
+        A captured sphere was followed past the capture test (its ``stop_reason`` is "settled").
 
     References
     ----------
@@ -1383,6 +1263,7 @@ def normal_solution(contact, scales, y0, trace, *, trajectory=None) -> NormalSol
         slip_end_time=trace.tau_slip_end * scales.time,
         n_steps=int(trace.n_steps),
         n_rejected=int(trace.n_rejected),
+        stop_reason=driver.stop_reason(trace.status, captured, followed),
         time=time,
         penetration=pen,
         penetration_rate=rate,
@@ -1391,8 +1272,8 @@ def normal_solution(contact, scales, y0, trace, *, trajectory=None) -> NormalSol
 
 def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DEFAULT_RTOL,
                       tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT,
-                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> NormalBatch:
-    """Solve many normal impacts in parallel (both cores); arrays in, a :class:`NormalBatch` of SI
+                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> SolutionBatch:
+    """Solve many normal impacts in parallel (both cores); arrays in, a :class:`SolutionBatch` of SI
     arrays out.
 
     Parameters
@@ -1408,7 +1289,7 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
 
     Returns
     -------
-    NormalBatch
+    SolutionBatch
         ``captured`` (bool), ``e_n`` [-], ``contact_time`` [s], ``capture_time`` [s],
         ``max_penetration`` [m], ``friction_impulse`` [N s], ``twist_impulse`` [N m s],
         ``dissipated_energy`` [J], ``final_energy`` [J], ``n_steps``.
@@ -1463,7 +1344,7 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     eu = contact.mass * u * u
     e_n = np.where(captured, 0.0, -out[:, 2] / y0)
     _check_restitution(e_n, v, rtol)
-    result = NormalBatch(
+    result = SolutionBatch(
         captured=captured,
         e_n=e_n,
         contact_time=np.where(captured, np.inf, out[:, 3] * time),

@@ -60,7 +60,7 @@ from microimpact.model.coefficients import coefficients_kernel
 from microimpact.model.law import contact_potential_energy
 from microimpact.model.tangential import tangential_kernel
 from microimpact.solvers import DEFAULT_RTOL, SolverError, engine
-from microimpact.solvers.engine import NormalBatch
+from microimpact.solvers.solution import SolutionBatch
 
 __all__ = ["NormalFamily", "normal_family", "normal_restitution", "FamilyBudgetExceeded", "DEGREE", "GUARD", "GUARD_IMPACTS",
            "FAMILY_MIN_SPEEDS"]
@@ -337,10 +337,10 @@ class NormalFamily:
                 f"solves, tolerance {self.rtol:g} verified at non-node points (largest check error "
                 f"{self.max_check_error:.2g} of it), {int(self.direct.sum())} guard band(s) solved directly")
 
-    def evaluate(self, normal_speed) -> NormalBatch:
+    def evaluate(self, normal_speed) -> SolutionBatch:
         """The outputs at ``normal_speed`` (1-D array within :attr:`speed_range`) [m/s].
 
-        Returns the :class:`~microimpact.solvers.engine.NormalBatch` of
+        Returns the :class:`~microimpact.solvers.solution.SolutionBatch` of
         :func:`microimpact.solvers.engine.solve_normal_many` (``n_steps`` is 0 for interpolated
         speeds); for a captured impact J and J_a are totals over the settling.
         """
@@ -371,7 +371,7 @@ class NormalFamily:
                         engine_settled_energy(c), out, solve_directly)
         return dict(zip(BATCH_VARIABLES, out)), solve_directly
 
-    def _assemble(self, v, piece, use_direct, values) -> NormalBatch:
+    def _assemble(self, v, piece, use_direct, values) -> SolutionBatch:
         c = self.contact
         captured = self.captured[piece]
         kinetic = 0.5 * c.mass * v * v
@@ -401,7 +401,7 @@ class NormalFamily:
                                            tail_tolerance=NODE_RTOL_FLOOR)
             for k, val in sol.items():
                 out[k][idx] = val
-        return NormalBatch(**out)
+        return SolutionBatch(**out)
 
 
 def engine_settled_energy(contact) -> float:

@@ -367,14 +367,13 @@ def _dem_tangential_batch(contact, v_in, w_in, f, rtol) -> dict:
     for i in range(n):
         one = contact if f[i] == contact.friction else contact.with_(friction=float(f[i]))
         r = solve_dem_tangential(one, tuple(float(x[i]) for x in v_in), tuple(float(w[i]) for w in w_in), rtol=rtol)
-        normal = r["normal"]
-        out["captured"][i] = normal.outcome == "capture"
-        out["e_n"][i] = normal.e_n
-        out["v_t"][i], out["v_tp"][i] = r["velocity_out"][1:]
-        out["omega_n"][i], out["omega_t"][i], out["omega_tp"][i] = r["omega_out"]
-        out["contact_time"][i], out["capture_time"][i] = normal.contact_time, normal.capture_time
-        out["max_penetration"][i], out["friction_impulse"][i] = normal.max_penetration, normal.friction_impulse
-        out["slip_ended"][i], out["slip_end_time"][i] = r["slip_ended"], r["slip_end_time"]
+        out["captured"][i] = r.captured
+        out["e_n"][i] = r.e_n
+        out["v_t"][i], out["v_tp"][i] = r.state["velocity_out"][1:]
+        out["omega_n"][i], out["omega_t"][i], out["omega_tp"][i] = r.state["omega_out"]
+        out["contact_time"][i], out["capture_time"][i] = r.contact_time, r.capture_time
+        out["max_penetration"][i], out["friction_impulse"][i] = r.max_penetration, r.friction_impulse
+        out["slip_ended"][i], out["slip_end_time"][i] = r.state["slip_ended"], r.slip_end_time
     return out
 
 

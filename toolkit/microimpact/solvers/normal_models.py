@@ -2,7 +2,7 @@
 
 The paper's ring law keeps its tuned engine (:mod:`.engine`); the alternative normal models of
 :mod:`microimpact.model.adhesion_models` are integrated here and return the same
-:class:`~microimpact.solvers.engine.NormalSolution` (e_n, contact time, friction impulse
+:class:`~microimpact.solvers.solution.NormalSolution` (e_n, contact time, friction impulse
 J = int |F_n| dt, twist impulse J_a = int a |F_n| dt, largest penetration, rebound or capture), so
 that :func:`microimpact.simulate_impact` and :func:`microimpact.simulate_many` apply the same
 closed-form tangential map to them. The decoupling that makes the map exact for the ring law holds
@@ -74,7 +74,8 @@ from microimpact.model.contact import check_positive
 from microimpact.solvers import DEFAULT_RTOL, dopri, driver, engine
 from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
 from microimpact.solvers.engine import (CAPTURE, INERTIA_FREE_ENTER, INERTIA_FREE_RESUME, OUTCOME_NAMES, REBOUND,
-                                       RELAXATION_ENTER, RELAXATION_RESUME, EngineError, NormalBatch, NormalSolution)
+                                       RELAXATION_ENTER, RELAXATION_RESUME, EngineError)
+from microimpact.solvers.solution import NormalSolution, SolutionBatch
 
 __all__ = ["solve_normal", "solve_normal_many", "solve_normal_reference", "settled_contact_energy",
            "MODEL_CODES"]
@@ -867,14 +868,15 @@ def solve_normal(contact, normal_speed: float, *, rtol: float = DEFAULT_RTOL, ne
         slip_end_time=r.tau_slip_end * sc.time,
         n_steps=int(r.n_steps),
         n_rejected=int(r.n_rejected),
+        stop_reason=driver.stop_reason(r.status, captured, need_tail),
     )
 
 
 def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DEFAULT_RTOL,
                       tail_tolerance: float | None = None, max_steps: int = _MAX_STEPS_DEFAULT,
-                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> NormalBatch:
+                      friction_impulse_stop=math.inf, twist_impulse_stop=math.inf) -> SolutionBatch:
     """JKR or DMT normal solves of many speeds in parallel; the
-    :class:`~microimpact.solvers.engine.NormalBatch` of :func:`microimpact.solvers.engine.solve_normal_many`
+    :class:`~microimpact.solvers.solution.SolutionBatch` of :func:`microimpact.solvers.engine.solve_normal_many`
     (SI arrays).
 
     Parameters as there: ``normal_speed`` [m/s] (1-D, > 0), ``need_tail`` per speed,
@@ -925,7 +927,7 @@ def solve_normal_many(contact, normal_speed, need_tail=None, *, rtol: float = DE
     captured = out[:, 1] == CAPTURE
     e_unit = sc.force * sc.length
     e_n = np.where(captured, 0.0, _restitution(model, y0, out[:, 4], out[:, 2]))
-    return NormalBatch(
+    return SolutionBatch(
         captured=captured,
         e_n=e_n,
         contact_time=np.where(captured, np.inf, out[:, 3] * sc.time),
@@ -1088,4 +1090,5 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
         slip_end_time=math.nan,
         n_steps=sum(int(part.t.size) for part in parts),
         n_rejected=0,
+        stop_reason=("settled" if need_tail else "capture") if captured else "separation",
     )

@@ -30,55 +30,19 @@ ed., Springer (DOP853).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from microimpact.model import thornton_ning as tn
+from microimpact.solvers.solution import NormalSolution
 
-__all__ = ["PlasticImpact", "plastic_impact", "REFERENCE_RTOL"]
+__all__ = ["plastic_impact", "REFERENCE_RTOL"]
 
 #: relative tolerance of the DOP853 integration; the absolute one is REFERENCE_RTOL * 1e-3 of the
 #: nondimensional state (its scale is 1). Chosen so that e agrees with the closed forms to 1e-8.
 REFERENCE_RTOL = 1e-12
-
-
-@dataclass(frozen=True)
-class PlasticImpact:
-    """One undamped normal impact under the Thornton & Ning law.
-
-    Attributes
-    ----------
-    normal_speed : float
-        V_i. [m/s]
-    rebound_speed : float
-        |delta'| at the break (0 if captured). [m/s]
-    restitution : float
-        e = rebound_speed / V_i. [-]
-    captured : bool
-        True if the sphere turned back before the break (it stays on the unloading curve).
-    status : str
-        Why the integration stopped: "separated" or "captured".
-    state : UnloadingState
-        The law's state from the turning point (R_p, delta_p, break). [SI]
-    work_loading : float
-        Integrated work of the contact force on the loading curve, int F d delta. [J]
-    work_unloading : float
-        Integrated work the contact force returns from delta_max to the end. [J]
-    contact_time : float
-        From first contact to the break (to the capture turning point if captured). [s]
-    """
-
-    normal_speed: float
-    rebound_speed: float
-    restitution: float
-    captured: bool
-    status: str
-    state: tn.UnloadingState
-    work_loading: float
-    work_unloading: float
-    contact_time: float
 
 
 def _solve(rhs, y0, events, span):
@@ -98,7 +62,7 @@ def _first_event(sol):
     return None, sol.y[:, -1], sol.t[-1]
 
 
-def plastic_impact(pc: tn.PlasticContact, normal_speed: float) -> PlasticImpact:
+def plastic_impact(pc: tn.PlasticContact, normal_speed: float) -> NormalSolution:
     """Integrate one undamped normal impact at ``normal_speed`` under the Thornton & Ning law.
 
     Parameters
@@ -107,6 +71,14 @@ def plastic_impact(pc: tn.PlasticContact, normal_speed: float) -> PlasticImpact:
         The contact (R, m, K, w, p_y).
     normal_speed : float
         Incident normal speed V_i > 0. [m/s]
+
+    Returns
+    -------
+    NormalSolution
+        As :func:`microimpact.solvers.thornton_ning_law.solve_thornton_ning`'s (the same fields
+        and the same ``state``, here also ``work_loading``, the work of the contact force on the
+        loading curve, and ``work_unloading``, the work it returns from delta_max to the end [J]);
+        ``n_steps`` counts solve_ivp's points.
 
     Raises
     ------
@@ -125,8 +97,8 @@ def plastic_impact(pc: tn.PlasticContact, normal_speed: float) -> PlasticImpact:
 
     >>> pc = tn.PlasticContact(1e-6, 1e-14, 4e9 / 3, 0.0, 1e8)
     >>> r = plastic_impact(pc, 4 * tn.yield_velocity(pc))
-    >>> r.status, round(r.restitution, 8), round(float(tn.thornton_restitution(0.25)), 8)
-    ('separated', 0.81227887, 0.81227887)
+    >>> r.stop_reason, round(r.e_n, 8), round(float(tn.thornton_restitution(0.25)), 8)
+    ('separation', 0.81227887, 0.81227887)
     """
     v_i = float(normal_speed)
     if not (math.isfinite(v_i) and v_i > 0.0):
@@ -143,8 +115,8 @@ def plastic_impact(pc: tn.PlasticContact, normal_speed: float) -> PlasticImpact:
         return y[1]
 
     turned.terminal, turned.direction = True, -1.0
-    sol = _solve(loading, [0.0, 1.0, 0.0], [turned], 50.0)
-    i, y_max, t_max = _first_event(sol)
+    first = _solve(loading, [0.0, 1.0, 0.0], [turned], 50.0)
+    i, y_max, t_max = _first_event(first)
     if i is None:
         raise RuntimeError("plastic_impact: the loading did not reach a turning point")
     state = tn.unloading_state(pc, y_max[0] * length)
@@ -172,7 +144,13 @@ def plastic_impact(pc: tn.PlasticContact, normal_speed: float) -> PlasticImpact:
         raise RuntimeError("plastic_impact: the unloading reached neither the break nor a turning point")
     captured = j == 1
     rebound = 0.0 if captured else float(abs(y_end[1])) * v_i
-    return PlasticImpact(v_i, rebound, rebound / v_i, captured, "captured" if captured else "separated", state,
-                         float(y_max[2]) * work_unit, float(y_end[2]) * work_unit,
-                         float(t_max + t_end + h) * length / v_i)
-
+    loaded, returned = float(y_max[2]) * work_unit, float(y_end[2]) * work_unit
+    end = float(t_max + t_end + h) * length / v_i
+    return NormalSolution(
+        outcome="capture" if captured else "rebound", e_n=rebound / v_i,
+        contact_time=math.inf if captured else end, capture_time=end if captured else math.nan,
+        max_penetration=state.max_approach, friction_impulse=math.nan, twist_impulse=math.nan,
+        dissipated_energy=math.nan if captured else loaded - returned, final_energy=0.5 * pc.mass * rebound**2,
+        slip_end_time=math.nan, n_steps=int(first.t.size + sol.t.size), n_rejected=0,
+        stop_reason="capture" if captured else "separation",
+        state={**asdict(state), "work": loaded - returned, "work_loading": loaded, "work_unloading": returned})

@@ -96,13 +96,13 @@ from microimpact.solvers import DEFAULT_RTOL, Deadline, SolverError, TimeBudgetE
 from microimpact.model.coefficients import impact_coefficients
 from microimpact.model.kinematics import ImpactResult, incident_velocity
 from microimpact.model.contact import Contact
+from microimpact.solvers.solution import NormalSolution
 
 __all__ = [
     "ReferenceSolverError",
     "TimeBudgetExceeded",
     "simulate_reference",
     "reference_trajectory",
-    "ReferenceTrajectory",
 ]
 
 #: Longest nondimensional time allowed before an outcome (rebound or capture). A rebound lasts
@@ -693,56 +693,9 @@ def _reference_result(contact: Contact, sc: _Scales, run: _Run, vel_in, omega_in
     )
 
 
-@dataclass(frozen=True)
-class ReferenceTrajectory:
-    """Normal motion of one impact at the solver's steps (SI units).
-
-    Attributes
-    ----------
-    time : ndarray
-        Time since first contact. [s]
-    penetration : ndarray
-        x = -n. [m]
-    penetration_rate : ndarray
-        x' = -n'. [m/s]
-    energy : ndarray
-        Normal contact energy E = m x'^2 / 2 + V(x). [J]
-    dissipated_energy : ndarray
-        Energy dissipated by normal damping so far (integrated independently of E). [J]
-    outcome : str
-        "rebound", "capture" or "in contact" (duration reached before either).
-    capture_time : float
-        Time at which E first fell below 0; NaN if it did not. [s]
-
-    Examples
-    --------
-    An elastic Hertz impact: no energy dissipated, contact time 2.94328 x_max / v (x_max =
-    (5 m v^2 / (4 k))^(2/5)); the largest penetration among the solver's steps is a little short of
-    x_max (the steps do not land on it):
-
-    >>> import math
-    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
-    >>> h = c.with_(zeta_hertz=0.0, zeta_adhesion=0.0, adhesion_line_force=0.0)
-    >>> tr = reference_trajectory(h, 1.0)
-    >>> x_max = (1.25 * h.mass / (math.sqrt(h.radius) * h.stiffness)) ** 0.4
-    >>> tr.outcome, round(float(tr.time[-1]) / x_max, 6), float(tr.dissipated_energy[-1])
-    ('rebound', 2.943275, 0.0)
-    >>> bool(tr.penetration.max() <= x_max)
-    True
-    """
-
-    time: np.ndarray
-    penetration: np.ndarray
-    penetration_rate: np.ndarray
-    energy: np.ndarray
-    dissipated_energy: np.ndarray
-    outcome: str
-    capture_time: float
-
-
 def reference_trajectory(contact: Contact, normal_speed: float, *, duration: float | None = None,
                          rtol: float = DEFAULT_RTOL, atol: float = 1e-13, method: str = "DOP853",
-                         max_step: float = math.inf) -> ReferenceTrajectory:
+                         max_step: float = math.inf) -> NormalSolution:
     """Normal motion, Eq. (27), of an impact at the solver's steps.
 
     The normal motion does not depend on the tangential state, so only (xi, y, D) are integrated.
@@ -760,7 +713,13 @@ def reference_trajectory(contact: Contact, normal_speed: float, *, duration: flo
 
     Returns
     -------
-    ReferenceTrajectory
+    NormalSolution
+        With the trajectory at the solver's steps: ``time`` since first contact [s],
+        ``penetration`` x = -n [m], ``penetration_rate`` x' [m/s]; ``outcome`` "rebound",
+        "capture" or "in contact" (the duration ended first, ``stop_reason`` "duration");
+        ``state["energy"]``, the normal contact energy E = m x'^2 / 2 + V(x) along it, and
+        ``state["dissipated"]``, the energy dissipated by the normal damping so far (integrated
+        independently of E) [J]. J and J_a are not integrated (NaN); ``e_n`` is NaN in contact.
 
     References
     ----------
@@ -772,12 +731,26 @@ def reference_trajectory(contact: Contact, normal_speed: float, *, duration: flo
 
     Examples
     --------
+    An elastic Hertz impact: no energy dissipated, contact time 2.94328 x_max / v (x_max =
+    (5 m v^2 / (4 k))^(2/5)); the largest penetration among the solver's steps is a little short of
+    x_max (the steps do not land on it):
+
+    >>> import math
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> h = c.with_(zeta_hertz=0.0, zeta_adhesion=0.0, adhesion_line_force=0.0)
+    >>> tr = reference_trajectory(h, 1.0)
+    >>> x_max = (1.25 * h.mass / (math.sqrt(h.radius) * h.stiffness)) ** 0.4
+    >>> tr.outcome, round(float(tr.time[-1]) / x_max, 6), tr.dissipated_energy
+    ('rebound', 2.943275, 0.0)
+    >>> bool(tr.penetration.max() <= x_max)
+    True
+
     The arrays share the solver's time points:
 
     >>> from microimpact.model.parameters import TABLE1_ROW2 as c
     >>> tr = reference_trajectory(c, 1.0)  # below the capture velocity, 1.449 m/s
-    >>> len(tr.time) == len(tr.penetration) == len(tr.energy), tr.outcome
-    (True, 'capture')
+    >>> len(tr.time) == len(tr.penetration) == len(tr.state["energy"]), tr.outcome, tr.stop_reason
+    (True, 'capture', 'capture')
     """
     normal_speed = _validate_speed("normal_speed", normal_speed)
     rtol, atol, _ = _validate_common(rtol, atol, None)
@@ -830,12 +803,23 @@ def reference_trajectory(contact: Contact, normal_speed: float, *, duration: flo
     V, m = sc.speed, sc.mass
     s_, y, d, tau = sol.y
     energy = np.array([_energy(sc, a, b) for a, b in zip(s_, y)]) * m * V * V
-    return ReferenceTrajectory(
+    rebound = outcome == "rebound"
+    return NormalSolution(
+        outcome=outcome,
+        e_n=-float(y[-1]) * V / normal_speed if rebound else (0.0 if outcome == "capture" else math.nan),
+        contact_time=float(tau[-1] * sc.time) if rebound else math.inf,
+        capture_time=float(sol.y_events[1][0][3] * sc.time) if captured else math.nan,
+        max_penetration=float(np.max(s_ * s_)) * sc.length,
+        friction_impulse=math.nan,
+        twist_impulse=math.nan,
+        dissipated_energy=float(d[-1] * m * V * V),
+        final_energy=float(energy[-1]),
+        slip_end_time=math.nan,
+        n_steps=int(sol.t.size),
+        n_rejected=0,
+        stop_reason="separation" if rebound else ("duration" if len(sol.t_events[2]) else "capture"),
         time=tau * sc.time,
         penetration=s_ * s_ * sc.length,
         penetration_rate=y * V,
-        energy=energy,
-        dissipated_energy=d * m * V * V,
-        outcome=outcome,
-        capture_time=float(sol.y_events[1][0][3] * sc.time) if captured else math.nan,
+        state={"energy": energy, "dissipated": d * m * V * V},
     )

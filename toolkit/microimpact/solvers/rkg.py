@@ -19,7 +19,6 @@ the global order drops from 4 to 2.5 or lower; with adhesion N = 1600 gives e_n 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from numba import prange
@@ -30,9 +29,9 @@ from microimpact.model.law import nondimensional_impact
 from microimpact.solvers import compiled_law as law
 from microimpact.solvers import engine
 from microimpact.solvers.driver import OK, Trace
-from microimpact.solvers._by_name import ReadableByName
+from microimpact.solvers.solution import NormalSolution, SolutionBatch
 
-__all__ = ["RkgBatch", "rkg_setup", "rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
+__all__ = ["rkg_setup", "rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
 
 #: Default steps per estimated contact duration of :func:`solve_normal_rkg` (e_n to ~1e-6 with
 #: adhesion, tests/test_benchmark.py).
@@ -47,38 +46,6 @@ _G2 = 1.0 + 1.0 / math.sqrt(2.0)
 # Columns of the compiled impact result
 _Y_OUT, _TAU_END, _N_STEPS, _OUTCOME, _J, _J_A, _XI_MAX, _TAU_J, _E_END = range(9)
 _NCOL = 9
-
-
-@dataclass(frozen=True, eq=False)
-class RkgBatch(ReadableByName):
-    """Result of :func:`rkg_restitution`: one element per speed, as a
-    :class:`~microimpact.solvers.engine.NormalBatch` is for the engine.
-
-    Read by attribute (``batch.e_n``) or, as the dict it replaced was, by name (``batch["e_n"]``).
-
-    Attributes
-    ----------
-    e_n : numpy.ndarray
-        Normal restitution coefficient; 0 if captured, NaN if no outcome within the step limit. [-]
-    captured : numpy.ndarray of bool
-    n_steps : numpy.ndarray of int
-        Fixed steps taken.
-    tau : numpy.ndarray
-        Nondimensional separation time t / T_c; NaN unless it rebounded. [-]
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> b = RkgBatch(np.ones(2), np.zeros(2, bool), np.zeros(2, int), np.ones(2))
-    >>> list(b), b["e_n"] is b.e_n, len(b)
-    (['e_n', 'captured', 'n_steps', 'tau'], True, 4)
-    """
-
-    e_n: np.ndarray
-    captured: np.ndarray
-    n_steps: np.ndarray
-    tau: np.ndarray
-
 
 
 @njit(cache=True)
@@ -233,7 +200,7 @@ def rkg_setup(contact, speeds):
     return y0, c1, c2, sc.a_hertz, sc.a_adhesion, dur
 
 
-def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> RkgBatch:
+def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> SolutionBatch:
     """e_n by the fixed-step Runge-Kutta-Gill method, dtau = (estimated contact duration) / N.
 
     Parameters
@@ -248,9 +215,9 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> R
 
     Returns
     -------
-    RkgBatch
-        ``e_n`` [-] (0 if captured, NaN if no outcome in 20 N steps), ``captured`` (bool),
-        ``n_steps`` (int) and ``tau`` (nondimensional separation time; NaN if captured) [-].
+    SolutionBatch
+        ``e_n`` [-] (0 if captured, NaN if no outcome in 20 N steps), ``captured`` (bool) and
+        ``n_steps`` (int); the other quantities are None (the benchmark times e_n alone).
 
     References
     ----------
@@ -275,16 +242,15 @@ def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> R
     out = np.empty((y0.size, _NCOL))
     _rkg_many(y0, c1, c2, ah, aa, h, max_steps, out)
     outcome = out[:, _OUTCOME]
-    return RkgBatch(
+    return SolutionBatch(
         e_n=np.where(outcome == 1, 0.0, np.where(outcome < 0, np.nan, out[:, _Y_OUT] / y0)),
         captured=outcome == 1,
         n_steps=out[:, _N_STEPS].astype(np.int64),
-        tau=np.where(outcome == 0, out[:, _TAU_END], np.nan),
     )
 
 
 def solve_normal_rkg(contact, normal_speed: float, *, steps: int = DEFAULT_STEPS,
-                     friction_impulse_target: float | None = None) -> engine.NormalSolution:
+                     friction_impulse_target: float | None = None) -> NormalSolution:
     """Solve the normal contact, Eq. (27), of one impact with the paper's fixed-step RKG.
 
     Parameters

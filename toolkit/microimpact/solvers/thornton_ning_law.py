@@ -35,20 +35,19 @@ plastic spheres, J. Appl. Mech. 64:383-386, doi:10.1115/1.2787319.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict
 
 import numpy as np
 
 from microimpact._numba import njit
 from microimpact.model import thornton_ning as tn
 from microimpact.solvers import DEFAULT_RTOL, driver, dopri
+from microimpact.solvers.solution import NormalSolution
 
-__all__ = ["ThorntonNingImpact", "solve_thornton_ning", "law_parameters", "REBOUND", "CAPTURE", "STATUS"]
+__all__ = ["solve_thornton_ning", "law_parameters", "REBOUND", "CAPTURE"]
 
 #: outcomes of one impact
 REBOUND, CAPTURE = 0, 1
-#: why the driver stopped, by its status code
-STATUS = {driver.OK: "ok", driver.MAX_STEPS: "max_steps", driver.STEP_UNDERFLOW: "step_underflow"}
 _N = 4  # state: x, y, tau, W
 _MAX_STEPS_DEFAULT = 1_000_000
 #: branches of the law (w[_W_BRANCH])
@@ -58,50 +57,6 @@ _W_SIZE = 8
 #: the parameters tuple p: R [m], E* [Pa], w [J/m^2], p_y [Pa], a_y [m], delta_y [m], F_y [N], L [m],
 #: acc = L / (m V_i^2) [1/N]
 _P_R, _P_ES, _P_W, _P_PY, _P_AY, _P_DY, _P_FY, _P_L, _P_ACC = range(9)
-
-
-@dataclass(frozen=True)
-class ThorntonNingImpact:
-    """One undamped normal impact under the Thornton & Ning law, solved by the compiled driver.
-
-    Attributes
-    ----------
-    normal_speed : float
-        V_i. [m/s]
-    rebound_speed : float
-        |delta'| at the break (0 if captured). [m/s]
-    restitution : float
-        e = rebound_speed / V_i. [-]
-    captured : bool
-        True if the sphere turned back on the unloading curve before the break.
-    status : str
-        Why the driver stopped: "ok", "max_steps" or "step_underflow" (:data:`STATUS`).
-    max_approach : float
-        delta_max. [m]
-    plastic_radius : float
-        R_p of the unloading curve (R below yield), (TN4). [m]
-    yielded : bool
-        True if delta_max > delta_y.
-    work : float
-        Work of the contact force from first contact to the end, int F d delta. [J]
-    contact_time : float
-        From first contact to the break (to the capture turning point if captured). [s]
-    n_steps, n_rejected : int
-        Accepted and rejected steps of the driver.
-    """
-
-    normal_speed: float
-    rebound_speed: float
-    restitution: float
-    captured: bool
-    status: str
-    max_approach: float
-    plastic_radius: float
-    yielded: bool
-    work: float
-    contact_time: float
-    n_steps: int
-    n_rejected: int
 
 
 # --------------------------------------------------------------------------- the law's force, compiled
@@ -278,6 +233,15 @@ _drive = driver.make_driver(driver.Law(_law_start, _law_args, _step, _law_too_sm
 _NO_RECORD = np.zeros((1, 3))
 
 
+@njit(cache=True)
+def _integrate(p, rtol, max_steps):
+    """One impact by the one driver: its :class:`~microimpact.solvers.driver.Trace`. Called from Python
+    through this module-level function, not as ``_drive``: numba's cache keys a closure such as
+    ``_drive`` by its pickled contents, which differ between processes, so ``_drive`` called
+    directly would be compiled again in every process; compiled into this function it is cached."""
+    return _drive(p, rtol, max_steps, _NO_RECORD, 0)
+
+
 # --------------------------------------------------------------------------- Python interface
 def law_parameters(pc: tn.PlasticContact, normal_speed: float) -> tuple:
     """The law's parameters tuple p of one impact (SI; see the module docstring) and its length L [m].
@@ -300,7 +264,7 @@ def law_parameters(pc: tn.PlasticContact, normal_speed: float) -> tuple:
 
 
 def solve_thornton_ning(pc: tn.PlasticContact, normal_speed: float, *, rtol: float = DEFAULT_RTOL,
-                        max_steps: int = _MAX_STEPS_DEFAULT) -> ThorntonNingImpact:
+                        max_steps: int = _MAX_STEPS_DEFAULT) -> NormalSolution:
     """One undamped normal impact under the Thornton & Ning (1998) law, by the compiled driver.
 
     Parameters
@@ -316,7 +280,18 @@ def solve_thornton_ning(pc: tn.PlasticContact, normal_speed: float, *, rtol: flo
 
     Returns
     -------
-    ThorntonNingImpact
+    NormalSolution
+        ``e_n`` the restitution |delta'| / V_i at the break (0 if captured, NaN if the driver
+        stopped at its budget, which ``stop_reason`` says); ``max_penetration`` delta_max;
+        ``capture_time`` the time of the turning point on the unloading curve at which a captured
+        sphere is recognised; ``dissipated_energy`` the work of the contact force over the contact,
+        int F d delta = the kinetic energy lost (plastic work plus adhesive hysteresis; NaN if
+        captured: undamped, a captured sphere keeps its energy in the contact);
+        ``final_energy`` the kinetic energy at the end; J and J_a are not integrated (NaN).
+        ``state``: the plastic state of the unloading curve, the fields of
+        :class:`~microimpact.model.thornton_ning.UnloadingState` (``plastic_radius`` R_p [m],
+        ``plastic_approach`` delta_p [m], ``break_approach`` [m], ``yielded``, ...), and ``work``,
+        int F d delta from first contact to the end [J].
 
     Raises
     ------
@@ -333,8 +308,8 @@ def solve_thornton_ning(pc: tn.PlasticContact, normal_speed: float, *, rtol: flo
 
     >>> pc = tn.PlasticContact(1e-6, 1e-14, 4e9 / 3, 0.0, 1e8)
     >>> r = solve_thornton_ning(pc, 4 * tn.yield_velocity(pc), rtol=1e-11)
-    >>> r.status, r.captured, round(r.restitution, 8), round(float(tn.thornton_restitution(0.25)), 8)
-    ('ok', False, 0.81227887, 0.81227887)
+    >>> r.stop_reason, r.state["yielded"], round(r.e_n, 8), round(float(tn.thornton_restitution(0.25)), 8)
+    ('separation', True, 0.81227887, 0.81227887)
     """
     v = float(normal_speed)
     if not (math.isfinite(v) and v > 0.0):
@@ -342,13 +317,23 @@ def solve_thornton_ning(pc: tn.PlasticContact, normal_speed: float, *, rtol: flo
     if not (0.0 < rtol < 1.0):
         raise ValueError(f"solve_thornton_ning: rtol must be in (0, 1), got {rtol!r}")
     p, length = law_parameters(pc, v)
-    r = _drive(p, float(rtol), int(max_steps), _NO_RECORD, 0)
-    captured = r.outcome == CAPTURE
-    rebound = 0.0 if captured or r.status != driver.OK else abs(float(r.y_end)) * v
+    r = _integrate(p, float(rtol), int(max_steps))
+    return _solution(pc, v, length, r)
+
+
+def _solution(pc: tn.PlasticContact, v: float, length: float, r) -> NormalSolution:
+    """The NormalSolution (SI) of the driver's Trace ``r`` of one impact at ``v`` [m/s], length unit L [m]."""
+    captured = bool(r.outcome == CAPTURE)
+    ok = r.status == driver.OK
+    rebound = 0.0 if captured or not ok else abs(float(r.y_end)) * v
     d_max = float(r.max_approach)
-    return ThorntonNingImpact(
-        normal_speed=v, rebound_speed=rebound, restitution=rebound / v, captured=bool(captured),
-        status=STATUS[int(r.status)], max_approach=d_max,
-        plastic_radius=float(tn.unloading_state(pc, d_max).plastic_radius) if d_max > 0.0 else pc.radius,
-        yielded=bool(d_max > p[_P_DY]), work=float(r.final_energy) * pc.mass * v * v,
-        contact_time=float(r.tau_end) * length / v, n_steps=int(r.n_steps), n_rejected=int(r.n_rejected))
+    work = float(r.final_energy) * pc.mass * v * v
+    state = asdict(tn.unloading_state(pc, d_max)) if d_max > 0.0 else {}
+    return NormalSolution(
+        outcome="capture" if captured else "rebound", e_n=rebound / v if ok else math.nan,
+        contact_time=math.inf if captured else float(r.tau_end) * length / v,
+        capture_time=float(r.tau_capture) * length / v, max_penetration=d_max,
+        friction_impulse=math.nan, twist_impulse=math.nan,
+        dissipated_energy=math.nan if captured else work, final_energy=0.5 * pc.mass * v * v - work,
+        slip_end_time=math.nan, n_steps=int(r.n_steps), n_rejected=int(r.n_rejected),
+        stop_reason=driver.stop_reason(r.status, captured), state={**state, "work": work})
