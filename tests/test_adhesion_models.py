@@ -154,10 +154,10 @@ def test_damped_dmt_sticking_velocity_engine_and_reference_agree():
 
 # ----------------------------------------------------------------------------- solvers
 # the grazing JKR capture is the slowest case for DOP853 (it follows the captured sphere's tangential
-# tail: about 15 s against 0.1-5 s for the others): -m slow; DMT's grazing capture stays by default
+# tail: about 15 s against 0.1-5 s for the others): -m extended; DMT's grazing capture stays by default
 @pytest.mark.parametrize("model,speed,incidence", [
     (model, speed, incidence) if (model, incidence) != ("jkr", 80.0) else
-    pytest.param(model, speed, incidence, marks=pytest.mark.slow)
+    pytest.param(model, speed, incidence, marks=pytest.mark.extended)
     for model in ("jkr", "dmt") for speed, incidence in [(2.0, 40.0), (10.0, 10.0), (1.0, 80.0), (30.0, 60.0)]])
 def test_engine_agrees_with_reference(model, speed, incidence):
     c = _contact(model)

@@ -199,7 +199,9 @@ def _adhesive_table(normal_model, damping_model, w, eta_factor, speed, radius=3.
     return pd.DataFrame({"radius": radius, "normal_speed": speed, "e_n": e, "e_n_uncertainty": sigma}), eta
 
 
-@pytest.mark.parametrize("normal_model,damping_model", [("jkr_force", "viscoelastic"), ("dmt", "mass_velocity")])
+# the DMT/mass-velocity recovery is -m extended (its fit takes several times the JKR one's)
+@pytest.mark.parametrize("normal_model,damping_model", [
+    ("jkr_force", "viscoelastic"), pytest.param("dmt", "mass_velocity", marks=pytest.mark.extended)])
 def test_joint_fit_recovers_the_work_of_adhesion_and_the_damping(normal_model, damping_model):
     """Noise-free impacts from below to above the sticking velocity: both parameters come back to
     1e-5 (the solver's rtol 1e-8 and the minimiser's tolerances), each interval holds the truth, and
@@ -234,6 +236,7 @@ def test_joint_fit_coverage_over_random_designs():
     assert _within_binomial(covered, 2 * adequate), (covered, adequate)
 
 
+@pytest.mark.extended  # 16 Brent searches on chi-square contours of three fits
 def test_the_confidence_region_lies_on_its_chi2_contour_and_projects_to_the_profile_intervals():
     """Every point the region returns has chi^2 = chi^2_min + Delta, recomputed here from
     dem_law_restitution (to 1e-6 of Delta: Brent's xtol); at 95 % (Delta = 3.84) its projection on each parameter

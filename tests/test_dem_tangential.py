@@ -572,6 +572,7 @@ def test_lammps_fit_auto_ranks_the_tangential_laws_and_writes_the_best(tmp_path,
     assert "needs --tangential-stiffness" in capsys.readouterr().err and not (tmp_path / "c2.lmp").exists()
 
 
+@pytest.mark.extended  # two DEM friction fits with profiles over the scipy tangential solver
 def test_a_stated_angle_uncertainty_enters_the_dem_friction_fit_as_effective_variance():
     # sigma_eff^2 = sigma^2 + (d e_t / d theta sigma_theta)^2 with the slope of the law itself: here
     # from central differences of simulate_impact (step 0.1 deg; the fit's own step is 0.05 deg, so
@@ -646,6 +647,7 @@ def test_the_profiled_stiffness_finds_the_least_penalised_deviance():
         assert profile.deviance(f) < held.deviance(f)
 
 
+@pytest.mark.extended  # a DEM friction fit with its profile over the scipy tangential solver
 def test_an_unweighted_fit_of_mu_has_the_profile_interval_of_its_scatter():
     # no stated uncertainties: the profile is divided by the reduced chi-square, and the interval's
     # ends are where the raw chi-square has risen by 3.84 times it. Checked against the chi-square

@@ -393,13 +393,18 @@ def test_entry_point(argv, words, workspace):
     assert _snapshot(workspace) == before
 
 
-INTERRUPTED = [(["fit", "data.csv", "--out", "f.nc", "--posterior", "p.nc"], after) for after in (1.5, 4.0, 7.0)] + [
-    (["flags", "data.csv", "--fit", "fit.nc", "--out", "x.csv", "--nc", "x.nc"], 1.5),
-    (["sweep", "--case", "2.3", "--out", "s.nc"], 1.5),
+_FIT_WITH_POSTERIOR = ["fit", "data.csv", "--out", "f.nc", "--posterior", "p.nc"]
+INTERRUPTED = [
+    pytest.param(_FIT_WITH_POSTERIOR, 1.5, id="fit-1.5s"),
+    pytest.param(_FIT_WITH_POSTERIOR, 4.0, id="fit-4.0s"),
+    # the latest moment, inside the posterior's sampling, waits 7 s: -m extended
+    pytest.param(_FIT_WITH_POSTERIOR, 7.0, id="fit-7.0s", marks=pytest.mark.extended),
+    pytest.param(["flags", "data.csv", "--fit", "fit.nc", "--out", "x.csv", "--nc", "x.nc"], 1.5, id="flags-1.5s"),
+    pytest.param(["sweep", "--case", "2.3", "--out", "s.nc"], 1.5, id="sweep-1.5s"),
 ]
 
 
-@pytest.mark.parametrize("argv,after", INTERRUPTED, ids=[f"{a[0]}-{t}s" for a, t in INTERRUPTED])
+@pytest.mark.parametrize("argv,after", INTERRUPTED)
 def test_ctrl_c_ends_in_one_line_with_status_130_and_writes_nothing(argv, after, workspace):
     """Ctrl-C (SIGINT to the process group, as a terminal sends it) at several moments of
     ``fit --posterior`` (reading, fitting, sampling), of ``flags`` and of ``sweep``: exit 130 within

@@ -207,6 +207,7 @@ def test_cli_never_prints_a_meaningless_friction(tmp_path, pairs, capsys):
     assert "Fit succeeded" not in out or "not determine" in out
 
 
+@pytest.mark.extended  # one whole calibration design with its profiles
 def test_the_profile_is_not_stopped_by_the_capture_plateau():
     """Design 1240 of the calibration study (w_A fitted; truth zeta_A = 86): with zeta_A held above
     its estimate, the previous optimum's w_A leaves every impact captured, a plateau without
