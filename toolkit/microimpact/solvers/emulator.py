@@ -23,14 +23,24 @@ Method
   Chebyshev interpolant of degree :data:`DEGREE_AB` x :data:`DEGREE_AB` x :data:`DEGREE_T` through
   Lobatto nodes. Each piece is checked at points that are not nodes: in t at random (a, b) nodes
   (a failing piece is halved; one narrower than :data:`MIN_PIECE` is left to the solver) and in (a, b)
-  at the cell's check points (a failing cell is split). The largest error seen on a piece, times
-  :data:`SAFETY`, is its error estimate.
+  at the cell's check points (a failing cell is split; a failing piece near capture,
+  :data:`NEAR_CAPTURE_T`, or in a cell at :data:`MAX_DEPTH`, is left to the solver alone). The
+  largest error seen on a piece, times :data:`SAFETY`, is its error estimate.
+* **Node and check solves.** Near capture a solve's e_n error is ~1.2 rtol / e_n (the energy left at
+  separation has an absolute error ~ rtol and e_n is its square root), so the nodes are solved at
+  :data:`NODE_RTOL` tol (1e-12 for tol 1e-8) and the checks :data:`CHECK_RTOL_FACTOR` tighter still:
+  checks at the nodes' own rtol share the nodes' bias and cannot see it.
 * **The guard band.** Between y_c (1 - g) and y_c (1 + g) the outcome and the root are too sensitive
   to the surface's error eps: there the solver runs. g = max(SAFETY eps, (SAFETY eps / tol)^2)
   bounds the error of the root (e_n error ~ eps / (2 sqrt(g)) just above the band).
 * **Fallback.** Impacts outside the domain (C1, C2 or y0, also C1 = 0 or C2 = 0), in the band, in a
   piece or cell left to the solver, or whose piece's estimate exceeds ``tol``, are solved
-  (:func:`microimpact.solvers.family.normal_restitution`), per contact, at ``rtol = tol / 100``.
+  (:func:`microimpact.solvers.family.normal_restitution`), per contact, at ``rtol = tol / 100``;
+  those whose e_n comes out below :data:`NEAR_CAPTURE_E` again at ``tol e_n / 12``
+  (:data:`FALLBACK_RTOL`). Why they fall back is counted by :meth:`RingEmulator.fallback_reasons`.
+* **Limits.** Within ~ (rtol_min / tol)^2 of y_c in ln y0 (rtol_min the solvers' MIN_RTOL; e_n below
+  ~3e-6 at tol 1e-8) no solve resolves e_n to ``tol``: that sliver, a share ~1e-12 of log-uniform
+  speeds, is beyond the error control.
 
 The table is built once per tolerance and cached outside the install tree (:func:`cache_dir`, like
 numba's cache): an ``.npz`` whose name carries the tolerance, the domain, the degrees and a hash of
@@ -79,8 +89,9 @@ DEFAULT_TOLERANCE = 1e-6
 DEGREE_SURFACE, DEGREE_AB, DEGREE_T = 12, 6, 12
 #: root cells per decade of C1 and C2
 CELLS_PER_DECADE = 1
-#: deepest quadtree level below a root cell
-MAX_DEPTH = 2
+#: deepest quadtree level below a root cell (at tol 1e-8 level 2 left the fastest pieces, t > 0.75, of
+#: four of its 16 cells to the solver, 2-3 % of the benchmark's impacts; level 3 none)
+MAX_DEPTH = 3
 #: random (a, b) check points per cell (surface and e_n), and t check points per piece and node
 CELL_CHECKS, T_CHECKS = 4, 4
 #: (a, b) nodes per piece at which t is checked
@@ -213,27 +224,37 @@ def _chebyshev_row(x, n, out):
 
 
 @njit(cache=True)
-def _tensor2(c, ta, tb):
-    s = 0.0
+def _tensor2(c, ta, tb, w):
+    """sum_ij ta_i c_ij tb_j, summed over i first into w_j: independent sums the compiler can
+    vectorize (one running sum would chain every addition to the one before; no fastmath)."""
+    nb = c.shape[1]
+    for j in range(nb):
+        w[j] = 0.0
     for i in range(c.shape[0]):
-        r = 0.0
-        for j in range(c.shape[1]):
-            r += c[i, j] * tb[j]
-        s += ta[i] * r
-    return s
+        s = ta[i]
+        for j in range(nb):
+            w[j] += s * c[i, j]
+    r = 0.0
+    for j in range(nb):
+        r += w[j] * tb[j]
+    return r
 
 
 @njit(cache=True)
-def _tensor3(c, ta, tb, tt):
-    s = 0.0
+def _tensor3(c, ta, tb, tt, w):
+    """sum_ijk ta_i tb_j tt_k c_ijk, summed over (i, j) first into w_k (as :func:`_tensor2`)."""
+    nk = c.shape[2]
+    for k in range(nk):
+        w[k] = 0.0
     for i in range(c.shape[0]):
         for j in range(c.shape[1]):
-            w = ta[i] * tb[j]
-            r = 0.0
-            for k in range(c.shape[2]):
-                r += c[i, j, k] * tt[k]
-            s += w * r
-    return s
+            s = ta[i] * tb[j]
+            for k in range(nk):
+                w[k] += s * c[i, j, k]
+    r = 0.0
+    for k in range(nk):
+        r += w[k] * tt[k]
+    return r
 
 
 def _local(x, lo, hi):
@@ -352,7 +373,10 @@ def _evaluate_many(y0, c1, c2, tol, box, roots, children, leaf, cell_state, guar
     """The table at each point: e, and state _OK, _CAPTURED or _SOLVE (module docstring)."""
     na, nt = max(surface.shape[1], piece_coef.shape[1]) - 1, piece_coef.shape[3] - 1
     ta, tb, tt = np.empty(na + 1), np.empty(na + 1), np.empty(nt + 1)  # T_k rows; each sum takes what it needs
+    w = np.empty(max(na, nt) + 1)
     y_lo, y_hi = box[6], box[7]
+    log_y_hi = math.log(y_hi)
+    band_lo, band_hi = np.log1p(-guard), np.log1p(guard)  # per cell, not per point
     for n in range(y0.size):
         e[n], state[n] = 0.0, _SOLVE  # _SOLVE + k: reason k of FALLBACK_REASONS (0: outside the domain)
         if not (c1[n] > 0.0 and c2[n] > 0.0 and y_lo <= y0[n] <= y_hi):
@@ -369,15 +393,15 @@ def _evaluate_many(y0, c1, c2, tol, box, roots, children, leaf, cell_state, guar
             continue
         _chebyshev_row((2.0 * a - lo_a - hi_a) / (hi_a - lo_a), na, ta)
         _chebyshev_row((2.0 * b - lo_b - hi_b) / (hi_b - lo_b), na, tb)
-        log_yc = _tensor2(surface[cell], ta, tb)
+        log_yc = _tensor2(surface[cell], ta, tb, w)
         ly = math.log(y0[n])
-        if ly <= log_yc + math.log1p(-guard[cell]):
+        if ly <= log_yc + band_lo[cell]:
             state[n] = _CAPTURED
             continue
-        if ly < log_yc + math.log1p(guard[cell]):
+        if ly < log_yc + band_hi[cell]:
             state[n] = _SOLVE + 2
             continue
-        width = math.log(y_hi) - log_yc
+        width = log_y_hi - log_yc
         t = math.sqrt(min((ly - log_yc) / width, 1.0))
         for p in range(piece_start[cell], piece_start[cell] + piece_count[cell]):
             if piece_t[p, 0] <= t <= piece_t[p, 1]:
@@ -387,7 +411,7 @@ def _evaluate_many(y0, c1, c2, tol, box, roots, children, leaf, cell_state, guar
                     state[n] = _SOLVE + 4
                 else:
                     _chebyshev_row((2.0 * t - piece_t[p, 0] - piece_t[p, 1]) / (piece_t[p, 1] - piece_t[p, 0]), nt, tt)
-                    e[n] = _tensor3(piece_coef[p], ta, tb, tt)
+                    e[n] = _tensor3(piece_coef[p], ta, tb, tt, w)
                     state[n] = _OK
                 break
 
