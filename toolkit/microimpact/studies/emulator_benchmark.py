@@ -28,7 +28,7 @@ What is measured
   (captures included; the D impacts are the first of them). The largest e_n errors of the emulator
   and of the solver against it are over these S, and so are the outcome disagreements.
 * Times with ``time.perf_counter``, the median of ``--repeats`` runs (DOP853: one run of D
-  impacts), one thread each (the solvers' setting in fits, :func:`microimpact.solvers.engine_threads`),
+  impacts, between two timings of the emulator, both reported), one thread each (the solvers' setting in fits, :func:`microimpact.solvers.engine_threads`),
   on a warm numba cache. The ratios are of times measured in this one run; the load average before
   and after is recorded: on a shared machine only ratios measured side by side compare.
 """
@@ -101,13 +101,12 @@ def _dop853(contacts, speeds, flat, rtol, atol):
     return e, time.perf_counter() - t0
 
 
-def _cheapest_dop853(contacts, speeds, flat, e_ref, tol):
-    """DOP853 per impact at each rtol of DOP853_RTOLS on ``flat``, its errors against ``e_ref``, and the
-    loosest setting within ``tol`` (or the tightest)."""
+def _cheapest_dop853(timed, e_ref, tol):
+    """DOP853 per impact at each rtol of ``timed`` ({rtol: (e_n, seconds)}), its errors against
+    ``e_ref``, and the loosest setting within ``tol`` (or the tightest)."""
     runs = {}
-    for rtol in DOP853_RTOLS:
-        e, t = _dop853(contacts, speeds, flat, rtol, rtol)
-        runs[f"{rtol:g}"] = {"time_per_impact_s": t / flat.size, "max_error_e_n": float(np.max(np.abs(e - e_ref))),
+    for rtol, (e, t) in timed.items():
+        runs[f"{rtol:g}"] = {"time_per_impact_s": t / e.size, "max_error_e_n": float(np.max(np.abs(e - e_ref))),
                              "outcome_disagreements": int(np.count_nonzero((e == 0.0) != (e_ref == 0.0)))}
     ok = [k for k, r in runs.items() if r["max_error_e_n"] <= tol and r["outcome_disagreements"] == 0]
     chosen = ok[0] if ok else f"{DOP853_RTOLS[-1]:g}"
@@ -143,14 +142,16 @@ def run_emulator_benchmark(contacts: int = 1000, impacts: int = 10, tol: float =
         y0, c1, c2 = reduction.ring_groups(cs, v)
         t_table, _ = _timed(lambda: table.evaluate(y0, c1, c2, tol), repeats)
         t_solver, e_solver = _timed(lambda: _solver(cs[:k], v[:k], DEFAULT_RTOL), repeats)
+        timed_dop853 = {rtol: _dop853(cs, v, d, rtol, rtol) for rtol in DOP853_RTOLS}  # beside the emulator's times
+        t_emu_after, _ = _timed(lambda: emulator.restitution(cs, v, tol=tol, domain=domain), repeats)
         e_ref, t_ref = _dop853(cs, v, flat, REFERENCE_RTOL, REFERENCE_ATOL)
-        dop853, chosen, reached = _cheapest_dop853(cs, v, d, e_ref[:d.size], tol)
+        dop853, chosen, reached = _cheapest_dop853(timed_dop853, e_ref[:d.size], tol)
         e_solver_sample = _solver_at(cs, v, flat, DEFAULT_RTOL)
     t_dop853 = dop853[chosen]["time_per_impact_s"]
     decided = ~r.solved.ravel()[flat]
     e_emu, cap_emu = r.e_n.ravel()[flat], r.captured.ravel()[flat]
     per_impact = {"emulator": t_emu / n, "table_kernel": t_table / n, "solver": t_solver / v[:k].size,
-                  "dop853": t_dop853, "dop853_reference": t_ref / flat.size}
+                  "dop853": t_dop853, "dop853_reference": t_ref / flat.size, "emulator_after_dop853": t_emu_after / n}
     return {
         "command": "python -m microimpact.studies.emulator_benchmark " + " ".join(sys.argv[1:]),
         "machine": {"platform": platform.platform(), "python": platform.python_version(), "cpus": os.cpu_count(),
@@ -168,6 +169,7 @@ def run_emulator_benchmark(contacts: int = 1000, impacts: int = 10, tol: float =
         "dop853": {"sample_impacts": int(d.size), "settings": dop853, "chosen_rtol": float(chosen),
                    "chosen_reaches_tol": reached},
         "speed_ratio_dop853_over_emulator": t_dop853 / per_impact["emulator"],
+        "speed_ratio_dop853_over_emulator_after_dop853": t_dop853 / per_impact["emulator_after_dop853"],
         "speed_ratio_dop853_over_table_kernel": t_dop853 / per_impact["table_kernel"],
         "speed_ratio_solver_over_emulator": per_impact["solver"] / per_impact["emulator"],
         "speed_ratio_solver_over_table_kernel": per_impact["solver"] / per_impact["table_kernel"],
