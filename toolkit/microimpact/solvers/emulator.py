@@ -213,50 +213,6 @@ def _coefficients(values):
     return c
 
 
-@njit(cache=True)
-def _chebyshev_row(x, n, out):
-    """T_0(x) .. T_n(x) into out."""
-    out[0] = 1.0
-    if n > 0:
-        out[1] = x
-    for k in range(2, n + 1):
-        out[k] = 2.0 * x * out[k - 1] - out[k - 2]
-
-
-@njit(cache=True)
-def _tensor2(c, ta, tb, w):
-    """sum_ij ta_i c_ij tb_j, summed over i first into w_j: independent sums the compiler can
-    vectorize (one running sum would chain every addition to the one before; no fastmath)."""
-    nb = c.shape[1]
-    for j in range(nb):
-        w[j] = 0.0
-    for i in range(c.shape[0]):
-        s = ta[i]
-        for j in range(nb):
-            w[j] += s * c[i, j]
-    r = 0.0
-    for j in range(nb):
-        r += w[j] * tb[j]
-    return r
-
-
-@njit(cache=True)
-def _tensor3(c, ta, tb, tt, w):
-    """sum_ijk ta_i tb_j tt_k c_ijk, summed over (i, j) first into w_k (as :func:`_tensor2`)."""
-    nk = c.shape[2]
-    for k in range(nk):
-        w[k] = 0.0
-    for i in range(c.shape[0]):
-        for j in range(c.shape[1]):
-            s = ta[i] * tb[j]
-            for k in range(nk):
-                w[k] += s * c[i, j, k]
-    r = 0.0
-    for k in range(nk):
-        r += w[k] * tt[k]
-    return r
-
-
 def _local(x, lo, hi):
     return (2.0 * x - lo - hi) / (hi - lo)
 
@@ -370,13 +326,58 @@ def _find_cell(a, b, box, roots, children, leaf):
 @njit(cache=True)
 def _evaluate_many(y0, c1, c2, tol, box, roots, children, leaf, cell_state, guard, surface, piece_start,
                    piece_count, piece_t, piece_state, piece_error, piece_coef, e, state):
-    """The table at each point: e, and state _OK, _CAPTURED or _SOLVE (module docstring)."""
-    na, nt = max(surface.shape[1], piece_coef.shape[1]) - 1, piece_coef.shape[3] - 1
-    ta, tb, tt = np.empty(na + 1), np.empty(na + 1), np.empty(nt + 1)  # T_k rows; each sum takes what it needs
-    w = np.empty(max(na, nt) + 1)
-    y_lo, y_hi = box[6], box[7]
-    log_y_hi = math.log(y_hi)
+    """The table at each point: e, and state _OK, _CAPTURED or _SOLVE + k (module docstring).
+
+    The points are grouped by cell, then by piece, and each sum runs over a group's points at once:
+    sums of different points are independent, so the compiler vectorizes them (no fastmath; one
+    point's own sum would chain every addition to the one before)."""
+    cell_of, xa, xb, ly = _cells_of(y0, c1, c2, box, roots, children, leaf, cell_state, state, e)
+    order, start = _grouped(cell_of, cell_state.size)
+    piece_of, xt = np.full(y0.size, -1, dtype=np.int64), np.empty(y0.size)
+    log_y_hi = math.log(box[7])
     band_lo, band_hi = np.log1p(-guard), np.log1p(guard)  # per cell, not per point
+    for c in range(cell_state.size):
+        idx = order[start[c]:start[c + 1]]
+        if idx.size == 0:
+            continue
+        log_yc = _tensor2_at(surface[c], _rows(xa, idx, surface.shape[1]), _rows(xb, idx, surface.shape[2]))
+        for q in range(idx.size):
+            n = idx[q]
+            if ly[n] <= log_yc[q] + band_lo[c]:
+                state[n] = _CAPTURED
+                continue
+            if ly[n] < log_yc[q] + band_hi[c]:
+                state[n] = _SOLVE + 2
+                continue
+            t = math.sqrt(min((ly[n] - log_yc[q]) / (log_y_hi - log_yc[q]), 1.0))
+            for p in range(piece_start[c], piece_start[c] + piece_count[c]):
+                if piece_t[p, 0] <= t <= piece_t[p, 1]:
+                    if piece_state[p] != _OK:
+                        state[n] = _SOLVE + 3
+                    elif piece_error[p] > tol:
+                        state[n] = _SOLVE + 4
+                    else:
+                        piece_of[n] = p
+                        xt[n] = (2.0 * t - piece_t[p, 0] - piece_t[p, 1]) / (piece_t[p, 1] - piece_t[p, 0])
+                    break
+    order, start = _grouped(piece_of, piece_state.size)
+    for p in range(piece_state.size):
+        idx = order[start[p]:start[p + 1]]
+        if idx.size == 0:
+            continue
+        coef = piece_coef[p]
+        got = _tensor3_at(coef, _rows(xa, idx, coef.shape[0]), _rows(xb, idx, coef.shape[1]), _rows(xt, idx, coef.shape[2]))
+        for q in range(idx.size):
+            e[idx[q]], state[idx[q]] = got[q], _OK
+
+
+@njit(cache=True)
+def _cells_of(y0, c1, c2, box, roots, children, leaf, cell_state, state, e):
+    """Each point's cell (-1: decided here, or not the table's) and its local (a, b) and ln y0;
+    sets e = 0 and the state of the points outside the domain, in cells left to the solver or
+    captured throughout."""
+    cell_of, xa, xb, ly = np.full(y0.size, -1, dtype=np.int64), np.empty(y0.size), np.empty(y0.size), np.empty(y0.size)
+    y_lo, y_hi = box[6], box[7]
     for n in range(y0.size):
         e[n], state[n] = 0.0, _SOLVE  # _SOLVE + k: reason k of FALLBACK_REASONS (0: outside the domain)
         if not (c1[n] > 0.0 and c2[n] > 0.0 and y_lo <= y0[n] <= y_hi):
@@ -391,29 +392,75 @@ def _evaluate_many(y0, c1, c2, tol, box, roots, children, leaf, cell_state, guar
         if cell_state[cell] == _CAPTURED:
             state[n] = _CAPTURED
             continue
-        _chebyshev_row((2.0 * a - lo_a - hi_a) / (hi_a - lo_a), na, ta)
-        _chebyshev_row((2.0 * b - lo_b - hi_b) / (hi_b - lo_b), na, tb)
-        log_yc = _tensor2(surface[cell], ta, tb, w)
-        ly = math.log(y0[n])
-        if ly <= log_yc + band_lo[cell]:
-            state[n] = _CAPTURED
-            continue
-        if ly < log_yc + band_hi[cell]:
-            state[n] = _SOLVE + 2
-            continue
-        width = log_y_hi - log_yc
-        t = math.sqrt(min((ly - log_yc) / width, 1.0))
-        for p in range(piece_start[cell], piece_start[cell] + piece_count[cell]):
-            if piece_t[p, 0] <= t <= piece_t[p, 1]:
-                if piece_state[p] != _OK:
-                    state[n] = _SOLVE + 3
-                elif piece_error[p] > tol:
-                    state[n] = _SOLVE + 4
-                else:
-                    _chebyshev_row((2.0 * t - piece_t[p, 0] - piece_t[p, 1]) / (piece_t[p, 1] - piece_t[p, 0]), nt, tt)
-                    e[n] = _tensor3(piece_coef[p], ta, tb, tt, w)
-                    state[n] = _OK
-                break
+        cell_of[n] = cell
+        xa[n], xb[n] = (2.0 * a - lo_a - hi_a) / (hi_a - lo_a), (2.0 * b - lo_b - hi_b) / (hi_b - lo_b)
+        ly[n] = math.log(y0[n])
+    return cell_of, xa, xb, ly
+
+
+@njit(cache=True)
+def _grouped(key, n_keys):
+    """(order, start): the indices with key k (>= 0) are order[start[k]:start[k + 1]] (a counting sort)."""
+    start = np.zeros(n_keys + 1, dtype=np.int64)
+    for k in key:
+        if k >= 0:
+            start[k + 1] += 1
+    start = np.cumsum(start)
+    fill = start[:-1].copy()
+    order = np.empty(start[-1], dtype=np.int64)
+    for n in range(key.size):
+        k = key[n]
+        if k >= 0:
+            order[fill[k]] = n
+            fill[k] += 1
+    return order, start
+
+
+@njit(cache=True)
+def _rows(x, idx, n):
+    """T_k(x[idx[q]]) for k < n as an (n, len(idx)) array (the three-term recurrence, across points)."""
+    out = np.empty((n, idx.size))
+    for q in range(idx.size):
+        out[0, q] = 1.0
+        if n > 1:
+            out[1, q] = x[idx[q]]
+    for k in range(2, n):
+        for q in range(idx.size):
+            out[k, q] = 2.0 * out[1, q] * out[k - 1, q] - out[k - 2, q]
+    return out
+
+
+@njit(cache=True)
+def _tensor2_at(c, ta, tb):
+    """sum_ij c_ij ta[i, q] tb[j, q] for each point q."""
+    m = ta.shape[1]
+    out, w = np.zeros(m), np.empty(m)
+    for j in range(c.shape[1]):
+        w[:] = 0.0
+        for i in range(c.shape[0]):
+            cij = c[i, j]
+            for q in range(m):
+                w[q] += cij * ta[i, q]
+        for q in range(m):
+            out[q] += w[q] * tb[j, q]
+    return out
+
+
+@njit(cache=True)
+def _tensor3_at(c, ta, tb, tt):
+    """sum_ijk c_ijk ta[i, q] tb[j, q] tt[k, q] for each point q."""
+    m = ta.shape[1]
+    out, u = np.zeros(m), np.empty(m)
+    for i in range(c.shape[0]):
+        for j in range(c.shape[1]):
+            u[:] = 0.0
+            for k in range(c.shape[2]):
+                cijk = c[i, j, k]
+                for q in range(m):
+                    u[q] += cijk * tt[k, q]
+            for q in range(m):
+                out[q] += u[q] * ta[i, q] * tb[j, q]
+    return out
 
 
 # --------------------------------------------------------------------------- the build
