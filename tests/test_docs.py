@@ -120,7 +120,7 @@ HOW = {
     "snakemake --report report.html": "ci",
     "python -m microimpact.studies.benchmark": "study",
     # docs/studies.md: the emulator against the solver (tests/test_emulator.py runs a small form)
-    "python -m microimpact.studies.emulator_benchmark --contacts 1000 --impacts 10 --out docs/emulator-benchmark.json": "study",
+    "python -m microimpact.studies.emulator_benchmark --contacts 1000 --impacts 1000 --tol 1e-8 --out docs/emulator-benchmark-1e-8.json": "study",
     "python -m microimpact.studies.emulator_benchmark": "study",  # docs/guide/reduction.md: the same, its defaults
     "python -m microimpact.studies.stress": "study",
     "python .ci/startup.py": "ci",

@@ -23,14 +23,24 @@ Method
   Chebyshev interpolant of degree :data:`DEGREE_AB` x :data:`DEGREE_AB` x :data:`DEGREE_T` through
   Lobatto nodes. Each piece is checked at points that are not nodes: in t at random (a, b) nodes
   (a failing piece is halved; one narrower than :data:`MIN_PIECE` is left to the solver) and in (a, b)
-  at the cell's check points (a failing cell is split). The largest error seen on a piece, times
-  :data:`SAFETY`, is its error estimate.
+  at the cell's check points (a failing cell is split; a failing piece near capture,
+  :data:`NEAR_CAPTURE_T`, or in a cell at :data:`MAX_DEPTH`, is left to the solver alone). The
+  largest error seen on a piece, times :data:`SAFETY`, is its error estimate.
+* **Node and check solves.** Near capture a solve's e_n error is ~1.2 rtol / e_n (the energy left at
+  separation has an absolute error ~ rtol and e_n is its square root), so the nodes are solved at
+  :data:`NODE_RTOL` tol (1e-12 for tol 1e-8) and the checks :data:`CHECK_RTOL_FACTOR` tighter still:
+  checks at the nodes' own rtol share the nodes' bias and cannot see it.
 * **The guard band.** Between y_c (1 - g) and y_c (1 + g) the outcome and the root are too sensitive
   to the surface's error eps: there the solver runs. g = max(SAFETY eps, (SAFETY eps / tol)^2)
   bounds the error of the root (e_n error ~ eps / (2 sqrt(g)) just above the band).
 * **Fallback.** Impacts outside the domain (C1, C2 or y0, also C1 = 0 or C2 = 0), in the band, in a
   piece or cell left to the solver, or whose piece's estimate exceeds ``tol``, are solved
-  (:func:`microimpact.solvers.family.normal_restitution`), per contact, at ``rtol = tol / 100``.
+  (:func:`microimpact.solvers.family.normal_restitution`), per contact, at ``rtol = tol / 100``;
+  those whose e_n comes out below :data:`NEAR_CAPTURE_E` again at ``tol e_n / 12``
+  (:data:`FALLBACK_RTOL`). Why they fall back is counted by :meth:`RingEmulator.fallback_reasons`.
+* **Limits.** Within ~ (rtol_min / tol)^2 of y_c in ln y0 (rtol_min the solvers' MIN_RTOL; e_n below
+  ~3e-6 at tol 1e-8) no solve resolves e_n to ``tol``: that sliver, a share ~1e-12 of log-uniform
+  speeds, is beyond the error control.
 
 The table is built once per tolerance and cached outside the install tree (:func:`cache_dir`, like
 numba's cache): an ``.npz`` whose name carries the tolerance, the domain, the degrees and a hash of
@@ -79,8 +89,9 @@ DEFAULT_TOLERANCE = 1e-6
 DEGREE_SURFACE, DEGREE_AB, DEGREE_T = 12, 6, 12
 #: root cells per decade of C1 and C2
 CELLS_PER_DECADE = 1
-#: deepest quadtree level below a root cell
-MAX_DEPTH = 2
+#: deepest quadtree level below a root cell (at tol 1e-8 level 2 left the fastest pieces, t > 0.75, of
+#: four of its 16 cells to the solver, 2-3 % of the benchmark's impacts; level 3 none)
+MAX_DEPTH = 3
 #: random (a, b) check points per cell (surface and e_n), and t check points per piece and node
 CELL_CHECKS, T_CHECKS = 4, 4
 #: (a, b) nodes per piece at which t is checked
@@ -93,13 +104,31 @@ SCAN, SECTIONS, CAPTURE_WIDTH = 17, 4, 1e-10
 #: factor from the largest check error to the error estimate
 SAFETY = 2.0
 #: tolerance of the node solves (rtol) relative to the table's, its floor, and its ceiling (a node
-#: just above y_c must have the outcome right)
-NODE_RTOL, NODE_RTOL_FLOOR, NODE_RTOL_CEILING = 1e-2, 1e-12, 1e-10
+#: just above y_c must have the outcome right). Near capture a solve's e_n error grows like
+#: ~1.2 rtol / e_n (the energy left at separation carries an absolute error ~ rtol, and
+#: e_n ~ sqrt of it; measured against rtol 1e-13), so rtol = 1e-2 tol would miss tol wherever
+#: e_n < 1e-2: 1e-4 tol keeps the nodes within 1e-2 tol down to e_n ~ 1e-2.
+NODE_RTOL, NODE_RTOL_FLOOR, NODE_RTOL_CEILING = 1e-4, 1e-12, 1e-10
+#: the check solves run this much tighter than the nodes, so that a bias the nodes share with
+#: solves at their own rtol (the ~rtol / e_n error near capture) shows as check error
+CHECK_RTOL_FACTOR = 0.1
+#: a piece of e_n ending below this t (ln(y0 / y_c) below 1/1024 of the speed range) that misses the
+#: tolerance at the (a, b) checks is left to the solver instead of splitting its cell: there the
+#: error is the root's sensitivity to the surface and the node solves (~ eps / sqrt(ln(y0 / y_c))),
+#: which a split does not cure, and the piece holds a share ~ 1e-3 of the speeds
+NEAR_CAPTURE_T = 1.0 / 32.0
+#: the solver's rtol where the table leaves an impact to it, relative to ``tol``; a solve whose e_n
+#: comes out below :data:`NEAR_CAPTURE_E` (error ~1.2 rtol / e_n, NODE_RTOL) is redone at
+#: ``tol`` e_n / 12 (at least the solvers' MIN_RTOL), so that its error stays ~ tol / 10
+FALLBACK_RTOL, NEAR_CAPTURE_E = 1e-2, 0.12
 #: tolerance of the outcome solves of the capture multisection (at most; finer for a table finer than
 #: 1e-6: 1e-3 of :func:`surface_tolerance`), and CAPTURE_WIDTH at most 1e-2 of it
 CAPTURE_RTOL = 1e-11
 #: cell and piece states
 _OK, _CAPTURED, _SOLVE = 0, 1, 2
+#: why the table leaves an impact to the solver (:meth:`RingEmulator.fallback_reasons`), by code 1..5
+FALLBACK_REASONS = ("outside the domain", "cell left to the solver", "guard band about the capture speed",
+                    "piece left to the solver", "piece estimate above tol")
 #: the version of the table's layout (part of the cache key)
 _LAYOUT = 1
 
@@ -184,40 +213,6 @@ def _coefficients(values):
     return c
 
 
-@njit(cache=True)
-def _chebyshev_row(x, n, out):
-    """T_0(x) .. T_n(x) into out."""
-    out[0] = 1.0
-    if n > 0:
-        out[1] = x
-    for k in range(2, n + 1):
-        out[k] = 2.0 * x * out[k - 1] - out[k - 2]
-
-
-@njit(cache=True)
-def _tensor2(c, ta, tb):
-    s = 0.0
-    for i in range(c.shape[0]):
-        r = 0.0
-        for j in range(c.shape[1]):
-            r += c[i, j] * tb[j]
-        s += ta[i] * r
-    return s
-
-
-@njit(cache=True)
-def _tensor3(c, ta, tb, tt):
-    s = 0.0
-    for i in range(c.shape[0]):
-        for j in range(c.shape[1]):
-            w = ta[i] * tb[j]
-            r = 0.0
-            for k in range(c.shape[2]):
-                r += c[i, j, k] * tt[k]
-            s += w * r
-    return s
-
-
 def _local(x, lo, hi):
     return (2.0 * x - lo - hi) / (hi - lo)
 
@@ -277,6 +272,20 @@ class RingEmulator:
 
         :func:`restitution` is the entry point that uses it (and its example runs it).
         """
+        e, state = self._states(incident_speed, hertz_damping, adhesion_damping, tol)
+        return e, state == _CAPTURED, state >= _SOLVE
+
+    def fallback_reasons(self, incident_speed, hertz_damping, adhesion_damping, tol=None) -> dict:
+        """How many of these points the table leaves to the solver, by reason (:data:`FALLBACK_REASONS`).
+
+        :func:`restitution` is the entry point that uses the table (and its example runs it).
+        """
+        state = self._states(incident_speed, hertz_damping, adhesion_damping, tol)[1]
+        codes = np.bincount(state.ravel().astype(np.int64), minlength=_SOLVE + len(FALLBACK_REASONS))
+        return {name: int(codes[_SOLVE + k]) for k, name in enumerate(FALLBACK_REASONS)}
+
+    def _states(self, incident_speed, hertz_damping, adhesion_damping, tol):
+        """(e_n, state) at the groups: state _OK, _CAPTURED, or _SOLVE + k for reason k of FALLBACK_REASONS."""
         y0, c1, c2 = (np.ascontiguousarray(np.asarray(x, dtype=float).ravel()) for x in
                       np.broadcast_arrays(incident_speed, hertz_damping, adhesion_damping))
         shape = np.broadcast(incident_speed, hertz_damping, adhesion_damping).shape
@@ -285,7 +294,7 @@ class RingEmulator:
         _evaluate_many(y0, c1, c2, float(self.tolerance if tol is None else tol), a["box"], a["roots"], a["children"],
                        a["leaf"], a["cell_state"], a["guard"], a["surface"], a["piece_start"],
                        a["piece_count"], a["piece_t"], a["piece_state"], a["piece_error"], a["piece_coef"], e, state)
-        return e.reshape(shape), (state == _CAPTURED).reshape(shape), (state == _SOLVE).reshape(shape)
+        return e.reshape(shape), state.reshape(shape)
 
 
 @njit(cache=True)
@@ -317,39 +326,141 @@ def _find_cell(a, b, box, roots, children, leaf):
 @njit(cache=True)
 def _evaluate_many(y0, c1, c2, tol, box, roots, children, leaf, cell_state, guard, surface, piece_start,
                    piece_count, piece_t, piece_state, piece_error, piece_coef, e, state):
-    """The table at each point: e, and state _OK, _CAPTURED or _SOLVE (module docstring)."""
-    na, nt = max(surface.shape[1], piece_coef.shape[1]) - 1, piece_coef.shape[3] - 1
-    ta, tb, tt = np.empty(na + 1), np.empty(na + 1), np.empty(nt + 1)  # T_k rows; each sum takes what it needs
+    """The table at each point: e, and state _OK, _CAPTURED or _SOLVE + k (module docstring).
+
+    The points are grouped by cell, then by piece, and each sum runs over a group's points at once:
+    sums of different points are independent, so the compiler vectorizes them (no fastmath; one
+    point's own sum would chain every addition to the one before)."""
+    cell_of, xa, xb, ly = _cells_of(y0, c1, c2, box, roots, children, leaf, cell_state, state, e)
+    order, start = _grouped(cell_of, cell_state.size)
+    piece_of, xt = np.full(y0.size, -1, dtype=np.int64), np.empty(y0.size)
+    log_y_hi = math.log(box[7])
+    band_lo, band_hi = np.log1p(-guard), np.log1p(guard)  # per cell, not per point
+    for c in range(cell_state.size):
+        idx = order[start[c]:start[c + 1]]
+        if idx.size == 0:
+            continue
+        log_yc = _tensor2_at(surface[c], _rows(xa, idx, surface.shape[1]), _rows(xb, idx, surface.shape[2]))
+        for q in range(idx.size):
+            n = idx[q]
+            if ly[n] <= log_yc[q] + band_lo[c]:
+                state[n] = _CAPTURED
+                continue
+            if ly[n] < log_yc[q] + band_hi[c]:
+                state[n] = _SOLVE + 2
+                continue
+            t = math.sqrt(min((ly[n] - log_yc[q]) / (log_y_hi - log_yc[q]), 1.0))
+            for p in range(piece_start[c], piece_start[c] + piece_count[c]):
+                if piece_t[p, 0] <= t <= piece_t[p, 1]:
+                    if piece_state[p] != _OK:
+                        state[n] = _SOLVE + 3
+                    elif piece_error[p] > tol:
+                        state[n] = _SOLVE + 4
+                    else:
+                        piece_of[n] = p
+                        xt[n] = (2.0 * t - piece_t[p, 0] - piece_t[p, 1]) / (piece_t[p, 1] - piece_t[p, 0])
+                    break
+    order, start = _grouped(piece_of, piece_state.size)
+    for p in range(piece_state.size):
+        idx = order[start[p]:start[p + 1]]
+        if idx.size == 0:
+            continue
+        coef = piece_coef[p]
+        got = _tensor3_at(coef, _rows(xa, idx, coef.shape[0]), _rows(xb, idx, coef.shape[1]), _rows(xt, idx, coef.shape[2]))
+        for q in range(idx.size):
+            e[idx[q]], state[idx[q]] = got[q], _OK
+
+
+@njit(cache=True)
+def _cells_of(y0, c1, c2, box, roots, children, leaf, cell_state, state, e):
+    """Each point's cell (-1: decided here, or not the table's) and its local (a, b) and ln y0;
+    sets e = 0 and the state of the points outside the domain, in cells left to the solver or
+    captured throughout."""
+    cell_of, xa, xb, ly = np.full(y0.size, -1, dtype=np.int64), np.empty(y0.size), np.empty(y0.size), np.empty(y0.size)
     y_lo, y_hi = box[6], box[7]
     for n in range(y0.size):
-        e[n], state[n] = 0.0, _SOLVE
+        e[n], state[n] = 0.0, _SOLVE  # _SOLVE + k: reason k of FALLBACK_REASONS (0: outside the domain)
         if not (c1[n] > 0.0 and c2[n] > 0.0 and y_lo <= y0[n] <= y_hi):
             continue
         a, b = math.log(c1[n]), math.log(c2[n])
         cell, lo_a, hi_a, lo_b, hi_b = _find_cell(a, b, box, roots, children, leaf)
-        if cell < 0 or cell_state[cell] == _SOLVE:
+        if cell < 0:
+            continue
+        if cell_state[cell] == _SOLVE:
+            state[n] = _SOLVE + 1
             continue
         if cell_state[cell] == _CAPTURED:
             state[n] = _CAPTURED
             continue
-        _chebyshev_row((2.0 * a - lo_a - hi_a) / (hi_a - lo_a), na, ta)
-        _chebyshev_row((2.0 * b - lo_b - hi_b) / (hi_b - lo_b), na, tb)
-        log_yc = _tensor2(surface[cell], ta, tb)
-        ly = math.log(y0[n])
-        if ly <= log_yc + math.log1p(-guard[cell]):
-            state[n] = _CAPTURED
-            continue
-        if ly < log_yc + math.log1p(guard[cell]):
-            continue
-        width = math.log(y_hi) - log_yc
-        t = math.sqrt(min((ly - log_yc) / width, 1.0))
-        for p in range(piece_start[cell], piece_start[cell] + piece_count[cell]):
-            if piece_t[p, 0] <= t <= piece_t[p, 1]:
-                if piece_state[p] == _OK and piece_error[p] <= tol:
-                    _chebyshev_row((2.0 * t - piece_t[p, 0] - piece_t[p, 1]) / (piece_t[p, 1] - piece_t[p, 0]), nt, tt)
-                    e[n] = _tensor3(piece_coef[p], ta, tb, tt)
-                    state[n] = _OK
-                break
+        cell_of[n] = cell
+        xa[n], xb[n] = (2.0 * a - lo_a - hi_a) / (hi_a - lo_a), (2.0 * b - lo_b - hi_b) / (hi_b - lo_b)
+        ly[n] = math.log(y0[n])
+    return cell_of, xa, xb, ly
+
+
+@njit(cache=True)
+def _grouped(key, n_keys):
+    """(order, start): the indices with key k (>= 0) are order[start[k]:start[k + 1]] (a counting sort)."""
+    start = np.zeros(n_keys + 1, dtype=np.int64)
+    for k in key:
+        if k >= 0:
+            start[k + 1] += 1
+    start = np.cumsum(start)
+    fill = start[:-1].copy()
+    order = np.empty(start[-1], dtype=np.int64)
+    for n in range(key.size):
+        k = key[n]
+        if k >= 0:
+            order[fill[k]] = n
+            fill[k] += 1
+    return order, start
+
+
+@njit(cache=True)
+def _rows(x, idx, n):
+    """T_k(x[idx[q]]) for k < n as an (n, len(idx)) array (the three-term recurrence, across points)."""
+    out = np.empty((n, idx.size))
+    for q in range(idx.size):
+        out[0, q] = 1.0
+        if n > 1:
+            out[1, q] = x[idx[q]]
+    for k in range(2, n):
+        for q in range(idx.size):
+            out[k, q] = 2.0 * out[1, q] * out[k - 1, q] - out[k - 2, q]
+    return out
+
+
+@njit(cache=True)
+def _tensor2_at(c, ta, tb):
+    """sum_ij c_ij ta[i, q] tb[j, q] for each point q."""
+    m = ta.shape[1]
+    out, w = np.zeros(m), np.empty(m)
+    for j in range(c.shape[1]):
+        w[:] = 0.0
+        for i in range(c.shape[0]):
+            cij = c[i, j]
+            for q in range(m):
+                w[q] += cij * ta[i, q]
+        for q in range(m):
+            out[q] += w[q] * tb[j, q]
+    return out
+
+
+@njit(cache=True)
+def _tensor3_at(c, ta, tb, tt):
+    """sum_ijk c_ijk ta[i, q] tb[j, q] tt[k, q] for each point q."""
+    m = ta.shape[1]
+    out, u = np.zeros(m), np.empty(m)
+    for i in range(c.shape[0]):
+        for j in range(c.shape[1]):
+            u[:] = 0.0
+            for k in range(c.shape[2]):
+                cijk = c[i, j, k]
+                for q in range(m):
+                    u[q] += cijk * tt[k, q]
+            for q in range(m):
+                out[q] += u[q] * ta[i, q] * tb[j, q]
+    return out
 
 
 # --------------------------------------------------------------------------- the build
@@ -369,6 +480,7 @@ class _Builder:
         self.tol, self.domain = float(tol), dict(domain)
         self.y_range = tuple(float(y) for y in domain["incident_speed"])
         self.node_rtol = min(max(NODE_RTOL * self.tol, NODE_RTOL_FLOOR), NODE_RTOL_CEILING)
+        self.check_rtol = max(CHECK_RTOL_FACTOR * self.node_rtol, MIN_RTOL * 1.01)
         # the multisection finer than the surface tolerance, its solves' outcomes finer still
         self.capture_width = min(CAPTURE_WIDTH, 1e-2 * surface_tolerance(self.tol))
         self.capture_rtol = min(CAPTURE_RTOL, max(1e-3 * surface_tolerance(self.tol), MIN_RTOL * 1.01))
@@ -392,7 +504,7 @@ class _Builder:
         index = len(self.children)
         self.children.append([-1, -1, -1, -1])
         self.leaf.append(-1)
-        cell = self.cell(bounds)
+        cell = self.cell(bounds, last=depth >= MAX_DEPTH)
         if cell is None and depth < MAX_DEPTH:
             a0, a1, b0, b1 = bounds
             am, bm = 0.5 * (a0 + a1), 0.5 * (b0 + b1)
@@ -406,8 +518,10 @@ class _Builder:
         self.cells.append(cell)
         return index
 
-    def cell(self, bounds):
-        """The cell's table, or None where it must be split."""
+    def cell(self, bounds, last=False):
+        """The cell's table, or None where it must be split. A piece that misses the tolerance at the
+        (a, b) checks is left to the solver if it lies near capture (:data:`NEAR_CAPTURE_T`) or the
+        cell is ``last`` (at :data:`MAX_DEPTH`); any other such piece splits the cell."""
         a0, a1, b0, b1 = bounds
         x_s = _lobatto(DEGREE_SURFACE)
         found = [[self.capture_speed(a, b) for b in _map(x_s, b0, b1)] for a in _map(x_s, a0, a1)]
@@ -432,8 +546,12 @@ class _Builder:
         self._nodes = (_map(self.x_ab, a0, a1), _map(self.x_ab, b0, b1))
         log_yc = np.polynomial.chebyshev.chebgrid2d(self.x_ab, self.x_ab, surface)
         pieces = self.pieces(log_yc)
-        if not self.check_ab(pieces, surface, local, checks, guard):
+        failing = self.check_ab(pieces, surface, local, checks, guard)
+        if not last and any(pieces[p][1] > NEAR_CAPTURE_T for p in failing):
             return self.failed(bounds, "e_n between the (a, b) nodes")
+        for p in failing:
+            pieces[p] = (*pieces[p][:2], _SOLVE, math.inf, pieces[p][4])
+        self.max_check_error = max([self.max_check_error] + [p[3] / SAFETY for p in pieces if p[2] == _OK])
         return {"state": _OK, "guard": guard, "surface": surface, "pieces": pieces}
 
     def node_values(self, log_yc, edges):
@@ -487,14 +605,16 @@ class _Builder:
             if not t.size:
                 continue
             exact = _counted(self, math.exp(self.a_nodes[i]), math.exp(self.b_nodes[j]),
-                             np.exp(log_yc[i, j] + width * t * t), self.node_rtol)
+                             np.exp(log_yc[i, j] + width * t * t), self.check_rtol)
             got = np.polynomial.chebyshev.chebval3d(np.full(t.size, self.x_ab[i]), np.full(t.size, self.x_ab[j]), x, coef)
             err = max(err, float(np.max(np.abs(got - exact))))
         return err
 
     def check_ab(self, pieces, surface, local, checks, guard):
         """At the cell's check points, the table against solves at each piece's nodes (outside the
-        guard band): True if every accepted piece meets the tolerance (their estimates updated)."""
+        guard band): the indices of the accepted pieces that miss the tolerance (the others'
+        estimates updated)."""
+        failing = set()
         x_t = np.concatenate([self.x_t, np.cos(np.pi * (np.arange(DEGREE_T) + 0.5) / DEGREE_T)])
         for (x, y), (a, b) in zip(local, checks):
             log_yc = float(np.polynomial.chebyshev.chebval2d(x, y, surface))
@@ -506,14 +626,13 @@ class _Builder:
                 keep = width * t * t >= math.log1p(guard)
                 if not keep.any():
                     continue
-                exact = _counted(self, math.exp(a), math.exp(b), np.exp(log_yc + width * t[keep] ** 2), self.node_rtol)
+                exact = _counted(self, math.exp(a), math.exp(b), np.exp(log_yc + width * t[keep] ** 2), self.check_rtol)
                 got = np.polynomial.chebyshev.chebval3d(np.full(keep.sum(), x), np.full(keep.sum(), y), x_t[keep], coef)
                 err = SAFETY * float(np.max(np.abs(got - exact)))
                 if err > self.tol:
-                    return False
+                    failing.add(p)
                 pieces[p] = (t0, t1, state, max(error, err), coef)
-        self.max_check_error = max([self.max_check_error] + [p[3] / SAFETY for p in pieces if p[2] == _OK])
-        return True
+        return sorted(failing)
 
     @property
     def a_nodes(self):
@@ -613,7 +732,8 @@ def cache_dir() -> Path:
 
 _SOURCES = ("model/law.py", "model/contact.py", "model/reduction.py", "solvers/engine.py", "solvers/emulator.py")
 _SETTINGS = (DEGREE_SURFACE, DEGREE_AB, DEGREE_T, CELLS_PER_DECADE, MAX_DEPTH, CELL_CHECKS, T_CHECKS, T_CHECK_NODES, INITIAL_PIECES,
-             MIN_PIECE, SCAN, SECTIONS, CAPTURE_WIDTH, SAFETY, NODE_RTOL, NODE_RTOL_FLOOR, NODE_RTOL_CEILING, CAPTURE_RTOL, _LAYOUT)
+             MIN_PIECE, SCAN, SECTIONS, CAPTURE_WIDTH, SAFETY, NODE_RTOL, NODE_RTOL_FLOOR, NODE_RTOL_CEILING, CAPTURE_RTOL,
+             CHECK_RTOL_FACTOR, NEAR_CAPTURE_T, _LAYOUT)
 
 
 def _cache_path(tol, domain) -> Path:
@@ -745,9 +865,21 @@ def restitution(contacts, speeds, *, tol: float = DEFAULT_TOLERANCE, domain: dic
     if ring.size:  # the groups of all contacts and the table, each in one call
         y0, c1, c2 = reduction.ring_groups([rows[i] for i in ring], v[ring])
         e[ring], captured[ring], solve[ring] = table.evaluate(y0, c1, c2, tol)
-    rtol = max(float(tol) * 1e-2, NODE_RTOL_FLOOR)
     with engine_threads(1):
         for i in np.flatnonzero(solve.any(axis=1)):
-            e_i = normal_restitution(rows[i], v[i, solve[i]], rtol=rtol)
-            e[i, solve[i]], captured[i, solve[i]] = e_i, e_i == 0.0
+            e[i, solve[i]] = _fallback(rows[i], v[i, solve[i]], float(tol))
+    captured[solve] = e[solve] == 0.0
     return Restitution(e.reshape(shape), captured.reshape(shape), solve.reshape(shape), float(tol))
+
+
+def _fallback(contact, speeds, tol):
+    """e_n of one contact's impacts by the solver at ``FALLBACK_RTOL tol``, those that barely rebound
+    (e_n < NEAR_CAPTURE_E, where the solve's error ~1.2 rtol / e_n) again at ``tol e_n / 12``. [-]"""
+    rtol = max(tol * FALLBACK_RTOL, NODE_RTOL_FLOOR)
+    e = np.array(normal_restitution(contact, speeds, rtol=rtol), dtype=float)
+    near = (e > 0.0) & (e < NEAR_CAPTURE_E)
+    if near.any():
+        tight = max(tol * float(e[near].min()) / 12.0, MIN_RTOL * 1.01)
+        if tight < rtol:
+            e[near] = normal_restitution(contact, speeds[near], rtol=tight)
+    return e
