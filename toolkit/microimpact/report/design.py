@@ -79,7 +79,7 @@ def _rows_table(record: Mapping) -> pd.DataFrame:
     >>> rows = [{"id": f"design-00{k}", "radius": 1e-6, "speed": 2.0 if k < 3 else 4.0, "incidence_deg": 0.0,
     ...          "e_n_expected": 0.5, "reason": f"r{k}"} for k in (1, 2, 3)]
     >>> _rows_table({"rows": rows})[["id", "n", "reason"]].values.tolist()
-    [['design-001-002', '2', 'r1'], ['design-003', '1', 'r3']]
+    [['design-001..002', '2', 'r1'], ['design-003', '1', 'r3']]
     """
     rows = pd.DataFrame(list(record["rows"]))
     if rows.empty:
@@ -88,7 +88,7 @@ def _rows_table(record: Mapping) -> pd.DataFrame:
     run = (key != key.shift()).any(axis=1).cumsum()
     groups = [g for _, g in rows.groupby(run, sort=False)]
     first = pd.DataFrame([g.iloc[0] for g in groups])
-    ids = [g["id"].iloc[0] if len(g) == 1 else f"{g['id'].iloc[0]}-{str(g['id'].iloc[-1]).rsplit('-', 1)[-1]}"
+    ids = [g["id"].iloc[0] if len(g) == 1 else f"{g['id'].iloc[0]}..{str(g['id'].iloc[-1]).rsplit('-', 1)[-1]}"
            for g in groups]
     return pd.DataFrame({"id": ids, "n": [str(len(g)) for g in groups],
                          "d [um]": [f"{2e6 * r:.3g}" for r in first["radius"]],
