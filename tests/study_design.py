@@ -1,7 +1,8 @@
 """Study: do the recommended impacts narrow zeta_H more than the same number placed uniformly?
 
 Over random hidden truths (zeta_H log-uniform in [0.1, 2], zeta_A log-uniform in [10, 80], w_A and
-the material of Table 1, one radius), each with a random starting design of a few e_n impacts
+the material of Table 1), each with a random starting design of a few e_n impacts at the radius of
+Table 1
 (simulated with the toolkit's solver, Gaussian noise of SIGMA), the study fits the start, asks
 :func:`microimpact.analysis.design.design_impacts` for N impacts, simulates them and the N of
 :func:`~microimpact.analysis.design.uniform_design`, refits both and records the 95 % profile
@@ -15,12 +16,18 @@ of three oblique impacts at 10-30 deg (e_t measured, sigma SIGMA_T), which end r
 and leave f not determined. With the damping refitted after the recommended impacts,
 :func:`~microimpact.analysis.design.design_friction` recommends N_FRICTION oblique impacts; the
 study simulates them (the solver's closed-form tangential map at the truth) and the same number
-spread uniformly over the same angles and speeds, refits f with
+spread uniformly over the same angles, speeds and sizes, refits f with
 :func:`~microimpact.analysis.oblique.fit_friction` and records its status and coverage. The
 friction draws use their own random stream, so the damping rows do not depend on them.
 
+Size classes: ``--radii`` gives the sizes the laboratory can measure (default: Table 1's one). With
+several, the candidates and the uniform designs (sizes cycled) span them all, while the start stays
+at Table 1's radius; the multi-size case of docs/design-study-sizes.json uses 1.29, 3.45 and 6.9 um.
+
     python tests/study_design.py --truths 50 --n 6 --seed 54 --out docs/design-study.json
     python tests/study_design.py --replot docs/design-study.json --figure docs/design-study.png
+    python tests/study_design.py --truths 50 --n 6 --seed 54 --radii 1.29e-6,3.45e-6,6.9e-6 --out docs/design-study-sizes.json
+    python tests/study_design.py --replot docs/design-study-sizes.json --figure docs/design-study-sizes.png
 """
 
 from __future__ import annotations
@@ -46,32 +53,41 @@ PAIR = "ammonium_fluorescein_on_silicon"
 SIGMA_T = 0.02  # [-] e_t standard uncertainty
 N_FRICTION = 6  # new oblique impacts per friction design
 START_ANGLES = (10.0, 20.0, 30.0)  # [deg] the oblique start: rolling for most f, f not determined
-#: the oblique space: the design's default angles (20-85 deg), 2-20 m/s
-FRICTION_SPACE = DesignSpace(radii=(RADIUS,), speed_range=(2.0, 20.0), incidence_deg=OBLIQUE_ANGLES_DEG,
-                             e_t_sigma=SIGMA_T, n_speeds=10)
 
 
-def _simulate(material, truth, speeds, rng):
-    e = model_restitution(FitProblem.from_arrays(np.full(len(speeds), RADIUS), speeds, material),
+def friction_space(radii) -> DesignSpace:
+    """The oblique space: the design's default angles (20-85 deg), 2-20 m/s, the study's sizes."""
+    return DesignSpace(radii=tuple(radii), speed_range=(2.0, 20.0), incidence_deg=OBLIQUE_ANGLES_DEG,
+                       e_t_sigma=SIGMA_T, n_speeds=10)
+
+
+def _simulate(material, truth, radii, speeds, rng):
+    e = model_restitution(FitProblem.from_arrays(radii, speeds, material),
                           truth["zeta_hertz"], truth["zeta_adhesion"], truth["work_of_adhesion"])
     return np.clip(e + rng.normal(0.0, SIGMA, e.size), 0.0, 1.0)
 
 
-def _fit(material, speeds, e_n):
-    table = pd.DataFrame({"radius": RADIUS, "normal_speed": speeds, "e_n": e_n, "e_n_uncertainty": SIGMA})
+def _fit(material, radii, speeds, e_n):
+    table = pd.DataFrame({"radius": radii, "normal_speed": speeds, "e_n": e_n, "e_n_uncertainty": SIGMA})
     return fit_damping(table, material, confidence_intervals=False)
 
 
 def _oblique_table(material, truth, friction, rows, rng):
     """Oblique impacts (radius, speed, incidence_deg) with e_n and e_t of the truth plus noise."""
+    radius = rows["radius"].to_numpy(float) if "radius" in rows.columns else np.full(len(rows), RADIUS)
     speed, angle = rows["speed"].to_numpy(float), rows["incidence_deg"].to_numpy(float)
-    c = material.contact(RADIUS).with_(zeta_hertz=truth["zeta_hertz"], zeta_adhesion=truth["zeta_adhesion"],
-                                       friction=friction)
-    out = rebound_state(c, speed, angle, np.zeros(speed.size))
+    vt = np.empty(speed.size)
+    e_n = np.empty(speed.size)
+    for r in np.unique(radius):
+        i = radius == r
+        c = material.contact(float(r)).with_(zeta_hertz=truth["zeta_hertz"], zeta_adhesion=truth["zeta_adhesion"],
+                                             friction=friction)
+        out = rebound_state(c, speed[i], angle[i], np.zeros(int(i.sum())))
+        vt[i] = out["velocity_out_t"]
+        e_n[i] = np.where(out["captured"], 0.0, out["velocity_out_n"] / (speed[i] * np.cos(np.radians(angle[i]))))
     vt_in = speed * np.sin(np.radians(angle))
-    e_n = np.where(out["captured"], 0.0, out["velocity_out_n"] / (speed * np.cos(np.radians(angle))))
-    return pd.DataFrame({"radius": RADIUS, "speed": speed, "incidence_deg": angle, "e_n": e_n,
-                         "tangential_restitution": out["velocity_out_t"] / vt_in + rng.normal(0.0, SIGMA_T, speed.size),
+    return pd.DataFrame({"radius": radius, "speed": speed, "incidence_deg": angle, "e_n": e_n,
+                         "tangential_restitution": vt / vt_in + rng.normal(0.0, SIGMA_T, speed.size),
                          "tangential_restitution_uncertainty": SIGMA_T})
 
 
@@ -93,7 +109,7 @@ def friction_truth(material, truth, damping, space, rng) -> dict:
     row["refit_start"] = _friction_status(material, truth, friction, [start], damping)
     design = design_friction(damping, space, N_FRICTION, existing=start.assign(radius=RADIUS))
     noise_seed = int(rng.integers(2**31))
-    row["design_rows"] = design.rows[["speed", "incidence_deg"]].to_dict("records")
+    row["design_rows"] = design.rows[["radius", "speed", "incidence_deg"]].to_dict("records")
     for name, rows in (("design", design.rows), ("uniform", uniform_oblique_design(space, N_FRICTION))):
         new = _oblique_table(material, truth, friction, rows, np.random.default_rng(noise_seed))
         row[f"refit_{name}"] = _friction_status(material, truth, friction, [start, new[new["e_n"] > 0]], damping)
@@ -106,24 +122,26 @@ def one_truth(material, space, n, rng, friction_rng=None) -> dict:
              "zeta_adhesion": float(np.exp(rng.uniform(np.log(10.0), np.log(80.0)))),
              "work_of_adhesion": float(material.work_of_adhesion)}
     start_v = np.sort(np.exp(rng.uniform(np.log(1.0), np.log(10.0), 4)))
-    start_e = _simulate(material, truth, start_v, rng)
-    start = _fit(material, start_v, start_e)
+    start_r = np.full(start_v.size, RADIUS)
+    start_e = _simulate(material, truth, start_r, start_v, rng)
+    start = _fit(material, start_r, start_v, start_e)
     design = design_impacts(start, space, n, parameters=("zeta_hertz",))
     row = {"truth": truth, "start_speeds": start_v.tolist(), "start_status": start.identifiability["zeta_hertz"].status,
            "fisher_design": design.width("zeta_hertz"), "fisher_uniform": design.width("zeta_hertz", which="uniform"),
-           "design_speeds": design.rows["speed"].tolist()}
+           "design_speeds": design.rows["speed"].tolist(), "design_radii": design.rows["radius"].tolist()}
     noise_seed = int(rng.integers(2**31))
     fits = {}
-    for name, speeds in (("design", design.rows["normal_speed"].to_numpy()),
-                         ("uniform", uniform_design(space, n)["normal_speed"].to_numpy())):
-        e = _simulate(material, truth, speeds, np.random.default_rng(noise_seed))  # same noise draws for both
-        refit = _fit(material, np.concatenate([start_v, speeds]), np.concatenate([start_e, e]))
+    for name, rows in (("design", design.rows), ("uniform", uniform_design(space, n))):
+        radii, speeds = rows["radius"].to_numpy(float), rows["normal_speed"].to_numpy(float)
+        e = _simulate(material, truth, radii, speeds, np.random.default_rng(noise_seed))  # same noise draws for both
+        refit = _fit(material, np.concatenate([start_r, radii]), np.concatenate([start_v, speeds]),
+                     np.concatenate([start_e, e]))
         st = refit.identifiability["zeta_hertz"]
         row[f"refit_{name}"] = {"status": st.status, "lower": st.lower, "upper": st.upper, "width": st.upper - st.lower,
                                 "covers": bool(st.lower <= truth["zeta_hertz"] <= st.upper)}
         fits[name] = refit
     if friction_rng is not None:
-        row["friction"] = friction_truth(material, truth, fits["design"], FRICTION_SPACE, friction_rng)
+        row["friction"] = friction_truth(material, truth, fits["design"], friction_space(space.radii), friction_rng)
     return row
 
 
@@ -190,7 +208,9 @@ def draw_figure(result: dict, path) -> None:
     ax.plot(lim, np.array(lim) / 1.5, "k--", lw=0.7, label="1.5x narrower")
     ax.set_xlabel("95 % width of zeta_H, uniform [-]")
     ax.set_ylabel("95 % width of zeta_H, recommended [-]")
-    ax.set_title(f"median ratio {result['summary']['median_refit_width_ratio']:.2f} ({len(rows)} truths)", fontsize=9)
+    sizes = ", ".join(f"{2e6 * r:.3g}" for r in result["setup"].get("radii", [result["setup"]["radius"]]))
+    ax.set_title(f"median ratio {result['summary']['median_refit_width_ratio']:.2f} ({len(rows)} truths; "
+                 f"d = {sizes} um)", fontsize=9)
     ax.legend(fontsize=7, frameon=False)
     ticks = [t for t in (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0) if lim[0] <= t <= lim[1]]
     for axis in (ax.xaxis, ax.yaxis):  # plain labels at 1-2-5, no crowded minor ones
@@ -217,6 +237,7 @@ def main(argv=None) -> int:
     p.add_argument("--truths", type=int, default=50)
     p.add_argument("--n", type=int, default=6, help="new impacts per design")
     p.add_argument("--seed", type=int, default=54)
+    p.add_argument("--radii", default=str(RADIUS), help="comma-separated size classes [m] (default Table 1's)")
     p.add_argument("--out", default=None, help="JSON file (default: print)")
     p.add_argument("--figure", default=None, help="PNG of the widths and the friction statuses")
     p.add_argument("--replot", default=None, metavar="JSON", help="draw --figure from a study's JSON, run nothing")
@@ -226,7 +247,8 @@ def main(argv=None) -> int:
             draw_figure(json.load(f), args.figure or "design-study.png")
         return 0
     material = read_materials(default_materials_path())[PAIR]
-    space = DesignSpace(radii=(RADIUS,), speed_range=(0.5, 20.0), e_n_sigma=SIGMA, n_speeds=25)
+    radii = tuple(float(r) for r in args.radii.split(","))
+    space = DesignSpace(radii=radii, speed_range=(0.5, 20.0), e_n_sigma=SIGMA, n_speeds=25)
     rng = np.random.default_rng(args.seed)
     rows = []
     for k in range(args.truths):
@@ -238,13 +260,13 @@ def main(argv=None) -> int:
               f"{r['friction']['refit_design']['status']}, uniform {r['friction']['refit_uniform']['status']}",
               file=sys.stderr)
     result = {"command": "python tests/study_design.py " + " ".join(argv if argv is not None else sys.argv[1:]),
-              "setup": {"radius": RADIUS, "e_n_sigma": SIGMA, "speed_range": list(space.speed_range),
+              "setup": {"radius": RADIUS, "radii": list(radii), "e_n_sigma": SIGMA, "speed_range": list(space.speed_range),
                         "n_speeds": space.n_speeds, "speed_sigma": space.speed_sigma, "n_new": args.n, "seed": args.seed,
                         "criterion": "A-optimal on zeta_H by the linearised Fisher information",
                         "friction": {"range": list(FRICTION_RANGE), "e_t_sigma": SIGMA_T, "n_new": N_FRICTION,
                                      "start_angles_deg": list(START_ANGLES),
-                                     "angles_deg": list(FRICTION_SPACE.incidence_deg),
-                                     "speed_range": list(FRICTION_SPACE.speed_range),
+                                     "angles_deg": list(OBLIQUE_ANGLES_DEG),
+                                     "speed_range": list(friction_space(radii).speed_range),
                                      "criterion": "Bayesian A on ln f over the range (log-uniform)"},
                         "material_pair": PAIR},
               "summary": summary(rows), "rows": rows}

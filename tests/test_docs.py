@@ -89,6 +89,8 @@ HOW = {
     "microimpact design fit.nc --n 20 --speeds 0.5:20 --out design.csv": "run",
     "python tests/study_design.py --truths 50 --n 6 --seed 54 --out docs/design-study.json": "study",
     "python tests/study_design.py --replot docs/design-study.json --figure docs/design-study.png": "study",
+    "python tests/study_design.py --truths 50 --n 6 --seed 54 --radii 1.29e-6,3.45e-6,6.9e-6 --out docs/design-study-sizes.json": "study",
+    "python tests/study_design.py --replot docs/design-study-sizes.json --figure docs/design-study-sizes.png": "study",
     # docs/calibration.md: the calibration study (tens of minutes; tests/test_calibration.py runs a quick form)
     "python tests/study_calibration.py --designs 300 --posterior-designs 12 --workers 2 --seed 1000 --out docs/calibration.json --figure docs/calibration.png": "study",
     "python tests/study_calibration.py": "study",

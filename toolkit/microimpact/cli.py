@@ -33,6 +33,9 @@ from microimpact._runtime.locks import remove_stale_lock, snakemake_processes_in
 from microimpact._runtime.supervise import run_supervised
 from microimpact._runtime.signals import EXIT_INTERRUPTED, INTERRUPTED_LINE, interrupted_after_writing
 from microimpact._runtime.usage import exit_status
+from microimpact.analysis.design_defaults import (DEFAULT_E_T_SIGMA, DEFAULT_NEW_IMPACTS, DEFAULT_NEW_OBLIQUE,
+                                                  DEFAULT_OBLIQUE_QUANTITY, DEFAULT_PARAMETERS, DEFAULT_REBOUND_ANGLE_SIGMA,
+                                                  DEFAULT_REBOUND_SPIN_SIGMA, OBLIQUE_QUANTITIES)
 from microimpact.analysis.sampling_defaults import (DEFAULT_LOSS, DEFAULT_MAX_STEPS, DEFAULT_NU, DEFAULT_SEED,
                                                     DEFAULT_WALKERS, LIKELIHOODS, LOSSES, MAX_SEED)
 from microimpact.io.files import recorded_outputs
@@ -60,8 +63,10 @@ EXIT_BROKEN_PIPE = 141
 #: a negative number as an option's value: ``--radius -1e-6``, ``--omega-n -.5``, ``--speed -inf``.
 #: argparse's own pattern (``^-\d+$|^-\d*\.\d+$``) misses exponents and inf/nan, so that
 #: ``--radius -1e-6`` was read as an unknown option ("expected one argument"); no option of this
-#: command line starts with a digit, so every such word is a value.
-NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+#: command line starts with a digit, so every such word is a value; so is a list that starts with a
+#: negative number (``--speeds -1:2``, ``--radii -1e-6,2e-6``), which the option then refuses by name.
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?([,:][-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)*$"
+                             r"|^-(inf|infinity|nan)$", re.IGNORECASE)
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -393,18 +398,27 @@ def register_design(sub) -> None:
     p = sub.add_parser("design", help="the next impacts to measure to narrow the fitted damping (Fisher information); "
                                       "a measured-impact CSV template")
     p.add_argument("fit", help="fit NetCDF written by 'microimpact fit --out'")
-    p.add_argument("--n", type=lambda t: _whole_number(t, 1), default=20, help="number of new impacts (default 20)")
-    p.add_argument("--parameters", default="zeta_hertz",
+    p.add_argument("--n", type=lambda t: _whole_number(t, 1), default=DEFAULT_NEW_IMPACTS,
+                   help=f"number of new impacts (default {DEFAULT_NEW_IMPACTS})")
+    p.add_argument("--parameters", default=",".join(DEFAULT_PARAMETERS),
                    help="comma-separated parameters to narrow: zeta_hertz, zeta_adhesion, work_of_adhesion, friction "
-                        "(oblique impacts whose tangential restitution determines f); default zeta_hertz")
+                        f"(oblique impacts whose --measure determines f); default {','.join(DEFAULT_PARAMETERS)}")
     p.add_argument("--posterior", default=None, metavar="POST.nc",
                    help="the fit's posterior ('microimpact fit --posterior'): its covariance replaces the fit's "
                         "linearised information")
-    p.add_argument("--n-friction", type=lambda t: _whole_number(t, 1), default=6,
-                   help="number of new oblique impacts for friction (default 6)")
-    p.add_argument("--e-t-sigma", type=_positive_float, default=0.02,
-                   help="standard uncertainty of a new tangential restitution (default 0.02)")
-    p.add_argument("--speeds", default=None, metavar="MIN:MAX", help="incident speeds that can be set [m/s] (default: the fit's range)")
+    p.add_argument("--n-friction", type=lambda t: _whole_number(t, 1), default=DEFAULT_NEW_OBLIQUE,
+                   help=f"number of new oblique impacts for friction (default {DEFAULT_NEW_OBLIQUE})")
+    p.add_argument("--measure", choices=tuple(OBLIQUE_QUANTITIES), default=DEFAULT_OBLIQUE_QUANTITY,
+                   help="what is measured of an oblique impact besides e_n (default "
+                        f"{DEFAULT_OBLIQUE_QUANTITY}; none: e_n only)")
+    p.add_argument("--e-t-sigma", type=_positive_float, default=None,
+                   help=f"standard uncertainty of a new tangential restitution (default {DEFAULT_E_T_SIGMA})")
+    p.add_argument("--rebound-angle-sigma", type=_positive_float, default=None,
+                   help=f"standard uncertainty of a new rebound angle [deg] (default {DEFAULT_REBOUND_ANGLE_SIGMA})")
+    p.add_argument("--rebound-spin-sigma", type=_positive_float, default=None,
+                   help=f"standard uncertainty of a new rebound spin [rad/s] (default {DEFAULT_REBOUND_SPIN_SIGMA:g})")
+    p.add_argument("--speeds", default=None, metavar="MIN:MAX",
+                   help="incident speeds that can be set [m/s], MIN:MAX or MIN,MAX (default: the fit's range)")
     p.add_argument("--radii", default=None, help="comma-separated sphere radii [m] (default: the fit's)")
     p.add_argument("--angles", default="0", help="comma-separated incidence angles [deg] (default 0; for friction the "
                                                  "nonzero ones, else 20-85 deg)")

@@ -274,15 +274,21 @@ def analyst_report_inputs(wildcards):
     return inputs
 
 
-# the optional design step of workflow/rules/design.smk, off unless config design: {enabled: true}
+# the optional design step of workflow/rules/design.smk, off unless config design: {enabled: true}; a
+# number or list not given is None: the library's one default (microimpact.analysis.design_defaults)
 DESIGN = {
     "enabled": False,
-    "n": 20,
-    "parameters": ["zeta_hertz"],
-    "n_friction": 6,
+    "n": None,
+    "parameters": None,
+    "n_friction": None,
     **config.get("design", {}),
 }
 DESIGN_ENABLED = as_bool(DESIGN["enabled"])
+DESIGN_OPTIONS = {
+    "n": None if DESIGN["n"] is None else int(DESIGN["n"]),
+    "parameters": None if DESIGN["parameters"] is None else list(DESIGN["parameters"]),
+    "n_friction": None if DESIGN["n_friction"] is None else int(DESIGN["n_friction"]),
+}
 
 
 def design_report_inputs(wildcards):

@@ -17,9 +17,7 @@ rule design:
         "../envs/microimpact.yaml"
     threads: 1
     params:
-        n=int(DESIGN["n"]),
-        parameters=list(DESIGN["parameters"]),
-        n_friction=int(DESIGN["n_friction"]),
+        options=DESIGN_OPTIONS,
         rtol=RTOL,
     script:
         "../scripts/design.py"

@@ -18,10 +18,10 @@ from microimpact.io.files import atomic_write, write_csv  # noqa: E402
 
 fit = DampingFit.load(snakemake.input.fit)  # noqa: F821
 space = fit_design_space(fit)
-design = design_next_impacts(fit, space, snakemake.params.n, tuple(snakemake.params.parameters),  # noqa: F821
-                             n_friction=snakemake.params.n_friction, rtol=snakemake.params.rtol)  # noqa: F821
-write_csv(design_template(design, space.e_n_sigma, space.e_t_sigma), snakemake.output.csv,  # noqa: F821
-          float_format="%.6g")
+# only what the config gives: the rest is the library's default (microimpact.analysis.design_defaults)
+given = {k: (tuple(v) if k == "parameters" else v) for k, v in snakemake.params.options.items() if v is not None}  # noqa: F821
+design = design_next_impacts(fit, space, rtol=snakemake.params.rtol, **given)  # noqa: F821
+write_csv(design_template(design, space), snakemake.output.csv, float_format="%.6g")  # noqa: F821
 with atomic_write(snakemake.output.json) as f:  # noqa: F821
     json.dump(design_record(design, space, source=str(snakemake.input.fit)), f, indent=1)  # noqa: F821
 print(design.summary())

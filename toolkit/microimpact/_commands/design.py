@@ -21,27 +21,36 @@ _NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
 
 def _numbers(option: str, text: str, sep: str = ",") -> list:
-    parts = [t.strip() for t in str(text).split(sep)]
+    parts = [t.strip() for t in re.split(f"[{re.escape(sep)}]", str(text))]
     if not parts or not all(_NUMBER.fullmatch(t) for t in parts):
-        raise UsageError(f"{option} {text!r}: give numbers separated by {sep!r}")
+        raise UsageError(f"{option} {text!r}: give numbers separated by {' or '.join(repr(c) for c in sep)}")
     return [float(t) for t in parts]
+
+
+def _ranges(args) -> dict:
+    """The speed range, radii and angles given on the command line, checked before any file is read."""
+    given = {}
+    if args.speeds is not None:
+        speeds = _numbers("--speeds", args.speeds, ":,")
+        if len(speeds) != 2 or not 0 < speeds[0] < speeds[1]:
+            raise UsageError(f"--speeds {args.speeds!r}: give MIN:MAX incident speeds [m/s], 0 < MIN < MAX")
+        given["speed_range"] = tuple(speeds)
+    if args.radii is not None:
+        given["radii"] = tuple(_numbers("--radii", args.radii))
+        if not all(0 < r < 1e-2 for r in given["radii"]):
+            raise UsageError(f"--radii {args.radii!r}: give sphere radii in metres, each in (0, 0.01)")
+    given["incidence_deg"] = tuple(_numbers("--angles", args.angles))
+    if not all(0 <= a < 90 for a in given["incidence_deg"]):
+        raise UsageError(f"--angles {args.angles!r}: incidence angles from the normal lie in [0, 90) deg")
+    return given
 
 
 def _space(args, fit) -> DesignSpace:
     """The design space from the options, the fit's radii, speed range and e_n uncertainty by default."""
-    if args.speeds is None:
-        lo, hi = fit.speed_range
-    else:
-        speeds = _numbers("--speeds", args.speeds, ":")
-        if len(speeds) != 2 or not 0 < speeds[0] < speeds[1]:
-            raise UsageError(f"--speeds {args.speeds!r}: give MIN:MAX incident speeds [m/s], 0 < MIN < MAX")
-        lo, hi = speeds
-    radii = tuple(float(r) for r in fit.radii) if args.radii is None else tuple(_numbers("--radii", args.radii))
-    if not all(0 < r < 1e-2 for r in radii):
-        raise UsageError(f"--radii {args.radii!r}: give sphere radii in metres, each in (0, 0.01)")
-    angles = tuple(_numbers("--angles", args.angles))
-    if not all(0 <= a < 90 for a in angles):
-        raise UsageError(f"--angles {args.angles!r}: incidence angles from the normal lie in [0, 90) deg")
+    given = _ranges(args)
+    lo, hi = given.get("speed_range", fit.speed_range)
+    radii = given.get("radii", tuple(float(r) for r in fit.radii))
+    angles = given["incidence_deg"]
     sigma = args.e_n_sigma
     if sigma is None:
         s = fit.data["sigma"].to_numpy(float) if "sigma" in fit.data.columns else np.array([np.nan])
@@ -49,14 +58,16 @@ def _space(args, fit) -> DesignSpace:
     if not (math.isfinite(sigma) and 0 < sigma < 1):
         raise UsageError(f"--e-n-sigma {sigma!r}: a standard uncertainty of e_n in (0, 1)")
     try:
-        given = {} if args.speed_sigma is None else {"speed_sigma": args.speed_sigma}
+        optional = {k: getattr(args, k) for k in ("speed_sigma", "e_t_sigma", "rebound_angle_sigma",
+                                                  "rebound_spin_sigma") if getattr(args, k) is not None}
         return DesignSpace(radii=radii, speed_range=(lo, hi), incidence_deg=angles, e_n_sigma=sigma,
-                           n_speeds=args.n_speeds, e_t_sigma=args.e_t_sigma, **given)
+                           n_speeds=args.n_speeds, oblique_quantity=args.measure, **optional)
     except ValueError as exc:
         raise UsageError(str(exc)) from None
 
 
 def run(args) -> int:
+    _ranges(args)  # a bad range is named before any file is read
     fit_path = check_input_file("fit file", args.fit)
     inputs = {"fit file": fit_path}
     if args.posterior is not None:
@@ -75,6 +86,9 @@ def run(args) -> int:
         raise UsageError(f"--criterion {args.criterion!r}: one of {', '.join(DESIGN_CRITERIA)}")
     if args.n_friction > MAX_NEW_IMPACTS:
         raise UsageError(f"--n-friction {args.n_friction}: at most {MAX_NEW_IMPACTS}")
+    if args.measure == "none" and "friction" in parameters:
+        raise UsageError("--parameters friction with --measure none: e_n alone does not determine friction; measure "
+                         "tangential_restitution, rebound_angle or rebound_spin")
     fit = DampingFit.load(fit_path)
     space = _space(args, fit)
     post = None
@@ -91,7 +105,7 @@ def run(args) -> int:
                          + design.widths.to_string(index=False))
     if out is not None:
         with reporting_os_errors({"--out": out}):
-            write_csv(design_template(design, space.e_n_sigma, space.e_t_sigma), out, float_format="%.6g")
+            write_csv(design_template(design, space), out, float_format="%.6g")
         print(f"wrote {out}", file=sys.stderr)
     return 0
 

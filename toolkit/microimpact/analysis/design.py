@@ -49,15 +49,18 @@ References
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
 from scipy import stats
 
+from microimpact.analysis.design_defaults import (DEFAULT_E_T_SIGMA, DEFAULT_NEW_IMPACTS, DEFAULT_NEW_OBLIQUE,
+                                                  DEFAULT_OBLIQUE_QUANTITY, DEFAULT_PARAMETERS, DEFAULT_REBOUND_ANGLE_SIGMA,
+                                                  DEFAULT_REBOUND_SPIN_SIGMA, OBLIQUE_QUANTITIES)
 from microimpact.analysis.fit_result import PARAMETER_NAMES
 from microimpact.analysis.fitting import FitProblem, model_restitution
-from microimpact.analysis.oblique import normal_impulses, rebound_from_impulses
+from microimpact.analysis.oblique import _observables, normal_impulses, rebound_from_impulses
 from microimpact.io.materials import material_contact
 from microimpact.io.statuses import DEFAULT_LEVEL
 from microimpact.solvers import DEFAULT_RTOL
@@ -80,8 +83,9 @@ MAX_CANDIDATE_SPEEDS = 2000
 #: prior standard deviation, relative to the estimate, of a parameter the data leave free: a weak
 #: regulariser that keeps the information matrix invertible (its widths then say "not determined")
 WEAK_PRIOR_RELATIVE_SD = 10.0
-#: columns of the CSV template (the measured-impact format, data/README.md); e_n and its
-#: uncertainty are left empty for the laboratory to fill in
+#: columns of the CSV template (the measured-impact format, data/README.md) with the tangential
+#: restitution as the oblique quantity; e_n, the oblique quantity and e_n's uncertainty are left
+#: empty or stated for the laboratory to fill in (:func:`design_template`)
 TEMPLATE_COLUMNS = ("id", "radius [um]", "speed [m/s]", "incidence_angle [deg]", "e_n [1]", "e_n_uncertainty [1]",
                     "tangential_restitution [1]", "tangential_restitution_uncertainty [1]", "reason")
 #: Coulomb coefficients a friction design must determine when nothing else is known: the prior range
@@ -118,6 +122,16 @@ class DesignSpace:
     e_t_sigma : float
         Standard uncertainty of a measured tangential restitution e_t = v_t,out / v_t,in (the
         friction design). [-]
+    oblique_quantity : str
+        What is measured of an oblique impact besides e_n, a key of
+        :data:`~microimpact.analysis.design_defaults.OBLIQUE_QUANTITIES`:
+        ``tangential_restitution`` (uncertainty ``e_t_sigma``), ``rebound_angle`` (from the normal,
+        ``rebound_angle_sigma``), ``rebound_spin`` (|omega| after the impact, ``rebound_spin_sigma``)
+        or ``none`` (e_n only: friction cannot be designed for).
+    rebound_angle_sigma : float
+        Standard uncertainty of a measured rebound angle. [deg]
+    rebound_spin_sigma : float
+        Standard uncertainty of a measured rebound spin. [rad/s]
 
     Examples
     --------
@@ -131,7 +145,10 @@ class DesignSpace:
     e_n_sigma: float = 0.02
     speed_sigma: float = 0.01
     n_speeds: int = 60
-    e_t_sigma: float = 0.02
+    e_t_sigma: float = DEFAULT_E_T_SIGMA
+    oblique_quantity: str = DEFAULT_OBLIQUE_QUANTITY
+    rebound_angle_sigma: float = DEFAULT_REBOUND_ANGLE_SIGMA
+    rebound_spin_sigma: float = DEFAULT_REBOUND_SPIN_SIGMA
 
     def __post_init__(self):
         lo, hi = (float(x) for x in self.speed_range)
@@ -149,6 +166,21 @@ class DesignSpace:
             raise ValueError(f"e_t_sigma must be a finite standard uncertainty > 0, got {self.e_t_sigma!r}")
         if not 2 <= int(self.n_speeds) <= MAX_CANDIDATE_SPEEDS:
             raise ValueError(f"n_speeds must be in [2, {MAX_CANDIDATE_SPEEDS}], got {self.n_speeds!r}")
+        if self.oblique_quantity not in OBLIQUE_QUANTITIES:
+            raise ValueError(f"oblique_quantity must be one of {', '.join(OBLIQUE_QUANTITIES)}, got "
+                             f"{self.oblique_quantity!r}")
+        for name in ("rebound_angle_sigma", "rebound_spin_sigma"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a finite standard uncertainty > 0, got {value!r}")
+
+    @property
+    def oblique_sigma(self) -> float:
+        """Standard uncertainty of the measured oblique quantity, in its unit
+        (:data:`~microimpact.analysis.design_defaults.OBLIQUE_QUANTITIES`);
+        NaN for ``none``."""
+        return {"tangential_restitution": self.e_t_sigma, "rebound_angle": self.rebound_angle_sigma,
+                "rebound_spin": self.rebound_spin_sigma}.get(self.oblique_quantity, math.nan)
 
     def candidates(self) -> pd.DataFrame:
         """The candidate grid: radius [m], speed [m/s], incidence_deg [deg], normal_speed [m/s]."""
@@ -406,9 +438,9 @@ def _prior_information(varied, prior, values, z):
     return np.diag(1.0 / np.square(sd))
 
 
-def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, parameters=("zeta_hertz",),
-                   prior: dict | None = None, material=None, criterion: str = "A", rtol: float = DEFAULT_RTOL,
-                   friction_range: tuple = (0.05, 1.0), posterior=None) -> ExperimentDesign:
+def design_impacts(fit=None, space: DesignSpace | None = None, n: int = DEFAULT_NEW_IMPACTS, *,
+                   parameters=DEFAULT_PARAMETERS, prior: dict | None = None, material=None, criterion: str = "A",
+                   rtol: float = DEFAULT_RTOL, friction_range: tuple = FRICTION_RANGE, posterior=None) -> ExperimentDesign:
     """The next ``n`` impacts that most reduce the expected 95 % intervals of ``parameters``.
 
     Parameters
@@ -480,7 +512,9 @@ def design_impacts(fit=None, space: DesignSpace | None = None, n: int = 20, *, p
     sigma = np.sqrt(space.e_n_sigma ** 2 + (slope * space.speed_sigma * cand["normal_speed"].to_numpy()) ** 2)
     notes = _notes(fit, damping, varied, g, sigma, cand, space)
     if "friction" in wanted:
-        notes["friction"] = _friction_note(base, values, cand, friction_range, rtol)
+        notes["friction"] = _friction_note(base, values, cand, friction_range, rtol) + (
+            "; this design space measures e_n only, so no impact of it determines friction" if
+            space.oblique_quantity == "none" else "")
     if not damping:
         empty = pd.DataFrame(columns=["n_new", "parameter", "design", "uniform"])
         return ExperimentDesign(_rows(cand.iloc[[]], e[:0], []), empty, wanted, values, _CRITERION_TEXT[criterion], notes)
@@ -521,7 +555,8 @@ def _greedy(info0, gw, named, admissible, n, kind, cand, e, varied, values):
         info = info + np.outer(gw[best], gw[best])
         after = fisher_widths(info, values, varied)
         lead = max(named, key=lambda j: abs(gw[best, j]))
-        reasons.append(f"v_n = {cand['normal_speed'].iloc[best]:.3g} m/s, e_n ~ {e[best]:.3f}: "
+        size = f"d = {2e6 * cand['radius'].iloc[best]:.3g} um, " if cand["radius"].nunique() > 1 else ""
+        reasons.append(f"{size}v_n = {cand['normal_speed'].iloc[best]:.3g} m/s, e_n ~ {e[best]:.3f}: "
                        + ", ".join(f"{varied[j]} width {before[varied[j]]:.3g} -> {after[varied[j]]:.3g}" for j in named)
                        + f"; e_n moves {abs(gw[best, lead]):.2g} sigma per 100 % of {varied[lead]}")
         chosen.append(best)
@@ -596,40 +631,51 @@ def _friction_note(base, values, cand, friction_range, rtol):
                    f"slippery of them slides for f up to {min(float(fstar[slides].max()), friction_range[1]):.2g}")
 
 
-def design_template(design: ExperimentDesign, e_n_sigma: float, e_t_sigma: float | None = None) -> pd.DataFrame:
-    """The recommended rows as a measured-impact CSV table (:data:`TEMPLATE_COLUMNS`), e_n left empty.
+def design_template(design: ExperimentDesign, space: DesignSpace) -> pd.DataFrame:
+    """The recommended rows as a measured-impact CSV table, e_n and the oblique quantity left empty.
 
-    The oblique rows (incidence > 0) also leave ``tangential_restitution`` empty and state
-    ``e_t_sigma`` [-] as its uncertainty (empty at normal incidence, or when ``e_t_sigma`` is None);
-    ``e_n_sigma`` [-] is the uncertainty of every row's e_n.
+    Columns: :data:`TEMPLATE_COLUMNS`, with the oblique pair named after the space's
+    ``oblique_quantity`` (``rebound_angle [deg]``, ``rebound_spin [rad/s]``; none for ``none``).
+    The oblique rows (incidence > 0) state :attr:`DesignSpace.oblique_sigma` as the oblique
+    quantity's uncertainty (empty at normal incidence); ``e_n_sigma`` [-] is the uncertainty of
+    every row's e_n.
 
     Examples
     --------
     >>> rows = pd.DataFrame({"id": ["design-001"], "radius": [3.45e-6], "speed": [2.0], "incidence_deg": [0.0],
     ...                      "normal_speed": [2.0], "e_n_expected": [0.5], "reason": ["why"]})
     >>> d = ExperimentDesign(rows, pd.DataFrame(), ("zeta_hertz",), {}, "Fisher")
-    >>> t = design_template(d, 0.02)
+    >>> t = design_template(d, DesignSpace(radii=(3.45e-6,)))
     >>> list(t.columns) == list(TEMPLATE_COLUMNS), round(float(t["radius [um]"].iloc[0]), 6), t["e_n [1]"].iloc[0]
     (True, 3.45, '')
+    >>> list(design_template(d, DesignSpace(radii=(3.45e-6,), oblique_quantity="rebound_angle")).columns[6:8])
+    ['rebound_angle [deg]', 'rebound_angle_uncertainty [deg]']
     """
     r = design.rows
     oblique = r["incidence_deg"].to_numpy(float) > 0
-    e_t = "" if e_t_sigma is None else np.where(oblique, f"{float(e_t_sigma):.6g}", "")
-    return pd.DataFrame({TEMPLATE_COLUMNS[0]: r["id"], TEMPLATE_COLUMNS[1]: r["radius"] * 1e6,
-                         TEMPLATE_COLUMNS[2]: r["speed"], TEMPLATE_COLUMNS[3]: r["incidence_deg"],
-                         TEMPLATE_COLUMNS[4]: "", TEMPLATE_COLUMNS[5]: float(e_n_sigma),
-                         TEMPLATE_COLUMNS[6]: "", TEMPLATE_COLUMNS[7]: e_t, TEMPLATE_COLUMNS[8]: r["reason"]})
+    table = {TEMPLATE_COLUMNS[0]: r["id"], TEMPLATE_COLUMNS[1]: r["radius"] * 1e6,
+             TEMPLATE_COLUMNS[2]: r["speed"], TEMPLATE_COLUMNS[3]: r["incidence_deg"],
+             TEMPLATE_COLUMNS[4]: "", TEMPLATE_COLUMNS[5]: float(space.e_n_sigma)}
+    q = space.oblique_quantity
+    if q != "none":
+        unit = OBLIQUE_QUANTITIES[q]
+        table[f"{q} [{unit}]"] = ""
+        table[f"{q}_uncertainty [{unit}]"] = np.where(oblique, f"{space.oblique_sigma:.6g}", "")
+    return pd.DataFrame({**table, TEMPLATE_COLUMNS[8]: r["reason"]})
 
 
-def tangential_sensitivities(contact, speed, incidence_deg, frictions, rtol=DEFAULT_RTOL):
-    """e_n, and the tangential restitution e_t and d e_t / d ln f of impacts at several frictions.
+def tangential_sensitivities(contact, speed, incidence_deg, frictions, rtol=DEFAULT_RTOL,
+                             quantity: str = "tangential_restitution"):
+    """e_n, and an oblique quantity q (e_t by default) and d q / d ln f of impacts at several frictions.
 
     The normal solve does not depend on f (model-notes section 4), so each impact is solved once
     (:func:`~microimpact.analysis.oblique.normal_impulses`) and e_t follows from the closed-form map
     of Eqs. (16)-(20) (:func:`~microimpact.analysis.oblique.rebound_from_impulses`) at each f. The
     derivative is a central difference in ln f with step 1e-4: e_t is linear in f while the sphere
     slides throughout (v_t,out = v_t,in - f J / m) and constant once it ends rolling, so the only
-    error is at the kink f = f*, where the difference is a one-sided mean.
+    error is at the kink f = f*, where the difference is a one-sided mean. The rebound angle
+    atan(v_t,out / v_n,out) and the rebound spin (5 f J / (2 m R) while sliding, v_t,out / R once
+    rolling) are smooth functions of e_t, computed by the friction fit's own observables.
 
     Parameters
     ----------
@@ -641,12 +687,15 @@ def tangential_sensitivities(contact, speed, incidence_deg, frictions, rtol=DEFA
         Coulomb coefficients. [-]
     rtol : float
         Relative tolerance of the normal solves. [-]
+    quantity : str
+        ``tangential_restitution`` [-], ``rebound_angle`` [deg] or ``rebound_spin`` [rad/s].
 
     Returns
     -------
-    (e_n, e_t, gradient)
-        e_n [-] per impact; e_t [-] and gradient[i, k] = d e_t,i / d ln f_k [-], shape
-        (impacts, frictions); 0 where the impact is captured or ends in rolling at f_k.
+    (e_n, q, gradient)
+        e_n [-] per impact; q and gradient[i, k] = d q_i / d ln f_k [unit of q], shape
+        (impacts, frictions); NaN and 0 where the impact is captured, 0 where it ends in rolling
+        at f_k.
 
     Examples
     --------
@@ -660,46 +709,54 @@ def tangential_sensitivities(contact, speed, incidence_deg, frictions, rtol=DEFA
     >>> e_n, e_t, g = tangential_sensitivities(c, [10.0], [60.0], [0.1, 1.0])
     >>> bool(g[0, 0] < -0.01), round(float(e_t[0, 1]), 4), float(g[0, 1])
     (True, 0.7143, 0.0)
+
+    The rebound spin responds where e_t does, in rad/s:
+
+    >>> _, w, gw = tangential_sensitivities(c, [10.0], [60.0], [0.1, 1.0], quantity="rebound_spin")
+    >>> bool(gw[0, 0] > 1e4), float(gw[0, 1])
+    (True, 0.0)
     """
+    if quantity not in OBLIQUE_QUANTITIES or quantity == "none":
+        raise ValueError(f"quantity must be one of tangential_restitution, rebound_angle, rebound_spin, got {quantity!r}")
     speed, angle = np.asarray(speed, float), np.asarray(incidence_deg, float)
     imp = normal_impulses(contact, speed, angle, rtol)
     zero = np.zeros_like(speed)
+    names = np.full(speed.shape, "rebound_angle_deg" if quantity == "rebound_angle" else quantity, dtype=object)
     h = 1e-4
-    e_t, grad = np.empty((speed.size, len(frictions))), np.empty((speed.size, len(frictions)))
-    vt_in = imp["velocity_in_t"]
+    q, grad = np.empty((speed.size, len(frictions))), np.empty((speed.size, len(frictions)))
+    undefined = imp["captured"] | (imp["velocity_in_t"] <= 0)
 
-    def et(f):
-        vt = rebound_from_impulses(contact, imp, zero, friction=f)["velocity_out_t"]
-        return np.where(imp["captured"] | (vt_in <= 0), np.nan, vt / np.where(vt_in > 0, vt_in, 1.0))
+    def q_at(f):
+        out = rebound_from_impulses(contact, imp, zero, friction=f)
+        return np.where(undefined, np.nan, _observables(out, speed, angle, names))
 
     for k, f in enumerate(np.asarray(frictions, float)):
-        e_t[:, k] = et(f)
-        d = np.nan_to_num((et(f * math.exp(h)) - et(f * math.exp(-h))) / (2 * h))
-        # a rolling impact's e_t differs only by rounding (~1e-16 / h = 1e-12): that is no response
-        grad[:, k] = np.where(np.abs(d) > 1e-8, d, 0.0)
-    return imp["e_n"], e_t, grad
+        q[:, k] = q_at(f)
+        d = np.nan_to_num((q_at(f * math.exp(h)) - q_at(f * math.exp(-h))) / (2 * h))
+        # a rolling impact's q differs only by rounding (~1e-16 |q| / h = 1e-12 |q|): that is no response
+        grad[:, k] = np.where(np.abs(d) > 1e-8 * np.maximum(1.0, np.nan_to_num(np.abs(q[:, k]))), d, 0.0)
+    return imp["e_n"], q, grad
 
 
 def _friction_candidates(space: DesignSpace) -> pd.DataFrame:
     """The oblique candidates: the space's nonzero angles, else :data:`OBLIQUE_ANGLES_DEG`."""
     angles = tuple(a for a in space.incidence_deg if a > 0) or OBLIQUE_ANGLES_DEG
-    return DesignSpace(radii=space.radii, speed_range=space.speed_range, incidence_deg=angles,
-                       e_n_sigma=space.e_n_sigma, speed_sigma=space.speed_sigma, n_speeds=space.n_speeds,
-                       e_t_sigma=space.e_t_sigma).candidates()
+    return replace(space, incidence_deg=angles).candidates()
 
 
-def design_friction(fit=None, space: DesignSpace | None = None, n: int = 6, *, material=None, values=None,
+def design_friction(fit=None, space: DesignSpace | None = None, n: int = DEFAULT_NEW_OBLIQUE, *, material=None, values=None,
                     existing=None, friction_range: tuple = FRICTION_RANGE, rtol: float = DEFAULT_RTOL) -> ExperimentDesign:
     """The next ``n`` oblique impacts (angle, speed, size) that most narrow the Coulomb coefficient f.
 
-    e_n does not depend on f; a measured tangential restitution e_t does, but only while the
-    sphere slides throughout the contact (f < f*_i = 2 m |u_0| / (7 J_i)); an impact that ends
+    e_n does not depend on f; a measured tangential restitution e_t (or rebound angle, or rebound
+    spin: the space's ``oblique_quantity``) does, but only while the sphere slides throughout the contact (f < f*_i = 2 m |u_0| / (7 J_i)); an impact that ends
     rolling gives e_t = 5/7 whatever f and only bounds it (the ``lower_bound`` / ``not_determined``
     statuses of :func:`~microimpact.analysis.oblique.fit_friction`). Because where an impact slides
     depends on the unknown f itself, the criterion is averaged over ``friction_range``
     (log-uniform, :data:`FRICTION_GRID_POINTS` values): each greedy step adds the candidate that
     most reduces the mean over f of the relative variance 1 / I(f) of ln f, with
-    I(f) = I_0(f) + sum_k (d e_t,k / d ln f)^2 / sigma_t^2 (a Bayesian A-criterion; Chaloner &
+    I(f) = I_0(f) + sum_k (d q_k / d ln f)^2 / sigma_q^2, q the measured oblique quantity and
+    sigma_q its uncertainty (:attr:`DesignSpace.oblique_sigma`) (a Bayesian A-criterion; Chaloner &
     Verdinelli 1995). A candidate that is captured or ends rolling for every f of the range is never
     recommended.
 
@@ -708,7 +765,9 @@ def design_friction(fit=None, space: DesignSpace | None = None, n: int = 6, *, m
     fit : DampingFit, optional
         The damping fit whose contact the impacts are solved with (else ``material`` and ``values``).
     space : DesignSpace
-        Its nonzero ``incidence_deg`` are the candidate angles (:data:`OBLIQUE_ANGLES_DEG` if none).
+        Its nonzero ``incidence_deg`` are the candidate angles (:data:`OBLIQUE_ANGLES_DEG` if none);
+        its ``oblique_quantity`` is what is measured (``none`` is refused: e_n alone does not
+        determine f).
     n : int
         Number of new oblique impacts.
     material : MaterialPair, optional
@@ -751,6 +810,10 @@ def design_friction(fit=None, space: DesignSpace | None = None, n: int = 6, *, m
     lo, hi = (float(x) for x in friction_range)
     if not 0 < lo < hi:
         raise ValueError(f"friction_range must be 0 < min < max, got {friction_range!r}")
+    if space.oblique_quantity == "none":
+        raise ValueError("friction: the design space measures e_n only, and e_n does not depend on friction "
+                         "(Eqs. (16)-(20)); measure the tangential restitution, rebound angle or rebound spin of "
+                         "oblique impacts")
     if fit is not None:
         base, vals = fit, dict(fit.values)
     elif material is not None and values:
@@ -760,29 +823,32 @@ def design_friction(fit=None, space: DesignSpace | None = None, n: int = 6, *, m
         raise ValueError("give a damping fit, or a material with the damping values")
     grid = np.geomspace(lo, hi, FRICTION_GRID_POINTS)
     cand = _friction_candidates(space)
-    e_n, e_t, g = _oblique_sensitivities(base, vals, cand, grid, rtol)
+    q, sigma = space.oblique_quantity, space.oblique_sigma
+    e_n, e_t, g = _oblique_sensitivities(base, vals, cand, grid, rtol, q)
     info0 = np.full(grid.size, 1.0 / WEAK_PRIOR_RELATIVE_SD ** 2)
     if existing is not None and len(existing):
+        # the impacts already measured: their own quantity is not known here, so e_t with e_t_sigma
         _, _, g0 = _oblique_sensitivities(base, vals, existing, grid, rtol)
         info0 = info0 + np.sum(np.square(g0 / space.e_t_sigma), axis=0)
-    gw2 = np.square(g / space.e_t_sigma)
+    gw2 = np.square(g / sigma)
     admissible = (e_n > 0) & np.any(gw2 > 0, axis=1)
     if not admissible.any():
         raise ValueError("no oblique candidate of the design space slides for any f of the friction range (all "
                          "captured or rolling): add steeper incidence angles or higher speeds")
-    chosen, reasons, path = _greedy_friction(info0, gw2, admissible, int(n), cand, e_n, e_t, grid)
+    chosen, reasons, path = _greedy_friction(info0, gw2, admissible, int(n), cand, e_n, q, grid)
     uni = uniform_oblique_design(space, int(n))
-    _, _, gu = _oblique_sensitivities(base, vals, uni, grid, rtol)
+    _, _, gu = _oblique_sensitivities(base, vals, uni, grid, rtol, q)
     centre = int(np.argmin(np.abs(np.log(grid) - 0.5 * math.log(lo * hi))))
-    widths = _friction_width_table(info0, path, np.square(gu / space.e_t_sigma), grid, centre)
+    widths = _friction_width_table(info0, path, np.square(gu / sigma), grid, centre)
     rows = _rows(cand.iloc[chosen], e_n[chosen], reasons)
     notes = {"friction": _friction_design_note(cand, g, e_n, grid, chosen)}
     return ExperimentDesign(rows, widths, ("friction",), {**vals, "friction": float(grid[centre])},
-                            "Fisher information of e_t in ln f averaged over the friction range (Bayesian A-criterion, "
-                            "log-uniform prior); greedy sequential selection over the oblique candidates", notes)
+                            f"Fisher information of the {q.replace('_', ' ')} in ln f averaged over the friction range "
+                            "(Bayesian A-criterion, log-uniform prior); greedy sequential selection over the oblique "
+                            "candidates", notes)
 
 
-def _oblique_sensitivities(base, vals, table, grid, rtol):
+def _oblique_sensitivities(base, vals, table, grid, rtol, quantity="tangential_restitution"):
     """:func:`tangential_sensitivities` of the rows of ``table`` (radius, speed, incidence_deg), one contact per radius."""
     e_n = np.zeros(len(table))
     e_t, g = np.full((len(table), grid.size), np.nan), np.zeros((len(table), grid.size))
@@ -792,11 +858,12 @@ def _oblique_sensitivities(base, vals, table, grid, rtol):
         c = material_contact(base, float(r), zeta_hertz=vals["zeta_hertz"], zeta_adhesion=vals["zeta_adhesion"],
                              work_of_adhesion=vals["work_of_adhesion"])
         e_n[idx], e_t[idx], g[idx] = tangential_sensitivities(c, np.asarray(table["speed"], float)[idx],
-                                                              np.asarray(table["incidence_deg"], float)[idx], grid, rtol)
+                                                              np.asarray(table["incidence_deg"], float)[idx], grid, rtol,
+                                                              quantity)
     return e_n, e_t, g
 
 
-def _greedy_friction(info0, gw2, admissible, n, cand, e_n, e_t, grid):
+def _greedy_friction(info0, gw2, admissible, n, cand, e_n, quantity, grid):
     """Candidates chosen one at a time, each of least mean relative variance of ln f over the grid."""
     info, chosen, reasons, path = info0.copy(), [], [], []
     options = np.flatnonzero(admissible)
@@ -805,9 +872,11 @@ def _greedy_friction(info0, gw2, admissible, n, cand, e_n, e_t, grid):
         best = int(options[np.argmin(scores)])
         info = info + gw2[best]
         slides = grid[gw2[best] > 0]
-        reasons.append(f"{cand['incidence_deg'].iloc[best]:.3g} deg, {cand['speed'].iloc[best]:.3g} m/s, "
-                       f"e_n ~ {e_n[best]:.3f}: slides throughout for f up to {slides.max():.2g} (e_t responds to f "
-                       f"there, up to {math.sqrt(gw2[best].max()):.2g} sigma per 100 % of f)")
+        size = f"d = {2e6 * cand['radius'].iloc[best]:.3g} um, " if cand["radius"].nunique() > 1 else ""
+        reasons.append(f"{size}{cand['incidence_deg'].iloc[best]:.3g} deg, {cand['speed'].iloc[best]:.3g} m/s, "
+                       f"e_n ~ {e_n[best]:.3f}: slides throughout for f up to {slides.max():.2g} (its "
+                       f"{quantity.replace('_', ' ')} responds to f there, up to {math.sqrt(gw2[best].max()):.2g} "
+                       f"sigma per 100 % of f)")
         chosen.append(best)
         path.append(info.copy())
     return chosen, reasons, path
@@ -858,7 +927,7 @@ def design_record(design: ExperimentDesign, space: DesignSpace, source: str = ""
     dict
         ``criterion``, ``parameters``, ``values``, ``notes``, ``space`` (radii [m], speed_range
         [m/s], incidence_deg and the friction design's oblique_deg [deg], e_n_sigma, e_t_sigma,
-        speed_sigma [-], n_speeds), ``rows``
+        speed_sigma [-], n_speeds, oblique_quantity and its oblique_sigma [its unit]), ``rows``
         (records of :attr:`ExperimentDesign.rows`), ``widths`` (records of
         :attr:`ExperimentDesign.widths`), ``source``.
 
@@ -878,6 +947,7 @@ def design_record(design: ExperimentDesign, space: DesignSpace, source: str = ""
                       "incidence_deg": [float(a) for a in space.incidence_deg], "e_n_sigma": float(space.e_n_sigma),
                       "oblique_deg": sorted({float(a) for a in _friction_candidates(space)["incidence_deg"]}),
                       "e_t_sigma": float(space.e_t_sigma), "speed_sigma": float(space.speed_sigma),
+                      "oblique_quantity": space.oblique_quantity, "oblique_sigma": float(space.oblique_sigma),
                       "n_speeds": int(space.n_speeds)},
             "rows": design.rows.to_dict("records"), "widths": design.widths.to_dict("records"), "source": str(source)}
 
@@ -903,7 +973,8 @@ def fit_design_space(fit, **changes) -> DesignSpace:
     return DesignSpace(**{**base, **changes})
 
 
-def design_next_impacts(fit, space: DesignSpace, n: int = 20, parameters=("zeta_hertz",), *, n_friction: int = 6,
+def design_next_impacts(fit, space: DesignSpace, n: int = DEFAULT_NEW_IMPACTS, parameters=DEFAULT_PARAMETERS, *,
+                        n_friction: int = DEFAULT_NEW_OBLIQUE,
                         criterion: str = "A", rtol: float = DEFAULT_RTOL, posterior=None) -> ExperimentDesign:
     """The e_n design of the damping parameters named and, with ``"friction"`` named, the oblique
     design of :func:`design_friction` after it, as one :class:`ExperimentDesign` (ids renumbered).

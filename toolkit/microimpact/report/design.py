@@ -62,18 +62,50 @@ def plot_design_widths(record: Mapping) -> Plot:
     caption = ("Expected 95 % interval width (log scale) of each parameter against the number of new impacts, for the "
                "recommended impacts in the order chosen (solid) and for the same number spread uniformly over the "
                "same space (dashed); an expectation (" + record.get("criterion", "") + ") that the refit of the measured "
-               "impacts replaces. " + "; ".join(parts) + ".")
+               "impacts replaces. " + "; ".join(parts) + "."
+               + (" The friction panel is the width at the centre of the friction range; the recommended oblique "
+                  "impacts minimise its mean over the whole range (f unknown), so at the centre alone a uniform set "
+                  "can come out narrower." if "friction" in params else ""))
     return Plot(fig, caption)
 
 
 def _rows_table(record: Mapping) -> pd.DataFrame:
+    """The recommended impacts, a run of repeats of one impact (same size, speed and angle, chosen one
+    after another) as one line with its count and the reason of its first: a design that repeats the
+    most informative impact 20 times is one line, not 20 (the CSV template keeps every row).
+
+    Examples
+    --------
+    >>> rows = [{"id": f"design-00{k}", "radius": 1e-6, "speed": 2.0 if k < 3 else 4.0, "incidence_deg": 0.0,
+    ...          "e_n_expected": 0.5, "reason": f"r{k}"} for k in (1, 2, 3)]
+    >>> _rows_table({"rows": rows})[["id", "n", "reason"]].values.tolist()
+    [['design-001..002', '2', 'r1'], ['design-003', '1', 'r3']]
+    """
     rows = pd.DataFrame(list(record["rows"]))
     if rows.empty:
         return rows
-    return pd.DataFrame({"id": rows["id"], "d [um]": [f"{2e6 * r:.3g}" for r in rows["radius"]],
-                         "speed [m/s]": [f"{v:.3g}" for v in rows["speed"]],
-                         "angle [deg]": [f"{a:.3g}" for a in rows["incidence_deg"]],
-                         "e_n expected": [f"{e:.3f}" for e in rows["e_n_expected"]], "reason": rows["reason"]})
+    key = rows[["radius", "speed", "incidence_deg"]]
+    run = (key != key.shift()).any(axis=1).cumsum()
+    groups = [g for _, g in rows.groupby(run, sort=False)]
+    first = pd.DataFrame([g.iloc[0] for g in groups])
+    ids = [g["id"].iloc[0] if len(g) == 1 else f"{g['id'].iloc[0]}..{str(g['id'].iloc[-1]).rsplit('-', 1)[-1]}"
+           for g in groups]
+    return pd.DataFrame({"id": ids, "n": [str(len(g)) for g in groups],
+                         "d [um]": [f"{2e6 * r:.3g}" for r in first["radius"]],
+                         "speed [m/s]": [f"{v:.3g}" for v in first["speed"]],
+                         "angle [deg]": [f"{a:.3g}" for a in first["incidence_deg"]],
+                         "e_n expected": [f"{e:.3f}" for e in first["e_n_expected"]],
+                         "reason": list(first["reason"])})
+
+
+def _oblique_text(space: Mapping) -> str:
+    """'rebound angle measured to 1 deg' from a design record's space (e_t for records without the key)."""
+    q = space.get("oblique_quantity", "tangential_restitution")
+    if q == "none":
+        return "e_n only: nothing determines f"
+    unit = {"tangential_restitution": "", "rebound_angle": " deg", "rebound_spin": " rad/s"}.get(q, "")
+    sigma = space.get("oblique_sigma", space.get("e_t_sigma", float("nan")))
+    return f"{q.replace('_', ' ')} measured to {sigma:.3g}{unit}"
 
 
 def design_section(lay: Layout, record: Mapping) -> None:
@@ -103,18 +135,19 @@ def design_section(lay: Layout, record: Mapping) -> None:
         f"{', '.join(record['parameters'])} given the fit ({record.get('source', 'the damping fit')}), chosen one at a "
         f"time from candidates at the measured sphere diameters ({radii} um), incident speeds {lo:.3g}-{hi:.3g} m/s "
         f"and incidence angles {', '.join(f'{a:g}' for a in space.get('incidence_deg', []))} deg"
-        + (f" (friction: {', '.join(f'{a:g}' for a in space.get('oblique_deg', []))} deg, e_t measured to "
-           f"{space.get('e_t_sigma', float('nan')):.3g})" if "friction" in record["parameters"] else "")
+        + (f" (friction: {', '.join(f'{a:g}' for a in space.get('oblique_deg', []))} deg, "
+           f"{_oblique_text(space)})" if "friction" in record["parameters"] else "")
         + f", with e_n measured to {space.get('e_n_sigma', float('nan')):.3g}. Criterion: {record['criterion']}. "
         "No impact is recommended "
         "where the parameter has no effect (a captured impact for the damping; one that ends rolling for friction). "
-        "microimpact design fit.nc --out design.csv writes the same rows as a measured-impact CSV template; "
-        "measured, they are appended to the data and refitted.")
+        "A run of repeats of one impact is one line of the table below (n: how many). microimpact design fit.nc "
+        "--out design.csv writes the same rows as a measured-impact CSV template; measured, they are appended to "
+        "the data and refitted.")
     for p, note in record.get("notes", {}).items():
         lay.paragraph(f"{p}: {note}.")
     table = _rows_table(record)
     if not table.empty:
-        lay.table(table, {"id": 10, "d [um]": 6, "speed [m/s]": 7, "angle [deg]": 6, "e_n expected": 8, "reason": 60},
-                  size=6.5)
+        lay.table(table, {"id": 14, "n": 3, "d [um]": 6, "speed [m/s]": 7, "angle [deg]": 6, "e_n expected": 8,
+                          "reason": 58}, size=6.5)
     if record.get("widths"):
         lay.plot(plot_design_widths(record), max_height=2.8)
