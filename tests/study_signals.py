@@ -51,9 +51,14 @@ ENV = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
 INTERRUPTED = ("microimpact: workflow interrupted", "microimpact: interrupted")
 
 
+#: Snakemake targets of every run (empty: the whole pipeline); set from --targets by main
+TARGETS: list[str] = []
+
+
 def _command(run: Path, config: Path) -> list[str]:
-    return [sys.executable, "-m", "microimpact._entry", "workflow", "--directory", str(run), "--cores", "2",
-            "--configfile", str(config)]
+    # the targets before --configfile, which takes every word after it as a file
+    return [sys.executable, "-m", "microimpact._entry", "workflow", "--directory", str(run), *TARGETS,
+            "--cores", "2", "--configfile", str(config)]
 
 
 def _fresh(root: Path, template: Path, name: str) -> Path:
@@ -158,7 +163,10 @@ def main() -> int:
     parser.add_argument("--max-stop", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--out", default=None)
+    parser.add_argument("--targets", nargs="*", default=[],
+                        help="Snakemake targets (files) of every run; default: the whole pipeline")
     args = parser.parse_args()
+    TARGETS[:] = args.targets
     rng = random.Random(args.seed)
     root = Path(tempfile.mkdtemp(prefix="study-signals-"))
     template = make_copy(root / "template")
@@ -191,7 +199,8 @@ def main() -> int:
         row = trial(root, template, config, reference, number, signum, to_group, moment, args.max_stop)
         rows.append(row)
         print(json.dumps(row), flush=True)
-        summary = {"cold_seconds": round(cold, 1), "uninterrupted_seconds": round(duration, 1),
+        summary = {"targets": TARGETS or ["all"], "cold_seconds": round(cold, 1),
+                   "uninterrupted_seconds": round(duration, 1),
                    "planned": len(plan), "trials": len(rows), "passed": sum(r["passed"] for r in rows),
                    "signalled": sum(not r["finished_before_the_signal"] for r in rows), "rows": rows}
         if args.out:
