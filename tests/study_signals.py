@@ -16,9 +16,15 @@ process group and half to the wrapper's pid alone (``kill PID``). Each trial che
   uninterrupted run, bit for bit (``xarray.Dataset.equals``), every CSV the same bytes.
 
 The run is the tiny configuration of tests/test_workflow.py (``make_copy``) through
-``microimpact workflow --configfile``::
+``microimpact workflow --configfile``, with ``--targets`` the Snakemake targets of every run (the
+whole pipeline without; it takes several minutes a run, so each trial, a run and its resume, takes
+that twice). docs/signals.json holds the study of five targets (validation, reproduction table,
+Kharaz comparison, paper dynamics, LAMMPS check: start-up, job launches, jobs in numba kernels and
+in LAMMPS, and the end of a run in about a minute)::
 
-    python tests/study_signals.py --sigint 30 --early 10 --sigterm 10 --seed 1 --out signals.json
+    python tests/study_signals.py --sigint 30 --early 10 --sigterm 10 --seed 1 --targets \
+        results/impacts_validated.csv results/paper/reproduction.csv results/kharaz.nc \
+        results/paper/dynamics.nc results/lammps/check.csv --out docs/signals.json
 
 The trials run in a shuffled order and ``--out`` is rewritten after each one, so a study stopped
 early leaves a representative subset (``trials`` says how many ran of ``planned``).
