@@ -16,9 +16,15 @@ process group and half to the wrapper's pid alone (``kill PID``). Each trial che
   uninterrupted run, bit for bit (``xarray.Dataset.equals``), every CSV the same bytes.
 
 The run is the tiny configuration of tests/test_workflow.py (``make_copy``) through
-``microimpact workflow --configfile``::
+``microimpact workflow --configfile``, with ``--targets`` the Snakemake targets of every run (the
+whole pipeline without; it takes several minutes a run, so each trial, a run and its resume, takes
+that twice). docs/signals.json holds the study of five targets (validation, reproduction table,
+Kharaz comparison, paper dynamics, LAMMPS check: start-up, job launches, jobs in numba kernels and
+in LAMMPS, and the end of a run in about a minute)::
 
-    python tests/study_signals.py --sigint 30 --early 10 --sigterm 10 --seed 1 --out signals.json
+    python tests/study_signals.py --sigint 30 --early 10 --sigterm 10 --seed 1 --targets \
+        results/impacts_validated.csv results/paper/reproduction.csv results/kharaz.nc \
+        results/paper/dynamics.nc results/lammps/check.csv --out docs/signals.json
 
 The trials run in a shuffled order and ``--out`` is rewritten after each one, so a study stopped
 early leaves a representative subset (``trials`` says how many ran of ``planned``).
@@ -51,9 +57,14 @@ ENV = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
 INTERRUPTED = ("microimpact: workflow interrupted", "microimpact: interrupted")
 
 
+#: Snakemake targets of every run (empty: the whole pipeline); set from --targets by main
+TARGETS: list[str] = []
+
+
 def _command(run: Path, config: Path) -> list[str]:
-    return [sys.executable, "-m", "microimpact._entry", "workflow", "--directory", str(run), "--cores", "2",
-            "--configfile", str(config)]
+    # the targets before --configfile, which takes every word after it as a file
+    return [sys.executable, "-m", "microimpact._entry", "workflow", "--directory", str(run), *TARGETS,
+            "--cores", "2", "--configfile", str(config)]
 
 
 def _fresh(root: Path, template: Path, name: str) -> Path:
@@ -158,7 +169,10 @@ def main() -> int:
     parser.add_argument("--max-stop", type=float, default=5.0)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--out", default=None)
+    parser.add_argument("--targets", nargs="*", default=[],
+                        help="Snakemake targets (files) of every run; default: the whole pipeline")
     args = parser.parse_args()
+    TARGETS[:] = args.targets
     rng = random.Random(args.seed)
     root = Path(tempfile.mkdtemp(prefix="study-signals-"))
     template = make_copy(root / "template")
@@ -191,7 +205,8 @@ def main() -> int:
         row = trial(root, template, config, reference, number, signum, to_group, moment, args.max_stop)
         rows.append(row)
         print(json.dumps(row), flush=True)
-        summary = {"cold_seconds": round(cold, 1), "uninterrupted_seconds": round(duration, 1),
+        summary = {"targets": TARGETS or ["all"], "cold_seconds": round(cold, 1),
+                   "uninterrupted_seconds": round(duration, 1),
                    "planned": len(plan), "trials": len(rows), "passed": sum(r["passed"] for r in rows),
                    "signalled": sum(not r["finished_before_the_signal"] for r in rows), "rows": rows}
         if args.out:

@@ -97,7 +97,9 @@ HOW = {
     "python tests/study_calibration.py --dirty N --out docs/calibration_dirty.json --figure docs/calibration_dirty.png": "study",
     # README.md: signals at random moments of a pipeline run
     "python tests/study_interruptions.py --trials 20 --load 1 --seed 1 --out docs/interruptions.json": "study",
-    "python tests/study_signals.py --sigint 30 --early 10 --sigterm 10 --seed 1 --out docs/signals.json": "study",
+    ("python tests/study_signals.py --sigint 30 --early 10 --sigterm 10 --seed 1 --targets results/impacts_validated.csv "
+     "results/paper/reproduction.csv results/kharaz.nc results/paper/dynamics.nc results/lammps/check.csv "
+     "--out docs/signals.json"): "study",
     # README.md: one-line mutations of the physics (tests/test_mutation_table.py keeps its table true)
     "python tests/mutation_check.py --out docs/mutations.json": "study",
     # README.md: a cold and a warm pipeline (CI: its cold pipeline against the warm SLURM run), the

@@ -213,3 +213,30 @@ def test_every_law_on_every_path(tmp_path, capsys, monkeypatch):
         print(json.dumps({"combinations": len(COMBINATIONS), "passed": len(COMBINATIONS) - len(failed), **tally,
                           "failed": failed}, indent=1))
     assert not failed
+
+
+#: LAMMPS's rolling sds at its documented default mu_roll = 0 (the registry documents 0.1): it crashed
+#: every path (TypeError in solvers.dem_tangential, issue 55); a LAMMPS law of the sample, so that
+#: export, verify and fit are on its paths
+ROLLING_SDS_MU_0 = next(c for c in SAMPLE if c.contact.rolling_model == "lammps_sds" and lammps_law(c) is not None)
+ROLLING_SDS_MU_0 = dataclasses.replace(ROLLING_SDS_MU_0, contact=ROLLING_SDS_MU_0.contact.with_(rolling_friction=0.0))
+
+
+def test_rolling_sds_with_mu_roll_0_gives_a_result_in_the_library_simulate_sweep_and_export(tmp_path, capsys,
+                                                                                              monkeypatch):
+    c = ROLLING_SDS_MU_0
+    check_library(c)
+    # a result, not a refusal: the law is valid, so a one-line error would hide the crash's fix
+    assert one_result_or_one_line(["simulate", *contact_argv(c.contact), "--speed", SPEED, "--incidence-deg", ANGLE,
+                                   "--json"], capsys, allowed=(0,))[0] == 0
+    check_simulate(c, capsys)
+    monkeypatch.setattr(sweeps, "TABLE2_CASES", {**TABLE2_CASES, "2.1": TINY_CASE})
+    assert one_result_or_one_line(["sweep", *contact_argv(c.contact), "--case", "2.1", "--out", tmp_path / "s.nc"],
+                                  capsys, allowed=(0,))[0] == 0
+    assert check_lammps(c, tmp_path, capsys, verify=False, fit=False) == {"export": 0}
+
+
+def test_rolling_sds_with_mu_roll_0_is_verified_by_lammps(needs_lammps, tmp_path, capsys):
+    # (the normal fit of check_lammps does not hold the rolling law: left out here)
+    found = check_lammps(ROLLING_SDS_MU_0, tmp_path, capsys, fit=False)
+    assert found == {"export": 0, "verify": 0}, found  # LAMMPS's own law at its default: LAMMPS agrees

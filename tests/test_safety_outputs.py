@@ -1,12 +1,17 @@
 """Outputs all or nothing and options that read as they were meant (issue 55, items 3, 5, 7)."""
 
+import contextlib
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+import scipy.integrate
 
-from microimpact.cli import main
+from microimpact._commands import simulate as simulate_command
+from microimpact._commands.contacts import contact_from_args
+from microimpact.cli import build_parser, main
+from microimpact.model.adhesion_models import AdhesionRegimeWarning
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "data" / "synthetic_microspheres.csv"  # SYNTHETIC data (data/README.md)
@@ -100,6 +105,44 @@ def test_numbers_parse_strictly_and_counts_are_bounded_before_the_work(argv, nam
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and named in err[0], err
+
+
+@pytest.mark.parametrize("law", ["jkr", "jkr_force", "dmt"])
+def test_an_impossibly_long_adhesive_reference_run_is_refused_before_the_work(law, monkeypatch, capsys):
+    # the ring law's reference run had a bound; JKR and DMT, integrated by the same scipy solver, had
+    # none: at zeta_H 1e4 a JKR impact already took minutes, at 1e6 it would take days
+    def never(*args, **kwargs):
+        raise AssertionError("the reference run started")
+
+    monkeypatch.setattr(simulate_command, "simulate_impact", never)
+    argv = ["simulate", "--speed", "0.2", "--method", "reference", "--normal-model", law, "--zeta-hertz", "1e6"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--method reference" in err[0] and "--method engine" in err[0], err
+
+
+@pytest.mark.parametrize("law, speed, zeta", [("jkr_force", "2", "1e3"), ("jkr_force", "2", "2e3"),
+                                              ("dmt", "0.2", "3e3")])  # C1 0.86, 1.7, 13: a second or a few each
+def test_the_adhesive_reference_work_estimate_follows_the_solver(law, speed, zeta, monkeypatch):
+    # the estimate against the evaluations solve_ivp reports for the same impact (the JKR and DMT
+    # reference imports solve_ivp from scipy.integrate when it runs, so the module's name is patched)
+    counted = []
+    solve = scipy.integrate.solve_ivp
+
+    def counting(*args, **kwargs):
+        sol = solve(*args, **kwargs)
+        counted.append(sol.nfev)
+        return sol
+
+    monkeypatch.setattr(scipy.integrate, "solve_ivp", counting)
+    args = build_parser().parse_args(["simulate", "--speed", speed, "--normal-model", law, "--zeta-hertz", zeta])
+    contact = contact_from_args(args)
+    # DMT at 0.2 m/s lies outside its Tabor regime, and says so
+    with pytest.warns(AdhesionRegimeWarning) if law == "dmt" else contextlib.nullcontext():
+        simulate_command.simulate_impact(contact, float(speed), 0.0, method="reference")
+    assert counted  # the adhesive law's own integration ran, not the ring law's
+    # within a factor 2: an estimate for a bound (refused at 2e7 evaluations, where a factor 2 is an hour)
+    assert 0.5 < simulate_command.reference_evaluations(contact, float(speed)) / sum(counted) < 2.0, sum(counted)
 
 
 @pytest.mark.parametrize("name", ["", " "])

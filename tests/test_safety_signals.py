@@ -139,3 +139,43 @@ def test_a_time_limit_shorter_than_its_own_set_up_leaves_no_timer_behind():
     assert signal.getsignal(signal.SIGALRM) == before
     with timeout.time_limit(5.0, "after"):  # a later limit is not already expired
         time.sleep(0.01)
+
+
+# a stand-in for Snakemake that ends at once on SIGTERM, leaving its job (which ignores SIGTERM
+# and SIGINT) behind: an orphan, nobody's descendant once its parent has gone
+ORPHANING = """
+import os, signal, subprocess, sys, time
+job = subprocess.Popen([sys.executable, "-c", "import signal, time; signal.signal(signal.SIGTERM, signal.SIG_IGN); "
+                        "signal.signal(signal.SIGINT, signal.SIG_IGN); print('ready', flush=True); time.sleep(60)"],
+                       stdout=subprocess.PIPE, text=True)
+job.stdout.readline()
+print(os.getpid(), job.pid, flush=True)
+time.sleep(60)
+"""
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs /proc to find the child's jobs")
+def test_a_job_whose_parent_ended_first_on_a_sigterm_to_the_group_is_killed_too():
+    # a SIGTERM to the group of microimpact workflow during Snakemake's start-up once left a process
+    # running (docs/signals_supplement.json): Snakemake ended at once and its job, an orphan, was
+    # no longer among its descendants when the wrapper killed what was left
+    proc = subprocess.Popen([sys.executable, "-c", WRAPPER, ORPHANING, "x"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
+    try:
+        child_pid, job_pid = map(int, proc.stdout.readline().split())
+        os.killpg(proc.pid, signal.SIGTERM)  # the group: the child's default SIGTERM ends it at once
+        proc.communicate(timeout=10)
+        time.sleep(0.1)
+        assert not _alive(child_pid)
+        assert not _alive(job_pid)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL) if _group_alive(proc.pid) else None
+
+
+def _group_alive(pgid):
+    try:
+        os.killpg(pgid, 0)
+        return True
+    except ProcessLookupError:
+        return False

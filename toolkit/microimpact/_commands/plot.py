@@ -7,9 +7,10 @@ import sys
 import xarray as xr
 
 from microimpact._commands.common import FIGURE_FORMATS, UsageError
+from microimpact.analysis.fit_result import DampingFit
 from microimpact.io.paths import PathError, check_input_file, check_outputs, reporting_os_errors
 from microimpact.io.resources import check_memory
-from microimpact.report.standard import FigureFile, save_standard_figure
+from microimpact.report.standard import FigureFile, result_kind, save_standard_figure
 
 
 def run(args) -> int:
@@ -27,6 +28,10 @@ def run(args) -> int:
             check_memory(f"--dpi {args.dpi:g}", 2 * 4 * (8.0 * args.dpi) * (10.5 * args.dpi))
         except ValueError as exc:
             raise UsageError(str(exc)) from None
+    if result_kind(inputs["RESULT"]) == "fit":
+        # read as the --fit options read it: a parameter that is not a scalar ended in a TypeError
+        # traceback deep in the figure's caption (issue 55); the reader names the file and variable
+        DampingFit.load(inputs["RESULT"])
     figure = FigureFile(str(inputs["RESULT"]), str(out), inputs.get("--curves"), args.variant)
     with reporting_os_errors({"--out": out}):
         caption = save_standard_figure(figure, dpi=args.dpi)

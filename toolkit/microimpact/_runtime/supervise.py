@@ -70,6 +70,37 @@ def _signal_all(pids, signum) -> None:
             pass
 
 
+def _kill_orphans(pids, wait: float = 1.0) -> None:
+    """SIGKILL each of ``pids`` still alive in this process group (a job the stopped child left
+    behind when it ended first: a SIGTERM to the group once left one running, issue 55), and wait
+    up to ``wait`` seconds for them to be gone. The group check keeps a reused pid safe."""
+    group = os.getpgrp()
+    alive = []
+    for pid in pids:
+        try:
+            if os.getpgid(pid) == group:
+                os.kill(pid, signal.SIGKILL)
+                alive.append(pid)
+        except (ProcessLookupError, PermissionError):
+            pass
+    end = time.monotonic() + wait
+    while alive and time.monotonic() < end:
+        alive = [p for p in alive if _running(p)]
+        time.sleep(0.02)
+
+
+def _running(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    status = Path(f"/proc/{pid}/status")
+    try:
+        return "zombie" not in status.read_text()
+    except OSError:
+        return False
+
+
 def _copy(source, target, stopped: threading.Event) -> None:
     """Copy the child's stream ``source`` to ``target`` until it closes, each line :data:`HOLD`
     seconds after it was read, dropping every line not yet written once ``stopped`` is set.
@@ -141,9 +172,10 @@ def run_supervised(command: list[str], grace: float = STOP_GRACE) -> tuple[int, 
                    for stream, target in ((proc.stdout, sys.stdout), (proc.stderr, sys.stderr))]
         for c in copiers:
             c.start()
-        _wait(proc, received, grace)
+        seen = _wait(proc, received, grace)
         # nothing it started outlives it (a job whose parent was killed)
         _signal_all(descendants(proc.pid), signal.SIGKILL)
+        _kill_orphans(seen)
         for c in copiers:
             c.join(timeout=1.0 + HOLD)
     finally:
@@ -152,7 +184,7 @@ def run_supervised(command: list[str], grace: float = STOP_GRACE) -> tuple[int, 
     return proc.returncode, (received[0] if received else None)
 
 
-def _wait(proc: subprocess.Popen, received: list[int], grace: float) -> None:
+def _wait(proc: subprocess.Popen, received: list[int], grace: float) -> set[int]:
     """Wait for ``proc``; after a stop signal pass SIGINT on to it and its descendants, and kill
     them all ``grace`` seconds after the signal if it has not ended.
 
@@ -162,10 +194,15 @@ def _wait(proc: subprocess.Popen, received: list[int], grace: float) -> None:
     passed on only if the child still runs :data:`SIGINT_PASS_ON` seconds later (a SIGINT to the
     wrapper alone)."""
     came = passed_on = None
+    seen: set[int] = set()
     while True:
+        # once the child has ended its jobs are orphans, nobody's descendants: the last ones seen
+        # before a stop signal (a child may end at once on it) and all seen after it are remembered
+        current = descendants(proc.pid)
+        seen = seen | set(current) if received else set(current)
         try:
             proc.wait(timeout=0.05)
-            return
+            return seen
         except subprocess.TimeoutExpired:
             pass
         if received and came is None:
@@ -177,4 +214,4 @@ def _wait(proc: subprocess.Popen, received: list[int], grace: float) -> None:
         if came is not None and time.monotonic() - came > grace:
             _signal_all([proc.pid, *descendants(proc.pid)], signal.SIGKILL)
             proc.wait()
-            return
+            return seen
