@@ -253,6 +253,38 @@ def test_dem_laws_get_stiffnesses_of_the_hertz_contact():
     assert linear.tangential_stiffness == pytest.approx(2.0 * k_n / 7.0, rel=1e-12, abs=0.0)
 
 
+#: case 7862 of seed 0 (its drawn inputs): undamped, 3.7 um/s normal, captured under JKR
+_UNDAMPED_CAPTURE = {"case": 7862, "radius": 0.0009803992464730937, "density": 1073.9470354582918,
+                     "stiffness": 588658941940.8593, "work_of_adhesion": 0.0017090875359990095, "zeta_hertz": 0.0,
+                     "zeta_adhesion": 0.0, "friction": 1.1207900486717566, "speed": 2.6221135443355426e-05,
+                     "incidence_deg": 81.9718597289655, "azimuth_deg": 284.2371258060548,
+                     "omega_n": 2.4352806166089525, "omega_t": 2.012758367333998, "omega_tp": 2.2898412336100913}
+
+
+@pytest.mark.parametrize("law", ["jkr", "jkr_force"])
+def test_undamped_capture_ends_rolling(law):
+    """An undamped captured sphere oscillates in the well for ever, its friction impulse growing
+    each period without end: its slip stops and it rolls, slip u = 0, reached by the impulse
+    -u_in / kappa (kappa = 1 + m R^2 / I = 7/2; the contact force acts at the contact point). The
+    JKR solvers ran into their step limit (EngineError) on this case."""
+    case = _UNDAMPED_CAPTURE
+    c = stress.contact_of(case, law)
+    with stress._model_warnings_ignored():
+        r = simulate_impact(c, case["speed"], case["incidence_deg"], case["azimuth_deg"],
+                            (case["omega_n"], case["omega_t"], case["omega_tp"]), rtol=1e-10)
+    assert r.outcome == "capture"
+    rad, (_, vt, vtp), (_, wt, wtp) = c.radius, r.velocity_in, r.omega_in
+    slip_in = (vt + rad * wtp, vtp - rad * wt)
+    kappa = 1.0 + c.mass * rad**2 / c.moment_of_inertia
+    scale = case["speed"]  # [m/s]: the tolerance's scale
+    _, vt_out, vtp_out = r.velocity_out
+    _, wt_out, wtp_out = r.omega_out
+    assert vt_out + rad * wtp_out == pytest.approx(0.0, abs=1e-9 * scale)
+    assert vtp_out - rad * wt_out == pytest.approx(0.0, abs=1e-9 * scale)
+    assert (vt_out, vtp_out) == pytest.approx((vt - slip_in[0] / kappa, vtp - slip_in[1] / kappa), rel=0.0,
+                                              abs=1e-9 * scale)
+
+
 #: case 15 of seed 0 (its drawn inputs), friction 0, under the sweep's sds rolling law
 _FRICTIONLESS_ROLLING = {"case": 15, "radius": 0.006574925465721917, "density": 9555.568867562728,
                          "stiffness": 452220942393.6395, "work_of_adhesion": 2.08416071500343,
