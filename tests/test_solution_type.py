@@ -47,15 +47,15 @@ HELPERS = {
     "driver.make_error_norm": "factory",
     "driver.make_averaged_tail": "factory",
     "driver.linear_tail_variation": "compiled closed form",
-    "engine.engine_scales": "the nondimensional scales of a speed",
     "family.normal_family": "builds a NormalFamily (an interpolant; its evaluate returns a SolutionBatch)",
     "family.normal_restitution": "e_n alone, as an array, for the fits",
     "normal_models.settled_contact_energy": "a closed form",
-    "rkg.rkg_setup": "the RKG set-up arrays, kept out of the benchmark's timings",
-    "rkg.rkg_state": "the RKG state (xi, y) after n fixed steps, for the convergence check",
     "solution.frozen_state": "read-only copy of a state mapping",
-    "thornton_ning_law.law_parameters": "the law's parameter tuple, the driver's input",
 }
+#: public functions whose result is a set-up or a state (no solution), each a named result: the
+#: NamedTuple it returns (a tuple subclass, so that callers may still unpack it)
+NAMED = {"engine.engine_scales": "EngineScales", "rkg.rkg_setup": "RkgSetup", "rkg.rkg_state": "RkgState",
+         "thornton_ning_law.law_parameters": "LawParameters"}
 #: modules not enumerated, and why
 NOT_ENUMERATED = {"emulator": "an interpolant of e_n with its own Restitution record (outside this issue's solvers)",
                   "dopri": "the Dormand-Prince core: compiled building blocks, no solver"}
@@ -75,11 +75,11 @@ def _public_functions():
 
 def test_every_public_solver_function_is_classified_and_returns_no_dict_or_tuple():
     found = dict(_public_functions())
-    classified = SINGLE | BATCH | IMPACT | DATASET | set(HELPERS)
+    classified = SINGLE | BATCH | IMPACT | DATASET | set(HELPERS) | set(NAMED)
     assert not set(found) - classified, f"unclassified public functions: {sorted(set(found) - classified)}"
     assert not classified - set(found), f"classified but not public: {sorted(classified - set(found))}"
     expected = {**dict.fromkeys(SINGLE, "NormalSolution"), **dict.fromkeys(BATCH, "SolutionBatch"),
-                **dict.fromkeys(IMPACT, "ImpactResult"), **dict.fromkeys(DATASET, "xr.Dataset")}
+                **dict.fromkeys(IMPACT, "ImpactResult"), **dict.fromkeys(DATASET, "xr.Dataset"), **NAMED}
     wrong = {k: inspect.signature(found[k]).return_annotation for k in expected
              if inspect.signature(found[k]).return_annotation != expected[k]}
     assert not wrong, f"solvers annotated with another result type: {wrong}"
@@ -96,6 +96,31 @@ def test_result_types_are_frozen_and_the_old_shapes_are_gone():
         assert not set(names) & set(getattr(mod, "__all__", ())), module
     with pytest.raises(ValueError, match="stop_reason must be one of"):
         NormalSolution("rebound", *(0.0,) * 9, 1, 0, "ok")
+
+
+def test_named_results_are_named_tuples_and_the_family_returns_a_record():
+    """What crosses a module boundary is named: the set-ups and states of NAMED, and the whole
+    impacts of a NormalFamily (a frozen record, its columns read-only)."""
+    from microimpact.solvers import engine, family, rkg, thornton_ning_law
+
+    calls = {"engine.engine_scales": lambda: engine.engine_scales(TABLE1_ROW2, 2.0),
+             "rkg.rkg_setup": lambda: rkg.rkg_setup(TABLE1_ROW2, [2.0]),
+             "rkg.rkg_state": lambda: rkg.rkg_state(0.0, 0.0, 0.0, 1.0, 0.0, 0.01, 10, xi0=1.0),
+             "thornton_ning_law.law_parameters": lambda: thornton_ning_law.law_parameters(HARD, 1.0)}
+    assert set(calls) == set(NAMED)
+    for name, call in calls.items():
+        got = call()
+        assert type(got).__name__ == NAMED[name] and isinstance(got, tuple) and got._fields, name
+    sc = engine.engine_scales(TABLE1_ROW2, 2.0)
+    assert sc.y0 == 2.0 / sc.scales.speed  # y0 is the incident speed in the unit X / T
+    fam = family.normal_family(TABLE1_ROW2, 0.5, 5.0)
+    n = 3
+    out = fam.impacts(np.full(n, 2.0), np.full(n, 30.0), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                      np.full(n, 0.3))
+    assert isinstance(out, family.FamilyImpacts) and dataclasses.is_dataclass(out)
+    assert tuple(out.columns) == family.BATCH_VARIABLES and out.in_band.shape == (n,)
+    with pytest.raises(TypeError):
+        out.columns["e_n"] = np.zeros(n)
 
 
 HERTZ = TABLE1_ROW2.with_(zeta_hertz=0.0, zeta_adhesion=0.0, adhesion_line_force=0.0)

@@ -61,6 +61,7 @@ from __future__ import annotations
 
 import math
 import os
+from typing import NamedTuple
 
 import numpy as np
 from numba import prange, set_num_threads
@@ -74,7 +75,7 @@ from microimpact.solvers import dopri, driver
 from microimpact.solvers.dopri import hermite, illinois_point, illinois_update
 from microimpact.solvers.solution import NormalSolution, SolutionBatch
 
-__all__ = ["EngineError", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
+__all__ = ["EngineError", "EngineScales", "engine_scales", "MAX_ADHESIVE_SPEED", "solve_normal", "solve_normal_many", "normal_solution", "nondimensional_scales"]
 
 # Status codes of the compiled core
 _OK = 0
@@ -113,7 +114,19 @@ MIN_NONDIMENSIONAL_SPEED = 1e-30
 MAX_ADHESIVE_SPEED = 1e12
 
 
-def engine_scales(contact, normal_speed):
+class EngineScales(NamedTuple):
+    """The scales of the engine's solve of one impact (or per element, of arrays), :func:`engine_scales`."""
+
+    #: the units and coefficients a_h, a_a of Eq. (27)
+    scales: Scales
+    #: the incident speed in the unit X / T [-]
+    y0: object
+    #: the damping coefficients C1, C2 of Eq. (27) [-]
+    c1: object
+    c2: object
+
+
+def engine_scales(contact, normal_speed) -> EngineScales:
     """Scales of the engine's solve of each impact: (Scales, y0, C1, C2), per element for arrays.
 
     :func:`microimpact.model.law.nondimensional_impact`, except that an adhesive impact with
@@ -140,9 +153,9 @@ def engine_scales(contact, normal_speed):
     """
     sc, y0, c1, c2 = nondimensional_impact(contact, normal_speed)
     if type(y0) is float and (y0 <= MAX_ADHESIVE_SPEED or not sc.a_adhesion > 0.0):
-        return sc, y0, c1, c2  # one impact in the paper's scales: the common case, without numpy
+        return EngineScales(sc, y0, c1, c2)  # one impact in the paper's scales: the common case, without numpy
     if not (sc.a_adhesion > 0.0 and np.any(np.asarray(y0) > MAX_ADHESIVE_SPEED)):
-        return sc, y0, c1, c2
+        return EngineScales(sc, y0, c1, c2)
     v = np.asarray(normal_speed, dtype=float)
     shape = np.broadcast(v, y0).shape
     big = np.broadcast_to(np.asarray(y0) > MAX_ADHESIVE_SPEED, shape)
@@ -154,8 +167,8 @@ def engine_scales(contact, normal_speed):
     length[big], time[big], ah[big], aa[big] = xs, ts, 1.25, 1.25 * contact.length_scale / xs
     y0[big], c1[big], c2[big] = 1.0, c_h * vb, c_a * vb
     if not shape:
-        return Scales(float(length), float(time), float(ah), float(aa)), float(y0), float(c1), float(c2)
-    return Scales(length, time, ah, aa), y0, c1, c2
+        return EngineScales(Scales(float(length), float(time), float(ah), float(aa)), float(y0), float(c1), float(c2))
+    return EngineScales(Scales(length, time, ah, aa), y0, c1, c2)
 
 
 def _check_resolvable(y0, adhesive: bool, normal_speed) -> None:

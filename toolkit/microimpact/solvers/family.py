@@ -50,6 +50,7 @@ from __future__ import annotations
 import math
 import mmap
 from dataclasses import dataclass, field
+from types import MappingProxyType
 
 import numba
 import numpy as np
@@ -62,7 +63,7 @@ from microimpact.model.tangential import tangential_kernel
 from microimpact.solvers import DEFAULT_RTOL, SolverError, engine
 from microimpact.solvers.solution import SolutionBatch
 
-__all__ = ["NormalFamily", "normal_family", "normal_restitution", "FamilyBudgetExceeded", "DEGREE", "GUARD", "GUARD_IMPACTS",
+__all__ = ["FamilyImpacts", "NormalFamily", "normal_family", "normal_restitution", "FamilyBudgetExceeded", "DEGREE", "GUARD", "GUARD_IMPACTS",
            "FAMILY_MIN_SPEEDS"]
 
 #: from this many distinct normal speeds on, :func:`normal_restitution` and
@@ -165,6 +166,23 @@ def _evaluate(x, piece, left, right, coefficients, out):
         t = (2.0 * x[i] - left[p] - right[p]) / (right[p] - left[p])
         for q in range(coefficients.shape[1]):
             out[i, q] = _clenshaw(coefficients[p, q], t)
+
+
+@dataclass(frozen=True)
+class FamilyImpacts:
+    """Whole impacts of :meth:`NormalFamily.impacts`.
+
+    Attributes
+    ----------
+    columns : Mapping of str to ndarray
+        One flat array per :data:`BATCH_VARIABLES` name (SI; the outcome as its code); the rows of
+        the impacts in ``in_band`` are not filled.
+    in_band : ndarray of bool
+        The impacts in a guard band at the capture speed, which the caller solves directly.
+    """
+
+    columns: object
+    in_band: np.ndarray
 
 
 #: columns of :func:`_impacts_kernel`'s output, in order (the variables of simulate_many)
@@ -356,10 +374,11 @@ class NormalFamily:
                   self.coefficients, values)
         return self._assemble(v, piece, use_direct, values)
 
-    def impacts(self, speed, incidence_deg, azimuth_deg, w_n, w_t, w_tp, friction):
+    def impacts(self, speed, incidence_deg, azimuth_deg, w_n, w_t, w_tp, friction) -> FamilyImpacts:
         """Whole impacts (flat float arrays; speed [m/s], angles [deg], spins [rad/s], friction [-])
-        in one compiled pass; returns ({BATCH_VARIABLES name: array}, mask of the impacts in a
-        guard band, whose rows the caller must fill by direct solves)."""
+        in one compiled pass: the :class:`FamilyImpacts` (a read-only column per
+        :data:`BATCH_VARIABLES` name and the mask of the impacts in a guard band, whose rows the
+        caller must fill by direct solves)."""
         if self.restitution_only:
             raise ValueError("a restitution_only family has no impulses for the tangential map")
         c = self.contact
@@ -369,7 +388,7 @@ class NormalFamily:
         _impacts_kernel(speed, incidence_deg, azimuth_deg, w_n, w_t, w_tp, friction, self.edges, self.captured,
                         self.direct, self.coefficients, c.mass, c.moment_of_inertia, c.radius,
                         engine_settled_energy(c), out, solve_directly)
-        return dict(zip(BATCH_VARIABLES, out)), solve_directly
+        return FamilyImpacts(MappingProxyType(dict(zip(BATCH_VARIABLES, out))), solve_directly)
 
     def _assemble(self, v, piece, use_direct, values) -> SolutionBatch:
         c = self.contact

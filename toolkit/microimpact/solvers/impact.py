@@ -750,8 +750,9 @@ def _solve_batch(contact, flat: dict, rtol: float, family=None):
     fam = _family_of(contact, flat["speed"], flat["incidence_deg"], rtol, family)
     if fam is None:
         return (*_direct_batch(contact, flat, rtol), "direct: one engine solve per distinct normal speed")
-    results, in_band = fam.impacts(*(flat[k] for k in ("speed", "incidence_deg", "azimuth_deg", "omega_n",
-                                                        "omega_t", "omega_tp", "friction")))
+    impacts = fam.impacts(*(flat[k] for k in ("speed", "incidence_deg", "azimuth_deg", "omega_n",
+                                              "omega_t", "omega_tp", "friction")))
+    results, in_band = dict(impacts.columns), impacts.in_band
     n_solves = fam.n_solves
     if np.any(in_band):  # impacts in a guard band at the capture speed: solved directly, at the
         # tolerance of the nodes beside it (e_n ~ (v_n - v_c)^(1/2) turns a solve's error near v_c

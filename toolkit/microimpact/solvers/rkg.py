@@ -19,6 +19,7 @@ the global order drops from 4 to 2.5 or lower; with adhesion N = 1600 gives e_n 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import prange
@@ -31,7 +32,7 @@ from microimpact.solvers import engine
 from microimpact.solvers.driver import OK, Trace
 from microimpact.solvers.solution import NormalSolution, SolutionBatch
 
-__all__ = ["rkg_setup", "rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
+__all__ = ["RkgSetup", "RkgState", "rkg_setup", "rkg_state", "rkg_restitution", "solve_normal_rkg", "DEFAULT_STEPS"]
 
 #: Default steps per estimated contact duration of :func:`solve_normal_rkg` (e_n to ~1e-6 with
 #: adhesion, tests/test_benchmark.py).
@@ -137,6 +138,30 @@ def _rkg_many(y0, c1, c2, ah, aa, h, max_steps, out):
         out[i, 5], out[i, 6], out[i, 7], out[i, 8] = ja, xi_max, tau_j, e_end
 
 
+class RkgState(NamedTuple):
+    """The state of Eq. (27) after fixed RKG steps (:func:`rkg_state`). [-]"""
+
+    #: the nondimensional approach
+    xi: float
+    #: its rate d xi / d tau
+    y: float
+
+
+class RkgSetup(NamedTuple):
+    """The nondimensional set-up of RKG impacts, per speed (:func:`rkg_setup`). [-]"""
+
+    #: incident speed in the unit X / T, per speed
+    y0: np.ndarray
+    #: damping coefficients C1, C2 of Eq. (27), per speed
+    c1: np.ndarray
+    c2: np.ndarray
+    #: the coefficients a_h, a_a of Eq. (27)
+    a_hertz: object
+    a_adhesion: object
+    #: estimated contact duration in time units T, per speed
+    duration: np.ndarray
+
+
 @njit(cache=True)
 def _rkg_state_core(xi, y, c1, c2, ah, aa, h, n):
     for _ in range(n):
@@ -145,7 +170,7 @@ def _rkg_state_core(xi, y, c1, c2, ah, aa, h, n):
 
 
 def rkg_state(y0: float, c1: float, c2: float, a_hertz: float, a_adhesion: float, dtau: float,
-              n_steps: int, xi0: float = 0.0) -> tuple[float, float]:
+              n_steps: int, xi0: float = 0.0) -> RkgState:
     """State (xi, y) after ``n_steps`` fixed RKG steps of length ``dtau`` from (xi0, y0). [-]
 
     The nondimensional Eq. (27): xi'' = -a_h xi^(3/2) (1 + C1 y) + a_a xi^(1/2) (1 - C2 y).
@@ -166,11 +191,11 @@ def rkg_state(y0: float, c1: float, c2: float, a_hertz: float, a_adhesion: float
     >>> round(0.5 * y * y + 0.4 * xi ** 2.5, 9)
     0.4
     """
-    return _rkg_state_core(float(xi0), float(y0), float(c1), float(c2), float(a_hertz), float(a_adhesion),
-                           float(dtau), int(n_steps))
+    return RkgState(*_rkg_state_core(float(xi0), float(y0), float(c1), float(c2), float(a_hertz),
+                                     float(a_adhesion), float(dtau), int(n_steps)))
 
 
-def rkg_setup(contact, speeds):
+def rkg_setup(contact, speeds) -> RkgSetup:
     """Nondimensional y0, C1, C2, a_h, a_a and the estimated contact duration (tau) per speed.
 
     References
@@ -197,7 +222,7 @@ def rkg_setup(contact, speeds):
     # 50 time units for a captured sphere.
     t_contact = engine.solve_normal_many(contact, speeds, None, rtol=1e-6)["contact_time"]
     dur = np.where(np.isfinite(t_contact), t_contact / t_c, 50.0)
-    return y0, c1, c2, sc.a_hertz, sc.a_adhesion, dur
+    return RkgSetup(y0, c1, c2, sc.a_hertz, sc.a_adhesion, dur)
 
 
 def rkg_restitution(contact, speeds, steps_per_contact: int, *, setup=None) -> SolutionBatch:

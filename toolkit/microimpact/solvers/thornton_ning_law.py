@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict
+from typing import NamedTuple
 
 import numpy as np
 
@@ -44,7 +45,7 @@ from microimpact.model import thornton_ning as tn
 from microimpact.solvers import DEFAULT_RTOL, driver, dopri
 from microimpact.solvers.solution import NormalSolution
 
-__all__ = ["solve_thornton_ning", "law_parameters", "REBOUND", "CAPTURE"]
+__all__ = ["LawParameters", "solve_thornton_ning", "law_parameters", "REBOUND", "CAPTURE"]
 
 #: outcomes of one impact
 REBOUND, CAPTURE = 0, 1
@@ -243,7 +244,16 @@ def _integrate(p, rtol, max_steps):
 
 
 # --------------------------------------------------------------------------- Python interface
-def law_parameters(pc: tn.PlasticContact, normal_speed: float) -> tuple:
+class LawParameters(NamedTuple):
+    """The parameters of one impact for the compiled driver (:func:`law_parameters`)."""
+
+    #: the driver's positional parameter tuple p (SI; the module docstring), read inside compiled code
+    p: tuple
+    #: the length unit L of the impact [m]
+    length: float
+
+
+def law_parameters(pc: tn.PlasticContact, normal_speed: float) -> LawParameters:
     """The law's parameters tuple p of one impact (SI; see the module docstring) and its length L [m].
 
     Examples
@@ -260,7 +270,7 @@ def law_parameters(pc: tn.PlasticContact, normal_speed: float) -> tuple:
     length = max(hertz, jkr)
     p = (pc.radius, pc.e_star, pc.work_of_adhesion, pc.yield_pressure, y.contact_radius, y.approach, y.force,
          length, length / (pc.mass * v * v))
-    return tuple(float(x) for x in p), length
+    return LawParameters(tuple(float(x) for x in p), length)
 
 
 def solve_thornton_ning(pc: tn.PlasticContact, normal_speed: float, *, rtol: float = DEFAULT_RTOL,

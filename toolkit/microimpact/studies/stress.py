@@ -110,7 +110,7 @@ from microimpact.solvers.impact import settled_contact_energy, simulate_impact
 from microimpact.solvers import TimeBudgetExceeded, check_sub_models
 from microimpact.solvers.reference import simulate_reference
 from microimpact._runtime.timeout import time_limit
-from microimpact.model.adhesion_models import AdhesionRegimeWarning
+from microimpact.model.adhesion_models import AdhesionRegimeWarning, hertz_scales
 from microimpact.solvers import UndeterminedOutcomeWarning
 from microimpact._runtime.usage import parse_or_status
 
@@ -155,6 +155,23 @@ LAWS = {
     "hertz_coeff_restitution": {"damping_model": "coeff_restitution", "adhesion": False},
     "jkr_force_viscoelastic": {"normal_model": "jkr_force", "damping_model": "viscoelastic"},
     "dmt_mass_velocity": {"normal_model": "dmt", "damping_model": "mass_velocity"},
+    # LAMMPS's tangential, rolling and twisting laws (microimpact.model.dem_tangential, dem_rolling,
+    # dem_twisting), each on a DEM damping law (the only one they combine with, model.laws); their
+    # stiffnesses from the case's Hertz contact (:func:`_dem_stiffnesses`)
+    "hertz_mass_velocity_linear_history": {"damping_model": "mass_velocity", "adhesion": False,
+                                           "tangential_model": "linear_history"},
+    "jkr_force_viscoelastic_lammps_mindlin": {"normal_model": "jkr_force", "damping_model": "viscoelastic",
+                                              "tangential_model": "lammps_mindlin"},
+    "dmt_mass_velocity_lammps_mindlin_rescale": {"normal_model": "dmt", "damping_model": "mass_velocity",
+                                                 "tangential_model": "lammps_mindlin_rescale"},
+    "hertz_tsuji_lammps_mindlin_force": {"damping_model": "tsuji", "adhesion": False,
+                                         "tangential_model": "lammps_mindlin_force"},
+    "jkr_force_viscoelastic_lammps_mindlin_rescale_force_sds": {
+        "normal_model": "jkr_force", "damping_model": "viscoelastic", "tangential_model": "lammps_mindlin_rescale_force",
+        "rolling_model": "lammps_sds", "twisting_model": "lammps_sds"},
+    "hertz_coeff_restitution_linear_history_marshall": {"damping_model": "coeff_restitution", "adhesion": False,
+                                                        "tangential_model": "linear_history",
+                                                        "twisting_model": "lammps_marshall"},
     # the rate-independent elastic-plastic adhesive law of Thornton & Ning (1998), not a Contact
     # choice: its cases are checked by :func:`_plastic_check` (see :func:`plastic_contact_of`)
     "thornton_ning": {"plastic": True},
@@ -285,9 +302,7 @@ def contact_of(case: dict, law: str = "ring") -> Contact:
     if fields.get("damping_model", "paper") != "paper":
         return _dem_contact(case, fields, adhesive)
     if fields.get("tangential_model", "rigid") != "rigid":
-        youngs = 1.5 * case["stiffness"] * (1.0 - POISSON**2)
-        g = float(tc.shear_modulus_from_elastic(youngs, POISSON))
-        fields["shear_modulus"] = float(tc.effective_shear_modulus(g, POISSON, g, POISSON))
+        fields["shear_modulus"] = _effective_shear_modulus(case)
     return Contact.from_work_of_adhesion(
         case["radius"], case["density"], case["stiffness"], case["work_of_adhesion"],
         zeta_hertz=case["zeta_hertz"], zeta_adhesion=case["zeta_adhesion"], friction=case["friction"], **fields,
@@ -380,14 +395,46 @@ def _plastic_check(case: dict, reference: bool, tol: dict, out: dict) -> None:
 def _dem_contact(case: dict, fields: dict, adhesive: bool) -> Contact:
     """A case under a DEM damping law: the drawn zeta_H (1e-3 to 1e6, or 0) sets the damping as a
     multiple of the critical damping 2 sqrt(m k) of the case's Hertz impact (k = K a at its largest
-    approach), or the restitution e = 1 / (1 + zeta_H) of tsuji and coeff_restitution."""
+    approach), or the restitution e = 1 / (1 + zeta_H) of tsuji and coeff_restitution; a LAMMPS
+    tangential, rolling or twisting law gets the stiffnesses of :func:`_dem_stiffnesses`."""
     r, rho, k = case["radius"], case["density"], case["stiffness"]
     f0 = adhesion_line_force_from_work(k, r, case["work_of_adhesion"]) if adhesive else 0.0
+    fields = {**fields, **_dem_stiffnesses(case, fields)}
     zeta = case["zeta_hertz"]
     if fields["damping_model"] in ("tsuji", "coeff_restitution"):
         return Contact(r, rho, k, f0, friction=case["friction"], damping_coefficient=1.0 / (1.0 + zeta), **fields)
     base = Contact(r, rho, k, f0, friction=case["friction"], **fields)
     return base.with_(damping_coefficient=zeta * critical_damping_coefficient(base, _normal_speed(case)))
+
+
+def _dem_stiffnesses(case: dict, fields: dict) -> dict:
+    """The Contact fields a LAMMPS tangential, rolling or twisting law of ``fields`` needs, scaled
+    by the case's Hertz contact at its largest undamped approach (radius a, stiffness k_n = K a):
+    k_t = 2 k_n / 7 of linear_history (the ratio of the normal and tangential frequencies of a
+    Hookean sphere, Schaefer, Dippel & Wolf 1996), G* from the stiffness and :data:`POISSON` of the
+    Mindlin laws, k_roll = k_n and mu_roll = 0.1 of rolling sds, k_twist = k_n a^2 and
+    mu_twist = 0.1 a of twisting sds (sds laws: LAMMPS ``pair_style granular``)."""
+    plain = Contact(case["radius"], case["density"], case["stiffness"], 0.0)
+    a = float(hertz_scales(plain, _normal_speed(case)).radius)
+    k_n = case["stiffness"] * a
+    out = {}
+    tangential = fields.get("tangential_model", "rigid")
+    if tangential == "linear_history":
+        out["tangential_stiffness"] = 2.0 * k_n / 7.0
+    elif tangential.startswith("lammps_mindlin"):
+        out["shear_modulus"] = _effective_shear_modulus(case)
+    if fields.get("rolling_model") == "lammps_sds":
+        out.update(rolling_stiffness=k_n, rolling_friction=0.1)
+    if fields.get("twisting_model") == "lammps_sds":
+        out.update(twisting_stiffness=k_n * a * a, twisting_friction=0.1 * a)
+    return out
+
+
+def _effective_shear_modulus(case: dict) -> float:
+    """G* of two equal bodies of the drawn stiffness K and Poisson's ratio :data:`POISSON`. [Pa]"""
+    youngs = 1.5 * case["stiffness"] * (1.0 - POISSON**2)
+    g = float(tc.shear_modulus_from_elastic(youngs, POISSON))
+    return float(tc.effective_shear_modulus(g, POISSON, g, POISSON))
 
 
 def _omega(case):
