@@ -1,9 +1,9 @@
 """The one result type of every normal solve, and the one of every batch of solves.
 
 Every solver of one normal impact returns a :class:`NormalSolution` (SI units), whatever integrates
-it: the compiled driver's laws (the paper's ring law, :mod:`.engine`; JKR, DMT and Hertz with a DEM
-damping, :mod:`.normal_models`; Thornton & Ning, :mod:`.thornton_ning_law`), the paper's
-Runge-Kutta-Gill method (:mod:`.rkg`) and the independent scipy references
+it: the compiled driver's laws (the paper's ring law, :mod:`~microimpact.solvers.engine`; JKR, DMT and Hertz with a DEM
+damping, :mod:`~microimpact.solvers.normal_models`; Thornton & Ning, :mod:`~microimpact.solvers.thornton_ning_law`), the paper's
+Runge-Kutta-Gill method (:mod:`~microimpact.solvers.rkg`) and the independent scipy references
 (:func:`~microimpact.solvers.normal_models.solve_normal_reference`,
 :func:`~microimpact.solvers.reference.reference_trajectory`,
 :func:`~microimpact.solvers.plastic_reference.plastic_impact`). It says why the solve stopped
