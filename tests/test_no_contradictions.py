@@ -29,8 +29,9 @@ import io
 import json
 import math
 import re
-import subprocess
 
+
+import pypdf
 import pytest
 from scipy import stats
 
@@ -212,7 +213,9 @@ def test_the_json_checker_finds_planted_contradictions():
 
 # ----------------------------------------------------------------------------- the PDF of the report fixture
 def _pdf_text(path) -> str:
-    return subprocess.run(["pdftotext", "-layout", str(path), "-"], check=True, capture_output=True, text=True).stdout
+    # pypdf (a test dependency) rather than poppler's pdftotext, which a fresh machine may lack; its
+    # layout mode keeps each printed line on a line of its own, as the report draws it
+    return "\n".join(page.extract_text(extraction_mode="layout") for page in pypdf.PdfReader(path).pages)
 
 
 def test_the_report_fixture_pdf_says_nothing_its_numbers_contradict(tmp_path):
