@@ -30,7 +30,6 @@ import json
 import math
 import re
 
-
 import pypdf
 import pytest
 from scipy import stats
