@@ -79,11 +79,26 @@ from microimpact.io.resources import check_memory
 from microimpact.model.parameters import TABLE2_CASES
 from microimpact.solvers import DEFAULT_RTOL, Deadline, engine, engine_threads
 from microimpact.solvers.impact import simulate_many
+from microimpact.model import reduction
+from microimpact.solvers import emulator
 
 __all__ = ["Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "DEFAULT_WALKERS", "DEFAULT_MAX_STEPS",
            "DEFAULT_SEED", "DEFAULT_N_DRAWS", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
            "sweep_bands", "summary_table", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES", "LIKELIHOODS",
-           "DEFAULT_NU", "CONDITIONAL_ON_REJECTED"]
+           "DEFAULT_NU", "CONDITIONAL_ON_REJECTED", "METHODS", "EMULATOR_TOLERANCE"]
+
+#: how the likelihood evaluates the model e_n: "solve" (the solver at every call, the reference) or
+#: "emulator" (the ring law's table, :mod:`microimpact.solvers.emulator`, the solver where it falls back)
+METHODS = ("solve", "emulator")
+#: absolute e_n tolerance of the emulator in the likelihood: far below the data's noise (stated e_n
+#: uncertainties ~5e-3), so that 100 rows move the log-likelihood by at most ~100 x 1e-6 / 5e-3 = 0.02
+#: (a shift of the posterior far below its Monte Carlo error), and a table that builds in
+#: seconds to a minute on a cold cache where 1e-8 takes minutes
+EMULATOR_TOLERANCE = 1e-6
+#: the emulator's box of groups for the posterior: the table's default box with C2 down to 0.03, so
+#: that the bundled data's fastest impacts (C2 ~ 0.09 at 23 m/s, C2 falling as v^(-1/5)) are in it
+#: rather than solved at every evaluation
+POSTERIOR_DOMAIN = dict(emulator.DOMAIN) | {"adhesion_damping": (0.03, 0.5)}
 
 #: what a posterior of a rejected model says of itself
 CONDITIONAL_ON_REJECTED = "conditional on a rejected model"
@@ -368,7 +383,12 @@ class _Likelihood:
     the tangential part. Each evaluation: one model_restitution call (one engine call per radius)
     and, with oblique data, one simulate_many call per radius."""
 
-    def __init__(self, damping_fit, table, friction_fit, eiv, rtol, likelihood="normal", nu=DEFAULT_NU):
+    def __init__(self, damping_fit, table, friction_fit, eiv, rtol, likelihood="normal", nu=DEFAULT_NU,
+                 method="solve", tol=EMULATOR_TOLERANCE):
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {', '.join(METHODS)}, got {method!r}")
+        self.method, self.tol, self._groups = method, float(tol), {}
+        self.domain = POSTERIOR_DOMAIN  # the emulator's box of groups (tests give a small one)
         if likelihood not in LIKELIHOODS:
             raise ValueError(f"likelihood must be one of {', '.join(LIKELIHOODS)}, got {likelihood!r}")
         if not (isinstance(nu, numbers.Real) and math.isfinite(nu) and nu > 0):
@@ -424,8 +444,54 @@ class _Likelihood:
         near = v - 3 * sig_v < np.array([v_cap[float(rr)] for rr in r])
         return has & ((curvature > 0.25 * sig) | near)
 
+    def model(self, p: dict) -> np.ndarray:
+        """Model e_n at the likelihood's speeds (plain rows, then the latent rows' nodes). [-]"""
+        if self.method == "emulator":
+            return self._emulated(p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"])
+        return model_restitution(self.problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=self.rtol)
+
+    def _speed_groups(self, work_of_adhesion):
+        """(y0, C1 / zeta_H = C2 / zeta_A) of every speed at ``work_of_adhesion``, or None where a
+        radius's law is not the ring law. The groups are linear in the zetas (Eqs. (14)-(15),
+        :func:`microimpact.model.reduction.ring_groups`): computed once per w_A, they make an
+        evaluation one table lookup without building a Contact."""
+        key = float(work_of_adhesion)
+        if key not in self._groups:
+            pr = self.problem
+            y0, per = np.empty(pr.normal_speed.size), np.empty(pr.normal_speed.size)
+            ok = True
+            for r, idx in zip(pr.radii, pr.groups):
+                c = pr.contact(r, 1.0, 1.0, key)
+                ok = ok and reduction.law_of(c) == "ring"
+                if ok:
+                    y, per_speed, _ = reduction.ring_groups([c], pr.normal_speed[idx][None, :])
+                    y0[idx], per[idx] = y[0], per_speed[0]
+            self._groups = {key: (y0, per) if ok else None}  # one w_A at a time: a fitted w_A moves every call
+        return self._groups[key]
+
+    def _emulated(self, zeta_hertz, zeta_adhesion, work_of_adhesion) -> np.ndarray:
+        """e_n by the table where it meets ``tol``, by the emulator's fallback solves elsewhere. [-]"""
+        g = self._speed_groups(work_of_adhesion)
+        pr = self.problem
+        if g is None:  # not the ring law: the solver
+            return model_restitution(pr, zeta_hertz, zeta_adhesion, work_of_adhesion, rtol=self.rtol)
+        y0, per = g
+        if getattr(self, "_table", None) is None:  # looked up once: the lookup hashes the physics' source
+            self._table = emulator.ring_emulator(emulator._table_tolerance(self.tol), self.domain)
+        table = self._table
+        e, _, solve = table.evaluate(y0, zeta_hertz * per, zeta_adhesion * per, self.tol)
+        e = np.array(e, dtype=float)
+        if solve.any():
+            with engine_threads(1):
+                for r, idx in zip(pr.radii, pr.groups):
+                    s = idx[solve[idx]]
+                    if s.size:
+                        e[s] = emulator._fallback(pr.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion),
+                                                  pr.normal_speed[s], self.tol)
+        return e
+
     def __call__(self, p: dict) -> float:
-        m = model_restitution(self.problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=self.rtol)
+        m = self.model(p)
         plain = ~self.latent
         res = (m[: self.n_plain] - self.e[plain]) / self.sig_eff[plain]
         logl = float(np.sum(self.log_density(res)))
@@ -524,6 +590,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
                      max_steps: int | None = None, burn: int | None = None, seed: int = DEFAULT_SEED,
                      errors_in_variables: str = "auto", rtol: float = DEFAULT_RTOL, progress: bool = False,
                      time_budget: float | None = None, require_convergence: bool = True, likelihood: str = "normal",
+                     method: str = "solve", emulator_tol: float = EMULATOR_TOLERANCE,
                      nu: float = DEFAULT_NU) -> Posterior:
     """Sample the posterior of the fitted parameters with emcee until it converges (seeded).
 
@@ -561,6 +628,13 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
         e_n likelihood of each row (module docstring).
     nu : float
         Degrees of freedom of the Student-t likelihood (default :data:`DEFAULT_NU`). [-]
+    method : {"solve", "emulator"}
+        Model e_n of the likelihood: the solver at every evaluation (the reference), or the ring
+        law's table (:func:`microimpact.solvers.emulator.ring_emulator`, built and cached on first
+        use) with its groups computed once, the solver where the table falls back or the law is
+        not the ring law. The oblique part is always solved.
+    emulator_tol : float
+        Absolute e_n tolerance of ``method="emulator"`` (default :data:`EMULATOR_TOLERANCE`). [-]
 
     Returns
     -------
@@ -612,7 +686,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     """
     t0 = time.perf_counter()
     deadline = Deadline.start(time_budget, "posterior")
-    like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol, likelihood, nu)
+    like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol, likelihood, nu, method, emulator_tol)
     names = list(damping_fit.varied) + (["friction"] if friction_fit is not None else [])
     best = dict(damping_fit.values) | ({"friction": friction_fit.friction} if friction_fit is not None else {})
     stderr = dict(damping_fit.stderr) | ({"friction": friction_fit.stderr["friction"]} if friction_fit is not None else {})
@@ -682,7 +756,9 @@ def _posterior_record(sampler, diag, names, best, bounds, like, damping_fit, fri
                            "status": _statuses(damping_fit, friction_fit),
                            "bounds": _statuses(damping_fit, friction_fit, "bounds"),
                            "moves": "emcee DEMove 0.8 + DESnookerMove 0.2",
-                           "likelihood": like.description()} | _fit_verdict(damping_fit)
+                           "likelihood": like.description(),
+                           "method": like.method + (f" (tol {like.tol:g})" if like.method == "emulator" else "")}
+                     | _fit_verdict(damping_fit)
                      | ({"student_t_nu": like.nu} if like.student else {}))
 
 

@@ -1,0 +1,107 @@
+"""The posterior's emulated likelihood (method="emulator") against the solver's (method="solve").
+
+The fixture (a fit of six impacts and a small table, ~7 s) puts the tests that use it in the extended stage."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from microimpact.analysis.fitting import fit_damping
+from microimpact.analysis.posterior import _Likelihood, sample_posterior
+from microimpact.analysis.synthetic import write_synthetic_impacts
+from microimpact.io import default_materials_path, read_impacts, read_materials
+from microimpact.solvers import emulator as em
+
+#: a small box of groups about the six impacts' (C1 2e-3 to 4e-3, C2 0.09 to 0.2): a table that builds
+#: in seconds; the impacts outside it go to the fallback solves, which the test covers as well
+BOX = {"hertz_damping": (2e-3, 4e-3), "adhesion_damping": (0.1, 0.2), "incident_speed": (1e-2, 1e2)}
+#: the table's absolute e_n tolerance in these tests
+TOL = 1e-3
+
+
+@pytest.fixture(scope="module")
+def six(tmp_path_factory):
+    mp = pytest.MonkeyPatch()
+    mp.setenv("MICROIMPACT_CACHE", str(tmp_path_factory.mktemp("cache")))
+    em._LOADED.clear()
+    material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    path = write_synthetic_impacts(tmp_path_factory.mktemp("d") / "six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
+    table = read_impacts(path)
+    fit = fit_damping(table, material, confidence_intervals=False)
+    em.ring_emulator(TOL, BOX)
+    like = _Likelihood(fit, table, None, "auto", 1e-10, method="emulator", tol=TOL)
+    like.domain = BOX
+    like.model(dict(fit.values))  # the table's kernels loaded before the tests
+    yield table, fit
+    em._LOADED.clear()
+    mp.undo()
+
+
+def _pair(table, fit):
+    solve = _Likelihood(fit, table, None, "auto", 1e-10, method="solve")
+    emulated = _Likelihood(fit, table, None, "auto", 1e-10, method="emulator", tol=TOL)
+    emulated.domain = BOX
+    return solve, emulated
+
+
+@pytest.mark.extended
+def test_emulated_model_meets_its_tolerance_at_random_points(six):
+    table, fit = six
+    solve, emulated = _pair(table, fit)
+    rng = np.random.default_rng(5)
+    base = dict(fit.values)
+    decided = 0
+    for z_h, z_a in zip(rng.uniform(0.3, 0.7, 6), rng.uniform(27.0, 31.0, 6)):
+        p = base | {"zeta_hertz": float(z_h), "zeta_adhesion": float(z_a)}
+        a, b = solve.model(p), emulated.model(p)
+        # the table's error estimate is below TOL; the solves at rtol 1e-10 are exact on that scale
+        assert np.max(np.abs(a - b)) <= TOL
+        # log-likelihoods: every row moves by at most |z| TOL / sigma + (TOL / sigma)^2 / 2
+        z = (a - solve.e) / solve.sig_eff
+        bound = float(np.sum(np.abs(z) * TOL / solve.sig_eff + 0.5 * (TOL / solve.sig_eff) ** 2))
+        assert abs(solve(p) - emulated(p)) <= bound
+        decided += int(np.sum(np.abs(a - b) > 0))
+    assert decided > 0  # some points came from the table, not all from the fallback
+
+
+@pytest.mark.extended
+def test_emulated_model_is_the_solver_where_it_falls_back(six):
+    table, fit = six
+    solve, emulated = _pair(table, fit)
+    emulated.domain = {"hertz_damping": (1e-1, 2e-1), "adhesion_damping": (5.0, 10.0), "incident_speed": (1e-2, 1e2)}
+    p = dict(fit.values)
+    with pytest.MonkeyPatch.context() as mp:  # a box that holds no impact: no table is needed, every point is solved
+        mp.setattr(em.RingEmulator, "evaluate", lambda self, y0, c1, c2, tol: (np.zeros(y0.shape), np.zeros(y0.shape, bool),
+                                                                                 np.ones(y0.shape, bool)))
+        mp.setattr(em, "ring_emulator", lambda tol, domain=None: em.RingEmulator.__new__(em.RingEmulator))
+        b = emulated.model(p)
+    # the fallback solves at rtol tol / 100 and the reference at 1e-10: they differ by ~1e-5 at most
+    assert np.max(np.abs(solve.model(p) - b)) <= 10 * TOL * em.FALLBACK_RTOL
+
+
+def test_method_is_checked():
+    with pytest.raises(ValueError, match="method must be one of solve, emulator"):
+        _Likelihood(None, None, None, "auto", 1e-8, method="table")
+
+
+@pytest.mark.extended
+def test_posterior_medians_agree_between_methods(six):
+    table, fit = six
+    a = sample_posterior(table, fit, walkers=8, steps=40, require_convergence=False, method="solve")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(_Likelihood, "__init__", _boxed(_Likelihood.__init__))
+        b = sample_posterior(table, fit, walkers=8, steps=40, require_convergence=False, method="emulator",
+                             emulator_tol=TOL)
+    assert b.info["method"] == f"emulator (tol {TOL:g})" and a.info["method"] == "solve"
+    for name in a.names:
+        # same seed, likelihoods within ~0.01 of each other: the chains' medians within a tenth of the spread
+        spread = np.std(a.samples[:, a.names.index(name)])
+        assert abs(a.median()[name] - b.median()[name]) <= 0.1 * spread
+
+
+def _boxed(init):
+    def wrapped(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        self.domain = BOX
+    return wrapped
