@@ -106,6 +106,8 @@ HOW = {
     # compile time of each kernel group
     "python tests/study_cold_warm.py --pairs 3 --out docs/cold-warm.json": "study",
     "python tests/study_compile_times.py --repeats 2 --out docs/compile-times.json": "study",
+    # docs/studies.md: the posterior by method="solve" and method="emulator" side by side
+    "python tests/study_posterior_speed.py --out docs/posterior-speed.json": "study",
     # the quick benchmark and the stress sweep: the pipeline's benchmark and stress rules run both
     "microimpact benchmark --quick --out results/benchmark": "study",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "study",
