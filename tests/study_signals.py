@@ -161,6 +161,17 @@ def trial(root, template, config, reference, number, signum, to_group, moment, m
             "status": proc.returncode, "lines_after": len(after), "problems": problems, "passed": not problems}
 
 
+def _by_kind(rows) -> dict:
+    """Count the trials signalled while their run lived, by signal, recipient and (SIGINT) early or late."""
+    counts = {}
+    for r in rows:
+        if r["finished_before_the_signal"]:
+            continue
+        kind = f'{r["signal"]} to {r["to"]}' + ((" early" if r["moment"] < 10.0 else " late") if r["signal"] == "SIGINT" else "")
+        counts[kind] = counts.get(kind, 0) + 1
+    return counts
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sigint", type=int, default=30)
@@ -197,8 +208,11 @@ def main() -> int:
         return 1
     print(json.dumps({"cold_seconds": round(cold, 1), "warm_seconds": round(duration, 1)}), flush=True)
     plan = [(signal.SIGINT, True, rng.uniform(0.0, 10.0)) for _ in range(args.early)]
-    plan += [(signal.SIGINT, True, rng.uniform(0.0, duration)) for _ in range(args.sigint - args.early)]
-    plan += [(signal.SIGTERM, i % 2 == 0, rng.uniform(0.0, duration)) for i in range(args.sigterm)]
+    # Moments over the first 90 % of the uninterrupted run, so that a trial whose run is a little
+    # faster than the measured one still lives at its moment (a trial that ended first counts as unsignalled).
+    within = 0.9 * duration
+    plan += [(signal.SIGINT, True, rng.uniform(0.0, within)) for _ in range(args.sigint - args.early)]
+    plan += [(signal.SIGTERM, i % 2 == 0, rng.uniform(0.0, within)) for i in range(args.sigterm)]
     rng.shuffle(plan)  # any prefix of the trials is a sample of all kinds
     rows = []
     for number, (signum, to_group, moment) in enumerate(plan, 1):
@@ -208,7 +222,8 @@ def main() -> int:
         summary = {"targets": TARGETS or ["all"], "cold_seconds": round(cold, 1),
                    "uninterrupted_seconds": round(duration, 1),
                    "planned": len(plan), "trials": len(rows), "passed": sum(r["passed"] for r in rows),
-                   "signalled": sum(not r["finished_before_the_signal"] for r in rows), "rows": rows}
+                   "signalled": sum(not r["finished_before_the_signal"] for r in rows),
+                   "signalled_by_kind": _by_kind(rows), "rows": rows}
         if args.out:
             Path(args.out).write_text(json.dumps(summary, indent=1) + "\n")
     print(json.dumps({k: v for k, v in summary.items() if k != "rows"}))
