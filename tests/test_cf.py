@@ -91,7 +91,7 @@ def result_files(tmp_path_factory):
         repeats_single=1, repeats_scipy=1, repeats_batch=1, batch_size=10,
         throughput_impacts=100, throughput_repeats=1, memory_sizes=(50, 100), time_limit=5.0,
         reference_rtols=(1e-10, 1e-11), family_size=10, family_impacts=200, family_check=20,
-        family_memory_sizes=(10, 20), fit_rows=200,  # (the class defaults are the full run's millions)
+        family_memory_sizes=(10, 20), fit_rows=20,  # (the class defaults are the full run's millions)
     )
     files["benchmark"] = write_netcdf(benchmark.run_benchmark(config=cfg), out / "benchmark.nc")
     return files

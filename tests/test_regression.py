@@ -363,6 +363,7 @@ def test_one_core_against_the_three_steppers(integrators_base, selection):
 
 
 # --------------------------------------------------------------------------- the compiled solvers, bit for bit
+@pytest.mark.extended  # about 27 s: 1.8 million recorded steps of light-damped captures
 def test_compiled_solvers_bit_for_bit():
     """The engine, the JKR/DMT/Hertz solver and the coupled solver give the numbers of
     tests/regression/baseline/kernels.json exactly, step counts included (tests/regression/kernel_cases.py:
