@@ -333,6 +333,7 @@ class Posterior(ReportHTML, FitResult):
             **({"comment": f"this posterior is {CONDITIONAL_ON_REJECTED} ({info.get('verdict_text', '')})"}
                if self.rejected else {}),
             **({"moves": str(info["moves"])} if "moves" in info else {}),
+            **({"likelihood_method": str(info["method"])} if "method" in info else {}),
             **({"elapsed_s": float(info["elapsed_s"])} if "elapsed_s" in info else {}),
             **{f"fixed_{k}": float(v) for k, v in self.fixed.items()}})
         return ds
@@ -368,6 +369,8 @@ class Posterior(ReportHTML, FitResult):
                      "ess_bulk": {n: float(v["ess_bulk"]) for n, v in per.items()}}
         recorded = {"latent_rows": tuple(int(r) for r in str(a.get("latent_speed_rows", "")).split()),
                     "source": str(a.get("source", ""))}
+        if "likelihood_method" in a:
+            recorded["method"] = str(a["likelihood_method"])
         recorded |= {k: f(a[k]) for k, f in (("moves", str), ("elapsed_s", float), ("likelihood", str),
                                              ("verdict", str), ("verdict_text", str), ("p_value", float),
                                              ("student_t_nu", float)) if k in a}
