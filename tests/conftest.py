@@ -27,6 +27,7 @@ except ImportError:
 
 import microimpact as mi
 from microimpact.presets import WALL_1990
+from microimpact.solvers import emulator
 from microimpact.studies.lammps_check import LammpsUnavailable, load_lammps
 
 ApproxScalar.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
@@ -107,3 +108,15 @@ def needs_lammps():
         if os.environ.get("MICROIMPACT_REQUIRE_LAMMPS") == "1":
             pytest.fail(f"MICROIMPACT_REQUIRE_LAMMPS=1 but {exc}")
         pytest.skip(str(exc))
+
+
+@pytest.fixture(scope="module")
+def private_emulator_cache(tmp_path_factory):
+    """The emulator's tables cached in a directory of this module only, none loaded before or after
+    (a table built here for a small test box never reaches another test or the user's cache)."""
+    mp = pytest.MonkeyPatch()
+    mp.setenv("MICROIMPACT_CACHE", str(tmp_path_factory.mktemp("cache")))
+    emulator._LOADED.clear()
+    yield
+    emulator._LOADED.clear()
+    mp.undo()

@@ -25,13 +25,8 @@ JUDGE_RTOL = 1e-12
 
 
 @pytest.fixture(scope="module")
-def table(tmp_path_factory):
-    mp = pytest.MonkeyPatch()
-    mp.setenv("MICROIMPACT_CACHE", str(tmp_path_factory.mktemp("cache")))
-    em._LOADED.clear()
-    yield em.ring_emulator(TOL, SMALL)
-    em._LOADED.clear()
-    mp.undo()
+def table(private_emulator_cache):
+    return em.ring_emulator(TOL, SMALL)
 
 
 def _random_groups(rng, n, box=SMALL):

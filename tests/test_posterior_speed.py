@@ -21,10 +21,7 @@ TOL = 1e-3
 
 
 @pytest.fixture(scope="module")
-def six(tmp_path_factory):
-    mp = pytest.MonkeyPatch()
-    mp.setenv("MICROIMPACT_CACHE", str(tmp_path_factory.mktemp("cache")))
-    em._LOADED.clear()
+def six(tmp_path_factory, private_emulator_cache):
     material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
     path = write_synthetic_impacts(tmp_path_factory.mktemp("d") / "six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
     table = read_impacts(path)
@@ -33,9 +30,7 @@ def six(tmp_path_factory):
     like = _Likelihood(fit, table, None, "auto", 1e-10, method="emulator", tol=TOL)
     like.domain = BOX
     like.model(dict(fit.values))  # the table's kernels loaded before the tests
-    yield table, fit
-    em._LOADED.clear()
-    mp.undo()
+    return table, fit
 
 
 def _pair(table, fit):
