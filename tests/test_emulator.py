@@ -143,8 +143,8 @@ def test_bad_tolerance_is_refused():
 
 
 def test_the_table_tolerance_is_the_power_of_ten_below():
-    assert em._table_tolerance(3e-6) == pytest.approx(1e-6, rel=1e-12, abs=0)
-    assert em._table_tolerance(1e-6) == pytest.approx(1e-6, rel=1e-12, abs=0)
+    assert em.table_tolerance(3e-6) == pytest.approx(1e-6, rel=1e-12, abs=0)
+    assert em.table_tolerance(1e-6) == pytest.approx(1e-6, rel=1e-12, abs=0)
     assert math.isclose(em.surface_tolerance(1e-4), 1e-6)
 
 
@@ -219,8 +219,44 @@ def test_the_fallback_resolves_near_capture_impacts_tighter():
         yc = em._capture_speed(c1, c2, SMALL["incident_speed"])[0]
         v = yc * (1.0 + np.array([1e-5, 1e-4, 1e-3])) * u  # e_n ~ 3e-3 to 3e-2
         want = normal_restitution(contact, v, rtol=1e-13, family=False)
-        got = em._fallback(contact, v, tol)
+        got = em.fallback_restitution(contact, v, tol)
         loose = normal_restitution(contact, v, rtol=tol * em.FALLBACK_RTOL)
     assert np.all((want > 1e-3) & (want < 0.1))
     assert np.max(np.abs(got - want)) <= tol
     assert np.max(np.abs(loose - want)) > tol  # what the one solve at tol / 100 would have given
+
+
+# ------------------------------------------------------------------ the tables shipped with the package
+def test_every_shipped_table_is_current_and_none_is_stale():
+    names = {em._table_name(tol, dict(domain)) for tol, domain in em.SHIPPED}
+    present = {p.name for p in em.shipped_dir().glob("ring-*.npz")}
+    hint = ('a change of the law, the engine or the emulator changed the tables\' key: rerun '
+            '`python -c "from microimpact.solvers.emulator import ship_tables; ship_tables()"` and commit '
+            'toolkit/microimpact/data/emulator/')
+    assert names <= present, f"missing {sorted(names - present)}; {hint}"
+    assert present <= names, f"stale {sorted(present - names)}; {hint}"
+
+
+def test_the_shipped_table_is_read_not_built(private_emulator_cache):
+    tol, domain = em.SHIPPED[0]
+    em._LOADED.clear()
+    shipped = em.ring_emulator(tol, domain)
+    built = list(em.cache_dir().glob("*.npz")) if em.cache_dir().exists() else []
+    assert built == []  # read from the package, not built into the cache
+    assert shipped.tolerance == pytest.approx(tol, rel=1e-12, abs=0)
+    assert shipped.max_check_error <= tol  # the build's own certification, stored with the table
+
+
+def test_the_shipped_table_meets_its_tolerance_against_the_solver(private_emulator_cache):
+    """300 impacts at random points of the shipped box (log-uniform groups, each a dimensional contact
+    drawn at random), judged by solves at rtol 1e-12 (e_n error ~1e-11, far below tol 1e-6)."""
+    tol, domain = em.SHIPPED[0]
+    em._LOADED.clear()
+    table = em.ring_emulator(tol, domain)
+    g = _random_groups(np.random.default_rng(7), 300, box=domain)
+    e, captured, solve = table.evaluate(g["incident_speed"], g["hertz_damping"], g["adhesion_damping"], tol)
+    assert solve.mean() < 0.1  # the box is the table's: few impacts go to the solver
+    judged = np.array([_judge(*x) for x in zip(g["incident_speed"][~solve], g["hertz_damping"][~solve],
+                                                g["adhesion_damping"][~solve])])
+    assert np.max(np.abs(e[~solve] - judged)) <= tol
+    assert np.array_equal(captured[~solve], judged == 0.0)

@@ -23,6 +23,7 @@ import pytest
 import microimpact
 from microimpact.analysis.kharaz import default_kharaz_path
 from microimpact.io import default_materials_path
+from microimpact.solvers import emulator
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGE = files("microimpact")
@@ -47,6 +48,13 @@ def test_package_copies_equal_the_repository_copies(name):
     assert PACKAGE.joinpath(name).read_bytes() == BUNDLED[name].read_bytes(), (
         f"toolkit/microimpact/{name} differs from {BUNDLED[name].relative_to(REPO)}: copy the one you "
         "changed over the other")
+
+
+def test_the_emulator_tables_ship_with_the_package():
+    # the posterior's likelihood reads them (microimpact.solvers.emulator.SHIPPED): an install whose
+    # wheel lacks them would build each on first use (about a minute) instead of reading it
+    for tol, domain in emulator.SHIPPED:
+        assert PACKAGE.joinpath("data", "emulator", emulator._table_name(tol, dict(domain))).is_file()
 
 
 def test_default_data_paths_are_the_package_copies():

@@ -1,14 +1,20 @@
 """The posterior's emulated likelihood (method="emulator") against the solver's (method="solve").
 
-The fixture (a fit of six impacts and a small table, ~7 s) puts the tests that use it in the extended stage."""
+The fixture (a fit of six impacts and a small table, ~7 s) puts the tests that use it in the extended stage;
+the method as an option of the fit and the CLI is tested in the default run."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
+import xarray as xr
 
+from microimpact.analysis.analyst_fit import _posterior_options
 from microimpact.analysis.fitting import fit_damping
-from microimpact.analysis.posterior import _Likelihood, sample_posterior
+from microimpact.analysis.posterior import DEFAULT_METHOD, _Likelihood, sample_posterior
+from microimpact.cli import main
 from microimpact.analysis.synthetic import write_synthetic_impacts
 from microimpact.io import default_materials_path, read_impacts, read_materials
 from microimpact.solvers import emulator as em
@@ -76,7 +82,7 @@ def test_emulated_model_is_the_solver_where_it_falls_back(six):
 
 
 def test_method_is_checked():
-    with pytest.raises(ValueError, match="method must be one of solve, emulator"):
+    with pytest.raises(ValueError, match="method must be one of emulator, solve"):
         _Likelihood(None, None, None, "auto", 1e-8, method="table")
 
 
@@ -100,3 +106,35 @@ def _boxed(init):
         init(self, *args, **kwargs)
         self.domain = BOX
     return wrapped
+
+
+# ------------------------------------------------------------------ the method as an option of the fit and the CLI
+def test_the_analyst_fit_takes_the_method_and_checks_it():
+    assert _posterior_options(True)["method"] == DEFAULT_METHOD == "emulator"
+    assert _posterior_options({"method": "solve", "walkers": 8})["method"] == "solve"
+    assert _posterior_options({"method": None})["method"] == DEFAULT_METHOD
+    with pytest.raises(ValueError, match="method must be one of emulator, solve, got 'table'"):
+        _posterior_options({"method": "table"})
+
+
+def test_posterior_method_without_posterior_is_refused(tmp_path, capsys):
+    path = write_synthetic_impacts(tmp_path / "six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
+    out = tmp_path / "fit.nc"
+    assert main(["fit", str(path), "--out", str(out), "--posterior-method", "solve"]) == 2
+    assert "--posterior-method" in capsys.readouterr().err and not out.exists()
+    assert main(["fit", str(path), "--out", str(out), "--posterior", str(tmp_path / "p.nc"),
+                 "--posterior-method", "table"]) == 2
+    assert "--posterior-method: invalid choice: 'table'" in capsys.readouterr().err and not out.exists()
+
+
+def test_cli_posterior_uses_the_shipped_table_and_records_it(tmp_path, capsys):
+    """The default chain run to convergence on six impacts through the CLI, the likelihood emulated
+    from the shipped table: the JSON summary and the posterior file say so."""
+    path = write_synthetic_impacts(tmp_path / "six.csv", radii=(3.45e-6,), n_per_radius=6, seed=3)
+    out, post = tmp_path / "fit.nc", tmp_path / "post.nc"
+    assert main(["fit", str(path), "--out", str(out), "--posterior", str(post), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["posterior"]["converged"] is True
+    assert summary["posterior"]["method"] == "emulator (tol 1e-06)"
+    with xr.open_dataset(post) as ds:
+        assert ds.attrs["likelihood_method"] == "emulator (tol 1e-06)"

@@ -36,8 +36,9 @@ from microimpact._runtime.usage import exit_status
 from microimpact.analysis.design_defaults import (DEFAULT_E_T_SIGMA, DEFAULT_NEW_IMPACTS, DEFAULT_NEW_OBLIQUE,
                                                   DEFAULT_OBLIQUE_QUANTITY, DEFAULT_PARAMETERS, DEFAULT_REBOUND_ANGLE_SIGMA,
                                                   DEFAULT_REBOUND_SPIN_SIGMA, OBLIQUE_QUANTITIES)
-from microimpact.analysis.sampling_defaults import (DEFAULT_LOSS, DEFAULT_MAX_STEPS, DEFAULT_NU, DEFAULT_SEED,
-                                                    DEFAULT_WALKERS, LIKELIHOODS, LOSSES, MAX_SEED)
+from microimpact.analysis import sampling_defaults
+from microimpact.analysis.sampling_defaults import (DEFAULT_LOSS, DEFAULT_MAX_STEPS, DEFAULT_METHOD, DEFAULT_NU,
+                                                    DEFAULT_SEED, DEFAULT_WALKERS, LIKELIHOODS, LOSSES, MAX_SEED)
 from microimpact.io.files import recorded_outputs
 from microimpact.io.lammps import DEFAULT_POISSON, LAMMPS_UNITS
 from microimpact.io.paths import DATA_README, PathError, check_input_file, reporting_os_errors
@@ -309,6 +310,10 @@ def _add_posterior_options(p: argparse.ArgumentParser) -> None:
                         "outlier pulls the posterior by a bounded amount)")
     p.add_argument("--nu", type=_positive_float, default=None,
                    help=f"degrees of freedom of the student-t likelihood (default {DEFAULT_NU:g})")
+    p.add_argument("--posterior-method", choices=sampling_defaults.METHODS, default=None,
+                   help=f"model e_n of the posterior's likelihood: emulator (the ring law's certified table, the "
+                        f"solver where it falls back) or solve (the solver at every evaluation, the reference); "
+                        f"default {DEFAULT_METHOD}")
     p.add_argument("--oblique-out", default=None, metavar="NC",
                    help="write the friction fit (oblique columns: measured vs fitted per row) to this NetCDF")
 

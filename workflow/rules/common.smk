@@ -33,6 +33,7 @@ config["posterior"] = {
     "max_steps": None,
     "seed": None,
     "n_draws": None,
+    "method": None,
     "errors_in_variables": "auto",
     **config.get("posterior", {}),
 }
@@ -40,7 +41,7 @@ config["posterior"] = {
     k: (
         as_bool(v)
         if k in ("enabled", "full")
-        else v if k == "errors_in_variables" or v is None else int(v)
+        else v if k in ("errors_in_variables", "method") or v is None else int(v)
     )
     for k, v in config["posterior"].items()
 }

@@ -18,7 +18,7 @@ def run(args) -> int:
                             input_files(args))
     out = outputs["--out"]
     posterior = False
-    unused = [f"--{name.replace('_', '-')}" for name in ("walkers", "steps", "max_steps", "seed", "nu")
+    unused = [f"--{name.replace('_', '-')}" for name in ("walkers", "steps", "max_steps", "seed", "nu", "posterior_method")
               if getattr(args, name) is not None] + (["--likelihood"] if args.likelihood != "normal" else [])
     if outputs.get("--posterior") is None and unused:
         raise UsageError(f"{', '.join(unused)} set the posterior's sampler, which runs only with --posterior FILE")
@@ -26,7 +26,8 @@ def run(args) -> int:
         if args.full_chain:
             raise UsageError("--full-chain was removed: the default chain now runs until it converges; "
                              "--max-steps bounds it")
-        posterior = {"walkers": args.walkers, "steps": args.steps, "max_steps": args.max_steps, "seed": args.seed}
+        posterior = {"walkers": args.walkers, "steps": args.steps, "max_steps": args.max_steps, "seed": args.seed,
+                     "method": args.posterior_method}
 
         try:  # before the fit: the most parameters a chain can have (zeta_H, zeta_A, w_A, f)
             check_posterior_memory(args.walkers or DEFAULT_WALKERS, args.steps or args.max_steps or DEFAULT_MAX_STEPS, 4)
@@ -108,6 +109,7 @@ def _fit_summary(result, table, pair, written) -> dict:
         summary["posterior"] = {"converged": result.posterior.converged, "walkers": walkers, "steps": steps,
                                 "burn": int(result.posterior.burn), "seed": int(result.posterior.seed),
                                 "likelihood": str(result.posterior.info.get("likelihood", "normal")),
+                                "method": str(result.posterior.info.get("method", "")),
                                 "verdict": result.posterior.info.get("verdict", ""),
                                 "verdict_text": result.posterior.info.get("verdict_text", "")}
     return summary

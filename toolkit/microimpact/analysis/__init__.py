@@ -51,7 +51,7 @@ _HOMES = {
     **dict.fromkeys(("fit_dem_friction", "rank_dem_tangential_laws", "dem_friction_coverage"), "dem_friction"),
     **dict.fromkeys(("Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "posterior_contacts",
                      "restitution_bands", "capture_velocity_interval", "sweep_bands", "summary_table",
-                     "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES", "CONDITIONAL_ON_REJECTED", "METHODS",
+                     "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES", "CONDITIONAL_ON_REJECTED", "METHODS", "DEFAULT_METHOD",
                      "EMULATOR_TOLERANCE"), "posterior"),
     **dict.fromkeys(("DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS", "MAX_SEED", "LIKELIHOODS",
                      "DEFAULT_NU", "LOSSES", "DEFAULT_LOSS"),

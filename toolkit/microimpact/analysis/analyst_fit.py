@@ -29,8 +29,8 @@ from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import all_or_nothing, write_netcdf
 from microimpact.analysis.fitting import DEFAULT_LOSS, FitProblem, fit_damping, model_restitution
 from microimpact.analysis.oblique import ObliqueProblem, fit_friction
-from microimpact.analysis.posterior import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_NU, DEFAULT_SEED, DEFAULT_WALKERS,
-                                            capture_velocity_interval, restitution_bands, sample_posterior, sweep_bands)
+from microimpact.analysis.posterior import (DEFAULT_MAX_STEPS, DEFAULT_METHOD, DEFAULT_N_DRAWS, DEFAULT_NU, DEFAULT_SEED,
+                                            DEFAULT_WALKERS, METHODS, capture_velocity_interval, restitution_bands, sample_posterior, sweep_bands)
 from microimpact.io.provenance import stamp_parameters
 from microimpact.solvers import DEFAULT_RTOL, Deadline
 
@@ -38,7 +38,7 @@ __all__ = ["AnalystFit", "analyse_impacts", "POSTERIOR_DEFAULTS", "exclude_rows"
 
 def _posterior_defaults() -> dict:
     return dict(walkers=DEFAULT_WALKERS, max_steps=DEFAULT_MAX_STEPS, steps=None, burn=None, seed=DEFAULT_SEED,
-                n_draws=DEFAULT_N_DRAWS)
+                n_draws=DEFAULT_N_DRAWS, method=DEFAULT_METHOD)
 
 
 #: the posterior settings of the pipeline and the CLI: the library's one home of each
@@ -196,8 +196,9 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
         Fit the friction when the table has oblique columns.
     posterior : bool or dict
         False: no posterior; True: :data:`POSTERIOR_DEFAULTS` (run until converged); a dict overrides
-        them (``walkers``, ``max_steps``, ``steps`` (a fixed length), ``burn``, ``seed``, ``n_draws``;
-        None values keep the default).
+        them (``walkers``, ``max_steps``, ``steps`` (a fixed length), ``burn``, ``seed``, ``n_draws``,
+        ``method`` (the likelihood's e_n: "emulator" or "solve", :func:`sample_posterior
+        <microimpact.analysis.posterior.sample_posterior>`); None values keep the default).
     errors_in_variables : {"auto", "effective", "latent"}
         Speed-error treatment of the posterior (:mod:`microimpact.analysis.posterior`).
     rtol : float
@@ -249,7 +250,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     >>> analyse_impacts(table, material, posterior={"wlakers": 8})
     Traceback (most recent call last):
     ...
-    ValueError: unknown posterior option(s) ['wlakers']; known: ['burn', 'max_steps', 'n_draws', 'seed', 'steps', 'walkers']
+    ValueError: unknown posterior option(s) ['wlakers']; known: ['burn', 'max_steps', 'method', 'n_draws', 'seed', 'steps', 'walkers']
     """
     deadline = Deadline.start(time_budget, "analyst fit")
     table, excluded = exclude_rows(table, exclude)
@@ -283,7 +284,8 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
 
     post = sample_posterior(table, damping, ff, walkers=opts["walkers"], steps=opts["steps"], max_steps=opts["max_steps"],
                             burn=opts["burn"], seed=opts["seed"], errors_in_variables=errors_in_variables, rtol=rtol,
-                            progress=progress, time_budget=deadline, likelihood=likelihood, nu=nu)
+                            progress=progress, time_budget=deadline, likelihood=likelihood, nu=nu,
+                            method=opts["method"])
     nd = opts["n_draws"]
     ds = post.to_dataset(restitution_bands(post, damping, n_draws=nd, rtol=rtol, time_budget=deadline),
                          capture_velocity_interval(post, damping, n_draws=nd, time_budget=deadline),
@@ -397,6 +399,11 @@ def _posterior_options(posterior) -> dict:
     unknown = set(opts) - set(POSTERIOR_DEFAULTS)
     if unknown:
         raise ValueError(f"unknown posterior option(s) {sorted(unknown)}; known: {sorted(POSTERIOR_DEFAULTS)}")
+    method = opts.pop("method", None)
+    if method is not None and method not in METHODS:
+        raise ValueError(f"posterior option method must be one of {', '.join(METHODS)}, got {method!r}")
     base = dict(POSTERIOR_DEFAULTS)
     base.update({k: int(v) for k, v in opts.items() if v is not None})
+    if method is not None:
+        base["method"] = method
     return base

@@ -71,7 +71,8 @@ from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.formatting import ReportHTML
 from microimpact.analysis.fit_result import PARAMETER_NAMES, FitResult
 from microimpact.analysis.sampling_defaults import (DEFAULT_MAX_STEPS, DEFAULT_N_DRAWS, DEFAULT_NU, DEFAULT_SEED,
-                                                    DEFAULT_WALKERS, LIKELIHOODS, MAX_SEED)
+                                                    DEFAULT_METHOD, DEFAULT_WALKERS, LIKELIHOODS, MAX_SEED,
+                                                    METHODS)
 from microimpact.io.files import CONVENTIONS, restore_label_coordinates
 from microimpact.io.materials import material_contact
 from microimpact._runtime.progress import progress_bar
@@ -85,20 +86,17 @@ from microimpact.solvers import emulator
 __all__ = ["Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "DEFAULT_WALKERS", "DEFAULT_MAX_STEPS",
            "DEFAULT_SEED", "DEFAULT_N_DRAWS", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
            "sweep_bands", "summary_table", "PARAMETER_UNITS", "EIV_METHODS", "GAUSS_HERMITE_NODES", "LIKELIHOODS",
-           "DEFAULT_NU", "CONDITIONAL_ON_REJECTED", "METHODS", "EMULATOR_TOLERANCE"]
+           "DEFAULT_NU", "CONDITIONAL_ON_REJECTED", "METHODS", "DEFAULT_METHOD", "EMULATOR_TOLERANCE"]
 
-#: how the likelihood evaluates the model e_n: "solve" (the solver at every call, the reference) or
-#: "emulator" (the ring law's table, :mod:`microimpact.solvers.emulator`, the solver where it falls back)
-METHODS = ("solve", "emulator")
 #: absolute e_n tolerance of the emulator in the likelihood: far below the data's noise (stated e_n
 #: uncertainties ~5e-3), so that 100 rows move the log-likelihood by at most ~100 x 1e-6 / 5e-3 = 0.02
 #: (a shift of the posterior far below its Monte Carlo error), and a table that builds in
 #: seconds to a minute on a cold cache where 1e-8 takes minutes
 EMULATOR_TOLERANCE = 1e-6
-#: the emulator's box of groups for the posterior: the table's default box with C2 down to 0.03, so
-#: that the bundled data's fastest impacts (C2 ~ 0.09 at 23 m/s, C2 falling as v^(-1/5)) are in it
-#: rather than solved at every evaluation
-POSTERIOR_DOMAIN = dict(emulator.DOMAIN) | {"adhesion_damping": (0.03, 0.5)}
+#: the emulator's box of groups for the posterior (a table shipped with the package): the table's
+#: default box with C2 down to 0.03, so that the bundled data's fastest impacts are in it rather
+#: than solved at every evaluation
+POSTERIOR_DOMAIN = emulator.WIDE_DOMAIN
 
 #: what a posterior of a rejected model says of itself
 CONDITIONAL_ON_REJECTED = "conditional on a rejected model"
@@ -480,7 +478,7 @@ class _Likelihood:
             return model_restitution(pr, zeta_hertz, zeta_adhesion, work_of_adhesion, rtol=self.rtol)
         y0, per = g
         if getattr(self, "_table", None) is None:  # looked up once: the lookup hashes the physics' source
-            self._table = emulator.ring_emulator(emulator._table_tolerance(self.tol), self.domain)
+            self._table = emulator.ring_emulator(emulator.table_tolerance(self.tol), self.domain)
         table = self._table
         e, _, solve = table.evaluate(y0, zeta_hertz * per, zeta_adhesion * per, self.tol)
         e = np.array(e, dtype=float)
@@ -489,7 +487,7 @@ class _Likelihood:
                 for r, idx in zip(pr.radii, pr.groups):
                     s = idx[solve[idx]]
                     if s.size:
-                        e[s] = emulator._fallback(pr.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion),
+                        e[s] = emulator.fallback_restitution(pr.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion),
                                                   pr.normal_speed[s], self.tol)
         return e
 
@@ -593,7 +591,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
                      max_steps: int | None = None, burn: int | None = None, seed: int = DEFAULT_SEED,
                      errors_in_variables: str = "auto", rtol: float = DEFAULT_RTOL, progress: bool = False,
                      time_budget: float | None = None, require_convergence: bool = True, likelihood: str = "normal",
-                     method: str = "solve", emulator_tol: float = EMULATOR_TOLERANCE,
+                     method: str = DEFAULT_METHOD, emulator_tol: float = EMULATOR_TOLERANCE,
                      nu: float = DEFAULT_NU) -> Posterior:
     """Sample the posterior of the fitted parameters with emcee until it converges (seeded).
 
@@ -631,11 +629,11 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
         e_n likelihood of each row (module docstring).
     nu : float
         Degrees of freedom of the Student-t likelihood (default :data:`DEFAULT_NU`). [-]
-    method : {"solve", "emulator"}
-        Model e_n of the likelihood: the solver at every evaluation (the reference), or the ring
-        law's table (:func:`microimpact.solvers.emulator.ring_emulator`, built and cached on first
-        use) with its groups computed once, the solver where the table falls back or the law is
-        not the ring law. The oblique part is always solved.
+    method : {"emulator", "solve"}
+        Model e_n of the likelihood: the ring law's table (:func:`microimpact.solvers.emulator.ring_emulator`,
+        shipped with the package; the default, :data:`DEFAULT_METHOD`) with its groups computed
+        once, the solver where the table falls back or the law is not the ring law; or the solver
+        at every evaluation (the reference). The oblique part is always solved.
     emulator_tol : float
         Absolute e_n tolerance of ``method="emulator"`` (default :data:`EMULATOR_TOLERANCE`). [-]
 

@@ -13,7 +13,7 @@ True
 """
 
 __all__ = ["DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS", "MAX_SEED", "LIKELIHOODS",
-           "DEFAULT_NU", "LOSSES", "DEFAULT_LOSS"]
+           "DEFAULT_NU", "LOSSES", "DEFAULT_LOSS", "METHODS", "DEFAULT_METHOD"]
 
 #: walkers of the ensemble (at least 2 x the sampled parameters are needed; 16 suits 2-4)
 DEFAULT_WALKERS = 16
@@ -35,3 +35,9 @@ DEFAULT_NU = 4.0
 LOSSES = ("linear", "soft_l1", "huber")
 #: the loss of the damping fit: plain least squares
 DEFAULT_LOSS = "linear"
+#: how the posterior's likelihood evaluates the model e_n: "emulator" (the ring law's table,
+#: :mod:`microimpact.solvers.emulator`, the solver where it falls back) or "solve" (the solver at
+#: every evaluation, the reference)
+METHODS = ("emulator", "solve")
+#: the likelihood's method by default: the emulator, whose table comes with the package
+DEFAULT_METHOD = "emulator"

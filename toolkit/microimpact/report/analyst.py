@@ -353,7 +353,8 @@ def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset, note: str 
         f"(seed {post.attrs.get('seed')}), walkers started around the least-squares fit, run until converged "
         "(50 autocorrelation times with a stable tau, rank-normalised split R-hat < 1.01, bulk effective sample "
         "size >= 400; an unconverged chain stops the pipeline instead of reaching this page). Speed errors: "
-        + str(post.attrs.get("errors_in_variables", "")) + ". " + str(post.attrs.get("convergence", "")) + ".")
+        + str(post.attrs.get("errors_in_variables", "")) + ". " + _likelihood_method(post)
+        + str(post.attrs.get("convergence", "")) + ".")
     lay.table(_posterior_rows(post), {"parameter": 17, "median": 11, "ci95": 40, "prior": 18, "rhat": 8, "ess": 7,
                                       "units": 7},
               headers={"ci95": "95 % credible interval (or bound)", "prior": "flat prior", "rhat": "R-hat",
@@ -377,6 +378,15 @@ def posterior_section(lay: Layout, fit: xr.Dataset, post: xr.Dataset, note: str 
                                                                  "ci": "95 % credible interval [m/s]"}, size=7.2)
     if "sweep_e_n_band" in post:
         lay.plot(pfig.plot_sweep_bands(post), max_height=2.8)
+
+
+def _likelihood_method(post) -> str:
+    """How the likelihood computed the model e_n, as a sentence (files before the method was recorded: none)."""
+    method = str(post.attrs.get("likelihood_method", ""))
+    if method.startswith("emulator"):
+        return (f"Model e_n: the ring law's certified table ({method}; the solver where the table's error "
+                "estimate exceeds the tolerance). ")
+    return "Model e_n: the solver at every evaluation. " if method else ""
 
 
 def _posterior_rows(post: xr.Dataset) -> pd.DataFrame:

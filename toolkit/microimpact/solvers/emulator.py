@@ -44,7 +44,10 @@ Method
 
 The table is built once per tolerance and cached outside the install tree (:func:`cache_dir`, like
 numba's cache): an ``.npz`` whose name carries the tolerance, the domain, the degrees and a hash of
-the model's and this module's source, so that an edited law never reads a stale table.
+the model's and this module's source, so that an edited law never reads a stale table. The tables
+of :data:`SHIPPED` (a few hundred kB) come with the package (:func:`shipped_dir`), so that a fresh
+install does not build them; :func:`ship_tables` writes them, and a test fails when a change of the
+sources leaves a shipped table stale.
 
 References
 ----------
@@ -60,6 +63,7 @@ import hashlib
 import math
 import os
 from dataclasses import dataclass, field
+from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
@@ -70,8 +74,9 @@ from microimpact.model.contact import Contact
 from microimpact.solvers import MIN_RTOL, engine_threads
 from microimpact.solvers.family import normal_restitution
 
-__all__ = ["DOMAIN", "EXAMPLE_DOMAIN", "DEFAULT_TOLERANCE", "Restitution", "RingEmulator", "build_ring_emulator", "cache_dir",
-           "ring_emulator", "restitution", "surface_tolerance"]
+__all__ = ["DOMAIN", "EXAMPLE_DOMAIN", "DEFAULT_TOLERANCE", "SHIPPED", "WIDE_DOMAIN", "Restitution", "RingEmulator",
+           "build_ring_emulator", "cache_dir", "ring_emulator", "restitution", "ship_tables", "shipped_dir",
+           "surface_tolerance", "table_tolerance", "fallback_restitution"]
 
 #: the groups' box the table covers: C1, C2 and y0 ranges [-]; outside it the solver runs. It holds
 #: the paper's microsphere (Table 1 row 2: C1 = 2.5e-3 to 6e-3, C2 = 0.15 to 0.37, y0 = 0.08 to 80 over
@@ -83,6 +88,12 @@ DOMAIN = {"hertz_damping": (1e-3, 1e-2), "adhesion_damping": (0.1, 0.5), "incide
 EXAMPLE_DOMAIN = {"hertz_damping": (1e-3, 2e-3), "adhesion_damping": (0.1, 0.2), "incident_speed": (1e-2, 1e2)}
 #: absolute tolerance on e_n of :func:`restitution` by default [-]
 DEFAULT_TOLERANCE = 1e-6
+#: :data:`DOMAIN` with C2 down to 0.03: the fastest impacts of micrometre spheres (C2 falls as
+#: v^(-1/5); C2 ~ 0.09 at 23 m/s for the paper's microsphere) are in it rather than solved [-]
+WIDE_DOMAIN = dict(DOMAIN) | {"adhesion_damping": (0.03, 0.5)}
+#: the tables that come with the package, as (table tolerance, domain): the posterior's
+#: (:data:`microimpact.analysis.posterior.EMULATOR_TOLERANCE` over :data:`WIDE_DOMAIN`)
+SHIPPED = ((1e-6, WIDE_DOMAIN),)
 #: Chebyshev degree of the capture surface ln y_c in ln C1 and ln C2 per cell (y_c grows steeply
 #: towards the damping at which nothing rebounds: its coefficients fall by ~0.1 per degree on a
 #: quarter decade), of e_n in ln C1 and ln C2, and of e_n in t per piece
@@ -736,13 +747,54 @@ _SETTINGS = (DEGREE_SURFACE, DEGREE_AB, DEGREE_T, CELLS_PER_DECADE, MAX_DEPTH, C
              CHECK_RTOL_FACTOR, NEAR_CAPTURE_T, _LAYOUT)
 
 
-def _cache_path(tol, domain) -> Path:
-    """The table's file: its tolerance, and a hash of the domain, the settings and the physics' source."""
+def _table_name(tol, domain) -> str:
+    """The table's file name: its tolerance, and a hash of the domain, the settings and the physics' source."""
     root = Path(__file__).resolve().parent.parent
     h = hashlib.sha256(repr((float(tol), sorted(domain.items()), _SETTINGS)).encode())
     for name in _SOURCES:
         h.update((root / name).read_bytes())
-    return cache_dir() / f"ring-{tol:.0e}-{h.hexdigest()[:16]}.npz"
+    return f"ring-{tol:.0e}-{h.hexdigest()[:16]}.npz"
+
+
+def _cache_path(tol, domain) -> Path:
+    return cache_dir() / _table_name(tol, domain)
+
+
+def shipped_dir() -> Path:
+    """The package's directory of shipped tables (read only; :data:`SHIPPED`).
+
+    Examples
+    --------
+    >>> shipped_dir().parts[-2:]
+    ('data', 'emulator')
+    """
+    return Path(str(files("microimpact") / "data" / "emulator"))
+
+
+def ship_tables(dest: str | os.PathLike | None = None) -> list[Path]:
+    """Write the tables of :data:`SHIPPED` to ``dest`` (default :func:`shipped_dir`), removing stale ones.
+
+    Run after a change of the law, the engine or this module (the test of the shipped tables says
+    when): ``python -c "from microimpact.solvers.emulator import ship_tables; ship_tables()"`` in a
+    clone with an editable install. Each table comes from :func:`ring_emulator` (the cache, or built).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The tables written.
+    """
+    dest = shipped_dir() if dest is None else Path(dest)
+    dest.mkdir(parents=True, exist_ok=True)
+    keep = {_table_name(tol, dict(domain)) for tol, domain in SHIPPED}
+    for old in dest.glob("ring-*.npz"):
+        if old.name not in keep:
+            old.unlink()
+    written = []
+    for tol, domain in SHIPPED:
+        path = dest / _table_name(tol, dict(domain))
+        _save(ring_emulator(tol, domain), path)
+        written.append(path)
+    return written
 
 
 def _save(em: RingEmulator, path: Path) -> None:
@@ -762,7 +814,8 @@ _LOADED: dict = {}
 
 
 def ring_emulator(tol: float = DEFAULT_TOLERANCE, domain: dict | None = None) -> RingEmulator:
-    """The table for ``tol`` over ``domain``: from memory, else from :func:`cache_dir`, else built and saved.
+    """The table for ``tol`` over ``domain``: from memory, else shipped (:func:`shipped_dir`), else from
+    :func:`cache_dir`, else built and saved there.
 
     Examples
     --------
@@ -777,21 +830,31 @@ def ring_emulator(tol: float = DEFAULT_TOLERANCE, domain: dict | None = None) ->
     >>> del os.environ["MICROIMPACT_CACHE"]
     """
     domain = dict(DOMAIN if domain is None else domain)
-    path = _cache_path(tol, domain)
-    if path in _LOADED:
-        return _LOADED[path]
-    if path.exists():
+    name = _table_name(tol, domain)
+    if name in _LOADED:
+        return _LOADED[name]
+    shipped, path = shipped_dir() / name, cache_dir() / name
+    if shipped.exists():
+        em = _load(shipped, domain)
+    elif path.exists():
         em = _load(path, domain)
     else:
         em = build_ring_emulator(tol, domain)
         _save(em, path)
-    _LOADED[path] = em
+    _LOADED[name] = em
     return em
 
 
 # --------------------------------------------------------------------------- the entry point
-def _table_tolerance(tol) -> float:
-    """The table used for ``tol``: the power of ten at or below it (a few tables serve every tol)."""
+def table_tolerance(tol) -> float:
+    """The table used for the e_n tolerance ``tol``: the power of ten at or below it (a few tables
+    serve every tol). [-]
+
+    Examples
+    --------
+    >>> table_tolerance(3e-6)
+    1e-06
+    """
     t = float(tol)
     if not (math.isfinite(t) and 0.0 < t < 1.0):
         raise ValueError(f"tol must be a finite number in (0, 1), got {tol!r}")
@@ -856,7 +919,7 @@ def restitution(contacts, speeds, *, tol: float = DEFAULT_TOLERANCE, domain: dic
     rows, v, shape = _as_rows(contacts, speeds)
     if not np.all(np.isfinite(v) & (v > 0.0)):
         raise ValueError("speeds must be finite numbers > 0")
-    table_tol = _table_tolerance(tol)
+    table_tol = table_tolerance(tol)
     rings = [reduction.law_of(c) == "ring" for c in rows]
     table = ring_emulator(table_tol, domain) if any(rings) else None
     e, captured = np.zeros(v.shape), np.zeros(v.shape, dtype=bool)
@@ -867,14 +930,37 @@ def restitution(contacts, speeds, *, tol: float = DEFAULT_TOLERANCE, domain: dic
         e[ring], captured[ring], solve[ring] = table.evaluate(y0, c1, c2, tol)
     with engine_threads(1):
         for i in np.flatnonzero(solve.any(axis=1)):
-            e[i, solve[i]] = _fallback(rows[i], v[i, solve[i]], float(tol))
+            e[i, solve[i]] = fallback_restitution(rows[i], v[i, solve[i]], float(tol))
     captured[solve] = e[solve] == 0.0
     return Restitution(e.reshape(shape), captured.reshape(shape), solve.reshape(shape), float(tol))
 
 
-def _fallback(contact, speeds, tol):
-    """e_n of one contact's impacts by the solver at ``FALLBACK_RTOL tol``, those that barely rebound
-    (e_n < NEAR_CAPTURE_E, where the solve's error ~1.2 rtol / e_n) again at ``tol e_n / 12``. [-]"""
+def fallback_restitution(contact, speeds, tol: float) -> np.ndarray:
+    """e_n of one contact's impacts by the solver, to the absolute tolerance ``tol``: where the table
+    leaves an impact to the solver.
+
+    The solves run at ``rtol = FALLBACK_RTOL tol``; those that barely rebound (e_n <
+    :data:`NEAR_CAPTURE_E`, where the solve's error is ~1.2 rtol / e_n) again at ``tol e_n / 12``.
+
+    Parameters
+    ----------
+    contact : Contact
+    speeds : array_like
+        Incident normal speeds, > 0. [m/s]
+    tol : float
+        Absolute tolerance on e_n. [-]
+
+    Returns
+    -------
+    numpy.ndarray
+        e_n of each speed, 0 where captured. [-]
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2
+    >>> fallback_restitution(TABLE1_ROW2, [0.5, 3.0], 1e-6).round(4).tolist()
+    [0.0, 0.5866]
+    """
     rtol = max(tol * FALLBACK_RTOL, NODE_RTOL_FLOOR)
     e = np.array(normal_restitution(contact, speeds, rtol=rtol), dtype=float)
     near = (e > 0.0) & (e < NEAR_CAPTURE_E)

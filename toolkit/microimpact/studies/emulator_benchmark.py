@@ -132,7 +132,7 @@ def run_emulator_benchmark(contacts: int = 1000, impacts: int = 10, tol: float =
     d = flat[:min(dop853_sample, flat.size)]
     k = min(solver_contacts, contacts)
     t0 = time.perf_counter()
-    table = emulator.ring_emulator(emulator._table_tolerance(tol), domain)
+    table = emulator.ring_emulator(emulator.table_tolerance(tol), domain)
     build = time.perf_counter() - t0
     with engine_threads(1):
         emulator.restitution(cs[:2], v[:2], tol=tol, domain=domain)  # warm: the kernels compiled or loaded
