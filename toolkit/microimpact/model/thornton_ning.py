@@ -33,7 +33,7 @@ here: the contact yields where the two statements agree, where the JKR increment
 (without adhesion a_y = pi R p_y / (2 E*), Thornton 1997, as the paper's criterion). The JKR
 increment grows with a, so the plastic force F_y + pi p_y (a^2 - a_y^2) stays at or below the JKR
 force F(a; R) of the same contact radius: R_p >= R at every delta_max >= delta_y (R_p = R at
-yield, continuous), and the line (TN3) is softer than the JKR curve from yield on. The price: the
+yield, continuous), and at yield the line (TN3) is softer than the JKR curve. The price: the
 centre pressure at yield is p_y + p_2 / 2, above the paper's limit, while this law is still
 elastic. Alternatives not taken: the paper's criterion with R_p clamped to R (it keeps the
 stiffening at yield, the unloading curve of radius R cannot pass through (delta_max, F_max) at
@@ -43,7 +43,8 @@ closed-form work and largest approach). PyGran's ``computeYieldRadius`` solves t
 centre-pressure equation (it cites it as Eq. (65) of the paper); ``docs/laws/thornton_ning.md``
 gives the reasons at more length.
 
-With this yield, W_p >= 0 at every largest approach above yield where the yield force F_y >= 0,
+With this yield W_p >= 0 (checked on a grid over the whole parameter range, not proven) at every
+largest approach above yield where the yield force F_y >= 0,
 i.e. p_y >= (9/4)^(1/3) times the first-contact centre pressure (:data:`TENSILE_YIELD_LIMIT`;
 the yield then lies at or beyond the JKR zero-load radius). Below that the contact yields under
 tension, and W_p < 0 just above yield: the contact radius of (TN3) grows over a longer approach
