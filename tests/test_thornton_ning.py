@@ -9,7 +9,10 @@ reference integration (solvers/plastic_reference.py), against what they must rep
   (model/adhesion_models.py) and the Johnson & Pollock rebound e = sqrt(1 - v_s^2 / v^2);
 * the energy balance (1/2 m V_i^2 = 1/2 m V_r^2 + W_p + H) between the integration and the law's
   account, to 1e-8 of the incident energy;
-* hand-derived forms of R_p, the plastic slope and the JKR pressure at yield.
+* hand-derived forms of R_p, the plastic slope and the JKR pressure at yield;
+* the yield with adhesion (TN2), where the JKR force per contact area reaches p_y: R_p >= R and
+  W_p >= 0 over the stress sweep's domain (both fail with the paper's centre-pressure yield), and
+  the tensile-yield limit below which a state's W_p < 0 is not reached by an impact.
 
 Tolerances: the DOP853 integration at rtol 1e-12 agrees with the closed forms to about 1e-11
 (measured); the tests ask 1e-8 (1e-6 for e against Thornton's form, the issue's figure), so they
