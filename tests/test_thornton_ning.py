@@ -9,7 +9,10 @@ reference integration (solvers/plastic_reference.py), against what they must rep
   (model/adhesion_models.py) and the Johnson & Pollock rebound e = sqrt(1 - v_s^2 / v^2);
 * the energy balance (1/2 m V_i^2 = 1/2 m V_r^2 + W_p + H) between the integration and the law's
   account, to 1e-8 of the incident energy;
-* hand-derived forms of R_p, the plastic slope and the JKR pressure at yield.
+* hand-derived forms of R_p, the plastic slope and the JKR pressure at yield;
+* the yield with adhesion (TN2), where the JKR force per contact area reaches p_y: R_p >= R and
+  W_p >= 0 over the stress sweep's domain (both fail with the paper's centre-pressure yield), and
+  the tensile-yield limit below which a state's W_p < 0 is not reached by an impact.
 
 Tolerances: the DOP853 integration at rtol 1e-12 agrees with the closed forms to about 1e-11
 (measured); the tests ask 1e-8 (1e-6 for e against Thornton's form, the issue's figure), so they
@@ -94,14 +97,22 @@ def test_plastic_radius_and_slope_by_hand():
 
 
 # =============================================================================== adhesion
-def test_yield_is_where_the_jkr_centre_pressure_reaches_p_y():
+def test_yield_is_where_the_jkr_force_per_contact_area_reaches_p_y():
     # The JKR pressure p(r) = p1 sqrt(1 - rho^2) - p2 / sqrt(1 - rho^2) (p1 = 2 E* a / (pi R),
-    # p2 = sqrt(2 w E* / (pi a))) integrates to the JKR force of (TN1); at a_y its centre value is p_y.
+    # p2 = sqrt(2 w E* / (pi a))) integrates to the JKR force of (TN1). The law's yield (TN2) is where
+    # the increment dF / d(pi a^2) = p1 - (3/2) p2 reaches p_y (by a central difference of (TN1) too),
+    # where the paper's centre pressure p1 - p2 is p_y + p2 / 2 (model docstring, "Yield").
     pc = ADHESIVE
     y = tn.yield_point(pc)
     a, e_star, w, r = y.contact_radius, pc.e_star, pc.work_of_adhesion, pc.radius
     p1, p2 = 2.0 * e_star * a / (math.pi * r), math.sqrt(2.0 * w * e_star / (math.pi * a))
-    assert p1 - p2 == pytest.approx(pc.yield_pressure, rel=1e-12)
+    assert p1 - 1.5 * p2 == pytest.approx(pc.yield_pressure, rel=1e-12)
+    h = 1e-5 * a  # central difference: error ~ (h / a)^2 = 1e-10
+    def force(x):
+        return float(tn.jkr_curve_force(x, r, e_star, w))
+    increment = (force(a + h) - force(a - h)) / (math.pi * ((a + h) ** 2 - (a - h) ** 2))
+    assert increment / pc.yield_pressure == pytest.approx(1.0, abs=1e-8)
+    assert (p1 - p2) / pc.yield_pressure == pytest.approx(1.0 + 0.5 * p2 / pc.yield_pressure, abs=1e-12)
     total = quad(lambda rho: 2.0 * math.pi * a * a * rho * (p1 * math.sqrt(1 - rho * rho) - p2 / math.sqrt(1 - rho * rho)),
                  0.0, 1.0, limit=200)[0]
     assert total == pytest.approx(y.force, rel=1e-8)
@@ -131,6 +142,78 @@ def test_energy_balance_between_integration_and_account(speed):
     assert r.state["work_loading"] / en.incident == pytest.approx(1.0, abs=1e-8)
     assert (r.state["work_loading"] - r.state["work_unloading"]) / en.incident == pytest.approx((en.plastic + en.hysteresis) / en.incident,
                                                                              abs=1e-8)
+
+
+#: the nondimensional domain of the yield tests: w / (E* R) over (and beyond) the stress sweep's
+#: 3e-14 to 41 (studies/stress.py draws), p_y in units of the first-contact centre pressure from
+#: just above the law's limit 1 to beyond the sweep's largest (6e4)
+_W_OVER_ER = np.geomspace(1e-15, 1e2, 9)
+_PY_OVER_FIRST = np.geomspace(1.0 + 1e-6, 1e5, 9)
+
+
+def _scaled_contact(w_over_er, py_over_first):
+    """R = 1 m, E* = 1 Pa, m = 1 kg: the law depends on w / (E* R) and p_y / E* only (lengths in R)."""
+    w = float(w_over_er)
+    return tn.PlasticContact(1.0, 1.0, 4.0 / 3.0, w, float(py_over_first) * tn.first_contact_pressure(1.0, 1.0, w))
+
+
+def test_the_flattened_contact_is_never_sharper_than_the_sphere():
+    """R_p >= R at every largest approach above yield, and R_p -> R at yield (continuous). With the
+    paper's centre-pressure yield R_p < R just above yield at every w > 0 (model docstring, "Yield"):
+    this test fails if the yield criterion (TN2) is changed back."""
+    for w in _W_OVER_ER:
+        for m in _PY_OVER_FIRST:
+            pc = _scaled_contact(w, m)
+            y = tn.yield_point(pc)
+            unit = max(abs(y.approach), y.contact_radius**2 / pc.radius)
+            for x in np.concatenate([np.geomspace(1e-9, 1.0, 8), np.geomspace(2.0, 1e5, 6)]):
+                s = tn.unloading_state(pc, y.approach + x * unit)
+                assert s.yielded
+                # R_p / R - 1 is a difference of numbers of order 1: rounding 1e-13 at most
+                assert s.plastic_radius / pc.radius - 1.0 >= -1e-13, (w, m, x, s.plastic_radius)
+            near = tn.unloading_state(pc, y.approach + 1e-9 * unit)
+            assert near.plastic_radius / pc.radius == pytest.approx(1.0, abs=1e-6)  # continuous at yield
+
+
+def test_plastic_dissipation_of_an_impact_is_not_negative():
+    """W_p (TN9) >= 0 over the stress sweep's domain (p_y >= 1.5 first-contact pressures) and down to
+    just above the law's limit (1 + 1e-6), at speeds from just above the adhesive yield velocity to
+    1e3 V_y. The paper's centre-pressure yield gives W_p down to -2e-2 of the energy scale here."""
+    for w in _W_OVER_ER:
+        for m in np.concatenate([[tn.TENSILE_YIELD_LIMIT], _PY_OVER_FIRST]):
+            pc = _scaled_contact(w, m)
+            v_ay, v_y = tn.adhesive_yield_velocity(pc), tn.yield_velocity(pc)
+            speeds = np.concatenate([v_ay * (1.0 + np.geomspace(1e-8, 1.0, 8)), v_y * np.geomspace(1e-6, 1e3, 16)])
+            speeds = speeds[speeds > 0.0]
+            ke, plastic, hysteresis = tn._energy_account(pc, speeds)
+            scale = np.maximum(ke, hysteresis)
+            # W_p = ke - (U(a_max) - U(a_0p)): a difference of terms of the size of the scale,
+            # rounding 1e-15 of it (measured 7e-16 at worst); 1e-12 leaves room, far above -2e-2
+            assert (plastic / scale).min() >= -1e-12, (w, m)
+            assert np.all(hysteresis >= 0.0)
+
+
+def test_below_the_tensile_yield_limit_the_contact_yields_under_tension():
+    """At p_y = TENSILE_YIELD_LIMIT first-contact pressures the yield force is 0 (the yield is at the
+    JKR zero-load radius a^3 = 9 pi w R^2 / (2 E*)). Below it F_y < 0, and just above yield the
+    state's W_p (TN9) < 0 (the known limit of the model docstring), where the loading work is
+    negative too: no impact (W_load = (1/2) m V_i^2 >= 0) ends its loading there."""
+    w = 1e-2
+    at = tn.yield_point(_scaled_contact(w, tn.TENSILE_YIELD_LIMIT))
+    f_c = 1.5 * math.pi * w  # JKR pull-off force of R = 1, the force scale
+    assert at.force / f_c == pytest.approx(0.0, abs=1e-12)
+    assert at.contact_radius**3 == pytest.approx(4.5 * math.pi * w, rel=1e-12)
+    pc = _scaled_contact(w, 1.2)
+    y = tn.yield_point(pc)
+    assert y.force < 0.0
+    es, unit = pc.e_star, y.contact_radius**2 / pc.radius
+    for x in (1e-6, 1e-3, 1e-2):
+        s = tn.unloading_state(pc, y.approach + x * unit)
+        def u(a):
+            return float(tn.jkr_curve_potential(a, s.plastic_radius, es, w))
+        loading = float(tn.loading_work(pc, s.max_approach))
+        w_p = loading - (u(s.max_contact_radius) - u(tn._first_contact_radius(s.plastic_radius, es, w)))  # (TN9)
+        assert w_p < 0.0 and loading < 0.0  # documented, not wanted: change this test if it is ever cured
 
 
 def test_adhesive_hysteresis_is_the_jkr_cycle_of_the_flattened_contact():

@@ -33,9 +33,10 @@ Hessian, and the four ends of the profile intervals), which for a model linear n
 its profile-likelihood interval (Press et al. 2007, Sec. 15.6.5).
 
 Where the yield pressure falls below the JKR centre pressure at first contact of a size
-(:func:`~microimpact.model.thornton_ning.first_contact_pressure`), the law yields as the contact
-forms, which it does not describe; the model holds p_y at that limit there (e_n then no longer
-depends on V_y, and a profile that reaches it ends as a bound).
+(:func:`~microimpact.model.thornton_ning.first_contact_pressure`), the paper's criterion yields the
+contact as it forms, outside the law's domain; the model holds p_y at that limit there (e_n then no
+longer depends on V_y, and a profile that reaches it ends as a bound). The law's own yield (TN2) is
+where the JKR force per contact area reaches p_y (the model module says why).
 
 References
 ----------

@@ -13,12 +13,45 @@ Loading, elastic (JKR; Johnson, Kendall & Roberts 1971), with the radius of curv
 contact forms at delta = 0 (a = a_0 = 4^(2/3) a_c, a_c^3 = pi w R^2 / (8 E*)); without adhesion
 (w = 0) this is Hertz's law F = K sqrt(R) delta^(3/2).
 
-Yield (Thornton & Ning 1998): the JKR pressure, largest at the centre, reaches p_y there,
+Yield. The JKR pressure is p(r) = p_1 sqrt(1 - r^2/a^2) - p_2 / sqrt(1 - r^2/a^2), with the Hertz
+part p_1 = 2 E* a / (pi R) and the adhesive part p_2 = sqrt(2 w E* / (pi a)). Thornton & Ning
+(1998) make the contact yield where its centre value p_1 - p_2 reaches p_y, and beyond yield let
+each increment of contact area carry p_y, dF / d(pi a^2) = p_y, (TN3). Without adhesion the two
+statements agree: the Hertz contact's increment dF / d(pi a^2) = p_1 is its centre pressure (which
+makes (TN3) exact for a Hertz pressure cut off at p_y, Thornton 1997). With adhesion they do not:
+the JKR contact's increment, from (TN1) at fixed R, is
 
-    (TN2)  p_centre(a) = 2 E* a / (pi R) - sqrt(2 w E* / (pi a)) = p_y   ->   a_y, delta_y, F_y by (TN1)
+    dF / d(pi a^2) = p_1 - (3/2) p_2   (< p_1 - p_2),
 
-(without adhesion a_y = pi R p_y / (2 E*), Thornton 1997). PyGran's ``computeYieldRadius`` solves
-the same equation (it cites it as Eq. (65) of the paper).
+so at the centre-pressure yield (TN3) would make new area carry p_2 / 2 more than the elastic contact
+gives it: the loading would stiffen as it yields, R_p (TN4) would come out below R (a flattening
+that sharpens the contact) and W_p (TN9) below 0 just above yield (e > 1 in a rebound). Choice made
+here: the contact yields where the two statements agree, where the JKR increment reaches p_y::
+
+    (TN2)  dF / d(pi a^2) = 2 E* a / (pi R) - (3/2) sqrt(2 w E* / (pi a)) = p_y   ->   a_y, delta_y, F_y by (TN1)
+
+(without adhesion a_y = pi R p_y / (2 E*), Thornton 1997, as the paper's criterion). The JKR
+increment grows with a, so the plastic force F_y + pi p_y (a^2 - a_y^2) stays at or below the JKR
+force F(a; R) of the same contact radius: R_p >= R at every delta_max >= delta_y (R_p = R at
+yield, continuous), and at yield the line (TN3) is softer than the JKR curve. The price: the
+centre pressure at yield is p_y + p_2 / 2, above the paper's limit, while this law is still
+elastic. Alternatives not taken: the paper's criterion with R_p clamped to R (it keeps the
+stiffening at yield, the unloading curve of radius R cannot pass through (delta_max, F_max) at
+a_max, and W_p < 0 remains in some cases) and the JKR pressure cut off at p_y over the elastic
+contact (it keeps the paper's criterion and R_p >= R but replaces the straight line (TN3), its
+closed-form work and largest approach). PyGran's ``computeYieldRadius`` solves the paper's
+centre-pressure equation (it cites it as Eq. (65) of the paper); ``docs/laws/thornton_ning.md``
+gives the reasons at more length.
+
+With this yield W_p >= 0 (checked on a grid over the whole parameter range, not proven) at every
+largest approach above yield where the yield force F_y >= 0,
+i.e. p_y >= (9/4)^(1/3) times the first-contact centre pressure (:data:`TENSILE_YIELD_LIMIT`;
+the yield then lies at or beyond the JKR zero-load radius). Below that the contact yields under
+tension, and W_p < 0 just above yield: the contact radius of (TN3) grows over a longer approach
+than the unloading curve (TN6) needs for the same a, and under a tensile F_y that extra approach
+gains work. The loading work W_load is negative there too, so no impact ends its loading there:
+over impacts (W_load(delta_max) = (1/2) m V_i^2 >= 0) W_p >= 0 on the whole domain p_y > the
+first-contact centre pressure (the tests scan it).
 
 Loading, plastic (Thornton 1997; Thornton & Ning 1998): the pressure is held at p_y over the
 growing contact, so each increment of contact area carries p_y::
@@ -112,6 +145,7 @@ from microimpact.model.adhesion_models import jkr_q_from_approach
 
 __all__ = [
     "YIELD_VELOCITY_COEFFICIENT",
+    "TENSILE_YIELD_LIMIT",
     "PlasticContact",
     "YieldPoint",
     "UnloadingState",
@@ -143,6 +177,13 @@ __all__ = [
 YIELD_VELOCITY_COEFFICIENT = math.pi**2 / math.sqrt(40.0)
 #: a_0 / a_c = 4^(2/3): JKR contact radius at delta = 0 on the stable branch, in units of a_c. [-]
 _A0_OVER_AC = 4.0 ** (2.0 / 3.0)
+#: the factor of the adhesive pressure p_2 in the yield criterion (TN2): 3/2, the JKR increment
+#: dF / d(pi a^2) = p_1 - (3/2) p_2 (the paper's centre pressure would be 1). [-]
+_YIELD_ADHESIVE_FACTOR = 1.5
+#: p_y / (first-contact centre pressure) at which the yield force F_y of (TN2) is 0: (9/4)^(1/3),
+#: the JKR increment at the zero-load radius a^3 = 9 pi w R^2 / (2 E*). At and above it W_p >= 0
+#: (module docstring, "Yield"). [-]
+TENSILE_YIELD_LIMIT = (9.0 / 4.0) ** (1.0 / 3.0)
 
 
 @dataclass(frozen=True)
@@ -380,11 +421,11 @@ def jkr_curve_contact_radius(approach, radius, e_star, work_of_adhesion):
 
 # =============================================================================== yield, loading (TN2), (TN3), (TN8)
 def first_contact_pressure(radius, e_star, work_of_adhesion):
-    """The JKR centre pressure (TN2) as the contact forms (delta = 0, a = a_0): E* a_0 / (pi R). [Pa]
+    """The JKR centre pressure as the contact forms (delta = 0, a = a_0): E* a_0 / (pi R). [Pa]
 
-    A yield pressure at or below it would yield the contact as it forms, which (TN2)-(TN3) do not
-    describe (:func:`yield_point` refuses it); it is 0 without adhesion. Parameters: R [m], E* [Pa],
-    w [J/m^2].
+    A yield pressure at or below it would yield the contact as it forms by the paper's
+    centre-pressure criterion, which (TN2)-(TN3) do not describe (:func:`yield_point` refuses it);
+    it is 0 without adhesion. Parameters: R [m], E* [Pa], w [J/m^2].
 
     References
     ----------
@@ -392,7 +433,7 @@ def first_contact_pressure(radius, e_star, work_of_adhesion):
 
     Examples
     --------
-    It is where the centre pressure 2 E* a / (pi R) - sqrt(2 w E* / (pi a)) of (TN2) is at a = a_0:
+    It is the centre pressure 2 E* a / (pi R) - sqrt(2 w E* / (pi a)) at a = a_0:
 
     >>> import math
     >>> r, es, w = 1e-6, 1e9, 0.1
@@ -408,14 +449,18 @@ def first_contact_pressure(radius, e_star, work_of_adhesion):
 def yield_point(pc: PlasticContact) -> YieldPoint:
     """Contact radius, approach and force at which the loading yields, (TN2).
 
-    Solves (2 E* / (pi R)) s^3 - p_y s - sqrt(2 w E* / pi) = 0 for s = sqrt(a_y) (one positive
-    root) by Newton's method from above; a_y = pi R p_y / (2 E*) without adhesion.
+    The JKR increment dF / d(pi a^2) = 2 E* a / (pi R) - (3/2) sqrt(2 w E* / (pi a)) reaches p_y
+    (not the paper's centre pressure, the module docstring says why): solves
+    (2 E* / (pi R)) s^3 - p_y s - (3/2) sqrt(2 w E* / pi) = 0 for s = sqrt(a_y) (one positive root,
+    the increment grows with a) by Newton's method from above; a_y = pi R p_y / (2 E*) without
+    adhesion.
 
     Raises
     ------
     ValueError
-        If p_y is so low that the centre pressure at first contact, E* a_0 / (pi R), exceeds it:
-        the contact would yield as it forms, which (TN2)-(TN3) do not describe.
+        If p_y is at or below the centre pressure at first contact, E* a_0 / (pi R): by the paper's
+        criterion the contact would yield as it forms, which (TN2)-(TN3) do not describe. The law
+        keeps the paper's domain (at first contact the JKR increment of (TN2) is half that pressure).
 
     References
     ----------
@@ -430,6 +475,15 @@ def yield_point(pc: PlasticContact) -> YieldPoint:
     >>> y = yield_point(pc)
     >>> round(y.approach / (math.pi**2 * 1e-6 * 1e16 / 4e18), 12), round(y.force / (math.pi**3 * 1e-12 * 1e24 / 6e18), 12)
     (1.0, 1.0)
+
+    With adhesion the elastic curve's force per contact area, dF / d(pi a^2), is p_y at a_y (a
+    central difference, to 1e-6):
+
+    >>> pc = PlasticContact(1e-6, 1e-14, 4e9 / 3, 0.05, 1e8)
+    >>> a, h = yield_point(pc).contact_radius, 1e-6 * yield_point(pc).contact_radius
+    >>> f = lambda a: float(jkr_curve_force(a, pc.radius, pc.e_star, pc.work_of_adhesion))
+    >>> round((f(a + h) - f(a - h)) / (math.pi * ((a + h)**2 - (a - h)**2)) / pc.yield_pressure, 6)
+    1.0
     """
     r, es, w, py = pc.radius, pc.e_star, pc.work_of_adhesion, pc.yield_pressure
     if w == 0.0:
@@ -439,7 +493,9 @@ def yield_point(pc: PlasticContact) -> YieldPoint:
         if py <= p_first:
             raise ValueError(f"yield_pressure={py!r} Pa is below the JKR centre pressure at first contact "
                              f"({p_first:.4g} Pa): the contact would yield as it forms")
-        c3, c1, c0 = 2.0 * es / (math.pi * r), py, math.sqrt(2.0 * w * es / math.pi)
+        # (TN2): the JKR increment dF / d(pi a^2) = p_1 - (3/2) p_2, not the centre pressure p_1 - p_2
+        # (module docstring, "Yield")
+        c3, c1, c0 = 2.0 * es / (math.pi * r), py, _YIELD_ADHESIVE_FACTOR * math.sqrt(2.0 * w * es / math.pi)
         s = math.sqrt(c1 / c3) + (c0 / c3) ** (1.0 / 3.0)  # above the root (convex, increasing there)
         for _ in range(100):
             step = (c3 * s**3 - c1 * s - c0) / (3.0 * c3 * s * s - c1)
@@ -559,7 +615,9 @@ def largest_approach(pc: PlasticContact, normal_speed):
     a = np.full(v.shape, y.contact_radius)
     for _ in range(200):
         dda = 2.0 * a / r - (0.5 * np.sqrt(2.0 * math.pi * w / (es * a)) if w > 0.0 else 0.0)
-        step = (jkr_curve_potential(a, r, es, w) - u_target) / (jkr_curve_force(a, r, es, w) * dda)
+        slope = jkr_curve_force(a, r, es, w) * dda
+        # a plastic row sits at a_y, where F_y may be 0 (p_y = TENSILE_YIELD_LIMIT): its step is 0, not 0/0
+        step = np.where(slope != 0.0, (jkr_curve_potential(a, r, es, w) - u_target) / np.where(slope != 0.0, slope, 1.0), 0.0)
         a = a - step
         if np.all(np.abs(step) <= 1e-15 * a):
             break

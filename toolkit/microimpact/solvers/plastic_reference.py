@@ -15,6 +15,10 @@ It is the pattern a plastic law needs from any driver:
    delta' rising (event: captured, e = 0; undamped, it then oscillates on (TN6) forever and never
    again reaches delta_max, so no further plastic state update is needed).
 
+The law's yield (TN2) is the model's :func:`~microimpact.model.thornton_ning.yield_point` (where
+the JKR force per contact area reaches p_y, not the paper's centre pressure; the model module says
+why), read through the law's forces, the one place it is written.
+
 Variables are nondimensional: delta / L and t / (L / V_i), L the undamped Hertz largest approach at
 V_i, (5 m V_i^2 / (4 K sqrt(R)))^(2/5). A third state variable integrates the work of the contact
 force, so that the energy account is checked along the integration too.

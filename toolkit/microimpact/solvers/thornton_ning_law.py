@@ -19,6 +19,11 @@ with :func:`microimpact.solvers.driver.make_driver`'s ``drive`` (no loop of its 
   curve, a turning point with y rising (captured: undamped, it oscillates on (TN6) forever, never
   again reaching delta_max, as :mod:`microimpact.solvers.plastic_reference` also ends it).
 
+The yield point (a_y, delta_y, F_y) is the model's (TN2), :func:`~microimpact.model.thornton_ning.yield_point`,
+passed in the parameters: where the JKR force per contact area reaches p_y, not the paper's centre
+pressure (the model module's docstring, "Yield", gives the reasons and the alternatives), so the
+driver, the closed form and the scipy reference share one yield and R_p >= R on every unloading.
+
 The force on a JKR curve is written in q = sqrt(a / a_c) (a_c of the branch's radius):
 delta - delta_p = (a_c^2 / R_b) (q^4 - 4 q), solved for q >= 1 by Newton's method (the package's
 :func:`microimpact.model.adhesion_models.jkr_q_from_approach`, scalar); without adhesion
