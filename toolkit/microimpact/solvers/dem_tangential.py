@@ -108,8 +108,18 @@ _MAX_EVENTS = 1000
 _MAX_EVALUATIONS = 2_000_000
 #: stretch of the Sundman variable (relative) kept in one mode where the switches chatter
 _CHATTER_SPAN = 1e-7
-#: span of the Sundman variable given to scipy: the contact ends by its event long before
-_SIGMA_SPAN = 1e7
+#: span of the Sundman variable given to scipy: the contact ends by its event long before. A Hertz
+#: sphere that creeps out under a damping ~ a (``viscoelastic``) reaches s ~ 1 / eta^2 before it
+#: leaves, at sigma ~ eta^3 (s = 2 eta / sigma on the slow manifold y = -s^2 / eta): 1e19 at the
+#: extended domain's 1e6 critical dampings, which 1e7 cut short
+_SIGMA_SPAN = 1e30
+#: damping rate of the normal law at its largest contact (eta = c3 a^p3, in its units, where the
+#: elastic rate is ~1) above which the integration is implicit (Radau): an explicit method is held
+#: to steps ~1 / eta by its stability and needs ~eta^2 of them (DOP853: 4e4 evaluations at 160,
+#: past 2e6 at 4e4), Radau ~2e4 at any eta (the stress sweep's jkr_force_viscoelastic_lammps_mindlin,
+#: seed 0: cases 59, 126, 144 at 1e5, 2e6, 4e4 ended in the evaluation budget); at eta 34 to 160
+#: both agree to 5e-10 of the outcome and DOP853 is the faster below ~100
+_STIFF_DAMPING = 100.0
 #: step (relative to the Sundman variable) of the central difference of slide's switch function
 _RATE_STEP = 1e-7
 #: points of the dense output scanned for the force inside the limit after a restart on it
@@ -381,6 +391,8 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
     if law.force_history:
         history *= law.stiffness(z_scale**2 if law.jkr else z_scale)
     springs = (0, 1) if law.rolling else (0,)
+    if _normal_damping_rate(law, z_scale) > _STIFF_DAMPING:  # a strongly damped normal motion: stiff
+        law.method = "Radau"
     evaluations = [0]
     budget = _MAX_EVALUATIONS if law.method == "DOP853" else _MAX_EVALUATIONS // 10  # Radau's cost ~10 DOP853's
     sigma, switches, events, slide_end = 0.0, 0, 0, math.nan
@@ -460,6 +472,12 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
         switches += switched and spring == 0
         if switched and spring == 0 and mode[0] == _STICK:
             slide_end = x[6]
+
+
+def _normal_damping_rate(law, z_scale):
+    """eta = c3 a^p3 of the normal law at its largest contact radius (z_scale), in its units. [-]"""
+    a = z_scale * z_scale if law.jkr else z_scale
+    return law.c3 * a**law.p3 if law.c3 > 0.0 else 0.0
 
 
 def _stopped(what, sol) -> str:
@@ -835,7 +853,15 @@ def _twist(contact, normal, v_n, omega_n, rtol):
     sigma, switches = 0.0, 0
     atol = tol * np.array([z_scale, law.y0, tau_scale, abs(w0) * tau_scale, abs(w0)])
 
+    # a strongly damped normal motion is stiff here as in the slip's integration (_STIFF_DAMPING)
+    method = "Radau" if _normal_damping_rate(law, z_scale) > _STIFF_DAMPING else "DOP853"
+    budget = _MAX_EVALUATIONS if method == "DOP853" else _MAX_EVALUATIONS // 10
+    evaluations = [0]
+
     def rhs(_, state):
+        evaluations[0] += 1
+        if evaluations[0] > budget:
+            raise DemTangentialError(f"DEM twisting integration ({method}): more than {budget} evaluations")
         return _twist_rates(twist, state, mode, sign)[0]
 
     def separation(_, state):
@@ -854,8 +880,9 @@ def _twist(contact, normal, v_n, omega_n, rtol):
     stopped.direction = -1.0
     while True:
         switch.direction = 1.0 if mode == _STICK else -1.0
-        sol = solve_ivp(rhs, (sigma, sigma + _SIGMA_SPAN), x, method="DOP853", rtol=tol, atol=atol,
-                        events=(separation, switch, stopped))
+        with np.errstate(over="ignore"):  # Radau's difference Jacobian probes far steps; it recovers
+            sol = solve_ivp(rhs, (sigma, sigma + _SIGMA_SPAN), x, method=method, rtol=tol, atol=atol,
+                            events=(separation, switch, stopped))
         if sol.status != 1:
             raise DemTangentialError(_stopped("twisting", sol))
         hits = [(float(t[0]), i) for i, t in enumerate(sol.t_events) if len(t)]
