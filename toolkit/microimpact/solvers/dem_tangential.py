@@ -44,14 +44,19 @@ limit; slide ends where e . G' falls below the rate of the limit (the trial forc
 the contact ends where the normal law separates (s = 0, or q^3 = 3 for LAMMPS's JKR). At a switch
 the state is mapped (e = F / |F|; xi = -(F + eta_t u) / k) and the integration restarts.
 
-Method: scipy's DOP853 (Hairer et al. 1993) at the toolkit's rtol, per impact in Python; Radau
-(implicit) where the rolling velocity has a part across the slip, whose force directions turn at
-rates |G'| / (mu F_n0) that an explicit method cannot follow where a limit is small. There a
-rolling limit far below the friction's (mu_roll <= 1e-6 beside mu 0.3) still fails, with a
-:class:`DemTangentialError`; a rolling law whose largest effect is below the tolerance is dropped. It is an
-integrator of its own beside the compiled ones (the one-core issue, docs/guide/lammps.md), slower
-(tens of ms per impact) and without the engine's overdamped limits: an impact whose normal motion
-creeps (tens of thousands of critical dampings) ends in a :class:`DemTangentialError`.
+Method: scipy's DOP853 (Hairer et al. 1993) at the toolkit's rtol, per impact in Python; implicit
+methods where the problem is stiff. Where the rolling velocity has a part across the slip, the
+force directions turn at rates |G'| / (mu F_n0) that an explicit method cannot follow where a limit
+is small: LSODA, BDF and Radau are tried in turn (``_ACROSS_METHODS``; none of them alone solved
+every case of the stress sweep). A rolling limit far below the friction's (mu_roll <= 1e-6 beside
+mu 0.3) may still fail, with a :class:`DemTangentialError`; a rolling law whose largest effect is
+below the tolerance is dropped. Where the normal damping rate dwarfs the elastic one
+(``_STIFF_DAMPING``, ~50 critical dampings) the normal motion itself is stiff, and a sphere that
+creeps (tens of thousands of critical dampings) took DOP853 past its budget: the slip and the
+twist are then integrated by Radau, which follows the creep along its slow manifold in ~1e4
+evaluations (the same outcome as BDF's to 1e-9 of the speed scale, tests/test_dem_tangential_stress.py).
+It is an integrator of its own beside the compiled ones (the one-core issue, docs/guide/lammps.md),
+slower (tens of ms per impact, seconds where it is implicit).
 
 Events are located by sign changes between the ends of a step, and after a switch the state
 starts on the limit (the switch function is 0 to rounding): a crossing inside one step, in the
@@ -533,6 +538,8 @@ def _switch(law, x, mode, spring):
         model, k, eta_v, mu, state, velocity = "linear_history", law.k_r, law.gamma_r, law.mu_r, slice(7, 9), slice(9, 11)
     if mode[spring] == _STICK:
         f = lammps_elastic_force(model, x[state], k) - eta_v * x[velocity]
+        if not math.hypot(*f) > 0.0:  # no force, no direction to slide along: the limit only grazed (0 = 0)
+            return mode, x, False
         sliding = x.copy()
         sliding[state] = f / math.hypot(*f)
         new = (_SLIDE, mode[1]) if spring == 0 else (mode[0], _SLIDE)
