@@ -240,3 +240,36 @@ def test_rolling_sds_with_mu_roll_0_is_verified_by_lammps(needs_lammps, tmp_path
     # (the normal fit of check_lammps does not hold the rolling law: left out here)
     found = check_lammps(ROLLING_SDS_MU_0, tmp_path, capsys, fit=False)
     assert found == {"export": 0, "verify": 0}, found  # LAMMPS's own law at its default: LAMMPS agrees
+
+
+@pytest.mark.extended  # a friction fit with its profile over the scipy tangential solver: ~1 min
+def test_rolling_sds_with_mu_roll_0_is_fitted_by_lammps_fit(tmp_path, capsys, monkeypatch):
+    """``lammps fit`` with LAMMPS's rolling sds at its default mu_roll 0 (--rolling-stiffness without
+    --rolling-friction): the friction of the Mindlin law is fitted to impacts of the law without
+    rolling (mu_roll 0 is that law, to the bit: tests/test_dem_rolling.py), its 95 % interval holds
+    the true 0.3, and the rolling law is written with mu_roll 0 (the one path of issue 55's list the
+    tests above leave out). The data: noise-free e_t at 6 speeds and angles, e_n with 1 % noise."""
+    from microimpact.analysis.dem_fit import dem_law_contact
+    from microimpact.io.materials import read_materials
+
+    pair = read_materials()[PAIR]
+    truth = dem_law_contact(pair, 2e-6, "hertz", "coeff_restitution", 0.6).with_(
+        friction=0.3, tangential_model="lammps_mindlin", shear_modulus=1e9)
+    speed, angle = np.geomspace(0.3, 10.0, 6), np.linspace(15.0, 60.0, 6)
+    e_t = [simulate_impact(truth, v, a).velocity_out[1] / (v * math.sin(math.radians(a))) for v, a in zip(speed, angle)]
+    rng = np.random.default_rng(2)
+    monkeypatch.chdir(tmp_path)
+    pd.DataFrame({"material_pair": PAIR, "radius [um]": 2.0, "speed [m/s]": speed, "incidence_angle [deg]": angle,
+                  "e_n [1]": 0.6 + rng.normal(0.0, 0.01, 6), "e_n_uncertainty [1]": 0.01,
+                  "tangential_restitution [1]": e_t,
+                  "tangential_restitution_uncertainty [1]": 0.01}).to_csv("impacts.csv", index=False)
+    status, _ = one_result_or_one_line(["lammps", "fit", "impacts.csv", "--material-pair", PAIR, "--law",
+                                        "hertz+coeff_restitution", "--tangential-model", "lammps_mindlin",
+                                        "--shear-modulus", "1e9", "--rolling-stiffness", "200", "--out", "c.lmp"],
+                                       capsys, allowed=(0,))
+    assert status == 0
+    text = (tmp_path / "c.lmp").read_text()
+    assert text.splitlines()[-1].split(" rolling sds ")[1].split()[:3] == ["200", "0", "0"]
+    interval = text.split("# fitted friction: ")[1].split("95% profile-likelihood interval ")[1].split(";")[0]
+    low, high = (float(x) for x in interval.split(" to "))
+    assert low < 0.3 < high

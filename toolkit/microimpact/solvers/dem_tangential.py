@@ -44,14 +44,19 @@ limit; slide ends where e . G' falls below the rate of the limit (the trial forc
 the contact ends where the normal law separates (s = 0, or q^3 = 3 for LAMMPS's JKR). At a switch
 the state is mapped (e = F / |F|; xi = -(F + eta_t u) / k) and the integration restarts.
 
-Method: scipy's DOP853 (Hairer et al. 1993) at the toolkit's rtol, per impact in Python; Radau
-(implicit) where the rolling velocity has a part across the slip, whose force directions turn at
-rates |G'| / (mu F_n0) that an explicit method cannot follow where a limit is small. There a
-rolling limit far below the friction's (mu_roll <= 1e-6 beside mu 0.3) still fails, with a
-:class:`DemTangentialError`; a rolling law whose largest effect is below the tolerance is dropped. It is an
-integrator of its own beside the compiled ones (the one-core issue, docs/guide/lammps.md), slower
-(tens of ms per impact) and without the engine's overdamped limits: an impact whose normal motion
-creeps (tens of thousands of critical dampings) ends in a :class:`DemTangentialError`.
+Method: scipy's DOP853 (Hairer et al. 1993) at the toolkit's rtol, per impact in Python; implicit
+methods where the problem is stiff. Where the rolling velocity has a part across the slip, the
+force directions turn at rates |G'| / (mu F_n0) that an explicit method cannot follow where a limit
+is small: LSODA, BDF and Radau are tried in turn (``_ACROSS_METHODS``; none of them alone solved
+every case of the stress sweep). A rolling limit far below the friction's (mu_roll <= 1e-6 beside
+mu 0.3) may still fail, with a :class:`DemTangentialError`; a rolling law whose largest effect is
+below the tolerance is dropped. Where the normal damping rate dwarfs the elastic one
+(``_STIFF_DAMPING``, ~50 critical dampings) the normal motion itself is stiff, and a sphere that
+creeps (tens of thousands of critical dampings) took DOP853 past its budget: the slip and the
+twist are then integrated by Radau, which follows the creep along its slow manifold in ~1e4
+evaluations (the same outcome as BDF's to 1e-9 of the speed scale, tests/test_dem_tangential_stress.py).
+It is an integrator of its own beside the compiled ones (the one-core issue, docs/guide/lammps.md),
+slower (tens of ms per impact, seconds where it is implicit).
 
 Events are located by sign changes between the ends of a step, and after a switch the state
 starts on the limit (the switch function is 0 to rounding): a crossing inside one step, in the
@@ -108,10 +113,28 @@ _MAX_EVENTS = 1000
 _MAX_EVALUATIONS = 2_000_000
 #: stretch of the Sundman variable (relative) kept in one mode where the switches chatter
 _CHATTER_SPAN = 1e-7
-#: span of the Sundman variable given to scipy: the contact ends by its event long before
-_SIGMA_SPAN = 1e7
+#: span of the Sundman variable given to scipy: the contact ends by its event long before. A Hertz
+#: sphere that creeps out under a damping ~ a (``viscoelastic``) reaches s ~ 1 / eta^2 before it
+#: leaves, at sigma ~ eta^3 (s = 2 eta / sigma on the slow manifold y = -s^2 / eta): 1e19 at the
+#: extended domain's 1e6 critical dampings, which 1e7 cut short
+_SIGMA_SPAN = 1e30
+#: damping rate of the normal law at its largest contact (eta = c3 a^p3, in its units, where the
+#: elastic rate is ~1) above which the integration is implicit (Radau): an explicit method is held
+#: to steps ~1 / eta by its stability and needs ~eta^2 of them (DOP853: 4e4 evaluations at 160,
+#: past 2e6 at 4e4), Radau ~2e4 at any eta (the stress sweep's jkr_force_viscoelastic_lammps_mindlin,
+#: seed 0: cases 59, 126, 144 at 1e5, 2e6, 4e4 ended in the evaluation budget); at eta 34 to 160
+#: both agree to 5e-10 of the outcome and DOP853 is the faster below ~100
+_STIFF_DAMPING = 100.0
 #: step (relative to the Sundman variable) of the central difference of slide's switch function
 _RATE_STEP = 1e-7
+#: the implicit methods tried in turn where the rolling velocity has a part across the slip, each
+#: from touch with its own evaluation budget where the one before failed: none of scipy's three
+#: solves every case. Over the stress sweep's sds law (seed 0, 40 cases, rtol 1e-10) Radau failed
+#: to locate an event (case 37), ran out of its budget (38) and took 4725 steps, ~10x the time of
+#: BDF and LSODA (39); BDF took 15094 steps where LSODA took 1294 (38); LSODA failed to locate an
+#: event where BDF took 424 steps (37). Each is an integration of the same equations to the same tolerance, so
+#: that the first that reaches the end of contact gives the outcome
+_ACROSS_METHODS = ("LSODA", "BDF", "Radau")
 #: points of the dense output scanned for the force inside the limit after a restart on it
 _SCAN_POINTS = 257
 #: JKR's state where LAMMPS's contact breaks, q^3 = 3 (F = -F_c)
@@ -381,6 +404,8 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
     if law.force_history:
         history *= law.stiffness(z_scale**2 if law.jkr else z_scale)
     springs = (0, 1) if law.rolling else (0,)
+    if law.method == "DOP853" and _normal_damping_rate(law, z_scale) > _STIFF_DAMPING:  # strongly damped: stiff
+        law.method = "Radau"
     evaluations = [0]
     budget = _MAX_EVALUATIONS if law.method == "DOP853" else _MAX_EVALUATIONS // 10  # Radau's cost ~10 DOP853's
     sigma, switches, events, slide_end = 0.0, 0, 0, math.nan
@@ -462,6 +487,12 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
             slide_end = x[6]
 
 
+def _normal_damping_rate(law, z_scale):
+    """eta = c3 a^p3 of the normal law at its largest contact radius (z_scale), in its units. [-]"""
+    a = z_scale * z_scale if law.jkr else z_scale
+    return law.c3 * a**law.p3 if law.c3 > 0.0 else 0.0
+
+
 def _stopped(what, sol) -> str:
     """The message of an integration that ended without the contact's end: scipy's own where it
     failed; where it ran through its whole span (status 0, which scipy calls a success) the contact
@@ -507,6 +538,8 @@ def _switch(law, x, mode, spring):
         model, k, eta_v, mu, state, velocity = "linear_history", law.k_r, law.gamma_r, law.mu_r, slice(7, 9), slice(9, 11)
     if mode[spring] == _STICK:
         f = lammps_elastic_force(model, x[state], k) - eta_v * x[velocity]
+        if not math.hypot(*f) > 0.0:  # no force, no direction to slide along: the limit only grazed (0 = 0)
+            return mode, x, False
         sliding = x.copy()
         sliding[state] = f / math.hypot(*f)
         new = (_SLIDE, mode[1]) if spring == 0 else (mode[0], _SLIDE)
@@ -681,7 +714,10 @@ def _with_rolling(contact, normal, velocity_in, omega_in, rtol):
     spin = m * r * r / inertia  # kappa - 1
     switches, slip_ended, slip_end_time = 0, False, math.nan
     mu, mu_r = contact.friction, contact.rolling_friction
-    if (mu == 0.0 and mu_r == 0.0) or not (slip.any() or roll.any()):
+    # without friction the slip carries no force, and a rolling velocity 0 leaves the rolling spring
+    # unloaded: nothing acts (the rolling velocity's frame below was 0 / 0, the stress sweep's sds
+    # law, case 30 of seed 0)
+    if (mu == 0.0 and (mu_r == 0.0 or not roll.any())) or not (slip.any() or roll.any()):
         du, dw = np.zeros(2), np.zeros(2)
     elif normal.outcome == "capture":
         # at rest on the wall both limits stay > 0 (2 mu F_po): the slip stops, and the rolling where
@@ -722,12 +758,21 @@ def _with_rolling(contact, normal, velocity_in, omega_in, rtol):
         if most <= tol * max(math.hypot(*u0), math.hypot(*w0), law.y0):
             return _slip(contact.with_(rolling_model="torque", rolling_stiffness=None, rolling_friction=0.0,
                                        rolling_damping=0.0), normal, velocity_in, omega_in, rtol)
-        if w0[1] != 0.0:
-            # rolling across the slip: the directions of both forces turn, at rates |G'| / (mu F_n0) that
-            # made DOP853 take millions of steps where a limit is small; Radau (implicit) follows them
-            # (mu_roll >= 1e-4 at 5 deg; below that, at 1e-6, it fails: DemTangentialError)
-            law.method = "Radau"
-        end, slide_end, switches, slip_ended = _integrate(law, tuple(u0), tol, tau_scale, z_scale, w0=tuple(w0))
+        # rolling across the slip: the directions of both forces turn, at rates |G'| / (mu F_n0) that
+        # made DOP853 take millions of steps where a limit is small; an implicit method follows them
+        # (_ACROSS_METHODS)
+        methods = _ACROSS_METHODS if w0[1] != 0.0 else ("DOP853",)
+        failed = []
+        for method in methods:
+            law.method = method
+            try:
+                end, slide_end, switches, slip_ended = _integrate(law, tuple(u0), tol, tau_scale, z_scale,
+                                                                  w0=tuple(w0))
+                break
+            except DemTangentialError as exc:
+                failed.append(str(exc))
+        else:
+            raise DemTangentialError("; ".join(failed))
         du_f, dw_f = (end[4:6] - u0) * unit, (end[9:11] - w0) * unit
         du, dw = du_f[0] * e1 + du_f[1] * e2, dw_f[0] * e1 + dw_f[1] * e2
         slip_end_time = slide_end * float(sc.time) if math.isfinite(slide_end) else math.nan
@@ -835,7 +880,15 @@ def _twist(contact, normal, v_n, omega_n, rtol):
     sigma, switches = 0.0, 0
     atol = tol * np.array([z_scale, law.y0, tau_scale, abs(w0) * tau_scale, abs(w0)])
 
+    # a strongly damped normal motion is stiff here as in the slip's integration (_STIFF_DAMPING)
+    method = "Radau" if _normal_damping_rate(law, z_scale) > _STIFF_DAMPING else "DOP853"
+    budget = _MAX_EVALUATIONS if method == "DOP853" else _MAX_EVALUATIONS // 10
+    evaluations = [0]
+
     def rhs(_, state):
+        evaluations[0] += 1
+        if evaluations[0] > budget:
+            raise DemTangentialError(f"DEM twisting integration ({method}): more than {budget} evaluations")
         return _twist_rates(twist, state, mode, sign)[0]
 
     def separation(_, state):
@@ -854,8 +907,9 @@ def _twist(contact, normal, v_n, omega_n, rtol):
     stopped.direction = -1.0
     while True:
         switch.direction = 1.0 if mode == _STICK else -1.0
-        sol = solve_ivp(rhs, (sigma, sigma + _SIGMA_SPAN), x, method="DOP853", rtol=tol, atol=atol,
-                        events=(separation, switch, stopped))
+        with np.errstate(over="ignore"):  # Radau's difference Jacobian probes far steps; it recovers
+            sol = solve_ivp(rhs, (sigma, sigma + _SIGMA_SPAN), x, method=method, rtol=tol, atol=atol,
+                            events=(separation, switch, stopped))
         if sol.status != 1:
             raise DemTangentialError(_stopped("twisting", sol))
         hits = [(float(t[0]), i) for i, t in enumerate(sol.t_events) if len(t)]
