@@ -1,9 +1,12 @@
 """Posterior of the fitted parameters by MCMC (emcee), run until it converges, and what it implies.
 
 :func:`sample_posterior` samples (zeta_H, zeta_A[, w_A][, friction]) with emcee's ensemble sampler
-(Foreman-Mackey et al. 2013, doi:10.1086/670067; differential-evolution moves), from walkers started
-in a small ball around the least-squares fit, seeded (``seed``): the same inputs give the same
-chain. Priors are flat within :func:`prior_bounds` (the ranges the least-squares fits search).
+(Foreman-Mackey et al. 2013, doi:10.1086/670067), from walkers started in a small ball around the
+least-squares fit, seeded (``seed``): the same inputs give the same chain. Priors are flat within
+:func:`prior_bounds` (the ranges the least-squares fits search); the posterior's attributes state
+them. Moves: a mixture of differential-evolution moves (80 %) and their snooker variant (20 %),
+which the emcee documentation recommends for correlated, low-dimensional posteriors; on the
+bundled data they reach the 50-tau rule in fewer steps than the default stretch move.
 
 Likelihood
 ----------
@@ -598,20 +601,14 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     Parameters
     ----------
     table : pandas.DataFrame or None
-        The impact table that was fitted (for the stated uncertainties and the oblique columns);
-        None uses the fit's own data (effective variance only).
+        The fitted impact table (stated uncertainties, oblique columns); None: the fit's own data.
     damping_fit : DampingFit
         The least-squares fit: start of the walkers, material, fitted rows.
     friction_fit : FrictionFit, optional
         Also sample the friction under the tangential likelihood.
-    walkers : int, optional
-        Ensemble size (>= 2 x parameters); default :data:`DEFAULT_WALKERS`.
-    steps : int, optional
-        Run exactly this many steps (no early stop); default: until converged.
-    max_steps : int, optional
-        Budget of a chain run until converged; default :data:`DEFAULT_MAX_STEPS`.
-    burn : int, optional
-        Steps discarded; default a third of the chain.
+    walkers, steps, max_steps, burn : int, optional
+        Ensemble size (>= 2 x parameters; :data:`DEFAULT_WALKERS`); exactly ``steps`` steps, else
+        until converged within ``max_steps`` (:data:`DEFAULT_MAX_STEPS`); steps discarded (a third).
     seed : int
         Seeds the start ball and the sampler.
     errors_in_variables : {"auto", "effective", "latent"}
@@ -621,21 +618,18 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     progress : bool
         Progress bar on stderr (a terminal only).
     time_budget : float or Deadline, optional
-        Wall-clock budget of the sampling; None: no limit. Checked between steps. [s]
+        Wall-clock budget, checked between steps; None: no limit. [s]
     require_convergence : bool
-        Raise :class:`PosteriorError` for a chain that has not converged (default). False returns it,
-        marked ``converged = False`` (for studies of the sampler itself).
+        Raise :class:`PosteriorError` for an unconverged chain (default); False returns it marked
+        ``converged = False`` (for studies of the sampler).
     likelihood : {"normal", "student-t"}
-        e_n likelihood of each row (module docstring).
-    nu : float
-        Degrees of freedom of the Student-t likelihood (default :data:`DEFAULT_NU`). [-]
+        e_n likelihood of each row, with ``nu`` degrees of freedom (:data:`DEFAULT_NU`) (module docstring).
     method : {"emulator", "solve"}
-        Model e_n of the likelihood: the ring law's table (:func:`microimpact.solvers.emulator.ring_emulator`,
-        shipped with the package; the default, :data:`DEFAULT_METHOD`) with its groups computed
-        once, the solver where the table falls back or the law is not the ring law; or the solver
-        at every evaluation (the reference). The oblique part is always solved.
-    emulator_tol : float
-        Absolute e_n tolerance of ``method="emulator"`` (default :data:`EMULATOR_TOLERANCE`). [-]
+        Model e_n of the likelihood: the ring law's table shipped with the package
+        (:func:`microimpact.solvers.emulator.ring_emulator`, :data:`DEFAULT_METHOD`; the solver where
+        it falls back or for another law) to the absolute tolerance ``emulator_tol``
+        (:data:`EMULATOR_TOLERANCE`), or the solver at every evaluation (the reference). The
+        oblique part is always solved.
 
     Returns
     -------
@@ -646,19 +640,11 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     ValueError
         Too few walkers or steps, a bad ``burn`` or ``time_budget``.
     PosteriorError
-        The chain collapsed (mean acceptance below :data:`MIN_ACCEPTANCE`, walkers at zero
-        probability, no autocorrelation time), or has not converged by :data:`TAU_FACTOR`
-        autocorrelation times, R-hat below :data:`~microimpact.analysis.diagnostics.RHAT_MAX` and an
-        effective sample size of :data:`~microimpact.analysis.diagnostics.ESS_MIN` within its budget.
+        The chain collapsed (acceptance below :data:`MIN_ACCEPTANCE`, walkers at zero probability,
+        no autocorrelation time) or has not converged (:data:`TAU_FACTOR` autocorrelation times,
+        R-hat, effective sample size: :mod:`microimpact.analysis.diagnostics`) within its budget.
     TimeBudgetExceeded
-        The chain ran past ``time_budget``; the message gives the steps done. No chain is returned.
-
-    Notes
-    -----
-    Priors are flat within :func:`prior_bounds`; the posterior's attributes state them. Moves: a
-    mixture of differential-evolution moves (80 %) and their snooker variant (20 %), which the emcee
-    documentation recommends for correlated, low-dimensional posteriors; on the bundled data they
-    reach the 50-tau rule in fewer steps than the default stretch move.
+        The chain ran past ``time_budget`` (the message gives the steps done).
 
     References
     ----------
@@ -667,9 +653,7 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
 
     Examples
     --------
-    Six synthetic impacts. A chain whose budget is too small is refused, saying why, rather than
-    returned as a result; ``require_convergence=False`` returns it marked as not converged (the
-    default chain, 16 walkers until converged, converges):
+    Six synthetic impacts: a chain whose budget is too small is refused, saying why, or returned marked:
 
     >>> from microimpact.analysis.fitting import fit_damping
     >>> from microimpact.analysis.synthetic import write_synthetic_impacts
@@ -681,28 +665,18 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     Traceback (most recent call last):
     ...
     microimpact.analysis.posterior.PosteriorError: the posterior has not converged after 60 steps of 8 walkers ...
-    >>> post = sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
-    >>> post
+    >>> sample_posterior(table, fit, walkers=8, steps=60, require_convergence=False)  # short: an illustration
     Posterior(zeta_hertz, zeta_adhesion; 8 walkers x 60 steps, burn-in 20, seed 2002, converged=False)
     """
-    t0 = time.perf_counter()
-    deadline = Deadline.start(time_budget, "posterior")
+    t0, deadline = time.perf_counter(), Deadline.start(time_budget, "posterior")
     like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol, likelihood, nu, method, emulator_tol)
     names = list(damping_fit.varied) + (["friction"] if friction_fit is not None else [])
     best = dict(damping_fit.values) | ({"friction": friction_fit.friction} if friction_fit is not None else {})
     stderr = dict(damping_fit.stderr) | ({"friction": friction_fit.stderr["friction"]} if friction_fit is not None else {})
     walkers, budget, fixed_length = _sampler_options(walkers, steps, max_steps, burn, seed, len(names))
     bounds = prior_bounds(names, best)
-    lo = np.array([bounds[n][0] for n in names])
-    hi = np.array([bounds[n][1] for n in names])
-    base = {n: best[n] for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion", "friction") if n in best}
-
-    def log_probability(x):
-        if np.any(x < lo) or np.any(x > hi):
-            return -np.inf
-        value = like(base | dict(zip(names, map(float, x))))
-        return value if math.isfinite(value) else -np.inf
-
+    lo, hi = (np.array([bounds[n][k] for n in names]) for k in (0, 1))
+    log_probability = _LogProbability(like, names, best, lo, hi)
     pos = np.clip(_start_ball(names, best, stderr, lo, walkers, seed), lo, hi)
     with progress_bar(budget, "posterior", progress) as advance, engine_threads(1):
         advance = deadline.ticking(advance, budget, "emcee steps")
@@ -716,6 +690,22 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
                              + _undetermined_hint(damping_fit, friction_fit))
     return _posterior_record(sampler, diag, names, best, bounds, like, damping_fit, friction_fit, seed, converged,
                              text, errors_in_variables, time.perf_counter() - t0)
+
+
+class _LogProbability:
+    """log posterior of a walker's position: the likelihood inside the flat prior's box, -inf outside
+    it and where the likelihood is not finite."""
+
+    def __init__(self, like, names, best, lo, hi):
+        self.like, self.names, self.lo, self.hi = like, names, lo, hi
+        self.base = {n: best[n] for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion", "friction") if n in best}
+
+    def __call__(self, x):
+        if np.any(x < self.lo) or np.any(x > self.hi):
+            return -np.inf
+        value = self.like(self.base | dict(zip(self.names, map(float, x))))
+        return value if math.isfinite(value) else -np.inf
+
 
 def _sampler_options(walkers, steps, max_steps, burn, seed, n_params: int) -> tuple[int, int, bool]:
     """(walkers, steps budget, fixed length) of :func:`sample_posterior`'s options, checked before
