@@ -173,6 +173,40 @@ def test_a_job_whose_parent_ended_first_on_a_sigterm_to_the_group_is_killed_too(
         os.killpg(proc.pid, signal.SIGKILL) if _group_alive(proc.pid) else None
 
 
+# a stand-in for Snakemake that, on a stop signal, starts one more job (which ignores SIGTERM and
+# SIGINT) and ends at once: the job is an orphan the wrapper never saw among its descendants (a
+# SIGTERM to the group as Snakemake launched its jobs once left such a process, issue 55's study)
+LATE_JOB = """
+import os, signal, subprocess, sys, time
+def stop(signum, frame):
+    job = subprocess.Popen([sys.executable, "-c", "import signal, time; signal.signal(signal.SIGTERM, signal.SIG_IGN); "
+                            "signal.signal(signal.SIGINT, signal.SIG_IGN); time.sleep(60)"])
+    open(sys.argv[1], "w").write(str(job.pid))  # the wrapper drops what a stopped child prints
+    os._exit(0)
+signal.signal(signal.SIGTERM, stop)
+signal.signal(signal.SIGINT, stop)
+print(os.getpid(), flush=True)
+time.sleep(60)
+"""
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs /proc to find the child's jobs")
+def test_a_job_started_as_the_child_ends_on_a_stop_signal_is_killed_too(tmp_path):
+    proc = subprocess.Popen([sys.executable, "-c", WRAPPER, LATE_JOB, str(tmp_path / "job")], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)))
+    try:
+        int(proc.stdout.readline())  # the child is up, its handlers set
+        os.killpg(proc.pid, signal.SIGTERM)
+        out, _ = proc.communicate(timeout=10)
+        job_pid = int((tmp_path / "job").read_text())
+        assert out.split() == ["wrapper", "0", str(int(signal.SIGTERM))]
+        assert not _group_alive(proc.pid)  # the late job is gone as the wrapper ends, not left running
+        assert not _alive(job_pid)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL) if _group_alive(proc.pid) else None
+
+
 def _group_alive(pgid):
     try:
         os.killpg(pgid, 0)

@@ -8,6 +8,9 @@ and everything it started within seconds, with one line of the wrapper's and non
 - The child's stdout and stderr pass through the wrapper; once a stop signal has come they are
   dropped, so what a child prints while it is stopped in its start-up (a KeyboardInterrupt
   traceback from an import, an event-loop traceback as jobs launch) never reaches the user.
+- While the child runs the wrapper is its jobs' subreaper (Linux ``prctl(PR_SET_CHILD_SUBREAPER)``):
+  a job the child starts as it ends on a signal, too late for the wrapper to have seen it, is
+  re-parented to the wrapper instead of init, and killed with the rest when the child has ended.
 - A child that has not ended :data:`STOP_GRACE` seconds after the signal is killed with its
   descendants (SIGKILL); what it leaves (a lock, an unfinished output) is what a plain rerun of
   ``microimpact workflow`` clears (its stale-lock check and ``--rerun-incomplete``).
@@ -15,6 +18,7 @@ and everything it started within seconds, with one line of the wrapper's and non
 
 from __future__ import annotations
 
+import ctypes
 import os
 import queue
 import signal
@@ -36,6 +40,17 @@ HOLD = 0.1
 SIGINT_PASS_ON = 1.0
 #: the stop signals the wrapper takes and passes on
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+#: prctl's option that makes a process the subreaper of its descendants' orphans (linux/prctl.h)
+PR_SET_CHILD_SUBREAPER = 36
+
+
+def _set_subreaper(on: bool) -> bool:
+    """Make this process the subreaper of its descendants' orphans (or stop being one); False where
+    the system has no such call (not Linux)."""
+    try:
+        return ctypes.CDLL(None, use_errno=True).prctl(PR_SET_CHILD_SUBREAPER, int(on), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
 
 
 def descendants(pid: int) -> list[int]:
@@ -87,6 +102,17 @@ def _kill_orphans(pids, wait: float = 1.0) -> None:
     while alive and time.monotonic() < end:
         alive = [p for p in alive if _running(p)]
         time.sleep(0.02)
+
+
+def _reap(pids) -> None:
+    """SIGKILL ``pids`` (the child's orphans, re-parented to this process as their subreaper) and
+    collect their exit status, so that none is left running or as a zombie."""
+    _signal_all(pids, signal.SIGKILL)
+    for pid in pids:
+        try:
+            os.waitpid(pid, 0)
+        except ChildProcessError:  # an orphan's own descendant: its parent, killed here, was ours
+            pass
 
 
 def _running(pid: int) -> bool:
@@ -166,6 +192,8 @@ def run_supervised(command: list[str], grace: float = STOP_GRACE) -> tuple[int, 
         stopped.set()
 
     previous = {s: signal.signal(s, on_signal) for s in STOP_SIGNALS}
+    ours = set(descendants(os.getpid()))  # what the caller had started itself is left alone
+    subreaper = _set_subreaper(True)
     try:
         proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
         copiers = [threading.Thread(target=_copy, args=(stream, target, stopped), daemon=True)
@@ -176,9 +204,12 @@ def run_supervised(command: list[str], grace: float = STOP_GRACE) -> tuple[int, 
         # nothing it started outlives it (a job whose parent was killed)
         _signal_all(descendants(proc.pid), signal.SIGKILL)
         _kill_orphans(seen)
+        _reap([pid for pid in descendants(os.getpid()) if pid not in ours])  # re-parented to us
         for c in copiers:
             c.join(timeout=1.0 + HOLD)
     finally:
+        if subreaper:
+            _set_subreaper(False)
         for s, handler in previous.items():
             signal.signal(s, handler)
     return proc.returncode, (received[0] if received else None)
