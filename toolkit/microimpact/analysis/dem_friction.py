@@ -666,23 +666,8 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
     rows = []
     normal_laws = _COVERAGE_NORMAL[2:] if fit_adhesion else _COVERAGE_NORMAL
     for _ in range(trials):
-        law = str(rng.choice(_COVERAGE_TANGENTIAL))
-        normal, damping = normal_laws[int(rng.integers(0, len(normal_laws)))]
-        mat = {"density": 2000.0, "stiffness": 1e9,
-               "work_of_adhesion": 0.0 if normal == "hertz" else float(10 ** rng.uniform(-3, -1.5))}
-        if damping in RESTITUTION_DAMPING_MODELS:
-            coef = float(rng.uniform(0.3, 0.95))
-        else:
-            unit = critical_damping_coefficient(dem_law_contact(mat, 1e-6, normal, damping, 1.0), 1.0)
-            coef = float(10 ** rng.uniform(-2, -0.7)) * unit
-        mu = float(10 ** rng.uniform(-1.3, 0))
-        stiffness = ({"tangential_stiffness": float(10 ** rng.uniform(0.5, 3))} if law == "linear_history"
-                     else {"shear_modulus": float(1e9 * 10 ** rng.uniform(-1, -0.2))})
-        n = int(rng.integers(4, 14))
-        lo = rng.uniform(0, 70)
-        hi = min(lo + rng.uniform(5, 60), 85)
-        angles, speeds = rng.uniform(lo, hi, n), 10 ** rng.uniform(-1, 1, n)
-        noise_t, noise_n = float(10 ** rng.uniform(-2.3, -1.3)), float(10 ** rng.uniform(-2.3, -1.3))
+        law, normal, damping, mat, coef, mu, stiffness, speeds, angles, noise_n, noise_t = _coverage_design(
+            rng, normal_laws)
         tangential = {"friction": mu, "tangential_model": law, **stiffness}
         truth = dem_law_contact(mat, 1e-6, normal, damping, coef).with_(**tangential)
         table = _measured_rebounds(truth, speeds, angles, noise_n, noise_t, rng, rtol)
@@ -711,6 +696,30 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
         rows.append(row)
     return pd.DataFrame(rows)
 
+
+
+def _coverage_design(rng, normal_laws) -> tuple:
+    """One random design of :func:`dem_friction_coverage`, drawn from ``rng``: (tangential law,
+    normal law, damping law, material, damping coefficient, mu, {stiffness field: value}, speeds
+    [m/s], angles [deg], e_n noise, e_t noise), the normal and damping laws from ``normal_laws``."""
+    law = str(rng.choice(_COVERAGE_TANGENTIAL))
+    normal, damping = normal_laws[int(rng.integers(0, len(normal_laws)))]
+    mat = {"density": 2000.0, "stiffness": 1e9,
+           "work_of_adhesion": 0.0 if normal == "hertz" else float(10 ** rng.uniform(-3, -1.5))}
+    if damping in RESTITUTION_DAMPING_MODELS:
+        coef = float(rng.uniform(0.3, 0.95))
+    else:
+        unit = critical_damping_coefficient(dem_law_contact(mat, 1e-6, normal, damping, 1.0), 1.0)
+        coef = float(10 ** rng.uniform(-2, -0.7)) * unit
+    mu = float(10 ** rng.uniform(-1.3, 0))
+    stiffness = ({"tangential_stiffness": float(10 ** rng.uniform(0.5, 3))} if law == "linear_history"
+                 else {"shear_modulus": float(1e9 * 10 ** rng.uniform(-1, -0.2))})
+    n = int(rng.integers(4, 14))
+    lo = rng.uniform(0, 70)
+    hi = min(lo + rng.uniform(5, 60), 85)
+    angles, speeds = rng.uniform(lo, hi, n), 10 ** rng.uniform(-1, 1, n)
+    noise_t, noise_n = float(10 ** rng.uniform(-2.3, -1.3)), float(10 ** rng.uniform(-2.3, -1.3))
+    return law, normal, damping, mat, coef, mu, stiffness, speeds, angles, noise_n, noise_t
 
 def _measured_rebounds(truth, speeds, angles, noise_n, noise_t, rng, rtol):
     """The rebounds of ``truth`` as an impact table with Gaussian noise of the stated sigma on e_n
