@@ -7,6 +7,20 @@ mu moves with it) or, with its uncertainty, profiled out. :func:`rank_dem_tangen
 laws by AIC and :func:`dem_friction_coverage` measures the coverage of mu's interval over random
 designs. Every DEM law is solved in full for each trial mu, so the profile, its interval and its
 status come from :mod:`microimpact.analysis.oblique` (the rigid law's fit), with a costlier objective.
+
+The held tangential stiffness
+-----------------------------
+The data of a fit rarely determine the tangential stiffness alone, and mu depends on it where the
+contact sticks (low incidence): :func:`fit_dem_friction` refits mu at the stiffness 10 % below and
+above the given one, and the report states both. Without ``stiffness_uncertainty`` the interval
+holds at the given stiffness only: on four noisy rebounds at 10-70 deg (LAMMPS's Mindlin law,
+mu = 0.25) half and twice the true G* gave mu = 0.36 and a lower bound of 9.9, far outside the
+interval [0.234, 0.264] at the true G*. With it (u), the stiffness is a nuisance parameter with a
+Gaussian prior, (1 + u z) times the given one, z standard normal, profiled out
+(:class:`_StiffnessProfile`): the interval is mu's profile likelihood over mu and z jointly, so
+rebounds that constrain the stiffness narrow it and a valley of e_t(mu) that moves with the
+stiffness is followed. The normal law's shift is measured at the given stiffness and widens this
+interval as it widens the held one (:func:`fit_dem_friction`, Notes). Measured calibration: :data:`STIFFNESS_COVERAGE`.
 """
 
 from __future__ import annotations
@@ -98,29 +112,16 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
 
     Notes
     -----
-    The law has no closed-form map, so every trial mu solves every entry
-    (:func:`microimpact.solvers.dem_tangential.solve_dem_tangential`): the profile has
-    :data:`DEM_PROFILE_POINTS` log-spaced points over ``PARAMETER_BOUNDS["friction"]``, refined and
-    polished as in :func:`fit_friction`; the interval is the profile-likelihood interval. With
-    stated speed or angle uncertainties the effective variance is evaluated once, at a first fit
+    Every trial mu solves every entry (:func:`microimpact.solvers.dem_tangential.solve_dem_tangential`):
+    the profile has :data:`DEM_PROFILE_POINTS` log-spaced points over ``PARAMETER_BOUNDS["friction"]``,
+    refined and polished as in :func:`fit_friction`; the interval is the profile-likelihood interval.
+    With stated speed or angle uncertainties the effective variance is evaluated once, at a first fit
     with the stated uncertainties alone, and held for the second (it depends on mu only through the
-    model's slopes).
-
-    With ``normal_fit``, mu is refitted over the boundary of the normal law's 95 % confidence region
-    (:meth:`~microimpact.analysis.dem_fit.DemLawFit.confidence_region`) and each end of its 95 %
-    interval widened in quadrature by how far the refits move it that way (:func:`_normal_law_shift`).
-
-    The data of a fit rarely determine the tangential stiffness alone, and mu depends on it where
-    the contact sticks (low incidence): mu is refitted at the stiffness 10 % below and above the
-    given one, and the report states both. Without ``stiffness_uncertainty`` the interval holds at
-    the given stiffness only: on four noisy rebounds at 10-70 deg (LAMMPS's Mindlin law, mu = 0.25)
-    half and twice the true G* gave mu = 0.36 and a lower bound of 9.9, far outside the interval
-    [0.234, 0.264] at the true G*. With it (u), the stiffness is a nuisance parameter with a
-    Gaussian prior, (1 + u z) times the given one, z standard normal, profiled out
-    (:class:`_StiffnessProfile`): the interval is mu's profile likelihood over mu and z jointly, so
-    rebounds that constrain the stiffness narrow it and a valley of e_t(mu) that moves with the
-    stiffness is followed. The normal law's shift is measured at the given stiffness and widens
-    this interval as above. Measured calibration: :data:`STIFFNESS_COVERAGE`.
+    model's slopes). With ``normal_fit``, mu is refitted over the boundary of the normal law's 95 %
+    confidence region (:meth:`~microimpact.analysis.dem_fit.DemLawFit.confidence_region`) and each
+    end of its 95 % interval widened in quadrature by how far the refits move it that way
+    (:func:`_normal_law_shift`). How the held tangential stiffness is reported or, with
+    ``stiffness_uncertainty``, profiled out: the module docstring (The held tangential stiffness).
 
     References
     ----------
@@ -144,40 +145,72 @@ def fit_dem_friction(table, contact_of, *, normal_fit=None, stiffness_uncertaint
     t0 = time.perf_counter()
     deadline = Deadline.start(time_budget, "friction fit")
     problem = ObliqueProblem.from_table(table, warn=True)
-    contact = contact_of(float(problem.radius[0]))
-    if not uses_dem_tangential(contact):
-        raise ValueError(f"fit_dem_friction fits a DEM tangential law ({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}); the "
-                         f"contact has tangential_model={contact.tangential_model!r} (use fit_friction)")
+    contact = _dem_contact(contact_of, problem)
     ends = _normal_fit_ends(normal_fit, contact_of, problem) if normal_fit is not None else {}
     u = _stiffness_uncertainty(stiffness_uncertainty)
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
-    profile = 2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20)
-    total = profile * (1 + 2 * bool(u)) + (_region_refits(ends) + 2) * _REFIT_EVALUATIONS
-    with progress_bar(total, "friction fit", progress) as advance:
+    with progress_bar(_fit_evaluations(u, ends), "friction fit", progress) as advance:
         objective = _DemFrictionObjective(problem, contact_of, weighted, rtol, advance)
-        best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
-        if weighted and (np.any(problem.sigma_speed > 0) or np.any(problem.sigma_angle > 0)):
-            objective.hold_effective_sigma(best.value)
-            best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
-        held, fitted = best, objective
-        if u and getattr(contact, _stiffness_field(contact.tangential_model)):
-            weight = _profile_scale(objective, best.chisqr, max(problem.size - 1, 1))
-            fitted = _StiffnessProfile(objective, contact_of, u, weight)
-            best = _profile_fit(fitted, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
-        shift, gradient, sensitivity = None, {}, {}
-        if _friction_status(best, fitted, 0.0).determined:
-            if ends:  # at the given stiffness, about its own fit: a shift applied to the profiled interval
-                shift, gradient = _normal_law_shift(objective, contact_of, normal_fit, held, deadline)
-            sensitivity = _stiffness_sensitivity(objective, contact_of, held, deadline)
-            if u and sensitivity:
-                z = fitted.stiffness_z(best.value)
-                sensitivity |= {"uncertainty": u, "profiled_factor": 1.0 + u * z,
-                                "friction_at_given": held.value if _friction_status(held, objective, 0.0).determined
-                                else math.nan}
+        held, fitted, best = _profiled_friction(objective, contact, contact_of, u, deadline)
+        shift, gradient, sensitivity = _friction_sensitivities(objective, fitted, contact_of, normal_fit, ends,
+                                                               held, best, u, deadline)
     fit = _friction_result(problem, fitted, best, 0.0, {"friction": gradient} if gradient else {}, weighted,
                            contact.tangential_model, t0, shift=shift)
     return replace(fit, info=fit.info | {"normal_propagated": ", ".join(gradient), "stiffness_sensitivity": sensitivity,
                                          "stiffness_uncertainty": u if sensitivity else None})
+
+
+def _dem_contact(contact_of, problem):
+    """The contact of the first entry's radius, checked to hold a DEM tangential law (ValueError)."""
+    contact = contact_of(float(problem.radius[0]))
+    if not uses_dem_tangential(contact):
+        raise ValueError(f"fit_dem_friction fits a DEM tangential law ({', '.join(map(repr, DEM_TANGENTIAL_MODELS))}); the "
+                         f"contact has tangential_model={contact.tangential_model!r} (use fit_friction)")
+    return contact
+
+
+def _fit_evaluations(u, ends) -> int:
+    """The progress bar's total of :func:`fit_dem_friction`: its profiles (three more with a
+    stiffness uncertainty ``u``) and the refits over the normal law's interval ``ends``."""
+    profile = 2 * (DEM_PROFILE_POINTS + DEM_REFINE_POINTS + 20)
+    return profile * (1 + 2 * bool(u)) + (_region_refits(ends) + 2) * _REFIT_EVALUATIONS
+
+
+def _profiled_friction(objective, contact, contact_of, u, deadline):
+    """(held, fitted, best): mu's profile fit at the given stiffness (``held``, the effective variance
+    held at a first fit where speeds or angles carry uncertainties), the objective of the final fit
+    (``objective``, or the :class:`_StiffnessProfile` over the stiffness with relative uncertainty
+    ``u``) and that fit (``best``)."""
+    problem = objective.problem
+    best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
+    if objective.weighted and (np.any(problem.sigma_speed > 0) or np.any(problem.sigma_angle > 0)):
+        objective.hold_effective_sigma(best.value)
+        best = _profile_fit(objective, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
+    held, fitted = best, objective
+    if u and getattr(contact, _stiffness_field(contact.tangential_model)):
+        weight = _profile_scale(objective, best.chisqr, max(problem.size - 1, 1))
+        fitted = _StiffnessProfile(objective, contact_of, u, weight)
+        best = _profile_fit(fitted, lmfit, deadline, DEM_PROFILE_POINTS, DEM_REFINE_POINTS)
+    return held, fitted, best
+
+
+def _friction_sensitivities(objective, fitted, contact_of, normal_fit, ends, held, best, u, deadline):
+    """(shift, gradient, sensitivity) of a determined mu (else (None, {}, {})): the normal law's
+    shift and gradient (:func:`_normal_law_shift`, with interval ``ends``; measured at the given
+    stiffness, about its own fit ``held``, and applied to the profiled interval) and
+    :func:`_stiffness_sensitivity`, with ``u`` also the profiled stiffness factor and mu at the
+    given stiffness."""
+    shift, gradient, sensitivity = None, {}, {}
+    if _friction_status(best, fitted, 0.0).determined:
+        if ends:
+            shift, gradient = _normal_law_shift(objective, contact_of, normal_fit, held, deadline)
+        sensitivity = _stiffness_sensitivity(objective, contact_of, held, deadline)
+        if u and sensitivity:
+            z = fitted.stiffness_z(best.value)
+            sensitivity |= {"uncertainty": u, "profiled_factor": 1.0 + u * z,
+                            "friction_at_given": held.value if _friction_status(held, objective, 0.0).determined
+                            else math.nan}
+    return shift, gradient, sensitivity
 
 
 def _refit(deviance, brackets, width, lo_lim, hi_lim) -> float:
@@ -633,23 +666,8 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
     rows = []
     normal_laws = _COVERAGE_NORMAL[2:] if fit_adhesion else _COVERAGE_NORMAL
     for _ in range(trials):
-        law = str(rng.choice(_COVERAGE_TANGENTIAL))
-        normal, damping = normal_laws[int(rng.integers(0, len(normal_laws)))]
-        mat = {"density": 2000.0, "stiffness": 1e9,
-               "work_of_adhesion": 0.0 if normal == "hertz" else float(10 ** rng.uniform(-3, -1.5))}
-        if damping in RESTITUTION_DAMPING_MODELS:
-            coef = float(rng.uniform(0.3, 0.95))
-        else:
-            unit = critical_damping_coefficient(dem_law_contact(mat, 1e-6, normal, damping, 1.0), 1.0)
-            coef = float(10 ** rng.uniform(-2, -0.7)) * unit
-        mu = float(10 ** rng.uniform(-1.3, 0))
-        stiffness = ({"tangential_stiffness": float(10 ** rng.uniform(0.5, 3))} if law == "linear_history"
-                     else {"shear_modulus": float(1e9 * 10 ** rng.uniform(-1, -0.2))})
-        n = int(rng.integers(4, 14))
-        lo = rng.uniform(0, 70)
-        hi = min(lo + rng.uniform(5, 60), 85)
-        angles, speeds = rng.uniform(lo, hi, n), 10 ** rng.uniform(-1, 1, n)
-        noise_t, noise_n = float(10 ** rng.uniform(-2.3, -1.3)), float(10 ** rng.uniform(-2.3, -1.3))
+        law, normal, damping, mat, coef, mu, stiffness, speeds, angles, noise_n, noise_t = _coverage_design(
+            rng, normal_laws)
         tangential = {"friction": mu, "tangential_model": law, **stiffness}
         truth = dem_law_contact(mat, 1e-6, normal, damping, coef).with_(**tangential)
         table = _measured_rebounds(truth, speeds, angles, noise_n, noise_t, rng, rtol)
@@ -678,6 +696,30 @@ def dem_friction_coverage(trials: int = 60, seed: int = 11, propagate: bool = Tr
         rows.append(row)
     return pd.DataFrame(rows)
 
+
+
+def _coverage_design(rng, normal_laws) -> tuple:
+    """One random design of :func:`dem_friction_coverage`, drawn from ``rng``: (tangential law,
+    normal law, damping law, material, damping coefficient, mu, {stiffness field: value}, speeds
+    [m/s], angles [deg], e_n noise, e_t noise), the normal and damping laws from ``normal_laws``."""
+    law = str(rng.choice(_COVERAGE_TANGENTIAL))
+    normal, damping = normal_laws[int(rng.integers(0, len(normal_laws)))]
+    mat = {"density": 2000.0, "stiffness": 1e9,
+           "work_of_adhesion": 0.0 if normal == "hertz" else float(10 ** rng.uniform(-3, -1.5))}
+    if damping in RESTITUTION_DAMPING_MODELS:
+        coef = float(rng.uniform(0.3, 0.95))
+    else:
+        unit = critical_damping_coefficient(dem_law_contact(mat, 1e-6, normal, damping, 1.0), 1.0)
+        coef = float(10 ** rng.uniform(-2, -0.7)) * unit
+    mu = float(10 ** rng.uniform(-1.3, 0))
+    stiffness = ({"tangential_stiffness": float(10 ** rng.uniform(0.5, 3))} if law == "linear_history"
+                 else {"shear_modulus": float(1e9 * 10 ** rng.uniform(-1, -0.2))})
+    n = int(rng.integers(4, 14))
+    lo = rng.uniform(0, 70)
+    hi = min(lo + rng.uniform(5, 60), 85)
+    angles, speeds = rng.uniform(lo, hi, n), 10 ** rng.uniform(-1, 1, n)
+    noise_t, noise_n = float(10 ** rng.uniform(-2.3, -1.3)), float(10 ** rng.uniform(-2.3, -1.3))
+    return law, normal, damping, mat, coef, mu, stiffness, speeds, angles, noise_n, noise_t
 
 def _measured_rebounds(truth, speeds, angles, noise_n, noise_t, rng, rtol):
     """The rebounds of ``truth`` as an impact table with Gaussian noise of the stated sigma on e_n

@@ -803,24 +803,8 @@ def design_friction(fit=None, space: DesignSpace | None = None, n: int = DEFAULT
     >>> sorted(set(d.rows["incidence_deg"].tolist())) != [10.0], d.parameters
     (True, ('friction',))
     """
-    if space is None:
-        raise ValueError("give the design space (DesignSpace)")
-    if not 1 <= int(n) <= MAX_NEW_IMPACTS:
-        raise ValueError(f"the number of new impacts must be in [1, {MAX_NEW_IMPACTS}], got {n!r}")
-    lo, hi = (float(x) for x in friction_range)
-    if not 0 < lo < hi:
-        raise ValueError(f"friction_range must be 0 < min < max, got {friction_range!r}")
-    if space.oblique_quantity == "none":
-        raise ValueError("friction: the design space measures e_n only, and e_n does not depend on friction "
-                         "(Eqs. (16)-(20)); measure the tangential restitution, rebound angle or rebound spin of "
-                         "oblique impacts")
-    if fit is not None:
-        base, vals = fit, dict(fit.values)
-    elif material is not None and values:
-        base = material
-        vals = {"work_of_adhesion": float(material.work_of_adhesion), **{k: float(v) for k, v in values.items()}}
-    else:
-        raise ValueError("give a damping fit, or a material with the damping values")
+    lo, hi = _checked_friction_request(space, n, friction_range)
+    base, vals = _friction_design_base(fit, material, values)
     grid = np.geomspace(lo, hi, FRICTION_GRID_POINTS)
     cand = _friction_candidates(space)
     q, sigma = space.oblique_quantity, space.oblique_sigma
@@ -847,6 +831,34 @@ def design_friction(fit=None, space: DesignSpace | None = None, n: int = DEFAULT
                             "(Bayesian A-criterion, log-uniform prior); greedy sequential selection over the oblique "
                             "candidates", notes)
 
+
+
+def _checked_friction_request(space, n, friction_range) -> tuple[float, float]:
+    """The ends of ``friction_range`` of :func:`design_friction`, its design ``space`` and ``n``
+    checked (ValueError: no space, ``n`` outside [1, MAX_NEW_IMPACTS], a range not 0 < min < max,
+    a space that measures e_n only)."""
+    if space is None:
+        raise ValueError("give the design space (DesignSpace)")
+    if not 1 <= int(n) <= MAX_NEW_IMPACTS:
+        raise ValueError(f"the number of new impacts must be in [1, {MAX_NEW_IMPACTS}], got {n!r}")
+    lo, hi = (float(x) for x in friction_range)
+    if not 0 < lo < hi:
+        raise ValueError(f"friction_range must be 0 < min < max, got {friction_range!r}")
+    if space.oblique_quantity == "none":
+        raise ValueError("friction: the design space measures e_n only, and e_n does not depend on friction "
+                         "(Eqs. (16)-(20)); measure the tangential restitution, rebound angle or rebound spin of "
+                         "oblique impacts")
+    return lo, hi
+
+
+def _friction_design_base(fit, material, values) -> tuple:
+    """(base, values) the impacts of :func:`design_friction` are solved with: the damping ``fit`` and
+    its values, else ``material`` with its work of adhesion and ``values`` (ValueError without)."""
+    if fit is not None:
+        return fit, dict(fit.values)
+    if material is not None and values:
+        return material, {"work_of_adhesion": float(material.work_of_adhesion), **{k: float(v) for k, v in values.items()}}
+    raise ValueError("give a damping fit, or a material with the damping values")
 
 def _oblique_sensitivities(base, vals, table, grid, rtol, quantity="tangential_restitution"):
     """:func:`tangential_sensitivities` of the rows of ``table`` (radius, speed, incidence_deg), one contact per radius."""

@@ -398,21 +398,10 @@ def _effective_sigma(problem, p, sigma_e, sigma_v, rtol, h=1e-4):
     return np.sqrt(np.maximum(sigma_e**2 + (slope * sv) ** 2 + cross, 0.0))
 
 
-def fit_damping(
-    table,
-    base,
-    *,
-    fit_work_of_adhesion: bool = False,
-    weights="auto",
-    start_grid=DEFAULT_START_GRID,
-    rtol: float = DEFAULT_RTOL,
-    confidence_intervals: bool = True,
-    scale_covar: bool | None = None,
-    threads: int | None = 1,
-    progress: bool = False,
-    time_budget: float | None = None,
-    loss: str = DEFAULT_LOSS,
-) -> DampingFit:
+def fit_damping(table, base, *, fit_work_of_adhesion: bool = False, weights="auto", start_grid=DEFAULT_START_GRID,
+                rtol: float = DEFAULT_RTOL, confidence_intervals: bool = True, scale_covar: bool | None = None,
+                threads: int | None = 1, progress: bool = False, time_budget: float | None = None,
+                loss: str = DEFAULT_LOSS) -> DampingFit:
     """Fit zeta_H, zeta_A (and optionally w_A) to measured e_n(v_n), jointly over particle sizes.
 
     Parameters

@@ -305,6 +305,21 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
     offsets = np.unique(np.append(np.asarray(angle_offsets, dtype=float), 0.0))  # 0: the nominal angle
     out = _spread(imp, contact_or_fit, unit, offsets, rtol, progress, deadline)
 
+    en_limit, ratio, flags = _sensitivity_flags(imp, out, th)
+    res = _flags_dataset(imp, out, ratio, en_limit, flags)
+    _add_flag_attributes(res, th, imp, n_spin, fr, offsets, unit, table)
+    if explain and hasattr(contact_or_fit, "varied"):
+        res = _with_explanation(res, table, contact_or_fit, posterior=posterior, friction=friction, n_draws=n_draws,
+                                spin_bound=spin_bound, angle_uncertainty_deg=angle_uncertainty_deg,
+                                default_angle_uncertainty_deg=default_angle_uncertainty_deg, rtol=rtol,
+                                progress=progress, time_budget=deadline)
+    return _with_ids(res, table)
+
+
+def _sensitivity_flags(imp: _Impacts, out: dict, th: dict) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(en_limit, ratio, flags) of :func:`flag_measurements`: the e_n spread that flags a row (its
+    stated e_n uncertainty, else the threshold), the normal speed over the capture velocity and the
+    flags ``rotation_sensitive``, ``angle_sensitive`` and ``near_capture`` from the spreads ``out``."""
     en_limit = np.where(np.isfinite(imp.e_n_uncertainty) & (imp.e_n_uncertainty > 0), imp.e_n_uncertainty, th["e_n"])
 
     def rng(c, s):
@@ -315,8 +330,14 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
     rot = (rng("e_n", "spin") > en_limit) | out["switch_spin"]
     ang = (rng("e_n", "angle") > en_limit) | out["switch_angle"]
     ratio = imp.normal_speed / out["capture_velocity"]
-    res = _flags_dataset(imp, out, ratio, en_limit, {"rotation_sensitive": rot, "angle_sensitive": ang,
-                                                     "near_capture": ratio < th["near_capture_ratio"]})
+    return en_limit, ratio, {"rotation_sensitive": rot, "angle_sensitive": ang,
+                             "near_capture": ratio < th["near_capture_ratio"]}
+
+
+def _add_flag_attributes(res: xr.Dataset, th: dict, imp: _Impacts, n_spin: int, fr, offsets, unit, table) -> None:
+    """Record on ``res`` the thresholds ``th``, the samples (``n_spin`` directions, spin fractions
+    ``fr``, angle ``offsets``, the spin samples ``unit``), where the bounds came from, the model
+    and the table's source and checksum."""
     res.attrs.update({f"threshold_{k}": v for k, v in th.items()})
     res.attrs.update({
         "title": "measurement flags: sensitivity to unmeasured spin and angle error, closeness to capture",
@@ -328,12 +349,6 @@ def flag_measurements(table, contact_or_fit, *, spin_bound=None, angle_uncertain
     })
     if "sha256" in table.attrs:
         res.attrs["source_sha256"] = table.attrs["sha256"]
-    if explain and hasattr(contact_or_fit, "varied"):
-        res = _with_explanation(res, table, contact_or_fit, posterior=posterior, friction=friction, n_draws=n_draws,
-                                spin_bound=spin_bound, angle_uncertainty_deg=angle_uncertainty_deg,
-                                default_angle_uncertainty_deg=default_angle_uncertainty_deg, rtol=rtol,
-                                progress=progress, time_budget=deadline)
-    return _with_ids(res, table)
 
 
 def _with_ids(res: xr.Dataset, table) -> xr.Dataset:

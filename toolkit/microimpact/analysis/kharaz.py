@@ -265,13 +265,26 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
     if contact.zeta_hertz == 0.0:  # the readings' integration covers the elastic Hertz contact only
         _compare_readings(ds, data, contact.with_(tangential_model="mindlin_deresiewicz"), sliding_threshold_deg)
     if contact_models:
-        allowed = {"tangential_model", "friction_model", "rolling_friction"}
-        unknown = set(contact_models) - allowed
-        if unknown:
-            raise ValueError(f"contact_models: unknown key(s) {', '.join(sorted(unknown))}; accepted: {', '.join(sorted(allowed))}")
-        _compare_compliant(ds, data, contact.with_(**contact_models), grid, f_nom, sliding_threshold_deg, "_selected")
-        ds.attrs["selected_contact_models"] = ", ".join(f"{k}={v}" for k, v in sorted(contact_models.items()))
-    ds.attrs.update({
+        _compare_selected(ds, data, contact, contact_models, grid, f_nom, sliding_threshold_deg)
+    ds.attrs.update(_comparison_attrs(src, contact, e_n, sliding_threshold_deg))
+    return stamp_parameters(ds, contact, materials_parameter_source(KHARAZ_CONDITIONS["material_pair"]))
+
+
+def _compare_selected(ds, data, contact, contact_models: dict, grid, f_nom, sliding_threshold_deg) -> None:
+    """Add to ``ds`` the comparison of the sub-models ``contact_models`` (suffix ``_selected``) and
+    the attribute ``selected_contact_models``; ValueError for a key that is not a sub-model field."""
+    allowed = {"tangential_model", "friction_model", "rolling_friction"}
+    unknown = set(contact_models) - allowed
+    if unknown:
+        raise ValueError(f"contact_models: unknown key(s) {', '.join(sorted(unknown))}; accepted: {', '.join(sorted(allowed))}")
+    _compare_compliant(ds, data, contact.with_(**contact_models), grid, f_nom, sliding_threshold_deg, "_selected")
+    ds.attrs["selected_contact_models"] = ", ".join(f"{k}={v}" for k, v in sorted(contact_models.items()))
+
+
+def _comparison_attrs(src: str, contact, e_n: float, sliding_threshold_deg) -> dict:
+    """The global attributes of :func:`kharaz_comparison`: the data's source and reference, the
+    impact's conditions with the model's e_n and zeta_H, the threshold and the spin convention."""
+    return {
         "title": "microimpact model vs Kharaz, Gorham & Salman (2001) oblique impacts",
         "source": src,
         "reference": "Kharaz, Gorham & Salman (2001), Powder Technol. 120:281-291, doi:10.1016/S0032-5910(01)00283-2",
@@ -282,8 +295,7 @@ def kharaz_comparison(path=None, *, normal_restitution=None, friction=None, slid
         "impact_speed_units": "m s-1",
         "spin_convention": "omega_t' < 0 is forward rolling for v_t > 0 (slip u_t = v_t + r omega_t'); compared as |omega|",
         "Conventions": CONVENTIONS,
-    })
-    return stamp_parameters(ds, contact, materials_parameter_source(KHARAZ_CONDITIONS["material_pair"]))
+    }
 
 
 def _fit_friction(contact, data, sliding_threshold_deg, src) -> tuple[float, float]:

@@ -747,14 +747,7 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
     deadline = Deadline.start(time_budget, "friction fit")
     problem = ObliqueProblem.from_table(table, warn=True)
     contact_of = damping_fit.contact
-    model_name = tangential_model or contact_of(float(problem.radius[0])).tangential_model
-    if model_name not in TANGENTIAL_PARAMETERS:
-        raise ValueError(f"tangential_model {model_name!r} has no fitted parameters registered; add them to "
-                         f"microimpact.analysis.oblique.TANGENTIAL_PARAMETERS (known: {', '.join(TANGENTIAL_PARAMETERS)})")
-    names = TANGENTIAL_PARAMETERS[model_name]
-    if names != ("friction",):  # the profile below is the rigid law's closed form in f
-        raise ValueError(f"tangential_model {model_name!r}: only the Coulomb coefficient of the rigid law is fitted "
-                         "from oblique data; add a profile for its parameters in microimpact.analysis.oblique")
+    model_name = _fitted_tangential_model(tangential_model or contact_of(float(problem.radius[0])).tangential_model)
     weighted = bool(np.all(np.isfinite(problem.sigma_measured) & (problem.sigma_measured > 0)))
     n_var = len(damping_fit.varied) if propagate_damping else 0
     with progress_bar(3 + 2 * n_var, "friction fit", progress) as advance, engine_threads(1):
@@ -762,14 +755,32 @@ def fit_friction(table, damping_fit, *, tangential_model: str | None = None, rto
         deadline.check("the normal solves of the friction fit")
         best = _profile_fit(objective, lmfit, deadline)
         advance(3)
-        gradient = {}
-        var_damping = 0.0
+        gradient, var_damping = {}, 0.0
         if propagate_damping and damping_fit.varied:
-            gradient = _damping_gradient(problem, damping_fit, best.value, weighted, rtol, lmfit, advance, deadline)
-            cov = _damping_covariance(damping_fit)
-            g = np.array([gradient["friction"][p] for p in damping_fit.varied])
-            var_damping = float(g @ cov @ g) if np.all(np.isfinite(g)) else math.nan
+            gradient, var_damping = _damping_variance(problem, damping_fit, best, weighted, rtol, advance, deadline)
     return _friction_result(problem, objective, best, var_damping, gradient, weighted, model_name, t0)
+
+
+def _fitted_tangential_model(model_name: str) -> str:
+    """``model_name``, checked to be a key of :data:`TANGENTIAL_PARAMETERS` whose parameters the
+    profile of :func:`fit_friction` fits (the rigid law's f alone); ValueError naming the hook."""
+    if model_name not in TANGENTIAL_PARAMETERS:
+        raise ValueError(f"tangential_model {model_name!r} has no fitted parameters registered; add them to "
+                         f"microimpact.analysis.oblique.TANGENTIAL_PARAMETERS (known: {', '.join(TANGENTIAL_PARAMETERS)})")
+    names = TANGENTIAL_PARAMETERS[model_name]
+    if names != ("friction",):  # the profile below is the rigid law's closed form in f
+        raise ValueError(f"tangential_model {model_name!r}: only the Coulomb coefficient of the rigid law is fitted "
+                         "from oblique data; add a profile for its parameters in microimpact.analysis.oblique")
+    return model_name
+
+
+def _damping_variance(problem, damping_fit, best, weighted, rtol, advance, deadline) -> tuple[dict, float]:
+    """(gradient, variance) of the fitted f ``best`` from the damping fit's uncertainty: d f / d zeta
+    by refits (:func:`_damping_gradient`) and g^T Cov(zeta) g (NaN where a refit failed)."""
+    gradient = _damping_gradient(problem, damping_fit, best.value, weighted, rtol, lmfit, advance, deadline)
+    cov = _damping_covariance(damping_fit)
+    g = np.array([gradient["friction"][p] for p in damping_fit.varied])
+    return gradient, (float(g @ cov @ g) if np.all(np.isfinite(g)) else math.nan)
 
 
 def _friction_result(problem, objective, best, var_damping, gradient, weighted, model_name, t0,

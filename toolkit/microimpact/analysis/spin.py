@@ -194,6 +194,31 @@ def spin_explanation(table, fit, *, posterior=None, friction: float | None = Non
         raise ValueError(f"n_scan must be odd and >= 3 (so that zero spin is scanned), got {n_scan}")
     quantity, measured, sigma_m = _row_quantities(table)
     sigma_m = np.where(np.isfinite(sigma_m) & (sigma_m > 0), sigma_m, default_sigma)
+    radius, inc, speed, sig_a, sig_v, bound = _row_inputs(table, spin_bound, angle_uncertainty_deg,
+                                                          default_angle_uncertainty_deg)
+    scan = np.linspace(-1.0, 1.0, n_scan)  # x bound
+    k0 = n_scan // 2
+    draws = _parameter_draws(fit, posterior, friction, n_draws)
+    # per draw: predictions (impact, n_scan + 4): spins at the nominal angle, then angle -/+ sigma, speed -/+ sigma
+    pred = np.empty((len(draws), n, n_scan + 4))
+
+    with progress_bar(len(draws), "spin ranges", progress) as advance, engine_threads(1):
+        advance = deadline.ticking(advance, len(draws), "posterior draws")
+        for j, d in enumerate(draws):
+            for r in np.unique(radius):
+                idx = np.flatnonzero(radius == r)
+                pred[j, idx] = _scan_predictions(_contact(fit, float(r), d), speed[idx], inc[idx], sig_v[idx],
+                                                 sig_a[idx], bound[idx], scan, quantity[idx])
+            advance(1)
+    return _explain(pred, k0, n_scan, quantity, measured, sigma_m, bound, scan, table)
+
+
+def _row_inputs(table, spin_bound, angle_uncertainty_deg, default_angle_uncertainty_deg) -> tuple:
+    """(radius [m], incidence [deg], speed [m/s], angle uncertainty [deg], speed uncertainty [m/s],
+    spin bound [rad/s]) of each row of :func:`spin_explanation`: the speed is the normal speed where
+    no speed is given, the angle uncertainty ``angle_uncertainty_deg``, else the table's, else the
+    default, and the spin bound ``spin_bound``, else speed / radius."""
+    n = len(table)
     radius = table["radius"].to_numpy(dtype=float)
     inc = np.nan_to_num(table["incidence_deg"].to_numpy(dtype=float))
     speed = table["speed"].to_numpy(dtype=float)
@@ -205,36 +230,34 @@ def spin_explanation(table, fit, *, posterior=None, friction: float | None = Non
         sig_a = np.where(np.isfinite(col), col, default_angle_uncertainty_deg)
     sig_v = np.nan_to_num(table["speed_uncertainty"].to_numpy(dtype=float)) if "speed_uncertainty" in table.columns else np.zeros(n)
     bound = speed / radius if spin_bound is None else np.broadcast_to(np.asarray(spin_bound, dtype=float), (n,)).copy()
-    scan = np.linspace(-1.0, 1.0, n_scan)  # x bound
-    k0 = n_scan // 2
+    return radius, inc, speed, sig_a, sig_v, bound
 
+
+def _parameter_draws(fit, posterior, friction, n_draws) -> list[dict]:
+    """The parameter sets of :func:`spin_explanation`: the fit's point estimate, or ``n_draws``
+    posterior draws, each with the friction ``friction`` (default the fit's) where it has none."""
     if posterior is None:
-        draws = [dict(fit.values) | {"friction": fit.friction if friction is None else friction}]
-    else:
-        draws = posterior.draws(n_draws)
-        for d in draws:
-            d.setdefault("friction", fit.friction if friction is None else friction)
-    # per draw: predictions (impact, n_scan + 4): spins at the nominal angle, then angle -/+ sigma, speed -/+ sigma
-    pred = np.empty((len(draws), n, n_scan + 4))
+        return [dict(fit.values) | {"friction": fit.friction if friction is None else friction}]
+    draws = posterior.draws(n_draws)
+    for d in draws:
+        d.setdefault("friction", fit.friction if friction is None else friction)
+    return draws
 
-    with progress_bar(len(draws), "spin ranges", progress) as advance, engine_threads(1):
-        advance = deadline.ticking(advance, len(draws), "posterior draws")
-        for j, d in enumerate(draws):
-            for r in np.unique(radius):
-                idx = np.flatnonzero(radius == r)
-                c = _contact(fit, float(r), d)
-                m = idx.size
-                sp = np.concatenate([np.repeat(speed[idx, None], n_scan + 2, 1),
-                                     speed[idx, None] + sig_v[idx, None] * np.array([-1.0, 1.0])], axis=1)
-                an = np.concatenate([np.repeat(inc[idx, None], n_scan, 1),
-                                     inc[idx, None] + sig_a[idx, None] * np.array([-1.0, 1.0]),
-                                     np.repeat(inc[idx, None], 2, 1)], axis=1)
-                an = np.abs(an)
-                w = np.concatenate([bound[idx, None] * scan[None, :], np.zeros((m, 4))], axis=1)
-                q = np.repeat(quantity[idx, None], n_scan + 4, 1)
-                pred[j, idx] = _predict(c, sp.ravel(), an.ravel(), w.ravel(), q.ravel()).reshape(m, n_scan + 4)
-            advance(1)
-    return _explain(pred, k0, n_scan, quantity, measured, sigma_m, bound, scan, table)
+
+def _scan_predictions(c, speed, inc, sig_v, sig_a, bound, scan, quantity) -> np.ndarray:
+    """Predictions (row, len(scan) + 4) of each row's measured ``quantity`` with contact ``c``: at
+    the spins ``bound`` x ``scan`` and the nominal angle, then at the angle -/+ ``sig_a`` [deg] and
+    the speed -/+ ``sig_v`` [m/s] without spin."""
+    n_scan, m = scan.size, speed.size
+    sp = np.concatenate([np.repeat(speed[:, None], n_scan + 2, 1),
+                         speed[:, None] + sig_v[:, None] * np.array([-1.0, 1.0])], axis=1)
+    an = np.concatenate([np.repeat(inc[:, None], n_scan, 1),
+                         inc[:, None] + sig_a[:, None] * np.array([-1.0, 1.0]),
+                         np.repeat(inc[:, None], 2, 1)], axis=1)
+    an = np.abs(an)
+    w = np.concatenate([bound[:, None] * scan[None, :], np.zeros((m, 4))], axis=1)
+    q = np.repeat(quantity[:, None], n_scan + 4, 1)
+    return _predict(c, sp.ravel(), an.ravel(), w.ravel(), q.ravel()).reshape(m, n_scan + 4)
 
 
 def _explain(pred, k0, n_scan, quantity, measured, sigma_m, bound, scan, table) -> xr.Dataset:

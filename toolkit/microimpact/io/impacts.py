@@ -743,11 +743,7 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
     ([3.45e-06, 3.45e-06], [2.0, 3.464102], [1, 2])
     """
     source = os.fspath(path)
-    if materials is not None and not isinstance(materials, Mapping):
-        materials = read_materials(materials)
-    if material_pair is not None and (materials is None or material_pair not in materials):
-        known = f"known pairs: {', '.join(sorted(materials))}" if materials is not None else "materials= is not given"
-        raise ValueError(f"material_pair {material_pair!r} is not a pair of the materials config; {known}")
+    materials = _checked_materials(materials, material_pair)
     data = Path(source).read_bytes()
     sha256 = hashlib.sha256(data).hexdigest()
     _refuse_binary(source)
@@ -775,6 +771,37 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
 
     with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
         out = _derive(values, cells.n)
+    _check_derived(cells, columns, values, out, labels, materials, material_pair, problems)
+    if problems:
+        raise ImpactDataError(source, _sorted(problems))
+
+    _warn_implausible(Path(source).name, cells, columns, out)
+    kept = _warn_kept_outside(Path(source).name, cells, columns)
+    df = _impact_frame(cells, records, columns, labels, out, kept_columns)
+    df.attrs["source"] = source
+    df.attrs["sha256"] = sha256
+    df.attrs["units"] = dict(COLUMN_UNITS)
+    df.attrs["measured"] = tuple(_QUANTITIES[n].canonical for n in columns if n in _QUANTITIES)
+    df.attrs["outside_physical_range"] = kept
+    return df
+
+
+def _checked_materials(materials, material_pair):
+    """The materials config of :func:`read_impacts` (read where a path is given), checked to hold
+    ``material_pair`` where one is given (ValueError)."""
+    if materials is not None and not isinstance(materials, Mapping):
+        materials = read_materials(materials)
+    if material_pair is not None and (materials is None or material_pair not in materials):
+        known = f"known pairs: {', '.join(sorted(materials))}" if materials is not None else "materials= is not given"
+        raise ValueError(f"material_pair {material_pair!r} is not a pair of the materials config; {known}")
+    return materials
+
+
+def _check_derived(cells: _Cells, columns, values: dict, out: dict, labels: dict, materials, material_pair,
+                   problems: list[Problem]) -> None:
+    """Add to ``problems`` those of the derived columns ``out``: overflow, a rebound faster than the
+    impact, a tangential ratio out of bounds and, with ``materials``, each row's contact (its pair
+    the row's ``material_pair`` label, else ``material_pair``)."""
     _check_overflow(cells, columns, values, out, problems)
     if "rebound_normal_speed" in values:
         _check_rebound(cells, columns["rebound_normal_speed"], out, problems)
@@ -783,11 +810,12 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
         pairs = labels.get("material_pair", np.full(cells.n, None, dtype=object))
         pairs = np.array([p if p is not None else material_pair for p in pairs], dtype=object)
         _check_contacts(cells, columns, out, materials, pairs, problems)
-    if problems:
-        raise ImpactDataError(source, _sorted(problems))
 
-    _warn_implausible(Path(source).name, cells, columns, out)
-    kept = _warn_kept_outside(Path(source).name, cells, columns)
+
+def _impact_frame(cells: _Cells, records: list[_Record], columns, labels: dict, out: dict,
+                  kept_columns: dict[str, int]) -> pd.DataFrame:
+    """The table of :func:`read_impacts`: row and line, the labels as strings, the canonical columns
+    of ``out`` and the analyst's own ``kept_columns`` as text (``attrs["kept_columns"]`` names them)."""
     frame = {"row": cells.rows, "line": cells.lines}
     for cname in _LABELS:
         frame[cname] = pd.array(labels.get(cname, [None] * cells.n), dtype="string")
@@ -796,11 +824,6 @@ def read_impacts(path, *, materials=None, material_pair=None) -> pd.DataFrame:
         frame[cname] = pd.array([r.fields[index].strip() or None for r in records], dtype="string")
     df = pd.DataFrame(frame, columns=[*CANONICAL_COLUMNS, *kept_columns])
     df.attrs["kept_columns"] = tuple(kept_columns)
-    df.attrs["source"] = source
-    df.attrs["sha256"] = sha256
-    df.attrs["units"] = dict(COLUMN_UNITS)
-    df.attrs["measured"] = tuple(_QUANTITIES[n].canonical for n in columns if n in _QUANTITIES)
-    df.attrs["outside_physical_range"] = kept
     return df
 
 

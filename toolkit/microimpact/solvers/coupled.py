@@ -1166,6 +1166,26 @@ def _tangential_si(contact, mindlin, states, info, f, v_in, w_in, slip, jl, jal,
             np.where(tan["slip_ended"], slip_end_time, np.nan))
 
 
+
+def _nondimensional_stops(mindlin: bool, m, inertia, r, f, slip, w_n, u, length) -> tuple[np.ndarray, np.ndarray]:
+    """(J, J_a) at which sliding and twist end (:func:`stop_impulses`), in units of m u and
+    m u sqrt(r L); for a compliant (Mindlin) law none: (inf, 0)."""
+    if mindlin:
+        return np.full(slip.size, np.inf), np.zeros(slip.size)
+    j_star, ja_star = stop_impulses(m, inertia, f, slip, w_n)
+    return j_star / (m * u), ja_star / (m * u * np.sqrt(r * length))
+
+
+def _check_status(info: np.ndarray, speed: np.ndarray) -> None:
+    """CoupledError for the first impact whose integration failed (``info[:, 0]``: the step limit
+    or a step-size underflow), naming its normal speed [m/s] and its steps."""
+    bad = info[:, 0] != _OK
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        what = "step limit reached" if info[i, 0] == _MAX_STEPS else "step size underflow"
+        raise CoupledError(f"coupled solver failed for normal speed {float(speed[i])!r} m/s: {what} "
+                           f"after {int(info[i, 5])} steps")
+
 def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_steps: int = _DEFAULT_MAX_STEPS,
                   check_held_rolling: bool = True) -> SolutionBatch:
     """Impacts of a contact that selects tangential compliance or adhesion-aware friction.
@@ -1222,12 +1242,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
     mindlin = mode > 0.0
     aware = contact.friction_model == "pulloff"
     slip = np.hypot(v_t + r * w_tp, v_tp - r * w_t)
-    if mindlin:
-        j_stop = np.full(speed.size, np.inf)
-        ja_stop = np.zeros(speed.size)
-    else:
-        j_star, ja_star = stop_impulses(m, inertia, f, slip, w_n)
-        j_stop, ja_stop = j_star / (m * u), ja_star / (m * u * np.sqrt(r * length))
+    j_stop, ja_stop = _nondimensional_stops(mindlin, m, inertia, r, f, slip, w_n, u, length)
     j_unit = m * u
     ja_unit = j_unit * np.sqrt(r * length)
     states = np.empty((speed.size, _N))
@@ -1236,12 +1251,7 @@ def solve_coupled(contact, velocity_in, omega_in, friction, *, rtol: float, max_
                  p, float(rtol), np.ascontiguousarray(j_stop), np.ascontiguousarray(ja_stop),
                  max(SETTLE_AMPLITUDE, SETTLE_PER_RTOL * rtol),
                  int(max_steps), states, info)
-    bad = info[:, 0] != _OK
-    if np.any(bad):
-        i = int(np.flatnonzero(bad)[0])
-        what = "step limit reached" if info[i, 0] == _MAX_STEPS else "step size underflow"
-        raise CoupledError(f"coupled solver failed for normal speed {float(speed[i])!r} m/s: {what} "
-                           f"after {int(info[i, 5])} steps")
+    _check_status(info, speed)
     captured = info[:, 1] >= 1
     jl = states[:, _J] * j_unit
     jal = states[:, _JA] * ja_unit

@@ -1100,21 +1100,11 @@ def _integrate_many(y0, c1, c2, ah, aa, rtol, need_tail, tail_tol, max_steps, j_
 _NO_RECORD = np.zeros((1, 3))
 
 
-def solve_normal(
-    contact,
-    normal_speed: float,
-    *,
-    rtol: float = DEFAULT_RTOL,
-    trajectory: bool = False,
-    follow_capture: bool = False,
-    need_tail: bool = False,
-    tail_tolerance: float | None = None,
-    friction_impulse_target: float | None = None,
-    settle_amplitude: float = 1e-4,
-    max_steps: int = _MAX_STEPS_DEFAULT,
-    friction_impulse_stop: float = math.inf,
-    twist_impulse_stop: float = math.inf,
-) -> NormalSolution:
+def solve_normal(contact, normal_speed: float, *, rtol: float = DEFAULT_RTOL, trajectory: bool = False,
+                 follow_capture: bool = False, need_tail: bool = False, tail_tolerance: float | None = None,
+                 friction_impulse_target: float | None = None, settle_amplitude: float = 1e-4,
+                 max_steps: int = _MAX_STEPS_DEFAULT, friction_impulse_stop: float = math.inf,
+                 twist_impulse_stop: float = math.inf) -> NormalSolution:
     """Solve the normal contact, Eq. (27), of one impact.
 
     Parameters
@@ -1197,10 +1187,7 @@ def solve_normal(
             break
         cap *= 4
     if c1 == 0.0 and c2 == 0.0 and jt > 0.0 and math.isnan(r.tau_slip_end) and jt < r.friction_impulse:
-        # time-reversible motion: J reaches jt on the way out when it reached J - jt on the way in
-        r_in = _integrate(y0, 0.0, 0.0, sc.a_hertz, sc.a_adhesion, rtol, False, rtol, r.friction_impulse - jt, False,
-                          0.0, max_steps, rec, 0, math.inf, math.inf)
-        r = r._replace(tau_slip_end=r.tau_end - r_in.tau_slip_end)
+        r = _slip_end_by_reversal(r, y0, sc, rtol, jt, max_steps, rec)
     if r.status != _OK:
         raise EngineError(f"engine failed for normal speed {v!r} m/s: {_failure(r.status)} after {r.n_steps} steps")
     solution = normal_solution(contact, sc, y0, r, trajectory=rec[:r.n_recorded] if cap else None,
@@ -1209,6 +1196,15 @@ def solve_normal(
     _check_domain(contact, vars(solution), v)
     return solution
 
+
+
+def _slip_end_by_reversal(r, y0, sc, rtol, jt, max_steps, rec):
+    """The trace ``r`` of an undamped impact whose J reached the target ``jt`` only on the way out,
+    with the time of that found by time reversal: J reaches jt on the way out when it reached
+    J - jt on the way in (nondimensional)."""
+    r_in = _integrate(y0, 0.0, 0.0, sc.a_hertz, sc.a_adhesion, rtol, False, rtol, r.friction_impulse - jt, False,
+                      0.0, max_steps, rec, 0, math.inf, math.inf)
+    return r._replace(tau_slip_end=r.tau_end - r_in.tau_slip_end)
 
 def normal_solution(contact, scales, y0, trace, *, trajectory=None, followed: bool = False) -> NormalSolution:
     """The :class:`NormalSolution` in SI units of a nondimensional normal solve (engine or RKG).

@@ -258,22 +258,8 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
     >>> r.outcome, round(r.mu_t, 6)
     ('rebound', -0.2)
     """
-    rtol = _check_call(contact, rtol)
-    omega = _check_omega(omega)
-    speed = _real_scalar("speed", speed)
-    incidence_deg = _real_scalar("incidence_deg", incidence_deg)
-    azimuth_deg = _real_scalar("azimuth_deg", azimuth_deg)
-    if not _FLOATS.issuperset(map(type, omega)):
-        omega = tuple(_real_scalar(name, w) for name, w in zip(("omega_n", "omega_t", "omega_tp"), omega))
-    _check_inputs(speed, incidence_deg, azimuth_deg, omega)
-    _check_scales(contact, speed, incidence_deg, omega)
-    if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}")
-    if steps is not None and method != "rkg":
-        raise ValueError(f"steps applies to method='rkg' only, got method={method!r}")
-    if steps is not None and (isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps < 1):
-        raise ValueError(f"steps must be a whole number >= 1, got {steps!r}")
-    check_sub_models(contact, method)
+    rtol, speed, incidence_deg, azimuth_deg, omega = _checked_impact(contact, speed, incidence_deg, azimuth_deg,
+                                                                     omega, rtol, method, steps)
     if method == "engine" and _needs_coupled(contact):
         v_in = incident_velocity(float(speed), float(incidence_deg), float(azimuth_deg))
         res = _coupled_results(contact, tuple(np.array([x]) for x in v_in), tuple(np.array([w]) for w in omega),
@@ -292,6 +278,38 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
     u_t, u_tp = slip_velocity(contact.radius, v_in[1], v_in[2], w_in[1], w_in[2])
     slip = math.hypot(u_t, u_tp)
     needs_tangential = contact.friction > 0.0 and (slip > 0.0 or w_in[0] != 0.0)
+    sol = _normal_solve(contact, normal, v_in, w_in, slip, needs_tangential, speed, rtol, method, steps)
+    return _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential)
+
+
+def _checked_impact(contact, speed, incidence_deg, azimuth_deg, omega, rtol, method, steps) -> tuple:
+    """(rtol, speed, incidence_deg, azimuth_deg, omega) of :func:`simulate_impact`, each checked
+    (TypeError or ValueError naming the argument), and the method, ``steps`` and the contact's
+    sub-models checked against each other."""
+    rtol = _check_call(contact, rtol)
+    omega = _check_omega(omega)
+    speed = _real_scalar("speed", speed)
+    incidence_deg = _real_scalar("incidence_deg", incidence_deg)
+    azimuth_deg = _real_scalar("azimuth_deg", azimuth_deg)
+    if not _FLOATS.issuperset(map(type, omega)):
+        omega = tuple(_real_scalar(name, w) for name, w in zip(("omega_n", "omega_t", "omega_tp"), omega))
+    _check_inputs(speed, incidence_deg, azimuth_deg, omega)
+    _check_scales(contact, speed, incidence_deg, omega)
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"method must be one of {', '.join(map(repr, METHODS))}, got {method!r}")
+    if steps is not None and method != "rkg":
+        raise ValueError(f"steps applies to method='rkg' only, got method={method!r}")
+    if steps is not None and (isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps < 1):
+        raise ValueError(f"steps must be a whole number >= 1, got {steps!r}")
+    check_sub_models(contact, method)
+    return rtol, speed, incidence_deg, azimuth_deg, omega
+
+
+def _normal_solve(contact, normal, v_in, w_in, slip, needs_tangential, speed, rtol, method, steps):
+    """The normal solution of one impact by ``method`` ("rkg", "reference": the scipy integration of
+    a JKR or DMT law, else the engine), followed as far as the tangential map needs (the sliding
+    and twist impulses of slip speed ``slip`` [m/s] and spin ``w_in``) where ``needs_tangential``;
+    ``normal`` is the module of the contact's normal law (:func:`_normal_solver`)."""
     j_star = _sliding_impulse(contact.mass, contact.friction, slip)
     j_target = j_star if needs_tangential and 0.0 < j_star < math.inf else None
     if method == "rkg":
@@ -312,7 +330,7 @@ def simulate_impact(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0
             friction_impulse_stop=j_star,
             twist_impulse_stop=_twist_stop(contact.moment_of_inertia, contact.friction, w_in[0]),
         )
-    return _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential)
+    return sol
 
 
 def _impact_result(contact, v_in, w_in, sol, slip, method, needs_tangential) -> ImpactResult:
@@ -650,32 +668,39 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
     rtol = _check_call(contact, rtol)
     check_sub_models(contact, "engine")
     omega = _check_omega(omega)
-    inputs = {
-        "speed": speed,
-        "incidence_deg": incidence_deg,
-        "azimuth_deg": azimuth_deg,
-        "omega_n": omega[0],
-        "omega_t": omega[1],
-        "omega_tp": omega[2],
-        "friction": contact.friction if friction is None else friction,
-    }
+    inputs = {"speed": speed, "incidence_deg": incidence_deg, "azimuth_deg": azimuth_deg, "omega_n": omega[0],
+              "omega_t": omega[1], "omega_tp": omega[2], "friction": contact.friction if friction is None else friction}
     arrays, flat = _broadcast_inputs(inputs)
     _check_scales(contact, flat["speed"], flat["incidence_deg"], (flat["omega_n"], flat["omega_t"], flat["omega_tp"]))
     if family is not None and not isinstance(family, (bool, np.bool_)):
         raise TypeError(f"family must be True, False or None, got {type(family).__name__} {family!r}")
     if _needs_coupled(contact):  # one coupled solve per impact
-        alpha, theta = np.radians(flat["incidence_deg"]), np.radians(flat["azimuth_deg"])
-        v = flat["speed"]
-        v_in = (-v * np.cos(alpha), v * np.sin(alpha) * np.cos(theta), v * np.sin(alpha) * np.sin(theta))
-        results = _coupled_results(contact, v_in, (flat["omega_n"], flat["omega_t"], flat["omega_tp"]),
-                                   flat["friction"], rtol)
-        error = results["tangential_error"][results["not_determined"]]
-        results = {k: results[k] for k in RESULT_VARIABLES} | {"not_determined": results["not_determined"].astype(np.int8)}
-        n_solves, path = int(v.size), "coupled: one normal-tangential solve per impact"
+        results, error, n_solves, path = _coupled_batch(contact, flat, rtol)
     else:  # the closed-form tangential map settles every impact the normal solve does
         results, n_solves, path = _solve_batch(contact, flat, rtol, family)
         results["not_determined"], error = np.zeros(flat["speed"].size, dtype=np.int8), np.zeros(0)
     ds = _batch_dataset(arrays, results)
+    _add_batch_attributes(ds, contact, rtol, error, n_solves, path)
+    return ds
+
+
+def _coupled_batch(contact, flat: dict, rtol: float):
+    """(results, error, n_solves, path) of :func:`simulate_many` for a contact whose tangential
+    motion acts back on the normal one: one coupled solve per impact of the flat inputs ``flat``;
+    ``error`` holds the tangential error estimates [m/s] of the impacts not determined."""
+    alpha, theta = np.radians(flat["incidence_deg"]), np.radians(flat["azimuth_deg"])
+    v = flat["speed"]
+    v_in = (-v * np.cos(alpha), v * np.sin(alpha) * np.cos(theta), v * np.sin(alpha) * np.sin(theta))
+    results = _coupled_results(contact, v_in, (flat["omega_n"], flat["omega_t"], flat["omega_tp"]),
+                               flat["friction"], rtol)
+    error = results["tangential_error"][results["not_determined"]]
+    results = {k: results[k] for k in RESULT_VARIABLES} | {"not_determined": results["not_determined"].astype(np.int8)}
+    return results, error, int(v.size), "coupled: one normal-tangential solve per impact"
+
+
+def _add_batch_attributes(ds: xr.Dataset, contact, rtol: float, error, n_solves: int, path: str) -> None:
+    """Record on ``ds`` the impacts not determined (``error``: their error estimates [m/s]), the
+    contact, the solver and its tolerance, the normal law and how the normal solves ran."""
     if error.size:  # which impacts: the not_determined flag; how far off: the largest estimate
         ds.attrs["not_determined"] = (f"{error.size} impacts: final tangential velocity and spin not settled "
                                       f"(largest error estimate {float(error.max()):.3g} m/s); see not_determined")
@@ -686,7 +711,6 @@ def simulate_many(contact, speed, incidence_deg=0.0, azimuth_deg=0.0, omega=(0.0
         ds.attrs["tabor_parameter"] = float(tabor_parameter(contact.radius, contact.stiffness, contact.work_of_adhesion))
     ds.attrs["normal_solves"] = n_solves
     ds.attrs["normal_solve_path"] = path
-    return ds
 
 
 def _broadcast_inputs(inputs: dict):

@@ -1024,6 +1024,36 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
     v = check_positive("normal_speed", normal_speed)
     model, sc, y0, c1, c2, c3, p3 = _setup(contact, v)
     sc = am.AdhesionScales(*(float(x) for x in (sc.length, sc.force, sc.time, sc.radius)))
+    zq, rhs, l_c = _reference_rhs(model, c1, c2, c3, p3)
+    potential = {_DMT: am.dmt_nondimensional_potential, _HERTZ: am.hertz_nondimensional_potential}.get(
+        model, am.jkr_nondimensional_potential)
+    energy = (lambda w: 0.5 * w[1] ** 2 + potential(zq(w[0])))
+    thr = energy([l_c, 0.0])
+    j_unit = sc.force * sc.time
+    js, jas = friction_impulse_stop / j_unit, twist_impulse_stop / (j_unit * sc.radius)
+    events = _reference_events(energy, thr, l_c, js, jas, need_tail)
+    _, capture, turning, stopped = events
+    w0 = [0.0, y0, 0.0, 0.0, 0.0]
+    captured = energy(w0) < thr  # at the start: an undamped JKR impact below the sticking velocity
+    opts = {"method": "DOP853", "rtol": rtol, "atol": rtol * max(1.0, y0) * 1e-2}
+    # first to the largest penetration, so that a capture on the way in does not end the solve
+    # short of it; then on to separation, or to the capture (the stops with need_tail)
+    capture.terminal, turning.terminal, stopped.terminal = False, True, False
+    parts = [solve_ivp(rhs, (0.0, max_time), w0, events=events, **opts)]
+    w1 = parts[0].y[:, -1]
+    captured = captured or parts[0].t_events[1].size > 0
+    turned = parts[0].status == 1 and parts[0].t_events[0].size == 0
+    if turned and not (captured and (not need_tail or (w1[3] >= js and w1[4] >= jas))):
+        capture.terminal, turning.terminal, stopped.terminal = not need_tail, False, True
+        parts.append(solve_ivp(rhs, (parts[0].t[-1], max_time), w1, events=events, **opts))
+        captured = captured or parts[1].t_events[1].size > 0
+    return _reference_solution(parts, captured, y0, sc, need_tail)
+
+
+def _reference_rhs(model, c1, c2, c3, p3):
+    """(zq, rhs, l_c) of :func:`solve_normal_reference` for the normal law ``model``: the model's z
+    (q for JKR, s for DMT) from delta / L, the right-hand side of (delta / L, its rate, D, J, J_a)
+    in time / T, and the delta / L at which the contact breaks."""
     jkr = model in (_JKR, _JKR_FORCE)
     # break at delta_c / L_J = -3 (JKR, q = 1), at -3^(1/3) (force-controlled JKR, q^3 = 3) or at
     # delta = 0 (DMT)
@@ -1043,11 +1073,15 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
         fd = dd.dem_damping_nondimensional_force(a, y, c3, p3)
         return [y, -(f + fd), diss + fd * y, abs(f + fd), a * abs(f + fd)]
 
-    potential = {_DMT: am.dmt_nondimensional_potential, _HERTZ: am.hertz_nondimensional_potential}.get(
-        model, am.jkr_nondimensional_potential)
-    energy = (lambda w: 0.5 * w[1] ** 2 + potential(zq(w[0])))
-    thr = energy([l_c, 0.0])
+    return zq, rhs, l_c
 
+
+def _reference_events(energy, thr, l_c, js, jas, need_tail) -> tuple:
+    """The solve_ivp events (separation, capture, turning, stopped) of :func:`solve_normal_reference`:
+    delta / L falling through the break ``l_c``, the contact energy ``energy`` falling through the
+    capture threshold ``thr``, the largest penetration, and (with ``need_tail``) a captured sphere
+    whose J, J_a have reached the stops ``js``, ``jas`` (nondimensional). Their ``terminal`` is set
+    by the caller."""
     def separation(_t, w):
         return w[0] - l_c
     separation.terminal, separation.direction = True, -1.0
@@ -1059,27 +1093,17 @@ def solve_normal_reference(contact, normal_speed: float, *, rtol: float = 1e-10,
     def turning(_t, w):
         return w[1]
     turning.direction = -1.0
-    j_unit = sc.force * sc.time
-    js, jas = friction_impulse_stop / j_unit, twist_impulse_stop / (j_unit * sc.radius)
 
     def stopped(_t, w):  # a captured sphere whose sliding and twist are over
         return min(w[3] - js, w[4] - jas, thr - energy(w)) if need_tail else -1.0
     stopped.direction = 1.0
-    events = (separation, capture, turning, stopped)
-    w0 = [0.0, y0, 0.0, 0.0, 0.0]
-    captured = energy(w0) < thr  # at the start: an undamped JKR impact below the sticking velocity
-    opts = {"method": "DOP853", "rtol": rtol, "atol": rtol * max(1.0, y0) * 1e-2}
-    # first to the largest penetration, so that a capture on the way in does not end the solve
-    # short of it; then on to separation, or to the capture (the stops with need_tail)
-    capture.terminal, turning.terminal, stopped.terminal = False, True, False
-    parts = [solve_ivp(rhs, (0.0, max_time), w0, events=events, **opts)]
-    w1 = parts[0].y[:, -1]
-    captured = captured or parts[0].t_events[1].size > 0
-    turned = parts[0].status == 1 and parts[0].t_events[0].size == 0
-    if turned and not (captured and (not need_tail or (w1[3] >= js and w1[4] >= jas))):
-        capture.terminal, turning.terminal, stopped.terminal = not need_tail, False, True
-        parts.append(solve_ivp(rhs, (parts[0].t[-1], max_time), w1, events=events, **opts))
-        captured = captured or parts[1].t_events[1].size > 0
+    return separation, capture, turning, stopped
+
+
+def _reference_solution(parts, captured, y0, sc, need_tail) -> NormalSolution:
+    """The NormalSolution of :func:`solve_normal_reference` from its solve_ivp results ``parts``
+    (nondimensional, incident rate ``y0``) in the SI units of the scales ``sc``."""
+    j_unit = sc.force * sc.time
     sol = parts[-1]
     capture_times = [t for part in parts for t in part.t_events[1]]
     w_end = sol.y[:, -1]

@@ -351,20 +351,10 @@ def _check_paper_law(contact) -> None:
                          f"rolling_friction={contact.rolling_friction!r}")
 
 
-def simulate_reference(
-    contact: Contact,
-    speed: float,
-    incidence_deg: float = 0.0,
-    azimuth_deg: float = 0.0,
-    omega: Sequence[float] = (0.0, 0.0, 0.0),
-    *,
-    rtol: float = DEFAULT_RTOL,
-    atol: float = 1e-13,
-    method: str = "DOP853",
-    max_step: float = math.inf,
-    settle_tolerance: float | None = None,
-    time_budget: float | None = None,
-) -> ImpactResult:
+def simulate_reference(contact: Contact, speed: float, incidence_deg: float = 0.0, azimuth_deg: float = 0.0,
+                       omega: Sequence[float] = (0.0, 0.0, 0.0), *, rtol: float = DEFAULT_RTOL, atol: float = 1e-13,
+                       method: str = "DOP853", max_step: float = math.inf, settle_tolerance: float | None = None,
+                       time_budget: float | None = None) -> ImpactResult:
     """Integrate one impact with the full 3-D equations (reference solution).
 
     Parameters
@@ -449,16 +439,29 @@ def simulate_reference(
     _check_paper_law(contact)
     speed, incidence, azimuth, omega_in = _validate_impact(speed, incidence_deg, azimuth_deg, omega)
     rtol, atol, settle_tol = _validate_common(rtol, atol, settle_tolerance)
-    max_step = float(max_step)
-    if not max_step > 0.0:
-        raise ValueError(f"max_step must be > 0, got {max_step!r}")
+    max_step = _validate_max_step(max_step)
     vel_in = incident_velocity(speed, incidence, azimuth)
     sc = _scales(contact, -vel_in[0])
     deadline = Deadline.start(time_budget, "reference solver")
     run = _Run.start(sc, contact.friction, vel_in, omega_in, settle_tol)
     if deadline.limited:
         run.counter[1:] = [deadline.end, deadline.budget]
-    solver = {"method": method, "rtol": rtol, "atol": atol, "max_step": max_step}
+    _run_to_outcome(run, {"method": method, "rtol": rtol, "atol": atol, "max_step": max_step})
+    return _reference_result(contact, sc, run, vel_in, omega_in, method)
+
+
+def _validate_max_step(max_step) -> float:
+    """``max_step`` as a float, checked to be > 0 (ValueError)."""
+    max_step = float(max_step)
+    if not max_step > 0.0:
+        raise ValueError(f"max_step must be > 0, got {max_step!r}")
+    return max_step
+
+
+def _run_to_outcome(run: _Run, solver: dict) -> None:
+    """Integrate ``run`` phase by phase (:func:`_run_phase`, with the ``solve_ivp`` options ``solver``),
+    applying each fired event, until it has a stop reason (ReferenceSolverError after
+    :data:`_MAX_PHASES` restarts)."""
     while run.stop_reason is None:
         run.n_phases += 1
         if run.n_phases > _MAX_PHASES:
@@ -466,7 +469,6 @@ def simulate_reference(
         fired = _run_phase(run, solver)
         if fired is not None:
             run.apply(fired)
-    return _reference_result(contact, sc, run, vel_in, omega_in, method)
 
 
 def _validate_impact(speed, incidence_deg, azimuth_deg, omega):
@@ -763,6 +765,25 @@ def reference_trajectory(contact: Contact, normal_speed: float, *, duration: flo
         out = rhs10(t, z)
         return [out[_S], out[_Y], out[_D], out[_TAU]]
 
+    sigma_limit = _MAX_TAU_CONTACT if duration is None else 2.0 * tau_end + _MAX_TAU_CONTACT
+    sol = solve_ivp(
+        rhs,
+        (0.0, sigma_limit),
+        [0.0, normal_speed / sc.speed, 0.0, 0.0],
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        max_step=max_step,
+        events=_normal_events(sc, tau_end, duration),
+    )
+    if sol.status == -1:
+        raise ReferenceSolverError(f"solve_ivp ({method}) failed: {sol.message}")
+    return _normal_solution(sc, sol, normal_speed, duration)
+
+
+def _normal_events(sc: _Scales, tau_end: float, duration: float | None) -> list:
+    """The events of :func:`reference_trajectory` on the state (s, y, D, tau): separation, capture
+    (terminal without a ``duration``; never without adhesion) and the end of the duration."""
     def ev_sep(_t, z):
         return z[0]
 
@@ -775,19 +796,12 @@ def reference_trajectory(contact: Contact, normal_speed: float, *, duration: flo
     events = [_event(ev_sep, True, -1.0), _event(ev_cap, duration is None, -1.0), _event(ev_end, True, 1.0)]
     if not sc.adhesive:
         events[1] = _event(lambda _t, z: 1.0, False, 0.0)  # no capture without adhesion
-    sigma_limit = _MAX_TAU_CONTACT if duration is None else 2.0 * tau_end + _MAX_TAU_CONTACT
-    sol = solve_ivp(
-        rhs,
-        (0.0, sigma_limit),
-        [0.0, normal_speed / sc.speed, 0.0, 0.0],
-        method=method,
-        rtol=rtol,
-        atol=atol,
-        max_step=max_step,
-        events=events,
-    )
-    if sol.status == -1:
-        raise ReferenceSolverError(f"solve_ivp ({method}) failed: {sol.message}")
+    return events
+
+
+def _normal_solution(sc: _Scales, sol, normal_speed: float, duration: float | None) -> NormalSolution:
+    """The NormalSolution of :func:`reference_trajectory` from its ``solve_ivp`` result ``sol``: the
+    outcome of its events (ReferenceSolverError where none ended the run) and the trajectory in SI."""
     captured = sc.adhesive and len(sol.t_events[1]) > 0
     if len(sol.t_events[0]):
         outcome = "rebound"

@@ -360,6 +360,14 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
         )
     order = [k for k in SWEEP_INPUTS if k not in dims] + [k for k in ds.data_vars if k not in SWEEP_INPUTS]
     ds = ds[order]
+    ds.attrs = _sweep_attributes(ds, dims, spec, case, label, rtol, institution)
+    return ds
+
+
+def _sweep_attributes(ds: xr.Dataset, dims: list, spec: Mapping, case, label: str, rtol: float, institution) -> dict:
+    """The global attributes of :func:`run_sweep`'s dataset ``ds`` (swept along ``dims``): CF-1.10's,
+    the case and its description, the contact and solver of :func:`~microimpact.solvers.impact.simulate_many`
+    (``ds.attrs``), the spec as JSON and the swept dimensions."""
     n = int(np.prod([ds.sizes[d] for d in dims])) if dims else 1
     attrs = {
         "Conventions": CONVENTIONS,
@@ -378,8 +386,7 @@ def run_sweep(contact, spec: Mapping | None = None, *, case: str | None = None, 
     attrs.update(ds.attrs)  # contact_* and solver, from simulate_many
     attrs["sweep_spec"] = _spec_json(spec)
     attrs["sweep_dims"] = " ".join(dims)
-    ds.attrs = attrs
-    return ds
+    return attrs
 
 
 def _grid_inputs(values: Mapping) -> dict:

@@ -378,25 +378,49 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
                       lambda: _run_scipy(contact, speeds, cases, cfg, table, notes, verbose)):
             stage()
             advance()
-        diag = _engine_diagnostics(contact, batch_speeds, cfg)
-        for line in diagnostics_lines(diag):
-            log(line, verbose)
-        sub_grid = (np.geomspace(speeds[0], speeds[-1], 4 if cfg.quick else 32),
-                    np.linspace(0.0, 85.0, 5 if cfg.quick else 18))
-        sub_costs = sub_model_costs(contact, *sub_grid, repeats=1 if cfg.quick else 3)
-        for line in sub_model_lines(sub_costs):
-            log(line, verbose)
+        diag, sub_grid, sub_costs = _diagnostics_and_sub_models(contact, speeds, batch_speeds, cfg, verbose)
         advance()
 
         targets = accuracy_targets(table.values["time_per_impact"], table.values["max_error_e_n"], cfg, b["e_n"])
         if throughput:
-            targets.update(throughput_targets(contact, cfg, verbose))
-            targets.update(family_targets(contact, cfg, table.values["time_per_impact"],
-                                          table.values["max_error_e_n"], verbose))
-            # the small fit of the side-by-side pair is 100 rows, or fit_rows when that is fewer
-            targets.update(fit_scaling((min(100, cfg.fit_rows), cfg.fit_rows), verbose=verbose))
+            targets.update(_throughput_stage(contact, cfg, table, verbose))
             advance()
-    attrs.update({
+    attrs.update(_run_attrs(contact, cfg, v_cap, speeds, cases, reference, notes, diag, sub_costs, sub_grid,
+                            t_start, targets))
+    return _dataset(table, cfg, speeds, batch_speeds.size, attrs)
+
+
+def _diagnostics_and_sub_models(contact, speeds, batch_speeds, cfg: BenchmarkConfig, verbose: bool) -> tuple:
+    """(diag, sub_grid, sub_costs) of :func:`run_benchmark`: the engine's diagnostics at the batch
+    speeds, and the grid of speeds [m/s] and angles [deg] of the sub-models' costs with those costs,
+    each logged."""
+    diag = _engine_diagnostics(contact, batch_speeds, cfg)
+    for line in diagnostics_lines(diag):
+        log(line, verbose)
+    sub_grid = (np.geomspace(speeds[0], speeds[-1], 4 if cfg.quick else 32),
+                np.linspace(0.0, 85.0, 5 if cfg.quick else 18))
+    sub_costs = sub_model_costs(contact, *sub_grid, repeats=1 if cfg.quick else 3)
+    for line in sub_model_lines(sub_costs):
+        log(line, verbose)
+    return diag, sub_grid, sub_costs
+
+
+def _throughput_stage(contact, cfg: BenchmarkConfig, table: _Table, verbose: bool) -> dict:
+    """The throughput targets of :func:`run_benchmark`: the 100,000-impact throughput and memory
+    scaling, the family's, and the fit's scaling."""
+    targets = dict(throughput_targets(contact, cfg, verbose))
+    targets.update(family_targets(contact, cfg, table.values["time_per_impact"],
+                                  table.values["max_error_e_n"], verbose))
+    # the small fit of the side-by-side pair is 100 rows, or fit_rows when that is fewer
+    targets.update(fit_scaling((min(100, cfg.fit_rows), cfg.fit_rows), verbose=verbose))
+    return targets
+
+
+def _run_attrs(contact, cfg: BenchmarkConfig, v_cap, speeds, cases, reference: Reference, notes, diag, sub_costs,
+               sub_grid, t_start, targets) -> dict:
+    """The attributes of :func:`run_benchmark`'s dataset beyond the machine's: the run, its reference,
+    diagnostics and sub-model costs, its duration, the targets and the contact."""
+    return {
         "title": "work-precision benchmark of the microimpact solvers",
         "contact": cfg.contact_name,
         "quick": int(cfg.quick),
@@ -415,5 +439,4 @@ def run_benchmark(quick: bool = False, *, contact=WALL_1990, config: BenchmarkCo
         **targets,
         **contact_attributes(contact),
         "parameter_source": preset_parameter_source(cfg.contact_name.lower().replace("_", "")),
-    })
-    return _dataset(table, cfg, speeds, batch_speeds.size, attrs)
+    }
