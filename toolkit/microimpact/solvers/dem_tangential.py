@@ -331,6 +331,8 @@ def _rhs_and_switch(law, x, mode):
     out[2], out[3], rate = _spring_rates(law.model, mode[0], tangential, u1, u2, du1, du2, g, k, law.k1 * da,
                                          eta_t, deta_t, cap, dcap, radius_rate, law.cap_floor)
     out[4], out[5] = du1, du2
+    if law.mu == 0.0:  # a frictionless slip (beside the rolling law): no force in either mode, it stays in
+        out[2], out[3], rate = 0.0, 0.0, 1.0  # slide (_start_mode), its direction idle
     switch = tangential[6] if mode[0] == _STICK else rate
     return out, (switch, switch_r), (rate, rate_r)
 
@@ -369,7 +371,14 @@ def _start_mode(law, x):
     switch = _rhs_and_switch(law, probe, (_STICK, _STICK))[1]
     x = x.copy()
     tangential = rolling = _STICK
-    if switch[0] > 0.0:
+    if law.mu == 0.0:
+        # without friction the slip's spring carries no force: it slides on its zero limit from touch and
+        # never switches (stuck, its force F_e(H) - eta_t u grew past the zero limit at once, and back
+        # inside it by rounding, so that it chattered across a whole contact: the sds law's case 55 of
+        # seed 0 took 32 s, the sweep's time box)
+        tangential = _SLIDE
+        x[2:4] = (1.0, 0.0)
+    elif switch[0] > 0.0:
         # sliding from touch; against the slip, except where LAMMPS's Mindlin spring starts at a = 0
         # under a damping that does not vanish as fast as a (mass_velocity, tsuji, coeff_restitution):
         # its history, reset to -(mu F_n0 e + eta_t u) / (k a), is then ~ a^(p - 1) and the spring
@@ -431,7 +440,7 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
         def peak(_, state):  # falls through 0 where spring i's switch function is farthest towards leaving:
             # a maximum of |F| - mu F_n0 in stick (its rate, exact), a minimum of slide's switch function
             # (its rate along the motion, a central difference over _RATE_STEP along the right-hand side)
-            if _separation(law, state) <= 0.0:
+            if _separation(law, state) <= 0.0 or (i == 0 and law.mu == 0.0):  # past the end; no friction
                 return 1.0
             if mode[i] == _STICK:
                 return _rhs_and_switch(law, state, mode)[2][i]
