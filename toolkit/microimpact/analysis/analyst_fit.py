@@ -199,8 +199,9 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
         them (``walkers``, ``max_steps``, ``steps`` (a fixed length), ``burn``, ``seed``, ``n_draws``,
         ``method`` (the likelihood's e_n: "emulator" or "solve", :func:`sample_posterior
         <microimpact.analysis.posterior.sample_posterior>`); None values keep the default).
-    errors_in_variables : {"auto", "effective", "latent"}
-        Speed-error treatment of the posterior (:mod:`microimpact.analysis.posterior`).
+    errors_in_variables, likelihood, nu
+        Speed-error treatment, e_n likelihood ("normal" or "student-t") and its degrees of freedom
+        [-] of the posterior (:func:`~microimpact.analysis.posterior.sample_posterior`).
     rtol : float
         Relative tolerance of the normal solves. [-]
     progress : bool
@@ -213,12 +214,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
         Where the verdict names outliers, refit without them and keep both fits
         (:attr:`AnalystFit.without_outliers`); the outliers named are those the refit confirms.
     loss : {"linear", "soft_l1", "huber"}
-        Loss of the damping fit (:func:`~microimpact.analysis.fitting.fit_damping`); the refit
-        without the outliers uses it too.
-    likelihood : {"normal", "student-t"}
-        e_n likelihood of the posterior (:func:`~microimpact.analysis.posterior.sample_posterior`).
-    nu : float
-        Degrees of freedom of the Student-t likelihood. [-]
+        Loss of the damping fit (:func:`~microimpact.analysis.fitting.fit_damping`) and its refit.
 
     Returns
     -------
@@ -227,14 +223,13 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     Raises
     ------
     TimeBudgetExceeded
-        A stage ran past ``time_budget``; the message names the stage and how far it got.
+        A stage ran past ``time_budget`` (the message names the stage and how far it got).
     PosteriorError
-        The posterior collapsed or did not converge (:func:`~microimpact.analysis.posterior.sample_posterior`).
+        The posterior collapsed or did not converge.
 
     Examples
     --------
-    Six synthetic impacts made with zeta_H = 0.5, zeta_A = 29 (w_A fixed at the material's): the
-    fitted values are within two standard errors of them:
+    Six synthetic impacts of zeta_H = 0.5, zeta_A = 29: the fit is within two standard errors of them:
 
     >>> from microimpact.analysis.synthetic import write_synthetic_impacts
     >>> from microimpact.io import default_materials_path, read_impacts, read_materials
@@ -245,7 +240,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     ...  for k, truth in (("zeta_hertz", 0.5), ("zeta_adhesion", 29.0))}
     {'zeta_hertz': True, 'zeta_adhesion': True}
 
-    A misspelt posterior option is refused, naming the known ones (after the damping fit):
+    A misspelt posterior option is refused, naming the known ones:
 
     >>> analyse_impacts(table, material, posterior={"wlakers": 8})
     Traceback (most recent call last):
@@ -266,18 +261,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
         damping, without = _refit_without_outliers(table, damping, damping_fit, rtol)
     if excluded:
         damping = dataclasses.replace(damping, info=damping.info | {"excluded_ids": ",".join(excluded)})
-    ff = None
-    if friction:
-        try:
-            ObliqueProblem.from_table(table)
-        except ValueError:
-            pass
-        else:
-            ff = fit_friction(table, damping, rtol=rtol, progress=progress, time_budget=deadline)
-            friction, source = _friction_for_simulations(ff, damping.friction)
-            damping = dataclasses.replace(damping, friction=friction, info=damping.info | {
-                "friction_stderr": ff.stderr["friction"], "friction_source": source, "friction_n_points": ff.n_points,
-                "friction_status": ff.identifiability["friction"].status})
+    damping, ff = _with_friction(table, damping, rtol, progress, deadline) if friction else (damping, None)
     if not posterior:
         return AnalystFit(damping, ff, without_outliers=without)
     opts = _posterior_options(posterior)
@@ -291,6 +275,20 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
                          capture_velocity_interval(post, damping, n_draws=nd, time_budget=deadline),
                          sweep_bands(post, damping, n_draws=max(nd // 2, 4), rtol=rtol, time_budget=deadline))
     return AnalystFit(damping, ff, post, ds, without)
+
+
+def _with_friction(table, damping, rtol, progress, deadline):
+    """(damping fit carrying the friction the simulations use, FrictionFit) where ``table`` has
+    oblique columns; (damping, None) where it has none."""
+    try:
+        ObliqueProblem.from_table(table)
+    except ValueError:
+        return damping, None
+    ff = fit_friction(table, damping, rtol=rtol, progress=progress, time_budget=deadline)
+    friction, source = _friction_for_simulations(ff, damping.friction)
+    return dataclasses.replace(damping, friction=friction, info=damping.info | {
+        "friction_stderr": ff.stderr["friction"], "friction_source": source, "friction_n_points": ff.n_points,
+        "friction_status": ff.identifiability["friction"].status}), ff
 
 
 def _table_ids(table) -> list[str]:
