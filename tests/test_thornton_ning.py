@@ -106,7 +106,7 @@ def test_yield_is_where_the_jkr_force_per_contact_area_reaches_p_y():
     y = tn.yield_point(pc)
     a, e_star, w, r = y.contact_radius, pc.e_star, pc.work_of_adhesion, pc.radius
     p1, p2 = 2.0 * e_star * a / (math.pi * r), math.sqrt(2.0 * w * e_star / (math.pi * a))
-    assert p1 - 1.5 * p2 == pytest.approx(pc.yield_pressure, rel=1e-12)
+    assert p1 - 1.5 * p2 == pytest.approx(pc.yield_pressure, rel=1e-12, abs=0.0)  # [Pa], relative only
     h = 1e-5 * a  # central difference: error ~ (h / a)^2 = 1e-10
     def force(x):
         return float(tn.jkr_curve_force(x, r, e_star, w))
@@ -202,7 +202,7 @@ def test_below_the_tensile_yield_limit_the_contact_yields_under_tension():
     at = tn.yield_point(_scaled_contact(w, tn.TENSILE_YIELD_LIMIT))
     f_c = 1.5 * math.pi * w  # JKR pull-off force of R = 1, the force scale
     assert at.force / f_c == pytest.approx(0.0, abs=1e-12)
-    assert at.contact_radius**3 == pytest.approx(4.5 * math.pi * w, rel=1e-12)
+    assert at.contact_radius**3 == pytest.approx(4.5 * math.pi * w, rel=1e-12, abs=0.0)  # relative only
     pc = _scaled_contact(w, 1.2)
     y = tn.yield_point(pc)
     assert y.force < 0.0
