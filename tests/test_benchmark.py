@@ -138,6 +138,7 @@ def small_benchmark():
     return benchmark.run_benchmark(config=cfg)
 
 
+@pytest.mark.extended
 def test_benchmark_dataset_structure(small_benchmark):
     ds = small_benchmark
     assert ds["time_per_impact"].dims == ("method", "setting")
@@ -178,6 +179,7 @@ def test_benchmark_dataset_structure(small_benchmark):
     assert ds.attrs["family_path"].startswith("family")
 
 
+@pytest.mark.extended
 def test_write_benchmark(small_benchmark, tmp_path):
     import xarray as xr
 
@@ -200,6 +202,7 @@ def test_write_benchmark(small_benchmark, tmp_path):
     assert not list((tmp_path / "out").glob(".*.tmp"))  # atomic writes leave no temporaries
 
 
+@pytest.mark.extended
 def test_markdown_says_the_cpus_were_shared_only_when_the_load_says_so(small_benchmark):
     ds = small_benchmark.copy()
     cpus = ds.attrs["machine_cpu_count"]
@@ -208,6 +211,7 @@ def test_markdown_says_the_cpus_were_shared_only_when_the_load_says_so(small_ben
         assert ("above 1 per CPU" in benchmark.benchmark_markdown(ds)) is shared
 
 
+@pytest.mark.extended
 def test_write_benchmark_without_a_figure_writes_the_data_files(small_benchmark, tmp_path):
     paths = benchmark.write_benchmark(small_benchmark, tmp_path / "out")
     assert set(paths) == {"netcdf", "json", "markdown"}

@@ -65,6 +65,7 @@ def few():
     return [run_design(draw_design(seed)) for seed in (504, 507, 509)]
 
 
+@pytest.mark.extended
 def test_every_statement_is_a_value_a_bound_or_nothing(few):
     statuses = {rec[name]["status"] for rec in few for name in FITTED if name in rec}
     assert {"determined", "upper_bound", "lower_bound"} <= statuses  # (the check below sees each kind)

@@ -19,6 +19,10 @@ import xarray as xr
 from microimpact.io.files import CONVENTIONS, read_netcdf_groups, write_netcdf
 from microimpact.io.variables import VARIABLES, udunits
 
+# the result files of every kind take a module fixture of many solves and fits, the checker seconds
+# per file: with the extended tests (.ci/run runs them), not the default run
+pytestmark = pytest.mark.extended
+
 SUITE = "cf:1.10"
 
 # Reduced grids: the CF form of a file does not depend on its size, and the whole module must stay

@@ -44,6 +44,7 @@ def test_interval_coverage_over_random_designs():
     assert _within_binomial(covered, determined), (covered, determined)
 
 
+@pytest.mark.extended
 def test_coverage_when_the_scatter_is_estimated():
     """Without stated uncertainties the interval uses s^2 t^2 (n - 1 degrees of freedom); 80 trials:
     coverage within 0.87-1.0, which a 68.27 % interval (or one with the normal z for t) does not reach."""
@@ -127,6 +128,7 @@ def test_a_law_that_does_not_describe_the_data_is_inadequate_and_unprinted():
     assert ranked[["value", "interval_low", "interval_high"]].isna().all(axis=None)
 
 
+@pytest.mark.extended
 def test_cli_refuses_to_export_a_law_that_does_not_describe_the_data(tmp_path, capsys):
     from pathlib import Path
 

@@ -1,7 +1,8 @@
 """Every docstring example of the package runs and prints what it says (the Examples sections of
 the API reference). One test per module, so a failure names the module and the example; the few
 examples that are studies in miniature (tens of seconds each, :data:`SLOW_EXAMPLES`) run with the
-slow tests (``pytest -m slow``), one test each."""
+slow tests (``pytest -m slow``), one test each; the modules whose examples take seconds
+(:data:`EXTENDED_MODULES`) with the extended tests."""
 
 from __future__ import annotations
 
@@ -22,6 +23,13 @@ FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
 SLOW_EXAMPLES = ("rank_dem_tangential_laws", "dem_friction_coverage", "plot_model_comparison",
                  "model_comparison_section", "compare_normal_models",
                  "build_ring_emulator", "ring_emulator", "restitution")  # each builds a small emulator table
+#: modules whose examples together take seconds of CPU (each fits, samples a posterior or draws a
+#: report page): with the extended tests (``pytest -m extended``, run by .ci/run), not the default run
+EXTENDED_MODULES = frozenset({
+    "microimpact.analysis.posterior", "microimpact.report.analyst", "microimpact.analysis.dem_friction",
+    "microimpact.analysis.dem_fit", "microimpact.report.posterior_figures", "microimpact.report.figures",
+    "microimpact.analysis.kharaz", "microimpact.studies.benchmark.family", "microimpact.studies.material",
+    "microimpact.analysis.oblique"})
 
 
 def _doctests(name: str) -> list[doctest.DocTest]:
@@ -49,7 +57,8 @@ def test_every_module_is_found():
             "microimpact.analysis.fitting", "microimpact._runtime.joblog"} <= set(MODULES)
 
 
-@pytest.mark.parametrize("name", MODULES)
+@pytest.mark.parametrize("name", [pytest.param(m, marks=pytest.mark.extended) if m in EXTENDED_MODULES else m
+                                  for m in MODULES])
 def test_docstring_examples(name, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # an example that writes a file writes it here
     tests = [t for t in _doctests(name) if not _is_slow(t)]
@@ -65,6 +74,11 @@ def test_slow_docstring_examples(function, tmp_path, monkeypatch):
     tests = [t for name in MODULES for t in _doctests(name) if t.name.rsplit(".", 1)[-1] == function]
     assert len(tests) == 1, f"{function}: {len(tests)} docstrings with examples of that name"
     _run(tests)
+
+
+def test_every_extended_module_exists():
+    """A renamed module must not leave its examples unrun."""
+    assert EXTENDED_MODULES <= set(MODULES), sorted(EXTENDED_MODULES - set(MODULES))
 
 
 def test_every_slow_example_exists():

@@ -444,6 +444,7 @@ def test_ctrl_c_ends_in_one_line_with_status_130_and_writes_nothing(argv, after,
     assert after_snapshot == before
 
 
+@pytest.mark.extended
 def test_a_warning_is_one_line_naming_the_input_not_the_installation(tmp_path):
     """The console script prints a warning as ``microimpact: warning: ...`` on one line (Python's
     form was two lines naming cli.py and a source line of the installation). A measured e_n of

@@ -308,6 +308,7 @@ def test_missing_file_is_file_not_found(tmp_path):
         read_impacts(tmp_path / "nope.csv")
 
 
+@pytest.mark.extended
 def test_large_file_loads(tmp_path):
     """200k rows load (vectorised checks); no timing assertion."""
     n = 200_000

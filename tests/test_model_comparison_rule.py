@@ -67,9 +67,10 @@ def _subset(tmp_path):
     return data
 
 
+@pytest.mark.extended
 def test_the_rule_script_fits_the_plastic_law(tmp_path):
-    """The script's path for a rate-independent law (fit_thornton_ning, no damping fit): a few
-    seconds, so in the default suite; the whole list of the rule is the slow test below."""
+    """The script's path for a rate-independent law (fit_thornton_ning, no damping fit), in a
+    subprocess as the pipeline runs it (extended); the whole list of the rule is the slow test below."""
     out = _run_rule_script(tmp_path, _subset(tmp_path), ["thornton_ning"])
     with xr.open_dataset(out, engine="netcdf4") as ds:
         assert [str(m) for m in ds["normal_model_label"].values] == ["thornton_ning"]

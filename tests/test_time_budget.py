@@ -211,6 +211,7 @@ def test_analyst_fit_shares_one_budget(table, pair, clock):
         analyse_impacts(table, pair, time_budget=fit_checks + 1.0, posterior={"walkers": 4, "steps": 3, "n_draws": 2})
 
 
+@pytest.mark.extended
 def test_calibration_budget():
     from study_calibration import calibration_study
 

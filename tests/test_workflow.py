@@ -434,6 +434,7 @@ def test_chunked_sweep_equals_unchunked(pipeline, tmp_path):
         assert a.attrs["sweep_spec"] == b.attrs["sweep_spec"]
 
 
+@pytest.mark.extended
 def test_lint_is_clean(tmp_path):
     root = make_copy(tmp_path / "lint")
     proc = snakemake(root, "--lint")
@@ -441,6 +442,7 @@ def test_lint_is_clean(tmp_path):
     assert "Lints for" not in proc.stdout, proc.stdout
 
 
+@pytest.mark.extended
 def test_bad_config_is_refused_by_snakemake_naming_the_key(tmp_path):
     # the wiring, through a real Snakemake: the schema validation stops the dry run
     root = make_copy(tmp_path / "bad")
@@ -478,6 +480,7 @@ def test_the_schema_passes_the_unchanged_config():
              str(REPO / "workflow" / "schemas" / "config.schema.yaml"))
 
 
+@pytest.mark.extended
 def test_bad_value_in_config_file_is_refused_naming_the_key(tmp_path):
     root = make_copy(tmp_path / "bad_file")
     cfg = root / "workflow" / "config" / "config.yaml"
@@ -489,6 +492,7 @@ def test_bad_value_in_config_file_is_refused_naming_the_key(tmp_path):
     assert "density" in proc.stdout and "paper_contact" in proc.stdout, proc.stdout
 
 
+@pytest.mark.extended
 def test_bad_data_file_stops_at_validation_with_every_problem(tmp_path):
     root = make_copy(tmp_path / "bad_data")
     bad = root / "data" / "bad.csv"
@@ -675,6 +679,7 @@ def test_plot_draws_every_result_file_or_says_why_not(pipeline, tmp_path, capsys
 
 
 # --------------------------------------------------------------------------- run from elsewhere
+@pytest.mark.extended
 def test_snakefile_runs_from_another_working_directory(tmp_path):
     """snakemake -s REPO/Snakefile -d elsewhere: config, schema and bundled data are found from the
     Snakefile's directory (a dry run, started in a third directory)."""
