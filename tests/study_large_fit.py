@@ -11,7 +11,11 @@ the fitted values and standard errors of both files::
 
     python tests/study_large_fit.py --pairs 2 --out docs/large-fit.json
 
-Extra arguments after ``--`` go to both fits (e.g. ``-- --fit-method solve``).
+Extra arguments after ``--`` go to both fits (e.g. ``-- --no-confidence-intervals``). With ``--agreement`` the
+large table is also fitted in this process by :func:`microimpact.analysis.fitting.fit_damping` with ``method="solve"``
+and ``method="emulator"``, and the differences of the estimates and of the 95 % interval ends are written in units of
+the solve fit's standard errors, with the bound the emulator fit states (``info["model_evaluation"]``) and each
+fit's CPU time.
 Exit status 0. Nothing is asserted: timings are not tests (tests/test_large_fit.py holds the tests).
 """
 
@@ -28,7 +32,10 @@ import tempfile
 import time
 from pathlib import Path
 
+import microimpact
+from microimpact.analysis.fitting import fit_damping
 from microimpact.analysis.synthetic import write_synthetic_impacts
+from microimpact.io import default_materials_path, read_impacts, read_materials
 
 REPO = Path(__file__).resolve().parents[1]
 SMALL = REPO / "data" / "synthetic_microspheres.csv"
@@ -61,11 +68,42 @@ def _estimates(result: dict) -> dict:
     return out
 
 
+def _commit() -> str:
+    """The commit of the microimpact imported (and "+dirty" for uncommitted changes)."""
+    root = Path(microimpact.__file__).resolve().parents[2]
+    run = lambda *a: subprocess.run(["git", "-C", str(root), *a], capture_output=True, text=True).stdout.strip()  # noqa: E731
+    return run("rev-parse", "--short", "HEAD") + ("+dirty" if run("status", "--porcelain", "--untracked-files=no") else "")
+
+
+def _agreement(large: Path) -> dict:
+    """The large table fitted in this process by "solve" and by "emulator": differences in standard errors."""
+    table = read_impacts(large, materials=default_materials_path())
+    material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    fits, cpu = {}, {}
+    for method in ("solve", "emulator"):
+        t = time.process_time()
+        fits[method] = fit_damping(table, material, method=method)
+        cpu[method] = time.process_time() - t
+    s, e = fits["solve"], fits["emulator"]
+    rows = {}
+    for name in s.varied:
+        se = s.stderr[name]
+        a, b = s.identifiability[name], e.identifiability[name]
+        rows[name] = {"solve": {"value": s.values[name], "stderr": se, "interval": [a.lower, a.upper]},
+                      "emulator": {"value": e.values[name], "stderr": e.stderr[name], "interval": [b.lower, b.upper]},
+                      "value_difference_in_stderr": abs(e.values[name] - s.values[name]) / se,
+                      "stderr_relative_difference": abs(e.stderr[name] - se) / se,
+                      "interval_end_differences_in_stderr": [abs(b.lower - a.lower) / se, abs(b.upper - a.upper) / se]}
+    return {"cpu_s": cpu, "parameters": rows, "chisqr": {"solve": s.chisqr, "emulator": e.chisqr},
+            "model_evaluation": {"solve": s.info["model_evaluation"], "emulator": e.info["model_evaluation"]}}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--pairs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=None)
     ap.add_argument("--large", type=Path, default=None, help="write (or reuse) the large CSV here")
+    ap.add_argument("--agreement", action="store_true", help="also fit the large table by both methods in-process")
     ap.add_argument("extra", nargs="*", help="arguments for both fits (after --)")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
@@ -79,6 +117,7 @@ def main(argv=None) -> int:
             order = ("small", "large") if k % 2 == 0 else ("large", "small")
             for which in order:
                 runs[which].append(_run_fit(SMALL if which == "small" else large, tmp / f"{which}.nc", args.extra))
+        agreement = _agreement(large) if args.agreement else None
     cpu_ratio = [b["cpu_s"] / a["cpu_s"] for a, b in zip(runs["small"], runs["large"])]
     wall_ratio = [b["wall_s"] / a["wall_s"] for a, b in zip(runs["small"], runs["large"])]
     summary = {
@@ -93,9 +132,12 @@ def main(argv=None) -> int:
         "estimates": {w: _estimates(rs[-1]["result"]) for w, rs in runs.items()},
         "verdict": {w: rs[-1]["result"]["damping"]["verdict"]["verdict_text"] for w, rs in runs.items()},
         "load_average_1min_at_end": os.getloadavg()[0],
-        "command": "python tests/study_large_fit.py --pairs " + str(args.pairs)
+        "commit": _commit(),
+        "command": "python tests/study_large_fit.py --pairs " + str(args.pairs) + (" --agreement" if args.agreement else "")
                    + (" --out " + str(args.out) if args.out else "") + (" -- " + " ".join(args.extra) if args.extra else ""),
     }
+    if agreement is not None:
+        summary["agreement_solve_vs_emulator"] = agreement
     text = json.dumps(summary, indent=1)
     print(text)
     if args.out:

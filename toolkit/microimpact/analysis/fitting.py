@@ -849,15 +849,42 @@ class _Profile:
     def __init__(self, problem, e_n, sigma, best, name, rtol, scale, deadline, level=math.inf, loss=DEFAULT_LOSS):
         self.problem, self.e_n, self.sigma, self.best, self.name = problem, e_n, sigma, best, name
         self.rtol, self.scale, self.deadline, self.level, self.loss = rtol, scale, deadline, level, loss
+        self.local = None  # (estimate, its stderr, {other: d other / d x}) while walked in standard errors
+        self.minimum = level - chi2_threshold(DEFAULT_LEVEL)  # the scaled objective at the estimate
 
     def __call__(self, x, start=None) -> tuple[float, object]:
         """(P(x), the re-fitted parameters): the re-fit starts from the previous point's optimum and,
         where that differs, from the best fit too (the lower wins: a continuation alone can follow a
         valley of the other parameters that the best fit's basin leaves). Where both end above the
         threshold, the re-fit is tried once more from the best rescaled start (:meth:`_rescue`)."""
+        if self.local is not None:
+            return self._local_call(x, start)
         results = [self._refit(x, s) for s in ([start, self.best] if start is not None else [self.best])]
         best = min(results, key=lambda r: r[0])
         if best[0] > self.level:
+            best = min(best, self._rescue(x, [s for s in (start, self.best) if s is not None]), key=lambda r: r[0])
+        return best
+
+    def _local_call(self, x, start) -> tuple[float, object]:
+        """P(x) within a few standard errors of the estimate (:meth:`_crossing_in_stderr`): the same
+        starts as :meth:`__call__`, tried in turn while P is above the threshold, so that whether P(x)
+        is above it is decided as by all of them (a lower minimum found by a later start cannot move a
+        point from below the threshold to above). The first start is the covariance's prediction of
+        the other parameters at x (in a quadratic bowl, the profile's optimum), so that the re-fit
+        takes a few evaluations. The rescue from a plateau (:meth:`_rescue`) runs only where P rose
+        by more than twice what the covariance predicts, ((x - estimate) / stderr)^2: a re-fit stuck
+        on a plateau is far above the bowl, one on the bowl is not."""
+        value, se, slopes = self.local
+        predicted = self.best.copy()
+        for n, b in slopes.items():
+            predicted[n].set(value=min(max(self.best[n].value + b * (x - value), predicted[n].min), predicted[n].max))
+        best = self._refit(x, predicted)
+        for s in ([start] if start is not None else []) + [self.best]:
+            if best[0] <= self.level:
+                return best
+            best = min(best, self._refit(x, s), key=lambda r: r[0])
+        rise = best[0] - self.minimum
+        if best[0] > self.level and rise > 2.0 * ((x - value) / se) ** 2:
             best = min(best, self._rescue(x, [s for s in (start, self.best) if s is not None]), key=lambda r: r[0])
         return best
 
@@ -938,6 +965,16 @@ class _Profile:
         level at 1.96 of them: the second step brackets it)."""
         up = limit > value
         x_in, step = value, se
+        estimate = self.best[self.name]
+        slopes = {n: (estimate.correl or {}).get(n, 0.0) * self.best[n].stderr / se for n in PARAMETER_NAMES
+                  if n != self.name and self.best[n].vary and self.best[n].stderr}
+        self.local = (float(estimate.value), se, slopes)
+        try:
+            return self._walk_in_stderr(value, limit, level, start, se, up, x_in, step)
+        finally:
+            self.local = None
+
+    def _walk_in_stderr(self, value, limit, level, start, se, up, x_in, step) -> float:
         for _ in range(200):
             x = min(value + step, limit) if up else max(value - step, limit)
             px, params = self(x, start)
