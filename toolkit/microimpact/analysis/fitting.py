@@ -201,6 +201,7 @@ class FitProblem:
     material: object
     method: str = "solve"
     _groups: dict = field(default_factory=dict, compare=False, repr=False)  # the table's groups, per w_A
+    _memo: dict = field(default_factory=dict, compare=False, repr=False)  # recent model e_n, by parameters
 
     @classmethod
     def from_arrays(cls, radius, normal_speed, base, method: str = "solve") -> "FitProblem":
@@ -289,6 +290,10 @@ def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_ad
     >>> model_restitution(problem, 0.5, 29.0, 0.215834).round(4).tolist()
     [0.0, 0.049, 0.5437]
     """
+    emulated = problem.method == "emulator" and any(idx.size >= EMULATOR_MIN_ROWS for idx in problem.groups)
+    key = (float(zeta_hertz), float(zeta_adhesion), float(work_of_adhesion), float(rtol), float(speed_factor))
+    if emulated and key in problem._memo:
+        return problem._memo[key].copy()
     out = np.empty(problem.normal_speed.size)
     for r, idx in zip(problem.radii, problem.groups):
         g = None
@@ -299,7 +304,15 @@ def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_ad
             out[idx] = normal_restitution(c, problem.normal_speed[idx] * speed_factor, rtol=rtol)
         else:
             out[idx] = _emulated(problem, r, idx, g, zeta_hertz, zeta_adhesion, work_of_adhesion, speed_factor)
+    if emulated:  # lmfit evaluates many points twice (a minimisation's start, its result, a re-fit's start)
+        if len(problem._memo) >= MEMO_SIZE:
+            problem._memo.pop(next(iter(problem._memo)))
+        problem._memo[key] = out.copy()
     return out
+
+
+#: model evaluations of a large fit kept for repeated parameters (:func:`model_restitution`)
+MEMO_SIZE = 64
 
 
 def _emulated(problem, radius, idx, groups, zeta_hertz, zeta_adhesion, work_of_adhesion, speed_factor):
