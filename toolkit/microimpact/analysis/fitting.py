@@ -742,9 +742,10 @@ def _model_evaluation(problem, rtol, shift) -> str:
     solved = f"the solver at rtol {rtol:g}"
     if not rows.any():
         return solved
+    rest = int((~rows).sum())
     return (f"the ring-law emulator (absolute tolerance {EMULATOR_TOLERANCE:g}; the solver where the table does not "
             f"meet it) for the {int(rows.sum())} rows of radii with at least {EMULATOR_MIN_ROWS} rows, which moves an "
-            f"estimate by at most {shift:.2g} standard errors; {solved} for the other {int((~rows).sum())}")
+            f"estimate by at most {shift:.2g} standard errors" + (f"; {solved} for the other {rest}" if rest else ""))
 
 
 #: allowed range of each damping parameter, searched by its profile (w_A relative to its fitted
