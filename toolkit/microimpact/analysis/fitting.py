@@ -9,7 +9,10 @@ damping forms of Eqs. (14)-(15). Here the fit is done with lmfit and
   w_A through Eq. (7), f0 = (9/(2 pi) K r w_A^2)^(1/3) (a fit per size would fit f0, which is not a
   material property; see notes/model-notes.md section 1);
 * with the model e_n(v_n) from :func:`microimpact.solvers.engine.solve_normal_many`, one call per distinct
-  radius per evaluation;
+  radius per evaluation; a radius with thousands of rows takes e_n from the ring law's error-controlled
+  table instead (:mod:`microimpact.solvers.emulator`, ``method="emulator"``, the default), where its
+  tolerance cannot move an estimate by more than a tenth of a standard error
+  (:func:`emulator_shift_bound`);
 * from a coarse global start: chi-square on a log-spaced (zeta_H, zeta_A) grid, then
   Levenberg-Marquardt (``leastsq``) from the best grid point, with bounds zeta >= 0 (w_A > 0).
 
@@ -183,6 +186,9 @@ class FitProblem:
         The material: density [kg/m^3], stiffness K [Pa], friction [-] (not used by e_n; kept for
         the fitted contact) and damping reference speed [m/s] (None: each impact's own normal
         speed). Its zetas and w_A are replaced by the trial values.
+    method : {"solve", "emulator"}
+        How :func:`model_restitution` computes e_n (:data:`FIT_METHODS`): "emulator" takes the e_n
+        of a radius with at least :data:`EMULATOR_MIN_ROWS` points from the ring law's table.
 
     Examples
     --------
@@ -258,7 +264,9 @@ def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_ad
                       speed_factor=1.0) -> np.ndarray:
     """Model e_n of every point, Eqs. (21), (27): one engine call per distinct radius (a
     restitution family of the normal speed when a radius has thousands of distinct speeds,
-    :func:`microimpact.solvers.family.normal_restitution`).
+    :func:`microimpact.solvers.family.normal_restitution`), or, for a problem of ``method``
+    "emulator", one table lookup for each radius with at least :data:`EMULATOR_MIN_ROWS` points
+    (the solver where the table does not meet :data:`EMULATOR_TOLERANCE`).
 
     Parameters
     ----------
