@@ -116,8 +116,8 @@ def test_precise_parameters_get_their_profile_interval():
     """Where the data determine a parameter to better than the profile's relative tolerance (here
     stated e_n uncertainties of 1e-4: relative standard errors ~1e-4), the interval is located in
     standard errors: it brackets the estimate and is 2 x 1.96 standard errors wide to 5 % (a nearly
-    linear model over so narrow a range; on d7f068d the 100,000-row study's zeta_A interval had
-    width 0)."""
+    linear model over so narrow a range). Located to the relative tolerance alone, the interval of
+    such a parameter can shrink to the estimate itself."""
     table = _table(40, seed=3, e_n_rel_sd=0.0)
     table["e_n_uncertainty"] = 1e-4
     fit = fit_damping(table, MATERIAL, confidence_intervals=False, method="solve")
