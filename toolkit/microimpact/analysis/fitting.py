@@ -9,7 +9,10 @@ damping forms of Eqs. (14)-(15). Here the fit is done with lmfit and
   w_A through Eq. (7), f0 = (9/(2 pi) K r w_A^2)^(1/3) (a fit per size would fit f0, which is not a
   material property; see notes/model-notes.md section 1);
 * with the model e_n(v_n) from :func:`microimpact.solvers.engine.solve_normal_many`, one call per distinct
-  radius per evaluation;
+  radius per evaluation; a radius with thousands of rows takes e_n from the ring law's error-controlled
+  table instead (:mod:`microimpact.solvers.emulator`, ``method="emulator"``, the default), where its
+  tolerance cannot move an estimate by more than a tenth of a standard error
+  (:func:`emulator_shift_bound`);
 * from a coarse global start: chi-square on a log-spaced (zeta_H, zeta_A) grid, then
   Levenberg-Marquardt (``leastsq``) from the best grid point, with bounds zeta >= 0 (w_A > 0).
 
@@ -45,7 +48,7 @@ import functools
 import math
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import lmfit
 import numba
@@ -61,9 +64,10 @@ from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold, 
 from microimpact.io.impacts import MEASUREMENT_TOLERANCE_SIGMAS, insert_row_labels, row_labels
 from microimpact.io.materials import material_contact
 from microimpact._runtime.progress import progress_bar
+from microimpact.model import reduction
 from microimpact.model.contact import Contact
-from microimpact.solvers import DEFAULT_RTOL, Deadline, TimeBudgetExceeded, engine
-from microimpact.solvers.family import normal_restitution
+from microimpact.solvers import DEFAULT_RTOL, Deadline, TimeBudgetExceeded, emulator, engine
+from microimpact.solvers.family import FAMILY_MIN_SPEEDS, normal_restitution
 
 # The engine (numba) is imported inside the two functions that solve, so that importing the fit
 # costs no numba start-up. The result record, DampingFit, lives in fit_result (no lmfit import):
@@ -83,10 +87,30 @@ __all__ = [
     "DEFAULT_LOSS",
     "robust_terms",
     "loss_description",
+    "FIT_METHODS",
+    "EMULATOR_TOLERANCE",
+    "EMULATOR_MIN_ROWS",
+    "EMULATOR_MAX_SHIFT",
+    "emulator_shift_bound",
 ]
 
 #: default start grid: log-spaced zeta_H and zeta_A values on which chi-square is evaluated
 DEFAULT_START_GRID = (np.geomspace(0.01, 10.0, 13), np.geomspace(0.1, 1000.0, 13))
+#: how a fit computes the model e_n: "emulator" (the default of :func:`fit_damping`) takes the e_n of a
+#: radius with EMULATOR_MIN_ROWS rows or more from the ring law's error-controlled table
+#: (:func:`microimpact.solvers.emulator.ring_emulator`), "solve" solves every evaluation
+FIT_METHODS = ("emulator", "solve")
+#: absolute e_n tolerance of the table in a fit: the posterior's (one shipped table serves both)
+EMULATOR_TOLERANCE = 1e-6
+#: the box of groups of that table (:data:`microimpact.solvers.emulator.WIDE_DOMAIN`, shipped)
+EMULATOR_DOMAIN = emulator.WIDE_DOMAIN
+#: a radius with this many rows or more takes its e_n from the table: from here on a solve builds a
+#: restitution family on every evaluation (:data:`microimpact.solvers.family.FAMILY_MIN_SPEEDS`),
+#: while fewer rows are solved directly at about the cost of a table lookup, to the fit's rtol
+EMULATOR_MIN_ROWS = FAMILY_MIN_SPEEDS
+#: the most, in standard errors, by which the table's tolerance may move an estimate
+#: (:func:`emulator_shift_bound`); a fit whose bound is larger is made again by "solve"
+EMULATOR_MAX_SHIFT = 0.1
 
 
 
@@ -162,6 +186,9 @@ class FitProblem:
         The material: density [kg/m^3], stiffness K [Pa], friction [-] (not used by e_n; kept for
         the fitted contact) and damping reference speed [m/s] (None: each impact's own normal
         speed). Its zetas and w_A are replaced by the trial values.
+    method : {"solve", "emulator"}
+        How :func:`model_restitution` computes e_n (:data:`FIT_METHODS`): "emulator" takes the e_n
+        of a radius with at least :data:`EMULATOR_MIN_ROWS` points from the ring law's table.
 
     Examples
     --------
@@ -178,22 +205,54 @@ class FitProblem:
     groups: tuple
     normal_speed: np.ndarray
     material: object
+    method: str = "solve"
+    _groups: dict = field(default_factory=dict, compare=False, repr=False)  # the table's groups, per w_A
+    _memo: dict = field(default_factory=dict, compare=False, repr=False)  # recent model e_n, by parameters
 
     @classmethod
-    def from_arrays(cls, radius, normal_speed, base) -> "FitProblem":
-        """Group points by radius [m] and normal speed [m/s]; ``base`` is the material."""
+    def from_arrays(cls, radius, normal_speed, base, method: str = "solve") -> "FitProblem":
+        """Group points by radius [m] and normal speed [m/s]; ``base`` is the material; ``method``
+        one of :data:`FIT_METHODS` (how :func:`model_restitution` computes e_n)."""
+        if method not in FIT_METHODS:
+            raise ValueError(f"method must be one of {', '.join(FIT_METHODS)}, got {method!r}")
         radius = np.asarray(radius, dtype=float)
         v = np.asarray(normal_speed, dtype=float)
         radii, inverse = np.unique(radius, return_inverse=True)
         groups = tuple(np.flatnonzero(inverse == i) for i in range(radii.size))
-        return cls(tuple(float(r) for r in radii), groups, v, base)
+        return cls(tuple(float(r) for r in radii), groups, v, base, method)
 
     def subset(self, rows) -> "FitProblem":
         """The problem restricted to the points ``rows`` (indices in the data order)."""
         radius = np.empty(self.normal_speed.size)
         for r, idx in zip(self.radii, self.groups):
             radius[idx] = r
-        return FitProblem.from_arrays(radius[rows], self.normal_speed[rows], self.material)
+        return FitProblem.from_arrays(radius[rows], self.normal_speed[rows], self.material, self.method)
+
+    def emulated_rows(self) -> np.ndarray:
+        """Whether each point's e_n comes from the table (``method`` "emulator", a radius with at least
+        :data:`EMULATOR_MIN_ROWS` points); the table may still hand single points to the solver."""
+        out = np.zeros(self.normal_speed.size, dtype=bool)
+        if self.method == "emulator":
+            for idx in self.groups:
+                out[idx] = idx.size >= EMULATOR_MIN_ROWS
+        return out
+
+    def table_groups(self, radius, idx, work_of_adhesion, speed_factor):
+        """(y0, C1 / zeta_H = C2 / zeta_A) of the points ``idx`` of one radius [m] at w_A [J/m^2] and the
+        speeds times ``speed_factor``, or None where the radius's law is not the ring law. The groups
+        are linear in the zetas (Eqs. (14)-(15), :func:`microimpact.model.reduction.ring_groups`):
+        computed once per w_A, an evaluation is one table lookup."""
+        key = (float(radius), float(work_of_adhesion), float(speed_factor))
+        if key not in self._groups:
+            if any(k[1] != key[1] for k in self._groups):  # one w_A at a time: a fitted w_A moves every call
+                self._groups.clear()
+            c = self.contact(radius, 1.0, 1.0, work_of_adhesion)
+            if reduction.law_of(c) != "ring":
+                self._groups[key] = None
+            else:
+                y0, per, _ = reduction.ring_groups([c], (self.normal_speed[idx] * speed_factor)[None, :])
+                self._groups[key] = (np.ascontiguousarray(y0[0]), np.ascontiguousarray(per[0]))
+        return self._groups[key]
 
     def contact(self, radius, zeta_hertz, zeta_adhesion, work_of_adhesion) -> Contact:
         """The Contact of one radius [m] at trial zetas [-] and w_A [J/m^2], f0 from Eq. (7)."""
@@ -205,7 +264,9 @@ def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_ad
                       speed_factor=1.0) -> np.ndarray:
     """Model e_n of every point, Eqs. (21), (27): one engine call per distinct radius (a
     restitution family of the normal speed when a radius has thousands of distinct speeds,
-    :func:`microimpact.solvers.family.normal_restitution`).
+    :func:`microimpact.solvers.family.normal_restitution`), or, for a problem of ``method``
+    "emulator", one table lookup for each radius with at least :data:`EMULATOR_MIN_ROWS` points
+    (the solver where the table does not meet :data:`EMULATOR_TOLERANCE`).
 
     Parameters
     ----------
@@ -237,11 +298,89 @@ def model_restitution(problem: FitProblem, zeta_hertz, zeta_adhesion, work_of_ad
     >>> model_restitution(problem, 0.5, 29.0, 0.215834).round(4).tolist()
     [0.0, 0.049, 0.5437]
     """
+    emulated = problem.method == "emulator" and any(idx.size >= EMULATOR_MIN_ROWS for idx in problem.groups)
+    key = (float(zeta_hertz), float(zeta_adhesion), float(work_of_adhesion), float(rtol), float(speed_factor))
+    if emulated and key in problem._memo:
+        return problem._memo[key].copy()
     out = np.empty(problem.normal_speed.size)
     for r, idx in zip(problem.radii, problem.groups):
-        c = problem.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion)
-        out[idx] = normal_restitution(c, problem.normal_speed[idx] * speed_factor, rtol=rtol)
+        g = None
+        if problem.method == "emulator" and idx.size >= EMULATOR_MIN_ROWS:
+            g = problem.table_groups(r, idx, work_of_adhesion, speed_factor)
+        if g is None:
+            c = problem.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion)
+            out[idx] = normal_restitution(c, problem.normal_speed[idx] * speed_factor, rtol=rtol)
+        else:
+            out[idx] = _emulated(problem, r, idx, g, zeta_hertz, zeta_adhesion, work_of_adhesion, speed_factor)
+    if emulated:  # lmfit evaluates many points twice (a minimisation's start, its result, a re-fit's start)
+        if len(problem._memo) >= MEMO_SIZE:
+            problem._memo.pop(next(iter(problem._memo)))
+        problem._memo[key] = out.copy()
     return out
+
+
+#: model evaluations of a large fit kept for repeated parameters (:func:`model_restitution`)
+MEMO_SIZE = 64
+
+
+def _emulated(problem, radius, idx, groups, zeta_hertz, zeta_adhesion, work_of_adhesion, speed_factor):
+    """e_n of the points ``idx`` of one radius by the table where it meets EMULATOR_TOLERANCE, by the
+    emulator's fallback solves (to the same absolute tolerance) where it does not. [-]"""
+    y0, per = groups
+    table = _table()
+    e, _, solve = table.evaluate(y0, zeta_hertz * per, zeta_adhesion * per, EMULATOR_TOLERANCE)
+    e = np.array(e, dtype=float)
+    if solve.any():
+        c = problem.contact(radius, zeta_hertz, zeta_adhesion, work_of_adhesion)
+        e[solve] = emulator.fallback_restitution(c, problem.normal_speed[idx][solve] * speed_factor, EMULATOR_TOLERANCE)
+    return e
+
+
+@functools.lru_cache(maxsize=1)
+def _table():
+    """The fit's emulator table, looked up once per process (the lookup hashes the physics' source)."""
+    return emulator.ring_emulator(emulator.table_tolerance(EMULATOR_TOLERANCE), EMULATOR_DOMAIN)
+
+
+def emulator_shift_bound(problem: FitProblem, sigma, scale: float = 1.0) -> float:
+    """The most, in standard errors, by which the table's tolerance can move an estimate of the fit. [-]
+
+    The table's e_n is within EMULATOR_TOLERANCE = tol of the law's (its verified bound; where it
+    is not, the solver runs). Linearised about the fit, an error de of the model moves the estimate
+    by d theta = (J^T J)^-1 J^T dz (dz = de / sigma, J = dz / d theta), and by Cauchy-Schwarz
+    |d theta_j| <= sqrt(((J^T J)^-1)_jj) ||dz||: the standard error (times sqrt(scale) where the
+    covariance is scaled by the reduced chi-square ``scale``) times ||dz|| <= tol sqrt(sum 1 /
+    sigma_i^2) over the rows the table serves. The same bound holds for the ends of a profile interval
+    where the profile is quadratic.
+
+    Parameters
+    ----------
+    problem : FitProblem
+    sigma : numpy.ndarray or None
+        The uncertainties the fit used (None: unweighted, 1). [-]
+    scale : float
+        Factor of the covariance (the reduced chi-square of an unweighted fit, else 1). [-]
+
+    Returns
+    -------
+    float
+        The bound; 0 where no row is served by the table. [-]
+
+    Examples
+    --------
+    2,000 rows of sigma 0.01 each served by the table: 1e-6 sqrt(2000 / 0.01^2) = 0.0045 standard errors:
+
+    >>> from microimpact.io import default_materials_path, read_materials
+    >>> material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    >>> problem = FitProblem.from_arrays(np.full(2000, 2e-6), np.geomspace(2.0, 50.0, 2000), material, "emulator")
+    >>> round(emulator_shift_bound(problem, np.full(2000, 0.01)), 4)
+    0.0045
+    """
+    rows = problem.emulated_rows()
+    if not rows.any():
+        return 0.0
+    s = np.ones(rows.size) if sigma is None else np.broadcast_to(np.asarray(sigma, dtype=float), rows.shape)
+    return float(EMULATOR_TOLERANCE * math.sqrt(np.sum(1.0 / s[rows] ** 2) / max(float(scale), 1e-300)))
 
 
 def damping_residual(params, problem: FitProblem, e_n=None, sigma=None, *, rtol=DEFAULT_RTOL):
@@ -401,7 +540,7 @@ def _effective_sigma(problem, p, sigma_e, sigma_v, rtol, h=1e-4):
 def fit_damping(table, base, *, fit_work_of_adhesion: bool = False, weights="auto", start_grid=DEFAULT_START_GRID,
                 rtol: float = DEFAULT_RTOL, confidence_intervals: bool = True, scale_covar: bool | None = None,
                 threads: int | None = 1, progress: bool = False, time_budget: float | None = None,
-                loss: str = DEFAULT_LOSS) -> DampingFit:
+                loss: str = DEFAULT_LOSS, method: str = "emulator") -> DampingFit:
     """Fit zeta_H, zeta_A (and optionally w_A) to measured e_n(v_n), jointly over particle sizes.
 
     Parameters
@@ -448,6 +587,16 @@ def fit_damping(table, base, *, fit_work_of_adhesion: bool = False, weights="aut
         intervals are the profile of the robust objective, scaled per parameter by the sandwich
         (Huber 1967) so that they have the M-estimator's width. The verdict's chi-square stays the
         plain sum of z^2 at the fitted values.
+    method : {"emulator", "solve"}
+        How the model e_n is computed (:data:`FIT_METHODS`). "emulator": a radius with at least
+        :data:`EMULATOR_MIN_ROWS` rows takes e_n from the ring law's error-controlled table
+        (absolute tolerance :data:`EMULATOR_TOLERANCE`; the solver where the table does not meet
+        it, and for every other law), the other radii are solved at ``rtol``; when the table's
+        tolerance could move an estimate by more than :data:`EMULATOR_MAX_SHIFT` standard errors
+        (:func:`emulator_shift_bound`) the fit is made again by "solve". "solve": every radius by
+        the solver at ``rtol`` (a restitution family where a radius has thousands of speeds).
+        A robust loss always solves (the bound is that of least squares). ``info["model_evaluation"]``
+        says which was used.
 
     Raises
     ------
@@ -486,28 +635,31 @@ def fit_damping(table, base, *, fit_work_of_adhesion: bool = False, weights="aut
     (0.5, 29.0)
     """
     deadline = Deadline.start(time_budget, "fit")
+    if method not in FIT_METHODS:
+        raise ValueError(f"method must be one of {', '.join(FIT_METHODS)}, got {method!r}")
     if threads is None:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
-                            scale_covar, progress, deadline, loss)
+                            scale_covar, progress, deadline, loss, method)
 
     previous = numba.get_num_threads()
     engine.set_threads(threads)
     try:
         return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
-                            scale_covar, progress, deadline, loss)
+                            scale_covar, progress, deadline, loss, method)
     finally:
         engine.set_threads(previous)
 
 
 def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals, scale_covar,
-                 progress=False, deadline=Deadline.start(None, "fit"), loss=DEFAULT_LOSS):
+                 progress=False, deadline=Deadline.start(None, "fit"), loss=DEFAULT_LOSS, method="solve"):
     """The fit of :func:`fit_damping`: check, start on the grid, least squares, collect the result."""
     t0 = time.perf_counter()
     density, stiffness, w_a0, friction, vref = _material(base)
     df, rows, arr, src = _table_arrays(table)
     sigma_e, effective, weighting = _sigma_e(weights, arr, rows, src)
     _check_loss(loss, sigma_e, src)
-    problem = FitProblem.from_arrays(arr["radius"], arr["normal_speed"], base)
+    # the table's bound on the estimates (emulator_shift_bound) is that of least squares
+    problem = FitProblem.from_arrays(arr["radius"], arr["normal_speed"], base, method if loss == "linear" else "solve")
     e_n = arr["e_n"]
     n_var = 3 if fit_work_of_adhesion else 2
     if e_n.size <= n_var:
@@ -540,6 +692,10 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
                 best, starts = again, dense
         advance(rounds)
         mini, result, sigma, n = best
+        shift = emulator_shift_bound(problem, sigma, result.redchi if scale_covar else 1.0)
+        if shift > EMULATOR_MAX_SHIFT:  # the data are too precise for the table's tolerance
+            return _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, confidence_intervals,
+                                scale_covar, progress, deadline, loss, "solve")
         mini.iter_cb = deadline.iter_cb("the confidence intervals")
         cis, ci_message = _confidence_intervals(mini, result, confidence_intervals and loss == "linear")
         if confidence_intervals and loss != "linear":
@@ -560,7 +716,7 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
             "rtol": float(rtol), "loss": loss, "loss_description": loss_description(loss),
             "elapsed_s": time.perf_counter() - t0, "source": df.attrs.get("source"),
             "sha256": df.attrs.get("sha256"), "material_pair": str(labels[0]) if len(labels) == 1 else None,
-            "ci_message": ci_message or None}
+            "ci_message": ci_message or None, "model_evaluation": _model_evaluation(problem, rtol, shift)}
     varied = tuple(n for n in PARAMETER_NAMES if result.params[n].vary)
     grid = starts.grid if e_n.size <= GRID_START_POINTS else None  # a subsampled grid is another chi-square
     identifiability = damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline, w_a0, grid,
@@ -588,12 +744,30 @@ def _fit_damping(table, base, fit_work_of_adhesion, weights, start_grid, rtol, c
                       identifiability=identifiability)
 
 
+def _model_evaluation(problem, rtol, shift) -> str:
+    """How the fit computed the model e_n, in words (``info["model_evaluation"]``)."""
+    rows = problem.emulated_rows()
+    solved = f"the solver at rtol {rtol:g}"
+    if not rows.any():
+        return solved
+    rest = int((~rows).sum())
+    return (f"the ring-law emulator (absolute tolerance {EMULATOR_TOLERANCE:g}; the solver where the table does not "
+            f"meet it) for the {int(rows.sum())} rows of radii with at least {EMULATOR_MIN_ROWS} rows, which moves an "
+            f"estimate by at most {shift:.2g} standard errors" + (f"; {solved} for the other {rest}" if rest else ""))
+
+
 #: allowed range of each damping parameter, searched by its profile (w_A relative to its fitted
 #: value): zeta_H of 1e3 or zeta_A of 1e4 damp every impact of the model to capture, so a profile
 #: flat up to there is flat for good
 DAMPING_RANGES = {"zeta_hertz": (0.0, 1e3), "zeta_adhesion": (0.0, 1e4), "work_of_adhesion": (1e-3, 1e2)}
 #: relative tolerance of the profile interval's ends (brentq on the profile)
 PROFILE_XTOL = 1e-3
+#: where PROFILE_XTOL relative would be coarser than this many standard errors, the profile is walked
+#: and its ends located in standard errors (:meth:`_Profile.crossing`); a quarter leaves the fit of the
+#: bundled data (100 rows) as it was
+PROFILE_PRECISE = 0.25
+#: tolerance of the profile interval's ends in standard errors, where they are located in them
+PROFILE_SE_XTOL = 0.01
 
 
 def damping_identifiability(problem, e_n, sigma, result, rtol, scale_covar, deadline=Deadline.start(None, "fit"),
@@ -697,15 +871,42 @@ class _Profile:
     def __init__(self, problem, e_n, sigma, best, name, rtol, scale, deadline, level=math.inf, loss=DEFAULT_LOSS):
         self.problem, self.e_n, self.sigma, self.best, self.name = problem, e_n, sigma, best, name
         self.rtol, self.scale, self.deadline, self.level, self.loss = rtol, scale, deadline, level, loss
+        self.local = None  # (estimate, its stderr, {other: d other / d x}) while walked in standard errors
+        self.minimum = level - chi2_threshold(DEFAULT_LEVEL)  # the scaled objective at the estimate
 
     def __call__(self, x, start=None) -> tuple[float, object]:
         """(P(x), the re-fitted parameters): the re-fit starts from the previous point's optimum and,
         where that differs, from the best fit too (the lower wins: a continuation alone can follow a
         valley of the other parameters that the best fit's basin leaves). Where both end above the
         threshold, the re-fit is tried once more from the best rescaled start (:meth:`_rescue`)."""
+        if self.local is not None:
+            return self._local_call(x, start)
         results = [self._refit(x, s) for s in ([start, self.best] if start is not None else [self.best])]
         best = min(results, key=lambda r: r[0])
         if best[0] > self.level:
+            best = min(best, self._rescue(x, [s for s in (start, self.best) if s is not None]), key=lambda r: r[0])
+        return best
+
+    def _local_call(self, x, start) -> tuple[float, object]:
+        """P(x) within a few standard errors of the estimate (:meth:`_crossing_in_stderr`): the same
+        starts as :meth:`__call__`, tried in turn while P is above the threshold, so that whether P(x)
+        is above it is decided as by all of them (a lower minimum found by a later start cannot move a
+        point from below the threshold to above). The first start is the covariance's prediction of
+        the other parameters at x (in a quadratic bowl, the profile's optimum), so that the re-fit
+        takes a few evaluations. The rescue from a plateau (:meth:`_rescue`) runs only where P rose
+        by more than twice what the covariance predicts, ((x - estimate) / stderr)^2: a re-fit stuck
+        on a plateau is far above the bowl, one on the bowl is not."""
+        value, se, slopes = self.local
+        predicted = self.best.copy()
+        for n, b in slopes.items():
+            predicted[n].set(value=min(max(self.best[n].value + b * (x - value), predicted[n].min), predicted[n].max))
+        best = self._refit(x, predicted)
+        for s in ([start] if start is not None else []) + [self.best]:
+            if best[0] <= self.level:
+                return best
+            best = min(best, self._refit(x, s), key=lambda r: r[0])
+        rise = best[0] - self.minimum
+        if best[0] > self.level and rise > 2.0 * ((x - value) / se) ** 2:
             best = min(best, self._rescue(x, [s for s in (start, self.best) if s is not None]), key=lambda r: r[0])
         return best
 
@@ -717,8 +918,12 @@ class _Profile:
         gradient and stops (the calibration study's designs 1017, 1240, 1254: the profile ended on
         the plateau at chi-square 240236, 4439, 22183 and reported zeta_A <= 1.8, 4.3, 3.6, while
         from a start with a smaller w_A it stays within 0.1 of its minimum up to the range end). A
-        few residual evaluations find a start off the plateau."""
+        few residual evaluations find a start off the plateau.
+
+        The candidates only pick the start, so a large data set is represented by GRID_START_POINTS
+        rows spread evenly over it, as on the start grid (:func:`_grid_start`); the re-fit uses all."""
         others = [n for n in PARAMETER_NAMES if n != self.name and self.best[n].vary]
+        problem, e_n, sigma = _represented(self.problem, self.e_n, self.sigma)
         candidates = []
         for s in starts:
             for n in others:
@@ -726,7 +931,7 @@ class _Profile:
                     p = s.copy()
                     p[self.name].set(value=x)
                     p[n].set(value=max(p[n].value, 1e-12) * factor)
-                    r = damping_residual(p, self.problem, self.e_n, self.sigma, rtol=self.rtol)
+                    r = damping_residual(p, problem, e_n, sigma, rtol=self.rtol)
                     candidates.append((_objective(r, self.loss), p))
         if not candidates:
             return math.inf, starts[0]
@@ -745,9 +950,17 @@ class _Profile:
         return _objective(res.residual, self.loss) / self.scale, res.params
 
     def crossing(self, value, limit, level, start=None) -> float:
-        """Where P rises to ``level`` between ``value`` and ``limit`` (``limit`` if it never does)."""
+        """Where P rises to ``level`` between ``value`` and ``limit`` (``limit`` if it never does).
+
+        The walk grows by factors of ``value`` and the crossing is located to PROFILE_XTOL relative;
+        where that tolerance would exceed PROFILE_PRECISE standard errors (a parameter the data
+        determine to better than ~0.1 %, as 100,000 rows do), both are in standard errors instead
+        (:meth:`_crossing_in_stderr`): the relative tolerance could otherwise swallow the interval."""
         if limit == value:
             return limit
+        se = self.best[self.name].stderr
+        if se is not None and math.isfinite(se) and se > 0 and PROFILE_XTOL * 1.1 * abs(value) > PROFILE_PRECISE * se:
+            return self._crossing_in_stderr(value, limit, level, start, float(se))
         up = limit > value
         x_in = value
         for k in range(200):
@@ -768,9 +981,48 @@ class _Profile:
             x_in, start = x, params
         return float(limit)
 
+    def _crossing_in_stderr(self, value, limit, level, start, se) -> float:
+        """:meth:`crossing` with steps of 1, 2, 4, ... standard errors ``se`` from ``value`` and the
+        crossing located to PROFILE_SE_XTOL standard errors (a quadratic profile crosses the 95 %
+        level at 1.96 of them: the second step brackets it)."""
+        up = limit > value
+        x_in, step = value, se
+        estimate = self.best[self.name]
+        slopes = {n: (estimate.correl or {}).get(n, 0.0) * self.best[n].stderr / se for n in PARAMETER_NAMES
+                  if n != self.name and self.best[n].vary and self.best[n].stderr}
+        self.local = (float(estimate.value), se, slopes)
+        try:
+            return self._walk_in_stderr(value, limit, level, start, se, up, x_in, step)
+        finally:
+            self.local = None
+
+    def _walk_in_stderr(self, value, limit, level, start, se, up, x_in, step) -> float:
+        for _ in range(200):
+            x = min(value + step, limit) if up else max(value - step, limit)
+            px, params = self(x, start)
+            if px > level:
+                try:
+                    return float(brentq(lambda t: self(t, start)[0] - level, x_in, x, xtol=PROFILE_SE_XTOL * se,
+                                        rtol=4 * np.finfo(float).eps))
+                except ValueError:  # P not above the level at x_in (a re-fit found a lower minimum): bracket edge
+                    return float(x)
+            if x == limit:
+                return float(limit)
+            x_in, start, step = x, params, 2.0 * step
+        return float(limit)
+
 
 #: points of a large data set that represent it on the start grid (:func:`_grid_start`)
 GRID_START_POINTS = 400
+
+
+def _represented(problem, e_n, sigma):
+    """(problem, e_n, sigma) restricted to GRID_START_POINTS rows spread evenly over the data, or as
+    they are when there are no more rows than that: what picks a start, not the fit."""
+    if e_n.size <= GRID_START_POINTS:
+        return problem, e_n, sigma
+    rows = np.unique(np.linspace(0, e_n.size - 1, GRID_START_POINTS).round().astype(int))
+    return problem.subset(rows), e_n[rows], (sigma[rows] if np.ndim(sigma) else sigma)
 
 
 #: least-squares runs started from the best local minima of the start grid
@@ -818,10 +1070,7 @@ def _grid_start(problem, e_n, sigma, work_of_adhesion, start_grid, rtol, advance
     gh, ga = (np.asarray(g, dtype=float).ravel() for g in start_grid)
     if gh.size == 0 or ga.size == 0 or np.any(gh < 0) or np.any(ga < 0):
         raise ValueError("start_grid must be two non-empty arrays of zeta values >= 0")
-    if e_n.size > GRID_START_POINTS:
-        rows = np.unique(np.linspace(0, e_n.size - 1, GRID_START_POINTS).round().astype(int))
-        problem, e_n = problem.subset(rows), e_n[rows]
-        sigma = sigma[rows] if np.ndim(sigma) else sigma
+    problem, e_n, sigma = _represented(problem, e_n, sigma)
     chi2 = np.full((gh.size, ga.size), math.inf)
     for i, zh in enumerate(gh):
         for j, za in enumerate(ga):
