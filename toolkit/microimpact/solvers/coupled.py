@@ -96,7 +96,8 @@ from microimpact.model.tangential import stop_impulses, tangential_outcome  # cl
 from microimpact.solvers import SolverError, UndeterminedOutcomeWarning, dopri, driver
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
-from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _slow_twist
+from microimpact.solvers.engine import _SLOW_ENERGY, _averaged_tail, _equilibrium, _inertia_free, _is_creeping
+from microimpact.solvers.engine import _slow_event_time, _slow_twist
 from microimpact.solvers.solution import SolutionBatch
 
 __all__ = ["solve_coupled", "coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
@@ -789,8 +790,37 @@ def _law_events(z, z1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
 
 @njit(cache=True)
 def _law_creep(z, k1, p, w, atol, rec, rec_cap):
-    """No inertia-free jump: a creeping captured sphere ends in :func:`_captured_stop`."""
-    return driver.CREEP_NONE
+    """The inertia-free limit before the capture: a sphere not yet captured whose normal motion
+    follows the slow manifold into the equilibrium (the engine's :func:`~microimpact.solvers.engine._inertia_free`,
+    its thresholds) is captured; the integration stops there with outcome _CREEPING, and its tail
+    is taken in closed form as that of a creeping captured sphere (:func:`_captured_stop`,
+    :func:`_settle_captured`). The capture time is where the energy on the manifold falls below
+    zero (or the capture margin), as the engine's jump finds it. A creeping captured sphere ends in
+    :func:`_captured_stop` (unchanged); no jump that resumes the integration (the tangential state
+    would have to be carried along it).
+
+    Why: a nanometre sphere under zeta_A ~ 1e6 creeps from first contact into the well at
+    y_m ~ 1 / C2, so slowly (tau ~ C2 to reach the equilibrium) that it is not captured within the
+    step budget (the energy test needs an approach of ~rtol^(2/3) of the equilibrium): the step
+    limit, at C2 ~ 2e9 (issue 55's corner of the stress domain)."""
+    hist, b = w
+    row = p[5]
+    c1, c2, ah, aa = row[0], row[1], row[2], row[3]
+    tail_closed = not row[10] > 0.0 or row[6] > 0.5  # as _law_captured_end: a closed form of the tail
+    if b[_B_CAPTURED] != 0.0 or not (aa > 0.0 and (c1 > 0.0 or c2 > 0.0) and z[_S] > 0.0 and tail_closed):
+        return driver.CREEP_NONE
+    xe = b[_B_XE]
+    slow, xi_t = _inertia_free(z, atol[_Y], c1, c2, ah, aa, xe)
+    if not (slow and xi_t == xe):
+        return driver.CREEP_NONE
+    tau_zero = b[_B_TAU_ZERO]
+    if math.isnan(tau_zero):
+        tau_zero = _slow_event_time(z, xe, 0.0, _SLOW_ENERGY, c1, c2, ah, aa)
+    tau_cap = _slow_event_time(z, xe, b[_B_ECAP], _SLOW_ENERGY, c1, c2, ah, aa)
+    b[_B_TAU_ZERO] = tau_zero
+    b[_B_TAU_CAP] = tau_cap if math.isnan(tau_zero) else tau_zero
+    b[_B_CAPTURED], b[_B_OUTCOME] = 1.0, _CREEPING
+    return driver.CREEP_END
 
 
 @njit(cache=True)
