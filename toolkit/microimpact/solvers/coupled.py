@@ -77,6 +77,19 @@ does not depend on when the integration stopped:
   variation of the normal rate, :func:`microimpact.solvers.driver.linear_tail_variation`) and twist
   impulse (times a at the equilibrium) act as sliding friction, the closed-form map of the rigid
   contact (the limit is tiny, so the compliant contact is in gross slip while it slides).
+
+Inertia-free limit before the capture (:func:`_law_creep`): a sphere not yet captured whose normal
+motion follows the slow manifold into the equilibrium (the engine's test and thresholds,
+:func:`microimpact.solvers.engine._inertia_free`: inertia ratio eps <= 1e-6, relaxation ratio >= 1e3,
+y within 2 eps |y_m| + 10 atol_y of y_m) is captured there, and the integration stops with the
+creeping captured sphere's tail above. Without it a nanometre sphere under zeta_A ~ 1e6 (C2 ~ 2e9)
+crept in at y_m ~ 1 / C2 and reached the step limit before the energy test could capture it. Error:
+the normal motion that of the engine's jump (the inertia ratio); the tail's friction impulse |y| is
+the total variation of y to rest up to 2 |y - y_m| (y relaxes onto the manifold, then falls
+monotonically), so the friction impulse is off by at most 2 f (2 eps |y_m| + 10 atol_y), whether
+the contact slides or sticks while y relaxes (along the manifold F_lim = f |dy_m/dtau| is tiny, so
+the contact slides, as the tail takes it); tests/test_coupled_creep.py checks the bound against
+solves at rtol 1e-12.
 """
 
 from __future__ import annotations
