@@ -6,7 +6,8 @@ y_m ~ 1 / C2 and is not captured within the step budget by the energy test. Ever
 ended in "step limit reached after 2000000 steps" there (8 of the 128 corners of the stress domain
 per law, whatever the density, zeta_H or friction). Now the normal motion takes the engine's
 inertia-free path into the equilibrium (microimpact.solvers.coupled._law_creep) and the tangential
-tail is the creeping captured sphere's closed form.
+tail is the creeping captured sphere's closed form. The other such corner: no adhesion, zeta_H =
+1e6, K = 1e8 Pa, 1e4 m/s, which now leaves on the engine's invariant line.
 """
 
 from __future__ import annotations
@@ -73,3 +74,25 @@ def test_the_creeping_tail_converges_within_its_bound(zeta_adhesion):
     v_n = 10.0 * math.cos(math.radians(89.0))
     v_in = 10.0 * math.sin(math.radians(89.0))
     assert all(v_in - 2.0 * v_n * (1.0 + 1e-9) <= v <= v_in for v in v_t.values())
+
+
+#: the other corner with no result under every compliant law: no adhesion, zeta_H = 1e6, K = 1e8 Pa,
+#: 1e4 m/s (whatever the radius, zeta_A or friction)
+HERTZ_CORNER = dict(CORNER, work_of_adhesion=0.0, zeta_hertz=1e6, speed=1e4)
+
+
+@pytest.mark.parametrize("law", COUPLED_LAWS)
+@pytest.mark.parametrize("incidence_deg, friction", [(0.0, 0.0), (45.0, 2.0)])
+def test_an_overdamped_hertz_exit_leaves_on_the_invariant_line(law, incidence_deg, friction):
+    """Without adhesion under zeta_H = 1e6 the sphere leaves along y = -1/C1, the exact invariant
+    line of the Hertz law with its damping (the engine's inertia-free exit; e_n = 1 / (C_H v_n),
+    tests/test_inertia_free.py checks it against the exact exit speed). Each compliant law raised
+    CoupledError (step limit) here; now it passes the stress checks and its e_n is the ring law's:
+    both end on the same line, where e_n is 1 / (C1 y0) in closed form, so they agree to rounding
+    (rel 1e-12)."""
+    case = dict(HERTZ_CORNER, incidence_deg=incidence_deg, friction=friction)
+    row = stress.check_case(case, law=law)
+    assert row["failures"] == [], row["failures"]
+    assert row["outcome"] == "rebound"
+    ring = simulate_impact(stress.contact_of(case, "ring"), case["speed"], incidence_deg)
+    assert row["e_n"] == pytest.approx(ring.e_n, rel=1e-12, abs=0.0)
