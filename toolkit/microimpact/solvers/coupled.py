@@ -77,6 +77,21 @@ does not depend on when the integration stopped:
   variation of the normal rate, :func:`microimpact.solvers.driver.linear_tail_variation`) and twist
   impulse (times a at the equilibrium) act as sliding friction, the closed-form map of the rigid
   contact (the limit is tiny, so the compliant contact is in gross slip while it slides).
+
+Inertia-free limit before the capture (:func:`_law_creep`): a sphere not yet captured whose normal
+motion follows the slow manifold into the equilibrium (the engine's test and thresholds,
+:func:`microimpact.solvers.engine._inertia_free`: inertia ratio eps <= 1e-6, relaxation ratio >= 1e3,
+y within 2 eps |y_m| + 10 atol_y of y_m) is captured there, and the integration stops with the
+creeping captured sphere's tail above. Without it a nanometre sphere under zeta_A ~ 1e6 (C2 ~ 2e9)
+crept in at y_m ~ 1 / C2 and reached the step limit before the energy test could capture it. Error:
+the normal motion that of the engine's jump (the inertia ratio); the tail's friction impulse |y| is
+the total variation of y to rest up to 2 |y - y_m| (y relaxes onto the manifold, then falls
+monotonically), so the friction impulse is off by at most 2 f (2 eps |y_m| + 10 atol_y), whether
+the contact slides or sticks while y relaxes (along the manifold F_lim = f |dy_m/dtau| is tiny, so
+the contact slides, as the tail takes it); tests/test_coupled_creep.py checks the bound against
+solves at rtol 1e-12. Without adhesion the strongly damped sphere leaves along the exact invariant
+line y = -1/C1, where F_n = 0 and no tangential force acts (:func:`_exit_on_invariant_line`, the
+engine's exit: at zeta_H ~ 1e6 and 1e4 m/s every compliant law reached the step limit before).
 """
 
 from __future__ import annotations
@@ -96,7 +111,8 @@ from microimpact.model.tangential import stop_impulses, tangential_outcome  # cl
 from microimpact.solvers import SolverError, UndeterminedOutcomeWarning, dopri, driver
 from microimpact.solvers.compiled_law import compiled
 from microimpact.solvers.driver import linear_tail_variation as _linear_tail_variation
-from microimpact.solvers.engine import _averaged_tail, _equilibrium, _is_creeping, _slow_twist
+from microimpact.solvers.engine import _SLOW_ENERGY, _averaged_tail, _equilibrium, _inertia_free, _is_creeping
+from microimpact.solvers.engine import _slow_event_time, _slow_twist
 from microimpact.solvers.solution import SolutionBatch
 
 __all__ = ["solve_coupled", "coupled_kernel", "coupled_many", "CoupledError", "stops_at_capture", "HELD_ROLLING_TOLERANCE"]
@@ -788,9 +804,72 @@ def _law_events(z, z1, k1, h, p, w, atol, rtol, k, tmp, err, rec, rec_cap):
 
 
 @njit(cache=True)
+def _exit_on_invariant_line(z, row, j_stop, b):
+    """The rest of an impact without adhesion on the inertia-free path y = -1/C1 (the engine's
+    jump, :func:`~microimpact.solvers.engine._inertia_free_jump`): the line is an exact invariant of
+    xi'' = -a_h xi^(3/2) (1 + C1 y), on which F_n = 0, so the sphere leaves at y = -1/C1 after
+    tau = C1 xi, and no tangential force acts on the way (F_lim = f |F_n| = 0, and F_po = 0; the
+    rolling torque mu_r r |F_n| = 0): the tangential state is kept, the stored displacement released
+    at separation (:func:`_separate`). The relaxation onto the line from within 10 atol_y of it is
+    booked in J and J_a as the engine books it (|dy|); its tangential impulse, at most
+    f 10 atol_y, is left out. z becomes the state at separation; outcome rebound into b.
+
+    Why: at zeta_H ~ 1e6 and 1e4 m/s the exit takes ~(C1 xi)^2 explicit steps: the step limit
+    under every compliant law (the ring law took the line before)."""
+    xi0 = z[_S] * z[_S]
+    y_t = -1.0 / row[0]
+    dj = abs(z[_Y] - y_t)
+    if math.isnan(b[_B_TAU_J]) and z[_J] < j_stop <= z[_J] + dj:
+        b[_B_TAU_J] = z[_TAU]
+    e_now = _energy(z[_S], z[_Y], row[2], row[3])
+    z[_J] += dj
+    z[_JA] += z[_S] * dj
+    z[_TAU] += row[0] * xi0
+    z[_S], z[_Y] = 0.0, y_t
+    z[_D] += e_now - 0.5 * y_t * y_t
+    z[_FT] = z[_FTP] = 0.0  # out of contact: nothing stored
+    b[_B_OUTCOME] = 0.0
+
+
+@njit(cache=True)
 def _law_creep(z, k1, p, w, atol, rec, rec_cap):
-    """No inertia-free jump: a creeping captured sphere ends in :func:`_captured_stop`."""
-    return driver.CREEP_NONE
+    """The inertia-free limit before the capture: a sphere not yet captured whose normal motion
+    follows the slow manifold into the equilibrium (the engine's :func:`~microimpact.solvers.engine._inertia_free`,
+    its thresholds) is captured; the integration stops there with outcome _CREEPING, and its tail
+    is taken in closed form as that of a creeping captured sphere (:func:`_captured_stop`,
+    :func:`_settle_captured`). The capture time is where the energy on the manifold falls below
+    zero (or the capture margin), as the engine's jump finds it. A creeping captured sphere ends in
+    :func:`_captured_stop` (unchanged); no jump that resumes the integration (the tangential state
+    would have to be carried along it).
+
+    Why: a nanometre sphere under zeta_A ~ 1e6 creeps from first contact into the well at
+    y_m ~ 1 / C2, so slowly (tau ~ C2 to reach the equilibrium) that it is not captured within the
+    step budget (the energy test needs an approach of ~rtol^(2/3) of the equilibrium): the step
+    limit, at C2 ~ 2e9 (issue 55's corner of the stress domain)."""
+    hist, b = w
+    row = p[5]
+    c1, c2, ah, aa = row[0], row[1], row[2], row[3]
+    if aa == 0.0 and c1 > 0.0 and z[_S] > 0.0:
+        slow, _ = _inertia_free(z, atol[_Y], c1, c2, ah, aa, 0.0)
+        if not slow:
+            return driver.CREEP_NONE
+        _exit_on_invariant_line(z, row, p[6], b)
+        return driver.CREEP_END
+    tail_closed = not row[10] > 0.0 or row[6] > 0.5  # as _law_captured_end: a closed form of the tail
+    if b[_B_CAPTURED] != 0.0 or not (aa > 0.0 and (c1 > 0.0 or c2 > 0.0) and z[_S] > 0.0 and tail_closed):
+        return driver.CREEP_NONE
+    xe = b[_B_XE]
+    slow, xi_t = _inertia_free(z, atol[_Y], c1, c2, ah, aa, xe)
+    if not (slow and xi_t == xe):
+        return driver.CREEP_NONE
+    tau_zero = b[_B_TAU_ZERO]
+    if math.isnan(tau_zero):
+        tau_zero = _slow_event_time(z, xe, 0.0, _SLOW_ENERGY, c1, c2, ah, aa)
+    tau_cap = _slow_event_time(z, xe, b[_B_ECAP], _SLOW_ENERGY, c1, c2, ah, aa)
+    b[_B_TAU_ZERO] = tau_zero
+    b[_B_TAU_CAP] = tau_cap if math.isnan(tau_zero) else tau_zero
+    b[_B_CAPTURED], b[_B_OUTCOME] = 1.0, _CREEPING
+    return driver.CREEP_END
 
 
 @njit(cache=True)
