@@ -349,14 +349,15 @@ def _quasi_static(law, x, mode):
 
 def _lag(law, x, mode, i, sigma, entry=None):
     """How far spring ``i``'s direction is from following its quasi-static value P / |P|
-    (``_quasi_static``), in radians: the lag of a direction that relaxes at rate r = |P| / (mu F_n0)
-    behind a value that turns at rate phi', phi' / r (the first term of the singular-perturbation
-    expansion; phi' a central difference over ``_RATE_STEP`` along the motion), and where ``entry``
-    is given (a sliding spring that may start following) the larger of that lag over
-    ``_FOLLOW_ENTRY`` and the distance of the state's direction from P / |P| (returned alone where
-    it is above ``entry``). inf without a rest point (|P| = 0), None where the difference reaches
-    past the end of contact (there the relaxation only quickens: r ~ 1 / s, and 1 / s^2 for the
-    rolling spring, at a Hertz separation)."""
+    (``_quasi_static``), in radians: the lag phi' / r of a direction that relaxes at the rate
+    r = |P| / (mu F_n0) behind a value that turns at the rate phi' (the first term of the
+    singular-perturbation expansion). Where ``entry`` is given (a sliding spring that may start
+    following) the larger of that lag over ``_FOLLOW_ENTRY`` and the distance of the state's
+    direction from P / |P|, the distance alone where it is above ``entry``. phi' is a central
+    difference along the motion over a step that changes the contact and the velocities by
+    a ``_RATE_STEP`` part of themselves at most. inf without a rest point (|P| = 0),
+    None where the difference reaches past the end of contact (there the relaxation only quickens:
+    r ~ 1 / s, and 1 / s^2 for the rolling spring, at a Hertz separation)."""
     if _separation(law, x) <= 0.0:
         return None
     follow = tuple(_FOLLOW if j == i else m for j, m in enumerate(mode))
@@ -370,7 +371,13 @@ def _lag(law, x, mode, i, sigma, entry=None):
         if distance > entry:
             return distance
     motion = _rhs_and_switch(law, x, mode)[0]
-    h = _RATE_STEP * max(1.0, abs(sigma))
+    # the step moves the contact (z) and the velocities (u, w) by a _RATE_STEP part of themselves at
+    # most (a step ~ sigma reached past the end of a fast impact's contact, where the lag is not
+    # determined, and held a direction that no longer followed)
+    speed = math.hypot(x[4], x[5]) + math.hypot(x[9], x[10])
+    change = max(abs(motion[0]) / abs(x[0]) if x[0] != 0.0 else math.inf, 1.0 / max(1.0, abs(sigma)),
+                 (math.hypot(motion[4], motion[5]) + math.hypot(motion[9], motion[10])) / speed if speed > 0.0 else 0.0)
+    h = _RATE_STEP / change
     ends = []
     for step in (h, -h):
         end = x + step * motion
@@ -382,7 +389,7 @@ def _lag(law, x, mode, i, sigma, entry=None):
             return math.inf
         ends.append(q / size)
     lag = math.hypot(*(ends[0] - ends[1])) / (2.0 * h) / rate
-    return max(lag / (1.0 if entry is None else _FOLLOW_ENTRY), distance)
+    return lag if entry is None else max(lag / _FOLLOW_ENTRY, distance)
 
 
 def _rates(law, x, mode):
@@ -604,7 +611,10 @@ def _peak_event(law, i, now):
         ahead, behind = state + h * rate, state - h * rate
         if _separation(law, ahead) <= 0.0 or _separation(law, behind) <= 0.0:
             return 1.0
-        return -(_rhs_and_switch(law, ahead, mode)[1][i] - _rhs_and_switch(law, behind, mode)[1][i])
+        change = _rhs_and_switch(law, ahead, mode)[1][i] - _rhs_and_switch(law, behind, mode)[1][i]
+        # a following spring's switch function held at exactly 1 (its limit falls, F_n0' < 0) has no
+        # extremum: 0 there read as a crossing at every step, and a root search in each (a creep)
+        return 1.0 if change == 0.0 and mode[i] == _FOLLOW else -change
     peak.direction = -1.0
     return peak
 
