@@ -116,6 +116,9 @@ _DIRECTIONS = (slice(2, 4), slice(7, 9))
 #: of the tolerance (and the direction within the tolerance of it), stops where the lag reaches
 #: the tolerance: the margin keeps one crossing of the lag from switching back and forth
 _FOLLOW_ENTRY = 0.25
+#: relative rounding of a quasi-static direction (``_lag``), and the part of the tolerance that the
+#: lag it leaves unresolved must stay below for the follow event to be decided
+_LAG_ROUNDING, _LAG_MARGIN = 1e-14, 1e-2
 #: largest relative tolerance of the tangential integration (DOP853 is cheap at it)
 TANGENTIAL_RTOL = 1e-10
 #: largest number of stick-slip events (switches and grazes) of one impact before it is reported as a failure
@@ -355,8 +358,8 @@ def _lag(law, x, mode, i, sigma, entry=None):
     following) the larger of that lag over ``_FOLLOW_ENTRY`` and the distance of the state's
     direction from P / |P|, the distance alone where it is above ``entry``. phi' is a central
     difference along the motion over a step that changes the contact and the velocities by
-    a ``_RATE_STEP`` part of themselves at most. inf without a rest point (|P| = 0),
-    None where the difference reaches past the end of contact (there the relaxation only quickens:
+    a ``_RATE_STEP`` part of themselves at most. Returned with the lag that the rounding of that
+    difference leaves unresolved (on the same scale). inf without a rest point (|P| = 0), None where the difference reaches past the end of contact (there the relaxation only quickens:
     r ~ 1 / s, and 1 / s^2 for the rolling spring, at a Hertz separation)."""
     if _separation(law, x) <= 0.0:
         return None
@@ -364,12 +367,12 @@ def _lag(law, x, mode, i, sigma, entry=None):
     p = _quasi_static(law, x, follow)[1][i]
     rate = math.hypot(p[0], p[1])
     if rate == 0.0:
-        return math.inf
+        return math.inf, 0.0
     distance = 0.0
     if entry is not None:
         distance = math.hypot(*(x[_DIRECTIONS[i]] / math.hypot(*x[_DIRECTIONS[i]]) - p / rate))
         if distance > entry:
-            return distance
+            return distance, 0.0
     motion = _rhs_and_switch(law, x, mode)[0]
     # the step moves the contact (z) and the velocities (u, w) by a _RATE_STEP part of themselves at
     # most (a step ~ sigma reached past the end of a fast impact's contact, where the lag is not
@@ -386,10 +389,14 @@ def _lag(law, x, mode, i, sigma, entry=None):
         q = _quasi_static(law, end, follow)[1][i]
         size = math.hypot(q[0], q[1])
         if size == 0.0:
-            return math.inf
+            return math.inf, 0.0
         ends.append(q / size)
     lag = math.hypot(*(ends[0] - ends[1])) / (2.0 * h) / rate
-    return lag if entry is None else max(lag / _FOLLOW_ENTRY, distance)
+    # the rounding of the two directions, ~1e-14 each (P is a sum of terms of either sign), over the
+    # step: a lag below it is not resolved (just after a Hertz touch the step is ~1e-13 and the
+    # difference noise, which took the event function across 0 and back at one state)
+    unresolved = _LAG_ROUNDING / (2.0 * h) / rate
+    return (lag, unresolved) if entry is None else (max(lag / _FOLLOW_ENTRY, distance), unresolved / _FOLLOW_ENTRY)
 
 
 def _rates(law, x, mode):
@@ -628,14 +635,18 @@ def _may_follow(law):
 
 def _follow_value(law, state, mode, i, sigma, rtol):
     """The follow event's function of spring ``i`` (``_follow_event``) at ``state``, relative, in
-    [-1, 1]: (lag - rtol) / (lag + rtol) of ``_lag``, 1 where the spring cannot follow, and on the
+    [-1, 1]: (lag - rtol) / (lag + rtol) of ``_lag``; 1 where the spring cannot follow or the lag is
+    not resolved to a ``_LAG_MARGIN`` part of rtol (its sign would then be rounding's), and on the
     side of the mode it is in where the lag is not determined (the end of contact)."""
     if mode[i] == _STICK or (i == 0 and law.mu == 0.0):
         return 1.0
-    lag = _lag(law, state, mode, i, sigma, None if mode[i] == _FOLLOW else rtol)
-    if lag is None:
+    found = _lag(law, state, mode, i, sigma, None if mode[i] == _FOLLOW else rtol)
+    if found is None:
         return -1.0 if mode[i] == _FOLLOW else 1.0
-    return (lag - rtol) / (lag + rtol) if math.isfinite(lag) else 1.0
+    lag, unresolved = found
+    if not math.isfinite(lag) or unresolved > _LAG_MARGIN * rtol:  # no rest point, or a lag not resolved
+        return 1.0
+    return (lag - rtol) / (lag + rtol)
 
 
 def _follow_event(law, i, now, rtol):
