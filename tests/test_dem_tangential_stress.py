@@ -233,7 +233,7 @@ def test_the_quasi_static_direction_is_the_rest_point_of_the_direction_equation(
     c = c.with_(tangential_damping=1e-3 if damped == "tangential" else 0.0,
                 rolling_damping=1e-4 if damped == "rolling" else 0.0)
     law = dt._Law(c, 1e-3)
-    law.method = "LSODA"
+    law.method, law.across = "LSODA", True
     law.cap_floor = law.cap_floor_r = 1e-20
     x = np.array([0.2, -1e-3, -math.cos(0.3), math.sin(0.3), 289.0, 2e-3, 1.0, math.cos(0.3), math.sin(0.3),
                   -292.0, 2.2])

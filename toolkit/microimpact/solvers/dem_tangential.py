@@ -216,6 +216,7 @@ class _Law:
         self.mu_r = contact.rolling_friction if self.rolling else 0.0
         self.cap_floor = self.cap_floor_r = 0.0  # set by _integrate from its tolerance
         self.method = "DOP853"
+        self.across = False  # the 2-D integration of the rolling law (_with_rolling), where directions may follow
 
     def normal(self, z, y):
         """(g = dtau/dsigma, dz/dsigma, a, da/dsigma, eta_n, deta_n/dsigma, dy/dsigma, F_n0, dF_n0/dsigma)
@@ -628,9 +629,9 @@ def _peak_event(law, i, now):
 
 def _may_follow(law):
     """Whether a sliding direction of this integration may follow its quasi-static value
-    (``_FOLLOW``): with the rolling law in 2-D (an implicit method: in 1-D the directions do not
-    turn), where at most one of the two springs' P depends on the other's direction (``_followed``)."""
-    return law.rolling and law.method != "DOP853" and (law.x_t == 0.0 or law.gamma_r == 0.0)
+    (``_FOLLOW``): with the rolling law in 2-D (``_Law.across``: in 1-D the directions do not turn,
+    and a strongly damped 1-D impact integrated by Radau is left as it was), where at most one of the two springs' P depends on the other's direction (``_followed``)."""
+    return law.rolling and law.across and (law.x_t == 0.0 or law.gamma_r == 0.0)
 
 
 def _follow_value(law, state, mode, i, sigma, rtol):
@@ -959,6 +960,7 @@ def _with_rolling(contact, normal, velocity_in, omega_in, rtol):
         # made DOP853 take millions of steps where a limit is small; an implicit method follows them
         # (_ACROSS_METHODS)
         methods = _ACROSS_METHODS if w0[1] != 0.0 else ("DOP853",)
+        law.across = w0[1] != 0.0
         failed = []
         for method in methods:
             law.method = method
