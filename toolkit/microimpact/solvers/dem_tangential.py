@@ -39,6 +39,19 @@ across are exactly 0 and the direction e is +-1 (in the wall's frame rounding no
 divided by a vanishing limit, made the steps fail near a Hertz separation); the solver keeps the
 two-component form, which is exact for any direction.
 
+Quasi-static directions. A sliding direction relaxes to its rest point P / |P| (P the part of G' not
+along e) at the rate r = |P| / (mu F_n0), which a creeping contact (a limit mu F_n0 made small by
+damping, rolling across the slip) takes to 5e6-3e8 per unit of the Sundman variable while the
+creep spans ~5e5 of it: scipy's implicit methods then held their steps far below 1 and ran out of
+their budgets. Where the lag of the direction behind its rest point, phi' / r (phi' the rate at
+which P / |P| turns, the first term of the singular-perturbation expansion), falls below a quarter
+of the tolerance and the direction is within the tolerance of it, the direction follows it: it is
+P / |P| at every instant, an algebraic variable, and only the slow variables are integrated
+(``_FOLLOW``, ``_quasi_static``). Events on the lag start and stop it (it stops where the lag
+reaches the tolerance, and the direction is written back to the state); the stick-slip events are
+those of slide. It is used in the 2-D rolling integration only, where at most one of the two
+springs' damping couples their directions.
+
 Events (located by scipy's root finding on the dense output): stick ends where |F| reaches the
 limit; slide ends where e . G' falls below the rate of the limit (the trial force turns inwards);
 the contact ends where the normal law separates (s = 0, or q^3 = 3 for LAMMPS's JKR). At a switch
@@ -107,8 +120,9 @@ __all__ = ["DemTangentialError", "solve_dem_tangential", "uses_dem_tangential", 
 #: the modes of a spring: stuck, sliding, and sliding with its direction at its quasi-static value
 #: (``_followed``): where the direction relaxes far faster than it turns (the 2-D rolling law under a
 #: limit mu F_n0 that a creeping contact makes small: the stress sweep's sds law, seed 0, cases 59,
-#: 66, 77, 144 relaxed at 5e6 to 3e8 per unit of the Sundman variable, and held the implicit methods'
-#: steps below 1e-6 there, past their budgets), the fast variable is replaced by its rest point
+#: 66, 77, 144: case 77's relaxed at 5e6 and 3e8 per unit of the Sundman variable over a creep of
+#: ~5e5 of it, and held the median step of LSODA, Radau, BDF to 8e-3, 3e-7, 9e-9 there, past their
+#: budgets), the fast variable is replaced by its rest point
 _STICK, _SLIDE, _FOLLOW = 0, 1, 2
 #: the direction state of each spring (tangential, rolling) in the state vector
 _DIRECTIONS = (slice(2, 4), slice(7, 9))
@@ -216,7 +230,7 @@ class _Law:
         self.mu_r = contact.rolling_friction if self.rolling else 0.0
         self.cap_floor = self.cap_floor_r = 0.0  # set by _integrate from its tolerance
         self.method = "DOP853"
-        self.across = False  # the 2-D integration of the rolling law (_with_rolling), where directions may follow
+        self.across = False  # the 2-D rolling integration (_with_rolling), where directions may follow
 
     def normal(self, z, y):
         """(g = dtau/dsigma, dz/dsigma, a, da/dsigma, eta_n, deta_n/dsigma, dy/dsigma, F_n0, dF_n0/dsigma)
@@ -360,8 +374,9 @@ def _lag(law, x, mode, i, sigma, entry=None):
     direction from P / |P|, the distance alone where it is above ``entry``. phi' is a central
     difference along the motion over a step that changes the contact and the velocities by
     a ``_RATE_STEP`` part of themselves at most. Returned with the lag that the rounding of that
-    difference leaves unresolved (on the same scale). inf without a rest point (|P| = 0), None where the difference reaches past the end of contact (there the relaxation only quickens:
-    r ~ 1 / s, and 1 / s^2 for the rolling spring, at a Hertz separation)."""
+    difference leaves unresolved (on the same scale). inf without a rest point (|P| = 0), None where
+    the difference reaches past the end of contact (there the relaxation only quickens: r ~ 1 / s,
+    and 1 / s^2 for the rolling spring, at a Hertz separation)."""
     if _separation(law, x) <= 0.0:
         return None
     follow = tuple(_FOLLOW if j == i else m for j, m in enumerate(mode))
@@ -379,8 +394,9 @@ def _lag(law, x, mode, i, sigma, entry=None):
     # most (a step ~ sigma reached past the end of a fast impact's contact, where the lag is not
     # determined, and held a direction that no longer followed)
     speed = math.hypot(x[4], x[5]) + math.hypot(x[9], x[10])
+    turning = math.hypot(motion[4], motion[5]) + math.hypot(motion[9], motion[10])
     change = max(abs(motion[0]) / abs(x[0]) if x[0] != 0.0 else math.inf, 1.0 / max(1.0, abs(sigma)),
-                 (math.hypot(motion[4], motion[5]) + math.hypot(motion[9], motion[10])) / speed if speed > 0.0 else 0.0)
+                 turning / speed if speed > 0.0 else 0.0)
     h = _RATE_STEP / change
     ends = []
     for step in (h, -h):
@@ -397,7 +413,9 @@ def _lag(law, x, mode, i, sigma, entry=None):
     # step: a lag below it is not resolved (just after a Hertz touch the step is ~1e-13 and the
     # difference noise, which took the event function across 0 and back at one state)
     unresolved = _LAG_ROUNDING / (2.0 * h) / rate
-    return (lag, unresolved) if entry is None else (max(lag / _FOLLOW_ENTRY, distance), unresolved / _FOLLOW_ENTRY)
+    if entry is None:
+        return lag, unresolved
+    return max(lag / _FOLLOW_ENTRY, distance), unresolved / _FOLLOW_ENTRY
 
 
 def _rates(law, x, mode):
@@ -553,7 +571,8 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
     now = [mode, sigma]  # the mode and the start of the solve, for the events defined outside
     follows = [_follow_event(law, i, now, rtol) for i in springs] if _may_follow(law) else []
     # scipy's order of events: separation, then (switch, peak) of each spring, then their follow events
-    watched = [separation] + [f for i in springs for f in (switches_[i], _peak_event(law, i, now))] + follows
+    watched = [separation] + [f for i in springs for f in (switches_[i], _peak_event(law, i, now))]
+    watched += follows
     last, repeats = -math.inf, 0
     while True:
         if follows:  # a direction already at (or already off) its quasi-static value (_follow_event)
@@ -630,7 +649,8 @@ def _peak_event(law, i, now):
 def _may_follow(law):
     """Whether a sliding direction of this integration may follow its quasi-static value
     (``_FOLLOW``): with the rolling law in 2-D (``_Law.across``: in 1-D the directions do not turn,
-    and a strongly damped 1-D impact integrated by Radau is left as it was), where at most one of the two springs' P depends on the other's direction (``_followed``)."""
+    and a strongly damped 1-D impact integrated by Radau is left as it was), where at most one of
+    the two springs' P depends on the other's direction (``_quasi_static``)."""
     return law.rolling and law.across and (law.x_t == 0.0 or law.gamma_r == 0.0)
 
 
