@@ -39,6 +39,19 @@ across are exactly 0 and the direction e is +-1 (in the wall's frame rounding no
 divided by a vanishing limit, made the steps fail near a Hertz separation); the solver keeps the
 two-component form, which is exact for any direction.
 
+Quasi-static directions. A sliding direction relaxes to its rest point P / |P| (P the part of G' not
+along e) at the rate r = |P| / (mu F_n0), which a creeping contact (a limit mu F_n0 made small by
+damping, rolling across the slip) takes to 5e6-3e8 per unit of the Sundman variable while the
+creep spans ~5e5 of it: scipy's implicit methods then held their steps far below 1 and ran out of
+their budgets. Where the lag of the direction behind its rest point, phi' / r (phi' the rate at
+which P / |P| turns, the first term of the singular-perturbation expansion), falls below a quarter
+of the tolerance and the direction is within the tolerance of it, the direction follows it: it is
+P / |P| at every instant, an algebraic variable, and only the slow variables are integrated
+(``_FOLLOW``, ``_quasi_static``). Events on the lag start and stop it (it stops where the lag
+reaches the tolerance, and the direction is written back to the state); the stick-slip events are
+those of slide. It is used in the 2-D rolling integration only, where at most one of the two
+springs' damping couples their directions.
+
 Events (located by scipy's root finding on the dense output): stick ends where |F| reaches the
 limit; slide ends where e . G' falls below the rate of the limit (the trial force turns inwards);
 the contact ends where the normal law separates (s = 0, or q^3 = 3 for LAMMPS's JKR). At a switch
@@ -104,7 +117,22 @@ from microimpact.solvers.solution import NormalSolution
 
 __all__ = ["DemTangentialError", "solve_dem_tangential", "uses_dem_tangential", "TANGENTIAL_RTOL"]
 
-_STICK, _SLIDE = 0, 1
+#: the modes of a spring: stuck, sliding, and sliding with its direction at its quasi-static value
+#: (``_followed``): where the direction relaxes far faster than it turns (the 2-D rolling law under a
+#: limit mu F_n0 that a creeping contact makes small: the stress sweep's sds law, seed 0, cases 59,
+#: 66, 77, 144: case 77's relaxed at 5e6 and 3e8 per unit of the Sundman variable over a creep of
+#: ~5e5 of it, and held the median step of LSODA, Radau, BDF to 8e-3, 3e-7, 9e-9 there, past their
+#: budgets), the fast variable is replaced by its rest point
+_STICK, _SLIDE, _FOLLOW = 0, 1, 2
+#: the direction state of each spring (tangential, rolling) in the state vector
+_DIRECTIONS = (slice(2, 4), slice(7, 9))
+#: a sliding direction starts to follow where its lag behind the quasi-static value is this part
+#: of the tolerance (and the direction within the tolerance of it), stops where the lag reaches
+#: the tolerance: the margin keeps one crossing of the lag from switching back and forth
+_FOLLOW_ENTRY = 0.25
+#: relative rounding of a quasi-static direction (``_lag``), and the part of the tolerance that the
+#: lag it leaves unresolved must stay below for the follow event to be decided
+_LAG_ROUNDING, _LAG_MARGIN = 1e-14, 1e-2
 #: largest relative tolerance of the tangential integration (DOP853 is cheap at it)
 TANGENTIAL_RTOL = 1e-10
 #: largest number of stick-slip events (switches and grazes) of one impact before it is reported as a failure
@@ -202,6 +230,7 @@ class _Law:
         self.mu_r = contact.rolling_friction if self.rolling else 0.0
         self.cap_floor = self.cap_floor_r = 0.0  # set by _integrate from its tolerance
         self.method = "DOP853"
+        self.across = False  # the 2-D rolling integration (_with_rolling), where directions may follow
 
     def normal(self, z, y):
         """(g = dtau/dsigma, dz/dsigma, a, da/dsigma, eta_n, deta_n/dsigma, dy/dsigma, F_n0, dF_n0/dsigma)
@@ -247,7 +276,7 @@ def _spring(model, mode, s1, s2, v1, v2, k, eta, cap):
         switch = (size - cap) / (size + cap) if size + cap > 0.0 else -1.0
         return f1, f2, e1, e2, h1, h2, switch
     norm = math.hypot(s1, s2)
-    e1, e2 = s1 / norm, s2 / norm
+    e1, e2 = (s1 / norm, s2 / norm) if norm > 0.0 else (0.0, 0.0)  # 0: the rate P of _followed
     f1, f2 = cap * e1, cap * e2
     # the history the force on the limit leaves (model.dem_tangential: LAMMPS resets it to the
     # elastic part of the scaled force)
@@ -290,7 +319,108 @@ def _spring_rates(model, mode, spring, v1, v2, dv1, dv2, g, k, dk, eta, deta, ca
 
 
 def _rhs_and_switch(law, x, mode):
-    """(d/dsigma of the state, the switch functions of ``mode``, the rates of stick's switches) at x.
+    """(d/dsigma of the state, the switch functions of ``mode``, the rates of stick's switches) at x:
+    those of ``_rates``, with a following spring's direction at its quasi-static value
+    (``_followed``) and held there (its rate 0)."""
+    if _FOLLOW not in mode:
+        return _rates(law, x, mode)
+    out, switch, rate = _rates(law, _followed(law, x, mode), mode)
+    for i in (0, 1):
+        if mode[i] == _FOLLOW:
+            out[_DIRECTIONS[i]] = 0.0
+    return out, switch, rate
+
+
+def _followed(law, x, mode):
+    """x with the direction of each following spring (``_FOLLOW``) at its quasi-static value P / |P|
+    (``_quasi_static``)."""
+    return _quasi_static(law, x, mode)[0]
+
+
+def _quasi_static(law, x, mode):
+    """(x with the direction of each following spring at its quasi-static value P / |P|, the rates
+    P / max(mu F_n0, floor) of the springs, None for one that does not follow).
+
+    In slide the trial force's rate is G' = P + c e (``_spring_rates``), affine in the spring's own
+    direction e with a scalar c (its history, the velocity's response to the spring's own force and
+    the rescaling are all along e), so P is G' at e = 0, and the direction's equation
+    de/dsigma = (1 - e e^T) G' / (mu F_n0) has the stable rest point e = P / |P|, relaxed to at the
+    rate |P| / (mu F_n0). P of one spring depends on the other's direction only through a damping
+    (eta_t of the slip, gamma_roll of the rolling); with one of them 0 (``_may_follow``) the
+    independent spring is set first, so that the other's P is that of its final direction, and with
+    both 0 one evaluation gives both."""
+    y, rates = x.copy(), [None, None]
+    following = [i for i in ((1, 0) if law.x_t != 0.0 else (0, 1)) if mode[i] == _FOLLOW]
+    together = len(following) == 2 and law.x_t == 0.0 and law.gamma_r == 0.0
+    for group in ([following] if together else [[i] for i in following]):
+        zeroed = y.copy()
+        for i in group:
+            zeroed[_DIRECTIONS[i]] = 0.0
+        out = _rates(law, zeroed, mode)[0]
+        for i in group:
+            rates[i] = out[_DIRECTIONS[i]]
+            size = math.hypot(rates[i][0], rates[i][1])
+            if size > 0.0:  # else (no rest point) the state's direction stays; the lag (_lag) is inf there
+                y[_DIRECTIONS[i]] = rates[i] / size
+    return y, rates
+
+
+def _lag(law, x, mode, i, sigma, entry=None):
+    """How far spring ``i``'s direction is from following its quasi-static value P / |P|
+    (``_quasi_static``), in radians: the lag phi' / r of a direction that relaxes at the rate
+    r = |P| / (mu F_n0) behind a value that turns at the rate phi' (the first term of the
+    singular-perturbation expansion). Where ``entry`` is given (a sliding spring that may start
+    following) the larger of that lag over ``_FOLLOW_ENTRY`` and the distance of the state's
+    direction from P / |P|, the distance alone where it is above ``entry``. phi' is a central
+    difference along the motion over a step that changes the contact and the velocities by
+    a ``_RATE_STEP`` part of themselves at most. Returned with the lag that the rounding of that
+    difference leaves unresolved (on the same scale). inf without a rest point (|P| = 0), None where
+    the difference reaches past the end of contact (there the relaxation only quickens: r ~ 1 / s,
+    and 1 / s^2 for the rolling spring, at a Hertz separation)."""
+    if _separation(law, x) <= 0.0:
+        return None
+    follow = tuple(_FOLLOW if j == i else m for j, m in enumerate(mode))
+    p = _quasi_static(law, x, follow)[1][i]
+    rate = math.hypot(p[0], p[1])
+    if rate == 0.0:
+        return math.inf, 0.0
+    distance = 0.0
+    if entry is not None:
+        distance = math.hypot(*(x[_DIRECTIONS[i]] / math.hypot(*x[_DIRECTIONS[i]]) - p / rate))
+        if distance > entry:
+            return distance, 0.0
+    motion = _rhs_and_switch(law, x, mode)[0]
+    # the step moves the contact (z) and the velocities (u, w) by a _RATE_STEP part of themselves at
+    # most (a step ~ sigma reached past the end of a fast impact's contact, where the lag is not
+    # determined, and held a direction that no longer followed)
+    speed = math.hypot(x[4], x[5]) + math.hypot(x[9], x[10])
+    turning = math.hypot(motion[4], motion[5]) + math.hypot(motion[9], motion[10])
+    change = max(abs(motion[0]) / abs(x[0]) if x[0] != 0.0 else math.inf, 1.0 / max(1.0, abs(sigma)),
+                 turning / speed if speed > 0.0 else 0.0)
+    h = _RATE_STEP / change
+    ends = []
+    for step in (h, -h):
+        end = x + step * motion
+        if _separation(law, end) <= 0.0:
+            return None
+        q = _quasi_static(law, end, follow)[1][i]
+        size = math.hypot(q[0], q[1])
+        if size == 0.0:
+            return math.inf, 0.0
+        ends.append(q / size)
+    lag = math.hypot(*(ends[0] - ends[1])) / (2.0 * h) / rate
+    # the rounding of the two directions, ~1e-14 each (P is a sum of terms of either sign), over the
+    # step: a lag below it is not resolved (just after a Hertz touch the step is ~1e-13 and the
+    # difference noise, which took the event function across 0 and back at one state)
+    unresolved = _LAG_ROUNDING / (2.0 * h) / rate
+    if entry is None:
+        return lag, unresolved
+    return max(lag / _FOLLOW_ENTRY, distance), unresolved / _FOLLOW_ENTRY
+
+
+def _rates(law, x, mode):
+    """(d/dsigma of the state, the switch functions of ``mode``, the rates of stick's switches) at x,
+    a following spring taken as sliding along the direction in x.
 
     ``mode`` is (tangential, rolling), each _STICK or _SLIDE; the switch functions and rates are
     pairs in that order (the rolling ones -1 without a rolling law). The switch functions are
@@ -436,31 +566,24 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
         switch.terminal = True
         return switch
 
-    def peak_of(i):
-        def peak(_, state):  # falls through 0 where spring i's switch function is farthest towards leaving:
-            # a maximum of |F| - mu F_n0 in stick (its rate, exact), a minimum of slide's switch function
-            # (its rate along the motion, a central difference over _RATE_STEP along the right-hand side)
-            if _separation(law, state) <= 0.0 or (i == 0 and law.mu == 0.0):  # past the end; no friction
-                return 1.0
-            if mode[i] == _STICK:
-                return _rhs_and_switch(law, state, mode)[2][i]
-            rate = _rhs_and_switch(law, state, mode)[0]
-            h = _RATE_STEP * max(1.0, abs(sigma))
-            ahead, behind = state + h * rate, state - h * rate
-            if _separation(law, ahead) <= 0.0 or _separation(law, behind) <= 0.0:
-                return 1.0
-            return -(_rhs_and_switch(law, ahead, mode)[1][i] - _rhs_and_switch(law, behind, mode)[1][i])
-        peak.direction = -1.0
-        return peak
-
     separation.terminal, separation.direction = True, -1.0
     switches_ = [switch_of(i) for i in springs]
-    # scipy's order of events: separation, then (switch, peak) of each spring
-    watched = [separation] + [f for i in springs for f in (switches_[i], peak_of(i))]
+    now = [mode, sigma]  # the mode and the start of the solve, for the events defined outside
+    follows = [_follow_event(law, i, now, rtol) for i in springs] if _may_follow(law) else []
+    # scipy's order of events: separation, then (switch, peak) of each spring, then their follow events
+    watched = [separation] + [f for i in springs for f in (switches_[i], _peak_event(law, i, now))]
+    watched += follows
     last, repeats = -math.inf, 0
     while True:
+        if follows:  # a direction already at (or already off) its quasi-static value (_follow_event)
+            mode, x = _follow_at_restart(law, x, mode, sigma, rtol)
+        if events > _MAX_EVENTS:
+            raise DemTangentialError(f"DEM tangential integration: more than {_MAX_EVENTS} stick-slip events")
+        now[:] = mode, sigma
         for i in springs:
             switches_[i].direction = 1.0 if mode[i] == _STICK else -1.0
+            if follows:
+                follows[i].direction = 1.0 if mode[i] == _FOLLOW else -1.0
         atol = [z_scale, law.y0, *[history if mode[0] == _STICK else 1.0] * 2, speed, speed, tau_scale]
         if law.rolling:
             atol += [speed * tau_scale if mode[1] == _STICK else 1.0] * 2 + [speed, speed]
@@ -482,18 +605,104 @@ def _integrate(law, u0, rtol, tau_scale, z_scale, w0=None):
         if sol.status != 1:
             raise DemTangentialError(_stopped("tangential", sol))
         first = _first_switch(sol, sigma, switches_, mode) if watch else None
+        hit = _first_follow(sol, len(springs)) if watch and follows else None
+        if hit is not None and (first is None or hit[0] < first[0]):  # a direction starts or stops following
+            sigma, x, mode = hit[0], *_follow_switch(law, hit[1], mode, hit[2])
+            events += 1
+            continue
         if first is None:  # the contact ended
             return sol.y_events[0][0], (slide_end if mode[0] == _STICK else math.nan), switches, mode[0] == _STICK
         sigma, x, spring = first
         repeats = repeats + 1 if sigma - last <= 1e-12 * max(sigma, 1.0) else 0
         last = sigma
         events += 1
-        if events > _MAX_EVENTS:
-            raise DemTangentialError(f"DEM tangential integration: more than {_MAX_EVENTS} stick-slip events")
         mode, x, switched = _switch(law, x, mode, spring)
         switches += switched and spring == 0
         if switched and spring == 0 and mode[0] == _STICK:
             slide_end = x[6]
+
+
+def _peak_event(law, i, now):
+    """The event that falls through 0 where spring ``i``'s switch function is farthest towards
+    leaving: a maximum of |F| - mu F_n0 in stick (its rate, exact), a minimum of slide's switch
+    function (its rate along the motion, a central difference over ``_RATE_STEP`` along the
+    right-hand side); ``now`` holds the mode and the start of the solve."""
+    def peak(_, state):
+        mode, sigma = now
+        if _separation(law, state) <= 0.0 or (i == 0 and law.mu == 0.0):  # past the end; no friction
+            return 1.0
+        if mode[i] == _STICK:
+            return _rhs_and_switch(law, state, mode)[2][i]
+        rate = _rhs_and_switch(law, state, mode)[0]
+        h = _RATE_STEP * max(1.0, abs(sigma))
+        ahead, behind = state + h * rate, state - h * rate
+        if _separation(law, ahead) <= 0.0 or _separation(law, behind) <= 0.0:
+            return 1.0
+        change = _rhs_and_switch(law, ahead, mode)[1][i] - _rhs_and_switch(law, behind, mode)[1][i]
+        # a following spring's switch function held at exactly 1 (its limit falls, F_n0' < 0) has no
+        # extremum: 0 there read as a crossing at every step, and a root search in each (a creep)
+        return 1.0 if change == 0.0 and mode[i] == _FOLLOW else -change
+    peak.direction = -1.0
+    return peak
+
+
+def _may_follow(law):
+    """Whether a sliding direction of this integration may follow its quasi-static value
+    (``_FOLLOW``): with the rolling law in 2-D (``_Law.across``: in 1-D the directions do not turn,
+    and a strongly damped 1-D impact integrated by Radau is left as it was), where at most one of
+    the two springs' P depends on the other's direction (``_quasi_static``)."""
+    return law.rolling and law.across and (law.x_t == 0.0 or law.gamma_r == 0.0)
+
+
+def _follow_value(law, state, mode, i, sigma, rtol):
+    """The follow event's function of spring ``i`` (``_follow_event``) at ``state``, relative, in
+    [-1, 1]: (lag - rtol) / (lag + rtol) of ``_lag``; 1 where the spring cannot follow or the lag is
+    not resolved to a ``_LAG_MARGIN`` part of rtol (its sign would then be rounding's), and on the
+    side of the mode it is in where the lag is not determined (the end of contact)."""
+    if mode[i] == _STICK or (i == 0 and law.mu == 0.0):
+        return 1.0
+    found = _lag(law, state, mode, i, sigma, None if mode[i] == _FOLLOW else rtol)
+    if found is None:
+        return -1.0 if mode[i] == _FOLLOW else 1.0
+    lag, unresolved = found
+    if not math.isfinite(lag) or unresolved > _LAG_MARGIN * rtol:  # no rest point, or a lag not resolved
+        return 1.0
+    return (lag - rtol) / (lag + rtol)
+
+
+def _follow_event(law, i, now, rtol):
+    """The terminal event where spring ``i``'s sliding direction starts (falling through 0) or stops
+    (rising through 0) following its quasi-static value; ``now`` holds the mode."""
+    def follow(t, state):
+        return _follow_value(law, state, now[0], i, t, rtol)
+    follow.terminal = True
+    return follow
+
+
+def _follow_at_restart(law, x, mode, sigma, rtol):
+    """(mode, state) at a restart: each sliding direction that may follow and is already within the
+    tolerance of its quasi-static value follows it, each following one already past its lag stops
+    (the events see only sign changes after the start)."""
+    for i in range(len(mode) if law.rolling else 1):
+        if (mode[i] == _FOLLOW) == (_follow_value(law, x, mode, i, sigma, rtol) >= 0.0):
+            x, mode = _follow_switch(law, x, mode, i)
+    return mode, x
+
+
+def _follow_switch(law, x, mode, i):
+    """(state, mode) once spring ``i`` starts or stops following: its direction is set to the
+    quasi-static value either way (the state held the direction of the start while following)."""
+    new = tuple((_SLIDE if m == _FOLLOW else _FOLLOW) if j == i else m for j, m in enumerate(mode))
+    x = _followed(law, x, mode if mode[i] == _FOLLOW else new)
+    return x, new
+
+
+def _first_follow(sol, n_springs):
+    """(sigma, state, spring) of the first follow event of the solve ``sol``, or None (its events are
+    separation, then (switch, peak) of each spring, then the follow event of each)."""
+    hits = [(float(sol.t_events[1 + 2 * n_springs + i][0]), sol.y_events[1 + 2 * n_springs + i][0].copy(), i)
+            for i in range(n_springs) if sol.t_events[1 + 2 * n_springs + i].size]
+    return min(hits, key=lambda hit: hit[0]) if hits else None
 
 
 def _normal_damping_rate(law, z_scale):
@@ -540,7 +749,7 @@ def _switch(law, x, mode, spring):
     its switch: from stick to slide along the force unless it only grazes the limit; from slide to
     stick with the history of the force on the limit."""
     _, _, a, _, eta, _, _, n0, _ = law.normal(x[0], x[1])
-    x = x.copy()
+    x = _followed(law, x, mode) if _FOLLOW in mode else x.copy()  # a following direction is not in x
     if spring == 0:
         model, k, eta_v, mu, state, velocity = law.model, law.stiffness(a), law.x_t * eta, law.mu, slice(2, 4), slice(4, 6)
     else:
@@ -771,6 +980,7 @@ def _with_rolling(contact, normal, velocity_in, omega_in, rtol):
         # made DOP853 take millions of steps where a limit is small; an implicit method follows them
         # (_ACROSS_METHODS)
         methods = _ACROSS_METHODS if w0[1] != 0.0 else ("DOP853",)
+        law.across = w0[1] != 0.0
         failed = []
         for method in methods:
             law.method = method
