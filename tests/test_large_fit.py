@@ -8,6 +8,8 @@ EMULATOR_MAX_SHIFT standard errors, else refits by the solver. docs/large-fit.js
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -15,7 +17,8 @@ import pytest
 from microimpact.analysis import fitting
 from microimpact.analysis.fitting import (EMULATOR_MAX_SHIFT, EMULATOR_MIN_ROWS, EMULATOR_TOLERANCE, FitProblem,
                                           emulator_shift_bound, fit_damping, model_restitution)
-from microimpact.analysis.synthetic import make_synthetic_impacts
+from microimpact.analysis.synthetic import make_synthetic_impacts, write_synthetic_impacts
+from microimpact.cli import main
 from microimpact.io import default_materials_path, read_materials
 from microimpact.solvers import DEFAULT_RTOL
 
@@ -126,3 +129,18 @@ def test_precise_parameters_get_their_profile_interval():
         assert fitting.PROFILE_XTOL * abs(value) > fitting.PROFILE_PRECISE * se  # the case tested
         assert st.lower < value < st.upper, name
         assert (st.upper - st.lower) / (2 * 1.96 * se) == pytest.approx(1.0, rel=0.05, abs=0), name
+
+
+def test_the_cli_takes_the_fit_method_and_says_which_one_ran(tmp_path, capsys):
+    """``fit --fit-method`` reaches the damping fit: on a radius of EMULATOR_MIN_ROWS rows the JSON
+    summary names the table by default and the solver with ``solve``; a wrong name is refused."""
+    path = write_synthetic_impacts(tmp_path / "big.csv", radii=(3.45e-6,), n_per_radius=fitting.EMULATOR_MIN_ROWS, seed=5)
+    said = {}
+    for method in ("emulator", "solve"):
+        out = tmp_path / f"{method}.nc"
+        argv = ["fit", str(path), "--out", str(out), "--no-confidence-intervals", "--json", "--fit-method", method]
+        assert main(argv) == 0
+        said[method] = json.loads(capsys.readouterr().out)["damping"]["model_evaluation"]
+    assert said["emulator"].startswith("the ring-law emulator") and said["solve"].startswith("the solver at rtol")
+    assert main(["fit", str(path), "--out", str(tmp_path / "x.nc"), "--fit-method", "table"]) == 2
+    assert "--fit-method: invalid choice: 'table'" in capsys.readouterr().err and not (tmp_path / "x.nc").exists()

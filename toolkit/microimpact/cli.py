@@ -314,6 +314,10 @@ def _add_posterior_options(p: argparse.ArgumentParser) -> None:
                    help=f"model e_n of the posterior's likelihood: emulator (the ring law's certified table, the "
                         f"solver where it falls back) or solve (the solver at every evaluation, the reference); "
                         f"default {DEFAULT_METHOD}")
+    p.add_argument("--fit-method", choices=sampling_defaults.METHODS, default=sampling_defaults.DEFAULT_FIT_METHOD,
+                   help="model e_n of the damping fit: emulator (the ring law's certified table for a radius with "
+                        "thousands of rows, refitted by the solver where its tolerance could move an estimate) or "
+                        f"solve (the solver at every evaluation); default {sampling_defaults.DEFAULT_FIT_METHOD}")
     p.add_argument("--oblique-out", default=None, metavar="NC",
                    help="write the friction fit (oblique columns: measured vs fitted per row) to this NetCDF")
 

@@ -39,7 +39,8 @@ def run(args) -> int:
                              confidence_intervals=not args.no_confidence_intervals, posterior=posterior,
                              errors_in_variables=args.errors_in_variables, rtol=args.rtol, progress=True,
                              time_budget=args.time_budget, exclude=_exclude_ids(args.exclude, table), loss=args.loss,
-                             likelihood=args.likelihood, nu=DEFAULT_NU if args.nu is None else args.nu)
+                             likelihood=args.likelihood, nu=DEFAULT_NU if args.nu is None else args.nu,
+                             method=args.fit_method)
     paths = (out, outputs.get("--posterior"), outputs.get("--oblique-out"))
     planned = tuple(p for p in paths if p is not None)
     text = (json.dumps(_json_ready(_fit_summary(result, table, pair, planned)), indent=2, allow_nan=False)
@@ -96,6 +97,7 @@ def _fit_summary(result, table, pair, written) -> dict:
     d = result.damping
     summary = {"material_pair": pair.name, "n_points": int(len(table)),
                "damping": {"parameters": parameters(d), "loss": str(d.info.get("loss", "linear")),
+                           "model_evaluation": str(d.info.get("model_evaluation", "")),
                            "chisqr": float(d.chisqr), "redchi": float(d.redchi),
                            "verdict": d.verdict.to_record()},
                "written": [str(p) for p in written]}

@@ -28,6 +28,7 @@ from microimpact.analysis.posterior import Posterior
 from microimpact.io.formatting import ReportHTML
 from microimpact.io.files import all_or_nothing, write_netcdf
 from microimpact.analysis.fitting import DEFAULT_LOSS, FitProblem, fit_damping, model_restitution
+from microimpact.analysis.sampling_defaults import DEFAULT_FIT_METHOD
 from microimpact.analysis.oblique import ObliqueProblem, fit_friction
 from microimpact.analysis.posterior import (DEFAULT_MAX_STEPS, DEFAULT_METHOD, DEFAULT_N_DRAWS, DEFAULT_NU, DEFAULT_SEED,
                                             DEFAULT_WALKERS, capture_velocity_interval, restitution_bands, sample_posterior,
@@ -182,7 +183,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
                     friction: bool = True, posterior: bool | dict = False, errors_in_variables: str = "auto",
                     rtol: float = DEFAULT_RTOL, progress: bool = False, time_budget: float | None = None,
                     exclude=(), outlier_refit: bool = True, loss: str = DEFAULT_LOSS, likelihood: str = "normal",
-                    nu: float = DEFAULT_NU) -> AnalystFit:
+                    nu: float = DEFAULT_NU, method: str = DEFAULT_FIT_METHOD) -> AnalystFit:
     """Fit the damping, the friction (if oblique columns) and optionally sample the posterior.
 
     Parameters
@@ -216,6 +217,8 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
         (:attr:`AnalystFit.without_outliers`); the outliers named are those the refit confirms.
     loss : {"linear", "soft_l1", "huber"}
         Loss of the damping fit (:func:`~microimpact.analysis.fitting.fit_damping`) and its refit.
+    method : {"emulator", "solve"}
+        How the damping fit evaluates the model e_n (:func:`~microimpact.analysis.fitting.fit_damping`).
 
     Returns
     -------
@@ -254,7 +257,7 @@ def analyse_impacts(table, base, *, fit_work_of_adhesion: bool = False, weights=
     def damping_fit(rows):
         return fit_damping(rows, base, fit_work_of_adhesion=fit_work_of_adhesion, weights=weights,
                            confidence_intervals=confidence_intervals, rtol=rtol, progress=progress,
-                           time_budget=deadline, loss=loss)
+                           time_budget=deadline, loss=loss, method=method)
 
     damping = damping_fit(table)
     without = None

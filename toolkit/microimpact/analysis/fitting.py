@@ -58,7 +58,7 @@ from scipy import integrate, stats
 from scipy.optimize import brentq
 
 from microimpact.analysis.fit_result import PARAMETER_NAMES, DampingFit, fit_parameter_table, format_fit
-from microimpact.analysis.sampling_defaults import DEFAULT_LOSS, LOSSES
+from microimpact.analysis.sampling_defaults import DEFAULT_FIT_METHOD, DEFAULT_LOSS, LOSSES, METHODS
 from microimpact.analysis.verdict import p_value_text
 from microimpact.analysis.identifiability import DEFAULT_LEVEL, chi2_threshold, status_from_interval
 from microimpact.io.impacts import MEASUREMENT_TOLERANCE_SIGMAS, insert_row_labels, row_labels
@@ -99,7 +99,7 @@ DEFAULT_START_GRID = (np.geomspace(0.01, 10.0, 13), np.geomspace(0.1, 1000.0, 13
 #: how a fit computes the model e_n: "emulator" (the default of :func:`fit_damping`) takes the e_n of a
 #: radius with EMULATOR_MIN_ROWS rows or more from the ring law's error-controlled table
 #: (:func:`microimpact.solvers.emulator.ring_emulator`), "solve" solves every evaluation
-FIT_METHODS = ("emulator", "solve")
+FIT_METHODS = METHODS
 #: absolute e_n tolerance of the table in a fit: the posterior's (one shipped table serves both)
 EMULATOR_TOLERANCE = 1e-6
 #: the box of groups of that table (:data:`microimpact.solvers.emulator.WIDE_DOMAIN`, shipped)
@@ -540,7 +540,7 @@ def _effective_sigma(problem, p, sigma_e, sigma_v, rtol, h=1e-4):
 def fit_damping(table, base, *, fit_work_of_adhesion: bool = False, weights="auto", start_grid=DEFAULT_START_GRID,
                 rtol: float = DEFAULT_RTOL, confidence_intervals: bool = True, scale_covar: bool | None = None,
                 threads: int | None = 1, progress: bool = False, time_budget: float | None = None,
-                loss: str = DEFAULT_LOSS, method: str = "emulator") -> DampingFit:
+                loss: str = DEFAULT_LOSS, method: str = DEFAULT_FIT_METHOD) -> DampingFit:
     """Fit zeta_H, zeta_A (and optionally w_A) to measured e_n(v_n), jointly over particle sizes.
 
     Parameters

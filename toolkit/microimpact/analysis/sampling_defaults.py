@@ -13,7 +13,7 @@ True
 """
 
 __all__ = ["DEFAULT_WALKERS", "DEFAULT_MAX_STEPS", "DEFAULT_SEED", "DEFAULT_N_DRAWS", "MAX_SEED", "LIKELIHOODS",
-           "DEFAULT_NU", "LOSSES", "DEFAULT_LOSS", "METHODS", "DEFAULT_METHOD"]
+           "DEFAULT_NU", "LOSSES", "DEFAULT_LOSS", "METHODS", "DEFAULT_METHOD", "DEFAULT_FIT_METHOD"]
 
 #: walkers of the ensemble (at least 2 x the sampled parameters are needed; 16 suits 2-4)
 DEFAULT_WALKERS = 16
@@ -41,3 +41,6 @@ DEFAULT_LOSS = "linear"
 METHODS = ("emulator", "solve")
 #: the likelihood's method by default: the emulator, whose table comes with the package
 DEFAULT_METHOD = "emulator"
+#: how the damping fit evaluates the model e_n (the same two methods; the fit takes the table only
+#: for a radius with thousands of rows, :data:`microimpact.analysis.fitting.EMULATOR_MIN_ROWS`)
+DEFAULT_FIT_METHOD = "emulator"
