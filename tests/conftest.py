@@ -14,6 +14,7 @@ and by every subprocess a test starts, instead of being compiled in each of them
 
 import os
 import signal
+import sys
 import warnings
 
 import numba
@@ -26,8 +27,10 @@ except ImportError:
     from _pytest.python_api import ApproxDecimal, ApproxScalar
 
 import microimpact as mi
+from microimpact.model import thornton_ning
 from microimpact.presets import WALL_1990
 from microimpact.solvers import emulator
+from microimpact.solvers.thornton_ning_law import solve_thornton_ning
 from microimpact.studies.lammps_check import LammpsUnavailable, load_lammps
 
 ApproxScalar.DEFAULT_ABSOLUTE_TOLERANCE = 0.0
@@ -43,7 +46,15 @@ if 1e-13 == pytest.approx(0.0):
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 
-#: one public call per group of compiled kernels (the groups of tests/study_compile_times.py)
+# An environment that turns Python's bytecode cache off (PYTHONDONTWRITEBYTECODE, as container images
+# often do) makes each worker, and each console script or Snakemake job a test starts, compile the
+# package's sources and rewrite the assertions of every test module again; the suite keeps the cache
+# that Python writes by default (__pycache__ beside the sources, ignored by git).
+sys.dont_write_bytecode = False
+os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+
+#: one public call per group of compiled kernels (the groups of tests/study_compile_times.py and the
+#: Thornton-Ning law)
 KERNEL_GROUPS = (
     lambda c: mi.simulate_impact(c, 2.0, 30.0, omega=(0.0, 0.0, 1e5)),
     lambda c: mi.simulate_many(c, speed=np.geomspace(0.5, 5.0, 8), incidence_deg=30.0, family=False),
@@ -53,6 +64,8 @@ KERNEL_GROUPS = (
     lambda c: mi.simulate_impact(c, 2.0, 20.0, method="rkg"),
     lambda c: mi.simulate_impact(c.with_(normal_model="jkr"), 2.0, 30.0),
     lambda c: mi.simulate_impact(c.with_(tangential_model="mindlin", shear_modulus=1e10), 2.0, 40.0),
+    # the Thornton-Ning law's driver (its own kernels: the material of its docstring examples)
+    lambda c: solve_thornton_ning(thornton_ning.PlasticContact(1e-6, 1e-14, 4e9 / 3, 0.0, 1e8), 1.0),
 )
 #: a run of at least this many tests is "the suite" (a single test file is not worth the wait)
 SUITE_SIZE = 300

@@ -312,6 +312,7 @@ def test_too_few_impacts_for_the_scatter_say_so():
     assert "2 impacts without stated e_n uncertainties cannot give 2 parameter(s)" in f.describe()
 
 
+@pytest.mark.extended
 def test_joint_fit_counts_two_parameters_and_refuses_hertz():
     t, _ = _adhesive_table("jkr_force", "viscoelastic", 0.05, 0.03, np.geomspace(0.02, 3.0, 8), rng=np.random.default_rng(1))
     one = fit_dem_law(t, {**ADHESIVE, "work_of_adhesion": 0.05}, "jkr_force", "viscoelastic")

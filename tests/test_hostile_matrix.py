@@ -17,6 +17,9 @@ import pytest
 from microimpact.cli import main
 from test_hostile_cli import _snapshot, fitted, workspace  # noqa: F401  (fixtures)
 
+# every option against every other and every kind of file, hundreds of CLI runs: with the extended tests
+pytestmark = pytest.mark.extended
+
 #: command -> (argv with one placeholder per file option, {option: (placeholder, valid value, "in"/"out")})
 COMMANDS = {
     "fit": (["fit", "{DATA}", "--config", "{--config}", "--out", "{--out}", "--posterior", "{--posterior}",

@@ -73,6 +73,7 @@ def test_shift_bound_formula():
     assert emulator_shift_bound(FitProblem.from_arrays([2e-6] * 3, [1.0, 2.0, 3.0], MATERIAL, "emulator"), None) == 0.0
 
 
+@pytest.mark.extended  # fits of thousands of rows: seconds each
 @pytest.mark.parametrize("work_of_adhesion", [False, True])
 def test_fit_by_the_table_agrees_with_the_solver_within_the_bound(monkeypatch, work_of_adhesion):
     """With the row threshold lowered so that a small fit is served by the table, its estimates and
@@ -98,6 +99,7 @@ def test_fit_by_the_table_agrees_with_the_solver_within_the_bound(monkeypatch, w
         assert abs(a.upper - b.upper) / se <= bound + 0.02, name
 
 
+@pytest.mark.extended  # fits of thousands of rows: seconds each
 def test_too_precise_data_are_fitted_by_the_solver(monkeypatch):
     """Where the table's tolerance could move an estimate by more than EMULATOR_MAX_SHIFT standard
     errors (stated e_n uncertainties of 5e-5: a bound of ~0.18), the fit is made by the solver instead."""
@@ -115,6 +117,7 @@ def test_unknown_method_is_refused():
         fit_damping(_table(5), MATERIAL, method="table")
 
 
+@pytest.mark.extended  # fits of thousands of rows: seconds each
 def test_precise_parameters_get_their_profile_interval():
     """Where the data determine a parameter to better than the profile's relative tolerance (here
     stated e_n uncertainties of 1e-4: relative standard errors ~1e-4), the interval is located in
@@ -131,6 +134,7 @@ def test_precise_parameters_get_their_profile_interval():
         assert (st.upper - st.lower) / (2 * 1.96 * se) == pytest.approx(1.0, rel=0.05, abs=0), name
 
 
+@pytest.mark.extended  # fits of thousands of rows: seconds each
 def test_the_cli_takes_the_fit_method_and_says_which_one_ran(tmp_path, capsys):
     """``fit --fit-method`` reaches the damping fit: on a radius of EMULATOR_MIN_ROWS rows the JSON
     summary names the table by default and the solver with ``solve``; a wrong name is refused."""

@@ -165,6 +165,7 @@ def tn_comparison(sample):
                                  start_grid=COARSE)
 
 
+@pytest.mark.extended
 def test_the_comparison_prefers_thornton_ning_on_its_data(tn_comparison):
     ds = tn_comparison
     delta = ds["delta_aic"].to_series()

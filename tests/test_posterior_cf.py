@@ -12,6 +12,9 @@ from microimpact.analysis import analyst_fit, posterior
 
 from test_cf import _failures, test_every_variable_in_every_group_is_described as _described
 
+# the real CF checker over the posterior's files, like tests/test_cf.py: with the extended tests
+pytestmark = pytest.mark.extended
+
 KINDS = ["posterior", "posterior_empty", "oblique", "oblique_empty", "target", "flags_explained"]
 
 

@@ -36,6 +36,7 @@ def test_out_dash_is_a_value_again(tmp_path, monkeypatch, capsys):
     assert "unrecognized option" not in err and "time budget" in err
 
 
+@pytest.mark.extended
 @pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
 def test_fit_to_a_full_stdout_writes_no_file(small_csv, tmp_path):
     # `fit > /dev/full` exited 2 after writing its NetCDF; the report is now printed first

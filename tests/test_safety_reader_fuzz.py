@@ -20,6 +20,9 @@ from microimpact.cli import main
 from test_fit_results import KINDS, results  # noqa: F401 - the fixture: one result of every kind
 from test_safety_outputs import small_csv  # noqa: F401 - the fixture
 
+# every variable of every result kind damaged, hundreds of reads and CLI runs: with the extended tests
+pytestmark = pytest.mark.extended
+
 HOW = ("dropped", "text", "another shape")
 
 

@@ -120,6 +120,7 @@ def test_fit_budget(table, pair, fit):
             fit_damping(table, pair, time_budget=bad)
 
 
+@pytest.mark.extended
 def test_fit_stopped_inside_lmfit_raises_instead_of_returning_a_half_fit(table, pair, clock):
     """lmfit's own abort (iter_cb returning True) returns a result; the budget must raise instead,
     in the least-squares rounds and in the confidence intervals alike."""
@@ -198,6 +199,7 @@ def test_posterior_products_budget(table, fit):
     assert a.identical(restitution_bands(post, fit, n_draws=2, time_budget=GENEROUS))
 
 
+@pytest.mark.extended
 def test_analyst_fit_shares_one_budget(table, pair, clock):
     """analyse_impacts passes one deadline to its stages: the budget is of the whole analysis."""
     from microimpact.analysis.analyst_fit import analyse_impacts
