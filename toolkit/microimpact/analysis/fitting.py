@@ -569,34 +569,23 @@ def fit_damping(table, base, *, fit_work_of_adhesion: bool = False, weights="aut
     scale_covar : bool, optional
         Scale the covariance by the reduced chi-square; default: only for unweighted fits.
     threads : int or None
-        Engine threads during the fit (restored afterwards); None keeps the current setting.
-        Default 1: a fit makes hundreds of small engine calls (one per radius, ~25 speeds each),
-        for which thread start-up and, on a busy machine, waiting for the second thread cost more
-        than the second core gains.
+        Engine threads during the fit (restored afterwards); None keeps the current setting. Default
+        1: for hundreds of small engine calls, thread start-up costs more than a second core gains.
     progress : bool
-        A progress bar on stderr (a terminal only; :func:`microimpact._runtime.progress.progress_bar`):
-        the start grid, then each least-squares round.
+        A progress bar on stderr (a terminal only): the start grid, then each least-squares round.
     time_budget : float or Deadline, optional
-        Wall-clock budget of the fit; None: no limit. Checked after every start-grid point and
-        every function evaluation of the least-squares rounds and the confidence intervals. [s]
+        Wall-clock budget of the fit (checked at every evaluation); None: no limit. [s]
     loss : {"linear", "soft_l1", "huber"}
-        The objective sum rho(z^2) of the standardized residuals z (:func:`robust_terms`):
-        "linear" is least squares (lmfit ``leastsq``); "soft_l1" and "huber" are robust (lmfit
-        ``least_squares``, scipy's loss at ``f_scale`` = 1 stated uncertainty), for data with gross
-        outliers. A robust loss needs stated e_n uncertainties (its scale is one of them). Its 95 %
-        intervals are the profile of the robust objective, scaled per parameter by the sandwich
-        (Huber 1967) so that they have the M-estimator's width. The verdict's chi-square stays the
-        plain sum of z^2 at the fitted values.
+        The objective sum rho(z^2) of the standardized residuals z (:func:`robust_terms`): least
+        squares, or robust (scipy's loss at ``f_scale`` = 1 stated uncertainty, which it needs) for
+        gross outliers, its 95 % intervals the robust profile scaled by the sandwich (Huber 1967).
+        The verdict's chi-square stays the plain sum of z^2 at the fitted values.
     method : {"emulator", "solve"}
-        How the model e_n is computed (:data:`FIT_METHODS`). "emulator": a radius with at least
-        :data:`EMULATOR_MIN_ROWS` rows takes e_n from the ring law's error-controlled table
-        (absolute tolerance :data:`EMULATOR_TOLERANCE`; the solver where the table does not meet
-        it, and for every other law), the other radii are solved at ``rtol``; when the table's
-        tolerance could move an estimate by more than :data:`EMULATOR_MAX_SHIFT` standard errors
-        (:func:`emulator_shift_bound`) the fit is made again by "solve". "solve": every radius by
-        the solver at ``rtol`` (a restitution family where a radius has thousands of speeds).
-        A robust loss always solves (the bound is that of least squares). ``info["model_evaluation"]``
-        says which was used.
+        How the model e_n is computed (:data:`FIT_METHODS`, the module docstring): "emulator" takes
+        the e_n of radii with :data:`EMULATOR_MIN_ROWS` rows from the ring law's table unless its
+        tolerance could move an estimate by :data:`EMULATOR_MAX_SHIFT` standard errors
+        (:func:`emulator_shift_bound`); "solve" and a robust loss solve every radius at ``rtol``.
+        ``info["model_evaluation"]`` says which was used.
 
     Raises
     ------
