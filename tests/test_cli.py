@@ -143,6 +143,7 @@ def _compile_seconds(events) -> float:
     return total
 
 
+@pytest.mark.extended
 def test_benchmark_stops_at_its_time_budget_and_writes_nothing(tmp_path, capsys):
     """benchmark --time-budget (issue 27: the one long command without a budget): a quick benchmark
     takes 30-60 s here; with a 3 s budget it ends in one line with status 3 and --out stays empty.

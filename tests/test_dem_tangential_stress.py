@@ -1,7 +1,8 @@
 """Cases of the stress sweep (microimpact.studies.stress, seed 0) that the DEM tangential solver
 (microimpact.solvers.dem_tangential) gave no result for: a normal motion that creeps, and LAMMPS's
 rolling law with the rolling velocity across the slip (issue 52). Each case is stored as its drawn
-inputs, so that the tests do not depend on the sweep's draw."""
+inputs, so that the tests do not depend on the sweep's draw. Extended (implicit integrations of
+creeping contacts, seconds each): ``pytest -n auto -m extended``."""
 
 from __future__ import annotations
 
@@ -14,6 +15,8 @@ from scipy.integrate import solve_ivp
 from microimpact.solvers import dem_tangential as dt
 from microimpact.solvers.impact import simulate_impact
 from microimpact.studies import stress
+
+pytestmark = pytest.mark.extended
 
 #: case 144 of seed 0 (its drawn inputs): 2e4 critical dampings, Hertz (w = 0) with LAMMPS's
 #: viscoelastic damping and Mindlin spring; the sphere stops within a tiny approach and creeps out
@@ -202,7 +205,6 @@ def test_rolling_across_the_slip_of_a_creeping_contact_gets_a_result(number, cou
     assert stress.kinetic_energy(c, r.velocity_out, r.omega_out) < ke_in
 
 
-@pytest.mark.extended
 @pytest.mark.parametrize("number", [59, 66, 77, 144])
 def test_rolling_across_the_slip_of_a_creeping_contact_passes_the_sweeps_checks(number):
     """The sweep's checks of these cases (stress.check_case): no failure, the energy balance to 1e-8

@@ -264,6 +264,7 @@ def test_report_has_the_design_page(tmp_path, start_fit):
     assert "recommended" in page and "uniform" in page  # the width figure's caption
 
 
+@pytest.mark.extended
 def test_design_from_a_posterior_uses_its_covariance(tmp_path, start_fit, material, capsys):
     # a short chain (an illustration, not converged): its sample covariance of ln zeta is M_0
     table = pd.DataFrame({"radius": RADIUS, "normal_speed": np.array(START_SPEEDS),

@@ -29,7 +29,8 @@ EXTENDED_MODULES = frozenset({
     "microimpact.analysis.posterior", "microimpact.report.analyst", "microimpact.analysis.dem_friction",
     "microimpact.analysis.dem_fit", "microimpact.report.posterior_figures", "microimpact.report.figures",
     "microimpact.analysis.kharaz", "microimpact.studies.benchmark.family", "microimpact.studies.material",
-    "microimpact.analysis.oblique"})
+    "microimpact.analysis.oblique", "microimpact.analysis.analyst_fit", "microimpact.analysis.fit_result",
+    "microimpact.analysis.flags", "microimpact.analysis.plastic_fit"})
 
 
 def _doctests(name: str) -> list[doctest.DocTest]:

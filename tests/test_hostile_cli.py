@@ -13,7 +13,8 @@ computation ran past its ``--time-budget``; default 2). Each case asserts
 
 Cases are plain data built from the tables below; add a row to grow the corpus. They run
 in-process (``microimpact.cli.main``) and are refused before any work, so the suite is fast; a few
-end-to-end cases run the installed entry point in a subprocess.
+end-to-end cases run the installed entry point in a subprocess. The whole suite is extended (its
+hundreds of command runs and Ctrl-Cs in real time): ``pytest -n auto -m extended``.
 """
 
 from __future__ import annotations
@@ -28,6 +29,8 @@ from pathlib import Path
 import pytest
 
 from microimpact.cli import main
+
+pytestmark = pytest.mark.extended
 from microimpact.io.materials import default_materials_path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -444,7 +447,6 @@ def test_ctrl_c_ends_in_one_line_with_status_130_and_writes_nothing(argv, after,
     assert after_snapshot == before
 
 
-@pytest.mark.extended
 def test_a_warning_is_one_line_naming_the_input_not_the_installation(tmp_path):
     """The console script prints a warning as ``microimpact: warning: ...`` on one line (Python's
     form was two lines naming cli.py and a source line of the installation). A measured e_n of

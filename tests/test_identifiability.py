@@ -196,6 +196,7 @@ def test_a_value_no_stated_error_explains_is_refused_naming_row_and_column(tmp_p
     assert not (tmp_path / "f.nc").exists()
 
 
+@pytest.mark.extended
 def test_cli_never_prints_a_meaningless_friction(tmp_path, pairs, capsys):
     path = tmp_path / "roll.csv"
     write_csv(make_synthetic_oblique(radii=(3.45e-6,), speeds=(5.0, 10.0, 20.0), incidence_deg=(5.0, 10.0, 15.0),

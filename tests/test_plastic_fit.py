@@ -182,6 +182,7 @@ def test_the_comparison_prefers_thornton_ning_on_its_data(tn_comparison):
     assert np.all(np.isfinite(ds["e_n_curve"].sel(normal_model="thornton_ning").values))
 
 
+@pytest.mark.extended
 def test_the_report_page_shows_the_thornton_ning_row(tn_comparison):
     # the report reads the comparison file: its page names the law, its V_y and its preference
     lay = Layout("Report")

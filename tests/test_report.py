@@ -141,12 +141,14 @@ def report_text(results):
     return [page.extract_text() or "" for page in reader.pages]
 
 
+@pytest.mark.extended
 def test_inputs_cover_every_key(results):
     _, inputs, _ = results
     # the design page (optional rule design) is tested with its own inputs in tests/test_design.py
     assert set(inputs) | {"work_precision", "design"} == set(INPUT_KEYS)
 
 
+@pytest.mark.extended
 def test_report_has_both_parts_and_their_sources(results, report_text):
     _, _, analyst_source = results
     text = "\n".join(report_text[1:]).replace("\n", " ")  # after the title page and its contents
@@ -176,6 +178,7 @@ def test_unknown_or_missing_inputs_are_named(tmp_path):
         build_report(tmp_path / "r.pdf", {"flags": "flags.csv"})
 
 
+@pytest.mark.extended
 def test_grouped_netcdf_reader(results):
     tmp, _, _ = results
     portraits = read_netcdf_groups(tmp / "portraits.nc")

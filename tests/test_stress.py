@@ -195,9 +195,15 @@ def test_summary_counts_notes_apart(tmp_path):
 
 
 # ------------------------------------------------------------------ every law
+#: cases of the every-law sweep in the default run (the first of seed 0: damping up to 9e5 in cases 0, 1,
+#: 7 and 9, f = 0 with the pulloff limit in case 2); the extended run takes all 40
+DEFAULT_CASES, EXTENDED_CASES = 10, 40
+
+
 @pytest.mark.parametrize("law", [law for law in stress.LAWS if law != "ring"])
-def test_every_law_passes_the_sweep(law):
-    """The first 40 cases of seed 0 under every contact law: all checks of the sweep (finite
+@pytest.mark.parametrize("n_cases", [DEFAULT_CASES, pytest.param(EXTENDED_CASES, marks=pytest.mark.extended)])
+def test_every_law_passes_the_sweep(law, n_cases):
+    """The first 40 cases of seed 0 (10 in the default run) under every contact law: all checks of the sweep (finite
     results, e_n, the energy balance to 1e-8 of the case's scale, convergence in rtol). They
     include damping up to 9e5 (cases 0, 1, 7, 9, 22, 36), which ended in the step limit for every
     law but the ring law before the JKR/DMT and coupled solvers took the inertia-free limit and the
@@ -213,9 +219,9 @@ def test_every_law_passes_the_sweep(law):
     slip: Radau alone failed or took ~56 s; friction 0 without spin: a 0 / 0 frame) before the DEM
     tangential solver tried LAMMPS's rolling across the slip by LSODA, BDF, then Radau
     (tests/test_dem_tangential_stress.py)."""
-    report = stress.stress_sweep(40, seed=0, reference_every=0, law=law)
+    report = stress.stress_sweep(n_cases, seed=0, reference_every=0, law=law)
     s = report.summary
-    assert s["law"] == law and s["cases_run"] == 40
+    assert s["law"] == law and s["cases_run"] == n_cases
     assert s["cases_failed"] == 0, s["failed_cases"]
     noted = {c["inputs"]["case"] for c in s["noted_cases"] if any(n["kind"] == "not_determined" for n in c["notes"])}
     assert noted == set()

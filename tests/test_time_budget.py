@@ -109,6 +109,7 @@ def _same_fit(a, b):
     assert a.info["nfev"] == b.info["nfev"] and a.chisqr == b.chisqr
 
 
+@pytest.mark.extended
 def test_fit_budget(table, pair, fit):
     from microimpact.analysis.fitting import fit_damping
 
