@@ -211,19 +211,20 @@ def _room_for_the_first(sizes: list[int], k: int) -> int:
     return sum(map(_pages, sizes[:k])) + max(4096, _pages(sizes[k]) // 2)
 
 
-def _all_or_nothing_on_a_full_disk(argv_for, names, room, small_tmpfs, tmp_path, capsys) -> None:
-    """``main(argv_for(dir, names))`` on a tmpfs of ``room`` bytes: first the outputs that fit (the
+def _all_or_nothing_on_a_full_disk(argv_for, names, room, small_tmpfs, capsys, run=main,
+                                   error="microimpact: error:") -> None:
+    """``run(argv_for(dir, names))`` on a tmpfs of ``room`` bytes: first the outputs that fit (the
     ones before the last ``room`` was made for) are written there alone, so the disk would hold a
     partial set; then the whole set is refused in one line and leaves no file, temporary or not."""
     point = small_tmpfs(room)
-    assert main(argv_for(point, names[:-1])) == 0, capsys.readouterr().err  # the first ones fit ...
+    assert run(argv_for(point, names[:-1])) == 0, capsys.readouterr().err  # the first ones fit ...
     for n in names[:-1]:
         (point / n).unlink()
     capsys.readouterr()
-    status = main(argv_for(point, names))  # ... all of them do not
+    status = run(argv_for(point, names))  # ... all of them do not
     out, err = capsys.readouterr()
     lines = err.strip().splitlines()
-    errors = [line for line in lines if line.startswith("microimpact: error:")]
+    errors = [line for line in lines if line.startswith(error)]
     assert status == 2, err
     assert len(errors) == 1 and errors[0] == lines[-1] and "No space left" in errors[0], err
     assert "Traceback" not in err
@@ -255,7 +256,7 @@ def test_fit_on_a_file_system_that_fills_up_writes_all_or_nothing(fitting, small
     sizes = [(whole / n).stat().st_size for n in names]
     capsys.readouterr()
     _all_or_nothing_on_a_full_disk(argv, names[:fitting + 1], _room_for_the_first(sizes, fitting), small_tmpfs,
-                                   tmp_path, capsys)
+                                   capsys)
 
 
 def test_flags_on_a_file_system_that_fills_up_writes_all_or_nothing(small_csv, small_fit, small_tmpfs, tmp_path,
@@ -283,7 +284,27 @@ def test_flags_on_a_file_system_that_fills_up_writes_all_or_nothing(small_csv, s
     assert main(argv(whole, names)) == 0
     sizes = [(whole / n).stat().st_size for n in names]
     capsys.readouterr()
-    _all_or_nothing_on_a_full_disk(argv, names, _room_for_the_first(sizes, 1), small_tmpfs, tmp_path, capsys)
+    _all_or_nothing_on_a_full_disk(argv, names, _room_for_the_first(sizes, 1), small_tmpfs, capsys)
+
+
+def test_the_stress_study_on_a_file_system_that_fills_up_writes_all_or_nothing(small_tmpfs, tmp_path, capsys):
+    # python -m microimpact.studies.stress writes its summary (--out), then its dataset (--netcdf):
+    # a disk that filled up after the summary left it alone, and ended in a traceback
+    from microimpact.studies import stress
+
+    names = ["stress.json", "stress.nc"]
+
+    def argv(directory, given):
+        return ["--cases", "3", "--reference-every", "0", "--no-progress", "--out", str(directory / given[0]),
+                *(["--netcdf", str(directory / given[1])] if len(given) > 1 else [])]
+
+    whole = tmp_path / "whole"
+    whole.mkdir()
+    assert stress.main(argv(whole, names)) == 0
+    sizes = [(whole / n).stat().st_size for n in names]
+    capsys.readouterr()
+    _all_or_nothing_on_a_full_disk(argv, names, _room_for_the_first(sizes, 1), small_tmpfs, capsys, run=stress.main,
+                                   error="python -m microimpact.studies.stress: error:")
 
 
 @pytest.mark.parametrize("form", [["--configfile", "{missing}"], ["--configfile={missing}"],
