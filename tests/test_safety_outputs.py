@@ -287,6 +287,21 @@ def test_flags_on_a_file_system_that_fills_up_writes_all_or_nothing(small_csv, s
     _all_or_nothing_on_a_full_disk(argv, names, _room_for_the_first(sizes, 1), small_tmpfs, capsys)
 
 
+def test_a_netcdf_library_error_with_room_on_the_disk_is_not_called_a_full_disk(tmp_path, monkeypatch):
+    # the ENOSPC of a NetCDF write is told by the free space (HDF5 says only "HDF error"): with room
+    # left, the library's own error stands
+    import xarray as xr
+
+    from microimpact.io.files import write_netcdf
+
+    def failing(self, *args, **kwargs):
+        raise RuntimeError("NetCDF: HDF error")
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", failing)
+    with pytest.raises(RuntimeError, match="NetCDF: HDF error"):
+        write_netcdf(xr.Dataset({"e_n": ("speed", [0.5])}), tmp_path / "a.nc")
+    assert list(tmp_path.iterdir()) == []
+
 def test_the_stress_study_on_a_file_system_that_fills_up_writes_all_or_nothing(small_tmpfs, tmp_path, capsys):
     # python -m microimpact.studies.stress writes its summary (--out), then its dataset (--netcdf):
     # a disk that filled up after the summary left it alone, and ended in a traceback
