@@ -12,13 +12,21 @@ and every solver path at least once; ``-m slow`` runs all of them (docs/studies.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 import math
+import runpy
+import signal
+import sys
 import warnings
+from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
 import pytest
+import xarray as xr
+import yaml
 
 from microimpact.cli import main
 from microimpact.io.lammps import LammpsExportError, lammps_wall_model
@@ -273,3 +281,86 @@ def test_rolling_sds_with_mu_roll_0_is_fitted_by_lammps_fit(tmp_path, capsys, mo
     interval = text.split("# fitted friction: ")[1].split("95% profile-likelihood interval ")[1].split(";")[0]
     low, high = (float(x) for x in interval.split(" to "))
     assert low < 0.3 < high
+
+
+# ---------------------------------------------------------------- the pipeline's path
+# The pipeline chooses a law in one place only: the config key contact_models, the sub-models of the
+# Kharaz comparison's "selected" model (rule kharaz, workflow/scripts/kharaz.py). paper_contact takes
+# a contact's numbers but no sub-model, and the model comparison's normal laws are the rule's fixed
+# list (tests/test_model_comparison_rule.py runs it). The tests below read the choices from the
+# schema the Snakefile validates the config against, so that a law choice added to it is under test.
+
+REPO = Path(__file__).resolve().parents[1]
+SCHEMA = REPO / "workflow" / "schemas" / "config.schema.yaml"
+KHARAZ_SCRIPT = REPO / "workflow" / "scripts" / "kharaz.py"
+#: rolling resistance of the selected model: Contact's default (none) and one that acts
+PIPELINE_ROLLING_FRICTION = (0.0, 0.1)
+
+
+def _schema_properties(key: str) -> dict:
+    found = yaml.safe_load(SCHEMA.read_text())["properties"][key]
+    return next((s for s in found.get("oneOf", []) if s.get("type") == "object"), found)["properties"]
+
+
+def _pipeline_choices() -> list[dict]:
+    """Every ``contact_models`` the schema allows: each enumerated sub-model pair, and rolling
+    resistance off and on."""
+    enums = {k: v["enum"] for k, v in _schema_properties("contact_models").items() if "enum" in v}
+    return [{**dict(zip(enums, names)), "rolling_friction": mu}
+            for names in itertools.product(*enums.values()) for mu in PIPELINE_ROLLING_FRICTION]
+
+
+def test_the_pipeline_chooses_only_the_sub_models_of_its_schema():
+    contact_models = _schema_properties("contact_models")
+    assert set(contact_models) == {"tangential_model", "friction_model", "rolling_friction"}
+    for field in ("tangential_model", "friction_model"):  # names of the registry, each one its own
+        assert set(contact_models[field]["enum"]) <= set(laws.names(field)), field
+    # the paper's contact: numbers only, no sub-model (a law field there would be a choice untested here)
+    assert not {f for f in _schema_properties("paper_contact") if f.endswith("_model")}
+    assert len(_pipeline_choices()) == 3 * 2 * len(PIPELINE_ROLLING_FRICTION)
+
+
+def _run_kharaz_rule(tmp_path, contact_models: dict, capsys) -> tuple[Path, str]:
+    """The rule's script as Snakemake runs it (in-process, a stand-in for its ``snakemake`` object),
+    after the config check of the Snakefile; (output, the terminal's stderr). An uncaught exception
+    goes, as in a job, to the hook log_job installed (one line on the terminal, the traceback in the log)."""
+    from snakemake.utils import validate
+
+    config = {**yaml.safe_load((REPO / "workflow" / "config" / "config.yaml").read_text()),
+              "contact_models": contact_models}
+    validate(config, str(SCHEMA))  # the pipeline accepts this choice at start-up
+    out = tmp_path / "kharaz.nc"
+    job = SimpleNamespace(rule="kharaz", log=[str(tmp_path / "kharaz.log")], threads=1,
+                          input=[str(REPO / config["kharaz_data"])],
+                          params=SimpleNamespace(contact_models=config["contact_models"]), output=[str(out)])
+    saved = (sys.stdout, sys.stderr, sys.excepthook, sys.unraisablehook, signal.getsignal(signal.SIGTERM))
+    capsys.readouterr()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            runpy.run_path(str(KHARAZ_SCRIPT), init_globals={"snakemake": job}, run_name="__main__")
+    except Exception as exc:  # noqa: BLE001 - what a job does with it: the hook log_job installed
+        sys.excepthook(type(exc), exc, exc.__traceback__)
+    finally:
+        if sys.stdout is not saved[0]:
+            sys.stdout.close()
+        sys.stdout, sys.stderr, sys.excepthook, sys.unraisablehook = saved[:4]
+        signal.signal(signal.SIGTERM, saved[4])
+    return out, capsys.readouterr().err
+
+
+@pytest.mark.extended  # the rule's whole comparison (its friction fit, its curves) per choice: ~1 s CPU each
+@pytest.mark.parametrize("contact_models", _pipeline_choices(), ids=lambda m: "+".join(map(str, m.values())))
+def test_every_law_the_pipeline_chooses_gives_a_result_or_one_line(contact_models, tmp_path, capsys):
+    out, err = _run_kharaz_rule(tmp_path, contact_models, capsys)
+    compliant = contact_models["tangential_model"] != "rigid"
+    if compliant or contact_models["rolling_friction"] == 0.0:  # a valid contact: a result
+        assert out.exists() and err == "", err
+        with xr.open_dataset(out, engine="netcdf4") as ds:
+            assert ds.attrs["selected_contact_models"] == ", ".join(f"{k}={v}" for k, v in sorted(contact_models.items()))
+            assert all(math.isfinite(float(ds.attrs[f"rms_tangential_restitution_{regime}_selected"]))
+                       for regime in ("sliding", "below"))
+    else:  # rolling resistance without a compliant tangential law: refused in one line, nothing written
+        lines = err.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("microimpact: rule kharaz failed: ValueError: rolling_friction"), err
+        assert "needs a compliant tangential model" in lines[0] and not out.exists()

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import errno
 import glob
 import os
 import stat
@@ -447,6 +448,10 @@ def write_netcdf_groups(groups: Mapping, path) -> Path:
     ------
     ValueError
         If no group is given, or an integer variable holds values outside the int32 range.
+    OSError
+        ENOSPC, naming ``path``, if the write failed on a file system without room for the file. The
+        temporary file is removed, but the HDF5 library cannot close a file it failed to flush: its
+        space comes back when the process ends.
 
     Examples
     --------
@@ -468,10 +473,37 @@ def write_netcdf_groups(groups: Mapping, path) -> Path:
     path = Path(path)
     prepared = [(name, *_cf_dataset(ds, root=i == 0, path=path)) for i, (name, ds) in enumerate(items)]
     with atomic_path(path) as tmp, deferred_signals():  # a signal lands after the write: tmp is then removed
-        for i, (name, ds, encoding) in enumerate(prepared):
-            ds.to_netcdf(tmp, mode="w" if i == 0 else "a", group=None if name in (None, "/") else str(name),
-                         engine="netcdf4", format="NETCDF4", encoding=encoding)
+        try:
+            for i, (name, ds, encoding) in enumerate(prepared):
+                ds.to_netcdf(tmp, mode="w" if i == 0 else "a", group=None if name in (None, "/") else str(name),
+                             engine="netcdf4", format="NETCDF4", encoding=encoding)
+        except RuntimeError as exc:
+            full = _no_room_for(prepared, tmp, path)
+            if full is None:
+                raise
+            raise full from exc
     return path
+
+
+#: bytes a NetCDF-4 file needs beyond its values (HDF5's superblock, object headers, attributes): an
+#: upper bound for the toolkit's files, whose metadata are tens of kilobytes
+_NETCDF_OVERHEAD = 1 << 20
+
+
+def _no_room_for(prepared, tmp: Path, path: Path) -> OSError | None:
+    """The ENOSPC error of a NetCDF write that failed on a file system with less room than the file
+    needs (its values uncompressed and :data:`_NETCDF_OVERHEAD`), else None.
+
+    HDF5 reports a write the disk refused only as ``RuntimeError('NetCDF: HDF error')``, its errno
+    lost in the library; a full disk, the one cause a user can act on, is told by the free space."""
+    try:
+        st = os.statvfs(tmp.parent)
+    except (OSError, AttributeError):  # no statvfs (Windows): the library's own message
+        return None
+    needed = sum(int(ds.nbytes) for _, ds, _ in prepared) + _NETCDF_OVERHEAD
+    if st.f_bavail * st.f_frsize >= needed:
+        return None
+    return OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
 
 
 def write_csv(df, path, **to_csv_kwargs) -> Path:

@@ -98,7 +98,8 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
-from microimpact.io.files import atomic_write, write_netcdf
+from microimpact.io.files import all_or_nothing, atomic_write, write_netcdf
+from microimpact.io.paths import PathError, reporting_os_errors
 from microimpact._runtime.progress import progress_bar
 from microimpact.io.variables import attributes
 from microimpact.model import tangential_compliance as tc
@@ -890,7 +891,8 @@ def write_stress_summary(summary: dict, path) -> None:
 
 def main(argv=None) -> int:
     """Command line; exit status 1 when a case failed a check (notes do not count), 2 for a usage
-    error (argparse's message on stderr), else 0.
+    error (argparse's message on stderr) or an output that cannot be written (one line on stderr;
+    ``--out`` and ``--netcdf`` are written both or neither), else 0.
 
     Examples
     --------
@@ -929,12 +931,17 @@ def main(argv=None) -> int:
         report = stress_sweep(args.cases, args.seed, reference_every=args.reference_every,
                               case_time_limit=args.case_time_limit, reference_budget=args.reference_budget,
                               progress=lambda i, n: advance(), law=args.law)
-    if args.out:
-        write_stress_summary(report.summary, args.out)
-    else:
+    if not args.out:
         print(json.dumps(report.summary, indent=2, allow_nan=False, default=str))
-    if args.netcdf:
-        write_netcdf(report.dataset, args.netcdf)
+    try:  # the summary and the dataset, both or neither (a disk that fills up after the first)
+        with reporting_os_errors({"--out": args.out, "--netcdf": args.netcdf}), all_or_nothing():
+            if args.out:
+                write_stress_summary(report.summary, args.out)
+            if args.netcdf:
+                write_netcdf(report.dataset, args.netcdf)
+    except PathError as exc:
+        print(f"{p.prog}: error: {exc}", file=sys.stderr)
+        return 2
     print(summary_line(report.summary), file=sys.stderr)
     return 1 if report.summary["cases_failed"] else 0
 
