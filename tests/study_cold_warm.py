@@ -65,13 +65,16 @@ def _pipeline(root: Path, cache: Path) -> float:
     return seconds
 
 
-def _rule_seconds(root: Path) -> dict:
-    """Wall time of every job of a run, from Snakemake's ``benchmark:`` files [s]: where a cold
-    run's extra time goes (the critical path of fit, flags, figures and report, or the other core)."""
+def _rule_seconds(root: Path, column: str = "s") -> dict:
+    """One column of every job's Snakemake ``benchmark:`` file: ``s``, the wall time [s], or
+    ``cpu_time``, the CPU time of the job's processes [s] (less disturbed by other load of a shared
+    machine than the wall time): where a cold run's extra time goes (the critical path of fit,
+    flags, figures and report, or the other core)."""
     seconds = {}
     for path in sorted((root / "benchmarks").rglob("*.tsv")):
-        last = path.read_text().strip().splitlines()[-1]
-        seconds[path.relative_to(root / "benchmarks").with_suffix("").as_posix()] = float(last.split("\t")[0])
+        header, *rows = path.read_text().strip().splitlines()
+        value = rows[-1].split("\t")[header.split("\t").index(column)]
+        seconds[path.relative_to(root / "benchmarks").with_suffix("").as_posix()] = float(value)
     return seconds
 
 
@@ -80,6 +83,7 @@ def main(argv=None) -> int:
     parser.add_argument("--pairs", type=int, default=2, help="cold/warm pairs (default 2)")
     parser.add_argument("--target", type=float, default=TARGET, help=f"largest median ratio (default {TARGET})")
     parser.add_argument("--out", type=Path, help="write the summary as JSON here")
+    parser.add_argument("--keep", type=Path, help="copy every run's logs/ and benchmarks/ into this new directory")
     args = parser.parse_args(argv)
     if args.pairs < 1:
         parser.error(f"--pairs must be at least 1, got {args.pairs}")
@@ -93,10 +97,16 @@ def main(argv=None) -> int:
             compare.LARGEST[0] = 0.0
             problems, files, values = compare.compare(Path(tmp) / f"cold{i}" / "results", Path(tmp) / f"warm{i}" / "results")
             jobs_cold, jobs_warm = (_rule_seconds(Path(tmp) / f"{kind}{i}") for kind in ("cold", "warm"))
+            cpu_cold, cpu_warm = (_rule_seconds(Path(tmp) / f"{kind}{i}", "cpu_time") for kind in ("cold", "warm"))
             pairs.append({"cold_seconds": round(cold, 2), "warm_seconds": round(warm, 2), "ratio": round(cold / warm, 3),
                           "files_compared": files, "values_compared": values,
                           "largest_relative_difference": compare.LARGEST[0], "differences": problems[:20],
-                          "job_seconds_cold_warm": {k: [jobs_cold[k], jobs_warm.get(k)] for k in jobs_cold}})
+                          "job_seconds_cold_warm": {k: [jobs_cold[k], jobs_warm.get(k)] for k in jobs_cold},
+                          "job_cpu_seconds_cold_warm": {k: [cpu_cold[k], cpu_warm.get(k)] for k in cpu_cold}})
+            if args.keep:
+                for kind in ("cold", "warm"):
+                    shutil.copytree(Path(tmp) / f"{kind}{i}", args.keep / f"{kind}{i}",
+                                    ignore=shutil.ignore_patterns("results", "reports", ".snakemake"))
             print(f"pair {i}: cold {cold:.1f} s, warm {warm:.1f} s, ratio {cold / warm:.3f}; "
                   f"{values} values in {files} files, {len(problems)} differ")
     ratio = statistics.median(p["ratio"] for p in pairs)
