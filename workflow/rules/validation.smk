@@ -30,10 +30,6 @@ rule lammps_check:
         "logs/lammps_check.log",
     benchmark:
         "benchmarks/lammps_check.tsv"
-    # beside the fit, before the benchmark: its kernels (JKR force law, DEM tangential) are not
-    # the fit's, while the benchmark's include the fit's engine, which the fit has compiled (and
-    # cached) by the time the benchmark starts; on an empty numba cache nothing is compiled twice
-    priority: 6
     conda:
         "../envs/microimpact.yaml"
     threads: 1
