@@ -8,7 +8,10 @@ empty ``NUMBA_CACHE_DIR``, runs the README's ``snakemake --cores 2`` in the firs
 run fills the cache) and then in the second (warm), and compares every result of the two runs
 with ``.ci/compare_runs.py`` at a relative tolerance of 0 (the machine's measurements, such as
 wall times, left out as there). The ratio is the median over pairs of cold over warm wall time:
-a loaded machine slows both runs of a pair alike, and the median discards one disturbed pair::
+a loaded machine slows both runs of a pair alike, and the median discards one disturbed pair.
+Each pair also gives the CPU time of both runs (Snakemake and all its jobs) and their ratio, which
+other load of a shared machine disturbs far less; ``--keep DIR`` keeps every run's logs and
+``benchmark:`` files (each job's wall time) there::
 
     python tests/study_cold_warm.py --pairs 3 --out docs/cold-warm.json
 
@@ -26,6 +29,7 @@ import importlib.util
 import json
 import os
 import platform
+import resource
 import shutil
 import statistics
 import subprocess
@@ -54,20 +58,27 @@ def _copy(root: Path) -> Path:
     return root
 
 
-def _pipeline(root: Path, cache: Path) -> float:
+def _pipeline(root: Path, cache: Path) -> tuple[float, float]:
+    """(wall time, CPU time) of one run [s]; the CPU time is that of Snakemake and every job it ran
+    (user and system, all threads), which a shared machine's other load disturbs far less than the
+    wall time: on 2 cores a run whose jobs keep both busy takes about half its CPU time."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "--quiet"], cwd=root, env=env,
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     seconds = time.perf_counter() - start
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode:
         sys.exit(f"study_cold_warm: snakemake failed in {root} (status {done.returncode}):\n{done.stdout[-3000:]}")
-    return seconds
+    return seconds, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def _rule_seconds(root: Path) -> dict:
     """Wall time of every job of a run, from Snakemake's ``benchmark:`` files [s]: where a cold
-    run's extra time goes (the critical path of fit, flags, figures and report, or the other core)."""
+    run's extra time goes (the critical path of fit, flags, figures and report, or the other core).
+    Their ``cpu_time`` column is left out: Snakemake samples it every 30 s once a job has run 15 s,
+    so it misses up to 30 s of a job's last stretch."""
     seconds = {}
     for path in sorted((root / "benchmarks").rglob("*.tsv")):
         last = path.read_text().strip().splitlines()[-1]
@@ -80,6 +91,7 @@ def main(argv=None) -> int:
     parser.add_argument("--pairs", type=int, default=2, help="cold/warm pairs (default 2)")
     parser.add_argument("--target", type=float, default=TARGET, help=f"largest median ratio (default {TARGET})")
     parser.add_argument("--out", type=Path, help="write the summary as JSON here")
+    parser.add_argument("--keep", type=Path, help="copy every run's logs/ and benchmarks/ into this new directory")
     args = parser.parse_args(argv)
     if args.pairs < 1:
         parser.error(f"--pairs must be at least 1, got {args.pairs}")
@@ -88,16 +100,23 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory(prefix="cold_warm_") as tmp:
         for i in range(args.pairs):
             cache = Path(tmp) / f"cache{i}"
-            cold = _pipeline(_copy(Path(tmp) / f"cold{i}"), cache)
-            warm = _pipeline(_copy(Path(tmp) / f"warm{i}"), cache)
+            cold, cold_cpu = _pipeline(_copy(Path(tmp) / f"cold{i}"), cache)
+            warm, warm_cpu = _pipeline(_copy(Path(tmp) / f"warm{i}"), cache)
             compare.LARGEST[0] = 0.0
             problems, files, values = compare.compare(Path(tmp) / f"cold{i}" / "results", Path(tmp) / f"warm{i}" / "results")
             jobs_cold, jobs_warm = (_rule_seconds(Path(tmp) / f"{kind}{i}") for kind in ("cold", "warm"))
             pairs.append({"cold_seconds": round(cold, 2), "warm_seconds": round(warm, 2), "ratio": round(cold / warm, 3),
+                          "cold_cpu_seconds": round(cold_cpu, 2), "warm_cpu_seconds": round(warm_cpu, 2),
+                          "cpu_ratio": round(cold_cpu / warm_cpu, 3),
                           "files_compared": files, "values_compared": values,
                           "largest_relative_difference": compare.LARGEST[0], "differences": problems[:20],
                           "job_seconds_cold_warm": {k: [jobs_cold[k], jobs_warm.get(k)] for k in jobs_cold}})
-            print(f"pair {i}: cold {cold:.1f} s, warm {warm:.1f} s, ratio {cold / warm:.3f}; "
+            if args.keep:
+                for kind in ("cold", "warm"):
+                    shutil.copytree(Path(tmp) / f"{kind}{i}", args.keep / f"{kind}{i}",
+                                    ignore=shutil.ignore_patterns("results", "reports", ".snakemake"))
+            print(f"pair {i}: cold {cold:.1f} s, warm {warm:.1f} s, ratio {cold / warm:.3f} (CPU {cold_cpu:.1f} and "
+                  f"{warm_cpu:.1f} s, {cold_cpu / warm_cpu:.3f}); "
                   f"{values} values in {files} files, {len(problems)} differ")
     ratio = statistics.median(p["ratio"] for p in pairs)
     equal = all(not p["differences"] for p in pairs)

@@ -118,3 +118,73 @@ def test_one_thread_compiles_no_parallel_kernel_and_gives_the_numbers_of_two(tmp
     assert len(used) == 6, runs[1][1]
     assert all(runs[1][1][k] == (False, True) for k in used), runs[1][1]
     assert all(runs[2][1][k] == (True, False) for k in used), runs[2][1]
+
+
+#: a batch kernel in a module of its own (numba caches only functions that live in a file)
+BATCH_MODULE = """
+import numba
+from microimpact._numba import njit_batch
+
+
+@njit_batch
+def squares(x, out):
+    for i in numba.prange(x.shape[0]):
+        out[i] = x[i] * x[i]
+"""
+
+#: holds the kernel's compile lock until a line arrives on stdin, then compiles it into the cache
+HOLDER = """
+import sys
+import numpy as np
+import batchmod
+from microimpact._numba import _compile_lock
+kernel = batchmod.squares.serial
+with _compile_lock(kernel):
+    print("held", flush=True)
+    sys.stdin.readline()
+    kernel.compile(tuple(kernel.typeof_pyval(a) for a in (np.arange(3.0), np.empty(3))))
+"""
+
+#: calls the kernel while the holder has the lock; says whether it compiled or loaded it
+CALLER = """
+import numpy as np
+import batchmod
+out = np.empty(3)
+print("calling", flush=True)
+batchmod.squares(np.arange(3.0), out)
+stats = batchmod.squares.serial.stats
+print(out.tolist(), sum(stats.cache_hits.values()), sum(stats.cache_misses.values()), flush=True)
+"""
+
+
+def test_a_batch_kernel_another_process_is_compiling_is_loaded_not_compiled_again(tmp_path):
+    """Two pipeline jobs that start at once on an empty cache (the fit and the benchmark) both
+    compiled the engine's batch kernel. The caller here reaches its first call while the holder has
+    the kernel's compile lock and has not compiled it yet: it must wait, then load the holder's
+    compiled kernel from the cache (a cache hit, no miss) instead of compiling it as well."""
+    (tmp_path / "batchmod.py").write_text(BATCH_MODULE)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tmp_path), str(REPO / "toolkit")]),
+               NUMBA_CACHE_DIR=str(tmp_path / "cache"), NUMBA_NUM_THREADS="1")
+    env.pop("NUMBA_DISABLE_JIT", None)
+    holder = subprocess.Popen([sys.executable, "-c", HOLDER], env=env, cwd=tmp_path, text=True,
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        caller = subprocess.Popen([sys.executable, "-c", CALLER], env=env, cwd=tmp_path, text=True,
+                                  stdout=subprocess.PIPE)
+        assert caller.stdout.readline().strip() == "calling"
+        try:
+            caller.wait(timeout=1.0)  # the caller must not finish while the holder has the lock
+        except subprocess.TimeoutExpired:
+            pass
+        assert caller.poll() is None, "the caller did not wait for the compile lock"
+        holder.stdin.write("go\n")
+        holder.stdin.flush()
+        assert holder.wait(timeout=120) == 0
+        line, _ = caller.communicate(timeout=120)
+    finally:
+        holder.kill()
+    assert caller.returncode == 0
+    assert line.split("]")[0] + "]" == "[0.0, 1.0, 4.0]"
+    hits, misses = (int(n) for n in line.split("]")[1].split())
+    assert (hits, misses) == (1, 0), f"the caller compiled the kernel itself (hits {hits}, misses {misses})"

@@ -21,11 +21,17 @@ not slower (``microimpact benchmark`` compares such variants side by side).
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import os
 import types
 from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # not POSIX (Windows): no lock between processes, each compiles on its own
+    fcntl = None
 
 import numba
 from numba.core import config
@@ -172,4 +178,39 @@ class _BatchKernel:
 
     def __call__(self, *args):
         kernel = self.parallel if numba.get_num_threads() > 1 else self.serial
+        if self._caching and getattr(kernel, "overloads", None) == {}:  # this process's first call
+            with _compile_lock(kernel):
+                # compile() first looks in the cache, which a process that held the lock before
+                # this one has just filled: a kernel is compiled once, not in every job at once
+                kernel.compile(tuple(kernel.typeof_pyval(a) for a in args))
         return kernel(*args)
+
+
+@contextlib.contextmanager
+def _compile_lock(kernel):
+    """Hold an exclusive lock, shared by every process that uses the same cache directory, on the
+    first compile of one batch kernel.
+
+    Two pipeline jobs that start at once (the fit and the benchmark) would otherwise both compile
+    the engine's batch kernel, tens of seconds of CPU each; with the lock the second waits for the
+    first to write the kernel to numba's cache and loads it from there. Without a lockable cache
+    directory (read-only, or no ``fcntl``) each process compiles on its own, as numba does.
+    """
+    handle = None
+    if fcntl is not None:
+        func = kernel.py_func
+        path = os.path.join(cache_directory(), f"{func.__module__}.{func.__qualname__}.lock")
+        try:
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+            handle = open(path, "a")
+            fcntl.flock(handle, fcntl.LOCK_EX)
+        except OSError:
+            if handle is not None:
+                handle.close()
+            handle = None
+    try:
+        yield
+    finally:
+        if handle is not None:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+            handle.close()
