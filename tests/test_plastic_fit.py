@@ -30,6 +30,7 @@ from microimpact import cli
 from microimpact.analysis.fit_result import DampingFit
 from microimpact.analysis.fitting import FitProblem
 from microimpact.analysis.model_comparison import compare_normal_models, normal_model_restitution
+from microimpact.analysis import plastic_fit
 from microimpact.analysis.plastic_fit import PlasticFit, PlasticProblem, fit_thornton_ning
 from microimpact.io import read_materials
 from microimpact.model import thornton_ning as tn
@@ -262,3 +263,27 @@ def test_cli_compare_ranks_the_laws(impacts_csv, capsys):
     assert str(ds["verdict"].sel(normal_model="thornton_ning").values) == "adequate"
     assert cli.main(["compare", "impacts.csv", "--models", "ring,plastic"]) == 2
     assert "'plastic' is not a law" in capsys.readouterr().err
+
+
+def test_a_profile_point_walked_again_keeps_its_value(monkeypatch):
+    """The profile's walk brackets the crossing of chi2_min + 3.84; a point searched again from its
+    own optimum came out lower (the pipeline's model comparison on 100,000 rows), which turned the
+    bracket's sign and Brent's method refused it. A stand-in optimiser that answers a second search
+    at the same point by half its first value: chi^2(t) = 4 t^2 at first, so the crossing is at
+    t = sqrt(3.84 / 4) (to the walk's xtol, 1e-4 in log coordinates)."""
+    calls = {}
+
+    def optimiser(obj, x0, fixed=None):
+        k, at = fixed
+        calls[at] = calls.get(at, 0) + 1
+        x = np.array(x0, dtype=float)
+        x[k] = at
+        return x, 4.0 * at**2 * (0.5 if calls[at] > 1 else 1.0)
+
+    class Box:
+        lo, hi = np.array([-10.0, -10.0]), np.array([10.0, 10.0])
+
+    monkeypatch.setattr(plastic_fit, "_least_squares", optimiser)
+    end, point = plastic_fit._profile_end(Box(), np.zeros(2), 0.0, 1.0, 0, +1, 0.5)
+    assert end == pytest.approx(math.sqrt(3.8414588 / 4.0), abs=2e-4)
+    assert point[0] == end

@@ -219,16 +219,22 @@ def _least_squares(obj, x0, fixed=None):
 def _profile_end(obj, best, chi_min, scale, k, side, half):
     """The end of parameter k's profile interval on ``side`` (-1, +1), in log coordinates, and the
     other coordinates' optimum there: walked out from the best fit in doubling steps from the Wald
-    half-width ``half``, the crossing of chi2_min + 3.84 (scaled) then located by Brent's method."""
+    half-width ``half``, the crossing of chi2_min + 3.84 (scaled) then located by Brent's method.
+
+    Each point's profile value is kept once computed: the optimum at a point depends on where its
+    search starts, and a point walked again from its own optimum can come out lower (on 100,000
+    rows by enough to turn the sign that bracketed the crossing, and Brent's method then refused
+    the bracket)."""
     level = chi_min / scale + chi2_threshold(DEFAULT_LEVEL)
     limit = obj.hi[k] if side > 0 else obj.lo[k]
-    start = {0.0: best}
+    start, value = {0.0: best}, {}
 
     def excess(t):  # P(best_k + side t) - level, continuing from the nearest point already walked
-        near = min(start, key=lambda s: abs(s - t))
-        x, chi = _least_squares(obj, start[near], fixed=(k, best[k] + side * t))
-        start[t] = x
-        return chi / scale - level
+        if t not in value:
+            near = min(start, key=lambda s: abs(s - t))
+            x, chi = _least_squares(obj, start[near], fixed=(k, best[k] + side * t))
+            start[t], value[t] = x, chi / scale - level
+        return value[t]
 
     t_in, t = 0.0, min(max(half, 1e-3), abs(limit - best[k]))
     while True:
