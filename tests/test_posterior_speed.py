@@ -17,6 +17,7 @@ from microimpact.analysis.posterior import DEFAULT_METHOD, _Likelihood, sample_p
 from microimpact.cli import main
 from microimpact.analysis.synthetic import write_synthetic_impacts
 from microimpact.io import default_materials_path, read_impacts, read_materials
+from microimpact.model import reduction
 from microimpact.solvers import emulator as em
 
 #: a small box of groups about the six impacts' (C1 2e-3 to 4e-3, C2 0.09 to 0.2): a table that builds
@@ -79,6 +80,42 @@ def test_emulated_model_is_the_solver_where_it_falls_back(six):
         b = emulated.model(p)
     # the fallback solves at rtol tol / 100 and the reference at 1e-10: they differ by ~1e-5 at most
     assert np.max(np.abs(solve.model(p) - b)) <= 10 * TOL * em.FALLBACK_RTOL
+
+
+@pytest.mark.extended
+def test_groups_of_many_work_of_adhesion_values_are_the_contacts_own(six):
+    # the walkers' groups come from the fit's by powers of w_A (_speed_groups_many); built from a
+    # contact at each w_A they must agree to rounding (a few ulps: the powers and the scales differ
+    # in the order of their products)
+    table, fit = six
+    like = _Likelihood(fit, table, None, "auto", 1e-10, method="emulator", tol=TOL)
+    w = fit.values["work_of_adhesion"] * np.array([0.2, 1.0, 1.3, 4.0])
+    y0, per = like._speed_groups_many(w)
+    pr = like.problem
+    for k, wk in enumerate(w):
+        for r, idx in zip(pr.radii, pr.groups):
+            y, c1, c2 = reduction.ring_groups([pr.contact(r, 1.0, 2.0, float(wk))], pr.normal_speed[idx][None, :])
+            np.testing.assert_allclose(y0[k, idx], y[0], rtol=1e-13)
+            np.testing.assert_allclose(per[k, idx], c1[0], rtol=1e-13)
+            np.testing.assert_allclose(2.0 * per[k, idx], c2[0], rtol=1e-13)
+    assert like._speed_groups_many(np.array([0.0])) is None  # no adhesion: not the ring law, the solver
+
+
+@pytest.mark.extended
+def test_the_likelihood_of_many_walkers_is_each_walkers_own(six):
+    # emcee's vectorized call (one table lookup for all walkers) against one call per walker: the
+    # same numbers, bit for bit where w_A is the fit's, to rounding of the groups elsewhere
+    table, fit = six
+    like = _Likelihood(fit, table, None, "auto", 1e-10, method="emulator", tol=TOL)
+    like.domain = BOX
+    rng = np.random.default_rng(8)
+    p = {"zeta_hertz": rng.uniform(0.3, 0.7, 5), "zeta_adhesion": rng.uniform(27.0, 31.0, 5),
+         "work_of_adhesion": np.full(5, fit.values["work_of_adhesion"]), "friction": np.full(5, 0.3)}
+    many = like.many(p)
+    one = [like({n: v[k] for n, v in p.items()}) for k in range(5)]
+    np.testing.assert_array_equal(many, one)
+    p["work_of_adhesion"] = p["work_of_adhesion"] * rng.uniform(0.9, 1.1, 5)
+    np.testing.assert_allclose(like.many(p), [like({n: v[k] for n, v in p.items()}) for k in range(5)], rtol=1e-12)
 
 
 def test_method_is_checked():

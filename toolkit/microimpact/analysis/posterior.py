@@ -450,9 +450,16 @@ class _Likelihood:
 
     def model(self, p: dict) -> np.ndarray:
         """Model e_n at the likelihood's speeds (plain rows, then the latent rows' nodes). [-]"""
-        if self.method == "emulator":
-            return self._emulated(p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"])
-        return model_restitution(self.problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=self.rtol)
+        return self.model_many({n: np.array([float(p[n])]) for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")})[0]
+
+    def model_many(self, p: dict) -> np.ndarray:
+        """:meth:`model` of K parameter sets at once: ``p`` maps zeta_hertz, zeta_adhesion and
+        work_of_adhesion to arrays of shape (K,); e_n of shape (K, speeds). [-]"""
+        zh, za, wa = (np.asarray(p[n], dtype=float).ravel() for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion"))
+        g = self._speed_groups_many(wa) if self.method == "emulator" else None
+        if g is None:  # the solver (method "solve", or not the ring law): one model evaluation per set
+            return np.array([model_restitution(self.problem, a, b, w, rtol=self.rtol) for a, b, w in zip(zh, za, wa)])
+        return self._emulated(zh, za, wa, *g)
 
     def _speed_groups(self, work_of_adhesion):
         """(y0, C1 / zeta_H = C2 / zeta_A) of every speed at ``work_of_adhesion``, or None where a
@@ -473,44 +480,67 @@ class _Likelihood:
             self._groups = {key: (y0, per) if ok else None}  # one w_A at a time: a fitted w_A moves every call
         return self._groups[key]
 
-    def _emulated(self, zeta_hertz, zeta_adhesion, work_of_adhesion) -> np.ndarray:
-        """e_n by the table where it meets ``tol``, by the emulator's fallback solves elsewhere. [-]"""
-        g = self._speed_groups(work_of_adhesion)
+    def _speed_groups_many(self, work_of_adhesion):
+        """(y0, C1 / zeta_H) of every speed for each w_A of the array ``work_of_adhesion`` (K,),
+        shape (K, speeds), or None where the law is not the ring law (or a w_A is not > 0).
+
+        From the groups at the fit's w_A by their powers of w_A: f0 ~ w_A^(2/3) (Eq. (7)), so
+        X = B / A ~ w_A^(2/3), T = (m / sqrt(A B))^(1/2) ~ w_A^(-1/6) (Eqs. (29)-(30)) and X / T ~
+        w_A^(5/6); y0 = v T / X ~ w_A^(-5/6), and C1 / zeta_H = (X / T) / (D v_ref^(1/5)) ~ w_A^(5/6)
+        (D does not hold f0). A contact per walker would cost more than the table lookup itself;
+        tests/test_posterior_speed.py compares these groups with the contacts' own."""
+        w = np.asarray(work_of_adhesion, dtype=float).ravel()
+        w_ref = float(self.fit.values["work_of_adhesion"])
+        if not (w_ref > 0.0 and np.all(w > 0.0)):
+            return None
+        g = self._speed_groups(w_ref)
+        if g is None:
+            return None
+        s = (w / w_ref)[:, None]
+        same = s == 1.0  # the fit's w_A (w_A given, not fitted): its groups as they are
+        return np.where(same, g[0], g[0] * s ** (-5.0 / 6.0)), np.where(same, g[1], g[1] * s ** (5.0 / 6.0))
+
+    def _emulated(self, zeta_hertz, zeta_adhesion, work_of_adhesion, y0, per) -> np.ndarray:
+        """e_n (K, speeds) by the table where it meets ``tol``, by the emulator's fallback solves
+        elsewhere (per parameter set and radius). [-]"""
         pr = self.problem
-        if g is None:  # not the ring law: the solver
-            return model_restitution(pr, zeta_hertz, zeta_adhesion, work_of_adhesion, rtol=self.rtol)
-        y0, per = g
         if getattr(self, "_table", None) is None:  # looked up once: the lookup hashes the physics' source
             self._table = emulator.ring_emulator(emulator.table_tolerance(self.tol), self.domain)
-        table = self._table
-        e, _, solve = table.evaluate(y0, zeta_hertz * per, zeta_adhesion * per, self.tol)
+        e, _, solve = self._table.evaluate(y0, zeta_hertz[:, None] * per, zeta_adhesion[:, None] * per, self.tol)
         e = np.array(e, dtype=float)
         if solve.any():
             with engine_threads(1):
-                for r, idx in zip(pr.radii, pr.groups):
-                    s = idx[solve[idx]]
-                    if s.size:
-                        e[s] = emulator.fallback_restitution(pr.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion),
-                                                  pr.normal_speed[s], self.tol)
+                for k in np.flatnonzero(solve.any(axis=1)):
+                    for r, idx in zip(pr.radii, pr.groups):
+                        s = idx[solve[k, idx]]
+                        if s.size:
+                            c = pr.contact(r, float(zeta_hertz[k]), float(zeta_adhesion[k]), float(work_of_adhesion[k]))
+                            e[k, s] = emulator.fallback_restitution(c, pr.normal_speed[s], self.tol)
         return e
 
     def __call__(self, p: dict) -> float:
-        m = self.model(p)
+        return float(self.many({n: np.array([float(v)]) for n, v in p.items()})[0])
+
+    def many(self, p: dict) -> np.ndarray:
+        """log p(data | parameters) of K parameter sets: ``p`` maps every parameter name to an
+        array of shape (K,) (the walkers of one emcee step, ``vectorize=True``). [-]"""
+        m = self.model_many(p)
         plain = ~self.latent
-        res = (m[: self.n_plain] - self.e[plain]) / self.sig_eff[plain]
-        logl = float(np.sum(self.log_density(res)))
+        res = (m[:, : self.n_plain] - self.e[plain]) / self.sig_eff[plain]
+        logl = np.sum(self.log_density(res), axis=1)
         if self.latent.any():
             k = GAUSS_HERMITE_NODES
-            ml = m[self.n_plain:].reshape(-1, k)
+            ml = m[:, self.n_plain:].reshape(m.shape[0], -1, k)
             e, s = self.e[self.latent, None], self.sig_e[self.latent, None]
-            like = (np.exp(self.log_density((ml - e) / s)) * self.weights[None, :]).sum(axis=1)
-            logl += float(np.sum(np.log(np.maximum(like, 1e-300))))
+            like = (np.exp(self.log_density((ml - e) / s)) * self.weights).sum(axis=2)
+            logl += np.sum(np.log(np.maximum(like, 1e-300)), axis=1)
         if self.oblique is not None:
-            values = {n: p[n] for n in PARAMETER_NAMES}
-            mo = oblique_model(self.oblique, lambda r: _contact(self.fit, r, values), {"friction": p["friction"]},
-                               rtol=self.rtol)
-            r2 = np.nan_to_num((mo - self.oblique.measured) / self.oblique_sigma, nan=1e3)
-            logl -= 0.5 * float(r2 @ r2)
+            for j in range(m.shape[0]):
+                values = {n: float(p[n][j]) for n in PARAMETER_NAMES}
+                mo = oblique_model(self.oblique, lambda r: _contact(self.fit, r, values), {"friction": float(p["friction"][j])},
+                                   rtol=self.rtol)
+                r2 = np.nan_to_num((mo - self.oblique.measured) / self.oblique_sigma, nan=1e3)
+                logl[j] -= 0.5 * float(r2 @ r2)
         return logl
 
     def log_density(self, z):
@@ -701,10 +731,16 @@ class _LogProbability:
         self.base = {n: best[n] for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion", "friction") if n in best}
 
     def __call__(self, x):
-        if np.any(x < self.lo) or np.any(x > self.hi):
-            return -np.inf
-        value = self.like(self.base | dict(zip(self.names, map(float, x))))
-        return value if math.isfinite(value) else -np.inf
+        """log posterior of the walkers ``x`` (K, parameters), all at once (emcee's ``vectorize``)."""
+        x = np.atleast_2d(np.asarray(x, dtype=float))
+        out = np.full(x.shape[0], -np.inf)
+        inside = np.all((x >= self.lo) & (x <= self.hi), axis=1)
+        if inside.any():
+            n = int(inside.sum())
+            p = {k: np.full(n, v) for k, v in self.base.items()} | {k: x[inside, i] for i, k in enumerate(self.names)}
+            value = self.like.many(p)
+            out[inside] = np.where(np.isfinite(value), value, -np.inf)
+        return out
 
 
 def _sampler_options(walkers, steps, max_steps, burn, seed, n_params: int) -> tuple[int, int, bool]:
@@ -766,7 +802,7 @@ def _run_chain(log_probability, pos, seed, budget, fixed_length, burn, advance, 
     collapsed (PosteriorError) or out of ``budget`` steps."""
     rng = np.random.default_rng(seed)
     moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
-    sampler = emcee.EnsembleSampler(len(pos), len(names), log_probability, moves=moves)
+    sampler = emcee.EnsembleSampler(len(pos), len(names), log_probability, moves=moves, vectorize=True)
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()  # seeded
     state = emcee.State(pos)
     done, previous_tau, diag = 0, None, None
