@@ -19,6 +19,7 @@ from microimpact.analysis.synthetic import write_synthetic_impacts
 from microimpact.io import default_materials_path, read_impacts, read_materials
 from microimpact.model import reduction
 from microimpact.solvers import emulator as em
+from microimpact.solvers import ring_groups_batch
 
 #: a small box of groups about the six impacts' (C1 2e-3 to 4e-3, C2 0.09 to 0.2): a table that builds
 #: in seconds; the impacts outside it go to the fallback solves, which the test covers as well
@@ -116,6 +117,26 @@ def test_the_likelihood_of_many_walkers_is_each_walkers_own(six):
     np.testing.assert_array_equal(many, one)
     p["work_of_adhesion"] = p["work_of_adhesion"] * rng.uniform(0.9, 1.1, 5)
     np.testing.assert_allclose(like.many(p), [like({n: v[k] for n, v in p.items()}) for k in range(5)], rtol=1e-12)
+
+
+def test_fallback_of_many_contacts_is_each_contacts_own():
+    # the posterior's fallback for all walkers at once (one engine call over their groups) against
+    # emulator.fallback_restitution of each contact: both solve to e_n within tol (rtol tol / 100,
+    # tighter near capture), so they differ by far less than tol; captures (e_n = 0) agree exactly
+    from microimpact.model.parameters import TABLE1_ROW2
+    rng = np.random.default_rng(3)
+    contacts = [TABLE1_ROW2.with_(zeta_hertz=float(zh), zeta_adhesion=float(za), radius=float(r))
+                for zh, za, r in zip(rng.uniform(0.0, 2.0, 6), rng.uniform(3.0, 100.0, 6), rng.uniform(0.5e-6, 1e-5, 6))]
+    speeds = np.geomspace(0.05, 100.0, 7)
+    y0, c1, c2 = reduction.ring_groups(contacts, np.tile(speeds, (len(contacts), 1)))
+    tol = 1e-6
+    got = ring_groups_batch.fallback_of_groups(y0, c1, c2, tol)
+    want = np.array([em.fallback_restitution(c, speeds, tol) for c in contacts])
+    assert (got == 0.0).any() and (got > 0.0).any()  # captures and rebounds both checked
+    np.testing.assert_array_equal(got == 0.0, want == 0.0)
+    assert np.max(np.abs(got - want)) <= 0.5 * tol
+    with pytest.raises(ValueError, match="y0 must lie in"):
+        ring_groups_batch.restitution_of_groups([0.0], [1e-3], [0.1])
 
 
 def test_method_is_checked():

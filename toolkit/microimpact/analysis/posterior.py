@@ -84,7 +84,7 @@ from microimpact.model.parameters import TABLE2_CASES
 from microimpact.solvers import DEFAULT_RTOL, Deadline, engine, engine_threads
 from microimpact.solvers.impact import simulate_many
 from microimpact.model import reduction
-from microimpact.solvers import emulator
+from microimpact.solvers import emulator, ring_groups_batch
 
 __all__ = ["Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "DEFAULT_WALKERS", "DEFAULT_MAX_STEPS",
            "DEFAULT_SEED", "DEFAULT_N_DRAWS", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
@@ -503,19 +503,16 @@ class _Likelihood:
     def _emulated(self, zeta_hertz, zeta_adhesion, work_of_adhesion, y0, per) -> np.ndarray:
         """e_n (K, speeds) by the table where it meets ``tol``, by the emulator's fallback solves
         elsewhere (per parameter set and radius). [-]"""
-        pr = self.problem
         if getattr(self, "_table", None) is None:  # looked up once: the lookup hashes the physics' source
             self._table = emulator.ring_emulator(emulator.table_tolerance(self.tol), self.domain)
-        e, _, solve = self._table.evaluate(y0, zeta_hertz[:, None] * per, zeta_adhesion[:, None] * per, self.tol)
+        c1, c2 = zeta_hertz[:, None] * per, zeta_adhesion[:, None] * per
+        e, _, solve = self._table.evaluate(y0, c1, c2, self.tol)
         e = np.array(e, dtype=float)
         if solve.any():
+            # every walker's fallback impacts in one engine call, from their groups (the impacts of
+            # many contacts: ring_groups_batch); the tolerances of emulator.fallback_restitution
             with engine_threads(1):
-                for k in np.flatnonzero(solve.any(axis=1)):
-                    for r, idx in zip(pr.radii, pr.groups):
-                        s = idx[solve[k, idx]]
-                        if s.size:
-                            c = pr.contact(r, float(zeta_hertz[k]), float(zeta_adhesion[k]), float(work_of_adhesion[k]))
-                            e[k, s] = emulator.fallback_restitution(c, pr.normal_speed[s], self.tol)
+                e[solve] = ring_groups_batch.fallback_of_groups(y0[solve], c1[solve], c2[solve], self.tol)
         return e
 
     def __call__(self, p: dict) -> float:
