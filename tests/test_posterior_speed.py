@@ -139,6 +139,32 @@ def test_fallback_of_many_contacts_is_each_contacts_own():
         ring_groups_batch.restitution_of_groups([0.0], [1e-3], [0.1])
 
 
+@pytest.mark.extended
+def test_oblique_model_of_many_walkers_is_each_walkers_own(tmp_path):
+    # the oblique part of the likelihood for all walkers at once (one engine call over their
+    # groups, the closed-form tangential map) against oblique_model per walker: the same kernel and
+    # rtol, groups to rounding, so agreement to 1e-12 relative; captures (NaN) at the same entries
+    from microimpact.analysis.oblique import fit_friction, oblique_model
+    from microimpact.analysis.posterior import PARAMETER_NAMES, _contact
+    from microimpact.analysis.synthetic import make_synthetic_oblique
+    from microimpact.io import write_csv
+    material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    data = make_synthetic_oblique(radii=(3.45e-6,), speeds=(2.0, 15.0), incidence_deg=(20.0, 50.0, 70.0))
+    table = read_impacts(write_csv(data, tmp_path / "oblique.csv"))
+    fit = fit_damping(table, material, fit_work_of_adhesion=True, confidence_intervals=False)
+    ff = fit_friction(table, fit)
+    like = _Likelihood(fit, table, ff, "auto", 1e-8, method="emulator")
+    rng = np.random.default_rng(4)
+    p = {n: fit.values[n] * rng.uniform(0.7, 1.4, 6) for n in PARAMETER_NAMES} | {"friction": rng.uniform(0.05, 1.0, 6)}
+    p["zeta_adhesion"][0] = 500.0  # a walker whose slow impacts are captured
+    many = like._oblique_many(p)
+    one = np.array([oblique_model(like.oblique, lambda r, j=j: _contact(fit, r, {n: p[n][j] for n in PARAMETER_NAMES}),
+                                  {"friction": p["friction"][j]}) for j in range(6)])
+    np.testing.assert_array_equal(np.isnan(many), np.isnan(one))
+    assert np.isnan(one[0]).any() and np.isfinite(one).sum() >= 12
+    np.testing.assert_allclose(many[np.isfinite(one)], one[np.isfinite(one)], rtol=1e-12)
+
+
 def test_method_is_checked():
     with pytest.raises(ValueError, match="method must be one of emulator, solve"):
         _Likelihood(None, None, None, "auto", 1e-8, method="table")

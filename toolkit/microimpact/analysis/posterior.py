@@ -69,7 +69,7 @@ import xarray as xr
 from microimpact._runtime.signals import interrupt_at_checkpoints
 from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX, ess_bulk, split_rhat
 from microimpact.analysis.fitting import DAMPING_RANGES, FitProblem, model_restitution
-from microimpact.analysis.oblique import ObliqueProblem, oblique_model
+from microimpact.analysis.oblique import ObliqueProblem, _observables, oblique_model, rebound_from_impulses
 from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.formatting import ReportHTML
 from microimpact.analysis.fit_result import PARAMETER_NAMES, FitResult
@@ -532,13 +532,52 @@ class _Likelihood:
             like = (np.exp(self.log_density((ml - e) / s)) * self.weights).sum(axis=2)
             logl += np.sum(np.log(np.maximum(like, 1e-300)), axis=1)
         if self.oblique is not None:
-            for j in range(m.shape[0]):
-                values = {n: float(p[n][j]) for n in PARAMETER_NAMES}
-                mo = oblique_model(self.oblique, lambda r: _contact(self.fit, r, values), {"friction": float(p["friction"][j])},
-                                   rtol=self.rtol)
-                r2 = np.nan_to_num((mo - self.oblique.measured) / self.oblique_sigma, nan=1e3)
-                logl[j] -= 0.5 * float(r2 @ r2)
+            mo = self._oblique_many(p)
+            if mo is None:  # not the ring law: oblique_model per parameter set
+                mo = np.array([oblique_model(self.oblique, lambda r, j=j: _contact(self.fit, r, {n: float(p[n][j]) for n in PARAMETER_NAMES}),
+                                             {"friction": float(p["friction"][j])}, rtol=self.rtol) for j in range(m.shape[0])])
+            r2 = np.nan_to_num((mo - self.oblique.measured) / self.oblique_sigma, nan=1e3)
+            logl -= 0.5 * np.sum(r2 * r2, axis=1)
         return logl
+
+    def _oblique_many(self, p: dict):
+        """:func:`~microimpact.analysis.oblique.oblique_model` of K parameter sets, shape (K, entries),
+        or None where a contact is not the ring law (or a w_A is not > 0).
+
+        The normal solves of all sets in one engine call from their groups (the groups, X / T and X
+        at each w_A by their powers of w_A, as :meth:`_speed_groups_many`), the impulses in SI units
+        as :func:`~microimpact.solvers.engine.solve_normal_many` gives them (J = J' m X / T,
+        J_a = J_a' m X / T sqrt(r X)), and the closed-form tangential map of each set's friction."""
+        ob, w = self.oblique, np.asarray(p["work_of_adhesion"], dtype=float)
+        w_ref = float(self.fit.values["work_of_adhesion"])
+        if not (w_ref > 0.0 and np.all(w > 0.0)):
+            return None
+        k = w.size
+        s = (w / w_ref)[:, None]
+        out = np.empty((k, ob.size))
+        for r in np.unique(ob.radius):
+            idx = np.flatnonzero(ob.radius == r)
+            c = _contact(self.fit, float(r), dict(self.fit.values) | {"zeta_hertz": 1.0, "zeta_adhesion": 1.0})
+            if reduction.law_of(c) != "ring":
+                return None
+            v, alpha = ob.speed[idx], np.radians(np.clip(ob.incidence_deg[idx], 0.0, 89.9))
+            vn = v * np.cos(alpha)
+            speeds, inverse = np.unique(vn, return_inverse=True)  # one solve per distinct normal speed
+            y_ref, per_ref, _ = reduction.ring_groups([c], speeds[None, :])
+            per = per_ref * s ** (5.0 / 6.0)
+            sol = ring_groups_batch.outcome_of_groups(y_ref * s ** (-5.0 / 6.0), np.asarray(p["zeta_hertz"])[:, None] * per,
+                                                      np.asarray(p["zeta_adhesion"])[:, None] * per, rtol=self.rtol)
+            ju = c.mass * c.length_scale / c.time_scale * s ** (5.0 / 6.0)  # m X / T of each set
+            jt = ju * np.sqrt(c.radius * c.length_scale * s ** (2.0 / 3.0))
+            impulses = {"captured": sol["captured"][:, inverse].ravel(), "e_n": sol["e_n"][:, inverse].ravel(),
+                        "velocity_in_n": np.tile(vn, k), "velocity_in_t": np.tile(v * np.sin(alpha), k),
+                        "friction_impulse": (sol["friction_impulse"] * ju)[:, inverse].ravel(),
+                        "twist_impulse": (sol["twist_impulse"] * jt)[:, inverse].ravel()}
+            st = rebound_from_impulses(c, impulses, np.tile(ob.spin[idx], k),
+                                       friction=np.repeat(np.asarray(p["friction"], dtype=float), idx.size))
+            values = _observables(st, np.tile(v, k), np.tile(ob.incidence_deg[idx], k), np.tile(ob.quantity[idx], k))
+            out[:, idx] = np.where(st["captured"], np.nan, values).reshape(k, idx.size)
+        return out
 
     def log_density(self, z):
         """log of the e_n density at standardized residuals z, up to a constant: -z^2/2 (normal) or

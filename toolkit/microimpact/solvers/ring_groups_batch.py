@@ -22,7 +22,52 @@ import numpy as np
 from microimpact.solvers import MIN_RTOL, DEFAULT_RTOL, engine
 from microimpact.solvers.emulator import FALLBACK_RTOL, NEAR_CAPTURE_E, NODE_RTOL_FLOOR
 
-__all__ = ["restitution_of_groups", "fallback_of_groups"]
+__all__ = ["restitution_of_groups", "fallback_of_groups", "outcome_of_groups"]
+
+
+def outcome_of_groups(y0, c1, c2, *, rtol: float = DEFAULT_RTOL) -> dict:
+    """:func:`restitution_of_groups` with the impulses: ``captured``, ``e_n`` [-], and the friction and
+    twist impulses in the groups' units, ``friction_impulse`` J / (m X / T) and ``twist_impulse``
+    J_a / (m X / T sqrt(r X)) [-] (the engine's own; :func:`~microimpact.solvers.engine.solve_normal_many`
+    multiplies them by these scales).
+
+    Examples
+    --------
+    >>> from microimpact.model.parameters import TABLE1_ROW2 as c
+    >>> from microimpact.model import reduction
+    >>> out = outcome_of_groups(*reduction.ring_groups([c], [[3.0]]), rtol=1e-10)
+    >>> j = engine.solve_normal_many(c, [3.0], rtol=1e-10)["friction_impulse"][0] / (c.mass * c.length_scale / c.time_scale)
+    >>> bool(abs(out["friction_impulse"][0, 0] / j - 1) < 1e-9)
+    True
+    """
+    y, a, b = (np.array(x, dtype=float) for x in np.broadcast_arrays(y0, c1, c2))
+    shape = y.shape
+    out = _solve(y.ravel(), a.ravel(), b.ravel(), rtol)
+    captured = out[:, 1] == engine.CAPTURE
+    e = np.where(captured, 0.0, -out[:, 2] / y.ravel())
+    engine._check_restitution(e, y.ravel(), rtol)
+    return {"captured": captured.reshape(shape), "e_n": e.reshape(shape), "friction_impulse": out[:, 5].reshape(shape),
+            "twist_impulse": out[:, 6].reshape(shape)}
+
+
+def _solve(y, a, b, rtol) -> np.ndarray:
+    """The engine batch kernel's rows (status, outcome, y_end, ..., impulses) of the impacts (y0, C1, C2)."""
+    y, a, b = (np.ascontiguousarray(x, dtype=float) for x in (y, a, b))
+    if y.size and not (np.all(y >= engine.MIN_NONDIMENSIONAL_SPEED) and np.all(y <= engine.MAX_ADHESIVE_SPEED)):
+        raise ValueError(f"y0 must lie in [{engine.MIN_NONDIMENSIONAL_SPEED:g}, {engine.MAX_ADHESIVE_SPEED:g}] "
+                         "(the paper's scales)")
+    ones, no = np.ones(y.size), np.zeros(y.size, dtype=np.bool_)
+    inf = np.full(y.size, np.inf)
+    out = np.empty((y.size, 11))
+    # writable, contiguous arrays of the engine's own dtypes: one compiled kernel for every caller
+    engine._integrate_many(y, a, b, ones, ones.copy(), float(rtol), no, float(rtol), int(engine._MAX_STEPS_DEFAULT),
+                           inf, inf.copy(), out)
+    status = out[:, 0]
+    if np.any(status != engine._OK):
+        i = int(np.flatnonzero(status != engine._OK)[0])
+        raise engine.EngineError(f"engine failed at y0 = {y[i]!r}, C1 = {a[i]!r}, C2 = {b[i]!r}: "
+                                 f"{engine._failure(status[i])}")
+    return out
 
 
 def restitution_of_groups(y0, c1, c2, *, rtol: float = DEFAULT_RTOL) -> np.ndarray:
@@ -59,26 +104,7 @@ def restitution_of_groups(y0, c1, c2, *, rtol: float = DEFAULT_RTOL) -> np.ndarr
     >>> bool(abs(e - engine.solve_normal_many(c, [0.5, 3.0], rtol=1e-10)["e_n"]).max() < 1e-9), float(e[0, 0])
     (True, 0.0)
     """
-    y, a, b = (np.array(x, dtype=float) for x in np.broadcast_arrays(y0, c1, c2))
-    shape = y.shape
-    y, a, b = (np.ascontiguousarray(x.ravel()) for x in (y, a, b))
-    if y.size and not (np.all(y >= engine.MIN_NONDIMENSIONAL_SPEED) and np.all(y <= engine.MAX_ADHESIVE_SPEED)):
-        raise ValueError(f"y0 must lie in [{engine.MIN_NONDIMENSIONAL_SPEED:g}, {engine.MAX_ADHESIVE_SPEED:g}] "
-                         "(the paper's scales)")
-    ones, no = np.ones(y.size), np.zeros(y.size, dtype=np.bool_)
-    inf = np.full(y.size, np.inf)
-    out = np.empty((y.size, 11))
-    # writable, contiguous arrays of the engine's own dtypes: one compiled kernel for every caller
-    engine._integrate_many(y, a, b, ones, ones.copy(), float(rtol), no, float(rtol), int(engine._MAX_STEPS_DEFAULT),
-                           inf, inf.copy(), out)
-    status = out[:, 0]
-    if np.any(status != engine._OK):
-        i = int(np.flatnonzero(status != engine._OK)[0])
-        raise engine.EngineError(f"engine failed at y0 = {y[i]!r}, C1 = {a[i]!r}, C2 = {b[i]!r}: "
-                                 f"{engine._failure(status[i])}")
-    e = np.where(out[:, 1] == engine.CAPTURE, 0.0, -out[:, 2] / y)
-    engine._check_restitution(e, y, rtol)
-    return e.reshape(shape)
+    return outcome_of_groups(y0, c1, c2, rtol=rtol)["e_n"]
 
 
 def fallback_of_groups(y0, c1, c2, tol: float) -> np.ndarray:
