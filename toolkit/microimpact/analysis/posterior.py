@@ -48,8 +48,11 @@ posterior is returned, written or reported. A parameter the least-squares fit fi
 (a one-sided bound, or nothing) is reported from the fit's profile bound, since the posterior beyond
 it is the prior's (:meth:`Posterior.bound`).
 
-Every model evaluation goes through :func:`microimpact.solvers.engine.solve_normal_many` (e_n) or
-:func:`microimpact.simulate_many` (tangential), so faster solvers speed up the sampler too.
+The walkers of one emcee step are evaluated together (``vectorize=True``): with the emulator
+(``method="emulator"``) their e_n is one table lookup, and the impacts the table leaves to the
+solver, like the normal solves of the oblique rows, are one engine call over the groups of all
+walkers (:mod:`microimpact.solvers.ring_groups_batch`); with ``method="solve"`` each walker's e_n
+goes through :func:`microimpact.solvers.engine.solve_normal_many`.
 """
 
 from __future__ import annotations
@@ -502,7 +505,7 @@ class _Likelihood:
 
     def _emulated(self, zeta_hertz, zeta_adhesion, work_of_adhesion, y0, per) -> np.ndarray:
         """e_n (K, speeds) by the table where it meets ``tol``, by the emulator's fallback solves
-        elsewhere (per parameter set and radius). [-]"""
+        elsewhere (all parameter sets in one engine call). [-]"""
         if getattr(self, "_table", None) is None:  # looked up once: the lookup hashes the physics' source
             self._table = emulator.ring_emulator(emulator.table_tolerance(self.tol), self.domain)
         c1, c2 = zeta_hertz[:, None] * per, zeta_adhesion[:, None] * per
