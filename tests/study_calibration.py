@@ -219,7 +219,8 @@ def run_design(design: dict, *, posterior: bool = False, folder: Path | None = N
     Returns
     -------
     dict
-        ``seed``, ``n_rows``, ``seconds``, and per fitted parameter a record: ``truth``, ``kind``,
+        ``seed``, ``n_rows``, ``seconds`` (wall), ``cpu_seconds`` (this process's CPU), and per
+        fitted parameter a record: ``truth``, ``kind``,
         the fit's ``status``, ``value``, ``lower``, ``upper``, ``covered``, ``printed_relative_error``
         (the relative standard error printed as a number, NaN where none is printed) and, with
         ``posterior``, ``posterior_lower``/``posterior_upper``/``posterior_covered`` (or
@@ -237,7 +238,7 @@ def run_design(design: dict, *, posterior: bool = False, folder: Path | None = N
     >>> {n: (record[n]["status"], record[n]["covered"]) for n in ("zeta_hertz", "zeta_adhesion")}
     {'zeta_hertz': ('upper_bound', True), 'zeta_adhesion': ('determined', True)}
     """
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     with tempfile.TemporaryDirectory() as tmp:
         path = _simulate(design, Path(folder or tmp))
         with warnings.catch_warnings():
@@ -256,7 +257,8 @@ def run_design(design: dict, *, posterior: bool = False, folder: Path | None = N
         fit = fit_damping(table, base, fit_work_of_adhesion=design["fit_work_of_adhesion"], confidence_intervals=False)
         ff = fit_friction(table, fit) if oblique else None
     except (ValueError, RuntimeError) as exc:
-        return out | {"error": f"{type(exc).__name__}: {exc}", "seconds": time.perf_counter() - t0}
+        return out | {"error": f"{type(exc).__name__}: {exc}", "seconds": time.perf_counter() - t0,
+                      "cpu_seconds": time.process_time() - c0}
     damping_kind = "one speed" if design["one_speed"] else "speed range"
     statuses = dict(fit.identifiability)
     kinds = {n: damping_kind for n in statuses}
@@ -275,6 +277,7 @@ def run_design(design: dict, *, posterior: bool = False, folder: Path | None = N
     if posterior:
         _check_posterior(out, table, fit, ff, design)
     out["seconds"] = time.perf_counter() - t0
+    out["cpu_seconds"] = time.process_time() - c0  # this process's CPU (one engine thread): the cost on a shared machine
     return out
 
 
@@ -309,7 +312,7 @@ def _worker(args):
 
 
 def calibration_study(n_designs: int, *, seed: int = 0, posterior_designs: int = 0, workers: int = 1,
-                      time_budget: float | None = None, progress: bool = False) -> list[dict]:
+                      time_budget: float | None = None, progress: bool = False, records_path=None) -> list[dict]:
     """Run :func:`run_design` for ``n_designs`` random designs (seeds ``seed`` ... ``seed + n - 1``).
 
     Parameters
@@ -325,6 +328,10 @@ def calibration_study(n_designs: int, *, seed: int = 0, posterior_designs: int =
         Wall-clock budget [s]; the study stops with TimeBudgetExceeded once past it.
     progress : bool
         One line per design on stderr.
+    records_path : path, optional
+        A JSON-lines file: each finished design's record is appended to it as it finishes, and the
+        designs already in it (same seed, same posterior flag) are taken from it instead of run
+        again, so that an interrupted study resumes where it stopped.
 
     Returns
     -------
@@ -342,14 +349,19 @@ def calibration_study(n_designs: int, *, seed: int = 0, posterior_designs: int =
     """
     deadline = Deadline.start(time_budget, "calibration study")
     jobs = [(seed + k, k < posterior_designs) for k in range(n_designs)]
-    records = []
+    done = _read_records(records_path, jobs)
+    records = list(done.values())
+    jobs = [j for j in jobs if j[0] not in done]
 
     def note(rec):
         records.append(rec)
+        if records_path is not None:
+            with open(records_path, "a") as f:  # one line per design, written as it finishes
+                f.write(json.dumps(rec, default=float) + "\n")
         if progress:
             parts = [f"{n} {'in' if rec[n]['covered'] else 'OUT'} ({rec[n]['status']})" for n in FITTED if n in rec]
             print(f"calibration: design {len(records)}/{n_designs} (seed {rec['seed']}, {rec['n_rows']} rows): "
-                  + (rec.get("error") or ", ".join(parts)) + f", {rec['seconds']:.1f} s", file=sys.stderr, flush=True)
+                  + (rec.get("error") or ", ".join(parts)) + f", {rec['seconds']:.1f} s ({rec.get('cpu_seconds', math.nan):.1f} CPU-s)", file=sys.stderr, flush=True)
         deadline.check(f"{len(records)} of {n_designs} designs")
 
     if workers > 1:
@@ -360,6 +372,23 @@ def calibration_study(n_designs: int, *, seed: int = 0, posterior_designs: int =
         for job in jobs:
             note(_worker(job))
     return sorted(records, key=lambda r: r["seed"])
+
+
+def _read_records(path, jobs) -> dict:
+    """{seed: record} of the designs of ``jobs`` already in the JSON-lines file ``path`` (a record
+    counts only when it was run with the posterior flag the job asks for)."""
+    if path is None or not Path(path).exists():
+        return {}
+    wanted = dict(jobs)
+    done = {}
+    for line in Path(path).read_text().splitlines():
+        if not line.strip():
+            continue
+        rec = json.loads(line)
+        with_posterior = any("posterior_covered" in rec.get(n, {}) or "posterior_error" in rec.get(n, {}) for n in FITTED)
+        if rec["seed"] in wanted and (with_posterior == wanted[rec["seed"]] or "error" in rec):
+            done[rec["seed"]] = rec
+    return done
 
 
 def _binomial(k: int, n: int) -> dict:
@@ -642,6 +671,8 @@ def main(argv=None) -> int:
     p.add_argument("--workers", type=int, default=1, help="processes (default 1)")
     p.add_argument("--time-budget", type=float, default=None, metavar="SECONDS", help="stop past this wall-clock time")
     p.add_argument("--out", required=True, help="output JSON")
+    p.add_argument("--records", default=None, metavar="JSONL",
+                   help="append each design's record here as it finishes and resume from the designs already in it")
     p.add_argument("--figure", default=None, help="also draw the coverage figure here (.png or .pdf)")
     p.add_argument("--dirty", type=int, default=0, metavar="N",
                    help="instead: the dirty-data study, N seeds of each kind (clean, 1-3 outliers, Thornton law)")
@@ -660,13 +691,16 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     try:
         records = calibration_study(args.designs, seed=args.seed, posterior_designs=args.posterior_designs,
-                                    workers=args.workers, time_budget=args.time_budget, progress=True)
+                                    workers=args.workers, time_budget=args.time_budget, progress=True,
+                                    records_path=args.records)
     except TimeBudgetExceeded as exc:
         print(f"calibration: error: {exc}", file=sys.stderr)
         return 3
     summary = summarise(records)
     summary["setup"] = {"designs": args.designs, "posterior_designs": args.posterior_designs, "seed": args.seed,
-                        "level": LEVEL, "seconds": round(time.perf_counter() - t0, 1)}
+                        "level": LEVEL, "workers": args.workers, "seconds": round(time.perf_counter() - t0, 1),
+                        "cpu_seconds_of_the_designs": round(sum(r.get("cpu_seconds", math.nan) for r in records), 1),
+                        "command": "python tests/study_calibration.py " + " ".join(argv if argv is not None else sys.argv[1:])}
     with atomic_write(args.out) as f:
         json.dump({"summary": summary, "designs": records}, f, indent=1, default=float)
     if args.figure:

@@ -17,7 +17,9 @@ from microimpact.analysis.posterior import DEFAULT_METHOD, _Likelihood, sample_p
 from microimpact.cli import main
 from microimpact.analysis.synthetic import write_synthetic_impacts
 from microimpact.io import default_materials_path, read_impacts, read_materials
+from microimpact.model import reduction
 from microimpact.solvers import emulator as em
+from microimpact.solvers import ring_groups_batch
 
 #: a small box of groups about the six impacts' (C1 2e-3 to 4e-3, C2 0.09 to 0.2): a table that builds
 #: in seconds; the impacts outside it go to the fallback solves, which the test covers as well
@@ -79,6 +81,88 @@ def test_emulated_model_is_the_solver_where_it_falls_back(six):
         b = emulated.model(p)
     # the fallback solves at rtol tol / 100 and the reference at 1e-10: they differ by ~1e-5 at most
     assert np.max(np.abs(solve.model(p) - b)) <= 10 * TOL * em.FALLBACK_RTOL
+
+
+@pytest.mark.extended
+def test_groups_of_many_work_of_adhesion_values_are_the_contacts_own(six):
+    # the walkers' groups come from the fit's by powers of w_A (_speed_groups_many); built from a
+    # contact at each w_A they must agree to rounding (a few ulps: the powers and the scales differ
+    # in the order of their products)
+    table, fit = six
+    like = _Likelihood(fit, table, None, "auto", 1e-10, method="emulator", tol=TOL)
+    w = fit.values["work_of_adhesion"] * np.array([0.2, 1.0, 1.3, 4.0])
+    y0, per = like._speed_groups_many(w)
+    pr = like.problem
+    for k, wk in enumerate(w):
+        for r, idx in zip(pr.radii, pr.groups):
+            y, c1, c2 = reduction.ring_groups([pr.contact(r, 1.0, 2.0, float(wk))], pr.normal_speed[idx][None, :])
+            np.testing.assert_allclose(y0[k, idx], y[0], rtol=1e-13)
+            np.testing.assert_allclose(per[k, idx], c1[0], rtol=1e-13)
+            np.testing.assert_allclose(2.0 * per[k, idx], c2[0], rtol=1e-13)
+    assert like._speed_groups_many(np.array([0.0])) is None  # no adhesion: not the ring law, the solver
+
+
+@pytest.mark.extended
+def test_the_likelihood_of_many_walkers_is_each_walkers_own(six):
+    # emcee's vectorized call (one table lookup for all walkers) against one call per walker: the
+    # same numbers, bit for bit where w_A is the fit's, to rounding of the groups elsewhere
+    table, fit = six
+    like = _Likelihood(fit, table, None, "auto", 1e-10, method="emulator", tol=TOL)
+    like.domain = BOX
+    rng = np.random.default_rng(8)
+    p = {"zeta_hertz": rng.uniform(0.3, 0.7, 5), "zeta_adhesion": rng.uniform(27.0, 31.0, 5),
+         "work_of_adhesion": np.full(5, fit.values["work_of_adhesion"]), "friction": np.full(5, 0.3)}
+    many = like.many(p)
+    one = [like({n: v[k] for n, v in p.items()}) for k in range(5)]
+    np.testing.assert_array_equal(many, one)
+    p["work_of_adhesion"] = p["work_of_adhesion"] * rng.uniform(0.9, 1.1, 5)
+    np.testing.assert_allclose(like.many(p), [like({n: v[k] for n, v in p.items()}) for k in range(5)], rtol=1e-12)
+
+
+def test_fallback_of_many_contacts_is_each_contacts_own():
+    # the posterior's fallback for all walkers at once (one engine call over their groups) against
+    # emulator.fallback_restitution of each contact: both solve to e_n within tol (rtol tol / 100,
+    # tighter near capture), so they differ by far less than tol; captures (e_n = 0) agree exactly
+    from microimpact.model.parameters import TABLE1_ROW2
+    rng = np.random.default_rng(3)
+    contacts = [TABLE1_ROW2.with_(zeta_hertz=float(zh), zeta_adhesion=float(za), radius=float(r))
+                for zh, za, r in zip(rng.uniform(0.0, 2.0, 6), rng.uniform(3.0, 100.0, 6), rng.uniform(0.5e-6, 1e-5, 6))]
+    speeds = np.geomspace(0.05, 100.0, 7)
+    y0, c1, c2 = reduction.ring_groups(contacts, np.tile(speeds, (len(contacts), 1)))
+    tol = 1e-6
+    got = ring_groups_batch.fallback_of_groups(y0, c1, c2, tol)
+    want = np.array([em.fallback_restitution(c, speeds, tol) for c in contacts])
+    assert (got == 0.0).any() and (got > 0.0).any()  # captures and rebounds both checked
+    np.testing.assert_array_equal(got == 0.0, want == 0.0)
+    assert np.max(np.abs(got - want)) <= 0.5 * tol
+    with pytest.raises(ValueError, match="y0 must lie in"):
+        ring_groups_batch.restitution_of_groups([0.0], [1e-3], [0.1])
+
+
+@pytest.mark.extended
+def test_oblique_model_of_many_walkers_is_each_walkers_own(tmp_path):
+    # the oblique part of the likelihood for all walkers at once (one engine call over their
+    # groups, the closed-form tangential map) against oblique_model per walker: the same kernel and
+    # rtol, groups to rounding, so agreement to 1e-12 relative; captures (NaN) at the same entries
+    from microimpact.analysis.oblique import fit_friction, oblique_model
+    from microimpact.analysis.posterior import PARAMETER_NAMES, _contact
+    from microimpact.analysis.synthetic import make_synthetic_oblique
+    from microimpact.io import write_csv
+    material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    data = make_synthetic_oblique(radii=(3.45e-6,), speeds=(2.0, 15.0), incidence_deg=(20.0, 50.0, 70.0))
+    table = read_impacts(write_csv(data, tmp_path / "oblique.csv"))
+    fit = fit_damping(table, material, fit_work_of_adhesion=True, confidence_intervals=False)
+    ff = fit_friction(table, fit)
+    like = _Likelihood(fit, table, ff, "auto", 1e-8, method="emulator")
+    rng = np.random.default_rng(4)
+    p = {n: fit.values[n] * rng.uniform(0.7, 1.4, 6) for n in PARAMETER_NAMES} | {"friction": rng.uniform(0.05, 1.0, 6)}
+    p["zeta_adhesion"][0] = 500.0  # a walker whose slow impacts are captured
+    many = like._oblique_many(p)
+    one = np.array([oblique_model(like.oblique, lambda r, j=j: _contact(fit, r, {n: p[n][j] for n in PARAMETER_NAMES}),
+                                  {"friction": p["friction"][j]}) for j in range(6)])
+    np.testing.assert_array_equal(np.isnan(many), np.isnan(one))
+    assert np.isnan(one[0]).any() and np.isfinite(one).sum() >= 12
+    np.testing.assert_allclose(many[np.isfinite(one)], one[np.isfinite(one)], rtol=1e-12)
 
 
 def test_method_is_checked():

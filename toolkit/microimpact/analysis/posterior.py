@@ -48,8 +48,11 @@ posterior is returned, written or reported. A parameter the least-squares fit fi
 (a one-sided bound, or nothing) is reported from the fit's profile bound, since the posterior beyond
 it is the prior's (:meth:`Posterior.bound`).
 
-Every model evaluation goes through :func:`microimpact.solvers.engine.solve_normal_many` (e_n) or
-:func:`microimpact.simulate_many` (tangential), so faster solvers speed up the sampler too.
+The walkers of one emcee step are evaluated together (``vectorize=True``): with the emulator
+(``method="emulator"``) their e_n is one table lookup, and the impacts the table leaves to the
+solver, like the normal solves of the oblique rows, are one engine call over the groups of all
+walkers (:mod:`microimpact.solvers.ring_groups_batch`); with ``method="solve"`` each walker's e_n
+goes through :func:`microimpact.solvers.engine.solve_normal_many`.
 """
 
 from __future__ import annotations
@@ -69,7 +72,7 @@ import xarray as xr
 from microimpact._runtime.signals import interrupt_at_checkpoints
 from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX, ess_bulk, split_rhat
 from microimpact.analysis.fitting import DAMPING_RANGES, FitProblem, model_restitution
-from microimpact.analysis.oblique import ObliqueProblem, oblique_model
+from microimpact.analysis.oblique import ObliqueProblem, _observables, oblique_model, rebound_from_impulses
 from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.formatting import ReportHTML
 from microimpact.analysis.fit_result import PARAMETER_NAMES, FitResult
@@ -84,7 +87,7 @@ from microimpact.model.parameters import TABLE2_CASES
 from microimpact.solvers import DEFAULT_RTOL, Deadline, engine, engine_threads
 from microimpact.solvers.impact import simulate_many
 from microimpact.model import reduction
-from microimpact.solvers import emulator
+from microimpact.solvers import emulator, ring_groups_batch
 
 __all__ = ["Posterior", "PosteriorError", "sample_posterior", "prior_bounds", "DEFAULT_WALKERS", "DEFAULT_MAX_STEPS",
            "DEFAULT_SEED", "DEFAULT_N_DRAWS", "posterior_contacts", "restitution_bands", "capture_velocity_interval",
@@ -450,9 +453,16 @@ class _Likelihood:
 
     def model(self, p: dict) -> np.ndarray:
         """Model e_n at the likelihood's speeds (plain rows, then the latent rows' nodes). [-]"""
-        if self.method == "emulator":
-            return self._emulated(p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"])
-        return model_restitution(self.problem, p["zeta_hertz"], p["zeta_adhesion"], p["work_of_adhesion"], rtol=self.rtol)
+        return self.model_many({n: np.array([float(p[n])]) for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion")})[0]
+
+    def model_many(self, p: dict) -> np.ndarray:
+        """:meth:`model` of K parameter sets at once: ``p`` maps zeta_hertz, zeta_adhesion and
+        work_of_adhesion to arrays of shape (K,); e_n of shape (K, speeds). [-]"""
+        zh, za, wa = (np.asarray(p[n], dtype=float).ravel() for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion"))
+        g = self._speed_groups_many(wa) if self.method == "emulator" else None
+        if g is None:  # the solver (method "solve", or not the ring law): one model evaluation per set
+            return np.array([model_restitution(self.problem, a, b, w, rtol=self.rtol) for a, b, w in zip(zh, za, wa)])
+        return self._emulated(zh, za, wa, *g)
 
     def _speed_groups(self, work_of_adhesion):
         """(y0, C1 / zeta_H = C2 / zeta_A) of every speed at ``work_of_adhesion``, or None where a
@@ -473,45 +483,104 @@ class _Likelihood:
             self._groups = {key: (y0, per) if ok else None}  # one w_A at a time: a fitted w_A moves every call
         return self._groups[key]
 
-    def _emulated(self, zeta_hertz, zeta_adhesion, work_of_adhesion) -> np.ndarray:
-        """e_n by the table where it meets ``tol``, by the emulator's fallback solves elsewhere. [-]"""
-        g = self._speed_groups(work_of_adhesion)
-        pr = self.problem
-        if g is None:  # not the ring law: the solver
-            return model_restitution(pr, zeta_hertz, zeta_adhesion, work_of_adhesion, rtol=self.rtol)
-        y0, per = g
+    def _speed_groups_many(self, work_of_adhesion):
+        """(y0, C1 / zeta_H) of every speed for each w_A of the array ``work_of_adhesion`` (K,),
+        shape (K, speeds), or None where the law is not the ring law (or a w_A is not > 0).
+
+        From the groups at the fit's w_A by their powers of w_A: f0 ~ w_A^(2/3) (Eq. (7)), so
+        X = B / A ~ w_A^(2/3), T = (m / sqrt(A B))^(1/2) ~ w_A^(-1/6) (Eqs. (29)-(30)) and X / T ~
+        w_A^(5/6); y0 = v T / X ~ w_A^(-5/6), and C1 / zeta_H = (X / T) / (D v_ref^(1/5)) ~ w_A^(5/6)
+        (D does not hold f0). A contact per walker would cost more than the table lookup itself;
+        tests/test_posterior_speed.py compares these groups with the contacts' own."""
+        w = np.asarray(work_of_adhesion, dtype=float).ravel()
+        w_ref = float(self.fit.values["work_of_adhesion"])
+        if not (w_ref > 0.0 and np.all(w > 0.0)):
+            return None
+        g = self._speed_groups(w_ref)
+        if g is None:
+            return None
+        s = (w / w_ref)[:, None]
+        same = s == 1.0  # the fit's w_A (w_A given, not fitted): its groups as they are
+        return np.where(same, g[0], g[0] * s ** (-5.0 / 6.0)), np.where(same, g[1], g[1] * s ** (5.0 / 6.0))
+
+    def _emulated(self, zeta_hertz, zeta_adhesion, work_of_adhesion, y0, per) -> np.ndarray:
+        """e_n (K, speeds) by the table where it meets ``tol``, by the emulator's fallback solves
+        elsewhere (all parameter sets in one engine call). [-]"""
         if getattr(self, "_table", None) is None:  # looked up once: the lookup hashes the physics' source
             self._table = emulator.ring_emulator(emulator.table_tolerance(self.tol), self.domain)
-        table = self._table
-        e, _, solve = table.evaluate(y0, zeta_hertz * per, zeta_adhesion * per, self.tol)
+        c1, c2 = zeta_hertz[:, None] * per, zeta_adhesion[:, None] * per
+        e, _, solve = self._table.evaluate(y0, c1, c2, self.tol)
         e = np.array(e, dtype=float)
         if solve.any():
+            # every walker's fallback impacts in one engine call, from their groups (the impacts of
+            # many contacts: ring_groups_batch); the tolerances of emulator.fallback_restitution
             with engine_threads(1):
-                for r, idx in zip(pr.radii, pr.groups):
-                    s = idx[solve[idx]]
-                    if s.size:
-                        e[s] = emulator.fallback_restitution(pr.contact(r, zeta_hertz, zeta_adhesion, work_of_adhesion),
-                                                  pr.normal_speed[s], self.tol)
+                e[solve] = ring_groups_batch.fallback_of_groups(y0[solve], c1[solve], c2[solve], self.tol)
         return e
 
     def __call__(self, p: dict) -> float:
-        m = self.model(p)
+        return float(self.many({n: np.array([float(v)]) for n, v in p.items()})[0])
+
+    def many(self, p: dict) -> np.ndarray:
+        """log p(data | parameters) of K parameter sets: ``p`` maps every parameter name to an
+        array of shape (K,) (the walkers of one emcee step, ``vectorize=True``). [-]"""
+        m = self.model_many(p)
         plain = ~self.latent
-        res = (m[: self.n_plain] - self.e[plain]) / self.sig_eff[plain]
-        logl = float(np.sum(self.log_density(res)))
+        res = (m[:, : self.n_plain] - self.e[plain]) / self.sig_eff[plain]
+        logl = np.sum(self.log_density(res), axis=1)
         if self.latent.any():
             k = GAUSS_HERMITE_NODES
-            ml = m[self.n_plain:].reshape(-1, k)
+            ml = m[:, self.n_plain:].reshape(m.shape[0], -1, k)
             e, s = self.e[self.latent, None], self.sig_e[self.latent, None]
-            like = (np.exp(self.log_density((ml - e) / s)) * self.weights[None, :]).sum(axis=1)
-            logl += float(np.sum(np.log(np.maximum(like, 1e-300))))
+            like = (np.exp(self.log_density((ml - e) / s)) * self.weights).sum(axis=2)
+            logl += np.sum(np.log(np.maximum(like, 1e-300)), axis=1)
         if self.oblique is not None:
-            values = {n: p[n] for n in PARAMETER_NAMES}
-            mo = oblique_model(self.oblique, lambda r: _contact(self.fit, r, values), {"friction": p["friction"]},
-                               rtol=self.rtol)
+            mo = self._oblique_many(p)
+            if mo is None:  # not the ring law: oblique_model per parameter set
+                mo = np.array([oblique_model(self.oblique, lambda r, j=j: _contact(self.fit, r, {n: float(p[n][j]) for n in PARAMETER_NAMES}),
+                                             {"friction": float(p["friction"][j])}, rtol=self.rtol) for j in range(m.shape[0])])
             r2 = np.nan_to_num((mo - self.oblique.measured) / self.oblique_sigma, nan=1e3)
-            logl -= 0.5 * float(r2 @ r2)
+            logl -= 0.5 * np.sum(r2 * r2, axis=1)
         return logl
+
+    def _oblique_many(self, p: dict):
+        """:func:`~microimpact.analysis.oblique.oblique_model` of K parameter sets, shape (K, entries),
+        or None where a contact is not the ring law (or a w_A is not > 0).
+
+        The normal solves of all sets in one engine call from their groups (the groups, X / T and X
+        at each w_A by their powers of w_A, as :meth:`_speed_groups_many`), the impulses in SI units
+        as :func:`~microimpact.solvers.engine.solve_normal_many` gives them (J = J' m X / T,
+        J_a = J_a' m X / T sqrt(r X)), and the closed-form tangential map of each set's friction."""
+        ob, w = self.oblique, np.asarray(p["work_of_adhesion"], dtype=float)
+        w_ref = float(self.fit.values["work_of_adhesion"])
+        if not (w_ref > 0.0 and np.all(w > 0.0)):
+            return None
+        k = w.size
+        s = (w / w_ref)[:, None]
+        out = np.empty((k, ob.size))
+        for r in np.unique(ob.radius):
+            idx = np.flatnonzero(ob.radius == r)
+            c = _contact(self.fit, float(r), dict(self.fit.values) | {"zeta_hertz": 1.0, "zeta_adhesion": 1.0})
+            if reduction.law_of(c) != "ring":
+                return None
+            v, alpha = ob.speed[idx], np.radians(np.clip(ob.incidence_deg[idx], 0.0, 89.9))
+            vn = v * np.cos(alpha)
+            speeds, inverse = np.unique(vn, return_inverse=True)  # one solve per distinct normal speed
+            y_ref, per_ref, _ = reduction.ring_groups([c], speeds[None, :])
+            per = per_ref * s ** (5.0 / 6.0)
+            sol = ring_groups_batch.outcome_of_groups(y_ref * s ** (-5.0 / 6.0), np.asarray(p["zeta_hertz"])[:, None] * per,
+                                                      np.asarray(p["zeta_adhesion"])[:, None] * per, rtol=self.rtol)
+            ju = c.mass * c.length_scale / c.time_scale * s ** (5.0 / 6.0)  # m X / T of each set
+            jt = ju * np.sqrt(c.radius * c.length_scale * s ** (2.0 / 3.0))
+            impulses = {"captured": sol["captured"][:, inverse].ravel(), "e_n": sol["e_n"][:, inverse].ravel(),
+                        "velocity_in_n": np.tile(vn, k), "velocity_in_t": np.tile(v * np.sin(alpha), k),
+                        "friction_impulse": (sol["friction_impulse"] * ju)[:, inverse].ravel(),
+                        "twist_impulse": (sol["twist_impulse"] * jt)[:, inverse].ravel()}
+            st = rebound_from_impulses(c, impulses, np.tile(ob.spin[idx], k),
+                                       friction=np.repeat(np.asarray(p["friction"], dtype=float), idx.size))
+            values = _observables(st, np.tile(v, k), np.tile(ob.incidence_deg[idx], k), np.tile(ob.quantity[idx], k))
+            out[:, idx] = np.where(st["captured"], np.nan, values).reshape(k, idx.size)
+        return out
 
     def log_density(self, z):
         """log of the e_n density at standardized residuals z, up to a constant: -z^2/2 (normal) or
@@ -701,10 +770,16 @@ class _LogProbability:
         self.base = {n: best[n] for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion", "friction") if n in best}
 
     def __call__(self, x):
-        if np.any(x < self.lo) or np.any(x > self.hi):
-            return -np.inf
-        value = self.like(self.base | dict(zip(self.names, map(float, x))))
-        return value if math.isfinite(value) else -np.inf
+        """log posterior of the walkers ``x`` (K, parameters), all at once (emcee's ``vectorize``)."""
+        x = np.atleast_2d(np.asarray(x, dtype=float))
+        out = np.full(x.shape[0], -np.inf)
+        inside = np.all((x >= self.lo) & (x <= self.hi), axis=1)
+        if inside.any():
+            n = int(inside.sum())
+            p = {k: np.full(n, v) for k, v in self.base.items()} | {k: x[inside, i] for i, k in enumerate(self.names)}
+            value = self.like.many(p)
+            out[inside] = np.where(np.isfinite(value), value, -np.inf)
+        return out
 
 
 def _sampler_options(walkers, steps, max_steps, burn, seed, n_params: int) -> tuple[int, int, bool]:
@@ -766,7 +841,7 @@ def _run_chain(log_probability, pos, seed, budget, fixed_length, burn, advance, 
     collapsed (PosteriorError) or out of ``budget`` steps."""
     rng = np.random.default_rng(seed)
     moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
-    sampler = emcee.EnsembleSampler(len(pos), len(names), log_probability, moves=moves)
+    sampler = emcee.EnsembleSampler(len(pos), len(names), log_probability, moves=moves, vectorize=True)
     sampler.random_state = np.random.RandomState(int(rng.integers(2**31))).get_state()  # seeded
     state = emcee.State(pos)
     done, previous_tau, diag = 0, None, None
