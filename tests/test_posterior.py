@@ -6,6 +6,7 @@ The data are the bundled SYNTHETIC microsphere file (data/README.md) and small s
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 from microimpact.analysis.fitting import FitProblem, fit_damping, model_restitution
-from microimpact.analysis.posterior import (GAUSS_HERMITE_NODES, Posterior, _Likelihood, capture_velocity_interval,
+from microimpact.analysis.posterior import (GAUSS_HERMITE_NODES, Posterior, PosteriorError, _Likelihood, capture_velocity_interval,
                                             restitution_bands, sample_posterior, sweep_bands)
 from microimpact.analysis.synthetic import make_synthetic_impacts
 from microimpact.io import default_materials_path, read_impacts, read_materials
@@ -35,6 +36,15 @@ def small(tmp_path_factory, pair):
     table = read_impacts(path)
     fit = fit_damping(table, pair, confidence_intervals=False)
     return table, fit, sample_posterior(table, fit, walkers=8, steps=120, seed=11, require_convergence=False)
+
+
+def test_a_fit_outside_the_prior_is_refused_naming_the_parameter(small):
+    # a calibration design's least squares put zeta_A at 1.8e5, beyond the prior's [0, 1e4]: the
+    # walkers, clipped onto the edge, were not linearly independent and emcee raised a ValueError
+    table, fit, _ = small
+    beyond = dataclasses.replace(fit, values=dict(fit.values) | {"zeta_adhesion": 1.8e5})
+    with pytest.raises(PosteriorError, match=r"zeta_adhesion = 180000 outside \[0, 10000\]"):
+        sample_posterior(table, beyond, walkers=8, steps=20, seed=11, require_convergence=False)
 
 
 def test_seeded_chain_is_reproducible(small):

@@ -711,7 +711,8 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     PosteriorError
         The chain collapsed (acceptance below :data:`MIN_ACCEPTANCE`, walkers at zero probability,
         no autocorrelation time) or has not converged (:data:`TAU_FACTOR` autocorrelation times,
-        R-hat, effective sample size: :mod:`microimpact.analysis.diagnostics`) within its budget.
+        R-hat, effective sample size: :mod:`microimpact.analysis.diagnostics`) within its budget,
+        or the fit lies outside the flat prior (:func:`prior_bounds`).
     TimeBudgetExceeded
         The chain ran past ``time_budget`` (the message gives the steps done).
 
@@ -738,13 +739,19 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     Posterior(zeta_hertz, zeta_adhesion; 8 walkers x 60 steps, burn-in 20, seed 2002, converged=False)
     """
     t0, deadline = time.perf_counter(), Deadline.start(time_budget, "posterior")
-    like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol, likelihood, nu, method, emulator_tol)
     names = list(damping_fit.varied) + (["friction"] if friction_fit is not None else [])
     best = dict(damping_fit.values) | ({"friction": friction_fit.friction} if friction_fit is not None else {})
     stderr = dict(damping_fit.stderr) | ({"friction": friction_fit.stderr["friction"]} if friction_fit is not None else {})
     walkers, budget, fixed_length = _sampler_options(walkers, steps, max_steps, burn, seed, len(names))
     bounds = prior_bounds(names, best)
     lo, hi = (np.array([bounds[n][k] for n in names]) for k in (0, 1))
+    outside = [f"{n} = {best[n]:.6g} outside [{bounds[n][0]:g}, {bounds[n][1]:g}]" for n in names
+               if not bounds[n][0] <= best[n] <= bounds[n][1]]
+    if outside:  # walkers started on the box's edge would all sit there (emcee: not linearly independent)
+        raise PosteriorError(f"the fit lies outside the posterior's flat prior ({'; '.join(outside)}): the data "
+                             "put the parameter beyond the range the toolkit samples; fit fewer parameters or "
+                             "add measurements that determine it")
+    like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol, likelihood, nu, method, emulator_tol)
     log_probability = _LogProbability(like, names, best, lo, hi)
     pos = np.clip(_start_ball(names, best, stderr, lo, walkers, seed), lo, hi)
     with progress_bar(budget, "posterior", progress) as advance, engine_threads(1):
