@@ -51,11 +51,13 @@ HELPERS = {
     "family.normal_restitution": "e_n alone, as an array, for the fits",
     "normal_models.settled_contact_energy": "a closed form",
     "solution.frozen_state": "read-only copy of a state mapping",
+    "ring_groups_batch.restitution_of_groups": "e_n alone, as an array, for the posterior's walkers",
+    "ring_groups_batch.fallback_of_groups": "e_n alone, as an array: the emulator's fallback over groups",
 }
 #: public functions whose result is a set-up or a state (no solution), each a named result: the
 #: NamedTuple it returns (a tuple subclass, so that callers may still unpack it)
 NAMED = {"engine.engine_scales": "EngineScales", "rkg.rkg_setup": "RkgSetup", "rkg.rkg_state": "RkgState",
-         "thornton_ning_law.law_parameters": "LawParameters"}
+         "thornton_ning_law.law_parameters": "LawParameters", "ring_groups_batch.outcome_of_groups": "GroupOutcome"}
 #: modules not enumerated, and why
 NOT_ENUMERATED = {"emulator": "an interpolant of e_n with its own Restitution record (outside this issue's solvers)",
                   "dopri": "the Dormand-Prince core: compiled building blocks, no solver"}
@@ -101,12 +103,15 @@ def test_result_types_are_frozen_and_the_old_shapes_are_gone():
 def test_named_results_are_named_tuples_and_the_family_returns_a_record():
     """What crosses a module boundary is named: the set-ups and states of NAMED, and the whole
     impacts of a NormalFamily (a frozen record, its columns read-only)."""
-    from microimpact.solvers import engine, family, rkg, thornton_ning_law
+    from microimpact.model import reduction
+    from microimpact.solvers import engine, family, ring_groups_batch, rkg, thornton_ning_law
 
     calls = {"engine.engine_scales": lambda: engine.engine_scales(TABLE1_ROW2, 2.0),
              "rkg.rkg_setup": lambda: rkg.rkg_setup(TABLE1_ROW2, [2.0]),
              "rkg.rkg_state": lambda: rkg.rkg_state(0.0, 0.0, 0.0, 1.0, 0.0, 0.01, 10, xi0=1.0),
-             "thornton_ning_law.law_parameters": lambda: thornton_ning_law.law_parameters(HARD, 1.0)}
+             "thornton_ning_law.law_parameters": lambda: thornton_ning_law.law_parameters(HARD, 1.0),
+             "ring_groups_batch.outcome_of_groups": lambda: ring_groups_batch.outcome_of_groups(
+                 *reduction.ring_groups([TABLE1_ROW2], [[3.0]]))}
     assert set(calls) == set(NAMED)
     for name, call in calls.items():
         got = call()

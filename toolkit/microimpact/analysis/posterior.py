@@ -572,10 +572,10 @@ class _Likelihood:
                                                       np.asarray(p["zeta_adhesion"])[:, None] * per, rtol=self.rtol)
             ju = c.mass * c.length_scale / c.time_scale * s ** (5.0 / 6.0)  # m X / T of each set
             jt = ju * np.sqrt(c.radius * c.length_scale * s ** (2.0 / 3.0))
-            impulses = {"captured": sol["captured"][:, inverse].ravel(), "e_n": sol["e_n"][:, inverse].ravel(),
+            impulses = {"captured": sol.captured[:, inverse].ravel(), "e_n": sol.e_n[:, inverse].ravel(),
                         "velocity_in_n": np.tile(vn, k), "velocity_in_t": np.tile(v * np.sin(alpha), k),
-                        "friction_impulse": (sol["friction_impulse"] * ju)[:, inverse].ravel(),
-                        "twist_impulse": (sol["twist_impulse"] * jt)[:, inverse].ravel()}
+                        "friction_impulse": (sol.friction_impulse * ju)[:, inverse].ravel(),
+                        "twist_impulse": (sol.twist_impulse * jt)[:, inverse].ravel()}
             st = rebound_from_impulses(c, impulses, np.tile(ob.spin[idx], k),
                                        friction=np.repeat(np.asarray(p["friction"], dtype=float), idx.size))
             values = _observables(st, np.tile(v, k), np.tile(ob.incidence_deg[idx], k), np.tile(ob.quantity[idx], k))
@@ -659,6 +659,19 @@ def prior_bounds(names, best: dict) -> dict:
     return out
 
 
+def _prior_holding_the_fit(names, best: dict) -> dict:
+    """:func:`prior_bounds`, or :class:`PosteriorError` naming each fitted value outside them: walkers
+    started on the box's edge would all sit there (emcee: not linearly independent)."""
+    bounds = prior_bounds(names, best)
+    outside = [f"{n} = {best[n]:.6g} outside [{bounds[n][0]:g}, {bounds[n][1]:g}]" for n in names
+               if not bounds[n][0] <= best[n] <= bounds[n][1]]
+    if outside:
+        raise PosteriorError(f"the fit lies outside the posterior's flat prior ({'; '.join(outside)}): the data "
+                             "put the parameter beyond the range the toolkit samples; fit fewer parameters or "
+                             "add measurements that determine it")
+    return bounds
+
+
 def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | None = None, steps: int | None = None,
                      max_steps: int | None = None, burn: int | None = None, seed: int = DEFAULT_SEED,
                      errors_in_variables: str = "auto", rtol: float = DEFAULT_RTOL, progress: bool = False,
@@ -694,11 +707,10 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     likelihood : {"normal", "student-t"}
         e_n likelihood of each row, with ``nu`` degrees of freedom (:data:`DEFAULT_NU`) (module docstring).
     method : {"emulator", "solve"}
-        Model e_n of the likelihood: the ring law's table shipped with the package
-        (:func:`microimpact.solvers.emulator.ring_emulator`, :data:`DEFAULT_METHOD`; the solver where
-        it falls back or for another law) to the absolute tolerance ``emulator_tol``
-        (:data:`EMULATOR_TOLERANCE`), or the solver at every evaluation (the reference). The
-        oblique part is always solved.
+        Model e_n of the likelihood: the ring law's shipped table (:func:`microimpact.solvers.emulator.ring_emulator`,
+        :data:`DEFAULT_METHOD`; the solver where it falls back or for another law) to the absolute
+        tolerance ``emulator_tol`` (:data:`EMULATOR_TOLERANCE`), or the solver at every evaluation
+        (the reference). The oblique part is always solved.
 
     Returns
     -------
@@ -743,14 +755,8 @@ def sample_posterior(table, damping_fit, friction_fit=None, *, walkers: int | No
     best = dict(damping_fit.values) | ({"friction": friction_fit.friction} if friction_fit is not None else {})
     stderr = dict(damping_fit.stderr) | ({"friction": friction_fit.stderr["friction"]} if friction_fit is not None else {})
     walkers, budget, fixed_length = _sampler_options(walkers, steps, max_steps, burn, seed, len(names))
-    bounds = prior_bounds(names, best)
+    bounds = _prior_holding_the_fit(names, best)
     lo, hi = (np.array([bounds[n][k] for n in names]) for k in (0, 1))
-    outside = [f"{n} = {best[n]:.6g} outside [{bounds[n][0]:g}, {bounds[n][1]:g}]" for n in names
-               if not bounds[n][0] <= best[n] <= bounds[n][1]]
-    if outside:  # walkers started on the box's edge would all sit there (emcee: not linearly independent)
-        raise PosteriorError(f"the fit lies outside the posterior's flat prior ({'; '.join(outside)}): the data "
-                             "put the parameter beyond the range the toolkit samples; fit fewer parameters or "
-                             "add measurements that determine it")
     like = _Likelihood(damping_fit, table, friction_fit, errors_in_variables, rtol, likelihood, nu, method, emulator_tol)
     log_probability = _LogProbability(like, names, best, lo, hi)
     pos = np.clip(_start_ball(names, best, stderr, lo, walkers, seed), lo, hi)

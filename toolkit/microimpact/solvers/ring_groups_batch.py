@@ -17,15 +17,27 @@ This module is not part of the emulator's table key (its sources do not change t
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from microimpact.solvers import MIN_RTOL, DEFAULT_RTOL, engine
 from microimpact.solvers.emulator import FALLBACK_RTOL, NEAR_CAPTURE_E, NODE_RTOL_FLOOR
 
-__all__ = ["restitution_of_groups", "fallback_of_groups", "outcome_of_groups"]
+__all__ = ["GroupOutcome", "restitution_of_groups", "fallback_of_groups", "outcome_of_groups"]
 
 
-def outcome_of_groups(y0, c1, c2, *, rtol: float = DEFAULT_RTOL) -> dict:
+class GroupOutcome(NamedTuple):
+    """The normal outcomes of impacts given by their groups (arrays of the groups' shape): captured,
+    e_n [-], and the friction and twist impulses in the groups' units (:func:`outcome_of_groups`)."""
+
+    captured: np.ndarray
+    e_n: np.ndarray
+    friction_impulse: np.ndarray
+    twist_impulse: np.ndarray
+
+
+def outcome_of_groups(y0, c1, c2, *, rtol: float = DEFAULT_RTOL) -> GroupOutcome:
     """:func:`restitution_of_groups` with the impulses: ``captured``, ``e_n`` [-], and the friction and
     twist impulses in the groups' units, ``friction_impulse`` J / (m X / T) and ``twist_impulse``
     J_a / (m X / T sqrt(r X)) [-] (the engine's own; :func:`~microimpact.solvers.engine.solve_normal_many`
@@ -37,7 +49,7 @@ def outcome_of_groups(y0, c1, c2, *, rtol: float = DEFAULT_RTOL) -> dict:
     >>> from microimpact.model import reduction
     >>> out = outcome_of_groups(*reduction.ring_groups([c], [[3.0]]), rtol=1e-10)
     >>> j = engine.solve_normal_many(c, [3.0], rtol=1e-10)["friction_impulse"][0] / (c.mass * c.length_scale / c.time_scale)
-    >>> bool(abs(out["friction_impulse"][0, 0] / j - 1) < 1e-9)
+    >>> bool(abs(out.friction_impulse[0, 0] / j - 1) < 1e-9)
     True
     """
     y, a, b = (np.array(x, dtype=float) for x in np.broadcast_arrays(y0, c1, c2))
@@ -46,8 +58,7 @@ def outcome_of_groups(y0, c1, c2, *, rtol: float = DEFAULT_RTOL) -> dict:
     captured = out[:, 1] == engine.CAPTURE
     e = np.where(captured, 0.0, -out[:, 2] / y.ravel())
     engine._check_restitution(e, y.ravel(), rtol)
-    return {"captured": captured.reshape(shape), "e_n": e.reshape(shape), "friction_impulse": out[:, 5].reshape(shape),
-            "twist_impulse": out[:, 6].reshape(shape)}
+    return GroupOutcome(captured.reshape(shape), e.reshape(shape), out[:, 5].reshape(shape), out[:, 6].reshape(shape))
 
 
 def _solve(y, a, b, rtol) -> np.ndarray:
@@ -104,7 +115,7 @@ def restitution_of_groups(y0, c1, c2, *, rtol: float = DEFAULT_RTOL) -> np.ndarr
     >>> bool(abs(e - engine.solve_normal_many(c, [0.5, 3.0], rtol=1e-10)["e_n"]).max() < 1e-9), float(e[0, 0])
     (True, 0.0)
     """
-    return outcome_of_groups(y0, c1, c2, rtol=rtol)["e_n"]
+    return outcome_of_groups(y0, c1, c2, rtol=rtol).e_n
 
 
 def fallback_of_groups(y0, c1, c2, tol: float) -> np.ndarray:
