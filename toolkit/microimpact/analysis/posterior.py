@@ -487,10 +487,8 @@ class _Likelihood:
         """(y0, C1 / zeta_H) of every speed for each w_A of the array ``work_of_adhesion`` (K,),
         shape (K, speeds), or None where the law is not the ring law (or a w_A is not > 0).
 
-        From the groups at the fit's w_A by their powers of w_A: f0 ~ w_A^(2/3) (Eq. (7)), so
-        X = B / A ~ w_A^(2/3), T = (m / sqrt(A B))^(1/2) ~ w_A^(-1/6) (Eqs. (29)-(30)) and X / T ~
-        w_A^(5/6); y0 = v T / X ~ w_A^(-5/6), and C1 / zeta_H = (X / T) / (D v_ref^(1/5)) ~ w_A^(5/6)
-        (D does not hold f0). A contact per walker would cost more than the table lookup itself;
+        From the groups at the fit's w_A by their powers of w_A (:func:`_groups_at_work_of_adhesion`):
+        a contact per walker would cost more than the table lookup itself;
         tests/test_posterior_speed.py compares these groups with the contacts' own."""
         w = np.asarray(work_of_adhesion, dtype=float).ravel()
         w_ref = float(self.fit.values["work_of_adhesion"])
@@ -499,9 +497,7 @@ class _Likelihood:
         g = self._speed_groups(w_ref)
         if g is None:
             return None
-        s = (w / w_ref)[:, None]
-        same = s == 1.0  # the fit's w_A (w_A given, not fitted): its groups as they are
-        return np.where(same, g[0], g[0] * s ** (-5.0 / 6.0)), np.where(same, g[1], g[1] * s ** (5.0 / 6.0))
+        return _groups_at_work_of_adhesion(g[0], g[1], (w / w_ref)[:, None])
 
     def _emulated(self, zeta_hertz, zeta_adhesion, work_of_adhesion, y0, per) -> np.ndarray:
         """e_n (K, speeds) by the table where it meets ``tol``, by the emulator's fallback solves
@@ -553,22 +549,15 @@ class _Likelihood:
         J_a = J_a' m X / T sqrt(r X)), and the closed-form tangential map of each set's friction."""
         ob, w = self.oblique, np.asarray(p["work_of_adhesion"], dtype=float)
         w_ref = float(self.fit.values["work_of_adhesion"])
-        if not (w_ref > 0.0 and np.all(w > 0.0)):
+        setup = self._oblique_setup()
+        if not (w_ref > 0.0 and np.all(w > 0.0)) or setup is None:
             return None
         k = w.size
         s = (w / w_ref)[:, None]
         out = np.empty((k, ob.size))
-        for r in np.unique(ob.radius):
-            idx = np.flatnonzero(ob.radius == r)
-            c = _contact(self.fit, float(r), dict(self.fit.values) | {"zeta_hertz": 1.0, "zeta_adhesion": 1.0})
-            if reduction.law_of(c) != "ring":
-                return None
-            v, alpha = ob.speed[idx], np.radians(np.clip(ob.incidence_deg[idx], 0.0, 89.9))
-            vn = v * np.cos(alpha)
-            speeds, inverse = np.unique(vn, return_inverse=True)  # one solve per distinct normal speed
-            y_ref, per_ref, _ = reduction.ring_groups([c], speeds[None, :])
-            per = per_ref * s ** (5.0 / 6.0)
-            sol = ring_groups_batch.outcome_of_groups(y_ref * s ** (-5.0 / 6.0), np.asarray(p["zeta_hertz"])[:, None] * per,
+        for c, idx, v, alpha, vn, inverse, y_ref, per_ref in setup:
+            y0, per = _groups_at_work_of_adhesion(y_ref, per_ref, s)
+            sol = ring_groups_batch.outcome_of_groups(y0, np.asarray(p["zeta_hertz"])[:, None] * per,
                                                       np.asarray(p["zeta_adhesion"])[:, None] * per, rtol=self.rtol)
             ju = c.mass * c.length_scale / c.time_scale * s ** (5.0 / 6.0)  # m X / T of each set
             jt = ju * np.sqrt(c.radius * c.length_scale * s ** (2.0 / 3.0))
@@ -581,6 +570,25 @@ class _Likelihood:
             values = _observables(st, np.tile(v, k), np.tile(ob.incidence_deg[idx], k), np.tile(ob.quantity[idx], k))
             out[:, idx] = np.where(st["captured"], np.nan, values).reshape(k, idx.size)
         return out
+
+    def _oblique_setup(self):
+        """Per radius of the oblique rows, what no walker changes: the contact at the fit's values
+        (zeta_H = zeta_A = 1), the rows, their speeds and angles, the distinct normal speeds and the
+        ring groups there at the fit's w_A; None where a contact is not the ring law. Built once."""
+        if not hasattr(self, "_oblique_cache"):
+            ob, self._oblique_cache = self.oblique, []
+            for r in np.unique(ob.radius):
+                idx = np.flatnonzero(ob.radius == r)
+                c = _contact(self.fit, float(r), dict(self.fit.values) | {"zeta_hertz": 1.0, "zeta_adhesion": 1.0})
+                if reduction.law_of(c) != "ring":
+                    self._oblique_cache = None
+                    break
+                v, alpha = ob.speed[idx], np.radians(np.clip(ob.incidence_deg[idx], 0.0, 89.9))
+                vn = v * np.cos(alpha)
+                speeds, inverse = np.unique(vn, return_inverse=True)  # one solve per distinct normal speed
+                y_ref, per_ref, _ = reduction.ring_groups([c], speeds[None, :])
+                self._oblique_cache.append((c, idx, v, alpha, vn, inverse, y_ref, per_ref))
+        return self._oblique_cache
 
     def log_density(self, z):
         """log of the e_n density at standardized residuals z, up to a constant: -z^2/2 (normal) or
@@ -657,6 +665,15 @@ def prior_bounds(names, best: dict) -> dict:
         else:
             out[n] = DAMPING_RANGES[n]
     return out
+
+
+def _groups_at_work_of_adhesion(y0, per, s):
+    """The ring groups (y0, C1 / zeta_H = C2 / zeta_A) at w_A = s w_ref from those at w_ref, by their
+    powers of w_A: f0 ~ w_A^(2/3) (Eq. (7)), so X = B / A ~ w_A^(2/3), T = (m / sqrt(A B))^(1/2) ~
+    w_A^(-1/6) (Eqs. (29)-(30)),
+    y0 = v T / X ~ w_A^(-5/6) and C1 / zeta_H = (X / T) / (D v_ref^(1/5)) ~ w_A^(5/6) (D holds no f0).
+    At s = 1 the powers are exactly 1: the groups come back bit for bit. [-]"""
+    return y0 * s ** (-5.0 / 6.0), per * s ** (5.0 / 6.0)
 
 
 def _prior_holding_the_fit(names, best: dict) -> dict:
