@@ -12,7 +12,9 @@ reference integration (solvers/plastic_reference.py), against what they must rep
 * hand-derived forms of R_p, the plastic slope and the JKR pressure at yield;
 * the yield with adhesion (TN2), where the JKR force per contact area reaches p_y: R_p >= R and
   W_p >= 0 over the stress sweep's domain (both fail with the paper's centre-pressure yield), and
-  the tensile-yield limit below which a state's W_p < 0 is not reached by an impact.
+  the tensile-yield limit below which a state's W_p < 0 is not reached by an impact;
+* the compiled law's formulas are the Python functions': its kernels give the unloading state bit
+  for bit and the unloading force to rounding.
 
 Tolerances: the DOP853 integration at rtol 1e-12 agrees with the closed forms to about 1e-11
 (measured); the tests ask 1e-8 (1e-6 for e against Thornton's form, the issue's figure), so they
@@ -277,3 +279,29 @@ def test_bad_inputs_say_what_is_wrong():
         tn.yield_point(tn.PlasticContact.from_contact(TABLE1_ROW2, 1e5))
     with pytest.raises(ValueError, match="normal_speed must be a finite number > 0"):
         plastic_impact(HARD, 0.0)
+
+
+# =============================================================================== the compiled kernels
+@pytest.mark.parametrize("contact", [HARD, ADHESIVE], ids=["no adhesion", "adhesive"])
+def test_the_compiled_law_calls_the_formulas_of_the_python_functions(contact):
+    # one source for both (issue 52): on scalars the compiled kernels and their NumPy evaluation
+    # round alike (IEEE + - * / and sqrt, libm's pow; the a^3 is passed in), so the unloading curve
+    # (TN4)-(TN7) and the plastic line (TN3) are the state's bit for bit
+    pc, y = contact, tn.yield_point(contact)
+    r, es, w = pc.radius, pc.e_star, pc.work_of_adhesion
+    for k in (0.5, 1.0, 1.5, 4.0, 40.0):
+        d_max = k * y.approach
+        s = tn.unloading_state(pc, d_max)
+        a3 = float(np.asarray(s.max_contact_radius) ** 3)
+        got = tn.unloading_curve(d_max, s.max_contact_radius, a3, s.max_force, s.yielded, r, es, w)
+        assert got == (s.plastic_radius, s.plastic_approach, s.break_contact_radius, s.break_approach)
+        if s.yielded:
+            assert tn.plastic_contact_radius(d_max, r, y.contact_radius, y.approach) == s.max_contact_radius
+            assert tn.plastic_force(d_max, r, pc.yield_pressure, y.approach, y.force) == s.max_force
+        # the force of an approach: a_c^3 q^6 against (a_c q^2)^3 and two Newton solves round apart,
+        # by <= 1.5e-15 of the largest |F| (measured), 1e-13 asked; from 1 % of the way off the
+        # break, whose square-root fold turns a rounding of delta into its square root in a
+        d = s.break_approach + (s.max_approach - s.break_approach) * np.linspace(0.01, 1.0, 41)
+        f = tn.unloading_force(pc, s, d)
+        compiled = [tn.curve_force(x - s.plastic_approach, s.plastic_radius, es, w) for x in d]
+        np.testing.assert_allclose(compiled, f, rtol=0, atol=1e-13 * np.abs(f).max())

@@ -4,7 +4,10 @@ A sphere of radius R (mass m) meets a flat; delta is the approach (penetration),
 radius, E* = 3 K / 4 the contact modulus (Eq. (3) of Cheng, Brach & Dunn 2002), w the work of
 adhesion and p_y the limiting contact pressure (yield pressure). Forces are positive when
 repulsive. Every formula below is written once, here; the equation numbers (TN1)-(TN12) are this
-module's, listed with their sources.
+module's, listed with their sources. Those the compiled law
+(:mod:`microimpact.solvers.thornton_ning_law`) needs, (TN1) and (TN3)-(TN7), are numba kernels of
+this module (:func:`curve_force`, :func:`plastic_force`, :func:`unloading_curve`, ...), which the
+Python functions evaluate with NumPy.
 
 Loading, elastic (JKR; Johnson, Kendall & Roberts 1971), with the radius of curvature R::
 
@@ -141,6 +144,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from microimpact._numba import njit
 from microimpact.model.adhesion_models import jkr_q_from_approach
 
 __all__ = [
@@ -322,6 +326,154 @@ class RestitutionSample:
     parameters: dict
 
 
+# =============================================================================== the formulas, compiled
+# Each formula the compiled law (solvers/thornton_ning_law.py) needs is written once, here, as a
+# numba kernel of scalars (in np.sqrt and np.maximum, so that NumPy arrays pass too). The Python
+# functions below run the same source with NumPy (``kernel.py_func``), not the compiled kernel: an
+# array call then compiles nothing, and each side rounds powers its own way (numba's x**3 is x*x*x,
+# NumPy's array power a SIMD pow; they differ in the last bit for about a quarter of random x), so
+# a power that enters a formula is passed in by the caller (a^3) and neither side's numbers move.
+@njit(cache=True)
+def critical_radius(radius, e_star, work_of_adhesion):
+    """a_c = (pi w R^2 / (8 E*))^(1/3), where d delta / d a = 0 on (TN1) (a_cp of (TN7) at R = R_p). [m]
+
+    Parameters: radius of curvature R [m], E* [Pa], w [J/m^2].
+    """
+    return (math.pi * work_of_adhesion * radius * radius / (8.0 * e_star)) ** (1.0 / 3.0)
+
+
+@njit(cache=True)
+def curve_approach(contact_radius, radius, e_star, work_of_adhesion):
+    """delta(a; R) = a^2 / R - sqrt(2 pi w a / E*), (TN1), on the curve of radius of curvature R. [m]"""
+    a = contact_radius
+    return a * a / radius - np.sqrt(2.0 * math.pi * work_of_adhesion * a / e_star)
+
+
+@njit(cache=True)
+def curve_force_of_cube(contact_radius_cubed, radius, e_star, work_of_adhesion):
+    """F(a; R) = 4 E* a^3 / (3 R) - sqrt(8 pi w E* a^3), (TN1), of a^3 [m^3]; positive = repulsive. [N]"""
+    a3 = contact_radius_cubed
+    return 4.0 * e_star * a3 / (3.0 * radius) - np.sqrt(8.0 * math.pi * work_of_adhesion * e_star * a3)
+
+
+@njit(cache=True)
+def curve_approach_ratio(approach, radius, critical_radius_):
+    """delta / L_J = delta R / a_c^2 on the JKR curve of radius of curvature R, a_c [m]: q^4 - 4 q. [-]"""
+    return approach * radius / (critical_radius_ * critical_radius_)
+
+
+@njit(cache=True)
+def hertz_contact_radius(approach, radius):
+    """a = sqrt(R max(delta, 0)), (TN1) without adhesion (Hertz). [m]"""
+    return np.sqrt(radius * np.maximum(approach, 0.0))
+
+
+@njit(cache=True)
+def curve_q(approach_ratio):
+    """q = sqrt(a / a_c) >= 1 with q^4 - 4 q = delta / L_J on the stable branch of (TN1); 1 at and
+    beyond the break (ratio <= -3). [-]
+
+    The scalar form, for compiled code, of :func:`microimpact.model.adhesion_models.jkr_q_from_approach`
+    (the same Newton iteration from above the root; that one is vectorised with NumPy and cannot be
+    called from a numba kernel). Scalar ``approach_ratio`` [-] only.
+
+    Examples
+    --------
+    >>> q = curve_q(10.0)
+    >>> round(q, 8), round(q**4 - 4 * q, 12), curve_q(-3.5)
+    (2.06744159, 10.0, 1.0)
+    """
+    if approach_ratio <= -3.0:
+        return 1.0
+    q = math.sqrt(math.sqrt(max(approach_ratio, 0.0) + 4.0)) + 1.0  # q^4 - 4q > ratio here
+    for _ in range(80):
+        step = (q**4 - 4.0 * q - approach_ratio) / (4.0 * q**3 - 4.0)
+        q = max(q - step, 1.0)
+        if abs(step) <= 4e-16 * q:
+            break
+    return q
+
+
+@njit(cache=True)
+def curve_force(approach, radius, e_star, work_of_adhesion):
+    """F on the JKR curve (TN1) of radius of curvature R at the approach delta [m] from its origin. [N]
+
+    Scalars only (the compiled law's loading (TN1) and unloading (TN6), delta - delta_p there):
+    a = a_c q^2 by :func:`curve_q` (a^3 = a_c^3 q^6), a = sqrt(R delta) without adhesion; beyond the
+    break a = a_c. The Python functions' equivalent is :func:`jkr_curve_force` of
+    :func:`jkr_curve_contact_radius`.
+
+    Examples
+    --------
+    It is that equivalent (to rounding), and Hertz's K sqrt(R) delta^(3/2) without adhesion:
+
+    >>> r, es, w = 1e-6, 1e9, 0.1
+    >>> a = float(jkr_curve_contact_radius(2e-9, r, es, w))
+    >>> round(curve_force(2e-9, r, es, w) / float(jkr_curve_force(a, r, es, w)), 12)
+    1.0
+    >>> round(curve_force(1e-8, r, es, 0.0) / (4e9 / 3 * 1e-3 * 1e-12), 12)
+    1.0
+    """
+    if work_of_adhesion == 0.0:
+        a = hertz_contact_radius(approach, radius)
+        return curve_force_of_cube(a**3, radius, e_star, work_of_adhesion)
+    a_c = critical_radius(radius, e_star, work_of_adhesion)
+    q = curve_q(curve_approach_ratio(approach, radius, a_c))
+    return curve_force_of_cube(a_c**3 * q**6, radius, e_star, work_of_adhesion)
+
+
+@njit(cache=True)
+def plastic_force(approach, radius, yield_pressure, yield_approach, yield_force):
+    """F = F_y + pi R p_y (delta - delta_y), the plastic loading line (TN3). [N]
+
+    Parameters: delta [m], R [m], p_y [Pa], delta_y [m], F_y [N] (:func:`yield_point`).
+    """
+    return yield_force + math.pi * radius * yield_pressure * (approach - yield_approach)
+
+
+@njit(cache=True)
+def plastic_contact_radius(approach, radius, yield_radius, yield_approach):
+    """a = sqrt(a_y^2 + R max(delta - delta_y, 0)), the contact radius on the plastic line (TN3). [m]"""
+    return np.sqrt(yield_radius * yield_radius + radius * np.maximum(approach - yield_approach, 0.0))
+
+
+@njit(cache=True)
+def plastic_radius(max_contact_radius_cubed, max_force, e_star, work_of_adhesion):
+    """R_p = 4 E* a_max^3 / (3 (F_max + sqrt(8 pi w E* a_max^3))), (TN4), of a_max^3 [m^3], F_max [N]. [m]"""
+    a3 = max_contact_radius_cubed
+    return 4.0 * e_star * a3 / (3.0 * (max_force + np.sqrt(8.0 * math.pi * work_of_adhesion * e_star * a3)))
+
+
+@njit(cache=True)
+def unloading_curve(max_approach, max_contact_radius, max_contact_radius_cubed, max_force, yielded, radius, e_star,
+                    work_of_adhesion):
+    """(R_p, delta_p, a_cp, delta_break) of the unloading curve from delta_max, (TN4), (TN5), (TN7).
+
+    Parameters: delta_max [m], a_max [m], a_max^3 [m^3] and F_max [N] on the loading curve, whether
+    it yielded (delta_max > delta_y; else R_p = R, delta_p = 0), R [m], E* [Pa], w [J/m^2]. Returns
+    [m] each; a_cp = 0 and delta_break = delta_p without adhesion.
+
+    Examples
+    --------
+    Below yield the curve is the loading curve, broken at -(3/4) (pi^2 w^2 R / E*^2)^(1/3), (TN7):
+
+    >>> r_p, d_p, a_cp, d_break = unloading_curve(1e-8, 0.0, 0.0, 0.0, False, 1e-6, 1e9, 0.1)
+    >>> r_p, d_p, round(d_break / (-0.75 * (math.pi**2 * 0.01 * 1e-6 / 1e18) ** (1 / 3)), 12)
+    (1e-06, 0.0, 1.0)
+    """
+    if yielded:
+        r_p = plastic_radius(max_contact_radius_cubed, max_force, e_star, work_of_adhesion)
+        d_p = max_approach - curve_approach(max_contact_radius, r_p, e_star, work_of_adhesion)  # (TN5)
+    else:
+        r_p, d_p = radius, 0.0
+    if work_of_adhesion > 0.0:
+        a_cp = critical_radius(r_p, e_star, work_of_adhesion)
+        d_break = d_p + curve_approach(a_cp, r_p, e_star, work_of_adhesion)  # (TN7)
+    else:
+        a_cp, d_break = 0.0, d_p
+    return r_p, d_p, a_cp, d_break
+
+
 # =============================================================================== the JKR curve (TN1), (TN8)
 def jkr_curve_approach(contact_radius, radius, e_star, work_of_adhesion):
     """delta(a; R) = a^2 / R - sqrt(2 pi w a / E*), (TN1). [m]
@@ -339,8 +491,7 @@ def jkr_curve_approach(contact_radius, radius, e_star, work_of_adhesion):
     >>> round(float(jkr_curve_approach(1e-7, 1e-6, 1e9, 0.0)) / 1e-8, 12)
     1.0
     """
-    a = np.asarray(contact_radius, dtype=float)
-    return a * a / radius - np.sqrt(2.0 * math.pi * work_of_adhesion * a / e_star)
+    return curve_approach.py_func(np.asarray(contact_radius, dtype=float), radius, e_star, work_of_adhesion)
 
 
 def jkr_curve_force(contact_radius, radius, e_star, work_of_adhesion):
@@ -358,7 +509,7 @@ def jkr_curve_force(contact_radius, radius, e_star, work_of_adhesion):
     1.0
     """
     a = np.asarray(contact_radius, dtype=float)
-    return 4.0 * e_star * a**3 / (3.0 * radius) - np.sqrt(8.0 * math.pi * work_of_adhesion * e_star * a**3)
+    return curve_force_of_cube.py_func(a**3, radius, e_star, work_of_adhesion)
 
 
 def jkr_curve_potential(contact_radius, radius, e_star, work_of_adhesion):
@@ -388,9 +539,7 @@ def jkr_curve_potential(contact_radius, radius, e_star, work_of_adhesion):
             + math.pi * work_of_adhesion * a * a)
 
 
-def _critical_radius(radius, e_star, work_of_adhesion):
-    """a_c = (pi w R^2 / (8 E*))^(1/3), where d delta / d a = 0 on (TN1). [m]"""
-    return (math.pi * work_of_adhesion * radius * radius / (8.0 * e_star)) ** (1.0 / 3.0)
+_critical_radius = critical_radius.py_func  # a_c of (TN1) for the Python functions, scalars or arrays
 
 
 def jkr_curve_contact_radius(approach, radius, e_star, work_of_adhesion):
@@ -412,9 +561,9 @@ def jkr_curve_contact_radius(approach, radius, e_star, work_of_adhesion):
     """
     d = np.asarray(approach, dtype=float)
     if work_of_adhesion == 0.0:
-        return np.sqrt(radius * np.maximum(d, 0.0))
+        return hertz_contact_radius.py_func(d, radius)
     a_c = _critical_radius(radius, e_star, work_of_adhesion)
-    ratio = d * radius / (a_c * a_c)  # delta / L_J; the break (fold) is at -3, where q = 1
+    ratio = curve_approach_ratio.py_func(d, radius, a_c)  # the break (fold) is at -3, where q = 1
     inside = ratio > -3.0
     return a_c * np.where(inside, jkr_q_from_approach(np.where(inside, ratio, 0.0)), 1.0) ** 2
 
@@ -519,7 +668,7 @@ def loading_contact_radius(pc: PlasticContact, approach):
     y = yield_point(pc)
     d = np.asarray(approach, dtype=float)
     elastic = jkr_curve_contact_radius(np.minimum(d, y.approach), pc.radius, pc.e_star, pc.work_of_adhesion)
-    plastic = np.sqrt(y.contact_radius**2 + pc.radius * np.maximum(d - y.approach, 0.0))
+    plastic = plastic_contact_radius.py_func(d, pc.radius, y.contact_radius, y.approach)
     return np.where(d > y.approach, plastic, elastic)
 
 
@@ -547,7 +696,7 @@ def loading_force(pc: PlasticContact, approach):
     d = np.asarray(approach, dtype=float)
     a = jkr_curve_contact_radius(np.minimum(d, y.approach), pc.radius, pc.e_star, pc.work_of_adhesion)
     elastic = jkr_curve_force(a, pc.radius, pc.e_star, pc.work_of_adhesion)
-    plastic = y.force + math.pi * pc.radius * pc.yield_pressure * (d - y.approach)
+    plastic = plastic_force.py_func(d, pc.radius, pc.yield_pressure, y.approach, y.force)
     return np.where(d > y.approach, plastic, elastic)
 
 
@@ -629,7 +778,7 @@ def largest_approach(pc: PlasticContact, normal_speed):
 def _plastic_radius(pc: PlasticContact, max_contact_radius, max_force):
     """R_p = 4 E* a_max^3 / (3 (F_max + sqrt(8 pi w E* a_max^3))), (TN4). [m]"""
     a3 = np.asarray(max_contact_radius, dtype=float) ** 3
-    return 4.0 * pc.e_star * a3 / (3.0 * (max_force + np.sqrt(8.0 * math.pi * pc.work_of_adhesion * pc.e_star * a3)))
+    return plastic_radius.py_func(a3, max_force, pc.e_star, pc.work_of_adhesion)
 
 
 def unloading_state(pc: PlasticContact, max_approach: float) -> UnloadingState:
@@ -659,16 +808,9 @@ def unloading_state(pc: PlasticContact, max_approach: float) -> UnloadingState:
     d_max = float(max_approach)
     a_max = float(loading_contact_radius(pc, d_max))
     f_max = float(loading_force(pc, d_max))
-    if d_max > y.approach:
-        r_p = float(_plastic_radius(pc, a_max, f_max))
-        d_p = d_max - float(jkr_curve_approach(a_max, r_p, es, w))  # (TN5)
-    else:
-        r_p, d_p = r, 0.0
-    if w > 0.0:
-        a_cp = _critical_radius(r_p, es, w)
-        d_break = d_p + float(jkr_curve_approach(a_cp, r_p, es, w))  # (TN7)
-    else:
-        a_cp, d_break = 0.0, d_p
+    a3 = float(np.asarray(a_max) ** 3)  # by NumPy, as _energy_account (_plastic_radius) takes it: one R_p for both
+    r_p, d_p, a_cp, d_break = (float(x) for x in unloading_curve.py_func(d_max, a_max, a3, f_max, d_max > y.approach,
+                                                                          r, es, w))
     f_break = float(jkr_curve_force(a_cp, r_p, es, w))
     return UnloadingState(d_max, a_max, f_max, r_p, d_p, d_break, a_cp, f_break, d_max > y.approach)
 

@@ -24,10 +24,15 @@ passed in the parameters: where the JKR force per contact area reaches p_y, not 
 pressure (the model module's docstring, "Yield", gives the reasons and the alternatives), so the
 driver, the closed form and the scipy reference share one yield and R_p >= R on every unloading.
 
-The force on a JKR curve is written in q = sqrt(a / a_c) (a_c of the branch's radius):
-delta - delta_p = (a_c^2 / R_b) (q^4 - 4 q), solved for q >= 1 by Newton's method (the package's
-:func:`microimpact.model.adhesion_models.jkr_q_from_approach`, scalar); without adhesion
-a = sqrt(R_b (delta - delta_p)). Beyond the break (a trial stage may probe there) a = a_c.
+The formulas are the model module's compiled kernels, each written there once and called here:
+the force on a JKR curve of radius R_b, :func:`~microimpact.model.thornton_ning.curve_force`
+(TN1), (TN6), in q = sqrt(a / a_c): delta - delta_p = (a_c^2 / R_b) (q^4 - 4 q), solved for q >= 1
+by Newton's method (:func:`~microimpact.model.thornton_ning.curve_q`); without adhesion
+a = sqrt(R_b (delta - delta_p)); beyond the break (a trial stage may probe there) a = a_c. The
+plastic line (TN3) is :func:`~microimpact.model.thornton_ning.plastic_force` and
+:func:`~microimpact.model.thornton_ning.plastic_contact_radius`, the unloading curve (TN4)-(TN7)
+:func:`~microimpact.model.thornton_ning.unloading_curve`, which
+:func:`~microimpact.model.thornton_ning.unloading_state` (the solution's ``state``) also evaluates.
 
 References
 ----------
@@ -67,40 +72,14 @@ _P_R, _P_ES, _P_W, _P_PY, _P_AY, _P_DY, _P_FY, _P_L, _P_ACC = range(9)
 
 # --------------------------------------------------------------------------- the law's force, compiled
 @njit(cache=True)
-def _jkr_q(ratio):
-    """q >= 1 with q^4 - 4 q = ratio (ratio >= -3; 1 below), Newton's method from above the root."""
-    if ratio <= -3.0:
-        return 1.0
-    q = math.sqrt(math.sqrt(max(ratio, 0.0) + 4.0)) + 1.0  # q^4 - 4q > ratio here
-    for _ in range(80):
-        step = (q**4 - 4.0 * q - ratio) / (4.0 * q**3 - 4.0)
-        q = max(q - step, 1.0)
-        if abs(step) <= 4e-16 * q:
-            break
-    return q
-
-
-@njit(cache=True)
-def _curve_force(d, r_b, es, w):
-    """F on the JKR curve (TN1) of radius of curvature r_b at the approach d from its origin. [N]"""
-    if w == 0.0:
-        a = math.sqrt(r_b * max(d, 0.0))
-        return 4.0 * es * a**3 / (3.0 * r_b)
-    a_c = (math.pi * w * r_b * r_b / (8.0 * es)) ** (1.0 / 3.0)
-    q = _jkr_q(d * r_b / (a_c * a_c))
-    a3 = a_c**3 * q**6
-    return 4.0 * es * a3 / (3.0 * r_b) - math.sqrt(8.0 * math.pi * w * es * a3)
-
-
-@njit(cache=True)
 def _force(x, args):
     """The contact force [N] at x = delta / L on the branch of args = (branch, R_b, delta_p, p...)."""
     branch, r_b, d_p, r, es, w, py, a_y, d_y, f_y, length = (args[0], args[1], args[2], args[3], args[4], args[5],
                                                             args[6], args[7], args[8], args[9], args[10])
     d = x * length
     if branch == _PLASTIC:
-        return f_y + math.pi * r * py * (d - d_y)  # (TN3)
-    return _curve_force(d - d_p, r_b, es, w)  # (TN1), (TN6)
+        return tn.plastic_force(d, r, py, d_y, f_y)  # (TN3)
+    return tn.curve_force(d - d_p, r_b, es, w)  # (TN1), (TN6)
 
 
 @njit(cache=True)
@@ -151,19 +130,12 @@ def _law_too_small(h, u):
 def _unloading(p, w, d_max):
     """The unloading curve from delta_max, (TN4)-(TN7), into w: R_p, delta_p, the break."""
     r, es, wa, py, a_y, d_y, f_y = p[_P_R], p[_P_ES], p[_P_W], p[_P_PY], p[_P_AY], p[_P_DY], p[_P_FY]
-    if d_max > d_y:
-        a_max = math.sqrt(a_y * a_y + r * (d_max - d_y))  # (TN3)
-        f_max = f_y + math.pi * r * py * (d_max - d_y)
-        a3 = a_max**3
-        r_p = 4.0 * es * a3 / (3.0 * (f_max + math.sqrt(8.0 * math.pi * wa * es * a3)))  # (TN4)
-        d_p = d_max - (a_max * a_max / r_p - math.sqrt(2.0 * math.pi * wa * a_max / es))  # (TN5)
-    else:
-        r_p, d_p = r, 0.0
-    if wa > 0.0:
-        a_cp = (math.pi * wa * r_p * r_p / (8.0 * es)) ** (1.0 / 3.0)
-        d_break = d_p + a_cp * a_cp / r_p - math.sqrt(2.0 * math.pi * wa * a_cp / es)  # (TN7)
-    else:
-        d_break = d_p
+    yielded = d_max > d_y
+    a_max, f_max = 0.0, 0.0  # not read below yield
+    if yielded:
+        a_max = tn.plastic_contact_radius(d_max, r, a_y, d_y)  # (TN3)
+        f_max = tn.plastic_force(d_max, r, py, d_y, f_y)
+    r_p, d_p, _, d_break = tn.unloading_curve(d_max, a_max, a_max**3, f_max, yielded, r, es, wa)
     w[_W_BRANCH], w[_W_RB], w[_W_DP], w[_W_DBREAK], w[_W_DMAX], w[_W_RP] = _UNLOADING, r_p, d_p, d_break, d_max, r_p
 
 
