@@ -16,6 +16,7 @@ import os
 import signal
 import sys
 import warnings
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -69,6 +70,22 @@ KERNEL_GROUPS = (
 )
 #: a run of at least this many tests is "the suite" (a single test file is not worth the wait)
 SUITE_SIZE = 300
+#: the tests left out of an interpreted run (NUMBA_DISABLE_JIT=1): each took longer than its time
+#: limit there (the file's header says how it was measured); one pytest node id (or its start, up
+#: to a "[" or "::") per line
+COMPILED_ONLY = Path(__file__).with_name("compiled_only.txt")
+
+
+def compiled_only_entries(path: Path = COMPILED_ONLY) -> list[str]:
+    """The node ids of :data:`COMPILED_ONLY`, comments and blank lines left out."""
+    lines = (line.split("#", 1)[0].strip() for line in path.read_text(encoding="utf-8").splitlines())
+    return [line for line in lines if line]
+
+
+def is_compiled_only(nodeid: str, entries) -> bool:
+    """True if ``nodeid`` is an entry or starts with one that ends where a name or a parameter
+    list ends (``test_a`` does not cover ``test_ab``)."""
+    return any(nodeid == e or (nodeid.startswith(e) and nodeid[len(e)] in "[:") for e in entries)
 
 
 #: the groups as units of work that share kernels (the batch and the family reuse the one-impact
@@ -113,7 +130,16 @@ def pytest_collection_modifyitems(config, items):
     the workers, and each worker then builds the module's fixture again (a benchmark, a sweep, a set
     of fits). The other tests are still spread one by one; so are those sharing only a
     session-scoped fixture (each worker builds it once whatever the grouping, and grouping the 500
-    hostile-input cases would put them all on one worker)."""
+    hostile-input cases would put them all on one worker).
+
+    Interpreted (``NUMBA_DISABLE_JIT=1``) the tests of :data:`COMPILED_ONLY` are skipped, saying so:
+    their solves take minutes to hours in Python."""
+    if numba.config.DISABLE_JIT:
+        entries = compiled_only_entries()
+        skip = pytest.mark.skip(reason=f"interpreted (NUMBA_DISABLE_JIT=1) beyond its time limit: {COMPILED_ONLY.name}")
+        for item in items:
+            if is_compiled_only(item.nodeid, entries):
+                item.add_marker(skip)
     for item in items:
         info = getattr(item, "_fixtureinfo", None)
         module = item.nodeid.split("::", 1)[0]
