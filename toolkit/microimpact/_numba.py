@@ -98,8 +98,12 @@ def njit(*args, **kwargs):
     >>> squared_norm(3.0, 4.0), squared_norm.py_func(3.0, 4.0)
     (25.0, 25.0)
     >>> from microimpact.solvers import engine
-    >>> engine._energy._cache.cache_path.startswith(cache_directory())
+    >>> cache = getattr(engine._energy, "_cache", None)  # None interpreted: nothing is compiled
+    >>> cache is None or cache.cache_path.startswith(cache_directory())
     True
+
+    Interpreted (``NUMBA_DISABLE_JIT=1``) the function is returned as it is, with ``py_func``
+    pointing to itself, so that code calling a kernel's Python source works either way.
     """
     if len(args) == 1 and callable(args[0]) and not kwargs:  # bare @njit
         return _decorate(args[0], ())
@@ -107,6 +111,9 @@ def njit(*args, **kwargs):
 
 
 def _decorate(func, args, **kwargs):
+    if config.DISABLE_JIT:
+        func.py_func = func
+        return func
     if not kwargs.get("cache"):
         return numba.njit(*args, **kwargs)(func)
     previous = config.CACHE_DIR

@@ -409,9 +409,9 @@ def curve_force(approach, radius, e_star, work_of_adhesion):
 
     >>> r, es, w = 1e-6, 1e9, 0.1
     >>> a = float(jkr_curve_contact_radius(2e-9, r, es, w))
-    >>> round(curve_force(2e-9, r, es, w) / float(jkr_curve_force(a, r, es, w)), 12)
+    >>> round(float(curve_force(2e-9, r, es, w)) / float(jkr_curve_force(a, r, es, w)), 12)
     1.0
-    >>> round(curve_force(1e-8, r, es, 0.0) / (4e9 / 3 * 1e-3 * 1e-12), 12)
+    >>> round(float(curve_force(1e-8, r, es, 0.0)) / (4e9 / 3 * 1e-3 * 1e-12), 12)
     1.0
     """
     if work_of_adhesion == 0.0:
@@ -458,7 +458,7 @@ def unloading_curve(max_approach, max_contact_radius, max_contact_radius_cubed, 
     Below yield the curve is the loading curve, broken at -(3/4) (pi^2 w^2 R / E*^2)^(1/3), (TN7):
 
     >>> r_p, d_p, a_cp, d_break = unloading_curve(1e-8, 0.0, 0.0, 0.0, False, 1e-6, 1e9, 0.1)
-    >>> r_p, d_p, round(d_break / (-0.75 * (math.pi**2 * 0.01 * 1e-6 / 1e18) ** (1 / 3)), 12)
+    >>> r_p, d_p, round(float(d_break) / (-0.75 * (math.pi**2 * 0.01 * 1e-6 / 1e18) ** (1 / 3)), 12)
     (1e-06, 0.0, 1.0)
     """
     if yielded:

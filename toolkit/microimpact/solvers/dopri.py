@@ -165,7 +165,7 @@ def make_root_on_step(step, value):
     >>> k, tmp, u1, err = np.zeros((7, 2)), np.zeros(2), np.zeros(2), np.zeros(2)
     >>> step(u0, k1, 2.0, (2.0,), k, tmp, u1, err)
     >>> h = root(0, 0.0, 1.0, u1[0], 0.0, 2.0, u0, k1, (2.0,), (), k, tmp, u1, err)
-    >>> round(h, 12)  # the fall from 1 m at 2 m/s^2 lasts 1 s
+    >>> round(float(h), 12)  # the fall from 1 m at 2 m/s^2 lasts 1 s
     1.0
     """
 

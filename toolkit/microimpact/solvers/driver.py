@@ -146,7 +146,7 @@ def make_driver(law):
     >>> pc = tn.PlasticContact(1e-6, 1e-14, 4e9 / 3, 0.0, 1e8)
     >>> p, length = tnl.law_parameters(pc, 4 * tn.yield_velocity(pc))
     >>> r = tnl._integrate(p, 1e-11, 100_000)
-    >>> r.status == OK, r.outcome == tnl.REBOUND, round(-r.y_end, 8), round(float(tn.thornton_restitution(0.25)), 8)
+    >>> r.status == OK, r.outcome == tnl.REBOUND, round(-float(r.y_end), 8), round(float(tn.thornton_restitution(0.25)), 8)
     (True, True, 0.81227887, 0.81227887)
     """
     start, args_of, step, too_small, error_norm = law.start, law.args, law.step, law.step_too_small, law.norm
@@ -320,7 +320,7 @@ def make_averaged_tail(orbit_integrals):
     ...     return math.pi * oargs[0] * amplitude**2, 4.0 * amplitude, 0.0
     >>> tail = make_averaged_tail(oscillator)
     >>> j, _ = tail(0.5, 0.0, (1e-3,))
-    >>> round(j / (4.0 / (math.pi * 1e-3)), 12)
+    >>> round(float(j) / (4.0 / (math.pi * 1e-3)), 12)
     1.0
     """
 
