@@ -34,6 +34,7 @@ except ImportError:  # not POSIX (Windows): no lock between processes, each comp
     fcntl = None
 
 import numba
+import numpy as np
 from numba.core import config
 
 __all__ = ["njit", "njit_batch", "cache_directory", "source_hash"]
@@ -102,8 +103,8 @@ def njit(*args, **kwargs):
     >>> cache is None or cache.cache_path.startswith(cache_directory())
     True
 
-    Interpreted (``NUMBA_DISABLE_JIT=1``) the function is returned as it is, with ``py_func``
-    pointing to itself, so that code calling a kernel's Python source works either way.
+    Interpreted (``NUMBA_DISABLE_JIT=1``) the function runs as Python and hands back what the
+    compiled one would (:func:`_interpreted`), with ``py_func`` its Python source as compiled.
     """
     if len(args) == 1 and callable(args[0]) and not kwargs:  # bare @njit
         return _decorate(args[0], ())
@@ -112,8 +113,7 @@ def njit(*args, **kwargs):
 
 def _decorate(func, args, **kwargs):
     if config.DISABLE_JIT:
-        func.py_func = func
-        return func
+        return _interpreted(func)
     if not kwargs.get("cache"):
         return numba.njit(*args, **kwargs)(func)
     previous = config.CACHE_DIR
@@ -122,6 +122,36 @@ def _decorate(func, args, **kwargs):
         return numba.njit(*args, **kwargs)(func)
     finally:
         config.CACHE_DIR = previous
+
+
+def _interpreted(func):
+    """``func`` run as Python, its results boxed as numba boxes a compiled function's: a numpy scalar
+    (interpreted, ``u[1]`` of an array is ``np.float64``) as the Python number it holds, also inside a
+    tuple or named tuple; arrays as they are. So results, and what they print, do not depend on
+    whether numba compiled the kernels, and code that builds records from them has nothing to convert.
+
+    Examples
+    --------
+    >>> run = _interpreted(lambda x: (np.float64(x), np.True_, np.zeros(1)))
+    >>> run(0.5)[:2], type(run(0.5)[2]).__name__, run.py_func(0.5)[0]
+    ((0.5, True), 'ndarray', np.float64(0.5))
+    """
+
+    @functools.wraps(func)
+    def run(*args, **kwargs):
+        return _boxed(func(*args, **kwargs))
+
+    run.py_func = func
+    return run
+
+
+def _boxed(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, tuple):
+        items = [_boxed(v) for v in value]
+        return type(value)(*items) if hasattr(value, "_fields") else tuple(items)
+    return value
 
 
 def njit_batch(func, *, cache: bool = True):

@@ -851,7 +851,7 @@ def _posterior_record(sampler, diag, names, best, bounds, like, damping_fit, fri
                            "priors": {n: tuple(map(float, bounds[n])) for n in names},
                            "status": _statuses(damping_fit, friction_fit),
                            "bounds": _statuses(damping_fit, friction_fit, "bounds"),
-                           "moves": "emcee DEMove 0.8 + DESnookerMove 0.2",
+                           "moves": "emcee " + " + ".join(f"{type(m).__name__} {w:g}" for m, w in _moves()),
                            "likelihood": like.description(),
                            "method": like.method + (f" (tol {like.tol:g})" if like.method == "emulator" else "")}
                      | _fit_verdict(damping_fit)

@@ -23,28 +23,8 @@ __all__ = [
     "ImpactResult",
     "flat_broadcast",
     "incident_velocity",
-    "python_numbers",
     "slip_velocity",
 ]
-
-
-def python_numbers(value):
-    """``value`` with every numpy scalar in it (also inside a tuple) as the Python number it holds.
-
-    Compiled kernels hand back Python floats, ints and bools; the same kernels interpreted
-    (``NUMBA_DISABLE_JIT=1``) hand back numpy scalars. Result records pass their fields through
-    this so that what they hold, and what they print, does not depend on which of the two ran.
-
-    Examples
-    --------
-    >>> python_numbers((np.float64(0.5), np.True_, "capture"))
-    (0.5, True, 'capture')
-    """
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, tuple) and not hasattr(value, "_fields"):
-        return tuple(python_numbers(v) for v in value)
-    return value
 
 def incident_velocity(speed: float, incidence_deg: float, azimuth_deg: float) -> tuple[float, float, float]:
     """Incident velocity components (v_n, v_t, v_t') from magnitude and angles. [m/s]
@@ -209,10 +189,6 @@ class ImpactResult:
     method: str
     stop_reason: str
     not_determined: str = ""
-
-    def __post_init__(self):
-        for name, value in vars(self).items():
-            object.__setattr__(self, name, python_numbers(value))
 
     def to_dict(self) -> dict:
         """Plain dict; non-finite floats become None so that the result is valid JSON."""

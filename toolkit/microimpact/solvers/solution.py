@@ -33,8 +33,6 @@ from types import MappingProxyType
 
 import numpy as np
 
-from microimpact.model.kinematics import python_numbers
-
 __all__ = ["NormalSolution", "SolutionBatch", "STOP_REASONS", "BATCH_UNITS", "frozen_state"]
 
 #: Why a solve stopped:
@@ -166,8 +164,6 @@ class NormalSolution:
     state: Mapping = field(default_factory=frozen_state)
 
     def __post_init__(self):
-        for name, value in vars(self).items():
-            object.__setattr__(self, name, python_numbers(value))
         if self.stop_reason not in STOP_REASONS:
             raise ValueError(f"NormalSolution.stop_reason must be one of {', '.join(STOP_REASONS)}, "
                              f"got {self.stop_reason!r}")
