@@ -148,12 +148,26 @@ def test_fit_time_budget_is_checked_at_start(root):
 @pytest.mark.parametrize(("posterior", "words"), [
     ({"seed": 2147483648}, ["config key 'posterior'", "seed 2147483648", "32-bit"]),
     ({"walkers": 1000000000, "max_steps": 1000000000}, ["config key 'posterior'", "TB of memory"]),
+    # one of the two set: the other is the library's default, and the chain is still checked
+    ({"walkers": 1000000000}, ["config key 'posterior'", "1000000000 walkers x 20000 steps"]),
+    ({"max_steps": 1000000000000}, ["config key 'posterior'", "16 walkers x 1000000000000 steps"]),
 ])
 def test_sampler_config_is_checked_at_start_with_the_clis_bounds(root, posterior, words):
     """The posterior's seed and chain size get the bounds of fit --seed and --walkers/--max-steps
     before any job runs (a seed beyond int32 failed only when the sampled posterior was written)."""
     line = problem(root, posterior=posterior)
     assert all(w in line for w in words), line
+
+
+def test_the_start_up_check_of_the_unchanged_config_imports_no_sampler(root):
+    """Snakemake's start-up, which every run waits for before its first job, checks the default
+    chain's size without importing the sampler (its import, with scipy.stats and xarray, cost 2 CPU-s
+    of the 3.7 of `snakemake -n`)."""
+    code = ("import sys, yaml; from microimpact.studies.workflow_config import config_problem; "
+            f"cfg = yaml.safe_load(open({str(root / 'workflow' / 'config' / 'config.yaml')!r})); "
+            f"print(config_problem(cfg, {str(root)!r}), 'microimpact.analysis.posterior' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], cwd=root, stdout=subprocess.PIPE, text=True, timeout=120)
+    assert out.stdout.split() == ["None", "False"], out.stdout
 
 
 @pytest.mark.slow  # 20 s or more: `pytest -m slow` (README, Tests), not the default run

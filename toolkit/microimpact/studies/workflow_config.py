@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from microimpact.analysis.posterior import check_posterior_memory
+from microimpact import analysis
 from microimpact.analysis.sampling_defaults import DEFAULT_MAX_STEPS, DEFAULT_WALKERS, MAX_SEED
 from microimpact.io.materials import MaterialsError, default_materials_path, read_materials
 from microimpact.presets import PRESETS, named_contact
@@ -85,9 +85,15 @@ def _posterior_problem(post: dict) -> str | None:
     if seed is not None and int(seed) > MAX_SEED:
         return (f"config key 'posterior': seed {seed} is above {MAX_SEED} (the posterior file stores it as "
                 "a 32-bit integer)")
+    if post.get("walkers") is None and post.get("max_steps") is None:
+        # the library's defaults: a chain of 26 MB (posterior_memory), which any machine that runs the pipeline
+        # holds; the check would import the sampler (scipy, xarray: 2 CPU-s) into snakemake's
+        # start-up, which every run waits for before its first job
+        return None
     try:
-        check_posterior_memory(int(post.get("walkers") or DEFAULT_WALKERS),
-                               int(post.get("max_steps") or DEFAULT_MAX_STEPS), _MAX_CHAIN_PARAMETERS)
+        analysis.posterior.check_posterior_memory(int(post.get("walkers") or DEFAULT_WALKERS),
+                                                  int(post.get("max_steps") or DEFAULT_MAX_STEPS),
+                                                  _MAX_CHAIN_PARAMETERS)
     except ValueError as e:
         return f"config key 'posterior': {e}"
     return None
