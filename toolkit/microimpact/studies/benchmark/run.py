@@ -86,10 +86,12 @@ class _Table:
 def _warm_up(contact) -> None:
     """Compile (or load from the cache) every numba function before anything is timed.
 
-    The order is for the pipeline on an empty cache, where the fit job compiles the engine at the
-    same time: the Runge-Kutta-Gill kernels (the benchmark's own) first, then the engine's batch
-    kernel, whose compile lock (:func:`microimpact._numba.njit_batch`) waits for the fit's compile
-    and loads it together with the single-impact kernel it calls, instead of compiling both again.
+    On an empty cache the fit job needs the engine's batch kernel too; its compile lock
+    (:func:`microimpact._numba.njit_batch`) lets one of the two jobs compile it and the other load
+    it, instead of both compiling it. The Runge-Kutta-Gill call comes first but takes that lock
+    first as well: its setup (:func:`microimpact.solvers.rkg.rkg_setup`) runs the engine's batch
+    kernel for the contact durations, so in the pipeline this job, which starts before the fit
+    (the fit waits for validate_data), compiles the engine and the fit loads it.
     """
     rkg_restitution(contact, [3.0], 10)
     engine.solve_normal_many(contact, np.array([2.0, 3.0]), np.array([False, True]))
