@@ -10,7 +10,8 @@ with ``.ci/compare_runs.py`` at a relative tolerance of 0 (the machine's measure
 wall times, left out as there). The ratio is the median over pairs of cold over warm wall time:
 a loaded machine slows both runs of a pair alike, and the median discards one disturbed pair.
 Each pair also gives the CPU time of both runs (Snakemake and all its jobs) and their ratio, which
-other load of a shared machine disturbs far less; ``--keep DIR`` keeps every run's logs and
+other load of a shared machine disturbs far less, and the CPU time of every job (its own process
+and forked workers, recorded at its exit); ``--keep DIR`` keeps every run's logs and
 ``benchmark:`` files (each job's wall time) there::
 
     python tests/study_cold_warm.py --pairs 3 --out docs/cold-warm.json
@@ -58,11 +59,50 @@ def _copy(root: Path) -> Path:
     return root
 
 
+#: a ``sitecustomize`` module for the jobs' processes: at exit, a job's script (Snakemake's copy of it
+#: in .snakemake/scripts/) appends its rule, wildcards and CPU time (user + system, all threads, and
+#: its forked workers) to the file $STUDY_JOB_CPU. Snakemake's ``benchmark:`` files cannot give it
+#: (see _rule_seconds)
+_JOB_CPU_HOOK = """\
+import atexit, os, resource, sys
+
+
+def _job_cpu():
+    job = getattr(sys.modules.get("__main__"), "snakemake", None)
+    if job is None or ".snakemake" not in sys.argv[0]:
+        return
+    usage, forked = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    name = "/".join([job.rule, *map(str, job.wildcards)])
+    with open(os.environ["STUDY_JOB_CPU"], "a") as f:
+        f.write(f"{name}\\t{usage.ru_utime + usage.ru_stime + forked.ru_utime + forked.ru_stime}\\n")
+
+
+if os.environ.get("STUDY_JOB_CPU"):
+    atexit.register(_job_cpu)
+"""
+
+
+def _job_cpu(root: Path) -> dict:
+    """CPU time of every job of a run [s], summed over its processes (the hook above)."""
+    seconds = {}
+    path = root / "job_cpu.tsv"
+    for line in path.read_text().splitlines() if path.exists() else []:
+        name, cpu = line.split("\t")
+        seconds[name] = round(seconds.get(name, 0.0) + float(cpu), 2)
+    return seconds
+
+
 def _pipeline(root: Path, cache: Path) -> tuple[float, float]:
     """(wall time, CPU time) of one run [s]; the CPU time is that of Snakemake and every job it ran
     (user and system, all threads), which a shared machine's other load disturbs far less than the
-    wall time: on 2 cores a run whose jobs keep both busy takes about half its CPU time."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONWARNINGS="ignore", MPLBACKEND="Agg")
+    wall time: on 2 cores a run whose jobs keep both busy takes about half its CPU time. Each job's
+    own CPU time goes to root/job_cpu.tsv (:func:`_job_cpu`)."""
+    hook = root / "study_hook"
+    hook.mkdir()
+    (hook / "sitecustomize.py").write_text(_JOB_CPU_HOOK)
+    path = os.pathsep.join(p for p in (str(hook), os.environ.get("PYTHONPATH", "")) if p)
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONWARNINGS="ignore", MPLBACKEND="Agg",
+               PYTHONPATH=path, STUDY_JOB_CPU=str(root / "job_cpu.tsv"))
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "--quiet"], cwd=root, env=env,
@@ -105,12 +145,14 @@ def main(argv=None) -> int:
             compare.LARGEST[0] = 0.0
             problems, files, values = compare.compare(Path(tmp) / f"cold{i}" / "results", Path(tmp) / f"warm{i}" / "results")
             jobs_cold, jobs_warm = (_rule_seconds(Path(tmp) / f"{kind}{i}") for kind in ("cold", "warm"))
+            cpu_cold, cpu_warm = (_job_cpu(Path(tmp) / f"{kind}{i}") for kind in ("cold", "warm"))
             pairs.append({"cold_seconds": round(cold, 2), "warm_seconds": round(warm, 2), "ratio": round(cold / warm, 3),
                           "cold_cpu_seconds": round(cold_cpu, 2), "warm_cpu_seconds": round(warm_cpu, 2),
                           "cpu_ratio": round(cold_cpu / warm_cpu, 3),
                           "files_compared": files, "values_compared": values,
                           "largest_relative_difference": compare.LARGEST[0], "differences": problems[:20],
-                          "job_seconds_cold_warm": {k: [jobs_cold[k], jobs_warm.get(k)] for k in jobs_cold}})
+                          "job_seconds_cold_warm": {k: [jobs_cold[k], jobs_warm.get(k)] for k in jobs_cold},
+                          "job_cpu_seconds_cold_warm": {k: [cpu_cold[k], cpu_warm.get(k)] for k in cpu_cold}})
             if args.keep:
                 for kind in ("cold", "warm"):
                     shutil.copytree(Path(tmp) / f"{kind}{i}", args.keep / f"{kind}{i}",
