@@ -111,6 +111,7 @@ HOW = {
     # docs/studies.md: the posterior by method="solve" and method="emulator" side by side
     "python tests/study_posterior_speed.py --out docs/posterior-speed.json": "study",
     "python tests/study_large_fit.py --pairs 2 --agreement --out docs/large-fit.json": "study",
+    "python tests/study_large_pipeline.py --pairs 1 --out docs/large-pipeline.json": "study",
     # the quick benchmark and the stress sweep: the pipeline's benchmark and stress rules run both
     "microimpact benchmark --quick --out results/benchmark": "study",
     "python -m microimpact.studies.stress --cases 3000 --out stress.json": "study",

@@ -72,6 +72,7 @@ import xarray as xr
 from microimpact._runtime.signals import interrupt_at_checkpoints
 from microimpact.analysis.diagnostics import ESS_MIN, RHAT_MAX, ess_bulk, split_rhat
 from microimpact.analysis.fitting import DAMPING_RANGES, FitProblem, model_restitution
+from microimpact.analysis import speed_curves
 from microimpact.analysis.oblique import ObliqueProblem, _observables, oblique_model, rebound_from_impulses
 from microimpact.dynamics.nonlinear import capture_velocity
 from microimpact.io.formatting import ReportHTML
@@ -519,14 +520,22 @@ class _Likelihood:
 
     def many(self, p: dict) -> np.ndarray:
         """log p(data | parameters) of K parameter sets: ``p`` maps every parameter name to an
-        array of shape (K,) (the walkers of one emcee step, ``vectorize=True``). [-]"""
-        m = self.model_many(p)
-        plain = ~self.latent
-        res = (m[:, : self.n_plain] - self.e[plain]) / self.sig_eff[plain]
-        logl = np.sum(self.log_density(res), axis=1)
+        array of shape (K,) (the walkers of one emcee step, ``vectorize=True``). [-]
+
+        The plain rows of a radius with a certified speed curve (:meth:`_curves`,
+        :mod:`microimpact.analysis.speed_curves`) take their model from it; every other row, and
+        every walker whose curve misses its tolerance, takes the per-row model (:meth:`model_many`)."""
+        curves = self._curves()
+        if curves is None:
+            m = self.model_many(p)
+            plain = ~self.latent
+            logl = np.sum(self.log_density((m[:, : self.n_plain] - self.e[plain]) / self.sig_eff[plain]), axis=1)
+            ml = m[:, self.n_plain:]
+        else:
+            logl, ml = self._by_curves(curves, p)
         if self.latent.any():
             k = GAUSS_HERMITE_NODES
-            ml = m[:, self.n_plain:].reshape(m.shape[0], -1, k)
+            ml = ml.reshape(ml.shape[0], -1, k)
             e, s = self.e[self.latent, None], self.sig_e[self.latent, None]
             like = (np.exp(self.log_density((ml - e) / s)) * self.weights).sum(axis=2)
             logl += np.sum(np.log(np.maximum(like, 1e-300)), axis=1)
@@ -534,10 +543,67 @@ class _Likelihood:
             mo = self._oblique_many(p)
             if mo is None:  # not the ring law: oblique_model per parameter set
                 mo = np.array([oblique_model(self.oblique, lambda r, j=j: _contact(self.fit, r, {n: float(p[n][j]) for n in PARAMETER_NAMES}),
-                                             {"friction": float(p["friction"][j])}, rtol=self.rtol) for j in range(m.shape[0])])
+                                             {"friction": float(p["friction"][j])}, rtol=self.rtol) for j in range(logl.size)])
             r2 = np.nan_to_num((mo - self.oblique.measured) / self.oblique_sigma, nan=1e3)
             logl -= 0.5 * np.sum(r2 * r2, axis=1)
         return logl
+
+    def _curves(self):
+        """The speed curves of the plain rows (:class:`~microimpact.analysis.speed_curves.SpeedCurves`),
+        or None: method "solve", a law other than the ring law, a w_A not > 0, or no radius with
+        :data:`~microimpact.analysis.speed_curves.MIN_ROWS` rows above its capture margin. Built once."""
+        if hasattr(self, "_speed_curves"):
+            return self._speed_curves
+        self._speed_curves = None
+        w_ref = float(self.fit.values["work_of_adhesion"])
+        if self.method != "emulator" or not w_ref > 0.0 or self._speed_groups(w_ref) is None:
+            return None
+        pr, n = self.problem, self.n_plain
+        rows = [idx[idx < n] for idx in pr.groups]
+        if max(idx.size for idx in rows) < speed_curves.MIN_ROWS:
+            return None
+        contacts = [pr.contact(r, 1.0, 1.0, w_ref) for r in pr.radii]
+
+        def groups(i, speeds):
+            y, per, _ = reduction.ring_groups([contacts[i]], speeds[None, :])
+            return y[0], per[0]
+        poles = [capture_velocity(self.fit.contact(float(r))) for r in pr.radii]
+        ref = (self.fit.values["zeta_hertz"], self.fit.values["zeta_adhesion"])
+        curves = speed_curves.SpeedCurves(pr.radii, rows, pr.normal_speed[:n], self.e[~self.latent],
+                                          self.sig_eff[~self.latent], poles, groups,
+                                          lambda zh, za, y0, per: self._emulated(zh, za, None, y0, per), ref,
+                                          speed_curves.TOLERANCE_FACTOR * self.tol)
+        if curves.n_curves:
+            on = np.zeros(pr.normal_speed.size, dtype=bool)
+            on[curves.curve_rows] = True
+            self._speed_curves, self._rowwise = curves, np.flatnonzero(~on)
+        return self._speed_curves
+
+    def _by_curves(self, curves, p):
+        """(log-likelihood of the plain rows (K,), per-row model of the latent rows' nodes (K, nodes))
+        with the speed curves: the rows on no curve, and the curves that miss their check, per row."""
+        zh, za, wa = (np.asarray(p[n], dtype=float).ravel() for n in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion"))
+        w_ref = float(self.fit.values["work_of_adhesion"])
+        s = (wa / w_ref)[:, None]
+        y_ref, per_ref = self._speed_groups(w_ref)
+        cols = self._rowwise
+        m = self._emulated(zh, za, wa, *_groups_at_work_of_adhesion(y_ref[cols], per_ref[cols], s))
+        plain = cols < self.n_plain
+        e_p, sig_p = self.e[~self.latent], self.sig_eff[~self.latent]
+        logl = np.sum(self.log_density((m[:, plain] - e_p[cols[plain]]) / sig_p[cols[plain]]), axis=1)
+        coef, ok = curves.coefficients(zh, za, None if np.all(s == 1.0) else s)
+        if self.student:
+            for j, (rows, vals) in enumerate(curves.values(coef)):
+                logl += np.where(ok[:, j], np.sum(self.log_density((vals - e_p[rows]) / sig_p[rows]), axis=1), 0.0)
+        else:
+            logl -= 0.5 * np.sum(np.where(ok, curves.sum_of_squares(coef), 0.0), axis=1)
+        walker, curve = np.nonzero(~ok)
+        for k, j in zip(walker, curve):  # a curve that misses its tolerance: that walker's rows, per row
+            rows = curves.rows[j]
+            g = _groups_at_work_of_adhesion(y_ref[rows][None, :], per_ref[rows][None, :], s[k:k + 1])
+            mk = self._emulated(zh[k:k + 1], za[k:k + 1], wa[k:k + 1], *g)[0]
+            logl[k] += np.sum(self.log_density((mk - e_p[rows]) / sig_p[rows]))
+        return logl, m[:, ~plain]
 
     def _oblique_many(self, p: dict):
         """:func:`~microimpact.analysis.oblique.oblique_model` of K parameter sets, shape (K, entries),
