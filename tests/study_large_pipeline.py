@@ -8,9 +8,8 @@ data/ into a fresh directory and runs the README's ``snakemake --cores 2``, the 
 ``--config data=data/large.csv``; both use the numba cache of the environment (``NUMBA_CACHE_DIR``),
 which a first, uncounted bundled run fills, so that the pair compares warm runs. The order of the
 pair alternates. Measured per run: the CPU time (user + system) of Snakemake and all its jobs, and
-of every job on its own: a ``sitecustomize`` module on the jobs' ``PYTHONPATH`` writes each Python
-process's ``resource.getrusage`` (itself and its children) at exit, keyed by the rule's script
-(Snakemake's ``benchmark:`` files sample the CPU only every 30 s). Wall times are recorded too
+of every job on its own, by tests/study_cold_warm.py's ``sitecustomize`` hook (Snakemake's
+``benchmark:`` files sample the CPU only every 30 s). Wall times are recorded too
 (the machine is shared). Printed and written as JSON::
 
     python tests/study_large_pipeline.py --pairs 1 --out docs/large-pipeline.json
@@ -31,55 +30,31 @@ import subprocess
 import sys
 import tempfile
 import time
-from collections import defaultdict
 from pathlib import Path
 
 from microimpact.analysis.synthetic import write_synthetic_impacts
+from study_cold_warm import _JOB_CPU_HOOK, _copy as _copy_workflow, _job_cpu, _rule_seconds
 
 REPO = Path(__file__).resolve().parents[1]
 #: impacts per radius of the large table (four radii: 100,000 rows) and its seed (tests/study_large_fit.py's)
 LARGE_PER_RADIUS, LARGE_SEED = 25_000, 53
 
-#: written into the jobs' PYTHONPATH: each process appends its CPU time to $STUDY_CPU_LOG at exit
-SITECUSTOMIZE = '''
-import atexit, json, os, resource, sys, time
-_start = time.perf_counter()
-def _record():
-    s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
-    cpu = s.ru_utime + s.ru_stime + c.ru_utime + c.ru_stime
-    with open(os.environ["STUDY_CPU_LOG"], "a") as f:
-        f.write(json.dumps({"argv": sys.argv[:3], "cpu_s": cpu, "wall_s": time.perf_counter() - _start}) + "\\n")
-if os.environ.get("STUDY_CPU_LOG"):
-    atexit.register(_record)
-'''
-
-
 def _copy(root: Path, large: Path | None) -> Path:
-    root.mkdir(parents=True)
-    shutil.copy(REPO / "Snakefile", root / "Snakefile")
-    for folder in ("workflow", "data"):
-        shutil.copytree(REPO / folder, root / folder, ignore=shutil.ignore_patterns("__pycache__"))
+    """A fresh copy of the workflow (study_cold_warm's), with the large CSV as data/large.csv."""
+    _copy_workflow(root)
     if large is not None:
         shutil.copy(large, root / "data" / "large.csv")
     return root
 
 
-def _job_name(argv) -> str:
-    """The rule's script of a recorded process ('fit', 'flags', ...), or its program."""
-    name = Path(argv[0]).name if argv else "?"
-    if name.startswith("tmp") and name.endswith(".py") and "." in name[:-3]:
-        return name[:-3].split(".", 1)[1]  # .snakemake/scripts/tmpXXXX.fit.py
-    return name
-
-
 def _pipeline(root: Path, config: list, keep: Path | None) -> dict:
-    """One run: its CPU and wall time [s] and every job's CPU and wall time [s]."""
-    site = root / ".study_site"
-    site.mkdir()
-    (site / "sitecustomize.py").write_text(SITECUSTOMIZE)
-    log = root / "cpu.jsonl"
-    env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg", STUDY_CPU_LOG=str(log),
-               PYTHONPATH=os.pathsep.join([str(site)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+    """One run: its CPU and wall time [s], every job's CPU time (study_cold_warm's hook) and wall
+    time (its ``benchmark:`` file) [s]."""
+    hook = root / "study_hook"
+    hook.mkdir()
+    (hook / "sitecustomize.py").write_text(_JOB_CPU_HOOK)
+    env = dict(os.environ, PYTHONWARNINGS="ignore", MPLBACKEND="Agg", STUDY_JOB_CPU=str(root / "job_cpu.tsv"),
+               PYTHONPATH=os.pathsep.join(p for p in (str(hook), os.environ.get("PYTHONPATH", "")) if p))
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", "--quiet", *config], cwd=root, env=env,
@@ -88,19 +63,12 @@ def _pipeline(root: Path, config: list, keep: Path | None) -> dict:
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode:
         sys.exit(f"study_large_pipeline: snakemake failed in {root} (status {done.returncode}):\n{done.stdout[-3000:]}")
-    jobs = defaultdict(lambda: {"cpu_s": 0.0, "wall_s": 0.0, "processes": 0})
-    for line in log.read_text().splitlines():
-        rec = json.loads(line)
-        name = _job_name(rec["argv"])
-        if name in ("snakemake", "__main__.py", "-m"):
-            continue  # Snakemake itself: its total includes its jobs
-        jobs[name]["cpu_s"] += rec["cpu_s"]
-        jobs[name]["wall_s"] += rec["wall_s"]
-        jobs[name]["processes"] += 1
+    walls = _rule_seconds(root)
+    jobs = {name: {"cpu_s": cpu, "wall_s": walls.get(name)} for name, cpu in sorted(_job_cpu(root).items())}
     if keep is not None:
         shutil.copytree(root, keep / root.name, ignore=shutil.ignore_patterns("results", ".snakemake", "data"))
     return {"cpu_s": round((after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), 2),
-            "wall_s": round(wall, 2), "jobs": {k: {q: round(x, 2) for q, x in v.items()} for k, v in sorted(jobs.items())}}
+            "wall_s": round(wall, 2), "jobs": jobs}
 
 
 def main(argv=None) -> int:
