@@ -10,7 +10,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from microimpact.analysis.model_comparison import compare_normal_models, normal_model_restitution
+from microimpact.analysis.model_comparison import (CURVE_TOLERANCE, _fit_restitution, compare_normal_models,
+                                                   normal_model_restitution)
+from microimpact.analysis.speed_curves import MIN_ROWS
 from microimpact.analysis.fitting import FitProblem
 from microimpact.model.parameters import TABLE1_ROW2
 
@@ -59,3 +61,19 @@ def test_dataset_is_self_describing(jkr_comparison):
     assert ds.e_n_curve.dims == ("normal_model", "radius", "curve_speed")
     # AIC - BIC = k (2 - ln N), the definitions
     assert np.allclose(ds.aic - ds.bic, 3 * (2 - np.log(18)), rtol=1e-12)
+
+
+def test_fit_rows_by_speed_curves_are_the_solver_within_tolerance():
+    """A radius of >= MIN_ROWS rows takes certified speed curves: within CURVE_TOLERANCE (1e-7,
+    far below SIGMA) of the solver row by row, captured rows included (their pieces fall back);
+    a radius of fewer rows is the solver's numbers bit for bit."""
+    speed = np.concatenate([np.geomspace(0.05, 80.0, 2 * MIN_ROWS), np.geomspace(1.0, 60.0, 9)])
+    radius = np.concatenate([np.full(2 * MIN_ROWS, 3.45e-6), np.full(9, 1.29e-6)])
+    problem = FitProblem.from_arrays(radius, speed, TABLE1_ROW2)
+    for model in ("ring", "jkr"):
+        args = (problem, model, TRUE["zeta_hertz"], TRUE["zeta_adhesion"], TRUE["work_of_adhesion"])
+        exact, fast = normal_model_restitution(*args), _fit_restitution(*args, 1e-8)
+        big = radius == 3.45e-6
+        assert np.abs(fast[big] - exact[big]).max() <= CURVE_TOLERANCE
+        assert np.array_equal(fast[~big], exact[~big])
+        assert (exact[big] == 0).any()  # the range holds capture: the fallback is exercised
