@@ -15,6 +15,11 @@ parameters are the yield velocity V_y and w_A (:func:`microimpact.analysis.plast
 with the same residuals); its row has ``yield_velocity`` where the others have the zetas (NaN
 elsewhere), and ``n_parameters`` says each model's k.
 
+Many rows: a radius with at least :data:`~microimpact.analysis.speed_curves.MIN_ROWS` rows is
+fitted through a certified Chebyshev curve of e_n in ln v per evaluation (:func:`_fit_restitution`,
+:func:`~microimpact.analysis.speed_curves.certified_curve`), within :data:`CURVE_TOLERANCE` of the
+solver, so that a fit's cost barely grows with the rows; fewer rows are solved one by one.
+
 Every model carries its verdict (:func:`microimpact.analysis.verdict.assess_residuals`), and the
 comparison's sentence (:func:`comparison_verdict`) never prefers a rejected model.
 
