@@ -13,7 +13,10 @@ import pytest
 from microimpact.analysis.model_comparison import (CURVE_TOLERANCE, _fit_restitution, compare_normal_models,
                                                    normal_model_restitution)
 from microimpact.analysis.speed_curves import MIN_ROWS
+from microimpact.analysis import model_comparison
 from microimpact.analysis.fitting import FitProblem
+from microimpact.analysis.synthetic import write_synthetic_impacts
+from microimpact.io import default_materials_path, read_impacts, read_materials
 from microimpact.model.parameters import TABLE1_ROW2
 
 TRUE = {"zeta_hertz": 0.3, "zeta_adhesion": 5.0, "work_of_adhesion": 0.25}
@@ -77,3 +80,24 @@ def test_fit_rows_by_speed_curves_are_the_solver_within_tolerance():
         assert np.abs(fast[big] - exact[big]).max() <= CURVE_TOLERANCE
         assert np.array_equal(fast[~big], exact[~big])
         assert (exact[big] == 0).any()  # the range holds capture: the fallback is exercised
+
+
+def test_comparison_by_speed_curves_is_the_per_row_one(tmp_path, monkeypatch):
+    """2 x MIN_ROWS synthetic rows of one radius: the comparison with curves and with every row
+    solved (MIN_ROWS raised) agree: AIC within 0.01 (chi-square moves by at most
+    2 tol sqrt(W chi2) + tol^2 W, see CURVE_TOLERANCE; far less in practice), estimates within 1e-4 of their standard
+    errors for ring, 30 % for jkr's flat valley, the same ranking."""
+    material = read_materials(default_materials_path())["ammonium_fluorescein_on_silicon"]
+    path = write_synthetic_impacts(tmp_path / "t.csv", radii=(3.45e-6,), n_per_radius=2 * MIN_ROWS, seed=3)
+    table = read_impacts(path)
+    grid = ([0.1, 1.0], [10.0, 100.0])
+    fast = compare_normal_models(table, material, ("ring", "jkr"), curve_points=3, start_grid=grid)
+    monkeypatch.setattr(model_comparison, "MIN_ROWS", 10 ** 9)
+    exact = compare_normal_models(table, material, ("ring", "jkr"), curve_points=3, start_grid=grid)
+    np.testing.assert_allclose(fast["aic"], exact["aic"], rtol=0, atol=0.01)
+    for name in ("zeta_hertz", "zeta_adhesion", "work_of_adhesion"):
+        shift = (np.abs(fast[name] - exact[name]) / exact[f"{name}_stderr"]).values
+        # ring, well determined: the same optimum; jkr (misspecified, zeta_H at its bound of 0) ends
+        # in a flat valley where leastsq's stopping point moves with 1e-7 changes (seen: 0.14)
+        assert shift[0] <= 1e-4 and shift[1] <= 0.3, (name, shift)
+    assert list(np.argsort(fast["aic"].values)) == list(np.argsort(exact["aic"].values))

@@ -239,8 +239,9 @@ def certified_curve(evaluate, z, tol):
 
     The nested pair of the module docstring on pieces of [min z, max z], without a fit to design
     them: a piece whose estimate eps exceeds ``tol``, or with a node not finite or not > 0 (capture:
-    e_n's root is not smooth) unless all its nodes are 0 (wholly captured), is halved while the pieces number at most :data:`MAX_PIECES`; the
-    points of a piece that still fails are reported as not certified, for the caller's own solve.
+    e_n's root is not smooth) unless all its nodes are 0 (wholly captured), is halved while the
+    pieces number at most :data:`MAX_PIECES`; the points of a piece that still fails are reported
+    as not certified, for the caller's own solve.
 
     Parameters
     ----------
@@ -274,7 +275,8 @@ def certified_curve(evaluate, z, tol):
         estimate = SAFETY * np.abs(values @ D.T).max(axis=1)
         # all nodes 0: the piece lies below the capture speed (capture holds from v = 0 up to v_c),
         # where e_n = 0 exactly, as p_2n of zeros is
-        good = (np.isfinite(estimate) & (estimate <= tol) & np.all(values > 0.0, axis=1)) | np.all(values == 0.0, axis=1)
+        good = np.isfinite(estimate) & (estimate <= tol) & np.all(values > 0.0, axis=1)
+        good |= np.all(values == 0.0, axis=1)
         can_split = len(done) + len(todo) + int((~good).sum()) <= MAX_PIECES
         todo_next = []
         for (a, b), v, g in zip(todo, values, good):
