@@ -128,3 +128,19 @@ def test_chains_with_the_same_seed_take_the_same_decisions(bundled, monkeypatch)
     b = posterior.sample_posterior(table, fit, steps=300, require_convergence=False)
     assert np.array_equal(a.chain, b.chain)  # positions follow from the seed and the accept decisions only
     assert np.abs(a.log_probability - b.log_probability).max() < 2e-3
+
+
+def test_certified_curve_meets_its_tolerance_and_refuses_a_kink():
+    """Smooth: every point certified and within tol; a capture-like root (0 below z = 1.1, sqrt
+    above) is not smooth: the points of the piece holding it are refused, the others still meet
+    tol, the wholly captured ones exactly 0 (a wrong estimate, split or piece lookup breaks one)."""
+    z = np.linspace(0.0, 4.0, 5000)
+    smooth = lambda t: 0.9 - 0.3 * np.exp(-t) + 0.01 * np.sin(3.0 * t)  # noqa: E731
+    v, ok = speed_curves.certified_curve(smooth, z, 1e-9)
+    assert ok.all() and np.abs(v - smooth(z)).max() <= 1e-9
+    root = lambda t: np.sqrt(np.clip(t - 1.1, 0.0, None))  # noqa: E731
+    z = np.sort(np.append(z, 1.1 + 1e-5))  # a point just above the root
+    v, ok = speed_curves.certified_curve(root, z, 1e-7)
+    assert not ok[z == 1.1 + 1e-5].any()  # the kink's piece (halved around it) is refused
+    assert ok.mean() > 0.99 and ok[z < 1.0].all()  # ... and only it; captured pieces pass
+    assert np.abs(v[ok] - root(z[ok])).max() <= 1e-7

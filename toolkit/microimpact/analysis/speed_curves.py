@@ -53,7 +53,7 @@ import math
 import numpy as np
 
 __all__ = ["SpeedCurves", "HALF_DEGREE", "SAFETY", "TOLERANCE_FACTOR", "NEAR_CAPTURE", "MIN_ROWS", "MAX_PIECES",
-           "SETUP_MARGIN", "chebyshev_matrices"]
+           "SETUP_MARGIN", "chebyshev_matrices", "certified_curve"]
 
 #: n of the nested pair: p_2n through 2n + 1 Lobatto points, p_n through the even ones
 HALF_DEGREE = 12
@@ -232,3 +232,68 @@ class SpeedCurves:
             vals = np.concatenate([c[:, p, :] @ self.basis[p].T for p in idx], axis=1)
             out.append((rows, vals))
         return out
+
+
+def certified_curve(evaluate, z, tol):
+    """A smooth function at many points ``z`` from a few evaluations: piecewise p_2n, checked.
+
+    The nested pair of the module docstring on pieces of [min z, max z], without a fit to design
+    them: a piece whose estimate eps exceeds ``tol``, or with a node not finite or not > 0 (capture:
+    e_n's root is not smooth) unless all its nodes are 0 (wholly captured), is halved while the
+    pieces number at most :data:`MAX_PIECES`; the points of a piece that still fails are reported
+    as not certified, for the caller's own solve.
+
+    Parameters
+    ----------
+    evaluate : callable
+        ``evaluate(z_nodes)`` -> the function at the nodes (1-D array in, same shape out).
+    z : ndarray
+        The points, 1-D, finite.
+    tol : float
+        Absolute tolerance of the certified points against ``evaluate``.
+
+    Returns
+    -------
+    values : ndarray
+        p_2n of each point's piece at the point (meaningful where ``ok``).
+    ok : ndarray of bool
+        Whether the point's piece passed its check (eps <= tol).
+
+    Examples
+    --------
+    >>> z = np.linspace(0.0, 3.0, 1000)
+    >>> v, ok = certified_curve(lambda t: np.exp(t / 2.0), z, 1e-10)
+    >>> bool(ok.all()), bool(np.abs(v - np.exp(z / 2.0)).max() < 1e-10)
+    (True, True)
+    """
+    x, M, D = chebyshev_matrices(HALF_DEGREE)
+    todo, done = [(float(z.min()), float(z.max()))], []  # done: (a, b, values, passed)
+    while todo:
+        bounds = np.array(todo)
+        nodes = bounds[:, :1] + (bounds[:, 1:] - bounds[:, :1]) * (x[None, :] + 1.0) / 2.0
+        values = np.asarray(evaluate(nodes.ravel()), dtype=float).reshape(nodes.shape)
+        estimate = SAFETY * np.abs(values @ D.T).max(axis=1)
+        # all nodes 0: the piece lies below the capture speed (capture holds from v = 0 up to v_c),
+        # where e_n = 0 exactly, as p_2n of zeros is
+        good = np.isfinite(estimate) & (estimate <= tol) & np.all(values > 0.0, axis=1)
+        good |= np.all(values == 0.0, axis=1)
+        can_split = len(done) + len(todo) + int((~good).sum()) <= MAX_PIECES
+        todo_next = []
+        for (a, b), v, g in zip(todo, values, good):
+            if g or not can_split or b <= a:
+                done.append((a, b, v, bool(g)))
+            else:
+                m = 0.5 * (a + b)
+                todo_next += [(a, m), (m, b)]
+        todo = todo_next
+    done.sort(key=lambda piece: piece[0])
+    lo = np.array([d[0] for d in done])
+    which = np.clip(np.searchsorted(lo[1:], z, side="right"), 0, len(done) - 1)
+    out = np.empty(z.size)
+    ok = np.zeros(z.size, dtype=bool)
+    for p, (a, b, v, g) in enumerate(done):
+        sel = which == p
+        xs = np.clip((2.0 * z[sel] - a - b) / (b - a), -1.0, 1.0) if b > a else np.zeros(int(sel.sum()))
+        out[sel] = np.polynomial.chebyshev.chebval(xs, M @ v)
+        ok[sel] = g
+    return out, ok
