@@ -14,6 +14,7 @@
 - :mod:`.plastic_fit`: the Thornton & Ning elastic-plastic adhesive law fitted to e_n(v_n) (yield
   velocity and w_A).
 - :mod:`.model_comparison`: the normal laws fitted to the same e_n(v_n) and ranked by AIC.
+- :mod:`.speed_curves`: certified Chebyshev curves of e_n in speed, so that many rows cost a few solves.
 """
 
 from microimpact._lazy import lazy_exports as _lazy_exports
@@ -31,6 +32,8 @@ _HOMES = {
                      "DEFAULT_OBLIQUE_QUANTITY", "DEFAULT_E_T_SIGMA", "DEFAULT_REBOUND_ANGLE_SIGMA",
                      "DEFAULT_REBOUND_SPIN_SIGMA"), "design_defaults"),
     **dict.fromkeys(("split_rhat", "ess_bulk", "RHAT_MAX", "ESS_MIN"), "diagnostics"),
+    **dict.fromkeys(("SpeedCurves", "HALF_DEGREE", "SAFETY", "TOLERANCE_FACTOR", "NEAR_CAPTURE", "MIN_ROWS",
+                     "MAX_PIECES", "SETUP_MARGIN", "chebyshev_matrices", "certified_curve"), "speed_curves"),
     **dict.fromkeys(("FitResult", "DampingFit", "fit_parameter_table", "format_fit", "PARAMETER_NAMES", "SIGMA_LEVELS",
                      "PARAMETER_TABLE_COLUMNS"), "fit_result"),
     **dict.fromkeys(("FitProblem", "fit_damping", "damping_residual", "model_restitution", "DEFAULT_START_GRID",
